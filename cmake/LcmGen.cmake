@@ -1,0 +1,31 @@
+# pidlab_lcm_cpp(TARGET <name> PACKAGE <pkg> FILES a.lcm b.lcm ...)
+#
+# Generates C++ headers with lcm-gen at build time and exposes them through an
+# INTERFACE library. Debian's LCM 1.3.1 ships no CMake helpers, so this is ours.
+# --cpp-std=c++11 is needed for constants; the headers are added as SYSTEM
+# includes because generated code does not pass our warning flags.
+function(pidlab_lcm_cpp)
+  cmake_parse_arguments(ARG "" "TARGET;PACKAGE" "FILES" ${ARGN})
+  set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/lcmgen_cpp)
+  set(headers)
+  foreach(f ${ARG_FILES})
+    get_filename_component(stem ${f} NAME_WE)
+    list(APPEND headers ${out_dir}/${ARG_PACKAGE}/${stem}.hpp)
+  endforeach()
+  set(abs_files)
+  foreach(f ${ARG_FILES})
+    list(APPEND abs_files ${CMAKE_CURRENT_SOURCE_DIR}/${f})
+  endforeach()
+  add_custom_command(
+    OUTPUT ${headers}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${out_dir}
+    COMMAND ${LCM_GEN_EXECUTABLE} --cpp --cpp-std=c++11 --cpp-hpath ${out_dir} ${abs_files}
+    DEPENDS ${abs_files}
+    COMMENT "lcm-gen --cpp ${ARG_PACKAGE}"
+    VERBATIM)
+  add_custom_target(${ARG_TARGET}_gen DEPENDS ${headers})
+  add_library(${ARG_TARGET} INTERFACE)
+  add_dependencies(${ARG_TARGET} ${ARG_TARGET}_gen)
+  target_include_directories(${ARG_TARGET} SYSTEM INTERFACE ${out_dir})
+  target_link_libraries(${ARG_TARGET} INTERFACE PkgConfig::LCM)
+endfunction()

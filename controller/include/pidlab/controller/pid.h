@@ -1,0 +1,177 @@
+#pragma once
+// PID controllers.
+//
+// Continuous (eq. 2 of the paper), ideal parallel form:
+//   u(t) = kp e(t) + ki \int_0^t e dt + kd de/dt,   e = r - y.
+//
+// Discrete, period dt, one call per sample k (t_k = k dt), u_k held over
+// [t_k, t_{k+1}):
+//   e_k = r_k - y_k
+//   P_k = kp e_k
+//   I_k = I_{k-1} + ki dt e_k                    (backward Euler, default)
+//       | I_{k-1} + ki dt e_{k-1}                 (forward Euler)
+//       | I_{k-1} + ki dt (e_k + e_{k-1}) / 2     (trapezoidal)
+//   D_k = tf/(tf+dt) D_{k-1} + kd/(tf+dt) (s_k - s_{k-1}),
+//         s = e (derivative on error) or s = -y (on measurement)
+//   u_k = sat(P_k + I_k + D_k)
+// The loop is at rest before k = 0 (r = y = e = 0), so with the defaults
+// (tf = 0, derivative on error, no limits) a unit step in r gives the
+// derivative kick kd/dt over the first step: area kd, the discrete image of
+// the ideal PID's impulse, and the loop converges to the continuous one as
+// dt -> 0.
+//
+// Templated on the scalar so the same code runs on double and ceres::Jet.
+// The per-sample Step() never throws: it returns a status (ruckig style).
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+
+namespace pidlab {
+
+template <typename T>
+struct PidGainsT {
+  T kp = T(0.0);
+  T ki = T(0.0);
+  T kd = T(0.0);
+};
+using PidGains = PidGainsT<double>;
+
+/// Gains must be finite and >= 0 (the paper's search box is [0, 30]^3).
+inline bool GainsAreValid(const PidGains& g, std::string* error) {
+  const std::pair<const char*, double> f[] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
+  for (const auto& [name, v] : f) {
+    if (!std::isfinite(v) || v < 0.0) {
+      if (error) {
+        std::ostringstream os;
+        os << "gain " << name << " = " << v << " must be finite and >= 0";
+        *error = os.str();
+      }
+      return false;
+    }
+  }
+  return true;
+}
+
+enum class DerivativeOn { kError, kMeasurement };
+enum class IntegralMethod { kBackwardEuler, kForwardEuler, kTrapezoidal };
+enum class AntiWindup { kNone, kClamping, kBackCalculation };
+
+struct PidOptions {
+  /// Sample period in s, > 0.
+  double dt_s = 1e-3;
+  /// Time constant of the first-order derivative filter in s; 0 = unfiltered.
+  double derivative_filter_s = 0.0;
+  /// Output limits; lower < upper. Infinite = unlimited.
+  double output_min = -std::numeric_limits<double>::infinity();
+  double output_max = std::numeric_limits<double>::infinity();
+  /// Integrator protection when the output saturates. Clamping stops
+  /// integrating while saturated and the error pushes further into the limit;
+  /// back-calculation feeds (u_sat - u) * back_calculation_gain into I.
+  AntiWindup anti_windup = AntiWindup::kClamping;
+  double back_calculation_gain = 1.0;  // 1/s, > 0
+  DerivativeOn derivative_on = DerivativeOn::kError;
+  IntegralMethod integral = IntegralMethod::kBackwardEuler;
+
+  bool IsValid(std::string* error) const {
+    std::ostringstream os;
+    if (!(dt_s > 0.0) || !std::isfinite(dt_s)) os << "dt " << dt_s << " s must be positive and finite";
+    else if (!(derivative_filter_s >= 0.0) || !std::isfinite(derivative_filter_s))
+      os << "derivative filter " << derivative_filter_s << " s must be >= 0 and finite";
+    else if (std::isnan(output_min) || std::isnan(output_max) || !(output_min < output_max))
+      os << "output limits [" << output_min << ", " << output_max << "] must satisfy min < max";
+    else if (anti_windup == AntiWindup::kBackCalculation &&
+             (!(back_calculation_gain > 0.0) || !std::isfinite(back_calculation_gain)))
+      os << "back-calculation gain " << back_calculation_gain << " must be positive";
+    else
+      return true;
+    if (error) *error = os.str();
+    return false;
+  }
+};
+
+bool ParseDerivativeOn(const std::string& s, DerivativeOn* v);
+bool ParseIntegralMethod(const std::string& s, IntegralMethod* v);
+bool ParseAntiWindup(const std::string& s, AntiWindup* v);
+std::string ToString(DerivativeOn v);
+std::string ToString(IntegralMethod v);
+std::string ToString(AntiWindup v);
+
+enum class PidStatus {
+  kOk,            // u computed, not saturated
+  kSaturated,     // u computed and clipped to the output limits
+  kInvalidInput,  // r or y not finite: u is left unchanged, state untouched
+};
+
+template <typename T>
+class DiscretePid {
+ public:
+  /// Options must be valid (checked by the caller with IsValid).
+  DiscretePid(const PidGainsT<T>& gains, const PidOptions& options)
+      : gains_(gains), options_(options) {}
+
+  PidStatus Step(const T& r, const T& y, T* u) {
+    using std::isfinite;
+    if (!IsFinite(r) || !IsFinite(y)) return PidStatus::kInvalidInput;
+    const double dt = options_.dt_s;
+    const T e = r - y;
+    const T p = gains_.kp * e;
+    T integral = integral_;
+    switch (options_.integral) {
+      case IntegralMethod::kBackwardEuler: integral += gains_.ki * T(dt) * e; break;
+      case IntegralMethod::kForwardEuler: integral += gains_.ki * T(dt) * prev_error_; break;
+      case IntegralMethod::kTrapezoidal: integral += gains_.ki * T(dt * 0.5) * (e + prev_error_); break;
+    }
+    const T signal = options_.derivative_on == DerivativeOn::kError ? e : T(-y);
+    const double tf = options_.derivative_filter_s;
+    const T d = T(tf / (tf + dt)) * derivative_ + gains_.kd * (signal - prev_signal_) * T(1.0 / (tf + dt));
+    const T unsaturated = p + integral + d;
+    T out = unsaturated;
+    bool saturated = false;
+    if (ToValue(out) > options_.output_max) { out = T(options_.output_max); saturated = true; }
+    if (ToValue(out) < options_.output_min) { out = T(options_.output_min); saturated = true; }
+    if (saturated) {
+      if (options_.anti_windup == AntiWindup::kClamping) {
+        // Integrate only if the error pulls the output back inside the limits.
+        const bool pushes_further = (ToValue(unsaturated) > options_.output_max && ToValue(e) > 0.0) ||
+                                    (ToValue(unsaturated) < options_.output_min && ToValue(e) < 0.0);
+        if (pushes_further) integral = integral_;
+      } else if (options_.anti_windup == AntiWindup::kBackCalculation) {
+        integral += T(options_.back_calculation_gain * dt) * (out - unsaturated);
+      }
+    }
+    integral_ = integral;
+    derivative_ = d;
+    prev_error_ = e;
+    prev_signal_ = signal;
+    *u = out;
+    return saturated ? PidStatus::kSaturated : PidStatus::kOk;
+  }
+
+  /// Back to rest: r = y = e = 0 before the next sample.
+  void Reset() {
+    integral_ = T(0.0);
+    derivative_ = T(0.0);
+    prev_error_ = T(0.0);
+    prev_signal_ = T(0.0);
+  }
+
+  const PidGainsT<T>& gains() const { return gains_; }
+  const PidOptions& options() const { return options_; }
+
+ private:
+  static double ToValue(double x) { return x; }
+  template <typename U>
+  static double ToValue(const U& x) { return ToValue(x.a); }
+  static bool IsFinite(const T& x) { return std::isfinite(ToValue(x)); }
+
+  PidGainsT<T> gains_;
+  PidOptions options_;
+  T integral_ = T(0.0);
+  T derivative_ = T(0.0);
+  T prev_error_ = T(0.0);
+  T prev_signal_ = T(0.0);
+};
+
+}  // namespace pidlab

@@ -1,0 +1,58 @@
+#pragma once
+// Disturbance signals n(t), added to the plant input as in eq. (18):
+// the plant sees u(t) + n(t).
+
+#include <cstdint>
+#include <string>
+
+namespace pidlab {
+
+enum class DisturbanceKind { kNone, kSquare, kStep, kSine, kNoise };
+
+/// Parses none|square|step|sine|noise.
+bool ParseDisturbanceKind(const std::string& s, DisturbanceKind* kind);
+std::string ToString(DisturbanceKind kind);
+
+struct DisturbanceOptions {
+  DisturbanceKind kind = DisturbanceKind::kNone;
+  /// Square: +/-amplitude. Step: final value. Sine: peak. Noise: std deviation.
+  double amplitude = 0.0;
+  /// Square and sine period in s. The paper does not state its period; 2 s
+  /// (a switch every second) is pidlab's choice.
+  double period_s = 2.0;
+  /// Time shift in s: the signal is evaluated at t + phase_s.
+  double phase_s = 0.0;
+  /// Step time in s (step only).
+  double step_time_s = 0.0;
+  /// Noise is white, Gaussian and held constant over this interval in s.
+  double noise_hold_s = 0.01;
+  /// Seed of the noise; the value at t depends only on (seed, t).
+  std::uint64_t seed = 1;
+
+  bool IsValid(std::string* error) const;
+};
+
+/// n(t) for t >= 0 (zero before). Stateless: Value(t) is a pure function, so a
+/// separate disturbance process computes exactly what an in-process loop does.
+/// The square wave is +amplitude on [0, period/2) (after the phase shift) and
+/// -amplitude on [period/2, period).
+class Disturbance {
+ public:
+  explicit Disturbance(const DisturbanceOptions& options);
+
+  double Value(double t) const;
+  /// True for none, square, step and noise: constant between breakpoints.
+  bool IsPiecewiseConstant() const;
+  /// The first breakpoint strictly after t (+infinity if none). Only for
+  /// piecewise-constant signals. Breakpoints closer than 1e-9 s to t count as t.
+  double NextBreakpoint(double t) const;
+  const DisturbanceOptions& options() const { return options_; }
+
+ private:
+  /// Index of the piece of length `piece` that t + shift falls in, robust to
+  /// rounding at the piece boundaries.
+  static double PieceIndex(double t, double piece);
+  DisturbanceOptions options_;
+};
+
+}  // namespace pidlab

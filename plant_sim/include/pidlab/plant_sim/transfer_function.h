@@ -1,0 +1,45 @@
+#pragma once
+// Single-input single-output linear plants: transfer functions and their
+// state-space realisations.
+
+#include <Eigen/Dense>
+#include <complex>
+#include <string>
+#include <vector>
+
+namespace pidlab {
+
+/// G(s) = num(s) / den(s), coefficients in descending powers of s.
+struct TransferFunction {
+  std::vector<double> num;
+  std::vector<double> den;
+
+  /// Finite coefficients, non-zero leading denominator coefficient, and
+  /// deg num <= deg den. Names the offending value on failure.
+  bool IsValid(std::string* error) const;
+  /// deg den - deg num (leading zeros ignored).
+  int RelativeDegree() const;
+  /// G(0) (infinite for a pole at the origin).
+  double DcGain() const;
+  std::string ToString() const;
+};
+
+/// x' = A x + B u, y = C x + D u.
+struct StateSpace {
+  Eigen::MatrixXd a;
+  Eigen::VectorXd b;
+  Eigen::RowVectorXd c;
+  double d = 0.0;
+  int order() const { return static_cast<int>(a.rows()); }
+};
+
+/// Controllable canonical realisation, then diagonally balanced (powers of two,
+/// so exact) to keep badly scaled plants such as the stepper motor, whose
+/// coefficients span nine decades, well conditioned. Throws
+/// std::invalid_argument if `tf` is not valid.
+StateSpace Realize(const TransferFunction& tf);
+
+/// Roots of a polynomial in descending powers (companion-matrix eigenvalues).
+std::vector<std::complex<double>> PolynomialRoots(const std::vector<double>& p);
+
+}  // namespace pidlab

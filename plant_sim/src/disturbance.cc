@@ -1,0 +1,122 @@
+#include "pidlab/plant_sim/disturbance.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace pidlab {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+
+// SplitMix64: a counter-based generator, so noise sample k is a pure function
+// of (seed, k) and needs no state.
+std::uint64_t SplitMix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+double UnitUniform(std::uint64_t bits) {  // (0, 1]
+  return (static_cast<double>(bits >> 11) + 1.0) * (1.0 / 9007199254740992.0);
+}
+
+double StandardNormal(std::uint64_t seed, std::int64_t k) {
+  const std::uint64_t base = SplitMix64(seed ^ SplitMix64(static_cast<std::uint64_t>(k)));
+  const double u1 = UnitUniform(SplitMix64(base));
+  const double u2 = UnitUniform(SplitMix64(base + 1));
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(kTwoPi * u2);
+}
+
+constexpr double kBreakTolerance = 1e-9;
+
+}  // namespace
+
+bool ParseDisturbanceKind(const std::string& s, DisturbanceKind* kind) {
+  if (s == "none") *kind = DisturbanceKind::kNone;
+  else if (s == "square") *kind = DisturbanceKind::kSquare;
+  else if (s == "step") *kind = DisturbanceKind::kStep;
+  else if (s == "sine") *kind = DisturbanceKind::kSine;
+  else if (s == "noise") *kind = DisturbanceKind::kNoise;
+  else return false;
+  return true;
+}
+
+std::string ToString(DisturbanceKind kind) {
+  switch (kind) {
+    case DisturbanceKind::kNone: return "none";
+    case DisturbanceKind::kSquare: return "square";
+    case DisturbanceKind::kStep: return "step";
+    case DisturbanceKind::kSine: return "sine";
+    case DisturbanceKind::kNoise: return "noise";
+  }
+  return "none";
+}
+
+bool DisturbanceOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  if (!std::isfinite(amplitude)) os << "disturbance amplitude " << amplitude << " must be finite";
+  else if (kind == DisturbanceKind::kNoise && amplitude < 0.0)
+    os << "noise amplitude (standard deviation) " << amplitude << " must be >= 0";
+  else if ((kind == DisturbanceKind::kSquare || kind == DisturbanceKind::kSine) &&
+           !(period_s > 0.0 && std::isfinite(period_s)))
+    os << "disturbance period " << period_s << " s must be positive and finite";
+  else if (!std::isfinite(phase_s)) os << "disturbance phase " << phase_s << " s must be finite";
+  else if (kind == DisturbanceKind::kStep && !(step_time_s >= 0.0 && std::isfinite(step_time_s)))
+    os << "disturbance step time " << step_time_s << " s must be >= 0 and finite";
+  else if (kind == DisturbanceKind::kNoise && !(noise_hold_s > 0.0 && std::isfinite(noise_hold_s)))
+    os << "noise hold " << noise_hold_s << " s must be positive";
+  else return true;
+  if (error) *error = os.str();
+  return false;
+}
+
+Disturbance::Disturbance(const DisturbanceOptions& options) : options_(options) {}
+
+double Disturbance::PieceIndex(double t, double piece) {
+  return std::floor(t / piece + kBreakTolerance);
+}
+
+double Disturbance::Value(double t) const {
+  const DisturbanceOptions& o = options_;
+  if (t < -kBreakTolerance) return 0.0;
+  switch (o.kind) {
+    case DisturbanceKind::kNone:
+      return 0.0;
+    case DisturbanceKind::kSquare: {
+      const double k = PieceIndex(t + o.phase_s, o.period_s / 2.0);
+      return std::fmod(std::abs(k), 2.0) == 0.0 ? o.amplitude : -o.amplitude;
+    }
+    case DisturbanceKind::kStep:
+      return t + kBreakTolerance >= o.step_time_s ? o.amplitude : 0.0;
+    case DisturbanceKind::kSine:
+      return o.amplitude * std::sin(kTwoPi * (t + o.phase_s) / o.period_s);
+    case DisturbanceKind::kNoise:
+      return o.amplitude * StandardNormal(o.seed, static_cast<std::int64_t>(PieceIndex(t, o.noise_hold_s)));
+  }
+  return 0.0;
+}
+
+bool Disturbance::IsPiecewiseConstant() const { return options_.kind != DisturbanceKind::kSine; }
+
+double Disturbance::NextBreakpoint(double t) const {
+  const DisturbanceOptions& o = options_;
+  const double inf = std::numeric_limits<double>::infinity();
+  switch (o.kind) {
+    case DisturbanceKind::kNone:
+    case DisturbanceKind::kSine:
+      return inf;
+    case DisturbanceKind::kStep:
+      return (o.step_time_s > t + kBreakTolerance) ? o.step_time_s : inf;
+    case DisturbanceKind::kSquare: {
+      const double half = o.period_s / 2.0;
+      return (PieceIndex(t + o.phase_s, half) + 1.0) * half - o.phase_s;
+    }
+    case DisturbanceKind::kNoise:
+      return (PieceIndex(t, o.noise_hold_s) + 1.0) * o.noise_hold_s;
+  }
+  return inf;
+}
+
+}  // namespace pidlab
