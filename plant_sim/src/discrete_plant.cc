@@ -1,5 +1,6 @@
 #include "pidlab/plant_sim/discrete_plant.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -17,26 +18,17 @@ DiscretePlant::DiscretePlant(const TransferFunction& tf, double dt_s) : dt_s_(dt
   ZeroOrderHold<double>(ss.a, Eigen::MatrixXd(ss.b), dt_s, &phi_, &gamma);
   gamma_ = gamma.col(0);
   c_ = ss.c;
-  state_ = Eigen::VectorXd::Zero(ss.order());
+  state_.assign(static_cast<std::size_t>(ss.order()), 0.0);
   next_ = state_;
 }
 
-double DiscretePlant::Output() const {
-  double y = 0.0;
-  for (Eigen::Index i = 0; i < state_.size(); ++i) y += c_(i) * state_(i);
-  return y;
-}
+double DiscretePlant::Output() const { return OutputOf(c_, state_); }
 
 void DiscretePlant::Step(double input) {
-  const Eigen::Index n = state_.size();
-  for (Eigen::Index i = 0; i < n; ++i) {
-    double acc = 0.0;
-    for (Eigen::Index j = 0; j < n; ++j) acc += phi_(i, j) * state_(j);
-    next_(i) = acc + gamma_(i) * input;
-  }
+  ZohStep(phi_, gamma_, state_, input, &next_);
   state_.swap(next_);
 }
 
-void DiscretePlant::Reset() { state_.setZero(); }
+void DiscretePlant::Reset() { std::fill(state_.begin(), state_.end(), 0.0); }
 
 }  // namespace pidlab

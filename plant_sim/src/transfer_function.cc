@@ -22,8 +22,8 @@ std::string PolyToString(const std::vector<double>& p) {
   return os.str();
 }
 
-// Diagonal balancing with powers of two (as LAPACK's gebal), so that rows and
-// columns of A have comparable norms. Returns the scaling d: A <- D^-1 A D.
+}  // namespace
+
 Eigen::VectorXd BalanceInPlace(Eigen::MatrixXd* a) {
   const Eigen::Index n = a->rows();
   Eigen::VectorXd d = Eigen::VectorXd::Ones(n);
@@ -53,7 +53,6 @@ Eigen::VectorXd BalanceInPlace(Eigen::MatrixXd* a) {
   return d;
 }
 
-}  // namespace
 
 bool TransferFunction::IsValid(std::string* error) const {
   auto fail = [&](const std::string& m) {

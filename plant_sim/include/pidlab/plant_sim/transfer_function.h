@@ -39,6 +39,11 @@ struct StateSpace {
 /// std::invalid_argument if `tf` is not valid.
 StateSpace Realize(const TransferFunction& tf);
 
+/// Diagonal balancing with powers of two (as LAPACK's gebal), so that rows
+/// and columns of A have comparable norms; eigenvalues are unchanged and
+/// computed more accurately. Returns d with A <- D^-1 A D.
+Eigen::VectorXd BalanceInPlace(Eigen::MatrixXd* a);
+
 /// Roots of a polynomial in descending powers (companion-matrix eigenvalues).
 std::vector<std::complex<double>> PolynomialRoots(const std::vector<double>& p);
 

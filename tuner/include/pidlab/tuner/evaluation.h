@@ -1,0 +1,108 @@
+#pragma once
+// Evaluation of a PID loop: the paper's objective (eq. 4-5), other error
+// measures, stability and MATLAB-stepinfo step metrics.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pidlab/tuner/closed_loop.h"
+
+namespace pidlab {
+
+/// Objectives over the error samples e_m = 1 - y(m ts), m = 0..M:
+///   iae  = sum |e_m|          (eq. 4, the paper's Error(K); not scaled by ts)
+///   ise  = sum e_m^2
+///   itae = sum t_m |e_m|
+///   iae_continuous = \int_0^n |e(t)| dt (continuous time, on a grid fine
+///                    enough for the fastest pole; trapezoidal at dt for the
+///                    sampled loop)
+enum class ObjectiveKind { kIae, kIse, kItae, kIaeContinuous };
+bool ParseObjectiveKind(const std::string& s, ObjectiveKind* kind);
+std::string ToString(ObjectiveKind kind);
+
+/// Step metrics as MATLAB's stepinfo defines them, for the undisturbed unit
+/// step response y1 (eq. 17): rise time 10 % -> 90 % of the final value,
+/// overshoot in % of the final value, settling time after which
+/// |y - y_final| <= 2 % of |y_final| for good.
+struct StepInfo {
+  bool valid = false;
+  std::string note;  // why not valid, or what limited accuracy
+  double final_value = 0, rise_time_s = 0, overshoot_pct = 0, settling_time_s = 0;
+  double peak = 0, peak_time_s = 0;
+};
+
+struct Evaluation {
+  Plant plant;
+  PidGains gains;
+  LoopOptions options;
+  Stability stability;
+  /// Sample times t_m, outputs y(t_m) with the disturbance, disturbance n(t_m).
+  std::vector<double> t, y, n;
+  /// Objectives of y (with the disturbance if one is set). +inf if unstable.
+  double iae = 0, ise = 0, itae = 0, iae_continuous = 0;
+  /// IAE of the undisturbed response y1 (equals iae without a disturbance).
+  double iae_undisturbed = 0;
+  StepInfo step;
+  /// Every step of the sampled loop (sampled loop with record_trajectory).
+  std::vector<SampledStep> trajectory;
+
+  double Objective(ObjectiveKind kind) const;
+};
+
+struct EvaluateOptions {
+  bool compute_step_info = true;
+  bool compute_iae_continuous = true;
+  bool record_trajectory = false;
+};
+
+/// Evaluates `gains` on `plant`. Returns false with a one-line *error for
+/// invalid input (the caller reports it as bad input). An unstable loop is
+/// not an error: evaluation->stability.stable is false and the objectives are
+/// +inf.
+bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+              const EvaluateOptions& what, Evaluation* evaluation, std::string* error);
+
+/// The tuner's inner loop: the objective of one gain vector, +inf for any loop
+/// that is not strictly stable. Realisation and discretisation are done once.
+class ObjectiveEvaluator {
+ public:
+  /// Throws std::invalid_argument if the options are invalid.
+  ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind);
+  double operator()(const PidGains& gains) const;
+  /// Evaluations so far (thread-compatible, not thread-safe).
+  long evaluations() const { return evaluations_; }
+  const LoopOptions& options() const { return options_; }
+  const Plant& plant() const { return plant_; }
+  ObjectiveKind kind() const { return kind_; }
+
+ private:
+  Plant plant_;
+  LoopOptions options_;
+  ObjectiveKind kind_;
+  StateSpace realization_;
+  Disturbance disturbance_;
+  std::unique_ptr<DiscretePlant> discrete_;
+  mutable long evaluations_ = 0;
+  mutable std::vector<double> y_;
+};
+
+/// Objective from output samples y_m at t_m = m ts (not kIaeContinuous).
+double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, double ts);
+
+/// MATLAB stepinfo on the exact continuous step response (no disturbance),
+/// on a grid whose step follows the fastest pole still alive, with crossings
+/// and the peak refined by exact propagation.
+StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stability& stability);
+
+/// \int_0^horizon |1 - y(t)| dt of the continuous loop (with its disturbance).
+double ContinuousIntegralAbsError(const ContinuousClosedLoop<double>& loop, const Disturbance& disturbance,
+                                  const Stability& stability, double horizon_s);
+
+/// stepinfo on a sampled response (linear interpolation at crossings).
+StepInfo SampledStepInfo(const std::vector<double>& t, const std::vector<double>& y, double final_value);
+
+/// Final value of the unit step response of a stable continuous loop.
+double ContinuousFinalValue(const ContinuousClosedLoop<double>& loop);
+
+}  // namespace pidlab

@@ -1,0 +1,135 @@
+#include "pidlab/tuner/closed_loop.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace pidlab {
+namespace {
+
+// |x / step - round(x / step)| small: x is a whole multiple of step.
+bool IsMultiple(double x, double step, long* count) {
+  const double ratio = x / step;
+  const double r = std::round(ratio);
+  if (std::abs(ratio - r) > 1e-9 * std::max(1.0, r)) return false;
+  *count = static_cast<long>(r);
+  return true;
+}
+
+}  // namespace
+
+bool ParseLoopKind(const std::string& s, LoopKind* kind) {
+  if (s == "continuous") *kind = LoopKind::kContinuous;
+  else if (s == "sampled") *kind = LoopKind::kSampled;
+  else return false;
+  return true;
+}
+
+std::string ToString(LoopKind kind) { return kind == LoopKind::kContinuous ? "continuous" : "sampled"; }
+
+bool LoopOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  long count = 0;
+  if (!(sample_time_s > 0.0) || !std::isfinite(sample_time_s))
+    os << "sample time " << sample_time_s << " s must be positive and finite";
+  else if (!(horizon_s > 0.0) || !std::isfinite(horizon_s))
+    os << "horizon " << horizon_s << " s must be positive and finite";
+  else if (!IsMultiple(horizon_s, sample_time_s, &count) || count < 1)
+    os << "horizon " << horizon_s << " s must be a whole multiple of the sample time " << sample_time_s << " s";
+  else if (count > 10000000)
+    os << "horizon / sample time = " << count << " samples is more than 1e7";
+  else if (!(stability_margin >= 0.0) || !(stability_margin < 1.0))
+    os << "stability margin " << stability_margin << " must be in [0, 1)";
+  else if (!disturbance.IsValid(error))
+    return false;
+  else if (loop == LoopKind::kSampled) {
+    PidOptions p = pid;
+    p.dt_s = dt_s;
+    if (!(dt_s > 0.0) || !std::isfinite(dt_s))
+      os << "dt " << dt_s << " s must be positive and finite";
+    else if (!IsMultiple(sample_time_s, dt_s, &count) || count < 1)
+      os << "sample time " << sample_time_s << " s must be a whole multiple of dt " << dt_s << " s";
+    else if (!IsMultiple(horizon_s, dt_s, &count) || count > 2000000000L)
+      os << "horizon " << horizon_s << " s / dt " << dt_s << " s is too many steps";
+    else if (!p.IsValid(error))
+      return false;
+    else
+      return true;
+  } else {
+    return true;
+  }
+  if (error) *error = os.str();
+  return false;
+}
+
+int LoopOptions::NumSamples() const { return static_cast<int>(std::lround(horizon_s / sample_time_s)) + 1; }
+int LoopOptions::StepsPerSample() const { return static_cast<int>(std::lround(sample_time_s / dt_s)); }
+long LoopOptions::TotalSteps() const { return std::lround(horizon_s / dt_s); }
+
+Stability ContinuousStability(const ContinuousClosedLoop<double>& loop, double margin) {
+  const int n = loop.loop_order();
+  Eigen::MatrixXd m = loop.m.topLeftCorner(n, n);
+  BalanceInPlace(&m);
+  Eigen::EigenSolver<Eigen::MatrixXd> es(m, false);
+  Stability s;
+  s.abscissa = -std::numeric_limits<double>::infinity();
+  bool ok = es.info() == Eigen::Success;
+  for (int i = 0; i < n && ok; ++i) {
+    const std::complex<double> p = es.eigenvalues()(i);
+    s.poles.push_back(p);
+    s.abscissa = std::max(s.abscissa, p.real());
+    if (!std::isfinite(p.real()) || !(p.real() < -margin * std::max(1.0, std::abs(p)))) ok = false;
+  }
+  s.stable = ok && static_cast<int>(s.poles.size()) == n;
+  std::sort(s.poles.begin(), s.poles.end(),
+            [](const auto& a, const auto& b) { return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag(); });
+  return s;
+}
+
+Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const PidOptions& o, double margin) {
+  // State z_k = [x_k; I_{k-1}; D_{k-1}; e_{k-1}; s_{k-1}] with r = n = 0, so
+  // e_k = s_k = -C x_k for both derivative modes.
+  const int n = plant.order();
+  const int size = n + 4;
+  const int ii = n, id = n + 1, iep = n + 2, isp = n + 3;
+  const double dt = o.dt_s, tf = o.derivative_filter_s;
+  const double a = tf / (tf + dt), b = g.kd / (tf + dt);
+  Eigen::RowVectorXd e_row = Eigen::RowVectorXd::Zero(size);
+  e_row.head(n) = -plant.c();
+  Eigen::RowVectorXd i_row = Eigen::RowVectorXd::Zero(size);
+  i_row(ii) = 1.0;
+  switch (o.integral) {
+    case IntegralMethod::kBackwardEuler: i_row += g.ki * dt * e_row; break;
+    case IntegralMethod::kForwardEuler: i_row(iep) += g.ki * dt; break;
+    case IntegralMethod::kTrapezoidal:
+      i_row += 0.5 * g.ki * dt * e_row;
+      i_row(iep) += 0.5 * g.ki * dt;
+      break;
+  }
+  Eigen::RowVectorXd d_row = b * e_row;
+  d_row(id) += a;
+  d_row(isp) -= b;
+  const Eigen::RowVectorXd u_row = g.kp * e_row + i_row + d_row;
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(size, size);
+  m.topLeftCorner(n, n) = plant.phi();
+  m.topRows(n) += plant.gamma() * u_row;
+  m.row(ii) = i_row;
+  m.row(id) = d_row;
+  m.row(iep) = e_row;
+  m.row(isp) = e_row;
+  BalanceInPlace(&m);
+  Eigen::EigenSolver<Eigen::MatrixXd> es(m, false);
+  Stability s;
+  s.abscissa = 0.0;
+  bool ok = es.info() == Eigen::Success;
+  for (int i = 0; i < size && ok; ++i) {
+    const std::complex<double> z = es.eigenvalues()(i);
+    s.poles.push_back(z);
+    s.abscissa = std::max(s.abscissa, std::abs(z));
+  }
+  s.stable = ok && std::isfinite(s.abscissa) && s.abscissa < 1.0 - margin;
+  std::sort(s.poles.begin(), s.poles.end(),
+            [](const auto& p, const auto& q) { return std::abs(p) != std::abs(q) ? std::abs(p) > std::abs(q) : p.imag() < q.imag(); });
+  return s;
+}
+
+}  // namespace pidlab

@@ -1,0 +1,443 @@
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+#include "pidlab/tuner/evaluation.h"
+
+namespace pidlab {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Grid step as a fraction of the time constant 1/|p| of the fastest live pole.
+constexpr double kGridFraction = 0.05;
+// A mode is dead once e^{Re p * tau} < e^-36 (about 2e-16).
+constexpr double kDeadExponent = -36.0;
+constexpr long kMaxGridPoints = 2000000;
+
+// Walks the continuous loop on a grid whose step follows the fastest pole
+// still alive since the last excitation (t = 0 or a disturbance breakpoint).
+// Steps are h0 * 2^j, so one matrix exponential per level is enough.
+class AdaptiveWalker {
+ public:
+  AdaptiveWalker(const ContinuousClosedLoop<double>& loop, const Disturbance* disturbance,
+                 const Stability& stability)
+      : loop_(loop), disturbance_(disturbance), poles_(stability.poles) {
+    double fastest = 0.0;
+    for (const auto& p : poles_) fastest = std::max(fastest, std::abs(p));
+    if (loop.exo_size == 2) fastest = std::max(fastest, ExoFrequency());
+    h0_ = kGridFraction / std::max(fastest, 1e-12);
+  }
+
+  /// Calls visit(t, w) at t = 0 and every grid point up to t_end (included).
+  /// Returns false if the grid would exceed kMaxGridPoints.
+  bool Run(double t_end, const std::function<void(double, const Eigen::VectorXd&)>& visit) {
+    Eigen::VectorXd w = loop_.w0;
+    double t = 0.0, excited = 0.0;
+    const bool piecewise = loop_.exo_size == 1 && disturbance_ != nullptr;
+    const int ie = loop_.plant_order + 2;
+    visit(t, w);
+    long points = 1;
+    while (t < t_end) {
+      double stop = t_end;
+      double tb = kInf;
+      if (piecewise) {
+        tb = disturbance_->NextBreakpoint(t);
+        stop = std::min(stop, tb);
+      }
+      const double h = StepAt(t - excited);
+      if (t + h < stop - 1e-12 * std::max(1.0, stop)) {
+        w = Phi(h) * w;
+        t += h;
+      } else {
+        w = MatrixExp<double>(Eigen::MatrixXd(loop_.m * (stop - t))) * w;
+        t = stop;
+        if (piecewise && stop == tb) {
+          w(ie) = disturbance_->Value(t);
+          excited = t;
+        }
+      }
+      visit(t, w);
+      if (++points > kMaxGridPoints) return false;
+    }
+    return true;
+  }
+
+  /// Exact state at t0 + tau from w at t0 (no breakpoint in between).
+  Eigen::VectorXd Propagate(const Eigen::VectorXd& w, double tau) const {
+    return MatrixExp<double>(Eigen::MatrixXd(loop_.m * tau)) * w;
+  }
+
+ private:
+  double ExoFrequency() const { return std::abs(loop_.m(loop_.plant_order + 2, loop_.plant_order + 3)); }
+
+  double StepAt(double tau) const {
+    double fastest = 0.0;
+    for (const auto& p : poles_)
+      if (p.real() * tau > kDeadExponent) fastest = std::max(fastest, std::abs(p));
+    if (loop_.exo_size == 2) fastest = std::max(fastest, ExoFrequency());
+    if (fastest == 0.0) return h0_ * std::ldexp(1.0, 40);
+    const int level = std::max(0, static_cast<int>(std::floor(std::log2(kGridFraction / fastest / h0_))));
+    return h0_ * std::ldexp(1.0, std::min(level, 40));
+  }
+
+  const Eigen::MatrixXd& Phi(double h) {
+    auto it = cache_.find(h);
+    if (it == cache_.end()) it = cache_.emplace(h, MatrixExp<double>(Eigen::MatrixXd(loop_.m * h))).first;
+    return it->second;
+  }
+
+  const ContinuousClosedLoop<double>& loop_;
+  const Disturbance* disturbance_;
+  std::vector<std::complex<double>> poles_;
+  double h0_ = 0.0;
+  std::map<double, Eigen::MatrixXd> cache_;
+};
+
+// Root of g on [a, b] with g(a), g(b) of opposite signs, by bisection.
+double Bisect(const std::function<double(double)>& g, double a, double b) {
+  double ga = g(a);
+  for (int i = 0; i < 80 && b - a > 1e-15 * std::max(1.0, std::abs(b)); ++i) {
+    const double mid = 0.5 * (a + b);
+    const double gm = g(mid);
+    if ((gm < 0.0) == (ga < 0.0)) {
+      a = mid;
+      ga = gm;
+    } else {
+      b = mid;
+    }
+  }
+  return 0.5 * (a + b);
+}
+
+}  // namespace
+
+bool ParseObjectiveKind(const std::string& s, ObjectiveKind* kind) {
+  if (s == "iae") *kind = ObjectiveKind::kIae;
+  else if (s == "ise") *kind = ObjectiveKind::kIse;
+  else if (s == "itae") *kind = ObjectiveKind::kItae;
+  else if (s == "iae-continuous") *kind = ObjectiveKind::kIaeContinuous;
+  else return false;
+  return true;
+}
+
+std::string ToString(ObjectiveKind kind) {
+  switch (kind) {
+    case ObjectiveKind::kIae: return "iae";
+    case ObjectiveKind::kIse: return "ise";
+    case ObjectiveKind::kItae: return "itae";
+    case ObjectiveKind::kIaeContinuous: return "iae-continuous";
+  }
+  return "iae";
+}
+
+double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, double ts) {
+  double sum = 0.0;
+  for (std::size_t m = 0; m < y.size(); ++m) {
+    const double e = 1.0 - y[m];
+    switch (kind) {
+      case ObjectiveKind::kIae: sum += std::abs(e); break;
+      case ObjectiveKind::kIse: sum += e * e; break;
+      case ObjectiveKind::kItae: sum += static_cast<double>(m) * ts * std::abs(e); break;
+      case ObjectiveKind::kIaeContinuous: throw std::logic_error("iae-continuous is not a sample sum");
+    }
+  }
+  return std::isfinite(sum) ? sum : kInf;
+}
+
+double ContinuousFinalValue(const ContinuousClosedLoop<double>& loop) {
+  const int n = loop.loop_order();
+  const Eigen::VectorXd w = loop.m.topLeftCorner(n, n).partialPivLu().solve(-loop.m.block(0, n, n, 1));
+  return loop.c.dot(w.head(loop.plant_order));
+}
+
+StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stability& stability) {
+  StepInfo info;
+  if (!stability.stable) {
+    info.note = "unstable loop: no step metrics";
+    return info;
+  }
+  // The undisturbed step response: same loop without exosystem input.
+  ContinuousClosedLoop<double> y1 = loop;
+  if (loop.exo_size > 0) {
+    const int size = loop.plant_order + 2;
+    y1.m = loop.m.topLeftCorner(size, size);
+    y1.w0 = loop.w0.head(size);
+    y1.exo_size = 0;
+  }
+  const double yf = ContinuousFinalValue(y1);
+  info.final_value = yf;
+  double slowest = kInf;
+  for (const auto& p : stability.poles) slowest = std::min(slowest, -p.real());
+  const double t_end = -kDeadExponent / slowest;
+  std::vector<double> ts, ys;
+  std::vector<Eigen::VectorXd> ws;
+  AdaptiveWalker walker(y1, nullptr, stability);
+  const bool complete = walker.Run(t_end, [&](double t, const Eigen::VectorXd& w) {
+    ts.push_back(t);
+    ys.push_back(y1.Output(w));
+    ws.push_back(w);
+  });
+  if (!complete) {
+    info.note = "response too slow to settle within the grid budget";
+    return info;
+  }
+  if (!(std::abs(yf) > 1e-12)) {
+    info.note = "final value is zero: stepinfo is undefined";
+    return info;
+  }
+  auto y_at = [&](std::size_t i, double t) { return y1.Output(walker.Propagate(ws[i], t - ts[i])); };
+  // Crossing of level (a fraction of yf) from below, first time.
+  auto first_crossing = [&](double level) {
+    for (std::size_t i = 0; i < ys.size(); ++i) {
+      if ((ys[i] - level) * (yf > 0 ? 1 : -1) >= 0.0) {
+        if (i == 0) return ts[0];
+        return Bisect([&](double t) { return (y_at(i - 1, t) - level) * (yf > 0 ? 1 : -1); }, ts[i - 1], ts[i]);
+      }
+    }
+    return kNaN;
+  };
+  const double t10 = first_crossing(0.1 * yf), t90 = first_crossing(0.9 * yf);
+  info.rise_time_s = t90 - t10;
+  // Peak: the largest |y| on the grid, refined by golden-section search on
+  // the exact response over the neighbouring intervals.
+  std::size_t ip = 0;
+  for (std::size_t i = 1; i < ys.size(); ++i)
+    if (std::abs(ys[i]) > std::abs(ys[ip])) ip = i;
+  double peak = std::abs(ys[ip]), peak_t = ts[ip];
+  if (ip > 0 && ip + 1 < ys.size()) {
+    double a = ts[ip - 1], b = ts[ip + 1];
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    auto f = [&](double t) { return -std::abs(y_at(ip - 1, t)); };
+    double c = b - g * (b - a), d = a + g * (b - a), fc = f(c), fd = f(d);
+    for (int it = 0; it < 100 && b - a > 1e-15 * std::max(1.0, b); ++it) {
+      if (fc < fd) { b = d; d = c; fd = fc; c = b - g * (b - a); fc = f(c); }
+      else { a = c; c = d; fc = fd; d = a + g * (b - a); fd = f(d); }
+    }
+    const double tp = 0.5 * (a + b), yp = -f(tp);
+    if (yp > peak) { peak = yp; peak_t = tp; }
+  }
+  info.peak = peak;
+  info.peak_time_s = peak_t;
+  info.overshoot_pct = std::max(0.0, 100.0 * (peak - std::abs(yf)) / std::abs(yf));
+  // Settling: the last exit from the 2 % band, refined on the exact response.
+  const double band = 0.02 * std::abs(yf);
+  std::size_t last_out = ys.size();
+  for (std::size_t i = ys.size(); i-- > 0;) {
+    if (std::abs(ys[i] - yf) > band) { last_out = i; break; }
+  }
+  if (last_out == ys.size()) {
+    info.settling_time_s = 0.0;
+  } else if (last_out + 1 == ys.size()) {
+    info.note = "response not settled at the end of the grid";
+    return info;
+  } else {
+    info.settling_time_s = Bisect([&](double t) { return std::abs(y_at(last_out, t) - yf) - band; },
+                                  ts[last_out], ts[last_out + 1]);
+  }
+  info.valid = std::isfinite(info.rise_time_s);
+  if (!info.valid) info.note = "response never reaches 90 % of its final value";
+  return info;
+}
+
+double ContinuousIntegralAbsError(const ContinuousClosedLoop<double>& loop, const Disturbance& disturbance,
+                                  const Stability& stability, double horizon_s) {
+  if (!stability.stable) return kInf;
+  AdaptiveWalker walker(loop, &disturbance, stability);
+  double sum = 0.0, t_prev = 0.0, e_prev = 0.0;
+  bool first = true;
+  const bool ok = walker.Run(horizon_s, [&](double t, const Eigen::VectorXd& w) {
+    const double e = 1.0 - loop.Output(w);
+    if (!first) {
+      const double h = t - t_prev;
+      if ((e > 0) == (e_prev > 0) || e == 0.0 || e_prev == 0.0) {
+        sum += 0.5 * h * (std::abs(e) + std::abs(e_prev));
+      } else {  // a sign change inside: integrate the two triangles
+        const double f = std::abs(e_prev) / (std::abs(e_prev) + std::abs(e));
+        sum += 0.5 * h * (f * std::abs(e_prev) + (1.0 - f) * std::abs(e));
+      }
+    }
+    first = false;
+    t_prev = t;
+    e_prev = e;
+  });
+  return ok ? sum : kNaN;
+}
+
+StepInfo SampledStepInfo(const std::vector<double>& t, const std::vector<double>& y, double yf) {
+  StepInfo info;
+  info.final_value = yf;
+  if (y.size() < 2 || !(std::abs(yf) > 1e-12)) {
+    info.note = "final value is zero or no samples: stepinfo is undefined";
+    return info;
+  }
+  const double sgn = yf > 0 ? 1.0 : -1.0;
+  auto crossing = [&](double level) {
+    for (std::size_t i = 0; i < y.size(); ++i)
+      if ((y[i] - level) * sgn >= 0.0) {
+        if (i == 0) return t[0];
+        return t[i - 1] + (t[i] - t[i - 1]) * (level - y[i - 1]) / (y[i] - y[i - 1]);
+      }
+    return kNaN;
+  };
+  info.rise_time_s = crossing(0.9 * yf) - crossing(0.1 * yf);
+  std::size_t ip = 0;
+  for (std::size_t i = 1; i < y.size(); ++i)
+    if (std::abs(y[i]) > std::abs(y[ip])) ip = i;
+  info.peak = std::abs(y[ip]);
+  info.peak_time_s = t[ip];
+  info.overshoot_pct = std::max(0.0, 100.0 * (info.peak - std::abs(yf)) / std::abs(yf));
+  const double band = 0.02 * std::abs(yf);
+  std::size_t last_out = y.size();
+  for (std::size_t i = y.size(); i-- > 0;)
+    if (std::abs(y[i] - yf) > band) { last_out = i; break; }
+  if (last_out == y.size()) {
+    info.settling_time_s = 0.0;
+  } else if (last_out + 1 == y.size()) {
+    info.note = "response not settled within the horizon";
+    return info;
+  } else {
+    const double a = std::abs(y[last_out] - yf) - band, b = std::abs(y[last_out + 1] - yf) - band;
+    info.settling_time_s = t[last_out] + (t[last_out + 1] - t[last_out]) * a / (a - b);
+  }
+  info.valid = std::isfinite(info.rise_time_s);
+  if (!info.valid) info.note = "response never reaches 90 % of its final value within the horizon";
+  return info;
+}
+
+double Evaluation::Objective(ObjectiveKind kind) const {
+  switch (kind) {
+    case ObjectiveKind::kIae: return iae;
+    case ObjectiveKind::kIse: return ise;
+    case ObjectiveKind::kItae: return itae;
+    case ObjectiveKind::kIaeContinuous: return iae_continuous;
+  }
+  return iae;
+}
+
+bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options, const EvaluateOptions& what,
+              Evaluation* ev, std::string* error) {
+  if (!GainsAreValid(gains, error)) return false;
+  if (!options.IsValid(error)) return false;
+  if (!plant.tf.IsValid(error)) return false;
+  if (plant.tf.RelativeDegree() < 1) {
+    if (error) *error = "plant " + plant.tf.ToString() + " must be strictly proper";
+    return false;
+  }
+  *ev = Evaluation();
+  ev->plant = plant;
+  ev->gains = gains;
+  ev->options = options;
+  const Disturbance disturbance(options.disturbance);
+  const Disturbance none(DisturbanceOptions{});
+  const int num = options.NumSamples();
+  const double ts = options.sample_time_s;
+  for (int m = 0; m < num; ++m) {
+    ev->t.push_back(m * ts);
+    ev->n.push_back(disturbance.Value(m * ts));
+  }
+  const StateSpace ss = Realize(plant.tf);
+  ContinuousClosedLoop<double> loop;
+  if (!BuildContinuousClosedLoop<double>(ss, gains, disturbance, &loop, error)) return false;
+  const Stability continuous_stability = ContinuousStability(loop, options.stability_margin);
+  const bool has_disturbance = options.disturbance.kind != DisturbanceKind::kNone;
+
+  if (options.loop == LoopKind::kContinuous) {
+    ev->stability = continuous_stability;
+    if (ev->stability.stable) {
+      SampleContinuousLoop<double>(loop, disturbance, ts, num, &ev->y);
+      if (has_disturbance) {
+        ContinuousClosedLoop<double> clean;
+        BuildContinuousClosedLoop<double>(ss, gains, none, &clean, error);
+        std::vector<double> y1;
+        SampleContinuousLoop<double>(clean, none, ts, num, &y1);
+        ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1, ts);
+      }
+      if (what.compute_iae_continuous)
+        ev->iae_continuous = ContinuousIntegralAbsError(loop, disturbance, ev->stability, options.horizon_s);
+      if (what.compute_step_info) ev->step = ContinuousStepInfo(loop, ev->stability);
+    }
+  } else {
+    PidOptions pid = options.pid;
+    pid.dt_s = options.dt_s;
+    const DiscretePlant discrete(plant.tf, options.dt_s);
+    ev->stability = SampledStability(discrete, gains, pid, options.stability_margin);
+    if (ev->stability.stable) {
+      std::vector<double> y_all;
+      RunSampledLoop<double>(discrete, gains, pid, disturbance, options.TotalSteps(), 1, &y_all,
+                             what.record_trajectory ? &ev->trajectory : nullptr);
+      const int per = options.StepsPerSample();
+      for (int m = 0; m < num; ++m) ev->y.push_back(y_all[static_cast<std::size_t>(m) * per]);
+      double integral = 0.0;
+      for (std::size_t k = 1; k < y_all.size(); ++k)
+        integral += 0.5 * options.dt_s * (std::abs(1.0 - y_all[k]) + std::abs(1.0 - y_all[k - 1]));
+      ev->iae_continuous = integral;
+      std::vector<double> y1 = y_all;
+      if (has_disturbance) {
+        RunSampledLoop<double>(discrete, gains, pid, none, options.TotalSteps(), 1, &y1);
+        std::vector<double> y1s;
+        for (int m = 0; m < num; ++m) y1s.push_back(y1[static_cast<std::size_t>(m) * per]);
+        ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1s, ts);
+      }
+      if (what.compute_step_info) {
+        std::vector<double> t_all(y1.size());
+        for (std::size_t k = 0; k < t_all.size(); ++k) t_all[k] = static_cast<double>(k) * options.dt_s;
+        const double yf = continuous_stability.stable ? ContinuousFinalValue(loop) : 1.0;
+        ev->step = SampledStepInfo(t_all, y1, yf);
+      }
+    }
+  }
+  if (ev->stability.stable) {
+    ev->iae = ObjectiveFromSamples(ObjectiveKind::kIae, ev->y, ts);
+    ev->ise = ObjectiveFromSamples(ObjectiveKind::kIse, ev->y, ts);
+    ev->itae = ObjectiveFromSamples(ObjectiveKind::kItae, ev->y, ts);
+    if (!has_disturbance) ev->iae_undisturbed = ev->iae;
+  } else {
+    ev->iae = ev->ise = ev->itae = ev->iae_continuous = ev->iae_undisturbed = kInf;
+    ev->step.note = "unstable loop: no step metrics";
+  }
+  return true;
+}
+
+ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind)
+    : plant_(plant), options_(options), kind_(kind), disturbance_(options.disturbance) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument(error);
+  if (!plant.tf.IsValid(&error)) throw std::invalid_argument(error);
+  realization_ = Realize(plant.tf);
+  if (options.loop == LoopKind::kSampled) {
+    options_.pid.dt_s = options.dt_s;
+    discrete_ = std::make_unique<DiscretePlant>(plant.tf, options.dt_s);
+  }
+}
+
+double ObjectiveEvaluator::operator()(const PidGains& gains) const {
+  ++evaluations_;
+  if (!GainsAreValid(gains, nullptr)) return kInf;
+  const double ts = options_.sample_time_s;
+  if (options_.loop == LoopKind::kContinuous) {
+    ContinuousClosedLoop<double> loop;
+    if (!BuildContinuousClosedLoop<double>(realization_, gains, disturbance_, &loop, nullptr)) return kInf;
+    const Stability s = ContinuousStability(loop, options_.stability_margin);
+    if (!s.stable) return kInf;
+    if (kind_ == ObjectiveKind::kIaeContinuous)
+      return ContinuousIntegralAbsError(loop, disturbance_, s, options_.horizon_s);
+    SampleContinuousLoop<double>(loop, disturbance_, ts, options_.NumSamples(), &y_);
+    return ObjectiveFromSamples(kind_, y_, ts);
+  }
+  if (!SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable) return kInf;
+  if (kind_ == ObjectiveKind::kIaeContinuous) {
+    RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(), 1, &y_);
+    double integral = 0.0;
+    for (std::size_t k = 1; k < y_.size(); ++k)
+      integral += 0.5 * options_.dt_s * (std::abs(1.0 - y_[k]) + std::abs(1.0 - y_[k - 1]));
+    return integral;
+  }
+  RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(),
+                         options_.StepsPerSample(), &y_);
+  return ObjectiveFromSamples(kind_, y_, ts);
+}
+
+}  // namespace pidlab
