@@ -317,8 +317,18 @@ double Evaluation::Objective(ObjectiveKind kind) const {
   return iae;
 }
 
+bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                             const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                             std::vector<SampledStep>* trajectory, std::string* /*error*/) {
+  PidOptions pid = options.pid;
+  pid.dt_s = options.dt_s;
+  const DiscretePlant discrete(plant.tf, options.dt_s);
+  RunSampledLoop<double>(discrete, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all, trajectory);
+  return true;
+}
+
 bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options, const EvaluateOptions& what,
-              Evaluation* ev, std::string* error) {
+              Evaluation* ev, std::string* error, const SampledRunner& runner) {
   if (!GainsAreValid(gains, error)) return false;
   if (!options.IsValid(error)) return false;
   if (!plant.tf.IsValid(error)) return false;
@@ -366,8 +376,9 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
     ev->stability = SampledStability(discrete, gains, pid, options.stability_margin);
     if (ev->stability.stable) {
       std::vector<double> y_all;
-      RunSampledLoop<double>(discrete, gains, pid, disturbance, options.TotalSteps(), 1, &y_all,
-                             what.record_trajectory ? &ev->trajectory : nullptr);
+      if (!runner(plant, gains, options, options.disturbance, &y_all,
+                  what.record_trajectory ? &ev->trajectory : nullptr, error))
+        return false;
       const int per = options.StepsPerSample();
       for (int m = 0; m < num; ++m) ev->y.push_back(y_all[static_cast<std::size_t>(m) * per]);
       double integral = 0.0;
@@ -376,7 +387,7 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
       ev->iae_continuous = integral;
       std::vector<double> y1 = y_all;
       if (has_disturbance) {
-        RunSampledLoop<double>(discrete, gains, pid, none, options.TotalSteps(), 1, &y1);
+        if (!runner(plant, gains, options, none.options(), &y1, nullptr, error)) return false;
         std::vector<double> y1s;
         for (int m = 0; m < num; ++m) y1s.push_back(y1[static_cast<std::size_t>(m) * per]);
         ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1s, ts);

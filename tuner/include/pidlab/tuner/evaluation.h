@@ -2,6 +2,7 @@
 // Evaluation of a PID loop: the paper's objective (eq. 4-5), other error
 // measures, stability and MATLAB-stepinfo step metrics.
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,12 +57,28 @@ struct EvaluateOptions {
   bool record_trajectory = false;
 };
 
+/// Runs the sampled loop of `options` with the disturbance `disturbance`
+/// (which may differ from options.disturbance: Evaluate also runs the
+/// undisturbed loop) and returns y at every step k = 0..TotalSteps() in
+/// *y_all; records every step in *trajectory when it is not null. The
+/// in-process runner is RunSampledLoop; the LCM backend runs an episode over
+/// the process trio instead, with bit-identical results.
+using SampledRunner = std::function<bool(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                                         const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                                         std::vector<SampledStep>* trajectory, std::string* error)>;
+
+/// The in-process SampledRunner.
+bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                             const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                             std::vector<SampledStep>* trajectory, std::string* error);
+
 /// Evaluates `gains` on `plant`. Returns false with a one-line *error for
 /// invalid input (the caller reports it as bad input). An unstable loop is
 /// not an error: evaluation->stability.stable is false and the objectives are
 /// +inf.
 bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options,
-              const EvaluateOptions& what, Evaluation* evaluation, std::string* error);
+              const EvaluateOptions& what, Evaluation* evaluation, std::string* error,
+              const SampledRunner& runner = RunSampledLoopInProcess);
 
 /// The tuner's inner loop: the objective of one gain vector, +inf for any loop
 /// that is not strictly stable. Realisation and discretisation are done once.
