@@ -1,0 +1,269 @@
+#include "cli_common.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace pidlab::cli {
+
+std::vector<RegisteredCommand>& Registry() {
+  static std::vector<RegisteredCommand> registry;
+  return registry;
+}
+
+CommandRegistrar::CommandRegistrar(const std::string& name, const std::string& description,
+                                   CommandFactory factory) {
+  Registry().push_back({name, description, std::move(factory)});
+}
+
+double ParseDouble(const std::string& text, const std::string& what) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(begin, &end);
+  if (text.empty() || end == begin || *end != '\0' || errno == ERANGE)
+    throw BadInput(what + " '" + text + "' is not a number");
+  return v;
+}
+
+std::vector<double> ParseList(const std::string& text, const std::string& what) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) out.push_back(ParseDouble(item, what));
+  if (out.empty() || (!text.empty() && text.back() == ','))
+    throw BadInput(what + " '" + text + "' must be a comma-separated list of numbers");
+  return out;
+}
+
+PidGains ParseGains(const std::string& text) {
+  const auto v = ParseList(text, "--gains");
+  if (v.size() != 3) throw BadInput("--gains '" + text + "' must be three numbers KP,KI,KD");
+  const PidGains g{v[0], v[1], v[2]};
+  std::string error;
+  if (!GainsAreValid(g, &error)) throw BadInput(error);
+  return g;
+}
+
+void PlantFlags::Register(CLI::App* app, bool required) {
+  auto* opt = app->add_option("--plant", plant,
+                              "double_integrator (alias linear) = 1/s^2, oscillator (alias nonlinear) = "
+                              "1/(s^2+1), stepper_motor (alias stepper) = eq. (3), or custom with --num/--den");
+  (void)required;
+  app->add_option("--num", num, "custom plant numerator, descending powers of s, e.g. 1");
+  app->add_option("--den", den, "custom plant denominator, descending powers of s, e.g. 1,0,0");
+  app->add_option("--stepper", stepper_overrides,
+                  "override a Table I parameter, NAME=VALUE (resistance_ohm, self_inductance_h, "
+                  "mutual_inductance_h, inertia_kg_m2, rotor_teeth, viscous_friction, tooth_pitch_rad, "
+                  "stationary_current_a, flux_linkage); repeatable")
+      ->take_all();
+  opt->check([](const std::string&) { return std::string(); });
+}
+
+Plant PlantFlags::Build() const {
+  std::string error;
+  Plant p;
+  const bool custom = !num.empty() || !den.empty();
+  if (custom && !plant.empty() && plant != "custom")
+    throw BadInput("--plant '" + plant + "' cannot be combined with --num/--den (use --plant custom or omit it)");
+  if (custom) {
+    if (num.empty() || den.empty()) throw BadInput("a custom plant needs both --num and --den");
+    if (!MakeCustomPlant(ParseList(num, "--num"), ParseList(den, "--den"), &p, &error)) throw BadInput(error);
+    return p;
+  }
+  if (plant.empty()) throw BadInput("--plant is required (or --num and --den for a custom plant)");
+  if (plant == "custom") throw BadInput("--plant custom needs --num and --den");
+  StepperMotorParameters sp;
+  for (const auto& kv : stepper_overrides) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) throw BadInput("--stepper '" + kv + "' must be NAME=VALUE");
+    const std::string name = kv.substr(0, eq);
+    const double v = ParseDouble(kv.substr(eq + 1), "--stepper " + name);
+    double* field = nullptr;
+    if (name == "resistance_ohm") field = &sp.resistance_ohm;
+    else if (name == "self_inductance_h") field = &sp.self_inductance_h;
+    else if (name == "mutual_inductance_h") field = &sp.mutual_inductance_h;
+    else if (name == "inertia_kg_m2") field = &sp.inertia_kg_m2;
+    else if (name == "rotor_teeth") field = &sp.rotor_teeth;
+    else if (name == "viscous_friction") field = &sp.viscous_friction;
+    else if (name == "tooth_pitch_rad") field = &sp.tooth_pitch_rad;
+    else if (name == "stationary_current_a") field = &sp.stationary_current_a;
+    else if (name == "flux_linkage") field = &sp.flux_linkage;
+    else throw BadInput("--stepper parameter '" + name + "' is unknown");
+    *field = v;
+  }
+  if (!stepper_overrides.empty() && plant != "stepper_motor" && plant != "stepper")
+    throw BadInput("--stepper overrides apply only to --plant stepper_motor, not '" + plant + "'");
+  if (!MakePlant(plant, sp, &p, &error)) throw BadInput(error);
+  return p;
+}
+
+void LoopFlags::Register(CLI::App* app) {
+  app->add_option("--loop", loop, "continuous (exact, ideal PID) or sampled (discrete PID at --dt, ZOH plant)")
+      ->capture_default_str();
+  app->add_option("--dt", dt_s, "sampled-loop period in s; --sample-time must be a multiple")->capture_default_str();
+  app->add_option("--sample-time", sample_time_s, "ts of eq. (4): spacing of the error samples in s")
+      ->capture_default_str();
+  app->add_option("--horizon", horizon_s, "n of eq. (4): last sample time in s")->capture_default_str();
+  app->add_option("--stability-margin", stability_margin,
+                  "strict stability: Re p < -margin*max(1,|p|) (continuous), |z| < 1-margin (sampled)")
+      ->capture_default_str();
+  app->add_option("--disturbance", disturbance,
+                  "none|square|step|sine|noise at the plant input (default: square if an amplitude is given)");
+  app->add_option("--disturbance-amplitude", disturbance_amplitude,
+                  "square +/-A, step height, sine peak or noise std deviation")
+      ->capture_default_str();
+  app->add_option("--disturbance-period", disturbance_period_s, "square/sine period in s")->capture_default_str();
+  app->add_option("--disturbance-phase", disturbance_phase_s, "time shift of the disturbance in s")
+      ->capture_default_str();
+  app->add_option("--disturbance-step-time", disturbance_step_time_s, "step disturbance time in s")
+      ->capture_default_str();
+  app->add_option("--noise-hold", noise_hold_s, "noise is held constant over this interval in s")
+      ->capture_default_str();
+  app->add_option("--seed", seed, "seed of the noise disturbance (and of the search, for tune)")
+      ->capture_default_str();
+  app->add_option("--derivative-filter", derivative_filter_s, "sampled PID: derivative filter time constant in s")
+      ->capture_default_str();
+  app->add_option("--output-limits", output_limits, "sampled PID: output limits LO,HI");
+  app->add_option("--anti-windup", anti_windup, "sampled PID: none|clamping|back-calculation")
+      ->capture_default_str();
+  app->add_option("--derivative-on", derivative_on, "sampled PID: error|measurement")->capture_default_str();
+  app->add_option("--integral", integral, "sampled PID: backward-euler|forward-euler|trapezoidal")
+      ->capture_default_str();
+}
+
+LoopOptions LoopFlags::Build() const {
+  LoopOptions o;
+  if (!ParseLoopKind(loop, &o.loop)) throw BadInput("--loop '" + loop + "' must be continuous or sampled");
+  o.dt_s = dt_s;
+  o.sample_time_s = sample_time_s;
+  o.horizon_s = horizon_s;
+  o.stability_margin = stability_margin;
+  DisturbanceOptions& d = o.disturbance;
+  if (disturbance.empty()) {
+    d.kind = disturbance_amplitude != 0.0 ? DisturbanceKind::kSquare : DisturbanceKind::kNone;
+  } else if (!ParseDisturbanceKind(disturbance, &d.kind)) {
+    throw BadInput("--disturbance '" + disturbance + "' must be none, square, step, sine or noise");
+  }
+  d.amplitude = disturbance_amplitude;
+  d.period_s = disturbance_period_s;
+  d.phase_s = disturbance_phase_s;
+  d.step_time_s = disturbance_step_time_s;
+  d.noise_hold_s = noise_hold_s;
+  d.seed = seed;
+  o.pid.dt_s = dt_s;
+  o.pid.derivative_filter_s = derivative_filter_s;
+  if (!output_limits.empty()) {
+    const auto v = ParseList(output_limits, "--output-limits");
+    if (v.size() != 2) throw BadInput("--output-limits '" + output_limits + "' must be LO,HI");
+    o.pid.output_min = v[0];
+    o.pid.output_max = v[1];
+  }
+  if (!ParseAntiWindup(anti_windup, &o.pid.anti_windup))
+    throw BadInput("--anti-windup '" + anti_windup + "' must be none, clamping or back-calculation");
+  if (!ParseDerivativeOn(derivative_on, &o.pid.derivative_on))
+    throw BadInput("--derivative-on '" + derivative_on + "' must be error or measurement");
+  if (!ParseIntegralMethod(integral, &o.pid.integral))
+    throw BadInput("--integral '" + integral + "' must be backward-euler, forward-euler or trapezoidal");
+  std::string error;
+  if (!o.IsValid(&error)) throw BadInput(error);
+  return o;
+}
+
+nlohmann::json JsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json ToJson(const PidGains& g) { return {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}}; }
+
+nlohmann::json ToJson(const Evaluation& ev) {
+  nlohmann::json poles = nlohmann::json::array();
+  for (const auto& p : ev.stability.poles) poles.push_back({{"re", p.real()}, {"im", p.imag()}});
+  nlohmann::json j;
+  j["plant"] = ev.plant.name;
+  j["plant_tf"] = {{"num", ev.plant.tf.num}, {"den", ev.plant.tf.den}};
+  j["gains"] = ToJson(ev.gains);
+  j["loop"] = ToString(ev.options.loop);
+  if (ev.options.loop == LoopKind::kSampled) j["dt_s"] = ev.options.dt_s;
+  j["sample_time_s"] = ev.options.sample_time_s;
+  j["horizon_s"] = ev.options.horizon_s;
+  j["samples"] = ev.options.NumSamples();
+  j["disturbance"] = {{"kind", ToString(ev.options.disturbance.kind)},
+                      {"amplitude", ev.options.disturbance.amplitude},
+                      {"period_s", ev.options.disturbance.period_s}};
+  j["stable"] = ev.stability.stable;
+  j["closed_loop_poles"] = poles;
+  j["pole_domain"] = ev.options.loop == LoopKind::kSampled ? "z" : "s";
+  j["iae"] = JsonNumber(ev.iae);
+  j["iae_undisturbed"] = JsonNumber(ev.iae_undisturbed);
+  j["ise"] = JsonNumber(ev.ise);
+  j["itae"] = JsonNumber(ev.itae);
+  j["iae_continuous"] = JsonNumber(ev.iae_continuous);
+  const bool v = ev.step.valid;
+  j["rise_time_s"] = v ? JsonNumber(ev.step.rise_time_s) : nlohmann::json(nullptr);
+  j["overshoot_pct"] = v ? JsonNumber(ev.step.overshoot_pct) : nlohmann::json(nullptr);
+  j["settling_time_s"] = v ? JsonNumber(ev.step.settling_time_s) : nlohmann::json(nullptr);
+  j["peak"] = v ? JsonNumber(ev.step.peak) : nlohmann::json(nullptr);
+  j["peak_time_s"] = v ? JsonNumber(ev.step.peak_time_s) : nlohmann::json(nullptr);
+  j["final_value"] = v ? JsonNumber(ev.step.final_value) : nlohmann::json(nullptr);
+  if (!ev.step.note.empty()) j["step_info_note"] = ev.step.note;
+  return j;
+}
+
+std::string FormatPoles(const std::vector<std::complex<double>>& poles) {
+  std::ostringstream os;
+  os << std::setprecision(6);
+  for (std::size_t i = 0; i < poles.size(); ++i) {
+    if (i) os << ", ";
+    os << poles[i].real();
+    if (poles[i].imag() != 0.0) os << (poles[i].imag() > 0 ? "+" : "-") << std::abs(poles[i].imag()) << "j";
+  }
+  return os.str();
+}
+
+std::string FormatEvaluation(const Evaluation& ev) {
+  std::ostringstream os;
+  auto num = [](double v) {
+    std::ostringstream s;
+    if (std::isfinite(v)) s << std::setprecision(6) << v; else s << "-";
+    return s.str();
+  };
+  os << "plant            " << ev.plant.name << "  G(s) = " << ev.plant.tf.ToString() << "\n";
+  os << "gains            kp = " << ev.gains.kp << ", ki = " << ev.gains.ki << ", kd = " << ev.gains.kd << "\n";
+  os << "loop             " << ToString(ev.options.loop);
+  if (ev.options.loop == LoopKind::kSampled) os << " (dt = " << ev.options.dt_s << " s)";
+  os << ", ts = " << ev.options.sample_time_s << " s, n = " << ev.options.horizon_s << " s, "
+     << ev.options.NumSamples() << " samples\n";
+  if (ev.options.disturbance.kind != DisturbanceKind::kNone)
+    os << "disturbance      " << ToString(ev.options.disturbance.kind) << " +/-" << ev.options.disturbance.amplitude
+       << ", period " << ev.options.disturbance.period_s << " s, at the plant input\n";
+  os << "stable           " << (ev.stability.stable ? "yes" : "NO (objectives are +inf)") << "\n";
+  os << "closed-loop poles " << (ev.options.loop == LoopKind::kSampled ? "(z) " : "(s) ")
+     << FormatPoles(ev.stability.poles) << "\n";
+  os << "IAE (eq. 4)      " << num(ev.iae) << "\n";
+  if (ev.options.disturbance.kind != DisturbanceKind::kNone)
+    os << "IAE undisturbed  " << num(ev.iae_undisturbed) << "\n";
+  os << "ISE              " << num(ev.ise) << "\n";
+  os << "ITAE             " << num(ev.itae) << "\n";
+  os << "integral |e| dt  " << num(ev.iae_continuous) << "\n";
+  if (ev.step.valid) {
+    os << "rise time        " << num(ev.step.rise_time_s) << " s   (10-90 %, stepinfo)\n";
+    os << "overshoot        " << num(ev.step.overshoot_pct) << " %\n";
+    os << "settling time    " << num(ev.step.settling_time_s) << " s   (2 % band)\n";
+    os << "peak             " << num(ev.step.peak) << " at " << num(ev.step.peak_time_s) << " s\n";
+  } else {
+    os << "step metrics     - (" << ev.step.note << ")\n";
+  }
+  return os.str();
+}
+
+void WriteSamplesCsv(const Evaluation& ev, const std::string& path) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error("cannot write " + path);
+  f << std::setprecision(17) << "t,r,y,e,n\n";
+  for (std::size_t m = 0; m < ev.y.size(); ++m)
+    f << ev.t[m] << ",1," << ev.y[m] << "," << 1.0 - ev.y[m] << "," << ev.n[m] << "\n";
+}
+
+}  // namespace pidlab::cli
