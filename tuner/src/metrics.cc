@@ -412,8 +412,9 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
   return true;
 }
 
-ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind)
-    : plant_(plant), options_(options), kind_(kind), disturbance_(options.disturbance) {
+ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
+                                       SampledRunner runner)
+    : plant_(plant), options_(options), kind_(kind), disturbance_(options.disturbance), runner_(std::move(runner)) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
   if (!plant.tf.IsValid(&error)) throw std::invalid_argument(error);
@@ -439,8 +440,20 @@ double ObjectiveEvaluator::operator()(const PidGains& gains) const {
     return ObjectiveFromSamples(kind_, y_, ts);
   }
   if (!SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable) return kInf;
-  if (kind_ == ObjectiveKind::kIaeContinuous) {
-    RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(), 1, &y_);
+  if (runner_ || kind_ == ObjectiveKind::kIaeContinuous) {
+    if (runner_) {
+      std::string error;
+      if (!runner_(plant_, gains, options_, options_.disturbance, &y_, nullptr, &error))
+        throw std::runtime_error("sampled-loop runner failed: " + error);
+    } else {
+      RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(), 1, &y_);
+    }
+    if (kind_ != ObjectiveKind::kIaeContinuous) {
+      std::vector<double> samples;
+      const int per = options_.StepsPerSample();
+      for (std::size_t k = 0; k < y_.size(); k += static_cast<std::size_t>(per)) samples.push_back(y_[k]);
+      return ObjectiveFromSamples(kind_, samples, ts);
+    }
     double integral = 0.0;
     for (std::size_t k = 1; k < y_.size(); ++k)
       integral += 0.5 * options_.dt_s * (std::abs(1.0 - y_[k]) + std::abs(1.0 - y_[k - 1]));

@@ -84,8 +84,10 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
 /// that is not strictly stable. Realisation and discretisation are done once.
 class ObjectiveEvaluator {
  public:
-  /// Throws std::invalid_argument if the options are invalid.
-  ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind);
+  /// Throws std::invalid_argument if the options are invalid. A sampled loop
+  /// is run in-process unless another `runner` (e.g. the LCM trio) is given.
+  ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
+                     SampledRunner runner = nullptr);
   double operator()(const PidGains& gains) const;
   /// Evaluations so far (thread-compatible, not thread-safe).
   long evaluations() const { return evaluations_; }
@@ -100,6 +102,7 @@ class ObjectiveEvaluator {
   StateSpace realization_;
   Disturbance disturbance_;
   std::unique_ptr<DiscretePlant> discrete_;
+  SampledRunner runner_;
   mutable long evaluations_ = 0;
   mutable std::vector<double> y_;
 };

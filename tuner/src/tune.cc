@@ -1,0 +1,164 @@
+#include "pidlab/tuner/tune.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "pidlab/tuner/genetic_algorithm.h"
+#include "pidlab/tuner/nelder_mead.h"
+#include "pidlab/tuner/paper_nelder_mead.h"
+#include "pidlab/tuner/pso_gsa.h"
+
+namespace pidlab {
+
+bool ParseTuneMethod(const std::string& s, TuneMethod* method) {
+  if (s == "nelder-mead") *method = TuneMethod::kNelderMead;
+  else if (s == "paper-nm") *method = TuneMethod::kPaperNelderMead;
+  else if (s == "ziegler-nichols") *method = TuneMethod::kZieglerNichols;
+  else if (s == "ga") *method = TuneMethod::kGeneticAlgorithm;
+  else if (s == "pso-gsa") *method = TuneMethod::kPsoGsa;
+  else return false;
+  return true;
+}
+
+std::string ToString(TuneMethod method) {
+  switch (method) {
+    case TuneMethod::kNelderMead: return "nelder-mead";
+    case TuneMethod::kPaperNelderMead: return "paper-nm";
+    case TuneMethod::kZieglerNichols: return "ziegler-nichols";
+    case TuneMethod::kGeneticAlgorithm: return "ga";
+    case TuneMethod::kPsoGsa: return "pso-gsa";
+  }
+  return "nelder-mead";
+}
+
+bool TuneOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  if (!std::isfinite(lower) || !std::isfinite(upper) || lower < 0.0 || !(lower < upper))
+    os << "bounds [" << lower << ", " << upper << "] must be finite with 0 <= lower < upper";
+  else if (max_iterations < 0) os << "max iterations " << max_iterations << " must be >= 0";
+  else if (max_evaluations < 0) os << "max evaluations " << max_evaluations << " must be >= 0";
+  else if (starts < 1) os << "starts " << starts << " must be >= 1";
+  else if (std::isnan(max_overshoot_pct) || max_overshoot_pct < 0.0)
+    os << "max overshoot " << max_overshoot_pct << " % must be >= 0";
+  else if (std::isnan(max_settling_time_s) || !(max_settling_time_s > 0.0))
+    os << "max settling time " << max_settling_time_s << " s must be positive";
+  else if (!(agree_tolerance > 0.0) || !(agree_tolerance < 1.0))
+    os << "agree tolerance " << agree_tolerance << " must be in (0, 1)";
+  else if (!loop.IsValid(error))
+    return false;
+  else
+    return true;
+  if (error) *error = os.str();
+  return false;
+}
+
+std::string TuneSummary::BriefReport() const {
+  std::ostringstream os;
+  os << ToString(method) << ": kp=" << gains.kp << " ki=" << gains.ki << " kd=" << gains.kd
+     << " objective=" << objective << " evaluations=" << evaluations << " refine=" << refine.verdict;
+  return os.str();
+}
+
+bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
+          const ProgressCallback& progress, const SampledRunner& runner) {
+  if (!options.IsValid(error)) return false;
+  const auto start_time = std::chrono::steady_clock::now();
+  *summary = TuneSummary();
+  summary->method = options.method;
+  const bool custom_runner = options.loop.loop == LoopKind::kSampled && runner &&
+                             runner.target<decltype(&RunSampledLoopInProcess)>() == nullptr;
+  const ObjectiveEvaluator evaluator(plant, options.loop, options.objective,
+                                     custom_runner ? runner : SampledRunner(nullptr));
+  const bool constrained = std::isfinite(options.max_overshoot_pct) || std::isfinite(options.max_settling_time_s);
+  const ObjectiveFunction f = [&](const Eigen::VectorXd& x) {
+    const PidGains g{x(0), x(1), x(2)};
+    const double value = evaluator(g);
+    if (!std::isfinite(value) || !constrained) return value;
+    LoopOptions undisturbed = options.loop;
+    undisturbed.disturbance = DisturbanceOptions{};
+    Evaluation ev;
+    EvaluateOptions what;
+    what.compute_iae_continuous = false;
+    if (!Evaluate(plant, g, undisturbed, what, &ev, nullptr) || !ev.step.valid) return HUGE_VAL;
+    if (ev.step.overshoot_pct > options.max_overshoot_pct) return HUGE_VAL;
+    if (ev.step.settling_time_s > options.max_settling_time_s) return HUGE_VAL;
+    return value;
+  };
+  Bounds bounds{Eigen::VectorXd::Constant(3, options.lower), Eigen::VectorXd::Constant(3, options.upper)};
+  OptimizerSummary& opt = summary->optimizer;
+  switch (options.method) {
+    case TuneMethod::kNelderMead: {
+      NelderMeadOptions o;
+      o.starts = options.starts;
+      o.seed = options.seed;
+      if (options.max_iterations > 0) o.max_iterations = options.max_iterations;
+      if (options.max_evaluations > 0) o.max_evaluations = options.max_evaluations;
+      NelderMead(f, bounds, o, &opt, progress);
+      break;
+    }
+    case TuneMethod::kPaperNelderMead: {
+      PaperNelderMeadOptions o;
+      o.starts = options.starts;
+      o.seed = options.seed;
+      if (options.max_iterations > 0) o.max_iterations = options.max_iterations;
+      if (options.max_evaluations > 0) o.max_evaluations = options.max_evaluations;
+      PaperNelderMead(f, bounds, o, &opt, progress);
+      break;
+    }
+    case TuneMethod::kGeneticAlgorithm: {
+      GeneticAlgorithmOptions o;
+      o.seed = options.seed;
+      if (options.max_iterations > 0) o.max_generations = options.max_iterations;
+      if (options.max_evaluations > 0) o.max_evaluations = options.max_evaluations;
+      GeneticAlgorithm(f, bounds, o, &opt, progress);
+      break;
+    }
+    case TuneMethod::kPsoGsa: {
+      PsoGsaOptions o;
+      o.seed = options.seed;
+      if (options.max_iterations > 0) o.max_iterations = options.max_iterations;
+      if (options.max_evaluations > 0) o.max_evaluations = options.max_evaluations;
+      PsoGsa(f, bounds, o, &opt, progress);
+      break;
+    }
+    case TuneMethod::kZieglerNichols: {
+      if (!ZieglerNicholsTune(plant.tf, options.zn_rule, &summary->ziegler_nichols, error)) return false;
+      const PidGains& g = summary->ziegler_nichols.gains;
+      opt.x = Eigen::Vector3d(g.kp, g.ki, g.kd);
+      opt.f = evaluator(g);
+      opt.evaluations = 1;
+      opt.termination = TerminationType::kConverged;
+      opt.message = summary->ziegler_nichols.message;
+      break;
+    }
+  }
+  summary->evaluations = opt.evaluations;
+  summary->iterations = opt.iterations;
+  if (opt.termination == TerminationType::kInvalidOptions) {
+    if (error) *error = opt.message;
+    return false;
+  }
+  if (!opt.IsUsable()) {
+    summary->message = "no strictly stable loop found in the box: " + opt.message;
+    summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+    return true;
+  }
+  summary->search_gains = {opt.x(0), opt.x(1), opt.x(2)};
+  summary->search_objective = opt.f;
+  summary->gains = summary->search_gains;
+  summary->objective = summary->search_objective;
+  summary->stable = true;
+  summary->message = opt.message;
+  if (options.refine && options.method != TuneMethod::kZieglerNichols) {
+    summary->refine = RefineWithCeres(plant, options, summary->search_gains, summary->search_objective);
+    if (summary->refine.objective < summary->objective) {
+      summary->gains = summary->refine.gains;
+      summary->objective = summary->refine.objective;
+    }
+  }
+  summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  return true;
+}
+
+}  // namespace pidlab
