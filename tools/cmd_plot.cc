@@ -1,0 +1,86 @@
+// pidlab plot: PNG figures of closed-loop runs (y with r, e, u, n), from an
+// evaluation of one or several gain sets, or from the episodes of an LCM log.
+
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "cli_common.h"
+#include "loop_figure.h"
+#include "plot_sources.h"
+
+namespace pidlab::cli {
+namespace {
+
+struct PlotCommand {
+  PlantFlags plant;
+  LoopFlags loop;
+  std::vector<std::string> gains;
+  std::string log_path;
+  std::vector<long> episodes;
+  std::string out_dir;
+  std::string name;
+  int width_px = 1200, height_px = 1000;
+
+  std::function<int()> Register(CLI::App* app) {
+    app->description(
+        "Draw PNG figures of the closed loop: step response y(t) with the reference, error e(t), control "
+        "u(t) and disturbance n(t), with units and legends. Either from an evaluation (--plant, --gains, "
+        "loop flags as for 'pidlab evaluate'; repeat --gains to overlay gain sets) or from an LCM log "
+        "(--log FILE [--episode ID]). Writes DIR/NAME.png and the data behind it in DIR/NAME_data/.");
+    plant.Register(app);
+    loop.Register(app);
+    app->add_option("--gains", gains, "KP,KI,KD; repeat to overlay several gain sets")->take_all();
+    app->add_option("--log", log_path, "plot the episodes of this LCM log instead of an evaluation");
+    app->add_option("--episode", episodes, "with --log: only these episode ids (repeatable; default all)")
+        ->take_all();
+    app->add_option("--out", out_dir, "output folder (created if needed)")->required();
+    app->add_option("--name", name, "file name stem (default: evaluation, or the log file's stem)");
+    app->add_option("--width", width_px, "PNG width in px")->capture_default_str();
+    app->add_option("--height", height_px, "PNG height in px")->capture_default_str();
+    return [this] { return Run(); };
+  }
+
+  int Run() {
+    plot::Figure figure;
+    figure.width_px = width_px;
+    figure.height_px = height_px;
+    std::string error;
+    if (!log_path.empty()) {
+      if (!gains.empty() || !plant.plant.empty() || !plant.num.empty())
+        throw BadInput("--log cannot be combined with --plant/--gains (the log carries its own)");
+      std::string report;
+      if (!LogFigure(log_path, episodes, &figure, &report, &error)) throw BadInput(error);
+      if (!report.empty()) std::cerr << report;
+      if (name.empty()) name = std::filesystem::path(log_path).stem().string();
+    } else {
+      if (!episodes.empty()) throw BadInput("--episode needs --log");
+      if (gains.empty()) throw BadInput("--gains is required (or --log FILE)");
+      const Plant p = plant.Build();
+      const LoopOptions options = loop.Build();
+      std::vector<PidGains> sets;
+      for (const auto& g : gains) sets.push_back(ParseGains(g));
+      if (!EvaluationFigure(p, sets, options, &figure, &error)) throw BadInput(error);
+      if (name.empty()) name = "evaluation";
+    }
+    if (name.empty() || name.find('/') != std::string::npos)
+      throw BadInput("--name '" + name + "' must be a plain file name stem");
+    std::error_code ec;
+    std::filesystem::create_directories(out_dir, ec);
+    if (ec) throw BadInput("--out '" + out_dir + "' cannot be created: " + ec.message());
+    figure.output_path = out_dir + "/" + name + ".png";
+    figure.data_dir = out_dir + "/" + name + "_data";
+    if (!figure.IsValid(&error)) throw BadInput(error);
+    if (!plot::DrawPng(figure, &error)) throw std::runtime_error(error);
+    std::cout << figure.output_path << "\n";
+    return 0;
+  }
+};
+
+PlotCommand command;
+const CommandRegistrar registrar("plot", "PNG figures of y, e, u, n from an evaluation or an LCM log",
+                                 [](CLI::App* sub) { return command.Register(sub); });
+
+}  // namespace
+}  // namespace pidlab::cli
