@@ -23,8 +23,16 @@ struct TuneOptions {
   TuneMethod method = TuneMethod::kNelderMead;
   ObjectiveKind objective = ObjectiveKind::kIae;
   /// The loop the objective is evaluated on (default: the paper's continuous
-  /// loop, ts = 0.05 s, n = 25 s, no disturbance).
-  LoopOptions loop;
+  /// loop, ts = 0.05 s, n = 25 s, no disturbance). Its stability_margin is the
+  /// acceptance margin of candidates; TuneOptions() raises it to 0.01, because
+  /// with a margin near zero the search parks poles a hair left of the
+  /// imaginary axis where the sampled objective cannot see them.
+  LoopOptions loop = DefaultTuneLoop();
+  static LoopOptions DefaultTuneLoop() {
+    LoopOptions o;
+    o.stability_margin = 0.01;
+    return o;
+  }
   /// Search box, the same for kp, ki and kd (paper: 0 to 30).
   double lower = 0.0;
   double upper = 30.0;

@@ -1,0 +1,177 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pidlab/tuner/tune.h"
+
+namespace pidlab {
+namespace {
+
+Plant MakeBuiltin(const std::string& name) {
+  Plant plant;
+  std::string error;
+  EXPECT_TRUE(MakePlant(name, StepperMotorParameters{}, &plant, &error)) << error;
+  return plant;
+}
+
+struct PaperCase {
+  const char* plant;
+  double paper_nelder_mead_iae;  // Tables II, III, IV
+};
+
+class TuneBeatsPaper : public ::testing::TestWithParam<PaperCase> {};
+
+TEST_P(TuneBeatsPaper, DefaultNelderMeadBeatsThePapersIaeWithAStrictlyStableLoop) {
+  const PaperCase& c = GetParam();
+  const Plant plant = MakeBuiltin(c.plant);
+  TuneOptions options;
+  TuneSummary dut;
+  std::string error;
+  ASSERT_TRUE(Tune(plant, options, &dut, &error)) << error;
+  ASSERT_TRUE(dut.stable);
+  EXPECT_LT(dut.objective, c.paper_nelder_mead_iae);
+  // Independent re-evaluation of the returned gains.
+  Evaluation ev;
+  ASSERT_TRUE(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev, &error)) << error;
+  EXPECT_TRUE(ev.stability.stable);
+  EXPECT_NEAR(ev.iae, dut.objective, 1e-9 * dut.objective);
+  for (const auto& p : ev.stability.poles) EXPECT_LE(p.real(), -0.01 * std::max(1.0, std::abs(p)) * (1 - 1e-9));
+  for (double g : {dut.gains.kp, dut.gains.ki, dut.gains.kd}) {
+    EXPECT_GE(g, 0.0);
+    EXPECT_LE(g, 30.0);
+  }
+  EXPECT_TRUE(dut.refine.ran);
+  EXPECT_NE(dut.refine.verdict, "not run");
+}
+
+INSTANTIATE_TEST_SUITE_P(Plants, TuneBeatsPaper,
+                         ::testing::Values(PaperCase{"double_integrator", 1.9151}, PaperCase{"oscillator", 2.2304},
+                                           PaperCase{"stepper_motor", 1.9751}));
+
+TEST(Tune, IsDeterministicForASeed) {
+  const Plant plant = MakeBuiltin("oscillator");
+  TuneOptions options;
+  options.method = TuneMethod::kPaperNelderMead;
+  options.seed = 7;
+  TuneSummary a, b;
+  ASSERT_TRUE(Tune(plant, options, &a, nullptr));
+  ASSERT_TRUE(Tune(plant, options, &b, nullptr));
+  EXPECT_EQ(a.gains.kp, b.gains.kp);
+  EXPECT_EQ(a.gains.ki, b.gains.ki);
+  EXPECT_EQ(a.gains.kd, b.gains.kd);
+  EXPECT_EQ(a.evaluations, b.evaluations);
+}
+
+TEST(Tune, NeverAcceptsALoopThatIsNotStrictlyStable) {
+  // With the evaluation margin near zero the search parks poles on the
+  // imaginary axis; every candidate it accepts must still be strictly stable.
+  const Plant plant = MakeBuiltin("oscillator");
+  TuneOptions options;
+  options.loop.stability_margin = 1e-9;
+  options.refine = false;
+  TuneSummary dut;
+  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  ASSERT_TRUE(dut.stable);
+  Evaluation ev;
+  ASSERT_TRUE(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev, nullptr));
+  for (const auto& p : ev.stability.poles) EXPECT_LT(p.real(), 0.0);
+}
+
+TEST(ObjectiveEvaluator, ReturnsInfinityForMarginalAndUnstableLoops) {
+  const ObjectiveEvaluator dut(MakeBuiltin("double_integrator"), LoopOptions{}, ObjectiveKind::kIae);
+  EXPECT_TRUE(std::isinf(dut(PidGains{1.0, 0.0, 0.0})));    // s^2 + 1: poles on the axis
+  EXPECT_TRUE(std::isinf(dut(PidGains{1.0, 10.0, 0.1})));   // Routh: kd*kp < ki -> unstable
+  EXPECT_TRUE(std::isfinite(dut(PidGains{29.6558, 0.4977, 28.3216})));
+}
+
+TEST(RefineWithCeres, SaysTheSearchStoppedShortWhenNelderMeadIsStoppedEarly) {
+  const Plant plant = MakeBuiltin("double_integrator");
+  TuneOptions options;
+  options.starts = 1;
+  options.max_evaluations = 8;  // a handful of evaluations: far from a minimum
+  TuneSummary dut;
+  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  ASSERT_TRUE(dut.stable);
+  ASSERT_TRUE(dut.refine.ran);
+  EXPECT_EQ(dut.refine.verdict, "nelder-mead stopped short");
+  EXPECT_LT(dut.refine.objective, dut.search_objective * (1.0 - options.agree_tolerance));
+  EXPECT_GT(dut.refine.relative_improvement, options.agree_tolerance);
+  // The better gains are returned, and re-evaluate to the reported objective.
+  EXPECT_EQ(dut.gains.kp, dut.refine.gains.kp);
+  const ObjectiveEvaluator exact(plant, options.loop, ObjectiveKind::kIae);
+  EXPECT_DOUBLE_EQ(exact(dut.gains), dut.objective);
+}
+
+TEST(RefineWithCeres, AgreesWithAConvergedNelderMead) {
+  const Plant plant = MakeBuiltin("stepper_motor");
+  TuneOptions options;
+  TuneSummary dut;
+  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  EXPECT_EQ(dut.refine.verdict, "agree");
+  EXPECT_LE(std::abs(dut.refine.relative_improvement), options.agree_tolerance);
+}
+
+TEST(RefineWithCeres, WorksOnTheSampledLoopToo) {
+  const Plant plant = MakeBuiltin("double_integrator");
+  TuneOptions options;
+  options.loop.loop = LoopKind::kSampled;
+  options.loop.dt_s = 1e-2;
+  options.loop.horizon_s = 5.0;
+  const PidGains start{10.0, 1.0, 5.0};
+  const ObjectiveEvaluator exact(plant, options.loop, ObjectiveKind::kIae);
+  const double f0 = exact(start);
+  const RefineSummary dut = RefineWithCeres(plant, options, start, f0);
+  ASSERT_TRUE(dut.ran);
+  EXPECT_LT(dut.objective, f0);
+  EXPECT_EQ(dut.verdict, "nelder-mead stopped short");
+}
+
+TEST(Tune, ZieglerNicholsOnTheDoubleIntegratorSaysItDoesNotApply) {
+  TuneOptions options;
+  options.method = TuneMethod::kZieglerNichols;
+  TuneSummary dut;
+  std::string error;
+  EXPECT_FALSE(Tune(MakeBuiltin("double_integrator"), options, &dut, &error));
+  EXPECT_NE(error.find("does not apply"), std::string::npos) << error;
+}
+
+TEST(Tune, RespectsAnOvershootConstraint) {
+  const Plant plant = MakeBuiltin("stepper_motor");
+  TuneOptions options;
+  options.max_overshoot_pct = 0.5;
+  options.refine = false;
+  TuneSummary dut;
+  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  ASSERT_TRUE(dut.stable);
+  Evaluation ev;
+  ASSERT_TRUE(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev, nullptr));
+  EXPECT_LE(ev.step.overshoot_pct, 0.5);
+}
+
+TEST(TuneOptions, RejectsAnEmptyBox) {
+  TuneOptions options;
+  options.lower = 5.0;
+  options.upper = 5.0;
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("bounds"), std::string::npos);
+}
+
+TEST(TuneOptions, RejectsNegativeLowerBound) {
+  TuneOptions options;
+  options.lower = -1.0;
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("-1"), std::string::npos);
+}
+
+TEST(TuneOptions, RejectsZeroStarts) {
+  TuneOptions options;
+  options.starts = 0;
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("starts"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pidlab

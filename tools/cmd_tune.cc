@@ -1,0 +1,195 @@
+// pidlab tune: Nelder-Mead (or a baseline) on the paper's objective, with a
+// Ceres least-squares cross-check.
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+#include "cli_common.h"
+#include "pidlab/tuner/tune.h"
+
+namespace pidlab::cli {
+namespace {
+
+struct TuneCommand {
+  PlantFlags plant;
+  LoopFlags loop;
+  std::string method = "nelder-mead", objective = "iae", backend = "local", bounds = "0,30";
+  std::string refine = "ceres", trace, zn_rule = "classic";
+  int max_iterations = 0, max_evaluations = 0, starts = 4;
+  double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3;
+  bool json = false;
+
+  // The tuner's acceptance margin: with the evaluation's 1e-9 the search games
+  // the sampled objective by parking poles a hair left of the imaginary axis
+  // (e.g. -1e-9 +/- 1j on 1/(s^2+1), nearly cancelled by the PID zeros). 0.01
+  // asks every pole for Re p <= -0.01 max(1, |p|): damping ratio >= 0.01, or a
+  // decay rate >= 0.01 1/s for poles slower than 1 rad/s. See docs/tuning.md.
+  TuneCommand() { loop.stability_margin = 0.01; }
+
+  std::function<int()> Register(CLI::App* app) {
+    app->description(
+        "Tune PID gains on the paper's objective (IAE of the unit-step response, eq. 4) by Nelder-Mead or a "
+        "baseline, rejecting every loop that is not strictly stable, then cross-check with Ceres.");
+    plant.Register(app);
+    loop.Register(app);
+    app->add_option("--method", method, "nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa")
+        ->capture_default_str();
+    app->add_option("--objective", objective, "iae | ise | itae | iae-continuous")->capture_default_str();
+    app->add_option("--backend", backend, "local (in-process) or lcm (episodes over a running trio)")
+        ->capture_default_str();
+    app->add_option("--bounds", bounds, "gain box LO,HI for each of kp, ki, kd")->capture_default_str();
+    app->add_option("--max-iter", max_iterations, "iteration budget (0 = method default; paper-nm: 100)")
+        ->capture_default_str();
+    app->add_option("--max-evals", max_evaluations, "evaluation budget over all starts (0 = method default)")
+        ->capture_default_str();
+    app->add_option("--starts", starts, "seeded starts (nelder-mead, paper-nm)")->capture_default_str();
+    app->add_option("--refine", refine, "ceres | none: the least-squares cross-check")->capture_default_str();
+    app->add_option("--agree-tolerance", agree_tolerance, "relative objective difference for the 'agree' verdict")
+        ->capture_default_str();
+    app->add_option("--max-overshoot", max_overshoot_pct, "reject candidates overshooting more (%)");
+    app->add_option("--max-settling", max_settling_time_s, "reject candidates settling later (s)");
+    app->add_option("--zn-rule", zn_rule, "classic | pessen | some-overshoot | no-overshoot")->capture_default_str();
+    app->add_option("--trace", trace, "write the best-so-far trajectory of the search to this CSV file");
+    app->add_flag("--json", json, "print one JSON object");
+    return [this] { return Run(); };
+  }
+
+  int Run() {
+    const Plant p = plant.Build();
+    TuneOptions o;
+    o.loop = loop.Build();
+    if (!ParseTuneMethod(method, &o.method))
+      throw BadInput("--method '" + method + "' must be nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
+    if (!ParseObjectiveKind(objective, &o.objective))
+      throw BadInput("--objective '" + objective + "' must be iae, ise, itae or iae-continuous");
+    if (!ParseZieglerNicholsRule(zn_rule, &o.zn_rule))
+      throw BadInput("--zn-rule '" + zn_rule + "' must be classic, pessen, some-overshoot or no-overshoot");
+    const auto b = ParseList(bounds, "--bounds");
+    if (b.size() != 2) throw BadInput("--bounds '" + bounds + "' must be LO,HI");
+    o.lower = b[0];
+    o.upper = b[1];
+    if (refine != "ceres" && refine != "none") throw BadInput("--refine '" + refine + "' must be ceres or none");
+    o.refine = refine == "ceres";
+    o.max_iterations = max_iterations;
+    o.max_evaluations = max_evaluations;
+    o.starts = starts;
+    o.seed = loop.seed;
+    o.max_overshoot_pct = max_overshoot_pct;
+    o.max_settling_time_s = max_settling_time_s;
+    o.agree_tolerance = agree_tolerance;
+    std::string error;
+    if (!o.IsValid(&error)) throw BadInput(error);
+    SampledRunner runner = RunSampledLoopInProcess;
+    if (backend == "lcm") {
+      if (o.loop.loop != LoopKind::kSampled) throw BadInput("--backend lcm runs the sampled loop: add --loop sampled");
+      runner = MakeLcmRunner();
+    } else if (backend != "local") {
+      throw BadInput("--backend '" + backend + "' must be local or lcm");
+    }
+
+    const bool tty = isatty(STDERR_FILENO) != 0;
+    ProgressCallback progress = [tty](const TracePoint& tp) {
+      if (!tty) return;
+      std::fprintf(stderr, "\r  iteration %5d  evaluations %6d  best %.6g   ", tp.iteration, tp.evaluations,
+                   tp.best_f);
+      std::fflush(stderr);
+    };
+    TuneSummary s;
+    if (!Tune(p, o, &s, &error, progress, runner)) throw BadInput(error);
+    if (tty) std::fprintf(stderr, "\r%70s\r", "");
+    if (!trace.empty()) WriteTrace(s);
+    Evaluation ev;
+    if (s.stable) {
+      EvaluateOptions what;
+      Evaluate(p, s.gains, o.loop, what, &ev, &error);
+    }
+    if (json) {
+      nlohmann::json j;
+      j["plant"] = p.name;
+      j["method"] = ToString(o.method);
+      j["objective_kind"] = ToString(o.objective);
+      j["backend"] = backend;
+      j["loop"] = ToString(o.loop.loop);
+      j["gains"] = ToJson(s.gains);
+      j["objective"] = JsonNumber(s.objective);
+      j["iae"] = s.stable ? JsonNumber(ev.iae) : nlohmann::json(nullptr);
+      j["stable"] = s.stable && ev.stability.stable;
+      j["closed_loop_poles"] = s.stable ? ToJson(ev)["closed_loop_poles"] : nlohmann::json::array();
+      j["rise_time_s"] = s.stable ? ToJson(ev)["rise_time_s"] : nlohmann::json(nullptr);
+      j["overshoot_pct"] = s.stable ? ToJson(ev)["overshoot_pct"] : nlohmann::json(nullptr);
+      j["settling_time_s"] = s.stable ? ToJson(ev)["settling_time_s"] : nlohmann::json(nullptr);
+      j["search"] = {{"gains", ToJson(s.search_gains)},
+                     {"objective", JsonNumber(s.search_objective)},
+                     {"termination", ToString(s.optimizer.termination)},
+                     {"message", s.optimizer.message}};
+      j["evaluations"] = s.evaluations;
+      j["rejected_evaluations"] = s.optimizer.rejected_evaluations;
+      j["iterations"] = s.iterations;
+      j["seed"] = o.seed;
+      j["wall_time_s"] = s.wall_time_s;
+      j["refine"] = {{"ran", s.refine.ran},
+                     {"gains", ToJson(s.refine.gains)},
+                     {"objective", JsonNumber(s.refine.objective)},
+                     {"iae", JsonNumber(o.objective == ObjectiveKind::kIae ? s.refine.objective : NAN)},
+                     {"verdict", s.refine.verdict},
+                     {"termination", s.refine.termination},
+                     {"iterations", s.refine.iterations},
+                     {"relative_improvement", JsonNumber(s.refine.relative_improvement)},
+                     {"message", s.refine.message}};
+      if (o.method == TuneMethod::kZieglerNichols)
+        j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},
+                                {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
+                                {"rule", ToString(o.zn_rule)}};
+      std::cout << j.dump() << "\n";
+    } else {
+      std::cout << std::setprecision(6);
+      std::cout << "method           " << ToString(o.method) << " on " << ToString(o.objective) << ", box ["
+                << o.lower << ", " << o.upper << "]^3, seed " << o.seed << "\n";
+      if (!s.stable) {
+        std::cout << "result           " << s.message << "\n";
+        return 1;
+      }
+      std::cout << "search           kp = " << s.search_gains.kp << ", ki = " << s.search_gains.ki
+                << ", kd = " << s.search_gains.kd << "  objective " << s.search_objective << "  ("
+                << s.evaluations << " evaluations, " << s.optimizer.rejected_evaluations << " rejected, "
+                << ToString(s.optimizer.termination) << ")\n";
+      if (s.refine.ran)
+        std::cout << "ceres            kp = " << s.refine.gains.kp << ", ki = " << s.refine.gains.ki
+                  << ", kd = " << s.refine.gains.kd << "  objective " << s.refine.objective << "  ("
+                  << s.refine.termination << ", " << s.refine.iterations << " iterations)\n";
+      std::cout << "verdict          " << s.refine.verdict << (s.refine.message.empty() ? "" : ": ")
+                << s.refine.message << "\n";
+      std::cout << "wall time        " << s.wall_time_s << " s\n\n";
+      std::cout << FormatEvaluation(ev);
+    }
+    return s.stable ? 0 : 1;
+  }
+
+  void WriteTrace(const TuneSummary& s) const {
+    std::ofstream f(trace);
+    if (!f) throw BadInput("--trace '" + trace + "' cannot be written");
+    f << std::setprecision(17) << "iteration,evaluations,best_objective,kp,ki,kd\n";
+    for (const auto& tp : s.optimizer.trace) {
+      f << tp.iteration << "," << tp.evaluations << "," << tp.best_f;
+      for (int i = 0; i < 3; ++i) f << "," << (tp.best_x.size() == 3 ? tp.best_x(i) : NAN);
+      f << "\n";
+    }
+  }
+
+  static SampledRunner MakeLcmRunner();
+};
+
+SampledRunner TuneCommand::MakeLcmRunner() {
+  throw BadInput("--backend lcm: the LCM episode runner is not built into this pidlab yet");
+}
+
+TuneCommand command;
+const CommandRegistrar registrar("tune", "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check",
+                                 [](CLI::App* sub) { return command.Register(sub); });
+
+}  // namespace
+}  // namespace pidlab::cli
