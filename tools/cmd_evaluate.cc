@@ -1,8 +1,12 @@
 // pidlab evaluate: IAE, stability and step metrics of one gain set.
 
+#include <cstdio>
+#include <cstdlib>
 #include <iostream>
+#include <memory>
 
 #include "cli_common.h"
+#include "pidlab/lcm/episode_client.h"
 
 namespace pidlab::cli {
 namespace {
@@ -13,6 +17,12 @@ struct EvaluateCommand {
   std::string gains;
   bool json = false;
   std::string samples_csv;
+  std::string trajectory_csv;
+  // --backend lcm: run the sampled loop over a running process trio.
+  std::string backend = "local";
+  std::string lcm_url, channel_prefix;
+  double episode_timeout_s = 600.0;
+  CLI::App* app_ = nullptr;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
@@ -23,23 +33,92 @@ struct EvaluateCommand {
     app->add_option("--gains", gains, "KP,KI,KD (each finite and >= 0)")->required();
     app->add_flag("--json", json, "print one JSON object instead of the table");
     app->add_option("--samples-csv", samples_csv, "write t,r,y,e,n at the sample times to this CSV file");
+    app->add_option("--trajectory-csv", trajectory_csv,
+                    "write k,t,r,y,u,n of every step of the sampled loop to this CSV file (%.17g)");
+    app->add_option(
+           "--backend", backend,
+           "local (in process) or lcm (one episode over a running trio, see pidlab launch); lcm implies "
+           "--loop sampled")
+        ->check(CLI::IsMember({"local", "lcm"}))
+        ->capture_default_str();
+    app->add_option("--lcm-url", lcm_url,
+                    "LCM URL of the trio (default $PIDLAB_LCM_URL, else the LCM default)");
+    app->add_option("--channel-prefix", channel_prefix,
+                    "channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
+    app->add_option("--episode-timeout", episode_timeout_s,
+                    "give up on an LCM episode after this many seconds")
+        ->capture_default_str();
+    app_ = app;
     return [this] { return Run(); };
   }
 
   int Run() {
     const Plant p = plant.Build();
     const PidGains g = ParseGains(gains);
-    const LoopOptions options = loop.Build();
+    LoopOptions options = loop.Build();
+    EvaluateOptions what;
+    what.record_trajectory = !trajectory_csv.empty();
+    if (what.record_trajectory && options.loop != LoopKind::kSampled && backend == "local")
+      throw BadInput("--trajectory-csv needs --loop sampled");
     Evaluation ev;
     std::string error;
-    if (!Evaluate(p, g, options, EvaluateOptions{}, &ev, &error)) throw BadInput(error);
+    std::unique_ptr<lcm_trio::EpisodeClient> client;
+    if (backend == "lcm") {
+      if (app_->count("--loop") > 0 && options.loop != LoopKind::kSampled)
+        throw BadInput("--backend lcm runs the sampled loop, not --loop " + loop.loop);
+      options.loop = LoopKind::kSampled;
+      lcm_trio::EpisodeClientOptions co;
+      co.lcm_url = FromEnv(lcm_url, "PIDLAB_LCM_URL", lcm_trio::kDefaultLcmUrl);
+      co.transport.channel_prefix =
+          FromEnv(channel_prefix, "PIDLAB_CHANNEL_PREFIX", lcm_trio::kDefaultChannelPrefix);
+      co.episode_timeout_s = episode_timeout_s;
+      if (!co.IsValid(&error)) throw BadInput(error);
+      client = std::make_unique<lcm_trio::EpisodeClient>(co);  // throws runtime_error: exit 1
+      std::string runner_error;
+      const bool ok = Evaluate(
+          p, g, options, what, &ev, &error,
+          [&](const Plant& pl, const PidGains& ga, const LoopOptions& lo, const DisturbanceOptions& d,
+              std::vector<double>* y, std::vector<SampledStep>* tr, std::string* err) {
+            const bool run_ok = client->Run(pl, ga, lo, d, y, tr, err);
+            if (!run_ok && err) runner_error = *err;
+            return run_ok;
+          });
+      // A failed episode is a runtime failure (exit 1), not bad input.
+      if (!ok && !runner_error.empty()) throw std::runtime_error(runner_error);
+      if (!ok) throw BadInput(error);
+    } else if (!Evaluate(p, g, options, what, &ev, &error)) {
+      throw BadInput(error);
+    }
     if (!samples_csv.empty()) WriteSamplesCsv(ev, samples_csv);
+    if (!trajectory_csv.empty()) WriteTrajectoryCsv(ev, trajectory_csv);
     if (json) {
-      std::cout << ToJson(ev).dump() << "\n";
+      nlohmann::json j = ToJson(ev);
+      j["backend"] = backend;
+      if (client) j["steps_per_second"] = JsonNumber(client->stats().StepsPerSecond());
+      std::cout << j.dump() << "\n";
     } else {
       std::cout << FormatEvaluation(ev);
+      if (client) {
+        std::printf("backend: lcm, %ld steps in %ld episode(s), %.0f steps/s\n", client->stats().steps,
+                    client->stats().episodes, client->stats().StepsPerSecond());
+      }
     }
     return 0;
+  }
+
+  static std::string FromEnv(const std::string& flag, const char* env, const char* fallback) {
+    if (!flag.empty()) return flag;
+    const char* v = std::getenv(env);
+    return v && *v ? v : fallback;
+  }
+
+  static void WriteTrajectoryCsv(const Evaluation& ev, const std::string& path) {
+    FILE* f = std::fopen(path.c_str(), "w");
+    if (!f) throw BadInput("cannot write --trajectory-csv " + path);
+    std::fprintf(f, "k,t,r,y,u,n\n");
+    for (const SampledStep& s : ev.trajectory)
+      std::fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.k, s.t, s.r, s.y, s.u, s.n);
+    if (std::fclose(f) != 0) throw std::runtime_error("writing " + path + " failed");
   }
 };
 
