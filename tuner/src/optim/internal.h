@@ -22,7 +22,7 @@ class Rng {
 
   /// Uniform in [0, 1), 53 random bits.
   double Uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-  /// Uniform in [a, b).
+  /// Uniform in [a, b) (b itself only by rounding).
   double Uniform(double a, double b) { return a + (b - a) * Uniform(); }
   /// Uniform integer in [0, n), n >= 1.
   int Index(int n) {
@@ -116,7 +116,7 @@ void Finish(TerminationType type, const std::string& message, OptimizerSummary* 
 /// Formats "Struct.field = value must be <rule>" into *error; returns false.
 template <typename T>
 bool FieldError(const char* owner, const char* field, const T& value, const char* rule, std::string* error) {
-  if (error) {
+  if (error != nullptr) {
     std::ostringstream os;
     os << owner << '.' << field << " = " << value << " must be " << rule;
     *error = os.str();

@@ -37,7 +37,8 @@ struct Simplex {
   void Sort() {
     std::vector<std::size_t> order(x.size());
     std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [this](std::size_t a, std::size_t b) { return f[a] < f[b]; });
+    std::stable_sort(order.begin(), order.end(),
+                     [this](std::size_t a, std::size_t b) { return f[a] < f[b]; });
     std::vector<Eigen::VectorXd> xs;
     std::vector<double> fs;
     for (std::size_t i : order) {
@@ -68,7 +69,7 @@ class NelderMeadStart {
 
   // x0 == nullptr: random base point. Throws EvaluationBudgetExhausted.
   StartResult Run(const Eigen::VectorXd* x0) {
-    Eigen::VectorXd base = x0 ? *x0 : rng_->PointIn(bounds_);
+    Eigen::VectorXd base = x0 != nullptr ? *x0 : rng_->PointIn(bounds_);
     double f_base = evaluator_->Evaluate(&base);
     for (int k = 0; k < options_.max_initial_redraws && !std::isfinite(f_base); ++k) {
       base = rng_->PointIn(bounds_);
@@ -94,13 +95,17 @@ class NelderMeadStart {
         }
         std::ostringstream os;
         os << "converged after " << restarts << (restarts == 1 ? " restart" : " restarts")
-           << ": relative simplex diameter " << diameter << " <= x_tolerance " << options_.x_tolerance
-           << ", f spread " << spread << " <= f_tolerance (1 + |f|)";
+           << ": relative simplex diameter " << diameter << " <= x_tolerance " << options_.x_tolerance;
+        if (std::isfinite(spread)) {
+          os << ", f spread " << spread << " <= f_tolerance (1 + |f|)";
+        } else {
+          os << " with some vertices rejected (the simplex straddles the edge of the feasible region)";
+        }
         return {TerminationType::kConverged, os.str()};
       }
       if (iterations >= options_.max_iterations) {
         std::ostringstream os;
-        os << "max_iterations = " << options_.max_iterations << " reached with relative simplex diameter "
+        os << "ran out of max_iterations = " << options_.max_iterations << " with relative simplex diameter "
            << diameter;
         return {TerminationType::kMaxIterations, os.str()};
       }

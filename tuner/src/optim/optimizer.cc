@@ -9,7 +9,7 @@ namespace pidlab {
 
 bool Bounds::IsValid(std::string* error) const {
   auto fail = [error](const std::string& message) {
-    if (error) *error = message;
+    if (error != nullptr) *error = message;
     return false;
   };
   std::ostringstream os;
@@ -61,7 +61,7 @@ std::string OptimizerSummary::BriefReport() const {
   os << ToString(termination) << ": ";
   if (IsUsable()) {
     os << "f = " << f << " at x = [";
-    for (Eigen::Index i = 0; i < x.size(); ++i) os << (i ? ", " : "") << x[i];
+    for (Eigen::Index i = 0; i < x.size(); ++i) os << (i > 0 ? ", " : "") << x[i];
     os << "]";
   } else {
     os << "no feasible point";

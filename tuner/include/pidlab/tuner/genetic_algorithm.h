@@ -69,7 +69,8 @@ struct GeneticAlgorithmOptions {
 };
 
 /// Minimises f over `bounds`. Never throws (exceptions from f propagate).
-void GeneticAlgorithm(const ObjectiveFunction& f, const Bounds& bounds, const GeneticAlgorithmOptions& options,
-                      OptimizerSummary* summary, const ProgressCallback& progress = nullptr);
+void GeneticAlgorithm(const ObjectiveFunction& f, const Bounds& bounds,
+                      const GeneticAlgorithmOptions& options, OptimizerSummary* summary,
+                      const ProgressCallback& progress = nullptr);
 
 }  // namespace pidlab

@@ -54,8 +54,8 @@ std::string ToString(TerminationType type);
 
 /// The state after one iteration (generation) of an optimiser.
 struct TracePoint {
-  int iteration = 0;    // 1-based, counted over all starts.
-  int evaluations = 0;  // Objective calls so far, over all starts.
+  int iteration = 0;                                        // 1-based, counted over all starts.
+  int evaluations = 0;                                      // Objective calls so far, over all starts.
   double best_f = std::numeric_limits<double>::infinity();  // Best feasible value so far; +inf if none.
   Eigen::VectorXd best_x;                                   // Its point; empty if none.
 };
