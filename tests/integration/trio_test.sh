@@ -1,0 +1,104 @@
+#!/usr/bin/env bash
+# Integration tests of the LCM trio. Run by ctest as
+#   unshare -n bash trio_test.sh BIN_DIR CASE
+# inside a private network namespace created for this test only: nothing is
+# ever sent outside its loopback. CASE: identity | faults | kill | stranger | log.
+set -u
+BIN=$1
+CASE=$2
+if [ "$(readlink /proc/self/ns/net)" = "$(readlink /proc/1/ns/net)" ]; then
+  echo "refusing to run outside a private network namespace (use unshare -n)" >&2
+  exit 1
+fi
+ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || exit 1
+URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"
+export PIDLAB_LCM_URL=$URL
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+PIDLAB=$BIN/pidlab
+fail=0
+
+# compare NAME ARGS...: local sampled loop vs --backend lcm on the running trio:
+# identical JSON (except backend keys) and identical full trajectory CSV.
+compare() {
+  local name=$1
+  shift
+  "$PIDLAB" evaluate --loop sampled --json --trajectory-csv "$TMP/$name.local.csv" "$@" >"$TMP/$name.local.json" ||
+    { echo "FAIL $name: local evaluate failed"; fail=1; return; }
+  "$PIDLAB" evaluate --backend lcm --json --trajectory-csv "$TMP/$name.lcm.csv" "$@" >"$TMP/$name.lcm.json" ||
+    { echo "FAIL $name: lcm evaluate failed"; fail=1; return; }
+  local a b
+  a=$(jq -S 'del(.backend, .steps_per_second)' "$TMP/$name.local.json")
+  b=$(jq -S 'del(.backend, .steps_per_second)' "$TMP/$name.lcm.json")
+  local lines
+  lines=$(wc -l <"$TMP/$name.lcm.csv")
+  if [ "$a" != "$b" ]; then
+    echo "FAIL $name: JSON differs"; diff <(echo "$a") <(echo "$b") | head -5; fail=1
+  elif ! cmp -s "$TMP/$name.local.csv" "$TMP/$name.lcm.csv"; then
+    echo "FAIL $name: trajectory differs"; cmp "$TMP/$name.local.csv" "$TMP/$name.lcm.csv"; fail=1
+  elif [ "$lines" -lt 100 ]; then
+    echo "FAIL $name: trajectory has only $lines lines"; fail=1
+  else
+    echo "ok   $name: iae $(jq .iae "$TMP/$name.lcm.json") identical, $((lines - 1)) steps identical," \
+      "$(jq '.steps_per_second | floor' "$TMP/$name.lcm.json") steps/s"
+  fi
+}
+
+run_all_plants() {
+  compare di_clean --plant double_integrator --gains 2,1,1.5 --horizon 10
+  compare di_square --plant double_integrator --gains 2,1,1.5 --horizon 10 --disturbance square --disturbance-amplitude 0.3
+  compare osc_clean --plant oscillator --gains 3,1,1 --horizon 10
+  compare osc_noise --plant oscillator --gains 3,1,1 --horizon 10 --disturbance noise --disturbance-amplitude 0.1 --seed 7
+  compare stepper_clean --plant stepper_motor --gains 1,20,0.001 --dt 1e-4 --sample-time 0.05 --horizon 0.5
+  compare stepper_sine --plant stepper_motor --gains 1,20,0.001 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --disturbance sine --disturbance-amplitude 0.05
+}
+
+case $CASE in
+  identity)
+    export -f compare run_all_plants
+    export TMP PIDLAB
+    "$PIDLAB" launch --lcm-url "$URL" -- bash -c 'fail=0; run_all_plants; exit $fail' || fail=1
+    ;;
+  faults)
+    export -f compare run_all_plants
+    export TMP PIDLAB
+    "$PIDLAB" launch --lcm-url "$URL" --drop-rate 0.05 -- bash -c 'fail=0; run_all_plants; exit $fail' || fail=1
+    ;;
+  stranger)
+    export -f compare
+    export TMP PIDLAB BIN URL
+    "$PIDLAB" launch --lcm-url "$URL" -- bash -c '
+      fail=0
+      "$BIN/trio_stranger" "$URL" PIDLAB_ 8 & s=$!
+      compare stranger_di --plant double_integrator --gains 2,1,1.5 --horizon 10 --disturbance step --disturbance-amplitude 0.2
+      compare stranger_osc --plant oscillator --gains 3,1,1 --horizon 5
+      wait $s || fail=1
+      exit $fail' || fail=1
+    ;;
+  kill)
+    # Kill the controller mid-episode: the episode must end with an error
+    # naming it within 2 s, and launch must return (no hang, no orphans).
+    "$PIDLAB" launch --lcm-url "$URL" -- bash -c '
+      pidlab evaluate --backend lcm --plant double_integrator --gains 2,1,1.5 --horizon 200 >/dev/null 2>'"$TMP"'/err &
+      e=$!
+      sleep 1.5
+      kill -9 $PIDLAB_CONTROLLER_PID
+      t0=$(date +%s.%N)
+      wait $e; rc=$?
+      t1=$(date +%s.%N)
+      echo "evaluate exit $rc after $(echo "$t1 - $t0" | bc) s: $(cat '"$TMP"'/err)"
+      [ $rc -eq 1 ] && grep -q "pidlab-controller" '"$TMP"'/err && [ "$(echo "$t1 - $t0 < 2.0" | bc)" = 1 ]' ||
+      fail=1
+    ;;
+  log)
+    rm -f "$TMP/run.lcmlog"
+    "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/run.lcmlog" -- \
+      pidlab evaluate --backend lcm --plant oscillator --gains 3,1,1 --horizon 10 --disturbance square \
+      --disturbance-amplitude 0.2 >/dev/null || fail=1
+    "$BIN/trio_log_check" "$TMP/run.lcmlog" || fail=1
+    ;;
+  *)
+    echo "unknown case $CASE"; exit 2 ;;
+esac
+[ $fail -eq 0 ] && echo "PASS $CASE" || echo "FAIL $CASE"
+exit $fail

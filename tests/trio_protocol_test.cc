@@ -1,0 +1,230 @@
+// Unit tests of the trio protocol: all three roles and the episode logic in
+// one memq:// LCM instance, single-threaded (no network).
+
+#include <gtest/gtest.h>
+#include <pidlab/lcmt_control_command.hpp>
+#include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_plant_output.hpp>
+
+#include <random>
+
+#include "pidlab/lcm/episode_config.h"
+#include "pidlab/lcm/roles.h"
+#include "pidlab/lcm/transport.h"
+#include "pidlab/tuner/evaluation.h"
+
+namespace pidlab::lcm_trio {
+namespace {
+
+struct Episode {
+  Plant plant;
+  PidGains gains{2.0, 1.0, 1.5};
+  LoopOptions options;
+};
+
+Episode DoubleIntegrator(double horizon_s = 2.0) {
+  Episode e;
+  std::string error;
+  EXPECT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &e.plant, &error)) << error;
+  e.options.loop = LoopKind::kSampled;
+  e.options.horizon_s = horizon_s;
+  e.options.disturbance.kind = DisturbanceKind::kSquare;
+  e.options.disturbance.amplitude = 0.3;
+  return e;
+}
+
+/// Records the plant's outputs and the summary from the memq traffic.
+struct Recorder {
+  std::vector<double> y;
+  std::vector<char> have;
+  bool summary = false;
+  pidlab::lcmt_episode_summary last;
+};
+
+/// Runs one episode through the three roles on memq:// and returns y_0..y_N.
+bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* controller_counters = nullptr,
+               bool with_controller = true) {
+  lcm::LCM lcm("memq://");
+  EXPECT_TRUE(lcm.good());
+  TransportOptions topt;
+  topt.drop_rate = drop_rate;
+  Transport plant_t(&lcm, topt), controller_t(&lcm, topt), disturbance_t(&lcm, topt), client_t(&lcm, {});
+  topt.drop_seed = 2;
+  Transport controller_t2(&lcm, topt);
+  PlantRole plant(&plant_t);
+  std::unique_ptr<ControllerRole> controller;
+  if (with_controller) controller = std::make_unique<ControllerRole>(drop_rate > 0 ? &controller_t2 : &controller_t);
+  DisturbanceRole disturbance(&disturbance_t);
+  const long total = e.options.TotalSteps();
+  rec->y.assign(static_cast<std::size_t>(total + 1), 0.0);
+  rec->have.assign(static_cast<std::size_t>(total + 1), 0);
+  int64_t id = 42;
+  client_t.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel, [&](const pidlab::lcmt_plant_output& m) {
+    if (m.episode_id == id && m.step >= 0 && m.step <= total) {
+      rec->y[static_cast<std::size_t>(m.step)] = m.y;
+      rec->have[static_cast<std::size_t>(m.step)] = 1;
+    }
+  });
+  client_t.Subscribe<pidlab::lcmt_episode_summary>(kSummaryChannel, [&](const pidlab::lcmt_episode_summary& m) {
+    rec->summary = true;
+    rec->last = m;
+  });
+  RecoveryOptions recovery;
+  recovery.retransmit_interval_s = 0.001;
+  recovery.silence_deadline_s = 0.2;
+  auto config = MakeEpisodeConfig(id, e.plant, e.gains, e.options, e.options.disturbance, recovery);
+  client_t.Publish(kEpisodeConfigChannel, &config);
+  const double start = NowSeconds();
+  while (!rec->summary && NowSeconds() - start < 20.0) {
+    client_t.WaitAndHandle(0.001);
+    const double now = NowSeconds();
+    plant.Tick(now);
+    if (controller) controller->Tick(now);
+    disturbance.Tick(now);
+  }
+  if (controller_counters && controller) *controller_counters = controller->counters();
+  return rec->summary && rec->last.status == pidlab::lcmt_episode_summary::OK;
+}
+
+std::vector<double> Reference(const Episode& e) {
+  std::vector<double> y;
+  std::string error;
+  EXPECT_TRUE(RunSampledLoopInProcess(e.plant, e.gains, e.options, e.options.disturbance, &y, nullptr, &error));
+  return y;
+}
+
+TEST(EpisodeConfig, RoundTripsEveryField) {
+  Episode e = DoubleIntegrator();
+  e.options.pid.derivative_filter_s = 0.01;
+  e.options.pid.output_min = -5;
+  e.options.pid.anti_windup = AntiWindup::kBackCalculation;
+  e.options.pid.integral = IntegralMethod::kTrapezoidal;
+  e.options.disturbance.seed = 99;
+  const auto msg = MakeEpisodeConfig(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{});
+  EpisodeSpec dut;
+  std::string error;
+  ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
+  EXPECT_EQ(dut.episode_id, 7);
+  EXPECT_EQ(dut.plant.tf.den, e.plant.tf.den);
+  EXPECT_EQ(dut.gains.kd, 1.5);
+  EXPECT_EQ(dut.options.pid.derivative_filter_s, 0.01);
+  EXPECT_EQ(dut.options.pid.output_min, -5);
+  EXPECT_EQ(dut.options.pid.anti_windup, AntiWindup::kBackCalculation);
+  EXPECT_EQ(dut.options.pid.integral, IntegralMethod::kTrapezoidal);
+  EXPECT_EQ(dut.options.disturbance.seed, 99u);
+  EXPECT_EQ(dut.total_steps, e.options.TotalSteps());
+}
+
+TEST(EpisodeConfig, RejectsMalformedFieldsByName) {
+  Episode e = DoubleIntegrator();
+  auto msg = MakeEpisodeConfig(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{});
+  EpisodeSpec dut;
+  std::string error;
+  auto bad = msg;
+  bad.kp = -1;
+  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_NE(error.find("kp"), std::string::npos) << error;
+  bad = msg;
+  bad.total_steps += 1;
+  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_NE(error.find("total steps"), std::string::npos) << error;
+  bad = msg;
+  bad.anti_windup = "sometimes";
+  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_NE(error.find("sometimes"), std::string::npos) << error;
+  bad = msg;
+  bad.episode_id = 0;
+  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+}
+
+TEST(Transport, CountsUndecodableMessagesAndIgnoresThem) {
+  lcm::LCM lcm("memq://");
+  Transport dut(&lcm, {});
+  int calls = 0;
+  dut.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel, [&](const pidlab::lcmt_plant_output&) { ++calls; });
+  std::mt19937 rng(3);
+  for (int i = 0; i < 50; ++i) {
+    std::vector<unsigned char> junk(1 + rng() % 100);
+    for (auto& b : junk) b = static_cast<unsigned char>(rng());
+    lcm.publish(dut.Channel(kPlantOutputChannel), junk.data(), static_cast<unsigned>(junk.size()));
+  }
+  pidlab::lcmt_control_command wrong_type{};
+  lcm.publish(dut.Channel(kPlantOutputChannel), &wrong_type);
+  pidlab::lcmt_plant_output good{};
+  dut.Publish(kPlantOutputChannel, &good);
+  while (dut.WaitAndHandle(0.01) > 0) {
+  }
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(dut.counters().undecodable, 51);
+  EXPECT_EQ(dut.counters().received, 52);
+}
+
+TEST(Transport, DropsTheConfiguredFractionReproducibly) {
+  auto run = [](uint64_t seed) {
+    lcm::LCM lcm("memq://");
+    TransportOptions o;
+    o.drop_rate = 0.2;
+    o.drop_seed = seed;
+    Transport dut(&lcm, o);
+    std::vector<int64_t> got;
+    dut.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel,
+                                             [&](const pidlab::lcmt_plant_output& m) { got.push_back(m.step); });
+    for (int k = 0; k < 2000; ++k) {
+      pidlab::lcmt_plant_output m{};
+      m.step = k;
+      dut.Publish(kPlantOutputChannel, &m);
+      dut.WaitAndHandle(0.0);
+    }
+    while (dut.WaitAndHandle(0.0) > 0) {
+    }
+    return got;
+  };
+  const auto a = run(5), b = run(5), c = run(6);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  EXPECT_NEAR(static_cast<double>(a.size()) / 2000.0, 0.8, 0.03);
+}
+
+TEST(Transport, RejectsADropRateOutsideUnitInterval) {
+  TransportOptions o;
+  std::string error;
+  o.drop_rate = 1.0;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("drop rate"), std::string::npos);
+}
+
+TEST(Trio, MatchesTheInProcessSampledLoopBitForBit) {
+  const Episode e = DoubleIntegrator();
+  Recorder rec;
+  ASSERT_TRUE(RunOnMemq(e, 0.0, &rec)) << rec.last.message;
+  const std::vector<double> expected = Reference(e);
+  ASSERT_EQ(rec.y.size(), expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    ASSERT_TRUE(rec.have[k]) << "step " << k;
+    ASSERT_EQ(rec.y[k], expected[k]) << "step " << k;  // bit for bit, no tolerance
+  }
+}
+
+TEST(Trio, RecoversFromDroppedMessagesWithIdenticalResults) {
+  const Episode e = DoubleIntegrator();
+  Recorder rec;
+  RoleCounters controller;
+  ASSERT_TRUE(RunOnMemq(e, 0.05, &rec, &controller)) << rec.last.message;
+  EXPECT_GT(controller.duplicates, 0);  // losses happened and were recovered
+  const std::vector<double> expected = Reference(e);
+  for (std::size_t k = 0; k < expected.size(); ++k) ASSERT_EQ(rec.y[k], expected[k]) << "step " << k;
+}
+
+TEST(Trio, NamesTheSilentControllerAfterTheDeadline) {
+  const Episode e = DoubleIntegrator();
+  Recorder rec;
+  EXPECT_FALSE(RunOnMemq(e, 0.0, &rec, nullptr, /*with_controller=*/false));
+  ASSERT_TRUE(rec.summary);
+  EXPECT_EQ(rec.last.status, pidlab::lcmt_episode_summary::FAILED);
+  EXPECT_EQ(rec.last.silent_role, "controller");
+  EXPECT_NE(rec.last.message.find("pidlab-controller"), std::string::npos) << rec.last.message;
+  EXPECT_EQ(rec.last.step, 0);
+}
+
+}  // namespace
+}  // namespace pidlab::lcm_trio
