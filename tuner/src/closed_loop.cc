@@ -39,6 +39,8 @@ bool LoopOptions::IsValid(std::string* error) const {
     os << "horizon / sample time = " << count << " samples is more than 1e7";
   else if (!(stability_margin >= 0.0) || !(stability_margin < 1.0))
     os << "stability margin " << stability_margin << " must be in [0, 1)";
+  else if (!(dt_s > 0.0) || !std::isfinite(dt_s))  // a bad --dt is an error even if the loop ignores it
+    os << "dt " << dt_s << " s must be positive and finite";
   else if (!disturbance.IsValid(error))
     return false;
   else if (loop == LoopKind::kSampled) {
@@ -73,7 +75,7 @@ Stability ContinuousStability(const ContinuousClosedLoop<double>& loop, double m
   Stability s;
   s.abscissa = -std::numeric_limits<double>::infinity();
   bool ok = es.info() == Eigen::Success;
-  for (int i = 0; i < n && ok; ++i) {
+  for (int i = 0; i < n && es.info() == Eigen::Success; ++i) {  // every pole, even past an unstable one
     const std::complex<double> p = es.eigenvalues()(i);
     s.poles.push_back(p);
     s.abscissa = std::max(s.abscissa, p.real());
