@@ -1,0 +1,161 @@
+#!/usr/bin/env bash
+# pidlab evaluate from the command line: the 13 reference IAEs through --json,
+# the JSON keys, --help, and every bad-input path (exit 2, one stderr line
+# naming the value, no core dump).
+# Usage: evaluate_cli_test.sh PIDLAB_BINARY PAPER_TABLES_CSV
+set -euo pipefail
+
+if [[ $# -ne 2 ]]; then
+  echo "usage: $0 PIDLAB_BINARY PAPER_TABLES_CSV" >&2
+  exit 2
+fi
+pidlab=$(realpath -- "$1")
+csv=$(realpath -- "$2")
+[[ -x $pidlab ]] || { echo "FAIL: $pidlab is not an executable" >&2; exit 1; }
+[[ -r $csv ]] || { echo "FAIL: cannot read $csv" >&2; exit 1; }
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"  # any core file would land here
+ulimit -c unlimited 2>/dev/null || true
+
+passed=0
+failed=0
+pass() { echo "PASS: $1"; passed=$((passed + 1)); }
+fail() { echo "FAIL: $1"; failed=$((failed + 1)); }
+
+# ---- --help ----
+status=0
+"$pidlab" evaluate --help >help.out 2>help.err || status=$?
+if [[ $status -eq 0 ]] && grep -q -- "--gains" help.out; then
+  pass "evaluate --help exits 0 and lists --gains"
+else
+  fail "evaluate --help exited $status"
+fi
+
+# ---- JSON keys ----
+status=0
+"$pidlab" evaluate --plant linear --gains 29.6558,0.4977,28.3216 --json >keys.json 2>keys.err || status=$?
+if [[ $status -eq 0 ]] && python3 - keys.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+for k in ["plant", "gains", "loop", "iae", "rise_time_s", "overshoot_pct", "settling_time_s", "stable",
+          "closed_loop_poles"]:
+    assert k in j, k
+for k in ["kp", "ki", "kd"]:
+    assert k in j["gains"], k
+assert j["plant"] == "double_integrator", j["plant"]
+assert abs(j["gains"]["kp"] - 29.6558) < 1e-12 and abs(j["gains"]["kd"] - 28.3216) < 1e-12
+assert j["loop"] == "continuous" and j["stable"] is True
+assert len(j["closed_loop_poles"]) == 3
+for p in j["closed_loop_poles"]:
+    assert p["re"] < 0, p
+PY
+then
+  pass "--json has plant, gains.kp/ki/kd, loop, iae, rise/overshoot/settling, stable, closed_loop_poles"
+else
+  fail "--json keys (exit $status)"
+fi
+
+# An unstable loop is reported, with null objectives and all its poles.
+status=0
+"$pidlab" evaluate --plant linear --gains 1,10,0 --json >unstable.json 2>/dev/null || status=$?
+if [[ $status -eq 0 ]] && python3 - unstable.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["stable"] is False
+assert j["iae"] is None
+assert len(j["closed_loop_poles"]) == 3, j["closed_loop_poles"]
+PY
+then
+  pass "unstable loop: stable false, iae null, three poles"
+else
+  fail "unstable loop report (exit $status)"
+fi
+
+# ---- The 13 reference rows ----
+row=0
+while IFS=, read -r table plant method amplitude kp ki kd _ _ _ _ ref_rise ref_over ref_settle ref_iae; do
+  [[ $table == table ]] && continue
+  row=$((row + 1))
+  args=(evaluate --plant "$plant" --gains "$kp,$ki,$kd" --json)
+  [[ -n $amplitude ]] && args+=(--disturbance-amplitude "$amplitude")
+  status=0
+  "$pidlab" "${args[@]}" >row.json 2>row.err || status=$?
+  name="table $table $plant $method${amplitude:+ A=$amplitude}"
+  if [[ $status -ne 0 ]]; then
+    fail "$name: exit $status: $(head -c 200 row.err)"
+    continue
+  fi
+  if msg=$(python3 - row.json "$ref_iae" "$ref_rise" "$ref_over" "$ref_settle" "$amplitude" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+ref_iae, ref_rise, ref_over, ref_settle = map(float, sys.argv[2:6])
+disturbed = sys.argv[6] != ""
+# ref_iae is the IAE of the response to the reference alone (y1 of eq. 17).
+iae = j["iae_undisturbed"] if disturbed else j["iae"]
+errors = []
+if not j["stable"]:
+    errors.append("not stable")
+if abs(iae - ref_iae) > 1e-4 * ref_iae:
+    errors.append(f"iae {iae} vs {ref_iae}")
+if not disturbed and j["iae"] != j["iae_undisturbed"]:
+    errors.append("iae != iae_undisturbed without disturbance")
+if abs(j["rise_time_s"] - ref_rise) > 0.01 * ref_rise:
+    errors.append(f"rise {j['rise_time_s']} vs {ref_rise}")
+if abs(j["overshoot_pct"] - ref_over) > max(0.01 * ref_over, 0.05):
+    errors.append(f"overshoot {j['overshoot_pct']} vs {ref_over}")
+if abs(j["settling_time_s"] - ref_settle) > 0.01 * ref_settle:
+    errors.append(f"settling {j['settling_time_s']} vs {ref_settle}")
+print("; ".join(errors) if errors else f"iae {iae:.6f}")
+sys.exit(1 if errors else 0)
+PY
+  ); then
+    pass "$name: $msg"
+  else
+    fail "$name: $msg"
+  fi
+done <"$csv"
+if [[ $row -eq 13 ]]; then pass "paper_tables.csv has 13 rows"; else fail "paper_tables.csv has $row rows, expected 13"; fi
+
+# ---- Bad input: exit 2, exactly one stderr line naming the value, no core ----
+bad() {
+  local what=$1 needle=$2
+  shift 2
+  local status=0
+  rm -f core core.*
+  "$pidlab" "$@" >bad.out 2>bad.err || status=$?
+  local lines
+  lines=$(wc -l <bad.err)
+  if [[ $status -ne 2 ]]; then
+    fail "$what: exit $status, expected 2 (stderr: $(head -c 200 bad.err))"
+  elif [[ $lines -ne 1 ]]; then
+    fail "$what: $lines stderr lines, expected 1"
+  elif ! grep -qF -- "$needle" bad.err; then
+    fail "$what: stderr does not name '$needle': $(cat bad.err)"
+  elif [[ -s bad.out ]]; then
+    fail "$what: wrote to stdout"
+  elif compgen -G 'core*' >/dev/null; then
+    fail "$what: dumped core"
+  else
+    pass "$what: exit 2, one line naming '$needle'"
+  fi
+}
+
+bad "unknown plant" "quadruple_integrator" evaluate --plant quadruple_integrator --gains 1,2,3
+bad "NaN gain" "nan" evaluate --plant linear --gains nan,2,3
+bad "negative gain" "-2" evaluate --plant linear --gains 1,-2,3
+bad "malformed number 1,x,3" "'x'" evaluate --plant linear --gains 1,x,3
+bad "two gains" "1,2" evaluate --plant linear --gains 1,2
+bad "--dt 0 (continuous)" "dt 0" evaluate --plant linear --gains 1,2,3 --dt 0
+bad "--dt 0 (sampled)" "dt 0" evaluate --plant linear --gains 1,2,3 --loop sampled --dt 0
+bad "--dt -0.001" "-0.001" evaluate --plant linear --gains 1,2,3 --loop sampled --dt -0.001
+bad "sample time 0.05 not a multiple of dt 0.03" "0.03" \
+  evaluate --plant linear --gains 1,2,3 --loop sampled --sample-time 0.05 --dt 0.03
+bad "--loop bogus" "bogus" evaluate --plant linear --gains 1,2,3 --loop bogus
+bad "unknown flag" "--bogus" evaluate --plant linear --gains 1,2,3 --bogus
+bad "malformed --dt" "abc" evaluate --plant linear --gains 1,2,3 --dt abc
+bad "improper custom plant" "strictly proper" evaluate --num 1,0 --den 1,1 --gains 1,2,3
+
+echo "$passed passed, $failed failed"
+[[ $failed -eq 0 ]]

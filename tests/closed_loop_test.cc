@@ -1,0 +1,390 @@
+// Closed-loop responses against closed forms and an independent RK4
+// integration; stability; convergence of the sampled loop; LoopOptions.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "pidlab/tuner/closed_loop.h"
+#include "pidlab/tuner/evaluation.h"
+
+namespace pidlab {
+namespace {
+
+Evaluation EvaluateOrFail(const TransferFunction& tf, const PidGains& gains, const LoopOptions& options) {
+  Evaluation ev;
+  std::string error;
+  EXPECT_TRUE(Evaluate(Plant{"custom", tf}, gains, options, EvaluateOptions{}, &ev, &error)) << error;
+  return ev;
+}
+
+Plant Builtin(const std::string& name) {
+  Plant p;
+  std::string error;
+  EXPECT_TRUE(MakePlant(name, StepperMotorParameters{}, &p, &error)) << error;
+  return p;
+}
+
+// ---- First order: 1/(s+1) under proportional control ----
+
+TEST(ContinuousLoop, ProportionalControlOfAFirstOrderLagIsAFirstOrderLoop) {
+  // y(t) = K/(1+K) (1 - e^{-(1+K) t}).
+  const double k = 4.0, a = 1.0 + k, yf = k / (1.0 + k);
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 1.0}}, {k, 0.0, 0.0}, LoopOptions{});
+  ASSERT_TRUE(dut.stability.stable) << "a P-only loop on 1/(s+1) has its single pole at -5";
+  ASSERT_EQ(dut.y.size(), 501u);
+  for (std::size_t m = 0; m < dut.y.size(); ++m) {
+    const double t = 0.05 * m;
+    EXPECT_NEAR(dut.y[m], yf * (1.0 - std::exp(-a * t)), 1e-12) << "t = " << t;
+  }
+  EXPECT_NEAR(dut.step.final_value, yf, 1e-12);
+}
+
+TEST(ContinuousLoop, ProportionalIntegralControlCancellingTheLagIsAFirstOrderLoop) {
+  // kp + ki/s = kp (s + 1)/s cancels the plant pole: L = kp/s, y = 1 - e^{-kp t}.
+  const double kp = 3.0;
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 1.0}}, {kp, kp, 0.0}, LoopOptions{});
+  ASSERT_TRUE(dut.stability.stable);
+  ASSERT_EQ(dut.y.size(), 501u);
+  for (std::size_t m = 0; m < dut.y.size(); ++m) {
+    const double t = 0.05 * m;
+    EXPECT_NEAR(dut.y[m], 1.0 - std::exp(-kp * t), 1e-12) << "t = " << t;
+  }
+}
+
+// ---- Second order: wn^2 / (s (s + 2 zeta wn)) under unit proportional control ----
+
+double SecondOrderStep(double zeta, double wn, double t) {
+  const double wd = wn * std::sqrt(1.0 - zeta * zeta);
+  return 1.0 - std::exp(-zeta * wn * t) * (std::cos(wd * t) + zeta / std::sqrt(1.0 - zeta * zeta) * std::sin(wd * t));
+}
+
+TEST(ContinuousLoop, UnitFeedbackOfATypeOnePlantIsTheClassicSecondOrderResponse) {
+  const double zeta = 0.3, wn = 2.0;
+  const Evaluation dut = EvaluateOrFail({{wn * wn}, {1.0, 2.0 * zeta * wn, 0.0}}, {1.0, 0.0, 0.0}, LoopOptions{});
+  ASSERT_TRUE(dut.stability.stable) << "poles of s^2 + 1.2 s + 4 are in the left half plane";
+  for (std::size_t m = 0; m < dut.y.size(); ++m)
+    EXPECT_NEAR(dut.y[m], SecondOrderStep(zeta, wn, 0.05 * m), 1e-12) << "m = " << m;
+}
+
+TEST(ContinuousLoop, CancellingPiControlGivesTheClassicSecondOrderResponse) {
+  // Plant wn^2 / ((s + 1)(s + 2 zeta wn)), kp = ki = 1: L = wn^2 / (s (s + 2 zeta wn)).
+  const double zeta = 0.3, wn = 2.0;
+  const Evaluation dut =
+      EvaluateOrFail({{wn * wn}, {1.0, 1.0 + 2.0 * zeta * wn, 2.0 * zeta * wn}}, {1.0, 1.0, 0.0}, LoopOptions{});
+  ASSERT_TRUE(dut.stability.stable);
+  for (std::size_t m = 0; m < dut.y.size(); ++m)
+    EXPECT_NEAR(dut.y[m], SecondOrderStep(zeta, wn, 0.05 * m), 1e-12) << "m = " << m;
+}
+
+// ---- Stability ----
+
+TEST(ContinuousStability, DoubleIntegratorWithProportionalControlIsMarginalAndNotStable) {
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 0.0, 0.0}}, {1.0, 0.0, 0.0}, LoopOptions{});
+  EXPECT_FALSE(dut.stability.stable);
+  EXPECT_TRUE(std::isinf(dut.iae) && dut.iae > 0);
+  EXPECT_TRUE(std::isinf(dut.ise));
+  EXPECT_TRUE(std::isinf(dut.itae));
+  EXPECT_TRUE(std::isinf(dut.iae_continuous));
+  EXPECT_FALSE(dut.step.valid);
+  // s^2 + 1 = 0: poles at +-j.
+  int on_axis = 0;
+  for (const auto& p : dut.stability.poles) on_axis += std::abs(p.real()) < 1e-9 && std::abs(std::abs(p.imag()) - 1.0) < 1e-9;
+  EXPECT_EQ(on_axis, 2);
+}
+
+TEST(ContinuousStability, OscillatorWithoutControlIsNotStable) {
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 0.0, 1.0}}, {0.0, 0.0, 0.0}, LoopOptions{});
+  EXPECT_FALSE(dut.stability.stable);
+  EXPECT_TRUE(std::isinf(dut.iae));
+}
+
+TEST(ContinuousStability, DoubleIntegratorWithALargeIntegralGainIsUnstable) {
+  // s^3 + kp s + ki: no s^2 term, a pole in the right half plane.
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 0.0, 0.0}}, {1.0, 10.0, 0.0}, LoopOptions{});
+  EXPECT_FALSE(dut.stability.stable);
+  EXPECT_GT(dut.stability.abscissa, 0.1);
+  EXPECT_TRUE(std::isinf(dut.iae));
+  // All three poles are reported, not only those up to the first unstable one.
+  ASSERT_EQ(dut.stability.poles.size(), 3u);
+  for (const auto& p : dut.stability.poles) EXPECT_LT(std::abs(p * p * p + p + 10.0), 1e-9) << p;
+}
+
+TEST(ContinuousStability, CriticallyDampedPdLoopIsStableWithItsPoles) {
+  // 1/s^2 with kp = 1, kd = 2, ki = 0.001: s^3 + 2 s^2 + s + 0.001.
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 0.0, 0.0}}, {1.0, 0.001, 2.0}, LoopOptions{});
+  ASSERT_TRUE(dut.stability.stable);
+  ASSERT_EQ(dut.stability.poles.size(), 3u);
+  // Each pole is a root of s^3 + 2 s^2 + s + 0.001.
+  for (const auto& p : dut.stability.poles)
+    EXPECT_LT(std::abs(p * p * p + 2.0 * p * p + p + 0.001), 1e-9) << p;
+  EXPECT_TRUE(std::isfinite(dut.iae));
+}
+
+TEST(ContinuousStability, ProportionalDerivativeLoopWithoutIntegralIsStable) {
+  // 1/s^2 with kp = 1, kd = 2: (s + 1)^2. The unused integrator state does not
+  // reach y and must not count as a pole at 0.
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 0.0, 0.0}}, {1.0, 0.0, 2.0}, LoopOptions{});
+  EXPECT_TRUE(dut.stability.stable) << "poles of (s + 1)^2 are at -1";
+  EXPECT_TRUE(std::isfinite(dut.iae));
+}
+
+TEST(SampledStability, StepperMotorWithNelderMeadGainsIsUnstableAtOneMillisecond) {
+  LoopOptions o;
+  o.loop = LoopKind::kSampled;
+  o.dt_s = 1e-3;
+  Evaluation dut;
+  std::string error;
+  ASSERT_TRUE(Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut, &error))
+      << error;
+  EXPECT_FALSE(dut.stability.stable);
+  EXPECT_GT(dut.stability.abscissa, 1.0);
+  EXPECT_TRUE(std::isinf(dut.iae));
+}
+
+TEST(SampledStability, StepperMotorWithNelderMeadGainsIsStableAtATenthOfAMillisecond) {
+  LoopOptions o;
+  o.loop = LoopKind::kSampled;
+  o.dt_s = 1e-4;
+  Evaluation dut;
+  std::string error;
+  ASSERT_TRUE(Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut, &error))
+      << error;
+  EXPECT_TRUE(dut.stability.stable);
+  EXPECT_LT(dut.stability.abscissa, 1.0);
+  EXPECT_TRUE(std::isfinite(dut.iae));
+}
+
+TEST(SampledStability, ProportionalLoopWithoutIntegralIsStable) {
+  // 1/(s+1) with kp = 4 at dt = 1e-3: y_{k+1} = (q - (1 - q) 4) y_k + ..., |.| < 1.
+  LoopOptions o;
+  o.loop = LoopKind::kSampled;
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 1.0}}, {4.0, 0.0, 0.0}, o);
+  EXPECT_TRUE(dut.stability.stable) << "the unused integrator must not count as a pole at z = 1";
+}
+
+// ---- Disturbance: exact propagation across breakpoints not aligned with ts ----
+
+// Independent RK4 of 1/s^2 under the ideal PID with the square wave at the
+// plant input: y' = v, v' = kp (1 - y) + ki z - kd v + n(t), z' = 1 - y, and
+// the derivative kick v(0+) = kd.
+std::vector<double> Rk4DoubleIntegrator(const PidGains& g, double amplitude, double period, double phase, double ts,
+                                        int samples) {
+  auto square = [&](double t_mid) {
+    const long piece = static_cast<long>(std::floor((t_mid + phase) / (period / 2.0)));
+    return piece % 2 == 0 ? amplitude : -amplitude;
+  };
+  std::vector<double> events;
+  for (int m = 1; m < samples; ++m) events.push_back(m * ts);
+  const double t_end = (samples - 1) * ts;
+  for (long j = 1; j * period / 2.0 - phase < t_end; ++j)
+    if (j * period / 2.0 - phase > 0.0) events.push_back(j * period / 2.0 - phase);
+  std::sort(events.begin(), events.end());
+  using State = std::array<double, 3>;
+  auto f = [&](const State& s, double n) {
+    return State{s[1], g.kp * (1.0 - s[0]) + g.ki * s[2] - g.kd * s[1] + n, 1.0 - s[0]};
+  };
+  State s{0.0, g.kd, 0.0};
+  std::vector<double> y = {0.0};
+  double t = 0.0;
+  for (double te : events) {
+    if (te - t < 1e-13) continue;
+    const double n = square(0.5 * (t + te));
+    const int steps = static_cast<int>(std::ceil((te - t) / 1e-4));
+    const double h = (te - t) / steps;
+    for (int i = 0; i < steps; ++i) {
+      const State k1 = f(s, n);
+      State tmp;
+      for (int j = 0; j < 3; ++j) tmp[j] = s[j] + 0.5 * h * k1[j];
+      const State k2 = f(tmp, n);
+      for (int j = 0; j < 3; ++j) tmp[j] = s[j] + 0.5 * h * k2[j];
+      const State k3 = f(tmp, n);
+      for (int j = 0; j < 3; ++j) tmp[j] = s[j] + h * k3[j];
+      const State k4 = f(tmp, n);
+      for (int j = 0; j < 3; ++j) s[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+    }
+    t = te;
+    const double m = te / ts;
+    if (std::abs(m - std::round(m)) < 1e-9) y.push_back(s[0]);
+  }
+  return y;
+}
+
+TEST(ContinuousLoop, SquareDisturbanceNotAlignedWithTheSamplesMatchesAnIndependentRk4) {
+  const PidGains g{2.0, 1.0, 3.0};
+  LoopOptions o;
+  o.horizon_s = 3.0;
+  o.disturbance.kind = DisturbanceKind::kSquare;
+  o.disturbance.amplitude = 0.5;
+  o.disturbance.period_s = 0.13;
+  o.disturbance.phase_s = 0.02;
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 0.0, 0.0}}, g, o);
+  ASSERT_TRUE(dut.stability.stable);
+  const std::vector<double> expected = Rk4DoubleIntegrator(g, 0.5, 0.13, 0.02, 0.05, 61);
+  ASSERT_EQ(expected.size(), 61u);
+  ASSERT_EQ(dut.y.size(), 61u);
+  for (std::size_t m = 0; m < expected.size(); ++m) EXPECT_NEAR(dut.y[m], expected[m], 1e-6) << "m = " << m;
+  // The disturbance really acted: the undisturbed IAE differs.
+  EXPECT_GT(std::abs(dut.iae - dut.iae_undisturbed), 1e-3);
+}
+
+TEST(ContinuousLoop, WithoutDisturbanceMatchesTheIndependentRk4) {
+  const PidGains g{2.0, 1.0, 3.0};
+  LoopOptions o;
+  o.horizon_s = 3.0;
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 0.0, 0.0}}, g, o);
+  const std::vector<double> expected = Rk4DoubleIntegrator(g, 0.0, 0.13, 0.0, 0.05, 61);
+  ASSERT_EQ(dut.y.size(), expected.size());
+  for (std::size_t m = 0; m < expected.size(); ++m) EXPECT_NEAR(dut.y[m], expected[m], 1e-6) << "m = " << m;
+  EXPECT_EQ(dut.iae, dut.iae_undisturbed);
+}
+
+// ---- Sampled loop converges to the continuous one ----
+
+void ExpectSampledConvergesToContinuous(const std::string& plant_name, const PidGains& gains) {
+  const Plant plant = Builtin(plant_name);
+  Evaluation continuous;
+  std::string error;
+  ASSERT_TRUE(Evaluate(plant, gains, LoopOptions{}, EvaluateOptions{}, &continuous, &error)) << error;
+  ASSERT_TRUE(continuous.stability.stable);
+  double previous = std::numeric_limits<double>::infinity();
+  for (double dt : {1e-2, 1e-3, 1e-4}) {
+    LoopOptions o;
+    o.loop = LoopKind::kSampled;
+    o.dt_s = dt;
+    Evaluation dut;
+    EvaluateOptions what;
+    what.compute_step_info = false;
+    ASSERT_TRUE(Evaluate(plant, gains, o, what, &dut, &error)) << error;
+    const double rel = std::abs(dut.iae - continuous.iae) / continuous.iae;
+    EXPECT_LT(rel, previous) << "dt = " << dt;
+    if (dt == 1e-3) {
+      EXPECT_LT(rel, 0.01) << "dt = 1e-3: sampled " << dut.iae << " continuous " << continuous.iae;
+    }
+    previous = rel;
+  }
+  EXPECT_LT(previous, 0.002);
+}
+
+TEST(SampledLoop, ConvergesToTheContinuousIaeForTableTwoNelderMeadGains) {
+  ExpectSampledConvergesToContinuous("double_integrator", {29.6558, 0.4977, 28.3216});
+}
+
+TEST(SampledLoop, ConvergesToTheContinuousIaeForTableThreeNelderMeadGains) {
+  ExpectSampledConvergesToContinuous("oscillator", {0.0774, 14.7575, 14.9913});
+}
+
+TEST(SampledLoop, FirstSamplesFollowTheLockstepOrder) {
+  // 1/s^2 with kd only at dt: u_0 = kd/dt held over [0, dt) gives
+  // y_1 = kd/dt * dt^2/2 = kd dt / 2 and y' = kd afterwards.
+  const double kd = 0.2, dt = 0.01;
+  const DiscretePlant plant({{1.0}, {1.0, 0.0, 0.0}}, dt);
+  PidOptions pid;
+  pid.dt_s = dt;
+  std::vector<double> y;
+  RunSampledLoop<double>(plant, PidGains{0.0, 0.0, kd}, pid, Disturbance(DisturbanceOptions{}), 3, 1, &y);
+  ASSERT_EQ(y.size(), 4u);
+  EXPECT_EQ(y[0], 0.0);
+  EXPECT_NEAR(y[1], kd * dt / 2.0, 1e-15);
+  // Step 1: e = 1 - y_1, D = -kd (y_1 - 0)/dt = -kd^2/2; constant over [dt, 2dt).
+  const double v1 = kd, u1 = -kd * (kd * dt / 2.0) / dt;
+  EXPECT_NEAR(y[2], y[1] + v1 * dt + u1 * dt * dt / 2.0, 1e-14);
+}
+
+// ---- LoopOptions ----
+
+TEST(LoopOptions, DefaultsAreValidAndGiveThePapersSampleCount) {
+  LoopOptions dut;
+  std::string error;
+  EXPECT_TRUE(dut.IsValid(&error)) << error;
+  EXPECT_EQ(dut.NumSamples(), 501);
+  dut.loop = LoopKind::kSampled;
+  EXPECT_TRUE(dut.IsValid(&error)) << error;
+  EXPECT_EQ(dut.StepsPerSample(), 50);
+  EXPECT_EQ(dut.TotalSteps(), 25000);
+}
+
+TEST(LoopOptions, RejectsASampleTimeNotAMultipleOfDt) {
+  LoopOptions dut;
+  dut.loop = LoopKind::kSampled;
+  dut.sample_time_s = 0.05;
+  dut.dt_s = 0.03;
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("0.05"), std::string::npos) << error;
+  EXPECT_NE(error.find("0.03"), std::string::npos) << error;
+}
+
+TEST(LoopOptions, RejectsAZeroDtForTheSampledLoop) {
+  LoopOptions dut;
+  dut.loop = LoopKind::kSampled;
+  dut.dt_s = 0.0;
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("dt 0"), std::string::npos) << error;
+}
+
+TEST(LoopOptions, RejectsANegativeDtForTheSampledLoop) {
+  LoopOptions dut;
+  dut.loop = LoopKind::kSampled;
+  dut.dt_s = -1e-3;
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("dt -0.001"), std::string::npos) << error;
+}
+
+TEST(LoopOptions, RejectsAZeroDtEvenForTheContinuousLoop) {
+  LoopOptions dut;
+  dut.dt_s = 0.0;
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error)) << "pidlab evaluate --dt 0 must be bad input";
+  EXPECT_NE(error.find("dt 0"), std::string::npos) << error;
+}
+
+TEST(LoopOptions, RejectsAHorizonNotAMultipleOfTheSampleTime) {
+  LoopOptions dut;
+  dut.horizon_s = 25.02;
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("25.02"), std::string::npos) << error;
+}
+
+TEST(LoopOptions, RejectsAZeroSampleTime) {
+  LoopOptions dut;
+  dut.sample_time_s = 0.0;
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("sample time 0"), std::string::npos) << error;
+}
+
+TEST(LoopOptions, RejectsAnInvalidDisturbance) {
+  LoopOptions dut;
+  dut.disturbance.kind = DisturbanceKind::kSquare;
+  dut.disturbance.period_s = -2.0;
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("-2"), std::string::npos) << error;
+}
+
+TEST(Evaluate, RejectsANegativeGainAsBadInput) {
+  Evaluation ev;
+  std::string error;
+  EXPECT_FALSE(Evaluate(Builtin("linear"), {1.0, -2.0, 0.0}, LoopOptions{}, EvaluateOptions{}, &ev, &error));
+  EXPECT_NE(error.find("ki = -2"), std::string::npos) << error;
+}
+
+TEST(Evaluate, RejectsABiproperPlantAsBadInput) {
+  Evaluation ev;
+  std::string error;
+  EXPECT_FALSE(
+      Evaluate(Plant{"custom", {{1.0, 0.0}, {1.0, 1.0}}}, {1.0, 0.0, 0.0}, LoopOptions{}, EvaluateOptions{}, &ev, &error));
+  EXPECT_NE(error.find("strictly proper"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace pidlab
