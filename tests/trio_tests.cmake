@@ -15,5 +15,5 @@ foreach(case identity faults stranger kill log)
            COMMAND unshare -n bash ${CMAKE_CURRENT_LIST_DIR}/integration/trio_test.sh
                    $<TARGET_FILE_DIR:pidlab> ${case})
   set_tests_properties(trio_integration_${case} PROPERTIES TIMEOUT 120 RUN_SERIAL TRUE
-                       FAIL_REGULAR_EXPRESSION "FAIL")
+                       FAIL_REGULAR_EXPRESSION "FAIL ")
 endforeach()
