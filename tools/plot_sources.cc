@@ -1,17 +1,23 @@
 #include "plot_sources.h"
 
+#include <algorithm>
+#include <filesystem>
 #include <iomanip>
 #include <sstream>
 
+#include "log_reader.h"
 #include "loop_figure.h"
 
 namespace pidlab::cli {
 
+namespace {
 std::string GainsLabel(const PidGains& g) {
   std::ostringstream os;
   os << std::setprecision(6) << "kp=" << g.kp << " ki=" << g.ki << " kd=" << g.kd;
   return os.str();
 }
+
+}  // namespace
 
 bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, const LoopOptions& options,
                       plot::Figure* figure, std::string* error) {
@@ -64,12 +70,67 @@ bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, co
 
 bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, plot::Figure* figure,
                std::string* report, std::string* error) {
-  (void)log_path;
-  (void)episodes;
-  (void)figure;
-  (void)report;
-  if (error) *error = "--log: not available yet";
-  return false;
+  replay::LogContents log;
+  if (!replay::ReadLog(log_path, replay::ReadOptions{}, &log, error)) return false;
+  for (const auto& n : log.notes) *report += "note: " + n + "\n";
+  std::vector<plot::LoopTrace> traces;
+  std::string plant_name;
+  bool mixed_plants = false;
+  for (long id : episodes) {
+    bool found = false;
+    for (const auto& e : log.episodes) found = found || e.episode_id == id;
+    if (!found) {
+      if (error) *error = "--episode " + std::to_string(id) + " is not in " + log_path;
+      return false;
+    }
+  }
+  for (const replay::Episode& e : log.episodes) {
+    if (!episodes.empty() && std::find(episodes.begin(), episodes.end(), e.episode_id) == episodes.end())
+      continue;
+    if (!e.has_config) {
+      *report +=
+          "note: episode " + std::to_string(e.episode_id) + " not plotted: " + e.CompletenessNote() + "\n";
+      continue;
+    }
+    if (!e.Complete())
+      *report += "note: episode " + std::to_string(e.episode_id) +
+                 " has gaps (drawn as breaks): " + e.CompletenessNote() + "\n";
+    plot::LoopTrace tr;
+    std::ostringstream name;
+    name << "episode " << e.episode_id << ": " << GainsLabel(e.spec.gains);
+    const DisturbanceOptions& d = e.spec.options.disturbance;
+    if (d.kind == DisturbanceKind::kNone)
+      name << ", no disturbance";
+    else
+      name << ", " << ToString(d.kind) << " " << d.amplitude;
+    Evaluation ev;
+    std::string why;
+    if (replay::EvaluateEpisode(e, &ev, &why)) name << std::setprecision(6) << " (IAE " << ev.iae << ")";
+    tr.name = name.str();
+    const double dt = e.spec.options.dt_s, r = e.spec.reference;
+    for (long k = 0; k < e.total_steps; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      tr.t.push_back(static_cast<double>(k) * dt);
+      tr.r.push_back(r);
+      tr.y.push_back(e.y[i]);  // NaN where missing: gnuplot leaves a gap
+      tr.e.push_back(r - e.y[i]);
+      tr.u.push_back(e.u[i]);
+      tr.n.push_back(e.n[i]);
+    }
+    if (!plant_name.empty() && plant_name != e.spec.plant.name) mixed_plants = true;
+    plant_name = e.spec.plant.name;
+    traces.push_back(std::move(tr));
+  }
+  if (traces.empty()) {
+    if (error) *error = "no episode with a configuration to plot in " + log_path;
+    return false;
+  }
+  std::ostringstream title;
+  title << "log " << std::filesystem::path(log_path).filename().string() << ": "
+        << (mixed_plants ? std::string("several plants") : plant_name)
+        << ", sampled loop over LCM, every step";
+  return plot::MakeLoopFigure(traces, plot::UnitsOfPlant(mixed_plants ? "" : plant_name), title.str(), figure,
+                              error);
 }
 
 }  // namespace pidlab::cli
