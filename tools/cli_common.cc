@@ -109,7 +109,7 @@ void LoopFlags::Register(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--horizon", horizon_s, "n of eq. (4): last sample time in s")->capture_default_str();
   app->add_option("--stability-margin", stability_margin,
-                  "strict stability: Re p < -margin*max(1,|p|) (continuous), |z| < 1-margin (sampled)")
+                  "strict stability: Re p < -margin*max(1,|p|), p = s-plane pole (sampled: p = log(z)/dt)")
       ->capture_default_str();
   app->add_option("--disturbance", disturbance,
                   "none|square|step|sine|noise at the plant input (default: square if an amplitude is given)");

@@ -67,8 +67,15 @@ int LoopOptions::NumSamples() const { return static_cast<int>(std::lround(horizo
 int LoopOptions::StepsPerSample() const { return static_cast<int>(std::lround(sample_time_s / dt_s)); }
 long LoopOptions::TotalSteps() const { return std::lround(horizon_s / dt_s); }
 
+int EffectiveLoopOrder(const ContinuousClosedLoop<double>& loop) {
+  // With ki = 0 the integrator state z never reaches u: its pole at s = 0 is
+  // a hidden mode of the realisation, not of the loop.
+  const int np = loop.plant_order;
+  return loop.m.block(0, np, np, 1).isZero(0.0) ? np : np + 1;
+}
+
 Stability ContinuousStability(const ContinuousClosedLoop<double>& loop, double margin) {
-  const int n = loop.loop_order();
+  const int n = EffectiveLoopOrder(loop);
   Eigen::MatrixXd m = loop.m.topLeftCorner(n, n);
   BalanceInPlace(&m);
   Eigen::EigenSolver<Eigen::MatrixXd> es(m, false);
@@ -118,17 +125,28 @@ Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const 
   m.row(id) = d_row;
   m.row(iep) = e_row;
   m.row(isp) = e_row;
+  // With ki = 0 the integral stays 0: drop its hidden eigenvalue at z = 1.
+  if (g.ki == 0.0) m.row(ii).setZero();
   BalanceInPlace(&m);
   Eigen::EigenSolver<Eigen::MatrixXd> es(m, false);
   Stability s;
   s.abscissa = 0.0;
   bool ok = es.info() == Eigen::Success;
-  for (int i = 0; i < size && ok; ++i) {
+  // The continuous criterion Re p < -margin max(1, |p|) applied to the
+  // equivalent s-plane poles p = log(z) / dt, so that a margin means the same
+  // in both loops whatever dt; z = 0 is the fastest possible decay.
+  for (int i = 0; i < size && es.info() == Eigen::Success; ++i) {  // every pole, even past an unstable one
     const std::complex<double> z = es.eigenvalues()(i);
     s.poles.push_back(z);
     s.abscissa = std::max(s.abscissa, std::abs(z));
+    if (!std::isfinite(std::abs(z)) || !(std::abs(z) < 1.0)) {
+      ok = false;
+    } else if (std::abs(z) > 0.0) {
+      const std::complex<double> p = std::log(z) / dt;
+      if (!(p.real() < -margin * std::max(1.0, std::abs(p)))) ok = false;
+    }
   }
-  s.stable = ok && std::isfinite(s.abscissa) && s.abscissa < 1.0 - margin;
+  s.stable = ok && std::isfinite(s.abscissa) && s.abscissa < 1.0;
   std::sort(s.poles.begin(), s.poles.end(),
             [](const auto& p, const auto& q) { return std::abs(p) != std::abs(q) ? std::abs(p) > std::abs(q) : p.imag() < q.imag(); });
   return s;

@@ -148,8 +148,9 @@ double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, do
 }
 
 double ContinuousFinalValue(const ContinuousClosedLoop<double>& loop) {
-  const int n = loop.loop_order();
-  const Eigen::VectorXd w = loop.m.topLeftCorner(n, n).partialPivLu().solve(-loop.m.block(0, n, n, 1));
+  const int n = EffectiveLoopOrder(loop);
+  const int ir = loop.plant_order + 1;  // the reference state
+  const Eigen::VectorXd w = loop.m.topLeftCorner(n, n).partialPivLu().solve(-loop.m.block(0, ir, n, 1));
   return loop.c.dot(w.head(loop.plant_order));
 }
 

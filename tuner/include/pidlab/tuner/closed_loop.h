@@ -45,8 +45,8 @@ struct LoopOptions {
   PidOptions pid;
   DisturbanceOptions disturbance;
   /// A loop is strictly stable when every closed-loop pole p has
-  /// Re p < -stability_margin * max(1, |p|) (continuous) or
-  /// |z| < 1 - stability_margin (sampled). Guards against loops that game the
+  /// Re p < -stability_margin * max(1, |p|), for the s-plane poles p of the
+  /// continuous loop or p = log(z) / dt of the sampled loop's eigenvalues z. Guards against loops that game the
   /// sampled objective with poles on the imaginary axis.
   double stability_margin = 1e-9;
 
@@ -144,7 +144,12 @@ bool BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
   return true;
 }
 
-/// Poles of the continuous loop (eigenvalues of its [x; z] block).
+/// Order of the loop without hidden modes: plant order + 1, or the plant
+/// order when ki = 0 (the integrator state is then disconnected).
+int EffectiveLoopOrder(const ContinuousClosedLoop<double>& loop);
+
+/// Poles of the continuous loop (eigenvalues of its [x; z] block, or of the
+/// x block when ki = 0).
 Stability ContinuousStability(const ContinuousClosedLoop<double>& loop, double margin);
 
 /// y at t = 0, ts, ..., (num_samples - 1) ts, exact. Piecewise-constant
