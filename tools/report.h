@@ -103,6 +103,8 @@ struct ReportOptions {
   std::function<bool(const Plant& plant, const PidGains& gains, double dt_s, Metrics* metrics,
                      std::string* note)>
       trio_runner;
+  /// What the trio section says when trio_runner is null.
+  std::string trio_absent_note = "the LCM trio runner was not available in this build";
 };
 
 struct ReportData {
