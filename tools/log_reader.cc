@@ -220,6 +220,38 @@ long NextMarker(FILE* f, long from) {
   return -1;
 }
 
+// One event read without LCM, for the events LCM's reader refuses.
+struct RawEvent {
+  int64_t eventnum = 0;
+  std::string channel;
+  std::vector<uint8_t> data;
+  long bytes = 0;  // whole event on disk
+};
+
+// Reads the event whose marker is at `at` if it lies wholly inside the file
+// and its lengths are sane (LCM's limits: channel 1..999 bytes).
+bool ReadRawEvent(FILE* f, long at, long file_bytes, RawEvent* ev) {
+  uint8_t h[28];
+  if (std::fseek(f, at, SEEK_SET) != 0 || std::fread(h, 1, sizeof h, f) != sizeof h) return false;
+  auto be = [&h](int from, int n) {
+    uint64_t v = 0;
+    for (int i = 0; i < n; ++i) v = (v << 8) | h[from + i];
+    return v;
+  };
+  if (be(0, 4) != 0xEDA1DA01u) return false;
+  const auto channel_len = static_cast<int32_t>(be(20, 4));
+  const auto data_len = static_cast<int32_t>(be(24, 4));
+  if (channel_len <= 0 || channel_len >= 1000 || data_len < 0) return false;
+  if (static_cast<long long>(at) + 28 + channel_len + data_len > file_bytes) return false;
+  ev->eventnum = static_cast<int64_t>(be(4, 8));
+  ev->channel.resize(static_cast<std::size_t>(channel_len));
+  ev->data.resize(static_cast<std::size_t>(data_len));
+  if (std::fread(&ev->channel[0], 1, ev->channel.size(), f) != ev->channel.size()) return false;
+  if (data_len > 0 && std::fread(ev->data.data(), 1, ev->data.size(), f) != ev->data.size()) return false;
+  ev->bytes = 28 + channel_len + data_len;
+  return true;
+}
+
 bool SameDisturbance(const DisturbanceOptions& a, const DisturbanceOptions& b) {
   return a.kind == b.kind && SameBits(a.amplitude, b.amplitude) && SameBits(a.period_s, b.period_s) &&
          SameBits(a.phase_s, b.phase_s) && SameBits(a.step_time_s, b.step_time_s) &&
@@ -291,49 +323,14 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
     return building.back();
   };
 
-  for (;;) {
-    const long start = std::ftell(f);
-    const lcm::LogEvent* ev = start >= 0 && start < out->file_bytes ? log.readNextEvent() : nullptr;
-    if (!ev) {
-      if (start < 0 || start >= out->file_bytes) break;
-      // Not a complete event at `start`: a malformed header, or the log was
-      // cut off. Resume at the next event marker if there is one.
-      out->clean_end = false;
-      std::clearerr(f);
-      const long next = NextMarker(f, start + 1);
-      std::ostringstream os;
-      if (next < 0) {
-        os << "the log ends with " << (out->file_bytes - start)
-           << " bytes that are not a complete event (from byte " << start
-           << "): it was cut off mid-write or its tail is corrupt; everything before was read";
-        out->notes.push_back(os.str());
-        out->bytes_read = start;
-        break;
-      }
-      os << "bytes " << start << ".." << next - 1 << " are not a readable event (corrupt); skipped";
-      unreadable.Add(os.str());
-      if (std::fseek(f, next, SEEK_SET) != 0) break;
-      continue;
-    }
-    const long end = std::ftell(f);
-    const long event_bytes = 4 + 8 + 8 + 4 + 4 + static_cast<long>(ev->channel.size()) + ev->datalen;
-    if (end - start > event_bytes) {
-      out->clean_end = false;
-      std::ostringstream os;
-      os << "bytes " << start << ".." << end - event_bytes - 1 << " between events are garbage; skipped";
-      unreadable.Add(os.str());
-    }
+  auto handle = [&](int64_t eventnum, const std::string& channel, const uint8_t* data, int size) {
     ++out->events;
-    out->bytes_read = std::ftell(f);
-    if (last_eventnum >= 0 && ev->eventnum != last_eventnum + 1) ++out->eventnum_gaps;
-    last_eventnum = ev->eventnum;
-    const std::string& channel = ev->channel;
+    if (last_eventnum >= 0 && eventnum != last_eventnum + 1) ++out->eventnum_gaps;
+    last_eventnum = eventnum;
     if (channel == "LCM_SELF_TEST") {
       ++out->self_test;
-      continue;
+      return;
     }
-    const auto* data = static_cast<const uint8_t*>(ev->data);
-    const int size = ev->datalen;
     int64_t hash = 0;
     if (size >= 8) {
       uint64_t h = 0;
@@ -354,7 +351,7 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
       } else {
         foreign.Add(channel);
       }
-      continue;
+      return;
     }
     std::string prefix = EndsWith(channel, type->suffix)
                              ? channel.substr(0, channel.size() - std::strlen(type->suffix))
@@ -364,7 +361,7 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
     // type, the suffix only the prefix.
     if (!options.channel_prefix.empty() && prefix != options.channel_prefix) {
       other_prefix.Add(prefix.empty() ? "(none)" : prefix);
-      continue;
+      return;
     }
     auto decode = [&](auto* msg) {
       if (!LayoutOk(type->name, data, size)) return false;
@@ -377,7 +374,7 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
     const std::string name = type->name;
     bool ok = true;
     if (name == "lcmt_episode_config") {
-      pidlab::lcmt_episode_config m;
+      pidlab::lcmt_episode_config m{};
       if ((ok = decode(&m))) {
         Building& b = episode_of(prefix, m.episode_id);
         if (!b.episode.has_config && b.episode.config_error.empty()) {
@@ -401,16 +398,16 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
         }
       }
     } else if (name == "lcmt_plant_output") {
-      pidlab::lcmt_plant_output m;
+      pidlab::lcmt_plant_output m{};
       if ((ok = decode(&m))) episode_of(prefix, m.episode_id).outputs.Add(m.step, {m.y, m.t_s, 0, -1});
     } else if (name == "lcmt_control_command") {
-      pidlab::lcmt_control_command m;
+      pidlab::lcmt_control_command m{};
       if ((ok = decode(&m))) episode_of(prefix, m.episode_id).commands.Add(m.step, {m.u, m.y, m.r, m.status});
     } else if (name == "lcmt_disturbance_sample") {
-      pidlab::lcmt_disturbance_sample m;
+      pidlab::lcmt_disturbance_sample m{};
       if ((ok = decode(&m))) episode_of(prefix, m.episode_id).disturbances.Add(m.step, {m.n, m.t_s, 0, -1});
     } else if (name == "lcmt_episode_summary") {
-      pidlab::lcmt_episode_summary m;
+      pidlab::lcmt_episode_summary m{};
       if ((ok = decode(&m))) {
         Episode& e = episode_of(prefix, m.episode_id).episode;
         e.has_summary = true;
@@ -419,24 +416,75 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
         e.summary_message = m.message;
       }
     } else if (name == "lcmt_trajectory_chunk") {
-      pidlab::lcmt_trajectory_chunk m;
+      pidlab::lcmt_trajectory_chunk m{};
       if ((ok = decode(&m))) {
         Building& b = episode_of(prefix, m.episode_id);
         for (int32_t i = 0; i < m.count; ++i)
           b.chunks.emplace(static_cast<long>(m.step) + i, StepRecord{m.y[i], m.u[i], m.n[i], -1});
       }
     } else if (name == "lcmt_ready") {
-      pidlab::lcmt_ready m;
+      pidlab::lcmt_ready m{};
       ok = decode(&m);
     } else if (name == "lcmt_trajectory_request") {
-      pidlab::lcmt_trajectory_request m;
+      pidlab::lcmt_trajectory_request m{};
       ok = decode(&m);
     }
     if (!ok) {
       decode_failed.Add(channel + " (" + name + ", " + std::to_string(size) + " bytes)");
-      continue;
+      return;
     }
     ++out->pidlab_messages;
+  };
+
+  auto garbage = [&](long from, long to) {
+    out->clean_end = false;
+    std::ostringstream os;
+    os << "bytes " << from << ".." << to - 1 << " between events are garbage; skipped";
+    unreadable.Add(os.str());
+  };
+  for (;;) {
+    const long start = std::ftell(f);
+    const lcm::LogEvent* ev = start >= 0 && start < out->file_bytes ? log.readNextEvent() : nullptr;
+    if (ev) {
+      const long end = std::ftell(f);
+      const long event_bytes = 4 + 8 + 8 + 4 + 4 + static_cast<long>(ev->channel.size()) + ev->datalen;
+      if (end - start > event_bytes) garbage(start, end - event_bytes);
+      out->bytes_read = end;
+      handle(ev->eventnum, ev->channel, static_cast<const uint8_t*>(ev->data), ev->datalen);
+      continue;
+    }
+    if (start < 0 || start >= out->file_bytes) break;
+    // LCM refuses an event that is not followed by another event marker (or
+    // the end of the file), and an event cut off or with a bad header. Read
+    // the event ourselves if it is whole, then resume at the next marker.
+    out->clean_end = false;
+    std::clearerr(f);
+    const long at = NextMarker(f, start);
+    RawEvent raw;
+    if (at >= 0 && ReadRawEvent(f, at, out->file_bytes, &raw)) {
+      if (at > start) garbage(start, at);
+      const long end = at + raw.bytes;
+      out->bytes_read = end;
+      handle(raw.eventnum, raw.channel, raw.data.data(), static_cast<int>(raw.data.size()));
+      const long next = NextMarker(f, end);
+      if (next > end) garbage(end, next);
+      if (next < 0 && end < out->file_bytes) garbage(end, out->file_bytes);
+      if (next < 0 || std::fseek(f, next, SEEK_SET) != 0) break;
+      continue;
+    }
+    const long next = NextMarker(f, (at >= 0 ? at : start) + 1);
+    std::ostringstream os;
+    if (next < 0) {
+      os << "the log ends with " << (out->file_bytes - start)
+         << " bytes that are not a complete event (from byte " << start
+         << "): it was cut off mid-write or its tail is corrupt; everything before was read";
+      out->notes.push_back(os.str());
+      out->bytes_read = start;
+      break;
+    }
+    os << "bytes " << start << ".." << next - 1 << " are not a readable event (corrupt); skipped";
+    unreadable.Add(os.str());
+    if (std::fseek(f, next, SEEK_SET) != 0) break;
   }
 
   // Assemble the episodes.
