@@ -343,11 +343,12 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
     if (!type) {
       bool pidlab_like = false;
       for (const auto& t : known) pidlab_like = pidlab_like || EndsWith(channel, t.suffix);
-      if (pidlab_like) {
+      if (pidlab_like && size < 8) {
+        decode_failed.Add(channel + " (" + std::to_string(size) + " bytes: too short for a fingerprint)");
+      } else if (pidlab_like) {
         char buf[40];
         std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(hash));
-        unknown_type.Add(channel + " (fingerprint " +
-                         std::string(size >= 8 ? buf : "none: payload < 8 bytes") + ")");
+        unknown_type.Add(channel + " (fingerprint " + std::string(buf) + ")");
       } else {
         foreign.Add(channel);
       }
