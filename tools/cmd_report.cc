@@ -36,7 +36,7 @@ std::string Quote(const std::string& s) {
 // and reads the evaluation back from its JSON. The trio's stderr goes to
 // <out>/trio.log.
 bool RunTrio(const std::string& log_path, const Plant& plant, const PidGains& g, double dt_s,
-             report::Metrics* metrics, std::string* note) {
+             double horizon_s, report::Metrics* metrics, std::string* note) {
   std::error_code ec;
   const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
   if (ec || self.empty()) {
@@ -45,11 +45,14 @@ bool RunTrio(const std::string& log_path, const Plant& plant, const PidGains& g,
   }
   char gains[128];
   std::snprintf(gains, sizeof gains, "%.17g,%.17g,%.17g", g.kp, g.ki, g.kd);
-  std::ostringstream dt;
+  std::ostringstream dt, horizon;
   dt.precision(17);
   dt << dt_s;
+  horizon.precision(17);
+  horizon << horizon_s;
   const std::string evaluate = Quote(self) + " evaluate --plant " + Quote(plant.name) + " --gains " + gains +
-                               " --loop sampled --dt " + dt.str() + " --backend lcm --json";
+                               " --loop sampled --dt " + dt.str() + " --horizon " + horizon.str() +
+                               " --backend lcm --json";
   const std::string command =
       Quote(self) + " launch --isolated -- " + evaluate + " 2>" + Quote(log_path) + " </dev/null";
   FILE* pipe = popen(command.c_str(), "r");
@@ -84,7 +87,7 @@ bool RunTrio(const std::string& log_path, const Plant& plant, const PidGains& g,
   *note =
       "one episode over the LCM trio (pidlab-plant, pidlab-controller, pidlab-disturbance) in a private "
       "network namespace, `pidlab launch --isolated -- pidlab evaluate --backend lcm --loop sampled --dt " +
-      dt.str() + " --json`";
+      dt.str() + " --horizon " + horizon.str() + " --json`";
   return true;
 }
 
@@ -127,8 +130,10 @@ struct ReportCommand {
     options.trio_absent_note = no_trio ? "skipped (--no-trio)" : "skipped (--quick)";
     if (!no_trio && !quick) {
       const std::string log = (std::filesystem::path(out_dir) / "trio.log").string();
-      options.trio_runner = [log](const Plant& plant, const PidGains& g, double dt_s, report::Metrics* m,
-                                  std::string* note) { return RunTrio(log, plant, g, dt_s, m, note); };
+      options.trio_runner = [log](const Plant& plant, const PidGains& g, double dt_s, double horizon_s,
+                                  report::Metrics* m, std::string* note) {
+        return RunTrio(log, plant, g, dt_s, horizon_s, m, note);
+      };
     }
     std::vector<report::PaperRow> paper;
     std::string error;

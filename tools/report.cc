@@ -656,7 +656,8 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
   if (options.trio_runner) {
     trio = std::async(std::launch::async, [&] {
       try {
-        return options.trio_runner(BuiltinPlant("stepper_motor"), s.gains, s.dt_s, &trio_metrics, &trio_note);
+        return options.trio_runner(BuiltinPlant("stepper_motor"), s.gains, s.dt_s, s.trio_horizon_s,
+                                   &trio_metrics, &trio_note);
       } catch (const std::exception& e) {
         trio_note = e.what();
         return false;
@@ -732,6 +733,11 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
     Evaluation ev;
     if (!Evaluate(stepper, s.gains, sampled, what, &ev, error)) return false;
     FillFromEvaluation(ev, &s.sampled_in_process);
+    LoopOptions short_horizon = sampled;
+    short_horizon.horizon_s = s.trio_horizon_s;
+    Evaluation same_as_trio;
+    if (!Evaluate(stepper, s.gains, short_horizon, what, &same_as_trio, error)) return false;
+    FillFromEvaluation(same_as_trio, &s.sampled_trio_horizon);
     sampled.dt_s = s.fine_dt_s;
     Evaluation fine;
     if (!Evaluate(stepper, s.gains, sampled, what, &fine, error)) return false;
@@ -838,18 +844,26 @@ std::string RenderMarkdown(const ReportData& data) {
      << "| sampled, in-process, dt = " << Num(s.fine_dt_s) << " s | "
      << (s.sampled_fine.stable ? "yes" : "no") << " | " << MetricsCells(s.sampled_fine) << " |\n";
   if (s.trio_ran) {
-    os << "| sampled, LCM trio, dt = " << Num(s.dt_s) << " s | " << (s.trio.stable ? "yes" : "no") << " | "
-       << MetricsCells(s.trio) << " |\n";
+    os << "| sampled, in-process, dt = " << Num(s.dt_s) << " s, horizon " << Num(s.trio_horizon_s) << " s | "
+       << (s.sampled_trio_horizon.stable ? "yes" : "no") << " | " << MetricsCells(s.sampled_trio_horizon)
+       << " |\n"
+       << "| sampled, LCM trio, dt = " << Num(s.dt_s) << " s, horizon " << Num(s.trio_horizon_s) << " s | "
+       << (s.trio.stable ? "yes" : "no") << " | " << MetricsCells(s.trio) << " |\n";
   }
   os << "\n"
      << (s.trio_ran ? "Trio run: " : "**The LCM trio run was not available**: ") << s.trio_note << ".";
   if (s.trio_ran) {
     const Metrics& a = s.trio;
-    const Metrics& b = s.sampled_in_process;
+    const Metrics& b = s.sampled_trio_horizon;
     const bool identical = a.stable == b.stable && a.iae == b.iae && a.rise_time_s == b.rise_time_s &&
                            a.overshoot_pct == b.overshoot_pct && a.settling_time_s == b.settling_time_s;
-    os << (identical
-               ? std::string(" Its IAE and step metrics equal the in-process sampled loop's bit for bit.")
+    os << " The episode covers " << Num(s.trio_horizon_s)
+       << " s instead of the paper's 25 s to keep the report "
+          "under a minute (one lockstep step over LCM costs about 0.13 ms here); the slow tail after it adds "
+       << Num(std::abs(s.sampled_in_process.iae - s.sampled_trio_horizon.iae), 3) << " to the IAE."
+       << (identical
+               ? std::string(" Its IAE and step metrics equal the in-process sampled loop's on the same "
+                             "horizon bit for bit.")
                : " **Its results differ from the in-process sampled loop's** (IAE " + Num(a.iae, 17) +
                      " vs " + Num(b.iae, 17) + ").");
   }

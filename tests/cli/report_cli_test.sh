@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# pidlab report, end to end: the full report (trio included) in under 60 s,
+# every figure it links exists and is a PNG, bad input exits 2 naming the path.
+# usage: report_cli_test.sh PIDLAB PAPER_TABLES
+set -u
+pidlab=$1
+tables=$2
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+start=$(date +%s.%N)
+"$pidlab" report --out "$out/r" --paper-tables "$tables" --seed 1 > "$out/stdout" 2> "$out/stderr" \
+  || { cat "$out/stderr"; fail "pidlab report exited $?"; }
+elapsed=$(echo "$(date +%s.%N) - $start" | bc)
+echo "pidlab report took $elapsed s: $(cat "$out/stdout")"
+(( $(echo "$elapsed < 60" | bc) )) || fail "took $elapsed s (limit 60 s)"
+
+md="$out/r/report.md"
+[[ -s $md ]] || fail "no report.md"
+for t in II III IV V VI; do grep -q "^### Table $t:" "$md" || fail "Table $t missing"; done
+grep -q "Trio run:" "$md" || fail "the LCM trio section did not run: $(grep -A1 'trio run was not' "$md")"
+grep -q "bit for bit" "$md" || fail "trio result differs from the in-process sampled loop"
+
+figures=$(grep -o '](fig[^)]*\.png)' "$md" | sed 's/^](//; s/)$//')
+count=$(echo "$figures" | grep -c png)
+(( count == 7 )) || fail "expected 7 figures linked, found $count"
+for f in $figures; do
+  [[ -s "$out/r/$f" ]] || fail "figure $f listed but missing"
+  sig=$(head -c 8 "$out/r/$f" | od -An -tx1 | tr -d ' \n')
+  [[ $sig == 89504e470d0a1a0a ]] || fail "$f is not a PNG (signature $sig)"
+done
+
+"$pidlab" report --out "$out/bad" --paper-tables /nonexistent/paper_tables.csv > /dev/null 2> "$out/err"
+status=$?
+(( status == 2 )) || fail "missing tables: exit $status, expected 2"
+grep -q "/nonexistent/paper_tables.csv" "$out/err" || fail "error does not name the path: $(cat "$out/err")"
+echo PASS

@@ -1,0 +1,137 @@
+// The paper report's data: the re-evaluation of the published gains must
+// reproduce paper_tables.csv's ref_* columns, every table and tuning must be
+// in the Markdown, and the report must be deterministic for a seed.
+
+#include "report.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+namespace pidlab::report {
+namespace {
+
+const char* const kPaperTables = PIDLAB_PAPER_TABLES;
+
+ReportData QuickReport(std::uint64_t seed) {
+  std::vector<PaperRow> paper;
+  std::string error;
+  EXPECT_TRUE(ReadPaperTables(kPaperTables, &paper, &error)) << error;
+  ReportOptions options;
+  options.paper_tables = kPaperTables;
+  options.quick = true;
+  options.figures = false;
+  options.seed = seed;
+  ReportData data;
+  EXPECT_TRUE(ComputeReport(options, paper, &data, &error)) << error;
+  return data;
+}
+
+void ExpectRel(double expected, double actual, double rel, double abs, const std::string& what) {
+  EXPECT_LE(std::abs(expected - actual), std::max(abs, rel * std::abs(expected)))
+      << what << ": reference " << expected << ", report " << actual;
+}
+
+TEST(Report, ReEvaluationMatchesReferenceColumns) {
+  const ReportData data = QuickReport(1);
+  ASSERT_EQ(data.rows.size(), 13u);
+  for (const RowResult& r : data.rows) {
+    const std::string what = r.paper.table + " " + r.paper.plant + " " + r.paper.method;
+    ASSERT_TRUE(r.pidlab.stable) << what;
+    ExpectRel(r.paper.ref_iae, r.pidlab.iae, 1e-6, 0.0, what + " IAE");
+    ExpectRel(r.paper.ref_rise_time_s, r.pidlab.rise_time_s, 1e-4, 0.0, what + " rise");
+    ExpectRel(r.paper.ref_overshoot_pct, r.pidlab.overshoot_pct, 1e-4, 1e-4, what + " overshoot");
+    ExpectRel(r.paper.ref_settling_time_s, r.pidlab.settling_time_s, 1e-4, 0.0, what + " settling");
+  }
+}
+
+TEST(Report, StepperSettlingDifferencesAreExplained) {
+  const ReportData data = QuickReport(1);
+  int explained = 0;
+  for (const RowResult& r : data.rows) {
+    if (r.paper.plant != "stepper_motor" || r.paper.method != "nelder_mead") continue;
+    bool found = false;
+    for (const std::string& d : r.differences) found |= d.find("settling time") != std::string::npos;
+    EXPECT_TRUE(found) << "Table " << r.paper.table << " +/-" << r.paper.disturbance_amplitude;
+    ++explained;
+  }
+  EXPECT_EQ(explained, 6);
+}
+
+TEST(Report, MarkdownListsEveryTableTuningAndSection) {
+  const ReportData data = QuickReport(1);
+  const std::string md = RenderMarkdown(data);
+  for (const char* table :
+       {"### Table II:", "### Table III:", "### Table IV:", "### Table V:", "### Table VI:"})
+    EXPECT_NE(md.find(table), std::string::npos) << table;
+  for (const char* plant : {"double_integrator", "oscillator", "stepper_motor"}) {
+    for (TuneMethod m : {TuneMethod::kNelderMead, TuneMethod::kPaperNelderMead, TuneMethod::kZieglerNichols,
+                         TuneMethod::kGeneticAlgorithm, TuneMethod::kPsoGsa}) {
+      bool found = false;
+      for (const Tuning& t : data.tunings)
+        found |= t.plant == plant && t.method == m && t.disturbance_amplitude == 0.0;
+      EXPECT_TRUE(found) << plant << " " << ToString(m);
+    }
+  }
+  // Ziegler-Nichols is reported as not applicable on 1/s^2, applicable on the stepper.
+  for (const Tuning& t : data.tunings) {
+    if (t.method != TuneMethod::kZieglerNichols) continue;
+    EXPECT_EQ(t.ok, t.plant == "stepper_motor") << t.plant << ": " << t.message;
+    if (t.ok)
+      EXPECT_EQ(t.summary.refine.verdict, "not run");
+    else
+      EXPECT_NE(t.message.find("no finite ultimate gain"), std::string::npos) << t.message;
+  }
+  for (const Tuning& t : data.tunings) {
+    if (t.ok && t.method != TuneMethod::kZieglerNichols)
+      EXPECT_TRUE(t.summary.refine.ran) << ToString(t.method);
+  }
+  EXPECT_NE(md.find("## Stepper motor on the sampled loop"), std::string::npos);
+  EXPECT_NE(md.find("The LCM trio run was not available"), std::string::npos);  // no runner in this test
+  EXPECT_NE(md.find("2 % band"), std::string::npos);
+}
+
+TEST(Report, DeterministicForASeed) {
+  EXPECT_EQ(RenderMarkdown(QuickReport(7)), RenderMarkdown(QuickReport(7)));
+}
+
+TEST(Report, MissingPaperTablesNamesThePath) {
+  std::vector<PaperRow> rows;
+  std::string error;
+  EXPECT_FALSE(ReadPaperTables("/nonexistent/paper_tables.csv", &rows, &error));
+  EXPECT_NE(error.find("/nonexistent/paper_tables.csv"), std::string::npos) << error;
+}
+
+TEST(Report, BadNumberNamesLineAndColumn) {
+  const std::string path = ::testing::TempDir() + "/bad_paper_tables.csv";
+  {
+    std::ofstream out(path);
+    out << "table,plant,method,disturbance_amplitude,kp,ki,kd,paper_rise_time_s,paper_overshoot_pct,"
+           "paper_settling_time_s,paper_iae,ref_rise_time_s,ref_overshoot_pct,ref_settling_time_s,ref_iae\n"
+        << "II,double_integrator,nelder_mead,,29.6,zero,28.3,1,1,1,1,1,1,1,1\n";
+  }
+  std::vector<PaperRow> rows;
+  std::string error;
+  EXPECT_FALSE(ReadPaperTables(path, &rows, &error));
+  EXPECT_NE(error.find("line 2"), std::string::npos) << error;
+  EXPECT_NE(error.find("ki"), std::string::npos) << error;
+  std::remove(path.c_str());
+}
+
+TEST(Report, MissingColumnIsNamed) {
+  const std::string path = ::testing::TempDir() + "/short_paper_tables.csv";
+  {
+    std::ofstream out(path);
+    out << "table,plant,method,kp,ki,kd\nII,double_integrator,nelder_mead,1,2,3\n";
+  }
+  std::vector<PaperRow> rows;
+  std::string error;
+  EXPECT_FALSE(ReadPaperTables(path, &rows, &error));
+  EXPECT_NE(error.find("missing column"), std::string::npos) << error;
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace pidlab::report
