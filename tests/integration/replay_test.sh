@@ -138,7 +138,7 @@ for panel, col in (("p0_s1", "y"), ("p2_s0", "u")):
 print("png", w, "x", h, "data match")
 PY
 then
-  pass "plot --log draws a ${id} PNG of the requested size from the logged data"
+  pass "plot --log draws episode ${id}: PNG of the requested size, data = the logged trajectory"
 else
   fail "plot --log: $(cat plot.err)"
 fi
