@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs, from Debian 12 packages, whatever pidlab needs and the machine
 # lacks. Safe to run again: it installs only missing packages.
-#   scripts/install-deps.sh [--with-java]   (--with-java: JDK for tools/lcm-spy)
+#   scripts/install-deps.sh [--no-java]   (--no-java: skip the JDK that tools/lcm-spy needs)
 set -euo pipefail
 
 packages=(
@@ -12,17 +12,23 @@ packages=(
   libcli11-dev nlohmann-json3-dev
   gnuplot-nox
   iproute2 util-linux python3
+  default-jdk-headless liblcm-java
 )
+no_java=0
 for arg in "$@"; do
   case "$arg" in
-    --with-java) packages+=(default-jdk-headless liblcm-java) ;;
+    --no-java) no_java=1 ;;
     -h|--help) sed -n '2,5p' "$0"; exit 0 ;;
     *) echo "install-deps.sh: error: unknown option '$arg'" >&2; exit 2 ;;
   esac
 done
 
+if [ "$no_java" -eq 1 ]; then
+  packages=("${packages[@]/default-jdk-headless}"); packages=("${packages[@]/liblcm-java}")
+fi
 missing=()
 for p in "${packages[@]}"; do
+  [ -n "$p" ] || continue
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -eq 0 ]; then
