@@ -354,9 +354,12 @@ struct LaunchCommand {
           break;
         }
         if (!forwarded) {
-          kill(cmd, SIGINT);
           forwarded = true;
+          // Ctrl-C reaches COMMAND as SIGINT; it gets 2 s to finish.
           if (!launcher.StopChild(cmd, SIGINT, 2.0)) launcher.StopChild(cmd, SIGKILL, 1.0);
+          const Launcher::Child* c = launcher.Find(cmd);
+          result = c && !c->alive ? ExitCodeOf(c->status) : 128 + g_signal;
+          break;
         }
       }
       transport.WaitAndHandle(0.02);
