@@ -60,6 +60,20 @@ std::string TuneSummary::BriefReport() const {
   return os.str();
 }
 
+namespace {
+
+// The seed and the budgets of TuneOptions (0 = the method's default) applied
+// to one optimiser's options.
+template <typename Options>
+Options WithBudget(Options o, const TuneOptions& t, int Options::*iterations) {
+  o.seed = t.seed;
+  if (t.max_iterations > 0) o.*iterations = t.max_iterations;
+  if (t.max_evaluations > 0) o.max_evaluations = t.max_evaluations;
+  return o;
+}
+
+}  // namespace
+
 bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
           const ProgressCallback& progress, const SampledRunner& runner) {
   if (!options.IsValid(error)) return false;
@@ -89,39 +103,26 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   OptimizerSummary& opt = summary->optimizer;
   switch (options.method) {
     case TuneMethod::kNelderMead: {
-      NelderMeadOptions o;
+      NelderMeadOptions o = WithBudget(NelderMeadOptions{}, options, &NelderMeadOptions::max_iterations);
       o.starts = options.starts;
-      o.seed = options.seed;
-      if (options.max_iterations > 0) o.max_iterations = options.max_iterations;
-      if (options.max_evaluations > 0) o.max_evaluations = options.max_evaluations;
       NelderMead(f, bounds, o, &opt, progress);
       break;
     }
     case TuneMethod::kPaperNelderMead: {
-      PaperNelderMeadOptions o;
+      PaperNelderMeadOptions o =
+          WithBudget(PaperNelderMeadOptions{}, options, &PaperNelderMeadOptions::max_iterations);
       o.starts = options.starts;
-      o.seed = options.seed;
-      if (options.max_iterations > 0) o.max_iterations = options.max_iterations;
-      if (options.max_evaluations > 0) o.max_evaluations = options.max_evaluations;
       PaperNelderMead(f, bounds, o, &opt, progress);
       break;
     }
-    case TuneMethod::kGeneticAlgorithm: {
-      GeneticAlgorithmOptions o;
-      o.seed = options.seed;
-      if (options.max_iterations > 0) o.max_generations = options.max_iterations;
-      if (options.max_evaluations > 0) o.max_evaluations = options.max_evaluations;
-      GeneticAlgorithm(f, bounds, o, &opt, progress);
+    case TuneMethod::kGeneticAlgorithm:
+      GeneticAlgorithm(f, bounds,
+                       WithBudget(GeneticAlgorithmOptions{}, options, &GeneticAlgorithmOptions::max_generations),
+                       &opt, progress);
       break;
-    }
-    case TuneMethod::kPsoGsa: {
-      PsoGsaOptions o;
-      o.seed = options.seed;
-      if (options.max_iterations > 0) o.max_iterations = options.max_iterations;
-      if (options.max_evaluations > 0) o.max_evaluations = options.max_evaluations;
-      PsoGsa(f, bounds, o, &opt, progress);
+    case TuneMethod::kPsoGsa:
+      PsoGsa(f, bounds, WithBudget(PsoGsaOptions{}, options, &PsoGsaOptions::max_iterations), &opt, progress);
       break;
-    }
     case TuneMethod::kZieglerNichols: {
       if (!ZieglerNicholsTune(plant.tf, options.zn_rule, &summary->ziegler_nichols, error)) return false;
       const PidGains& g = summary->ziegler_nichols.gains;
