@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -101,8 +102,13 @@ struct TuneCommand {
     }
 
     const bool tty = isatty(STDERR_FILENO) != 0;
-    ProgressCallback progress = [tty](const TracePoint& tp) {
+    // Progress on a terminal, at most ten lines a second; silent otherwise.
+    auto last = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+    ProgressCallback progress = [tty, &last](const TracePoint& tp) {
       if (!tty) return;
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last < std::chrono::milliseconds(100)) return;
+      last = now;
       std::fprintf(stderr, "\r  iteration %5d  evaluations %6d  best %.6g   ", tp.iteration, tp.evaluations,
                    tp.best_f);
       std::fflush(stderr);
