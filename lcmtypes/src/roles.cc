@@ -101,6 +101,16 @@ PlantRole::PlantRole(Transport* transport, LogFn log, bool verbose)
 PlantRole::~PlantRole() = default;
 
 void PlantRole::StartEpisode(const EpisodeSpec& spec) {
+  if (ep_) {  // keep the previous trajectory for late TRAJECTORY_REQUESTs (pidlab launch --log)
+    auto bytes = [](const Episode& e) { return 3 * sizeof(double) * e.y_hist.size(); };
+    ep_->plant.reset();
+    history_bytes_ += bytes(*ep_);
+    history_.push_back(std::move(ep_));
+    while (history_.size() > 1 && history_bytes_ > kPlantHistoryBytes) {
+      history_bytes_ -= bytes(*history_.front());
+      history_.pop_front();
+    }
+  }
   auto ep = std::make_unique<Episode>();
   ep->spec = spec;
   ep->plant = std::make_unique<DiscretePlant>(spec.plant.tf, spec.options.dt_s);
@@ -201,21 +211,29 @@ void PlantRole::Finish(bool ok, const std::string& silent_role, const std::strin
   Log(os.str());
 }
 
+const PlantRole::Episode* PlantRole::FindEpisode(int64_t episode_id) const {
+  if (ep_ && ep_->spec.episode_id == episode_id) return ep_.get();
+  for (auto it = history_.rbegin(); it != history_.rend(); ++it)
+    if ((*it)->spec.episode_id == episode_id) return it->get();
+  return nullptr;
+}
+
 void PlantRole::OnTrajectoryRequest(const pidlab::lcmt_trajectory_request& m) {
-  if (!ep_ || m.episode_id != ep_->spec.episode_id) {
+  const Episode* ep = FindEpisode(m.episode_id);
+  if (!ep) {
     ++counters_.foreign;
     return;
   }
   const long first = std::max<long>(0, static_cast<long>(m.step));
-  const long last = std::min<long>({first + std::min<long>(m.count, kMaxChunk), ep_->k + 1});
+  const long last = std::min<long>({first + std::min<long>(m.count, kMaxChunk), ep->k + 1});
   if (last <= first) return;
   pidlab::lcmt_trajectory_chunk c;
   c.episode_id = m.episode_id;
   c.step = first;
   c.count = static_cast<int32_t>(last - first);
-  c.y.assign(ep_->y_hist.begin() + first, ep_->y_hist.begin() + last);
-  c.u.assign(ep_->u_hist.begin() + first, ep_->u_hist.begin() + last);
-  c.n.assign(ep_->n_hist.begin() + first, ep_->n_hist.begin() + last);
+  c.y.assign(ep->y_hist.begin() + first, ep->y_hist.begin() + last);
+  c.u.assign(ep->u_hist.begin() + first, ep->u_hist.begin() + last);
+  c.n.assign(ep->n_hist.begin() + first, ep->n_hist.begin() + last);
   transport_->Publish(kTrajectoryChannel, &c);
 }
 

@@ -15,6 +15,8 @@
 // naming the silent process(es).
 
 #include <csignal>
+#include <cstddef>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -75,6 +77,14 @@ class Role {
   void OnReady(const pidlab::lcmt_ready& msg);
 };
 
+/// The plant answers TRAJECTORY_REQUEST for its current episode and for
+/// finished ones it still holds: the trajectories (y, u, n) of the most
+/// recent episodes are kept up to this many bytes in total (24 bytes a step:
+/// 64 MiB hold about 2.8 million steps), the oldest dropped first; the last
+/// finished episode is always kept. `pidlab launch --log` relies on this to
+/// repair its log after COMMAND (docs/trio.md).
+inline constexpr std::size_t kPlantHistoryBytes = std::size_t{64} << 20;
+
 class PlantRole : public Role {
  public:
   PlantRole(Transport* transport, LogFn log = {}, bool verbose = false);
@@ -95,7 +105,10 @@ class PlantRole : public Role {
   void Finish(bool ok, const std::string& silent_role, const std::string& message);
 
   struct Episode;
+  const Episode* FindEpisode(int64_t episode_id) const;
   std::unique_ptr<Episode> ep_;
+  std::deque<std::unique_ptr<Episode>> history_;  // finished or abandoned episodes, oldest first
+  std::size_t history_bytes_ = 0;
   bool running_ = false;
 };
 
