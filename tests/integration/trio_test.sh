@@ -2,7 +2,7 @@
 # Integration tests of the LCM trio. Run by ctest as
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
-# ever sent outside its loopback. CASE: identity | faults | kill | stranger | log.
+# ever sent outside its loopback. CASE: identity | faults | kill | stranger | log | log_repair.
 set -u
 BIN=$1
 CASE=$2
@@ -98,6 +98,46 @@ case $CASE in
       pidlab evaluate --backend lcm --plant oscillator --gains 3,1,1 --horizon 10 --disturbance square \
       --disturbance-amplitude 0.2 >/dev/null || fail=1
     "$BIN/trio_log_check" "$TMP/run.lcmlog" || fail=1
+    ;;
+  log_repair)
+    # Force lcm-logger to lose messages: SIGSTOP it for 1 s mid-episode (its
+    # socket buffer overflows). launch must repair the log from the plant's
+    # trajectory chunks, say so, and hand over a log holding every step.
+    EVAL="pidlab evaluate --backend lcm --plant oscillator --gains 3,1,1 --horizon 10 --disturbance square --disturbance-amplitude 0.2"
+    export EVAL
+    rm -f "$TMP/run.lcmlog"
+    "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/run.lcmlog" -- bash -c '
+      ni=$(awk "{print \$19}" /proc/$PIDLAB_LOGGER_PID/stat)
+      [ "$ni" = -10 ] || { echo "FAIL lcm-logger runs at nice $ni, not -10"; exit 1; }
+      $EVAL >/dev/null & e=$!
+      sleep 0.3; kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
+      wait $e' 2>"$TMP/launch.err" || { echo "FAIL launch: $(grep -v "^pidlab-" "$TMP/launch.err")"; fail=1; }
+    if grep -q "repaired .* from the plant's trajectory chunks" "$TMP/launch.err"; then
+      echo "ok   $(grep -o "lcm-logger lost messages.*" "$TMP/launch.err")"
+    else
+      echo "FAIL launch did not report a repair (did stopping the logger lose nothing?)"; fail=1
+    fi
+    "$BIN/trio_log_check" "$TMP/run.lcmlog" || fail=1
+    "$BIN/trio_log_check" "$TMP/run.lcmlog" | grep -q "[1-9][0-9]* from chunks" ||
+      { echo "FAIL no step of the log came from trajectory chunks"; fail=1; }
+    "$PIDLAB" replay "$TMP/run.lcmlog" >"$TMP/replay.txt" 2>&1 && ! grep -q INCOMPLETE "$TMP/replay.txt" &&
+      grep -q "filled from trajectory chunks" "$TMP/replay.txt" ||
+      { echo "FAIL pidlab replay does not call the repaired log complete:"; head -12 "$TMP/replay.txt"; fail=1; }
+
+    # The same loss with the plant killed after the episode: nobody can repair
+    # the log, and launch must fail with one line naming episode and steps.
+    rm -f "$TMP/run2.lcmlog"
+    rc=0
+    "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/run2.lcmlog" -- bash -c '
+      $EVAL >/dev/null & e=$!
+      sleep 0.3; kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
+      wait $e; s=$?; kill -9 $PIDLAB_PLANT_PID; exit $s' 2>"$TMP/launch2.err" || rc=$?
+    line=$(grep "is incomplete: episode [0-9]* misses [0-9]* steps" "$TMP/launch2.err")
+    if [ $rc -ne 0 ] && [ -n "$line" ] && grep -q "did not resend" <<<"$line"; then
+      echo "ok   unrepairable log: launch exit $rc: ${line:0:200}"
+    else
+      echo "FAIL unrepairable log: launch exit $rc, stderr: $(grep -v "^pidlab-" "$TMP/launch2.err" | head -5)"; fail=1
+    fi
     ;;
   *)
     echo "unknown case $CASE"; exit 2 ;;
