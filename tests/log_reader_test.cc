@@ -14,6 +14,8 @@
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <pidlab/lcmt_control_command.hpp>
+#include <pidlab/lcmt_disturbance_block.hpp>
+#include <pidlab/lcmt_disturbance_request.hpp>
 #include <pidlab/lcmt_disturbance_sample.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
@@ -85,6 +87,11 @@ struct EpisodeWriter {
   long duplicate_step = -1;      // resend this step's three messages
   long swap_step = -1;           // write step k+1 before step k
   bool with_config = true;
+  // Disturbance as the trio sends it now: lcmt_disturbance_block of at most
+  // 128 samples, requested ahead by the plant (false: one
+  // lcmt_disturbance_sample per step, as in older logs).
+  bool blocks = false;
+  long lose_block = -1;  // with blocks: this block (index) is not in the log
 
   void WriteStep(lcm::LogFile* log, long k, int64_t* num) const {
     const int64_t utime = 1700000000000000 + k;
@@ -107,6 +114,7 @@ struct EpisodeWriter {
     u.u = k == alter_command_step ? std::nextafter(s.u, HUGE_VAL) : s.u;
     u.status = 0;
     WriteMsg(log, prefix + "CONTROL", u, num);
+    if (blocks) return;
     pidlab::lcmt_disturbance_sample n{};
     n.utime = utime;
     n.episode_id = episode_id;
@@ -122,6 +130,23 @@ struct EpisodeWriter {
                                                       ref.options.disturbance, lcm_trio::RecoveryOptions{});
       WriteMsg(log, prefix + "EPISODE_CONFIG", config, num);
       WriteMsg(log, prefix + "EPISODE_CONFIG", config, num);  // republished until acknowledged
+    }
+    if (blocks) {
+      const long total = ref.total_steps();
+      pidlab::lcmt_disturbance_request r{};
+      r.episode_id = episode_id;
+      r.step = 0;
+      r.samples = static_cast<int32_t>(total);
+      WriteMsg(log, prefix + "DISTURBANCE_REQUEST", r, num);
+      for (long first = 0, index = 0; first < total; first += 32, ++index) {
+        pidlab::lcmt_disturbance_block b{};
+        b.episode_id = episode_id;
+        b.step = first;
+        b.dt_s = ref.options.dt_s;
+        b.count = static_cast<int32_t>(std::min<long>(32, total - first));
+        for (long k = first; k < first + b.count; ++k) b.n.push_back(ref.trajectory[static_cast<std::size_t>(k)].n);
+        if (index != lose_block) WriteMsg(log, prefix + "DISTURBANCE_BLOCK", b, num);
+      }
     }
     for (long k = 0; k <= ref.total_steps(); ++k) {
       if (k == swap_step) {
@@ -392,6 +417,50 @@ TEST_F(LogReaderTest, AFileThatIsNotALogIsRefused) {
   EXPECT_NE(error.find("not an LCM log"), std::string::npos) << error;
   EXPECT_FALSE(ReadLog((dir_ / "missing.lcmlog").string(), ReadOptions{}, &contents, &error));
   EXPECT_NE(error.find("cannot be opened"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace pidlab::replay
+
+namespace pidlab::replay {
+namespace {
+
+TEST_F(LogReaderTest, DisturbanceBlocksRebuildEveryStepAndALostBlockIsNamed) {
+  const Reference ref;
+  {
+    lcm::LogFile log(path_, "w");
+    int64_t num = 0;
+    EpisodeWriter w{ref};
+    w.blocks = true;
+    w.Write(&log, &num);
+  }
+  {
+    const LogContents dut = Read();
+    ASSERT_EQ(dut.episodes.size(), 1u);
+    const Episode& e = dut.episodes[0];
+    EXPECT_TRUE(e.Complete()) << e.CompletenessNote();
+    EXPECT_EQ(e.disturbances.received, 100);
+    Evaluation ev;
+    std::string error;
+    ASSERT_TRUE(EvaluateEpisode(e, &ev, &error)) << error;
+    EXPECT_EQ(ev.iae, ref.evaluation.iae);
+    ASSERT_EQ(ev.trajectory.size(), ref.trajectory.size());
+    for (std::size_t k = 0; k < ev.trajectory.size(); ++k) EXPECT_EQ(ev.trajectory[k].n, ref.trajectory[k].n) << k;
+  }
+  {
+    lcm::LogFile log(path_, "w");
+    int64_t num = 0;
+    EpisodeWriter w{ref};
+    w.blocks = true;
+    w.lose_block = 1;  // steps 32..63
+    w.Write(&log, &num);
+  }
+  const LogContents dut = Read();
+  ASSERT_EQ(dut.episodes.size(), 1u);
+  const Episode& e = dut.episodes[0];
+  EXPECT_FALSE(e.Complete());
+  ASSERT_EQ(e.disturbances.missing.size(), 1u);
+  EXPECT_EQ(e.disturbances.missing[0], std::make_pair(32L, 63L));
 }
 
 }  // namespace

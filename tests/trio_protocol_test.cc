@@ -43,7 +43,7 @@ struct Recorder {
 
 /// Runs one episode through the three roles on memq:// and returns y_0..y_N.
 bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* controller_counters = nullptr,
-               bool with_controller = true) {
+               bool with_controller = true, bool with_disturbance = true) {
   lcm::LCM lcm("memq://");
   EXPECT_TRUE(lcm.good());
   TransportOptions topt;
@@ -54,7 +54,8 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
   PlantRole plant(&plant_t);
   std::unique_ptr<ControllerRole> controller;
   if (with_controller) controller = std::make_unique<ControllerRole>(drop_rate > 0 ? &controller_t2 : &controller_t);
-  DisturbanceRole disturbance(&disturbance_t);
+  std::unique_ptr<DisturbanceRole> disturbance;
+  if (with_disturbance) disturbance = std::make_unique<DisturbanceRole>(&disturbance_t);
   const long total = e.options.TotalSteps();
   rec->y.assign(static_cast<std::size_t>(total + 1), 0.0);
   rec->have.assign(static_cast<std::size_t>(total + 1), 0);
@@ -80,7 +81,7 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
     const double now = NowSeconds();
     plant.Tick(now);
     if (controller) controller->Tick(now);
-    disturbance.Tick(now);
+    if (disturbance) disturbance->Tick(now);
   }
   if (controller_counters && controller) *controller_counters = controller->counters();
   return rec->summary && rec->last.status == pidlab::lcmt_episode_summary::OK;
@@ -223,6 +224,19 @@ TEST(Trio, NamesTheSilentControllerAfterTheDeadline) {
   EXPECT_EQ(rec.last.status, pidlab::lcmt_episode_summary::FAILED);
   EXPECT_EQ(rec.last.silent_role, "controller");
   EXPECT_NE(rec.last.message.find("pidlab-controller"), std::string::npos) << rec.last.message;
+  EXPECT_EQ(rec.last.step, 0);
+}
+
+TEST(Trio, NamesTheSilentDisturbanceAfterTheDeadline) {
+  // n comes in blocks requested ahead; without any, the plant cannot take
+  // step 0 and must name the disturbance, not the controller.
+  const Episode e = DoubleIntegrator();
+  Recorder rec;
+  EXPECT_FALSE(RunOnMemq(e, 0.0, &rec, nullptr, /*with_controller=*/true, /*with_disturbance=*/false));
+  ASSERT_TRUE(rec.summary);
+  EXPECT_EQ(rec.last.status, pidlab::lcmt_episode_summary::FAILED);
+  EXPECT_EQ(rec.last.silent_role, "disturbance");
+  EXPECT_NE(rec.last.message.find("pidlab-disturbance"), std::string::npos) << rec.last.message;
   EXPECT_EQ(rec.last.step, 0);
 }
 

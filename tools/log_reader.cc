@@ -9,6 +9,8 @@
 #include <iomanip>
 #include <lcm/lcm-cpp.hpp>
 #include <pidlab/lcmt_control_command.hpp>
+#include <pidlab/lcmt_disturbance_block.hpp>
+#include <pidlab/lcmt_disturbance_request.hpp>
 #include <pidlab/lcmt_disturbance_sample.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
@@ -96,6 +98,8 @@ bool LayoutOk(const std::string& type, const uint8_t* d, int n) {
     c.Fixed(1).Fixed(8).Fixed(8).String().String();
   } else if (type == "lcmt_trajectory_chunk") {
     c.Array(3 * 8);
+  } else if (type == "lcmt_disturbance_block") {
+    c.Fixed(8).Array(8);
   }
   return c.ok();
 }
@@ -112,7 +116,9 @@ std::vector<KnownType> KnownTypes() {
       {"lcmt_ready", "READY", pidlab::lcmt_ready::getHash()},
       {"lcmt_plant_output", "PLANT_OUTPUT", pidlab::lcmt_plant_output::getHash()},
       {"lcmt_control_command", "CONTROL", pidlab::lcmt_control_command::getHash()},
-      {"lcmt_disturbance_sample", "DISTURBANCE", pidlab::lcmt_disturbance_sample::getHash()},
+      {"lcmt_disturbance_sample", "DISTURBANCE", pidlab::lcmt_disturbance_sample::getHash()},  // older logs
+      {"lcmt_disturbance_block", "DISTURBANCE_BLOCK", pidlab::lcmt_disturbance_block::getHash()},
+      {"lcmt_disturbance_request", "DISTURBANCE_REQUEST", pidlab::lcmt_disturbance_request::getHash()},
       {"lcmt_episode_summary", "SUMMARY", pidlab::lcmt_episode_summary::getHash()},
       {"lcmt_trajectory_request", "TRAJECTORY_REQUEST", pidlab::lcmt_trajectory_request::getHash()},
       {"lcmt_trajectory_chunk", "TRAJECTORY", pidlab::lcmt_trajectory_chunk::getHash()},
@@ -407,6 +413,17 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
     } else if (name == "lcmt_disturbance_sample") {
       pidlab::lcmt_disturbance_sample m{};
       if ((ok = decode(&m))) episode_of(prefix, m.episode_id).disturbances.Add(m.step, {m.n, m.t_s, 0, -1});
+    } else if (name == "lcmt_disturbance_block") {
+      // n_k for k in [step, step + count): each sample counts as the step's
+      // disturbance sample (a resent block gives duplicates, as resent samples did).
+      pidlab::lcmt_disturbance_block m{};
+      if ((ok = decode(&m))) {
+        Stream& d = episode_of(prefix, m.episode_id).disturbances;
+        for (int32_t i = 0; i < m.count; ++i) {
+          const long k = static_cast<long>(m.step) + i;
+          d.Add(k, {m.n[static_cast<std::size_t>(i)], static_cast<double>(k) * m.dt_s, 0, -1});
+        }
+      }
     } else if (name == "lcmt_episode_summary") {
       pidlab::lcmt_episode_summary m{};
       if ((ok = decode(&m))) {
@@ -428,6 +445,9 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
       ok = decode(&m);
     } else if (name == "lcmt_trajectory_request") {
       pidlab::lcmt_trajectory_request m{};
+      ok = decode(&m);
+    } else if (name == "lcmt_disturbance_request") {
+      pidlab::lcmt_disturbance_request m{};
       ok = decode(&m);
     }
     if (!ok) {

@@ -5,10 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <pidlab/lcmt_control_command.hpp>
-#include <pidlab/lcmt_disturbance_sample.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
-#include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <pidlab/lcmt_trajectory_request.hpp>
@@ -84,44 +81,13 @@ EpisodeClient::EpisodeClient(const EpisodeClientOptions& options) : options_(opt
   state_ = std::make_unique<State>();
   State* s = state_.get();
   auto mine = [s](int64_t id) { return s->episode_id != 0 && id == s->episode_id; };
-  auto in_range = [s](int64_t k, bool last_ok) {
-    return k >= 0 && (k < s->total || (last_ok && k == s->total));
-  };
   transport_->Subscribe<pidlab::lcmt_ready>(kReadyChannel, [s, mine](const pidlab::lcmt_ready& m) {
     if (m.state == pidlab::lcmt_ready::CONFIG_ACK && mine(m.episode_id)) s->acked.insert(m.role);
   });
-  transport_->Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel,
-                                                   [s, mine, in_range](const pidlab::lcmt_plant_output& m) {
-                                                     if (!mine(m.episode_id) || !in_range(m.step, true))
-                                                       return;
-                                                     const auto k = static_cast<std::size_t>(m.step);
-                                                     if (!s->have_y[k]) {
-                                                       s->y[k] = m.y;
-                                                       s->have_y[k] = 1;
-                                                     }
-                                                     if (m.step > s->max_step) {
-                                                       s->max_step = m.step;
-                                                       s->last_progress_s = NowSeconds();
-                                                     }
-                                                   });
-  transport_->Subscribe<pidlab::lcmt_control_command>(
-      kControlChannel, [s, mine, in_range](const pidlab::lcmt_control_command& m) {
-        if (!mine(m.episode_id) || !in_range(m.step, false)) return;
-        const auto k = static_cast<std::size_t>(m.step);
-        if (!s->have_u[k]) {
-          s->u[k] = m.u;
-          s->have_u[k] = 1;
-        }
-      });
-  transport_->Subscribe<pidlab::lcmt_disturbance_sample>(
-      kDisturbanceChannel, [s, mine, in_range](const pidlab::lcmt_disturbance_sample& m) {
-        if (!mine(m.episode_id) || !in_range(m.step, false)) return;
-        const auto k = static_cast<std::size_t>(m.step);
-        if (!s->have_n[k]) {
-          s->n[k] = m.n;
-          s->have_n[k] = 1;
-        }
-      });
+  // The client does not follow the per-step traffic (PLANT_OUTPUT, CONTROL):
+  // the plant streams its trajectory in TRAJECTORY chunks (every 1000 steps or
+  // 0.1 s), which are also its liveness signal. Whatever chunk is lost is asked
+  // for again at the end (TRAJECTORY_REQUEST).
   transport_->Subscribe<pidlab::lcmt_trajectory_chunk>(
       kTrajectoryChannel, [s, mine](const pidlab::lcmt_trajectory_chunk& m) {
         if (!mine(m.episode_id) || m.step < 0 || m.count < 0 || m.step + m.count > s->total + 1) return;
@@ -132,6 +98,11 @@ EpisodeClient::EpisodeClient(const EpisodeClientOptions& options) : options_(opt
             if (!s->have_u[k] && std::isfinite(m.u[i])) s->u[k] = m.u[i], s->have_u[k] = 1;
             if (!s->have_n[k] && std::isfinite(m.n[i])) s->n[k] = m.n[i], s->have_n[k] = 1;
           }
+        }
+        const long last = static_cast<long>(m.step) + m.count - 1;
+        if (m.count > 0 && last > s->max_step) {
+          s->max_step = last;
+          s->last_progress_s = NowSeconds();
         }
       });
   transport_->Subscribe<pidlab::lcmt_episode_summary>(kSummaryChannel,

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <pidlab/lcmt_disturbance_block.hpp>
+#include <pidlab/lcmt_disturbance_request.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <sstream>
@@ -16,6 +18,11 @@
 namespace pidlab::lcm_trio {
 namespace {
 constexpr int kMaxChunk = 2000;         // steps per lcmt_trajectory_chunk
+constexpr int kStreamChunk = 1000;      // the plant streams its trajectory in chunks of this many steps...
+constexpr double kStreamPeriod = 0.1;   // ...or of whatever is new after this many seconds (liveness)
+constexpr long kNoiseBlock = 128;       // samples per lcmt_disturbance_block: one datagram
+constexpr long kNoiseLookahead = 2 * kNoiseBlock;  // the plant keeps n requested this far ahead
+constexpr long kMaxNoiseRequest = 8 * kNoiseBlock;  // the disturbance answers at most this much at once
 constexpr int kSummaryRepeats = 5;      // a summary is repeated this often...
 constexpr double kSummaryPeriod = 0.1;  // ...this many seconds apart
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -77,9 +84,13 @@ struct PlantRole::Episode {
   EpisodeSpec spec;
   std::unique_ptr<DiscretePlant> plant;
   long k = 0;
-  bool have_u = false, have_n = false;
-  double u = 0, n = 0;
-  std::vector<double> y_hist, u_hist, n_hist;
+  bool have_u = false;
+  double u = 0;
+  std::vector<double> y_hist, u_hist, n_hist;  // n_hist[k]: n_k once its block arrived
+  std::vector<char> have_n;                     // per step
+  long n_requested_end = 0;                     // n requested for steps [0, n_requested_end)
+  long streamed = 0;                            // trajectory streamed for steps [0, streamed)
+  double stream_last_s = 0;
   double step_start_s = 0, last_send_s = 0, start_s = 0;
   bool finished = false;
   pidlab::lcmt_episode_summary summary;
@@ -91,8 +102,8 @@ PlantRole::PlantRole(Transport* transport, LogFn log, bool verbose)
     : Role(transport, "plant", std::move(log), verbose) {
   transport_->Subscribe<pidlab::lcmt_control_command>(
       kControlChannel, [this](const pidlab::lcmt_control_command& m) { OnControl(m); });
-  transport_->Subscribe<pidlab::lcmt_disturbance_sample>(
-      kDisturbanceChannel, [this](const pidlab::lcmt_disturbance_sample& m) { OnDisturbance(m); });
+  transport_->Subscribe<pidlab::lcmt_disturbance_block>(
+      kDisturbanceBlockChannel, [this](const pidlab::lcmt_disturbance_block& m) { OnDisturbanceBlock(m); });
   transport_->Subscribe<pidlab::lcmt_trajectory_request>(
       kTrajectoryRequestChannel,
       [this](const pidlab::lcmt_trajectory_request& m) { OnTrajectoryRequest(m); });
@@ -119,11 +130,44 @@ void PlantRole::StartEpisode(const EpisodeSpec& spec) {
   ep->y_hist.assign(n + 1, kNaN);
   ep->u_hist.assign(n + 1, kNaN);
   ep->n_hist.assign(n + 1, kNaN);
+  ep->have_n.assign(n + 1, 0);
   ep->y_hist[0] = ep->plant->Output();
-  ep->start_s = ep->step_start_s = NowSeconds();
+  ep->start_s = ep->step_start_s = ep->stream_last_s = NowSeconds();
   ep_ = std::move(ep);
   running_ = true;
+  ep_->n_requested_end = std::min<long>(kNoiseLookahead, spec.total_steps);
+  RequestNoise(0, ep_->n_requested_end);
   PublishOutput();
+}
+
+void PlantRole::RequestNoise(long first, long samples) {
+  if (samples <= 0) return;
+  pidlab::lcmt_disturbance_request r;
+  r.episode_id = ep_->spec.episode_id;
+  r.step = first;
+  r.samples = static_cast<int32_t>(samples);
+  transport_->Publish(kDisturbanceRequestChannel, &r);
+}
+
+void PlantRole::PublishChunk(const Episode& ep, long first, long last) {
+  pidlab::lcmt_trajectory_chunk c;
+  c.episode_id = ep.spec.episode_id;
+  c.step = first;
+  c.count = static_cast<int32_t>(last - first);
+  c.y.assign(ep.y_hist.begin() + first, ep.y_hist.begin() + last);
+  c.u.assign(ep.u_hist.begin() + first, ep.u_hist.begin() + last);
+  c.n.assign(ep.n_hist.begin() + first, ep.n_hist.begin() + last);
+  transport_->Publish(kTrajectoryChannel, &c);
+}
+
+void PlantRole::StreamTrajectory(long upto) {
+  Episode& e = *ep_;
+  while (e.streamed < upto) {
+    const long last = std::min<long>(upto, e.streamed + kMaxChunk);
+    PublishChunk(e, e.streamed, last);
+    e.streamed = last;
+  }
+  e.stream_last_s = NowSeconds();
 }
 
 void PlantRole::PublishOutput() {
@@ -156,34 +200,57 @@ void PlantRole::OnControl(const pidlab::lcmt_control_command& m) {
   TryAdvance();
 }
 
-void PlantRole::OnDisturbance(const pidlab::lcmt_disturbance_sample& m) {
+void PlantRole::OnDisturbanceBlock(const pidlab::lcmt_disturbance_block& m) {
   if (!running_ || m.episode_id != ep_->spec.episode_id) {
     ++counters_.foreign;
     return;
   }
-  if (m.step != ep_->k || ep_->have_n) {
+  Episode& e = *ep_;
+  if (m.step < 0 || m.count < 0 || m.step + m.count > e.spec.total_steps ||
+      m.n.size() != static_cast<std::size_t>(m.count)) {
+    ++counters_.foreign;  // not an answer of this episode's disturbance
+    return;
+  }
+  bool fresh = false;
+  for (int32_t i = 0; i < m.count; ++i) {
+    const auto k = static_cast<std::size_t>(m.step + i);
+    if (e.have_n[k]) continue;
+    e.n_hist[k] = m.n[static_cast<std::size_t>(i)];
+    e.have_n[k] = 1;
+    fresh = true;
+  }
+  if (!fresh) {
     ++counters_.duplicates;
     return;
   }
-  ep_->n = m.n;
-  ep_->have_n = true;
   TryAdvance();
 }
 
 void PlantRole::TryAdvance() {
   Episode& e = *ep_;
-  if (!e.have_u || !e.have_n) return;
   const auto k = static_cast<std::size_t>(e.k);
+  if (!e.have_u || !e.have_n[k]) return;
   e.u_hist[k] = e.u;
-  e.n_hist[k] = e.n;
   // Same operation and order as RunSampledLoop: input = u + n, then ZOH.
-  e.plant->Step(e.u + e.n);
+  e.plant->Step(e.u + e.n_hist[k]);
   ++e.k;
-  e.have_u = e.have_n = false;
+  e.have_u = false;
   e.y_hist[k + 1] = e.plant->Output();
   e.step_start_s = NowSeconds();
+  if (e.k == e.spec.total_steps) {
+    PublishOutput();
+    StreamTrajectory(e.k + 1);  // the rest, y_N too (u and n NaN there)
+    Finish(true, "", "");
+    return;
+  }
   PublishOutput();
-  if (e.k == e.spec.total_steps) Finish(true, "", "");
+  // Keep n requested ahead: one request and one block per kNoiseBlock steps.
+  if (e.n_requested_end < e.spec.total_steps && e.n_requested_end - e.k <= kNoiseLookahead - kNoiseBlock) {
+    const long samples = std::min<long>(kNoiseBlock, e.spec.total_steps - e.n_requested_end);
+    RequestNoise(e.n_requested_end, samples);
+    e.n_requested_end += samples;
+  }
+  if (e.k - e.streamed >= kStreamChunk) StreamTrajectory(e.k);
 }
 
 void PlantRole::Finish(bool ok, const std::string& silent_role, const std::string& message) {
@@ -227,14 +294,7 @@ void PlantRole::OnTrajectoryRequest(const pidlab::lcmt_trajectory_request& m) {
   const long first = std::max<long>(0, static_cast<long>(m.step));
   const long last = std::min<long>({first + std::min<long>(m.count, kMaxChunk), ep->k + 1});
   if (last <= first) return;
-  pidlab::lcmt_trajectory_chunk c;
-  c.episode_id = m.episode_id;
-  c.step = first;
-  c.count = static_cast<int32_t>(last - first);
-  c.y.assign(ep->y_hist.begin() + first, ep->y_hist.begin() + last);
-  c.u.assign(ep->u_hist.begin() + first, ep->u_hist.begin() + last);
-  c.n.assign(ep->n_hist.begin() + first, ep->n_hist.begin() + last);
-  transport_->Publish(kTrajectoryChannel, &c);
+  PublishChunk(*ep, first, last);
 }
 
 double PlantRole::MaxWait() const {
@@ -253,10 +313,11 @@ void PlantRole::Tick(double now_s) {
     }
     return;
   }
+  const bool have_n = e.have_n[static_cast<std::size_t>(e.k)] != 0;
   if (now_s - e.step_start_s >= e.spec.recovery.silence_deadline_s) {
     std::string silent;
     if (!e.have_u) silent = "controller";
-    if (!e.have_n) silent += silent.empty() ? "disturbance" : ",disturbance";
+    if (!have_n) silent += silent.empty() ? "disturbance" : ",disturbance";
     std::ostringstream os;
     os << "no answer from pidlab-"
        << (silent == "controller,disturbance" ? "controller and pidlab-disturbance" : silent) << " for "
@@ -265,10 +326,22 @@ void PlantRole::Tick(double now_s) {
     return;
   }
   if (now_s - e.last_send_s >= e.spec.recovery.retransmit_interval_s) {
+    // Ask again only for what is missing: y_k makes the controller repeat u_k,
+    // a request makes the disturbance resend the blocks from n_k on.
     ++counters_.retransmits;
-    Verbose("resending y at step " + std::to_string(e.k));
-    PublishOutput();
+    Verbose(std::string("resending") + (e.have_u ? "" : " y") + (have_n ? "" : " n request") + " at step " +
+            std::to_string(e.k));
+    if (!have_n) {
+      const long samples = std::min<long>(kNoiseLookahead, e.spec.total_steps - e.k);
+      RequestNoise(e.k, samples);
+      e.n_requested_end = std::max(e.n_requested_end, e.k + samples);
+    }
+    if (!e.have_u)
+      PublishOutput();
+    else
+      e.last_send_s = now_s;
   }
+  if (now_s - e.stream_last_s >= kStreamPeriod) StreamTrajectory(e.k);  // also the client's liveness signal
 }
 
 // ---------------------------------------------------------------- controller
@@ -336,13 +409,14 @@ void ControllerRole::OnOutput(const pidlab::lcmt_plant_output& m) {
 struct DisturbanceRole::Episode {
   EpisodeSpec spec;
   std::unique_ptr<Disturbance> disturbance;
+  pidlab::lcmt_disturbance_block block;
   bool logged = false;
 };
 
 DisturbanceRole::DisturbanceRole(Transport* transport, LogFn log, bool verbose)
     : Role(transport, "disturbance", std::move(log), verbose) {
-  transport_->Subscribe<pidlab::lcmt_plant_output>(
-      kPlantOutputChannel, [this](const pidlab::lcmt_plant_output& m) { OnOutput(m); });
+  transport_->Subscribe<pidlab::lcmt_disturbance_request>(
+      kDisturbanceRequestChannel, [this](const pidlab::lcmt_disturbance_request& m) { OnRequest(m); });
 }
 DisturbanceRole::~DisturbanceRole() = default;
 
@@ -353,23 +427,35 @@ void DisturbanceRole::StartEpisode(const EpisodeSpec& spec) {
   ep_ = std::move(ep);
 }
 
-void DisturbanceRole::OnOutput(const pidlab::lcmt_plant_output& m) {
+void DisturbanceRole::OnRequest(const pidlab::lcmt_disturbance_request& m) {
   if (!ep_ || m.episode_id != ep_->spec.episode_id) {
     ++counters_.foreign;
     return;
   }
   Episode& e = *ep_;
-  if (m.step < 0 || m.step >= e.spec.total_steps) return;
+  const long total = e.spec.total_steps;
+  const long first = static_cast<long>(m.step);
+  const long end = std::min<long>(total, first + std::min<long>(m.samples, kMaxNoiseRequest));
+  if (first < 0 || end <= first) {
+    ++counters_.duplicates;
+    return;
+  }
   // Stateless: n_k depends on k only, so a repeated request gets the same answer.
-  pidlab::lcmt_disturbance_sample d;
-  d.episode_id = e.spec.episode_id;
-  d.step = m.step;
-  d.t_s = static_cast<double>(m.step) * e.spec.options.dt_s;
-  d.n = e.disturbance->Value(static_cast<double>(m.step) * e.spec.options.dt_s);
-  transport_->Publish(kDisturbanceChannel, &d);
-  if (m.step + 1 == e.spec.total_steps && !e.logged) {
+  pidlab::lcmt_disturbance_block& b = e.block;
+  b.episode_id = e.spec.episode_id;
+  b.dt_s = e.spec.options.dt_s;
+  for (long s = first; s < end; s += kNoiseBlock) {
+    const long count = std::min<long>(kNoiseBlock, end - s);
+    b.step = s;
+    b.count = static_cast<int32_t>(count);
+    b.n.resize(static_cast<std::size_t>(count));
+    for (long i = 0; i < count; ++i)
+      b.n[static_cast<std::size_t>(i)] = e.disturbance->Value(static_cast<double>(s + i) * e.spec.options.dt_s);
+    transport_->Publish(kDisturbanceBlockChannel, &b);
+  }
+  if (end == total && !e.logged) {
     e.logged = true;
-    Log("episode " + std::to_string(e.spec.episode_id) + ": done, " + std::to_string(e.spec.total_steps) +
+    Log("episode " + std::to_string(e.spec.episode_id) + ": done, " + std::to_string(total) +
         " samples (dropped " + std::to_string(transport_->counters().dropped) + ")");
   }
 }

@@ -1,10 +1,11 @@
 #include "pidlab/lcm/transport.h"
 
-#include <sys/select.h>
+#include <poll.h>
 
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 namespace pidlab::lcm_trio {
@@ -42,34 +43,38 @@ bool Transport::ShouldDrop() {
   return r < options_.drop_rate;
 }
 
-void Transport::Subscription::Handle(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
-  TransportCounters& c = owner->counters_;
+const std::string& Transport::CachedChannel(const char* name) {
+  // A handful of short names: a linear strcmp is cheaper than building the
+  // prefixed name (a heap allocation) for every message.
+  for (const auto& entry : channel_cache_)
+    if (std::strcmp(entry.first.c_str(), name) == 0) return entry.second;
+  if (channel_cache_.size() >= 64) channel_cache_.clear();  // bounded, whatever the callers pass
+  channel_cache_.emplace_back(name, Channel(name));
+  return channel_cache_.back().second;
+}
+
+void Transport::Subscription::HandleC(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
+  auto* sub = static_cast<Subscription*>(self);
+  TransportCounters& c = sub->owner->counters_;
   ++c.received;
-  if (owner->ShouldDrop()) {
+  if (sub->owner->ShouldDrop()) {
     ++c.dropped;
     return;
   }
-  if (!decode_and_call(rbuf->data, static_cast<int>(rbuf->data_size))) ++c.undecodable;
+  if (!sub->decode_and_call(rbuf->data, static_cast<int>(rbuf->data_size))) ++c.undecodable;
 }
 
 int Transport::WaitAndHandle(double timeout_s) {
   const int fd = lcm_->getFileno();
-  int handled = 0;
-  double wait = timeout_s > 0.0 ? timeout_s : 0.0;
-  for (;;) {
-    fd_set fds;
-    FD_ZERO(&fds);
-    FD_SET(fd, &fds);
-    timeval tv;
-    tv.tv_sec = static_cast<long>(std::floor(wait));
-    tv.tv_usec = static_cast<long>((wait - std::floor(wait)) * 1e6);
-    const int ready = select(fd + 1, &fds, nullptr, nullptr, &tv);
-    if (ready < 0) return errno == EINTR ? handled : -1;
-    if (ready == 0) return handled;
-    if (lcm_->handle() != 0) return -1;
-    ++handled;
-    wait = 0.0;  // then drain what is already queued, without waiting
-  }
+  const double wait = timeout_s > 0.0 ? timeout_s : 0.0;
+  // One poll and one handle per message: no extra zero-timeout poll to drain
+  // the queue (the caller's loop comes straight back here).
+  pollfd pfd{fd, POLLIN, 0};
+  const int ready = poll(&pfd, 1, static_cast<int>(std::ceil(wait * 1000.0)));
+  if (ready < 0) return errno == EINTR ? 0 : -1;
+  if (ready == 0) return 0;
+  if (lcm_handle(lcm_->getUnderlyingLCM()) != 0) return -1;
+  return 1;
 }
 
 }  // namespace pidlab::lcm_trio

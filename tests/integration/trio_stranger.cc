@@ -4,6 +4,8 @@
 
 #include <lcm/lcm-cpp.hpp>
 #include <pidlab/lcmt_control_command.hpp>
+#include <pidlab/lcmt_disturbance_block.hpp>
+#include <pidlab/lcmt_disturbance_request.hpp>
 #include <pidlab/lcmt_disturbance_sample.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
@@ -27,14 +29,14 @@ int main(int argc, char** argv) {
   const double seconds = std::atof(argv[3]);
   std::mt19937 rng(1234);
   const char* channels[] = {"EPISODE_CONFIG", "READY", "PLANT_OUTPUT", "CONTROL", "DISTURBANCE", "SUMMARY",
-                            "TRAJECTORY_REQUEST", "TRAJECTORY"};
+                            "TRAJECTORY_REQUEST", "TRAJECTORY", "DISTURBANCE_REQUEST", "DISTURBANCE_BLOCK"};
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   long sent = 0;
   for (int64_t i = 0; std::chrono::steady_clock::now() < end; ++i) {
     // Garbage bytes on every channel.
     std::vector<unsigned char> junk(1 + rng() % 200);
     for (auto& b : junk) b = static_cast<unsigned char>(rng());
-    lcm.publish(p + channels[i % 8], junk.data(), static_cast<unsigned>(junk.size()));
+    lcm.publish(p + channels[i % 10], junk.data(), static_cast<unsigned>(junk.size()));
     // Well-formed messages of a foreign episode, with plausible steps.
     const int64_t foreign = 777000 + (i % 5);
     pidlab::lcmt_plant_output y{};
@@ -52,9 +54,22 @@ int main(int argc, char** argv) {
     n.step = i % 50;
     n.n = 1e6;
     lcm.publish(p + "DISTURBANCE", &n);
+    pidlab::lcmt_disturbance_request q{};
+    q.episode_id = foreign;
+    q.step = i % 50;
+    q.samples = 1000000;
+    lcm.publish(p + "DISTURBANCE_REQUEST", &q);
+    pidlab::lcmt_disturbance_block b{};
+    b.episode_id = foreign;
+    b.step = i % 50;
+    b.dt_s = 0.01;
+    b.count = 3;
+    b.n = {1e6, 1e6, 1e6};
+    lcm.publish(p + "DISTURBANCE_BLOCK", &b);
     // Right type on the wrong channel.
     lcm.publish(p + "CONTROL", &y);
-    sent += 5;
+    lcm.publish(p + "DISTURBANCE_BLOCK", &u);
+    sent += 8;
     std::this_thread::sleep_for(std::chrono::microseconds(500));
   }
   std::printf("stranger: %ld messages sent\n", sent);

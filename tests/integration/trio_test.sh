@@ -103,7 +103,9 @@ case $CASE in
     # Force lcm-logger to lose messages: SIGSTOP it for 1 s mid-episode (its
     # socket buffer overflows). launch must repair the log from the plant's
     # trajectory chunks, say so, and hand over a log holding every step.
-    EVAL="pidlab evaluate --backend lcm --plant oscillator --gains 3,1,1 --horizon 10 --disturbance square --disturbance-amplitude 0.2"
+    # The episode must outlast the 1 s stop (at about 10k steps/s: 30000 steps), or the companion
+    # episode of evaluate starts while the logger's socket is full and its configuration is lost.
+    EVAL="pidlab evaluate --backend lcm --plant oscillator --gains 3,1,1 --horizon 30 --disturbance square --disturbance-amplitude 0.2"
     export EVAL
     rm -f "$TMP/run.lcmlog"
     "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/run.lcmlog" -- bash -c '
@@ -129,7 +131,7 @@ case $CASE in
     rm -f "$TMP/run2.lcmlog"
     rc=0
     "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/run2.lcmlog" -- bash -c '
-      ${EVAL/--horizon 10/--horizon 5} >/dev/null & e=$!
+      ${EVAL/--horizon 30/--horizon 5} >/dev/null & e=$!
       sleep 0.3; kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
       wait $e; s=$?; kill -9 $PIDLAB_PLANT_PID; exit $s' 2>"$TMP/launch2.err" || rc=$?
     line=$(grep "is incomplete: episode [0-9]* misses [0-9]* steps" "$TMP/launch2.err")

@@ -2,8 +2,9 @@
 // Runs one episode of the sampled loop over a running trio: the LCM backend of
 // `pidlab evaluate`. Publishes the configuration until the plant, controller
 // and disturbance acknowledge it, records y, u and n of every step from the
-// lockstep traffic, asks the plant to resend whatever it missed, and reports a
-// silent process by name.
+// trajectory chunks the plant streams (it does not wake for every lockstep
+// message), asks the plant to resend whatever it missed, and reports a silent
+// process by name.
 
 #include <lcm/lcm-cpp.hpp>
 #include <memory>

@@ -6,13 +6,16 @@
 // Lockstep, per step k of an episode:
 //   plant       publishes y_k = C x_k                       (PLANT_OUTPUT)
 //   controller  answers u_k = PID(r, y_k)                    (CONTROL)
-//   disturbance answers n_k = n(k dt)                        (DISTURBANCE)
-//   plant       waits for both, x_{k+1} = Phi x_k + Gamma (u_k + n_k)
-// Loss: the plant resends y_k after retransmit_interval_s without both
-// answers; the controller answers a repeated y_k with the u_k it already
-// computed (never steps its PID twice); the disturbance is stateless. After
-// silence_deadline_s without progress the plant publishes a FAILED summary
-// naming the silent process(es).
+//   plant       waits for u_k and n_k, x_{k+1} = Phi x_k + Gamma (u_k + n_k)
+// n does not depend on y: the plant requests it ahead in blocks
+// (DISTURBANCE_REQUEST), the disturbance answers n_k = n(k dt) for a block of
+// steps (DISTURBANCE_BLOCK). The plant streams its trajectory (TRAJECTORY
+// chunks, every 1000 steps or 0.1 s) and answers TRAJECTORY_REQUEST.
+// Loss: after retransmit_interval_s without u_k the plant resends y_k, without
+// n_k it requests n again; the controller answers a repeated y_k with the u_k
+// it already computed (never steps its PID twice); the disturbance is
+// stateless. After silence_deadline_s without progress the plant publishes a
+// FAILED summary naming the silent process(es).
 
 #include <csignal>
 #include <cstddef>
@@ -21,7 +24,8 @@
 #include <memory>
 #include <optional>
 #include <pidlab/lcmt_control_command.hpp>
-#include <pidlab/lcmt_disturbance_sample.hpp>
+#include <pidlab/lcmt_disturbance_block.hpp>
+#include <pidlab/lcmt_disturbance_request.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
@@ -98,13 +102,17 @@ class PlantRole : public Role {
 
  private:
   void OnControl(const pidlab::lcmt_control_command& msg);
-  void OnDisturbance(const pidlab::lcmt_disturbance_sample& msg);
+  void OnDisturbanceBlock(const pidlab::lcmt_disturbance_block& msg);
   void OnTrajectoryRequest(const pidlab::lcmt_trajectory_request& msg);
+  void RequestNoise(long first, long samples);
+  struct Episode;
+  void PublishChunk(const Episode& ep, long first, long last);
+  /// Publishes the current episode's trajectory of steps [streamed, upto) in chunks.
+  void StreamTrajectory(long upto);
   void TryAdvance();
   void PublishOutput();
   void Finish(bool ok, const std::string& silent_role, const std::string& message);
 
-  struct Episode;
   const Episode* FindEpisode(int64_t episode_id) const;
   std::unique_ptr<Episode> ep_;
   std::deque<std::unique_ptr<Episode>> history_;  // finished or abandoned episodes, oldest first
@@ -135,7 +143,7 @@ class DisturbanceRole : public Role {
   void StartEpisode(const EpisodeSpec& spec) override;
 
  private:
-  void OnOutput(const pidlab::lcmt_plant_output& msg);
+  void OnRequest(const pidlab::lcmt_disturbance_request& msg);
   struct Episode;
   std::unique_ptr<Episode> ep_;
 };

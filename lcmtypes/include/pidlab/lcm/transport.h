@@ -5,6 +5,7 @@
 // Works on any LCM URL, including memq:// for single-process tests.
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
@@ -23,7 +24,9 @@ inline constexpr const char* kEpisodeConfigChannel = "EPISODE_CONFIG";
 inline constexpr const char* kReadyChannel = "READY";
 inline constexpr const char* kPlantOutputChannel = "PLANT_OUTPUT";
 inline constexpr const char* kControlChannel = "CONTROL";
-inline constexpr const char* kDisturbanceChannel = "DISTURBANCE";
+inline constexpr const char* kDisturbanceChannel = "DISTURBANCE";  // lcmt_disturbance_sample: old logs only
+inline constexpr const char* kDisturbanceRequestChannel = "DISTURBANCE_REQUEST";
+inline constexpr const char* kDisturbanceBlockChannel = "DISTURBANCE_BLOCK";
 inline constexpr const char* kSummaryChannel = "SUMMARY";
 inline constexpr const char* kTrajectoryRequestChannel = "TRAJECTORY_REQUEST";
 inline constexpr const char* kTrajectoryChannel = "TRAJECTORY";
@@ -61,10 +64,20 @@ class Transport {
   std::string Channel(const std::string& name) const { return options_.channel_prefix + name; }
 
   /// Stamps utime and publishes on <prefix><name>. Returns false on a send error.
+  /// No allocation per message in the steady state: the channel name is
+  /// cached and the message is encoded into a buffer that is reused.
+  template <typename Msg>
+  bool Publish(const char* name, Msg* msg) {
+    msg->utime = NowUtime();
+    const int size = msg->getEncodedSize();
+    if (size < 0) return false;
+    if (encode_buffer_.size() < static_cast<std::size_t>(size)) encode_buffer_.resize(static_cast<std::size_t>(size));
+    if (msg->encode(encode_buffer_.data(), 0, size) != size) return false;
+    return lcm_->publish(CachedChannel(name), encode_buffer_.data(), static_cast<unsigned int>(size)) == 0;
+  }
   template <typename Msg>
   bool Publish(const std::string& name, Msg* msg) {
-    msg->utime = NowUtime();
-    return lcm_->publish(Channel(name), msg) == 0;
+    return Publish(name.c_str(), msg);
   }
 
   /// Calls on_message for every message on <prefix><name> that survives fault
@@ -83,13 +96,15 @@ class Transport {
       on_message(msg);
       return true;
     };
-    lcm_->subscribe(Channel(name), &Subscription::Handle, sub.get());
+    // The C API directly: lcm-cpp's trampoline builds a std::string of the
+    // channel name for every message received.
+    lcm_subscribe(lcm_->getUnderlyingLCM(), Channel(name).c_str(), &Subscription::HandleC, sub.get());
     subscriptions_.push_back(std::move(sub));
   }
 
-  /// Waits at most timeout_s for traffic and handles every message already
-  /// queued. Returns the number of messages handled (0 on timeout), -1 on an
-  /// LCM error.
+  /// Waits at most timeout_s for traffic and handles one message if one
+  /// arrived (callers loop). Returns the number of messages handled (0 on
+  /// timeout), -1 on an LCM error.
   int WaitAndHandle(double timeout_s);
 
   const TransportCounters& counters() const { return counters_; }
@@ -100,9 +115,13 @@ class Transport {
   struct Subscription {
     Transport* owner = nullptr;
     std::function<bool(const void*, int)> decode_and_call;
-    void Handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+    static void HandleC(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
   };
   bool ShouldDrop();
+  const std::string& CachedChannel(const char* name);
+
+  std::deque<std::pair<std::string, std::string>> channel_cache_;  // name, prefixed name (stable refs)
+  std::vector<uint8_t> encode_buffer_;
 
   lcm::LCM* lcm_;
   TransportOptions options_;
