@@ -128,10 +128,12 @@ case $CASE in
 
     # The same loss with the plant killed after the episode: nobody can repair
     # the log, and launch must fail with one line naming episode and steps.
+    # 20000 steps: the 1 s stop must end inside the first episode, or the
+    # companion episode's configuration is lost too (then nothing names steps).
     rm -f "$TMP/run2.lcmlog"
     rc=0
     "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/run2.lcmlog" -- bash -c '
-      ${EVAL/--horizon 30/--horizon 5} >/dev/null & e=$!
+      ${EVAL/--horizon 30/--horizon 20} >/dev/null & e=$!
       sleep 0.3; kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
       wait $e; s=$?; kill -9 $PIDLAB_PLANT_PID; exit $s' 2>"$TMP/launch2.err" || rc=$?
     line=$(grep "is incomplete: episode [0-9]* misses [0-9]* steps" "$TMP/launch2.err")
