@@ -70,9 +70,14 @@ void BM_TuneDefault(benchmark::State& state) {
     iae = summary.objective;
     evaluations = summary.evaluations;
   }
-  state.SetLabel(std::string(c.plant) + " iae=" + std::to_string(iae) + " evaluations=" + std::to_string(evaluations));
+  state.SetLabel(std::string(c.plant) + " iae=" + std::to_string(iae) +
+                 " evaluations=" + std::to_string(evaluations));
 }
-BENCHMARK(BM_TuneDefault)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_TuneDefault)
+    ->DenseRange(0, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 }  // namespace
 

@@ -1,6 +1,8 @@
 // Closed-loop responses against closed forms and an independent RK4
 // integration; stability; convergence of the sampled loop; LoopOptions.
 
+#include "pidlab/tuner/closed_loop.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/tuner/closed_loop.h"
 #include "pidlab/tuner/evaluation.h"
 
 namespace pidlab {
@@ -61,12 +62,14 @@ TEST(ContinuousLoop, ProportionalIntegralControlCancellingTheLagIsAFirstOrderLoo
 
 double SecondOrderStep(double zeta, double wn, double t) {
   const double wd = wn * std::sqrt(1.0 - zeta * zeta);
-  return 1.0 - std::exp(-zeta * wn * t) * (std::cos(wd * t) + zeta / std::sqrt(1.0 - zeta * zeta) * std::sin(wd * t));
+  return 1.0 - std::exp(-zeta * wn * t) *
+                   (std::cos(wd * t) + zeta / std::sqrt(1.0 - zeta * zeta) * std::sin(wd * t));
 }
 
 TEST(ContinuousLoop, UnitFeedbackOfATypeOnePlantIsTheClassicSecondOrderResponse) {
   const double zeta = 0.3, wn = 2.0;
-  const Evaluation dut = EvaluateOrFail({{wn * wn}, {1.0, 2.0 * zeta * wn, 0.0}}, {1.0, 0.0, 0.0}, LoopOptions{});
+  const Evaluation dut =
+      EvaluateOrFail({{wn * wn}, {1.0, 2.0 * zeta * wn, 0.0}}, {1.0, 0.0, 0.0}, LoopOptions{});
   ASSERT_TRUE(dut.stability.stable) << "poles of s^2 + 1.2 s + 4 are in the left half plane";
   for (std::size_t m = 0; m < dut.y.size(); ++m)
     EXPECT_NEAR(dut.y[m], SecondOrderStep(zeta, wn, 0.05 * m), 1e-12) << "m = " << m;
@@ -75,8 +78,8 @@ TEST(ContinuousLoop, UnitFeedbackOfATypeOnePlantIsTheClassicSecondOrderResponse)
 TEST(ContinuousLoop, CancellingPiControlGivesTheClassicSecondOrderResponse) {
   // Plant wn^2 / ((s + 1)(s + 2 zeta wn)), kp = ki = 1: L = wn^2 / (s (s + 2 zeta wn)).
   const double zeta = 0.3, wn = 2.0;
-  const Evaluation dut =
-      EvaluateOrFail({{wn * wn}, {1.0, 1.0 + 2.0 * zeta * wn, 2.0 * zeta * wn}}, {1.0, 1.0, 0.0}, LoopOptions{});
+  const Evaluation dut = EvaluateOrFail({{wn * wn}, {1.0, 1.0 + 2.0 * zeta * wn, 2.0 * zeta * wn}},
+                                        {1.0, 1.0, 0.0}, LoopOptions{});
   ASSERT_TRUE(dut.stability.stable);
   for (std::size_t m = 0; m < dut.y.size(); ++m)
     EXPECT_NEAR(dut.y[m], SecondOrderStep(zeta, wn, 0.05 * m), 1e-12) << "m = " << m;
@@ -94,7 +97,8 @@ TEST(ContinuousStability, DoubleIntegratorWithProportionalControlIsMarginalAndNo
   EXPECT_FALSE(dut.step.valid);
   // s^2 + 1 = 0: poles at +-j.
   int on_axis = 0;
-  for (const auto& p : dut.stability.poles) on_axis += std::abs(p.real()) < 1e-9 && std::abs(std::abs(p.imag()) - 1.0) < 1e-9;
+  for (const auto& p : dut.stability.poles)
+    on_axis += std::abs(p.real()) < 1e-9 && std::abs(std::abs(p.imag()) - 1.0) < 1e-9;
   EXPECT_EQ(on_axis, 2);
 }
 
@@ -140,7 +144,8 @@ TEST(SampledStability, StepperMotorWithNelderMeadGainsIsUnstableAtOneMillisecond
   o.dt_s = 1e-3;
   Evaluation dut;
   std::string error;
-  ASSERT_TRUE(Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut, &error))
+  ASSERT_TRUE(
+      Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut, &error))
       << error;
   EXPECT_FALSE(dut.stability.stable);
   EXPECT_GT(dut.stability.abscissa, 1.0);
@@ -153,7 +158,8 @@ TEST(SampledStability, StepperMotorWithNelderMeadGainsIsStableAtATenthOfAMillise
   o.dt_s = 1e-4;
   Evaluation dut;
   std::string error;
-  ASSERT_TRUE(Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut, &error))
+  ASSERT_TRUE(
+      Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut, &error))
       << error;
   EXPECT_TRUE(dut.stability.stable);
   EXPECT_LT(dut.stability.abscissa, 1.0);
@@ -173,8 +179,8 @@ TEST(SampledStability, ProportionalLoopWithoutIntegralIsStable) {
 // Independent RK4 of 1/s^2 under the ideal PID with the square wave at the
 // plant input: y' = v, v' = kp (1 - y) + ki z - kd v + n(t), z' = 1 - y, and
 // the derivative kick v(0+) = kd.
-std::vector<double> Rk4DoubleIntegrator(const PidGains& g, double amplitude, double period, double phase, double ts,
-                                        int samples) {
+std::vector<double> Rk4DoubleIntegrator(const PidGains& g, double amplitude, double period, double phase,
+                                        double ts, int samples) {
   auto square = [&](double t_mid) {
     const long piece = static_cast<long>(std::floor((t_mid + phase) / (period / 2.0)));
     return piece % 2 == 0 ? amplitude : -amplitude;
@@ -381,8 +387,8 @@ TEST(Evaluate, RejectsANegativeGainAsBadInput) {
 TEST(Evaluate, RejectsABiproperPlantAsBadInput) {
   Evaluation ev;
   std::string error;
-  EXPECT_FALSE(
-      Evaluate(Plant{"custom", {{1.0, 0.0}, {1.0, 1.0}}}, {1.0, 0.0, 0.0}, LoopOptions{}, EvaluateOptions{}, &ev, &error));
+  EXPECT_FALSE(Evaluate(Plant{"custom", {{1.0, 0.0}, {1.0, 1.0}}}, {1.0, 0.0, 0.0}, LoopOptions{},
+                        EvaluateOptions{}, &ev, &error));
   EXPECT_NE(error.find("strictly proper"), std::string::npos) << error;
 }
 

@@ -1,13 +1,13 @@
 // Disturbance signals: values, breakpoints, determinism of the noise.
 
+#include "pidlab/plant_sim/disturbance.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 #include <random>
 #include <string>
-
-#include "pidlab/plant_sim/disturbance.h"
 
 namespace pidlab {
 namespace {

@@ -144,7 +144,8 @@ struct EpisodeWriter {
         b.step = first;
         b.dt_s = ref.options.dt_s;
         b.count = static_cast<int32_t>(std::min<long>(32, total - first));
-        for (long k = first; k < first + b.count; ++k) b.n.push_back(ref.trajectory[static_cast<std::size_t>(k)].n);
+        for (long k = first; k < first + b.count; ++k)
+          b.n.push_back(ref.trajectory[static_cast<std::size_t>(k)].n);
         if (index != lose_block) WriteMsg(log, prefix + "DISTURBANCE_BLOCK", b, num);
       }
     }
@@ -445,7 +446,8 @@ TEST_F(LogReaderTest, DisturbanceBlocksRebuildEveryStepAndALostBlockIsNamed) {
     ASSERT_TRUE(EvaluateEpisode(e, &ev, &error)) << error;
     EXPECT_EQ(ev.iae, ref.evaluation.iae);
     ASSERT_EQ(ev.trajectory.size(), ref.trajectory.size());
-    for (std::size_t k = 0; k < ev.trajectory.size(); ++k) EXPECT_EQ(ev.trajectory[k].n, ref.trajectory[k].n) << k;
+    for (std::size_t k = 0; k < ev.trajectory.size(); ++k)
+      EXPECT_EQ(ev.trajectory[k].n, ref.trajectory[k].n) << k;
   }
   {
     lcm::LogFile log(path_, "w");

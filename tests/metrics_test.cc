@@ -12,7 +12,8 @@
 namespace pidlab {
 namespace {
 
-Evaluation EvaluateOrFail(const TransferFunction& tf, const PidGains& gains, const LoopOptions& options = {}) {
+Evaluation EvaluateOrFail(const TransferFunction& tf, const PidGains& gains,
+                          const LoopOptions& options = {}) {
   Evaluation ev;
   std::string error;
   EXPECT_TRUE(Evaluate(Plant{"custom", tf}, gains, options, EvaluateOptions{}, &ev, &error)) << error;
@@ -34,8 +35,8 @@ TEST(ObjectiveFromSamples, NonFiniteOutputGivesInfinity) {
 }
 
 TEST(ObjectiveKind, ParsesEveryKindAndRejectsOthers) {
-  for (ObjectiveKind k : {ObjectiveKind::kIae, ObjectiveKind::kIse, ObjectiveKind::kItae,
-                          ObjectiveKind::kIaeContinuous}) {
+  for (ObjectiveKind k :
+       {ObjectiveKind::kIae, ObjectiveKind::kIse, ObjectiveKind::kItae, ObjectiveKind::kIaeContinuous}) {
     ObjectiveKind dut = ObjectiveKind::kIae;
     EXPECT_TRUE(ParseObjectiveKind(ToString(k), &dut)) << ToString(k);
     EXPECT_EQ(dut, k);
@@ -158,7 +159,8 @@ void ExpectSecondOrderMetrics(const Evaluation& dut, double zeta, double wn) {
 
 TEST(Metrics, UnderdampedSecondOrderProportionalLoopMatchesTheClosedForms) {
   const double zeta = 0.3, wn = 2.0;
-  ExpectSecondOrderMetrics(EvaluateOrFail({{wn * wn}, {1.0, 2.0 * zeta * wn, 0.0}}, {1.0, 0.0, 0.0}), zeta, wn);
+  ExpectSecondOrderMetrics(EvaluateOrFail({{wn * wn}, {1.0, 2.0 * zeta * wn, 0.0}}, {1.0, 0.0, 0.0}), zeta,
+                           wn);
 }
 
 TEST(Metrics, UnderdampedSecondOrderPiLoopMatchesTheClosedForms) {
@@ -166,7 +168,8 @@ TEST(Metrics, UnderdampedSecondOrderPiLoopMatchesTheClosedForms) {
   for (const auto& [zeta, wn] : {std::pair{0.3, 2.0}, std::pair{0.6, 5.0}, std::pair{0.1, 1.0}}) {
     SCOPED_TRACE("zeta = " + std::to_string(zeta) + ", wn = " + std::to_string(wn));
     ExpectSecondOrderMetrics(
-        EvaluateOrFail({{wn * wn}, {1.0, 1.0 + 2.0 * zeta * wn, 2.0 * zeta * wn}}, {1.0, 1.0, 0.0}), zeta, wn);
+        EvaluateOrFail({{wn * wn}, {1.0, 1.0 + 2.0 * zeta * wn, 2.0 * zeta * wn}}, {1.0, 1.0, 0.0}), zeta,
+        wn);
   }
 }
 

@@ -50,8 +50,8 @@ std::vector<Row> ReadRows(std::string* error) {
   const std::vector<std::string> header = SplitCsv(line);
   std::map<std::string, std::size_t> col;
   for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
-  for (const char* name : {"table", "plant", "method", "disturbance_amplitude", "kp", "ki", "kd", "ref_rise_time_s",
-                           "ref_overshoot_pct", "ref_settling_time_s", "ref_iae"})
+  for (const char* name : {"table", "plant", "method", "disturbance_amplitude", "kp", "ki", "kd",
+                           "ref_rise_time_s", "ref_overshoot_pct", "ref_settling_time_s", "ref_iae"})
     if (!col.count(name)) {
       *error = std::string("column ") + name + " missing from " + PIDLAB_PAPER_TABLES;
       return {};

@@ -1,12 +1,12 @@
 // The discrete PID of controller/pid.h against its closed forms.
 
+#include "pidlab/controller/pid.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 #include <string>
-
-#include "pidlab/controller/pid.h"
 
 namespace pidlab {
 namespace {

@@ -1,6 +1,8 @@
 // Transfer functions, their realisation, the built-in plants, the matrix
 // exponential and the exact ZOH discretisation, against closed forms.
 
+#include "pidlab/plant_sim/transfer_function.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,7 +16,6 @@
 #include "pidlab/plant_sim/discrete_plant.h"
 #include "pidlab/plant_sim/matrix_exp.h"
 #include "pidlab/plant_sim/plants.h"
-#include "pidlab/plant_sim/transfer_function.h"
 
 namespace pidlab {
 namespace {
@@ -167,7 +168,7 @@ TEST(StepperMotor, CoefficientsFollowEquationThreeFromTableOne) {
   // Table I by hand.
   const double r = 33.0, l = 5.4e-3, m = 0.4e-3, j = 0.16e-4, nr = 6.0, d = 1.35e-5, lambda = M_PI / 12.0,
                io = 0.15, flux = 1.2e-3;
-  const double lp = l - m;  // 5.0e-3
+  const double lp = l - m;                // 5.0e-3
   const double half = nr * lambda / 2.0;  // pi / 4
   const double wnp2 = 2.0 * nr * nr * flux * io * std::cos(half) / j;
   const double kp = flux * std::sin(half) * std::sin(half) / (lp * io * std::cos(half));

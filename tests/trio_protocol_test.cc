@@ -2,10 +2,10 @@
 // one memq:// LCM instance, single-threaded (no network).
 
 #include <gtest/gtest.h>
+
 #include <pidlab/lcmt_control_command.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
-
 #include <random>
 
 #include "pidlab/lcm/episode_config.h"
@@ -53,7 +53,8 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
   Transport controller_t2(&lcm, topt);
   PlantRole plant(&plant_t);
   std::unique_ptr<ControllerRole> controller;
-  if (with_controller) controller = std::make_unique<ControllerRole>(drop_rate > 0 ? &controller_t2 : &controller_t);
+  if (with_controller)
+    controller = std::make_unique<ControllerRole>(drop_rate > 0 ? &controller_t2 : &controller_t);
   std::unique_ptr<DisturbanceRole> disturbance;
   if (with_disturbance) disturbance = std::make_unique<DisturbanceRole>(&disturbance_t);
   const long total = e.options.TotalSteps();
@@ -66,10 +67,11 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
       rec->have[static_cast<std::size_t>(m.step)] = 1;
     }
   });
-  client_t.Subscribe<pidlab::lcmt_episode_summary>(kSummaryChannel, [&](const pidlab::lcmt_episode_summary& m) {
-    rec->summary = true;
-    rec->last = m;
-  });
+  client_t.Subscribe<pidlab::lcmt_episode_summary>(kSummaryChannel,
+                                                   [&](const pidlab::lcmt_episode_summary& m) {
+                                                     rec->summary = true;
+                                                     rec->last = m;
+                                                   });
   RecoveryOptions recovery;
   recovery.retransmit_interval_s = 0.001;
   recovery.silence_deadline_s = 0.2;
@@ -90,7 +92,8 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
 std::vector<double> Reference(const Episode& e) {
   std::vector<double> y;
   std::string error;
-  EXPECT_TRUE(RunSampledLoopInProcess(e.plant, e.gains, e.options, e.options.disturbance, &y, nullptr, &error));
+  EXPECT_TRUE(
+      RunSampledLoopInProcess(e.plant, e.gains, e.options, e.options.disturbance, &y, nullptr, &error));
   return y;
 }
 
@@ -101,7 +104,8 @@ TEST(EpisodeConfig, RoundTripsEveryField) {
   e.options.pid.anti_windup = AntiWindup::kBackCalculation;
   e.options.pid.integral = IntegralMethod::kTrapezoidal;
   e.options.disturbance.seed = 99;
-  const auto msg = MakeEpisodeConfig(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{});
+  const auto msg =
+      MakeEpisodeConfig(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{});
   EpisodeSpec dut;
   std::string error;
   ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
@@ -142,7 +146,8 @@ TEST(Transport, CountsUndecodableMessagesAndIgnoresThem) {
   lcm::LCM lcm("memq://");
   Transport dut(&lcm, {});
   int calls = 0;
-  dut.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel, [&](const pidlab::lcmt_plant_output&) { ++calls; });
+  dut.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel,
+                                           [&](const pidlab::lcmt_plant_output&) { ++calls; });
   std::mt19937 rng(3);
   for (int i = 0; i < 50; ++i) {
     std::vector<unsigned char> junk(1 + rng() % 100);
@@ -168,8 +173,8 @@ TEST(Transport, DropsTheConfiguredFractionReproducibly) {
     o.drop_seed = seed;
     Transport dut(&lcm, o);
     std::vector<int64_t> got;
-    dut.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel,
-                                             [&](const pidlab::lcmt_plant_output& m) { got.push_back(m.step); });
+    dut.Subscribe<pidlab::lcmt_plant_output>(
+        kPlantOutputChannel, [&](const pidlab::lcmt_plant_output& m) { got.push_back(m.step); });
     for (int k = 0; k < 2000; ++k) {
       pidlab::lcmt_plant_output m{};
       m.step = k;

@@ -1,8 +1,8 @@
+#include "pidlab/tuner/tune.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "pidlab/tuner/tune.h"
 
 namespace pidlab {
 namespace {
@@ -35,7 +35,8 @@ TEST_P(TuneBeatsPaper, DefaultNelderMeadBeatsThePapersIaeWithAStrictlyStableLoop
   ASSERT_TRUE(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev, &error)) << error;
   EXPECT_TRUE(ev.stability.stable);
   EXPECT_NEAR(ev.iae, dut.objective, 1e-9 * dut.objective);
-  for (const auto& p : ev.stability.poles) EXPECT_LE(p.real(), -0.01 * std::max(1.0, std::abs(p)) * (1 - 1e-9));
+  for (const auto& p : ev.stability.poles)
+    EXPECT_LE(p.real(), -0.01 * std::max(1.0, std::abs(p)) * (1 - 1e-9));
   for (double g : {dut.gains.kp, dut.gains.ki, dut.gains.kd}) {
     EXPECT_GE(g, 0.0);
     EXPECT_LE(g, 30.0);
@@ -45,7 +46,8 @@ TEST_P(TuneBeatsPaper, DefaultNelderMeadBeatsThePapersIaeWithAStrictlyStableLoop
 }
 
 INSTANTIATE_TEST_SUITE_P(Plants, TuneBeatsPaper,
-                         ::testing::Values(PaperCase{"double_integrator", 1.9151}, PaperCase{"oscillator", 2.2304},
+                         ::testing::Values(PaperCase{"double_integrator", 1.9151},
+                                           PaperCase{"oscillator", 2.2304},
                                            PaperCase{"stepper_motor", 1.9751}));
 
 TEST(Tune, IsDeterministicForASeed) {
@@ -79,8 +81,8 @@ TEST(Tune, NeverAcceptsALoopThatIsNotStrictlyStable) {
 
 TEST(ObjectiveEvaluator, ReturnsInfinityForMarginalAndUnstableLoops) {
   const ObjectiveEvaluator dut(MakeBuiltin("double_integrator"), LoopOptions{}, ObjectiveKind::kIae);
-  EXPECT_TRUE(std::isinf(dut(PidGains{1.0, 0.0, 0.0})));    // s^2 + 1: poles on the axis
-  EXPECT_TRUE(std::isinf(dut(PidGains{1.0, 10.0, 0.1})));   // Routh: kd*kp < ki -> unstable
+  EXPECT_TRUE(std::isinf(dut(PidGains{1.0, 0.0, 0.0})));   // s^2 + 1: poles on the axis
+  EXPECT_TRUE(std::isinf(dut(PidGains{1.0, 10.0, 0.1})));  // Routh: kd*kp < ki -> unstable
   EXPECT_TRUE(std::isfinite(dut(PidGains{29.6558, 0.4977, 28.3216})));
 }
 

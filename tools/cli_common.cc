@@ -49,9 +49,10 @@ PidGains ParseGains(const std::string& text) {
 }
 
 void PlantFlags::Register(CLI::App* app, bool required) {
-  auto* opt = app->add_option("--plant", plant,
-                              "double_integrator (alias linear) = 1/s^2, oscillator (alias nonlinear) = "
-                              "1/(s^2+1), stepper_motor (alias stepper) = eq. (3), or custom with --num/--den");
+  auto* opt =
+      app->add_option("--plant", plant,
+                      "double_integrator (alias linear) = 1/s^2, oscillator (alias nonlinear) = "
+                      "1/(s^2+1), stepper_motor (alias stepper) = eq. (3), or custom with --num/--den");
   (void)required;
   app->add_option("--num", num, "custom plant numerator, descending powers of s, e.g. 1");
   app->add_option("--den", den, "custom plant denominator, descending powers of s, e.g. 1,0,0");
@@ -68,7 +69,8 @@ Plant PlantFlags::Build() const {
   Plant p;
   const bool custom = !num.empty() || !den.empty();
   if (custom && !plant.empty() && plant != "custom")
-    throw BadInput("--plant '" + plant + "' cannot be combined with --num/--den (use --plant custom or omit it)");
+    throw BadInput("--plant '" + plant +
+                   "' cannot be combined with --num/--den (use --plant custom or omit it)");
   if (custom) {
     if (num.empty() || den.empty()) throw BadInput("a custom plant needs both --num and --den");
     if (!MakeCustomPlant(ParseList(num, "--num"), ParseList(den, "--den"), &p, &error)) throw BadInput(error);
@@ -83,16 +85,26 @@ Plant PlantFlags::Build() const {
     const std::string name = kv.substr(0, eq);
     const double v = ParseDouble(kv.substr(eq + 1), "--stepper " + name);
     double* field = nullptr;
-    if (name == "resistance_ohm") field = &sp.resistance_ohm;
-    else if (name == "self_inductance_h") field = &sp.self_inductance_h;
-    else if (name == "mutual_inductance_h") field = &sp.mutual_inductance_h;
-    else if (name == "inertia_kg_m2") field = &sp.inertia_kg_m2;
-    else if (name == "rotor_teeth") field = &sp.rotor_teeth;
-    else if (name == "viscous_friction") field = &sp.viscous_friction;
-    else if (name == "tooth_pitch_rad") field = &sp.tooth_pitch_rad;
-    else if (name == "stationary_current_a") field = &sp.stationary_current_a;
-    else if (name == "flux_linkage") field = &sp.flux_linkage;
-    else throw BadInput("--stepper parameter '" + name + "' is unknown");
+    if (name == "resistance_ohm")
+      field = &sp.resistance_ohm;
+    else if (name == "self_inductance_h")
+      field = &sp.self_inductance_h;
+    else if (name == "mutual_inductance_h")
+      field = &sp.mutual_inductance_h;
+    else if (name == "inertia_kg_m2")
+      field = &sp.inertia_kg_m2;
+    else if (name == "rotor_teeth")
+      field = &sp.rotor_teeth;
+    else if (name == "viscous_friction")
+      field = &sp.viscous_friction;
+    else if (name == "tooth_pitch_rad")
+      field = &sp.tooth_pitch_rad;
+    else if (name == "stationary_current_a")
+      field = &sp.stationary_current_a;
+    else if (name == "flux_linkage")
+      field = &sp.flux_linkage;
+    else
+      throw BadInput("--stepper parameter '" + name + "' is unknown");
     *field = v;
   }
   if (!stepper_overrides.empty() && plant != "stepper_motor" && plant != "stepper")
@@ -102,21 +114,25 @@ Plant PlantFlags::Build() const {
 }
 
 void LoopFlags::Register(CLI::App* app) {
-  app->add_option("--loop", loop, "continuous (exact, ideal PID) or sampled (discrete PID at --dt, ZOH plant)")
+  app->add_option("--loop", loop,
+                  "continuous (exact, ideal PID) or sampled (discrete PID at --dt, ZOH plant)")
       ->capture_default_str();
-  app->add_option("--dt", dt_s, "sampled-loop period in s; --sample-time must be a multiple")->capture_default_str();
+  app->add_option("--dt", dt_s, "sampled-loop period in s; --sample-time must be a multiple")
+      ->capture_default_str();
   app->add_option("--sample-time", sample_time_s, "ts of eq. (4): spacing of the error samples in s")
       ->capture_default_str();
   app->add_option("--horizon", horizon_s, "n of eq. (4): last sample time in s")->capture_default_str();
   app->add_option("--stability-margin", stability_margin,
                   "strict stability: Re p < -margin*max(1,|p|), p = s-plane pole (sampled: p = log(z)/dt)")
       ->capture_default_str();
-  app->add_option("--disturbance", disturbance,
-                  "none|square|step|sine|noise at the plant input (default: square if an amplitude is given)");
+  app->add_option(
+      "--disturbance", disturbance,
+      "none|square|step|sine|noise at the plant input (default: square if an amplitude is given)");
   app->add_option("--disturbance-amplitude", disturbance_amplitude,
                   "square +/-A, step height, sine peak or noise std deviation")
       ->capture_default_str();
-  app->add_option("--disturbance-period", disturbance_period_s, "square/sine period in s")->capture_default_str();
+  app->add_option("--disturbance-period", disturbance_period_s, "square/sine period in s")
+      ->capture_default_str();
   app->add_option("--disturbance-phase", disturbance_phase_s, "time shift of the disturbance in s")
       ->capture_default_str();
   app->add_option("--disturbance-step-time", disturbance_step_time_s, "step disturbance time in s")
@@ -125,7 +141,8 @@ void LoopFlags::Register(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--seed", seed, "seed of the noise disturbance (and of the search, for tune)")
       ->capture_default_str();
-  app->add_option("--derivative-filter", derivative_filter_s, "sampled PID: derivative filter time constant in s")
+  app->add_option("--derivative-filter", derivative_filter_s,
+                  "sampled PID: derivative filter time constant in s")
       ->capture_default_str();
   app->add_option("--output-limits", output_limits, "sampled PID: output limits LO,HI");
   app->add_option("--anti-windup", anti_windup, "sampled PID: none|clamping|back-calculation")
@@ -226,18 +243,23 @@ std::string FormatEvaluation(const Evaluation& ev) {
   std::ostringstream os;
   auto num = [](double v) {
     std::ostringstream s;
-    if (std::isfinite(v)) s << std::setprecision(6) << v; else s << "-";
+    if (std::isfinite(v))
+      s << std::setprecision(6) << v;
+    else
+      s << "-";
     return s.str();
   };
   os << "plant            " << ev.plant.name << "  G(s) = " << ev.plant.tf.ToString() << "\n";
-  os << "gains            kp = " << ev.gains.kp << ", ki = " << ev.gains.ki << ", kd = " << ev.gains.kd << "\n";
+  os << "gains            kp = " << ev.gains.kp << ", ki = " << ev.gains.ki << ", kd = " << ev.gains.kd
+     << "\n";
   os << "loop             " << ToString(ev.options.loop);
   if (ev.options.loop == LoopKind::kSampled) os << " (dt = " << ev.options.dt_s << " s)";
   os << ", ts = " << ev.options.sample_time_s << " s, n = " << ev.options.horizon_s << " s, "
      << ev.options.NumSamples() << " samples\n";
   if (ev.options.disturbance.kind != DisturbanceKind::kNone)
-    os << "disturbance      " << ToString(ev.options.disturbance.kind) << " +/-" << ev.options.disturbance.amplitude
-       << ", period " << ev.options.disturbance.period_s << " s, at the plant input\n";
+    os << "disturbance      " << ToString(ev.options.disturbance.kind) << " +/-"
+       << ev.options.disturbance.amplitude << ", period " << ev.options.disturbance.period_s
+       << " s, at the plant input\n";
   os << "stable           " << (ev.stability.stable ? "yes" : "NO (objectives are +inf)") << "\n";
   os << "closed-loop poles " << (ev.options.loop == LoopKind::kSampled ? "(z) " : "(s) ")
      << FormatPoles(ev.stability.poles) << "\n";

@@ -322,8 +322,9 @@ struct LaunchCommand {
       if (logger_url.find("recv_buf_size=") == std::string::npos)
         logger_url += std::string(logger_url.find('?') == std::string::npos ? "?" : "&") + kRecvBuf;
       logger = launcher.Start(
-          "lcm-logger", {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + logger_url, log_file},
-          {}, kLoggerNice);
+          "lcm-logger",
+          {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + logger_url, log_file}, {},
+          kLoggerNice);
     }
     std::map<std::string, pid_t> trio;
     int seed = 1;
@@ -452,10 +453,10 @@ struct LaunchCommand {
   bool RepairLog(lcm_trio::Transport* transport, Launcher* launcher) {
     // The plant's answers, as launch hears them: (episode, first step) -> count.
     std::map<std::pair<int64_t, int64_t>, int> answers;
-    transport->Subscribe<pidlab::lcmt_trajectory_chunk>(
-        lcm_trio::kTrajectoryChannel, [&answers](const pidlab::lcmt_trajectory_chunk& c) {
-          answers[{c.episode_id, c.step}] = c.count;
-        });
+    transport->Subscribe<pidlab::lcmt_trajectory_chunk>(lcm_trio::kTrajectoryChannel,
+                                                        [&answers](const pidlab::lcmt_trajectory_chunk& c) {
+                                                          answers[{c.episode_id, c.step}] = c.count;
+                                                        });
     replay::ReadOptions options;
     options.channel_prefix = channel_prefix;
     std::map<int64_t, long> republished;  // episode -> steps asked for (all rounds)
@@ -498,9 +499,9 @@ struct LaunchCommand {
           for (const auto& r : g.ranges)
             for (long first = r.first; first <= r.second; first += kRepairChunk)
               answered = answered && answers.count({g.id, first});
-          std::cerr << "pidlab launch: error: " << log_file << " is incomplete: episode " << g.id << " misses "
-                    << CountSteps(g.ranges) << " steps (" << RangesText(g.ranges) << ") after " << kRepairRounds
-                    << " repair rounds: "
+          std::cerr << "pidlab launch: error: " << log_file << " is incomplete: episode " << g.id
+                    << " misses " << CountSteps(g.ranges) << " steps (" << RangesText(g.ranges) << ") after "
+                    << kRepairRounds << " repair rounds: "
                     << (answered ? "lcm-logger lost the plant's trajectory chunks every time"
                                  : "pidlab-plant did not resend them (no longer in its history, or it died)")
                     << "\n";
@@ -538,7 +539,8 @@ struct LaunchCommand {
         transport->WaitAndHandle(0.01);
       }
       if (!WaitForMarker(transport, launcher, "repair" + std::to_string(round))) {
-        std::cerr << "pidlab launch: error: lcm-logger stopped writing " << log_file << " during its repair\n";
+        std::cerr << "pidlab launch: error: lcm-logger stopped writing " << log_file
+                  << " during its repair\n";
         return false;
       }
     }

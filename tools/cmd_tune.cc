@@ -53,17 +53,22 @@ struct TuneCommand {
         ->capture_default_str();
     app->add_option("--starts", starts, "seeded starts (nelder-mead, paper-nm)")->capture_default_str();
     app->add_option("--refine", refine, "ceres | none: the least-squares cross-check")->capture_default_str();
-    app->add_option("--agree-tolerance", agree_tolerance, "relative objective difference for the 'agree' verdict")
+    app->add_option("--agree-tolerance", agree_tolerance,
+                    "relative objective difference for the 'agree' verdict")
         ->capture_default_str();
     app->add_option("--max-overshoot", max_overshoot_pct, "reject candidates overshooting more (%)");
     app->add_option("--max-settling", max_settling_time_s, "reject candidates settling later (s)");
-    app->add_option("--zn-rule", zn_rule, "classic | pessen | some-overshoot | no-overshoot")->capture_default_str();
+    app->add_option("--zn-rule", zn_rule, "classic | pessen | some-overshoot | no-overshoot")
+        ->capture_default_str();
     app->add_option("--trace", trace, "write the best-so-far trajectory of the search to this CSV file");
     app->add_flag("--json", json, "print one JSON object");
-    app->add_option("--lcm-url", lcm_url, "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's)");
-    app->add_option("--channel-prefix", channel_prefix,
-                    "--backend lcm: channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
-    app->add_option("--episode-timeout", episode_timeout_s, "--backend lcm: give up on an episode after this many s")
+    app->add_option("--lcm-url", lcm_url,
+                    "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's)");
+    app->add_option(
+        "--channel-prefix", channel_prefix,
+        "--backend lcm: channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
+    app->add_option("--episode-timeout", episode_timeout_s,
+                    "--backend lcm: give up on an episode after this many s")
         ->capture_default_str();
     return [this] { return Run(); };
   }
@@ -73,7 +78,8 @@ struct TuneCommand {
     TuneOptions o;
     o.loop = loop.Build();
     if (!ParseTuneMethod(method, &o.method))
-      throw BadInput("--method '" + method + "' must be nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
+      throw BadInput("--method '" + method +
+                     "' must be nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
     if (!ParseObjectiveKind(objective, &o.objective))
       throw BadInput("--objective '" + objective + "' must be iae, ise, itae or iae-continuous");
     if (!ParseZieglerNicholsRule(zn_rule, &o.zn_rule))
@@ -82,7 +88,8 @@ struct TuneCommand {
     if (b.size() != 2) throw BadInput("--bounds '" + bounds + "' must be LO,HI");
     o.lower = b[0];
     o.upper = b[1];
-    if (refine != "ceres" && refine != "none") throw BadInput("--refine '" + refine + "' must be ceres or none");
+    if (refine != "ceres" && refine != "none")
+      throw BadInput("--refine '" + refine + "' must be ceres or none");
     o.refine = refine == "ceres";
     o.max_iterations = max_iterations;
     o.max_evaluations = max_evaluations;
@@ -95,7 +102,8 @@ struct TuneCommand {
     if (!o.IsValid(&error)) throw BadInput(error);
     SampledRunner runner = RunSampledLoopInProcess;
     if (backend == "lcm") {
-      if (o.loop.loop != LoopKind::kSampled) throw BadInput("--backend lcm runs the sampled loop: add --loop sampled");
+      if (o.loop.loop != LoopKind::kSampled)
+        throw BadInput("--backend lcm runs the sampled loop: add --loop sampled");
       runner = MakeLcmRunner();
     } else if (backend != "local") {
       throw BadInput("--backend '" + backend + "' must be local or lcm");
@@ -217,7 +225,8 @@ SampledRunner TuneCommand::MakeLcmRunner() {
   return command.client->AsRunner();
 }
 
-const CommandRegistrar registrar("tune", "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check",
+const CommandRegistrar registrar("tune",
+                                 "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check",
                                  [](CLI::App* sub) { return command.Register(sub); });
 
 }  // namespace

@@ -693,7 +693,8 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
       o.method = method;
       o.seed = options.seed;
       o.loop = PaperLoop(amplitude);
-      o.loop.stability_margin = TuneOptions::DefaultTuneLoop().stability_margin;  // the tuner's acceptance margin
+      o.loop.stability_margin =
+          TuneOptions::DefaultTuneLoop().stability_margin;  // the tuner's acceptance margin
       if (options.quick) {
         o.starts = 1;
         if (method == TuneMethod::kGeneticAlgorithm || method == TuneMethod::kPsoGsa) o.max_evaluations = 400;

@@ -17,14 +17,14 @@
 
 namespace pidlab::lcm_trio {
 namespace {
-constexpr int kMaxChunk = 2000;         // steps per lcmt_trajectory_chunk
-constexpr int kStreamChunk = 1000;      // the plant streams its trajectory in chunks of this many steps...
-constexpr double kStreamPeriod = 0.1;   // ...or of whatever is new after this many seconds (liveness)
-constexpr long kNoiseBlock = 128;       // samples per lcmt_disturbance_block: one datagram
-constexpr long kNoiseLookahead = 2 * kNoiseBlock;  // the plant keeps n requested this far ahead
+constexpr int kMaxChunk = 2000;        // steps per lcmt_trajectory_chunk
+constexpr int kStreamChunk = 1000;     // the plant streams its trajectory in chunks of this many steps...
+constexpr double kStreamPeriod = 0.1;  // ...or of whatever is new after this many seconds (liveness)
+constexpr long kNoiseBlock = 128;      // samples per lcmt_disturbance_block: one datagram
+constexpr long kNoiseLookahead = 2 * kNoiseBlock;   // the plant keeps n requested this far ahead
 constexpr long kMaxNoiseRequest = 8 * kNoiseBlock;  // the disturbance answers at most this much at once
-constexpr int kSummaryRepeats = 5;      // a summary is repeated this often...
-constexpr double kSummaryPeriod = 0.1;  // ...this many seconds apart
+constexpr int kSummaryRepeats = 5;                  // a summary is repeated this often...
+constexpr double kSummaryPeriod = 0.1;              // ...this many seconds apart
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 }  // namespace
 
@@ -87,9 +87,9 @@ struct PlantRole::Episode {
   bool have_u = false;
   double u = 0;
   std::vector<double> y_hist, u_hist, n_hist;  // n_hist[k]: n_k once its block arrived
-  std::vector<char> have_n;                     // per step
-  long n_requested_end = 0;                     // n requested for steps [0, n_requested_end)
-  long streamed = 0;                            // trajectory streamed for steps [0, streamed)
+  std::vector<char> have_n;                    // per step
+  long n_requested_end = 0;                    // n requested for steps [0, n_requested_end)
+  long streamed = 0;                           // trajectory streamed for steps [0, streamed)
   double stream_last_s = 0;
   double step_start_s = 0, last_send_s = 0, start_s = 0;
   bool finished = false;
@@ -450,7 +450,8 @@ void DisturbanceRole::OnRequest(const pidlab::lcmt_disturbance_request& m) {
     b.count = static_cast<int32_t>(count);
     b.n.resize(static_cast<std::size_t>(count));
     for (long i = 0; i < count; ++i)
-      b.n[static_cast<std::size_t>(i)] = e.disturbance->Value(static_cast<double>(s + i) * e.spec.options.dt_s);
+      b.n[static_cast<std::size_t>(i)] =
+          e.disturbance->Value(static_cast<double>(s + i) * e.spec.options.dt_s);
     transport_->Publish(kDisturbanceBlockChannel, &b);
   }
   if (end == total && !e.logged) {

@@ -34,49 +34,61 @@ constexpr double kBreakTolerance = 1e-9;
 }  // namespace
 
 bool ParseDisturbanceKind(const std::string& s, DisturbanceKind* kind) {
-  if (s == "none") *kind = DisturbanceKind::kNone;
-  else if (s == "square") *kind = DisturbanceKind::kSquare;
-  else if (s == "step") *kind = DisturbanceKind::kStep;
-  else if (s == "sine") *kind = DisturbanceKind::kSine;
-  else if (s == "noise") *kind = DisturbanceKind::kNoise;
-  else return false;
+  if (s == "none")
+    *kind = DisturbanceKind::kNone;
+  else if (s == "square")
+    *kind = DisturbanceKind::kSquare;
+  else if (s == "step")
+    *kind = DisturbanceKind::kStep;
+  else if (s == "sine")
+    *kind = DisturbanceKind::kSine;
+  else if (s == "noise")
+    *kind = DisturbanceKind::kNoise;
+  else
+    return false;
   return true;
 }
 
 std::string ToString(DisturbanceKind kind) {
   switch (kind) {
-    case DisturbanceKind::kNone: return "none";
-    case DisturbanceKind::kSquare: return "square";
-    case DisturbanceKind::kStep: return "step";
-    case DisturbanceKind::kSine: return "sine";
-    case DisturbanceKind::kNoise: return "noise";
+    case DisturbanceKind::kNone:
+      return "none";
+    case DisturbanceKind::kSquare:
+      return "square";
+    case DisturbanceKind::kStep:
+      return "step";
+    case DisturbanceKind::kSine:
+      return "sine";
+    case DisturbanceKind::kNoise:
+      return "noise";
   }
   return "none";
 }
 
 bool DisturbanceOptions::IsValid(std::string* error) const {
   std::ostringstream os;
-  if (!std::isfinite(amplitude)) os << "disturbance amplitude " << amplitude << " must be finite";
+  if (!std::isfinite(amplitude))
+    os << "disturbance amplitude " << amplitude << " must be finite";
   else if (kind == DisturbanceKind::kNoise && amplitude < 0.0)
     os << "noise amplitude (standard deviation) " << amplitude << " must be >= 0";
   else if ((kind == DisturbanceKind::kSquare || kind == DisturbanceKind::kSine) &&
            !(period_s > 0.0 && std::isfinite(period_s)))
     os << "disturbance period " << period_s << " s must be positive and finite";
-  else if (!std::isfinite(phase_s)) os << "disturbance phase " << phase_s << " s must be finite";
+  else if (!std::isfinite(phase_s))
+    os << "disturbance phase " << phase_s << " s must be finite";
   else if (kind == DisturbanceKind::kStep && !(step_time_s >= 0.0 && std::isfinite(step_time_s)))
     os << "disturbance step time " << step_time_s << " s must be >= 0 and finite";
   else if (kind == DisturbanceKind::kNoise && !(noise_hold_s > 0.0 && std::isfinite(noise_hold_s)))
     os << "noise hold " << noise_hold_s << " s must be positive";
-  else return true;
+  else
+    return true;
   if (error) *error = os.str();
   return false;
 }
 
 Disturbance::Disturbance(const DisturbanceOptions& options) : options_(options) {}
 
-double Disturbance::PieceIndex(double t, double piece) {
-  return std::floor(t / piece + kBreakTolerance);
-}
+double Disturbance::PieceIndex(double t, double piece) { return std::floor(t / piece + kBreakTolerance); }
 
 double Disturbance::Value(double t) const {
   const DisturbanceOptions& o = options_;

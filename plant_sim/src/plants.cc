@@ -7,19 +7,18 @@
 namespace pidlab {
 
 bool StepperMotorParameters::IsValid(std::string* error) const {
-  const std::pair<const char*, double> fields[] = {
-      {"resistance_ohm", resistance_ohm},
-      {"self_inductance_h", self_inductance_h},
-      {"mutual_inductance_h", mutual_inductance_h},
-      {"inertia_kg_m2", inertia_kg_m2},
-      {"rotor_teeth", rotor_teeth},
-      {"viscous_friction", viscous_friction},
-      {"tooth_pitch_rad", tooth_pitch_rad},
-      {"stationary_current_a", stationary_current_a},
-      {"flux_linkage", flux_linkage}};
+  const std::pair<const char*, double> fields[] = {{"resistance_ohm", resistance_ohm},
+                                                   {"self_inductance_h", self_inductance_h},
+                                                   {"mutual_inductance_h", mutual_inductance_h},
+                                                   {"inertia_kg_m2", inertia_kg_m2},
+                                                   {"rotor_teeth", rotor_teeth},
+                                                   {"viscous_friction", viscous_friction},
+                                                   {"tooth_pitch_rad", tooth_pitch_rad},
+                                                   {"stationary_current_a", stationary_current_a},
+                                                   {"flux_linkage", flux_linkage}};
   for (const auto& [name, v] : fields) {
-    if (!std::isfinite(v) || v < 0.0 || (v == 0.0 && std::string(name) != "mutual_inductance_h" &&
-                                         std::string(name) != "viscous_friction")) {
+    if (!std::isfinite(v) || v < 0.0 ||
+        (v == 0.0 && std::string(name) != "mutual_inductance_h" && std::string(name) != "viscous_friction")) {
       if (error) {
         std::ostringstream os;
         os << "stepper motor " << name << " = " << v << " must be finite and positive";
@@ -72,7 +71,8 @@ bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, P
   } else {
     if (error)
       *error = "unknown plant '" + name +
-               "' (expected double_integrator|linear, oscillator|nonlinear, stepper_motor|stepper, or custom with --num/--den)";
+               "' (expected double_integrator|linear, oscillator|nonlinear, stepper_motor|stepper, or custom "
+               "with --num/--den)";
     return false;
   }
   return true;

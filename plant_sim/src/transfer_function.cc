@@ -40,8 +40,16 @@ Eigen::VectorXd BalanceInPlace(Eigen::MatrixXd* a) {
       if (c == 0.0 || r == 0.0) continue;
       double f = 1.0;
       const double s = c + r;
-      while (c < r / 2.0) { c *= 2.0; r /= 2.0; f *= 2.0; }
-      while (c >= r * 2.0) { c /= 2.0; r *= 2.0; f /= 2.0; }
+      while (c < r / 2.0) {
+        c *= 2.0;
+        r /= 2.0;
+        f *= 2.0;
+      }
+      while (c >= r * 2.0) {
+        c /= 2.0;
+        r *= 2.0;
+        f /= 2.0;
+      }
       if ((c + r) < 0.95 * s) {
         converged = false;
         d(i) *= f;
@@ -52,7 +60,6 @@ Eigen::VectorXd BalanceInPlace(Eigen::MatrixXd* a) {
   }
   return d;
 }
-
 
 bool TransferFunction::IsValid(std::string* error) const {
   auto fail = [&](const std::string& m) {
@@ -83,8 +90,8 @@ int TransferFunction::RelativeDegree() const {
 
 double TransferFunction::DcGain() const {
   const double n0 = num.back(), d0 = den.back();
-  if (d0 == 0.0) return n0 == 0.0 ? std::numeric_limits<double>::quiet_NaN()
-                                  : std::numeric_limits<double>::infinity();
+  if (d0 == 0.0)
+    return n0 == 0.0 ? std::numeric_limits<double>::quiet_NaN() : std::numeric_limits<double>::infinity();
   return n0 / d0;
 }
 

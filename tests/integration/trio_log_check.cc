@@ -37,7 +37,8 @@ int main(int argc, char** argv) {
     };
     std::printf("episode %lld: %ld steps, y %s, u %s, n %s: %s\n", static_cast<long long>(e.episode_id),
                 e.total_steps, stream(e.outputs).c_str(), stream(e.commands).c_str(),
-                stream(e.disturbances).c_str(), complete ? "complete" : ("INCOMPLETE: " + e.CompletenessNote()).c_str());
+                stream(e.disturbances).c_str(),
+                complete ? "complete" : ("INCOMPLETE: " + e.CompletenessNote()).c_str());
   }
   return ok ? 0 : 1;
 }

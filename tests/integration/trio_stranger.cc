@@ -2,6 +2,9 @@
 // messages on the trio's channels for SECONDS, as a stranger on the network
 // would. Seeded, so a run is reproducible.
 
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <lcm/lcm-cpp.hpp>
 #include <pidlab/lcmt_control_command.hpp>
 #include <pidlab/lcmt_disturbance_block.hpp>
@@ -9,10 +12,6 @@
 #include <pidlab/lcmt_disturbance_sample.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
-
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <random>
 #include <string>
 #include <thread>
@@ -28,8 +27,9 @@ int main(int argc, char** argv) {
   const std::string p = argv[2];
   const double seconds = std::atof(argv[3]);
   std::mt19937 rng(1234);
-  const char* channels[] = {"EPISODE_CONFIG", "READY", "PLANT_OUTPUT", "CONTROL", "DISTURBANCE", "SUMMARY",
-                            "TRAJECTORY_REQUEST", "TRAJECTORY", "DISTURBANCE_REQUEST", "DISTURBANCE_BLOCK"};
+  const char* channels[] = {
+      "EPISODE_CONFIG",     "READY",      "PLANT_OUTPUT",        "CONTROL",          "DISTURBANCE", "SUMMARY",
+      "TRAJECTORY_REQUEST", "TRAJECTORY", "DISTURBANCE_REQUEST", "DISTURBANCE_BLOCK"};
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   long sent = 0;
   for (int64_t i = 0; std::chrono::steady_clock::now() < end; ++i) {

@@ -53,12 +53,18 @@ struct ErrorResiduals {
     for (std::size_t m = 0; m < y.size(); ++m) {
       const T e = T(1.0) - y[m];
       switch (kind) {
-        case ObjectiveKind::kIse: residuals[m] = e; break;
-        case ObjectiveKind::kIae: residuals[m] = sqrt(sqrt(e * e + T(kSmoothing * kSmoothing))); break;
-        case ObjectiveKind::kItae:
-          residuals[m] = T(std::sqrt(static_cast<double>(m) * ts)) * sqrt(sqrt(e * e + T(kSmoothing * kSmoothing)));
+        case ObjectiveKind::kIse:
+          residuals[m] = e;
           break;
-        case ObjectiveKind::kIaeContinuous: return false;
+        case ObjectiveKind::kIae:
+          residuals[m] = sqrt(sqrt(e * e + T(kSmoothing * kSmoothing)));
+          break;
+        case ObjectiveKind::kItae:
+          residuals[m] =
+              T(std::sqrt(static_cast<double>(m) * ts)) * sqrt(sqrt(e * e + T(kSmoothing * kSmoothing)));
+          break;
+        case ObjectiveKind::kIaeContinuous:
+          return false;
       }
     }
     return true;
@@ -82,7 +88,8 @@ RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, co
   }
   const StateSpace realization = Realize(plant.tf);
   std::unique_ptr<DiscretePlant> discrete;
-  if (options.loop.loop == LoopKind::kSampled) discrete = std::make_unique<DiscretePlant>(plant.tf, options.loop.dt_s);
+  if (options.loop.loop == LoopKind::kSampled)
+    discrete = std::make_unique<DiscretePlant>(plant.tf, options.loop.dt_s);
   double x[3] = {start.kp, start.ki, start.kd};
   ceres::Problem problem;
   auto* cost = new ceres::AutoDiffCostFunction<ErrorResiduals, ceres::DYNAMIC, 3>(
@@ -114,15 +121,16 @@ RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, co
     summary.verdict = ToString(options.method) + " stopped short";
     summary.gains = refined;
     summary.objective = f;
-    summary.message = "Ceres lowered the objective by " + std::to_string(100.0 * summary.relative_improvement) +
-                      " %; its gains are returned";
+    summary.message = "Ceres lowered the objective by " +
+                      std::to_string(100.0 * summary.relative_improvement) + " %; its gains are returned";
   } else if (std::isfinite(f) && std::abs(f - start_objective) <= options.agree_tolerance * start_objective) {
     summary.verdict = "agree";
     if (f < start_objective) {
       summary.gains = refined;
       summary.objective = f;
     }
-    summary.message = "Ceres and the search agree within " + std::to_string(100.0 * options.agree_tolerance) + " %";
+    summary.message =
+        "Ceres and the search agree within " + std::to_string(100.0 * options.agree_tolerance) + " %";
   } else {
     summary.verdict = "search better";
     summary.message = "Ceres's smooth least-squares optimum is worse on the exact objective (" +

@@ -18,9 +18,12 @@ bool IsMultiple(double x, double step, long* count) {
 }  // namespace
 
 bool ParseLoopKind(const std::string& s, LoopKind* kind) {
-  if (s == "continuous") *kind = LoopKind::kContinuous;
-  else if (s == "sampled") *kind = LoopKind::kSampled;
-  else return false;
+  if (s == "continuous")
+    *kind = LoopKind::kContinuous;
+  else if (s == "sampled")
+    *kind = LoopKind::kSampled;
+  else
+    return false;
   return true;
 }
 
@@ -34,7 +37,8 @@ bool LoopOptions::IsValid(std::string* error) const {
   else if (!(horizon_s > 0.0) || !std::isfinite(horizon_s))
     os << "horizon " << horizon_s << " s must be positive and finite";
   else if (!IsMultiple(horizon_s, sample_time_s, &count) || count < 1)
-    os << "horizon " << horizon_s << " s must be a whole multiple of the sample time " << sample_time_s << " s";
+    os << "horizon " << horizon_s << " s must be a whole multiple of the sample time " << sample_time_s
+       << " s";
   else if (count > 10000000)
     os << "horizon / sample time = " << count << " samples is more than 1e7";
   else if (!(stability_margin >= 0.0) || !(stability_margin < 1.0))
@@ -89,12 +93,14 @@ Stability ContinuousStability(const ContinuousClosedLoop<double>& loop, double m
     if (!std::isfinite(p.real()) || !(p.real() < -margin * std::max(1.0, std::abs(p)))) ok = false;
   }
   s.stable = ok && static_cast<int>(s.poles.size()) == n;
-  std::sort(s.poles.begin(), s.poles.end(),
-            [](const auto& a, const auto& b) { return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag(); });
+  std::sort(s.poles.begin(), s.poles.end(), [](const auto& a, const auto& b) {
+    return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag();
+  });
   return s;
 }
 
-Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const PidOptions& o, double margin) {
+Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const PidOptions& o,
+                           double margin) {
   // State z_k = [x_k; I_{k-1}; D_{k-1}; e_{k-1}; s_{k-1}] with r = n = 0, so
   // e_k = s_k = -C x_k for both derivative modes.
   const int n = plant.order();
@@ -107,8 +113,12 @@ Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const 
   Eigen::RowVectorXd i_row = Eigen::RowVectorXd::Zero(size);
   i_row(ii) = 1.0;
   switch (o.integral) {
-    case IntegralMethod::kBackwardEuler: i_row += g.ki * dt * e_row; break;
-    case IntegralMethod::kForwardEuler: i_row(iep) += g.ki * dt; break;
+    case IntegralMethod::kBackwardEuler:
+      i_row += g.ki * dt * e_row;
+      break;
+    case IntegralMethod::kForwardEuler:
+      i_row(iep) += g.ki * dt;
+      break;
     case IntegralMethod::kTrapezoidal:
       i_row += 0.5 * g.ki * dt * e_row;
       i_row(iep) += 0.5 * g.ki * dt;
@@ -147,8 +157,9 @@ Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const 
     }
   }
   s.stable = ok && std::isfinite(s.abscissa) && s.abscissa < 1.0;
-  std::sort(s.poles.begin(), s.poles.end(),
-            [](const auto& p, const auto& q) { return std::abs(p) != std::abs(q) ? std::abs(p) > std::abs(q) : p.imag() < q.imag(); });
+  std::sort(s.poles.begin(), s.poles.end(), [](const auto& p, const auto& q) {
+    return std::abs(p) != std::abs(q) ? std::abs(p) > std::abs(q) : p.imag() < q.imag();
+  });
   return s;
 }
 

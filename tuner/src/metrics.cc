@@ -115,20 +115,29 @@ double Bisect(const std::function<double(double)>& g, double a, double b) {
 }  // namespace
 
 bool ParseObjectiveKind(const std::string& s, ObjectiveKind* kind) {
-  if (s == "iae") *kind = ObjectiveKind::kIae;
-  else if (s == "ise") *kind = ObjectiveKind::kIse;
-  else if (s == "itae") *kind = ObjectiveKind::kItae;
-  else if (s == "iae-continuous") *kind = ObjectiveKind::kIaeContinuous;
-  else return false;
+  if (s == "iae")
+    *kind = ObjectiveKind::kIae;
+  else if (s == "ise")
+    *kind = ObjectiveKind::kIse;
+  else if (s == "itae")
+    *kind = ObjectiveKind::kItae;
+  else if (s == "iae-continuous")
+    *kind = ObjectiveKind::kIaeContinuous;
+  else
+    return false;
   return true;
 }
 
 std::string ToString(ObjectiveKind kind) {
   switch (kind) {
-    case ObjectiveKind::kIae: return "iae";
-    case ObjectiveKind::kIse: return "ise";
-    case ObjectiveKind::kItae: return "itae";
-    case ObjectiveKind::kIaeContinuous: return "iae-continuous";
+    case ObjectiveKind::kIae:
+      return "iae";
+    case ObjectiveKind::kIse:
+      return "ise";
+    case ObjectiveKind::kItae:
+      return "itae";
+    case ObjectiveKind::kIaeContinuous:
+      return "iae-continuous";
   }
   return "iae";
 }
@@ -138,10 +147,17 @@ double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, do
   for (std::size_t m = 0; m < y.size(); ++m) {
     const double e = 1.0 - y[m];
     switch (kind) {
-      case ObjectiveKind::kIae: sum += std::abs(e); break;
-      case ObjectiveKind::kIse: sum += e * e; break;
-      case ObjectiveKind::kItae: sum += static_cast<double>(m) * ts * std::abs(e); break;
-      case ObjectiveKind::kIaeContinuous: throw std::logic_error("iae-continuous is not a sample sum");
+      case ObjectiveKind::kIae:
+        sum += std::abs(e);
+        break;
+      case ObjectiveKind::kIse:
+        sum += e * e;
+        break;
+      case ObjectiveKind::kItae:
+        sum += static_cast<double>(m) * ts * std::abs(e);
+        break;
+      case ObjectiveKind::kIaeContinuous:
+        throw std::logic_error("iae-continuous is not a sample sum");
     }
   }
   return std::isfinite(sum) ? sum : kInf;
@@ -195,7 +211,8 @@ StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stab
     for (std::size_t i = 0; i < ys.size(); ++i) {
       if ((ys[i] - level) * (yf > 0 ? 1 : -1) >= 0.0) {
         if (i == 0) return ts[0];
-        return Bisect([&](double t) { return (y_at(i - 1, t) - level) * (yf > 0 ? 1 : -1); }, ts[i - 1], ts[i]);
+        return Bisect([&](double t) { return (y_at(i - 1, t) - level) * (yf > 0 ? 1 : -1); }, ts[i - 1],
+                      ts[i]);
       }
     }
     return kNaN;
@@ -214,11 +231,25 @@ StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stab
     auto f = [&](double t) { return -std::abs(y_at(ip - 1, t)); };
     double c = b - g * (b - a), d = a + g * (b - a), fc = f(c), fd = f(d);
     for (int it = 0; it < 100 && b - a > 1e-15 * std::max(1.0, b); ++it) {
-      if (fc < fd) { b = d; d = c; fd = fc; c = b - g * (b - a); fc = f(c); }
-      else { a = c; c = d; fc = fd; d = a + g * (b - a); fd = f(d); }
+      if (fc < fd) {
+        b = d;
+        d = c;
+        fd = fc;
+        c = b - g * (b - a);
+        fc = f(c);
+      } else {
+        a = c;
+        c = d;
+        fc = fd;
+        d = a + g * (b - a);
+        fd = f(d);
+      }
     }
     const double tp = 0.5 * (a + b), yp = -f(tp);
-    if (yp > peak) { peak = yp; peak_t = tp; }
+    if (yp > peak) {
+      peak = yp;
+      peak_t = tp;
+    }
   }
   info.peak = peak;
   info.peak_time_s = peak_t;
@@ -227,7 +258,10 @@ StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stab
   const double band = 0.02 * std::abs(yf);
   std::size_t last_out = ys.size();
   for (std::size_t i = ys.size(); i-- > 0;) {
-    if (std::abs(ys[i] - yf) > band) { last_out = i; break; }
+    if (std::abs(ys[i] - yf) > band) {
+      last_out = i;
+      break;
+    }
   }
   if (last_out == ys.size()) {
     info.settling_time_s = 0.0;
@@ -293,7 +327,10 @@ StepInfo SampledStepInfo(const std::vector<double>& t, const std::vector<double>
   const double band = 0.02 * std::abs(yf);
   std::size_t last_out = y.size();
   for (std::size_t i = y.size(); i-- > 0;)
-    if (std::abs(y[i] - yf) > band) { last_out = i; break; }
+    if (std::abs(y[i] - yf) > band) {
+      last_out = i;
+      break;
+    }
   if (last_out == y.size()) {
     info.settling_time_s = 0.0;
   } else if (last_out + 1 == y.size()) {
@@ -310,10 +347,14 @@ StepInfo SampledStepInfo(const std::vector<double>& t, const std::vector<double>
 
 double Evaluation::Objective(ObjectiveKind kind) const {
   switch (kind) {
-    case ObjectiveKind::kIae: return iae;
-    case ObjectiveKind::kIse: return ise;
-    case ObjectiveKind::kItae: return itae;
-    case ObjectiveKind::kIaeContinuous: return iae_continuous;
+    case ObjectiveKind::kIae:
+      return iae;
+    case ObjectiveKind::kIse:
+      return ise;
+    case ObjectiveKind::kItae:
+      return itae;
+    case ObjectiveKind::kIaeContinuous:
+      return iae_continuous;
   }
   return iae;
 }
@@ -324,12 +365,13 @@ bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const Lo
   PidOptions pid = options.pid;
   pid.dt_s = options.dt_s;
   const DiscretePlant discrete(plant.tf, options.dt_s);
-  RunSampledLoop<double>(discrete, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all, trajectory);
+  RunSampledLoop<double>(discrete, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
+                         trajectory);
   return true;
 }
 
-bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options, const EvaluateOptions& what,
-              Evaluation* ev, std::string* error, const SampledRunner& runner) {
+bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+              const EvaluateOptions& what, Evaluation* ev, std::string* error, const SampledRunner& runner) {
   if (!GainsAreValid(gains, error)) return false;
   if (!options.IsValid(error)) return false;
   if (!plant.tf.IsValid(error)) return false;
@@ -415,7 +457,11 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
 
 ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
                                        SampledRunner runner)
-    : plant_(plant), options_(options), kind_(kind), disturbance_(options.disturbance), runner_(std::move(runner)) {
+    : plant_(plant),
+      options_(options),
+      kind_(kind),
+      disturbance_(options.disturbance),
+      runner_(std::move(runner)) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
   if (!plant.tf.IsValid(&error)) throw std::invalid_argument(error);

@@ -12,22 +12,33 @@
 namespace pidlab {
 
 bool ParseTuneMethod(const std::string& s, TuneMethod* method) {
-  if (s == "nelder-mead") *method = TuneMethod::kNelderMead;
-  else if (s == "paper-nm") *method = TuneMethod::kPaperNelderMead;
-  else if (s == "ziegler-nichols") *method = TuneMethod::kZieglerNichols;
-  else if (s == "ga") *method = TuneMethod::kGeneticAlgorithm;
-  else if (s == "pso-gsa") *method = TuneMethod::kPsoGsa;
-  else return false;
+  if (s == "nelder-mead")
+    *method = TuneMethod::kNelderMead;
+  else if (s == "paper-nm")
+    *method = TuneMethod::kPaperNelderMead;
+  else if (s == "ziegler-nichols")
+    *method = TuneMethod::kZieglerNichols;
+  else if (s == "ga")
+    *method = TuneMethod::kGeneticAlgorithm;
+  else if (s == "pso-gsa")
+    *method = TuneMethod::kPsoGsa;
+  else
+    return false;
   return true;
 }
 
 std::string ToString(TuneMethod method) {
   switch (method) {
-    case TuneMethod::kNelderMead: return "nelder-mead";
-    case TuneMethod::kPaperNelderMead: return "paper-nm";
-    case TuneMethod::kZieglerNichols: return "ziegler-nichols";
-    case TuneMethod::kGeneticAlgorithm: return "ga";
-    case TuneMethod::kPsoGsa: return "pso-gsa";
+    case TuneMethod::kNelderMead:
+      return "nelder-mead";
+    case TuneMethod::kPaperNelderMead:
+      return "paper-nm";
+    case TuneMethod::kZieglerNichols:
+      return "ziegler-nichols";
+    case TuneMethod::kGeneticAlgorithm:
+      return "ga";
+    case TuneMethod::kPsoGsa:
+      return "pso-gsa";
   }
   return "nelder-mead";
 }
@@ -36,9 +47,12 @@ bool TuneOptions::IsValid(std::string* error) const {
   std::ostringstream os;
   if (!std::isfinite(lower) || !std::isfinite(upper) || lower < 0.0 || !(lower < upper))
     os << "bounds [" << lower << ", " << upper << "] must be finite with 0 <= lower < upper";
-  else if (max_iterations < 0) os << "max iterations " << max_iterations << " must be >= 0";
-  else if (max_evaluations < 0) os << "max evaluations " << max_evaluations << " must be >= 0";
-  else if (starts < 1) os << "starts " << starts << " must be >= 1";
+  else if (max_iterations < 0)
+    os << "max iterations " << max_iterations << " must be >= 0";
+  else if (max_evaluations < 0)
+    os << "max evaluations " << max_evaluations << " must be >= 0";
+  else if (starts < 1)
+    os << "starts " << starts << " must be >= 1";
   else if (std::isnan(max_overshoot_pct) || max_overshoot_pct < 0.0)
     os << "max overshoot " << max_overshoot_pct << " % must be >= 0";
   else if (std::isnan(max_settling_time_s) || !(max_settling_time_s > 0.0))
@@ -84,7 +98,8 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
                              runner.target<decltype(&RunSampledLoopInProcess)>() == nullptr;
   const ObjectiveEvaluator evaluator(plant, options.loop, options.objective,
                                      custom_runner ? runner : SampledRunner(nullptr));
-  const bool constrained = std::isfinite(options.max_overshoot_pct) || std::isfinite(options.max_settling_time_s);
+  const bool constrained =
+      std::isfinite(options.max_overshoot_pct) || std::isfinite(options.max_settling_time_s);
   const ObjectiveFunction f = [&](const Eigen::VectorXd& x) {
     const PidGains g{x(0), x(1), x(2)};
     const double value = evaluator(g);
@@ -116,9 +131,10 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
       break;
     }
     case TuneMethod::kGeneticAlgorithm:
-      GeneticAlgorithm(f, bounds,
-                       WithBudget(GeneticAlgorithmOptions{}, options, &GeneticAlgorithmOptions::max_generations),
-                       &opt, progress);
+      GeneticAlgorithm(
+          f, bounds,
+          WithBudget(GeneticAlgorithmOptions{}, options, &GeneticAlgorithmOptions::max_generations), &opt,
+          progress);
       break;
     case TuneMethod::kPsoGsa:
       PsoGsa(f, bounds, WithBudget(PsoGsaOptions{}, options, &PsoGsaOptions::max_iterations), &opt, progress);
@@ -142,7 +158,8 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   }
   if (!opt.IsUsable()) {
     summary->message = "no strictly stable loop found in the box: " + opt.message;
-    summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+    summary->wall_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     return true;
   }
   summary->search_gains = {opt.x(0), opt.x(1), opt.x(2)};

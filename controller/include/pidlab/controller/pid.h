@@ -76,7 +76,8 @@ struct PidOptions {
 
   bool IsValid(std::string* error) const {
     std::ostringstream os;
-    if (!(dt_s > 0.0) || !std::isfinite(dt_s)) os << "dt " << dt_s << " s must be positive and finite";
+    if (!(dt_s > 0.0) || !std::isfinite(dt_s))
+      os << "dt " << dt_s << " s must be positive and finite";
     else if (!(derivative_filter_s >= 0.0) || !std::isfinite(derivative_filter_s))
       os << "derivative filter " << derivative_filter_s << " s must be >= 0 and finite";
     else if (std::isnan(output_min) || std::isnan(output_max) || !(output_min < output_max))
@@ -108,8 +109,7 @@ template <typename T>
 class DiscretePid {
  public:
   /// Options must be valid (checked by the caller with IsValid).
-  DiscretePid(const PidGainsT<T>& gains, const PidOptions& options)
-      : gains_(gains), options_(options) {}
+  DiscretePid(const PidGainsT<T>& gains, const PidOptions& options) : gains_(gains), options_(options) {}
 
   PidStatus Step(const T& r, const T& y, T* u) {
     using std::isfinite;
@@ -119,9 +119,15 @@ class DiscretePid {
     const T p = gains_.kp * e;
     T integral = integral_;
     switch (options_.integral) {
-      case IntegralMethod::kBackwardEuler: integral += gains_.ki * T(dt) * e; break;
-      case IntegralMethod::kForwardEuler: integral += gains_.ki * T(dt) * prev_error_; break;
-      case IntegralMethod::kTrapezoidal: integral += gains_.ki * T(dt * 0.5) * (e + prev_error_); break;
+      case IntegralMethod::kBackwardEuler:
+        integral += gains_.ki * T(dt) * e;
+        break;
+      case IntegralMethod::kForwardEuler:
+        integral += gains_.ki * T(dt) * prev_error_;
+        break;
+      case IntegralMethod::kTrapezoidal:
+        integral += gains_.ki * T(dt * 0.5) * (e + prev_error_);
+        break;
     }
     const T signal = options_.derivative_on == DerivativeOn::kError ? e : T(-y);
     const double tf = options_.derivative_filter_s;
@@ -129,8 +135,14 @@ class DiscretePid {
     const T unsaturated = p + integral + d;
     T out = unsaturated;
     bool saturated = false;
-    if (ToValue(out) > options_.output_max) { out = T(options_.output_max); saturated = true; }
-    if (ToValue(out) < options_.output_min) { out = T(options_.output_min); saturated = true; }
+    if (ToValue(out) > options_.output_max) {
+      out = T(options_.output_max);
+      saturated = true;
+    }
+    if (ToValue(out) < options_.output_min) {
+      out = T(options_.output_min);
+      saturated = true;
+    }
     if (saturated) {
       if (options_.anti_windup == AntiWindup::kClamping) {
         // Integrate only if the error pulls the output back inside the limits.
@@ -163,7 +175,9 @@ class DiscretePid {
  private:
   static double ToValue(double x) { return x; }
   template <typename U>
-  static double ToValue(const U& x) { return ToValue(x.a); }
+  static double ToValue(const U& x) {
+    return ToValue(x.a);
+  }
   static bool IsFinite(const T& x) { return std::isfinite(ToValue(x)); }
 
   PidGainsT<T> gains_;

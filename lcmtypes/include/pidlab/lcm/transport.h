@@ -71,7 +71,8 @@ class Transport {
     msg->utime = NowUtime();
     const int size = msg->getEncodedSize();
     if (size < 0) return false;
-    if (encode_buffer_.size() < static_cast<std::size_t>(size)) encode_buffer_.resize(static_cast<std::size_t>(size));
+    if (encode_buffer_.size() < static_cast<std::size_t>(size))
+      encode_buffer_.resize(static_cast<std::size_t>(size));
     if (msg->encode(encode_buffer_.data(), 0, size) != size) return false;
     return lcm_->publish(CachedChannel(name), encode_buffer_.data(), static_cast<unsigned int>(size)) == 0;
   }

@@ -14,12 +14,13 @@ namespace pidlab {
 /// Shared by DiscretePlant and the templated sampled loop so that both give
 /// the same bits for double.
 template <typename T>
-void ZohStep(const Eigen::MatrixXd& phi, const Eigen::VectorXd& gamma, const std::vector<T>& x, const T& input,
-             std::vector<T>* next) {
+void ZohStep(const Eigen::MatrixXd& phi, const Eigen::VectorXd& gamma, const std::vector<T>& x,
+             const T& input, std::vector<T>* next) {
   const std::size_t n = x.size();
   for (std::size_t i = 0; i < n; ++i) {
     T acc = T(0.0);
-    for (std::size_t j = 0; j < n; ++j) acc += phi(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) * x[j];
+    for (std::size_t j = 0; j < n; ++j)
+      acc += phi(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) * x[j];
     (*next)[i] = acc + gamma(static_cast<Eigen::Index>(i)) * input;
   }
 }

@@ -52,8 +52,7 @@ MatrixX<T> MatrixExp(const MatrixX<T>& a) {
 /// Exact zero-order-hold discretisation of x' = A x + B u over h:
 /// x(t+h) = phi x(t) + gamma u(t), from exp([[A, B], [0, 0]] h).
 template <typename T>
-void ZeroOrderHold(const MatrixX<T>& a, const MatrixX<T>& b, double h,
-                   MatrixX<T>* phi, MatrixX<T>* gamma) {
+void ZeroOrderHold(const MatrixX<T>& a, const MatrixX<T>& b, double h, MatrixX<T>* phi, MatrixX<T>* gamma) {
   const Eigen::Index n = a.rows(), m = b.cols();
   MatrixX<T> aug = MatrixX<T>::Zero(n + m, n + m);
   aug.topLeftCorner(n, n) = a * T(h);

@@ -12,15 +12,15 @@ namespace pidlab {
 /// "g.m^2" unit label notwithstanding): with it eq. (3) reproduces every
 /// published IAE of Tables IV-VI to four digits.
 struct StepperMotorParameters {
-  double resistance_ohm = 33.0;          // r, stator resistance
-  double self_inductance_h = 5.4e-3;     // L
-  double mutual_inductance_h = 0.4e-3;   // M
-  double inertia_kg_m2 = 0.16e-4;        // J
-  double rotor_teeth = 6.0;              // N_r
-  double viscous_friction = 1.35e-5;     // D, N m s / rad
+  double resistance_ohm = 33.0;                            // r, stator resistance
+  double self_inductance_h = 5.4e-3;                       // L
+  double mutual_inductance_h = 0.4e-3;                     // M
+  double inertia_kg_m2 = 0.16e-4;                          // J
+  double rotor_teeth = 6.0;                                // N_r
+  double viscous_friction = 1.35e-5;                       // D, N m s / rad
   double tooth_pitch_rad = 3.14159265358979323846 / 12.0;  // lambda
-  double stationary_current_a = 0.15;    // I_o
-  double flux_linkage = 1.2e-3;          // n Phi_M, T m^2
+  double stationary_current_a = 0.15;                      // I_o
+  double flux_linkage = 1.2e-3;                            // n Phi_M, T m^2
 
   /// All finite and positive, L > M, and cos(N_r lambda / 2) > 0.
   bool IsValid(std::string* error) const;
@@ -43,12 +43,11 @@ std::vector<std::string> BuiltinPlantNames();
 /// Builds a built-in plant by name or alias: double_integrator (linear) = 1/s^2,
 /// oscillator (nonlinear) = 1/(s^2+1), stepper_motor (stepper) = eq. (3) with
 /// `stepper`. Returns false and sets *error naming the value for an unknown name.
-bool MakePlant(const std::string& name, const StepperMotorParameters& stepper,
-               Plant* plant, std::string* error);
+bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, Plant* plant,
+               std::string* error);
 
 /// A user plant from coefficient lists; must be valid and strictly proper.
-bool MakeCustomPlant(const std::vector<double>& num,
-                     const std::vector<double>& den, Plant* plant,
+bool MakeCustomPlant(const std::vector<double>& num, const std::vector<double>& den, Plant* plant,
                      std::string* error);
 
 }  // namespace pidlab

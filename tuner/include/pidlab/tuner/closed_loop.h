@@ -46,8 +46,8 @@ struct LoopOptions {
   DisturbanceOptions disturbance;
   /// A loop is strictly stable when every closed-loop pole p has
   /// Re p < -stability_margin * max(1, |p|), for the s-plane poles p of the
-  /// continuous loop or p = log(z) / dt of the sampled loop's eigenvalues z. Guards against loops that game the
-  /// sampled objective with poles on the imaginary axis.
+  /// continuous loop or p = log(z) / dt of the sampled loop's eigenvalues z. Guards against loops that game
+  /// the sampled objective with poles on the imaginary axis.
   double stability_margin = 1e-9;
 
   bool IsValid(std::string* error) const;
@@ -76,7 +76,7 @@ struct Stability {
 template <typename T>
 struct ContinuousClosedLoop {
   MatrixX<T> m;
-  VectorX<T> w0;     // state at t = 0+, after the derivative kick
+  VectorX<T> w0;  // state at t = 0+, after the derivative kick
   int plant_order = 0;
   int exo_size = 0;  // 0 (no disturbance), 1 (piecewise constant), 2 (sine)
   Eigen::RowVectorXd c;

@@ -63,9 +63,10 @@ struct EvaluateOptions {
 /// *y_all; records every step in *trajectory when it is not null. The
 /// in-process runner is RunSampledLoop; the LCM backend runs an episode over
 /// the process trio instead, with bit-identical results.
-using SampledRunner = std::function<bool(const Plant& plant, const PidGains& gains, const LoopOptions& options,
-                                         const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                                         std::vector<SampledStep>* trajectory, std::string* error)>;
+using SampledRunner =
+    std::function<bool(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                       const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                       std::vector<SampledStep>* trajectory, std::string* error)>;
 
 /// The in-process SampledRunner.
 bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,

@@ -64,7 +64,7 @@ struct RefineSummary {
   bool ran = false;
   PidGains gains;
   double objective = std::numeric_limits<double>::infinity();  // re-evaluated exactly
-  std::string termination;  // Ceres's termination type
+  std::string termination;                                     // Ceres's termination type
   int iterations = 0;
   /// "agree", "nelder-mead stopped short" (Ceres found better; its gains are
   /// returned), or "not run".
@@ -86,7 +86,7 @@ struct TuneSummary {
   int evaluations = 0;
   int iterations = 0;
   double wall_time_s = 0.0;
-  OptimizerSummary optimizer;  // empty for ziegler-nichols
+  OptimizerSummary optimizer;            // empty for ziegler-nichols
   ZieglerNicholsResult ziegler_nichols;  // ziegler-nichols only
   RefineSummary refine;
   std::string message;
