@@ -134,8 +134,16 @@ else
 fi
 
 # ---- a log cut off mid-write ----
-size=$(stat -c %s run.lcmlog)
-head -c $((size * 3 / 5 + 7)) run.lcmlog >cut.lcmlog
+# Cut 20 bytes into the first event that starts after 3/5 of the file, so the
+# cut is always inside an event (a fixed byte count sometimes lands exactly on
+# an event boundary, which is a clean end, not a cut).
+cut=$(python3 -c '
+import sys
+b = open("run.lcmlog", "rb").read()
+i = b.find(bytes.fromhex("EDA1DA01"), len(b) * 3 // 5)
+assert i > 0
+print(i + 20)')
+head -c "$cut" run.lcmlog >cut.lcmlog
 status=0
 "$pidlab" replay cut.lcmlog >cut.txt 2>&1 || status=$?
 if [[ $status -eq 0 ]] && grep -q "cut off mid-write" cut.txt && grep -q "INCOMPLETE" cut.txt &&
