@@ -114,7 +114,7 @@ struct ReportCommand {
     app->add_flag("--quick", quick, "reduced tuning budgets (one start; smoke tests)");
     app->add_flag("--no-figures", no_figures, "write report.md only");
     app->add_flag("--no-trio", no_trio,
-                  "skip the LCM trio episode (about 30 s; --quick skips it too); the section then shows the "
+                  "skip the LCM trio episode (25 s of lockstep, under 20 s here; --quick skips it too); the section then shows the "
                   "in-process sampled loop only");
     return [this] { return Run(); };
   }
