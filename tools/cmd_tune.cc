@@ -23,7 +23,7 @@ struct TuneCommand {
   std::string refine = "ceres", trace, zn_rule = "classic";
   int max_iterations = 0, max_evaluations = 0, starts = 4;
   double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3;
-  bool json = false;
+  bool json = false, adaptive = false;
   std::string lcm_url, channel_prefix;
   double episode_timeout_s = 600.0;
   std::unique_ptr<lcm_trio::EpisodeClient> client;
@@ -52,6 +52,7 @@ struct TuneCommand {
     app->add_option("--max-evals", max_evaluations, "evaluation budget over all starts (0 = method default)")
         ->capture_default_str();
     app->add_option("--starts", starts, "seeded starts (nelder-mead, paper-nm)")->capture_default_str();
+    app->add_flag("--adaptive", adaptive, "nelder-mead: Gao & Han's adaptive coefficients");
     app->add_option("--refine", refine, "ceres | none: the least-squares cross-check")->capture_default_str();
     app->add_option("--agree-tolerance", agree_tolerance,
                     "relative objective difference for the 'agree' verdict")
@@ -94,6 +95,7 @@ struct TuneCommand {
     o.max_iterations = max_iterations;
     o.max_evaluations = max_evaluations;
     o.starts = starts;
+    o.adaptive = adaptive;
     o.seed = loop.seed;
     o.max_overshoot_pct = max_overshoot_pct;
     o.max_settling_time_s = max_settling_time_s;

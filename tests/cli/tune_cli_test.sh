@@ -37,6 +37,8 @@ bad "bad bounds" --plant linear --bounds 5,1
 bad "bad objective" --plant linear --objective mse
 bad "zero starts" --plant linear --starts 0
 bad "zn on 1/s^2" --plant linear --method ziegler-nichols
+"$pidlab" tune --plant stepper --adaptive --json > "$tmp/adaptive.json"
+check "tune --adaptive beats the paper's stepper IAE 1.9751" "python3 -c \"import json; j = json.load(open('$tmp/adaptive.json')); assert j['stable'] and j['iae'] < 1.9751, j['iae']\""
 "$pidlab" tune --help >/dev/null; check "tune --help exits 0" "[ $? -eq 0 ]"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

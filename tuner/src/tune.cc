@@ -120,6 +120,7 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
     case TuneMethod::kNelderMead: {
       NelderMeadOptions o = WithBudget(NelderMeadOptions{}, options, &NelderMeadOptions::max_iterations);
       o.starts = options.starts;
+      o.adaptive = options.adaptive;
       NelderMead(f, bounds, o, &opt, progress);
       break;
     }

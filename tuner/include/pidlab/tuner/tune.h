@@ -42,6 +42,9 @@ struct TuneOptions {
   int max_evaluations = 0;
   /// Independent seeded starts (nelder-mead, paper-nm).
   int starts = 4;
+  /// nelder-mead: Gao & Han's dimension-dependent coefficients instead of
+  /// (1, 2, 1/2, 1/2).
+  bool adaptive = false;
   std::uint64_t seed = 1;
   /// Constraints on the undisturbed step response (+inf = none): a candidate
   /// violating them is rejected like an unstable loop.
