@@ -11,7 +11,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   gnuplot-nox
-  iproute2 util-linux python3
+  iproute2 util-linux python3 bc
   default-jdk-headless liblcm-java
 )
 no_java=0
