@@ -201,6 +201,13 @@ bool EpisodeClient::Run(const Plant& plant, const PidGains& gains, const LoopOpt
         s.max_step == total || (s.summary && s.last_summary.status == pidlab::lcmt_episode_summary::OK);
     if (at_end && done_s < 0) done_s = now;
     if (!at_end && now - s.last_progress_s > plant_deadline) {
+      // A client that was itself starved of CPU may have the plant's progress
+      // queued unread: read everything waiting before blaming the plant.
+      int handled = 0;
+      while ((handled = transport_->WaitAndHandle(0.0)) > 0) {
+      }
+      if (handled < 0) return fail("LCM receive error" + where.str());
+      if (NowSeconds() - s.last_progress_s <= plant_deadline) continue;
       std::ostringstream os;
       os << "no answer from pidlab-plant for " << plant_deadline << " s at step " << s.max_step + 1 << " of "
          << total << where.str();
