@@ -5,7 +5,7 @@ set -uo pipefail
 spy=$(realpath -- "${1:?usage: lcm_spy_test.sh TOOLS_LCM_SPY}")
 types=$(dirname "$spy")/../lcmtypes
 if ! command -v javac >/dev/null || [[ ! -r /usr/share/java/lcm.jar ]]; then
-  echo "SKIPPED: javac or liblcm-java missing (scripts/install-deps.sh --with-java)"
+  echo "SKIPPED: javac or liblcm-java missing (scripts/install-deps.sh installs them unless --no-java)"
   exit 77
 fi
 export XDG_CACHE_HOME=$(mktemp -d)
