@@ -12,12 +12,12 @@
 #include <cstdlib>
 #include <string>
 
-#include "pidlab/lcm/episode_client.h"
-#include "pidlab/lcm/transport.h"
+#include "pidlab/tuner/episode_client.h"
+#include "pidlab/transport/transport.h"
 
 namespace {
 
-using pidlab::lcm_trio::NowSeconds;
+using pidlab::transport::NowSeconds;
 
 struct Ping {
   int64_t seq = 0;
@@ -83,8 +83,8 @@ int main(int argc, char** argv) {
   const long trips = argc > 1 ? std::atol(argv[1]) : 20000;
   const double horizon = argc > 2 ? std::atof(argv[2]) : 20.0;
   const char* env_url = std::getenv("PIDLAB_LCM_URL");
-  const std::string url = env_url ? env_url : pidlab::lcm_trio::kDefaultLcmUrl;
-  pidlab::lcm_trio::EpisodeClientOptions co;
+  const std::string url = env_url ? env_url : pidlab::transport::kDefaultLcmUrl;
+  pidlab::EpisodeClientOptions co;
   co.lcm_url = url;
   if (const char* p = std::getenv("PIDLAB_CHANNEL_PREFIX")) co.transport.channel_prefix = p;
 
@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   pidlab::LoopOptions options;
   options.loop = pidlab::LoopKind::kSampled;
   options.horizon_s = horizon;
-  pidlab::lcm_trio::EpisodeClient client(co);
+  pidlab::EpisodeClient client(co);
   std::vector<double> y;
   for (int episode = 0; episode < 3; ++episode) {
     if (!client.Run(plant, pidlab::PidGains{2.0, 1.0, 1.5}, options, options.disturbance, &y, nullptr,

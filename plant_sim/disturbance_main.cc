@@ -1,13 +1,14 @@
-// pidlab-disturbance: answers every plant output y_k with n_k = n(k dt).
+// pidlab-disturbance: answers the plant's requests for disturbance samples
+// with blocks of n_k = n(k dt). It never sees y_k (n does not depend on it).
 
-#include "pidlab/lcm/process_main.h"
+#include "pidlab/plant_sim/disturbance_role.h"
+#include "pidlab/transport/role_main.h"
 
 int main(int argc, char** argv) {
-  using namespace pidlab::lcm_trio;
-  return RoleMain(
-      argc, argv, "pidlab-disturbance",
-      "pidlab-disturbance: answers each plant output y_k with the disturbance sample n_k = n(k dt)",
-      [](Transport* t, LogFn log, bool verbose) {
-        return std::make_unique<DisturbanceRole>(t, log, verbose);
-      });
+  using namespace pidlab::transport;
+  return RoleMain(argc, argv, "pidlab-disturbance",
+                  "pidlab-disturbance: answers the plant's DISTURBANCE_REQUESTs with blocks of n_k = n(k dt)",
+                  [](Transport* t, LogFn log, bool verbose) {
+                    return std::make_unique<DisturbanceRole>(t, log, verbose);
+                  });
 }

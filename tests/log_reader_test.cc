@@ -2,7 +2,7 @@
 // with lcm::LogFile: honest logs, retransmissions, cut-off and corrupt tails,
 // foreign and garbage events, several prefixes, an altered command.
 
-#include "log_reader.h"
+#include "pidlab/replay/replay.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -21,7 +21,8 @@
 #include <pidlab/lcmt_plant_output.hpp>
 #include <random>
 
-#include "pidlab/lcm/episode_config.h"
+#include "pidlab/transport/episode_spec.h"
+#include "pidlab/tuner/episode_client.h"
 
 namespace pidlab::replay {
 namespace {
@@ -126,8 +127,8 @@ struct EpisodeWriter {
 
   void Write(lcm::LogFile* log, int64_t* num) const {
     if (with_config) {
-      const auto config = lcm_trio::MakeEpisodeConfig(episode_id, ref.plant, ref.gains, ref.options,
-                                                      ref.options.disturbance, lcm_trio::RecoveryOptions{});
+      const auto config = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(episode_id, ref.plant, ref.gains, ref.options,
+                                                      ref.options.disturbance, transport::RecoveryOptions{}));
       WriteMsg(log, prefix + "EPISODE_CONFIG", config, num);
       WriteMsg(log, prefix + "EPISODE_CONFIG", config, num);  // republished until acknowledged
     }
@@ -292,8 +293,8 @@ TEST_F(LogReaderTest, GarbageForeignAndSelfTestEventsAreCountedAndSkipped) {
     short_output.resize(20);
     WriteRaw(&log, "PIDLAB_PLANT_OUTPUT", short_output, &num);
     // A configuration whose num_size claims two billion doubles.
-    auto config = lcm_trio::MakeEpisodeConfig(99, ref.plant, ref.gains, ref.options, ref.options.disturbance,
-                                              lcm_trio::RecoveryOptions{});
+    auto config = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(99, ref.plant, ref.gains, ref.options, ref.options.disturbance,
+                                              transport::RecoveryOptions{}));
     std::vector<uint8_t> hostile(static_cast<std::size_t>(config.getEncodedSize()));
     config.encode(hostile.data(), 0, static_cast<int>(hostile.size()));
     const std::size_t num_size_at = 8 + 24 + 4 + config.plant_name.size() + 1;

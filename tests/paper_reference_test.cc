@@ -1,4 +1,4 @@
-// The 13 gain sets of the paper against ../shared/reference/paper_tables.csv,
+// The 13 gain sets of the paper against data/paper_tables.csv,
 // whose ref_* columns were computed independently (MATLAB stepinfo).
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // pidlab_plot: the PNG gnuplot draws has the requested size, and the data
 // files behind it hold exactly the series that were given.
 
-#include "plot.h"
+#include "pidlab/plot/plot.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -11,7 +11,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "loop_figure.h"
+#include "pidlab/plot/loop_figure.h"
 
 namespace pidlab::plot {
 namespace {

@@ -2,7 +2,7 @@
 // reproduce paper_tables.csv's ref_* columns, every table and tuning must be
 // in the Markdown, and the report must be deterministic for a seed.
 
-#include "report.h"
+#include "pidlab/report/report.h"
 
 #include <gtest/gtest.h>
 

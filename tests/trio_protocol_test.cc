@@ -8,12 +8,15 @@
 #include <pidlab/lcmt_plant_output.hpp>
 #include <random>
 
-#include "pidlab/lcm/episode_config.h"
-#include "pidlab/lcm/roles.h"
-#include "pidlab/lcm/transport.h"
+#include "pidlab/transport/episode_spec.h"
+#include "pidlab/controller/controller_role.h"
+#include "pidlab/plant_sim/disturbance_role.h"
+#include "pidlab/plant_sim/plant_role.h"
+#include "pidlab/transport/transport.h"
+#include "pidlab/tuner/episode_client.h"
 #include "pidlab/tuner/evaluation.h"
 
-namespace pidlab::lcm_trio {
+namespace pidlab::transport {
 namespace {
 
 struct Episode {
@@ -75,7 +78,7 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
   RecoveryOptions recovery;
   recovery.retransmit_interval_s = 0.001;
   recovery.silence_deadline_s = 0.2;
-  auto config = MakeEpisodeConfig(id, e.plant, e.gains, e.options, e.options.disturbance, recovery);
+  auto config = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
   client_t.Publish(kEpisodeConfigChannel, &config);
   const double start = NowSeconds();
   while (!rec->summary && NowSeconds() - start < 20.0) {
@@ -105,24 +108,24 @@ TEST(EpisodeConfig, RoundTripsEveryField) {
   e.options.pid.integral = IntegralMethod::kTrapezoidal;
   e.options.disturbance.seed = 99;
   const auto msg =
-      MakeEpisodeConfig(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{});
+      transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   EpisodeSpec dut;
   std::string error;
   ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
   EXPECT_EQ(dut.episode_id, 7);
   EXPECT_EQ(dut.plant.tf.den, e.plant.tf.den);
   EXPECT_EQ(dut.gains.kd, 1.5);
-  EXPECT_EQ(dut.options.pid.derivative_filter_s, 0.01);
-  EXPECT_EQ(dut.options.pid.output_min, -5);
-  EXPECT_EQ(dut.options.pid.anti_windup, AntiWindup::kBackCalculation);
-  EXPECT_EQ(dut.options.pid.integral, IntegralMethod::kTrapezoidal);
-  EXPECT_EQ(dut.options.disturbance.seed, 99u);
+  EXPECT_EQ(dut.pid.derivative_filter_s, 0.01);
+  EXPECT_EQ(dut.pid.output_min, -5);
+  EXPECT_EQ(dut.pid.anti_windup, AntiWindup::kBackCalculation);
+  EXPECT_EQ(dut.pid.integral, IntegralMethod::kTrapezoidal);
+  EXPECT_EQ(dut.disturbance.seed, 99u);
   EXPECT_EQ(dut.total_steps, e.options.TotalSteps());
 }
 
 TEST(EpisodeConfig, RejectsMalformedFieldsByName) {
   Episode e = DoubleIntegrator();
-  auto msg = MakeEpisodeConfig(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{});
+  auto msg = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   EpisodeSpec dut;
   std::string error;
   auto bad = msg;
@@ -246,4 +249,4 @@ TEST(Trio, NamesTheSilentDisturbanceAfterTheDeadline) {
 }
 
 }  // namespace
-}  // namespace pidlab::lcm_trio
+}  // namespace pidlab::transport

@@ -9,14 +9,28 @@
 
 namespace pidlab::cli {
 
-std::vector<RegisteredCommand>& Registry() {
-  static std::vector<RegisteredCommand> registry;
-  return registry;
+std::string FromEnv(const std::string& flag, const char* env, const char* fallback) {
+  if (!flag.empty()) return flag;
+  const char* v = std::getenv(env);
+  return v && *v ? v : fallback;
 }
 
-CommandRegistrar::CommandRegistrar(const std::string& name, const std::string& description,
-                                   CommandFactory factory) {
-  Registry().push_back({name, description, std::move(factory)});
+void LcmFlags::Register(CLI::App* app) {
+  app->add_option("--lcm-url", lcm_url, "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's)");
+  app->add_option("--channel-prefix", channel_prefix,
+                  "--backend lcm: channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
+  app->add_option("--episode-timeout", episode_timeout_s, "--backend lcm: give up on an episode after this many s")
+      ->capture_default_str();
+}
+
+std::unique_ptr<EpisodeClient> LcmFlags::MakeClient() const {
+  EpisodeClientOptions co;
+  co.lcm_url = FromEnv(lcm_url, "PIDLAB_LCM_URL", transport::kDefaultLcmUrl);
+  co.transport.channel_prefix = FromEnv(channel_prefix, "PIDLAB_CHANNEL_PREFIX", transport::kDefaultChannelPrefix);
+  co.episode_timeout_s = episode_timeout_s;
+  std::string error;
+  if (!co.IsValid(&error)) throw BadInput(error);
+  return std::make_unique<EpisodeClient>(co);  // throws runtime_error: exit 1
 }
 
 double ParseDouble(const std::string& text, const std::string& what) {

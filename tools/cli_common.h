@@ -5,11 +5,13 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "pidlab/tuner/episode_client.h"
 #include "pidlab/tuner/evaluation.h"
 
 namespace pidlab::cli {
@@ -19,17 +21,20 @@ struct BadInput : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// A subcommand: registers its flags on `sub` and returns the action to run
-/// after parsing (returns the exit status).
-using CommandFactory = std::function<std::function<int()>(CLI::App* sub)>;
-struct CommandRegistrar {
-  CommandRegistrar(const std::string& name, const std::string& description, CommandFactory factory);
+/// A flag's value, else the environment variable's (what `pidlab launch`
+/// exports to its COMMAND), else the fallback.
+std::string FromEnv(const std::string& flag, const char* env, const char* fallback);
+
+/// --lcm-url, --channel-prefix and --episode-timeout of the LCM backend.
+struct LcmFlags {
+  std::string lcm_url, channel_prefix;
+  double episode_timeout_s = 600.0;
+  void Register(CLI::App* app);
+  /// An episode client on the trio these flags (or $PIDLAB_LCM_URL and
+  /// $PIDLAB_CHANNEL_PREFIX) name. Throws BadInput for bad flags,
+  /// std::runtime_error if LCM cannot start.
+  std::unique_ptr<EpisodeClient> MakeClient() const;
 };
-struct RegisteredCommand {
-  std::string name, description;
-  CommandFactory factory;
-};
-std::vector<RegisteredCommand>& Registry();
 
 /// Strict number parsing: the whole string must be a finite-or-not double.
 double ParseDouble(const std::string& text, const std::string& what);

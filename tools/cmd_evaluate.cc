@@ -6,7 +6,8 @@
 #include <memory>
 
 #include "cli_common.h"
-#include "pidlab/lcm/episode_client.h"
+#include "commands.h"
+#include "pidlab/tuner/episode_client.h"
 
 namespace pidlab::cli {
 namespace {
@@ -20,8 +21,7 @@ struct EvaluateCommand {
   std::string trajectory_csv;
   // --backend lcm: run the sampled loop over a running process trio.
   std::string backend = "local";
-  std::string lcm_url, channel_prefix;
-  double episode_timeout_s = 600.0;
+  LcmFlags lcm;
   CLI::App* app_ = nullptr;
 
   std::function<int()> Register(CLI::App* app) {
@@ -41,13 +41,7 @@ struct EvaluateCommand {
            "--loop sampled")
         ->check(CLI::IsMember({"local", "lcm"}))
         ->capture_default_str();
-    app->add_option("--lcm-url", lcm_url,
-                    "LCM URL of the trio (default $PIDLAB_LCM_URL, else the LCM default)");
-    app->add_option("--channel-prefix", channel_prefix,
-                    "channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
-    app->add_option("--episode-timeout", episode_timeout_s,
-                    "give up on an LCM episode after this many seconds")
-        ->capture_default_str();
+    lcm.Register(app);
     app_ = app;
     return [this] { return Run(); };
   }
@@ -62,18 +56,12 @@ struct EvaluateCommand {
       throw BadInput("--trajectory-csv needs --loop sampled");
     Evaluation ev;
     std::string error;
-    std::unique_ptr<lcm_trio::EpisodeClient> client;
+    std::unique_ptr<EpisodeClient> client;
     if (backend == "lcm") {
       if (app_->count("--loop") > 0 && options.loop != LoopKind::kSampled)
         throw BadInput("--backend lcm runs the sampled loop, not --loop " + loop.loop);
       options.loop = LoopKind::kSampled;
-      lcm_trio::EpisodeClientOptions co;
-      co.lcm_url = FromEnv(lcm_url, "PIDLAB_LCM_URL", lcm_trio::kDefaultLcmUrl);
-      co.transport.channel_prefix =
-          FromEnv(channel_prefix, "PIDLAB_CHANNEL_PREFIX", lcm_trio::kDefaultChannelPrefix);
-      co.episode_timeout_s = episode_timeout_s;
-      if (!co.IsValid(&error)) throw BadInput(error);
-      client = std::make_unique<lcm_trio::EpisodeClient>(co);  // throws runtime_error: exit 1
+      client = lcm.MakeClient();
       std::string runner_error;
       const bool ok = Evaluate(
           p, g, options, what, &ev, &error,
@@ -106,12 +94,6 @@ struct EvaluateCommand {
     return 0;
   }
 
-  static std::string FromEnv(const std::string& flag, const char* env, const char* fallback) {
-    if (!flag.empty()) return flag;
-    const char* v = std::getenv(env);
-    return v && *v ? v : fallback;
-  }
-
   static void WriteTrajectoryCsv(const Evaluation& ev, const std::string& path) {
     FILE* f = std::fopen(path.c_str(), "w");
     if (!f) throw BadInput("cannot write --trajectory-csv " + path);
@@ -122,9 +104,12 @@ struct EvaluateCommand {
   }
 };
 
-EvaluateCommand command;
-const CommandRegistrar registrar("evaluate", "evaluate one gain set (IAE, poles, step metrics)",
-                                 [](CLI::App* sub) { return command.Register(sub); });
 
 }  // namespace
+std::function<int()> RegisterEvaluate(CLI::App* app) {
+  auto command = std::make_shared<EvaluateCommand>();
+  auto action = command->Register(app);
+  return [command, action] { return action(); };
+}
+
 }  // namespace pidlab::cli

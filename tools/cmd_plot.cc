@@ -7,7 +7,8 @@
 #include <sstream>
 
 #include "cli_common.h"
-#include "loop_figure.h"
+#include "commands.h"
+#include "pidlab/plot/loop_figure.h"
 #include "plot_sources.h"
 
 namespace pidlab::cli {
@@ -78,9 +79,12 @@ struct PlotCommand {
   }
 };
 
-PlotCommand command;
-const CommandRegistrar registrar("plot", "PNG figures of y, e, u, n from an evaluation or an LCM log",
-                                 [](CLI::App* sub) { return command.Register(sub); });
 
 }  // namespace
+std::function<int()> RegisterPlot(CLI::App* app) {
+  auto command = std::make_shared<PlotCommand>();
+  auto action = command->Register(app);
+  return [command, action] { return action(); };
+}
+
 }  // namespace pidlab::cli

@@ -14,9 +14,11 @@
 #include <sstream>
 
 #include "cli_common.h"
-#include "log_reader.h"
-#include "pidlab/lcm/episode_config.h"
-#include "pidlab/lcm/transport.h"
+#include "commands.h"
+#include "pidlab/replay/log_reader.h"
+#include "pidlab/replay/replay.h"
+#include "pidlab/transport/episode_spec.h"
+#include "pidlab/transport/transport.h"
 
 namespace pidlab::cli {
 namespace {
@@ -38,81 +40,6 @@ std::string Full(double v) {
   std::ostringstream os;
   os << std::setprecision(17) << v;
   return os.str();
-}
-
-// Re-drives a live pidlab-controller (started alone, without plant and
-// disturbance) with the logged plant outputs, one step at a time: publish y_k,
-// wait for the command of step k (resending y_k on silence), compare bits.
-replay::RedriveResult RedriveOverLcm(const replay::Episode& e, const std::string& url,
-                                     const std::string& prefix, double deadline_s) {
-  replay::RedriveResult r;
-  if (!e.has_config) {
-    r.message = e.CompletenessNote();
-    return r;
-  }
-  lcm::LCM lcm(url);
-  if (!lcm.good()) throw BadInput("--lcm-url '" + url + "': LCM cannot start");
-  lcm_trio::TransportOptions topt;
-  topt.channel_prefix = prefix;
-  lcm_trio::Transport transport(&lcm, topt);
-  const int64_t id = (lcm_trio::NowUtime() << 1) | 1;  // a fresh episode, never the logged one
-  bool acked = false;
-  long answered_step = -1;
-  double answered_u = 0.0;
-  transport.Subscribe<pidlab::lcmt_ready>(lcm_trio::kReadyChannel, [&](const pidlab::lcmt_ready& m) {
-    if (m.episode_id == id && m.state == pidlab::lcmt_ready::CONFIG_ACK && m.role == "controller")
-      acked = true;
-  });
-  transport.Subscribe<pidlab::lcmt_control_command>(lcm_trio::kControlChannel,
-                                                    [&](const pidlab::lcmt_control_command& m) {
-                                                      if (m.episode_id == id && m.step == answered_step + 1)
-                                                        answered_step = m.step, answered_u = m.u;
-                                                    });
-  auto config = lcm_trio::MakeEpisodeConfig(id, e.spec.plant, e.spec.gains, e.spec.options,
-                                            e.spec.options.disturbance, e.spec.recovery);
-  const double retransmit_s = 0.01;
-  for (double start = lcm_trio::NowSeconds(); !acked;) {
-    if (lcm_trio::NowSeconds() - start > deadline_s)
-      throw std::runtime_error("no pidlab-controller acknowledged the episode on " + url + " prefix " +
-                               prefix + " (start one alone: pidlab-controller --lcm-url ...)");
-    transport.Publish(lcm_trio::kEpisodeConfigChannel, &config);
-    transport.WaitAndHandle(retransmit_s);
-  }
-  for (long k = 0; k < e.total_steps; ++k) {
-    if (!e.has_y[k] || !e.has_u[k]) {
-      r.message = "cannot re-drive past step " + std::to_string(k) + ": the log has no " +
-                  (e.has_y[k] ? "command" : "plant output") + " for it";
-      return r;
-    }
-    pidlab::lcmt_plant_output y{};
-    y.episode_id = id;
-    y.step = k;
-    y.t_s = static_cast<double>(k) * e.spec.options.dt_s;
-    y.y = e.y[k];
-    for (double start = lcm_trio::NowSeconds(); answered_step < k;) {
-      if (lcm_trio::NowSeconds() - start > deadline_s)
-        throw std::runtime_error("pidlab-controller did not answer step " + std::to_string(k) + " within " +
-                                 Full(deadline_s) + " s");
-      transport.Publish(lcm_trio::kPlantOutputChannel, &y);
-      for (double sent = lcm_trio::NowSeconds();
-           answered_step < k && lcm_trio::NowSeconds() - sent < retransmit_s;)
-        transport.WaitAndHandle(retransmit_s);
-    }
-    ++r.steps_checked;
-    if (std::memcmp(&answered_u, &e.u[k], sizeof answered_u) != 0) {
-      r.first_mismatch = k;
-      r.logged_u = e.u[k];
-      r.recomputed_u = answered_u;
-      r.message = "first mismatch at step " + std::to_string(k) + " (t = " + Full(y.t_s) +
-                  " s): logged u = " + Full(e.u[k]) + ", live controller u = " + Full(answered_u) +
-                  " from y = " + Full(e.y[k]);
-      return r;
-    }
-  }
-  r.ok = true;
-  r.message =
-      "all " + std::to_string(r.steps_checked) + " commands reproduced bit for bit by the live controller";
-  return r;
 }
 
 struct ReplayCommand {
@@ -155,15 +82,17 @@ struct ReplayCommand {
     return [this] { return Run(); };
   }
 
-  std::string Url() const {
-    if (!lcm_url.empty()) return lcm_url;
-    const char* env = std::getenv("PIDLAB_LCM_URL");
-    return env && *env ? env : lcm_trio::kDefaultLcmUrl;
-  }
+  std::string Url() const { return FromEnv(lcm_url, "PIDLAB_LCM_URL", transport::kDefaultLcmUrl); }
   std::string Prefix() const {
-    if (!lcm_prefix.empty()) return lcm_prefix;
-    const char* env = std::getenv("PIDLAB_CHANNEL_PREFIX");
-    return env && *env ? env : lcm_trio::kDefaultChannelPrefix;
+    return FromEnv(lcm_prefix, "PIDLAB_CHANNEL_PREFIX", transport::kDefaultChannelPrefix);
+  }
+
+  replay::RedriveResult RedriveLive(const replay::Episode& e) const {
+    try {
+      return replay::RedriveOverLcm(e, Url(), Prefix(), 2.0);
+    } catch (const std::invalid_argument& bad_url) {
+      throw BadInput(std::string("--lcm-url: ") + bad_url.what());
+    }
   }
 
   int Run() {
@@ -238,8 +167,8 @@ struct ReplayCommand {
         gains = g.str();
         j["plant"] = plant;
         j["gains"] = cli::ToJson(e->spec.gains);
-        j["dt_s"] = e->spec.options.dt_s;
-        j["disturbance"] = ToString(e->spec.options.disturbance.kind);
+        j["dt_s"] = e->spec.dt_s;
+        j["disturbance"] = ToString(e->spec.disturbance.kind);
       } else {
         j["config_error"] = e->config_error;
       }
@@ -278,7 +207,7 @@ struct ReplayCommand {
         details << "    not evaluated: " << why << "\n";
       if (redrive) {
         const replay::RedriveResult r =
-            backend == "lcm" ? RedriveOverLcm(*e, Url(), Prefix(), 2.0) : replay::Redrive(*e);
+            backend == "lcm" ? RedriveLive(*e) : replay::Redrive(*e);
         j["redrive"] = {{"ok", r.ok},
                         {"steps_checked", r.steps_checked},
                         {"first_mismatch_step", r.first_mismatch},
@@ -293,7 +222,7 @@ struct ReplayCommand {
       table << details.str();
       if (csv_file.is_open()) {
         const double r = e->has_config ? e->spec.reference : 1.0;
-        const double dt = e->has_config ? e->spec.options.dt_s : std::nan("");
+        const double dt = e->has_config ? e->spec.dt_s : std::nan("");
         for (long k = 0; k <= e->total_steps; ++k) {
           const auto i = static_cast<std::size_t>(k);
           csv_file << e->episode_id << "," << k << "," << static_cast<double>(k) * dt << "," << r << ","
@@ -311,9 +240,12 @@ struct ReplayCommand {
   }
 };
 
-ReplayCommand command;
-const CommandRegistrar registrar("replay", "read an LCM log: episodes, IAE, completeness, --redrive",
-                                 [](CLI::App* sub) { return command.Register(sub); });
 
 }  // namespace
+std::function<int()> RegisterReplay(CLI::App* app) {
+  auto command = std::make_shared<ReplayCommand>();
+  auto action = command->Register(app);
+  return [command, action] { return action(); };
+}
+
 }  // namespace pidlab::cli

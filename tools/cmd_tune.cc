@@ -10,7 +10,8 @@
 #include <iostream>
 
 #include "cli_common.h"
-#include "pidlab/lcm/episode_client.h"
+#include "commands.h"
+#include "pidlab/tuner/episode_client.h"
 #include "pidlab/tuner/tune.h"
 
 namespace pidlab::cli {
@@ -24,9 +25,8 @@ struct TuneCommand {
   int max_iterations = 0, max_evaluations = 0, starts = 4;
   double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3;
   bool json = false, adaptive = false;
-  std::string lcm_url, channel_prefix;
-  double episode_timeout_s = 600.0;
-  std::unique_ptr<lcm_trio::EpisodeClient> client;
+  LcmFlags lcm;
+  std::unique_ptr<EpisodeClient> client;
 
   // The tuner's acceptance margin: with the evaluation's 1e-9 the search games
   // the sampled objective by parking poles a hair left of the imaginary axis
@@ -63,14 +63,7 @@ struct TuneCommand {
         ->capture_default_str();
     app->add_option("--trace", trace, "write the best-so-far trajectory of the search to this CSV file");
     app->add_flag("--json", json, "print one JSON object");
-    app->add_option("--lcm-url", lcm_url,
-                    "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's)");
-    app->add_option(
-        "--channel-prefix", channel_prefix,
-        "--backend lcm: channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
-    app->add_option("--episode-timeout", episode_timeout_s,
-                    "--backend lcm: give up on an episode after this many s")
-        ->capture_default_str();
+    lcm.Register(app);
     return [this] { return Run(); };
   }
 
@@ -205,31 +198,20 @@ struct TuneCommand {
     }
   }
 
-  static SampledRunner MakeLcmRunner();
+  SampledRunner MakeLcmRunner() {
+    client = lcm.MakeClient();
+    return client->AsRunner();
+  }
 };
 
-TuneCommand command;
 
-SampledRunner TuneCommand::MakeLcmRunner() {
-  auto from_env = [](const std::string& flag, const char* env, const char* fallback) {
-    if (!flag.empty()) return flag;
-    const char* v = std::getenv(env);
-    return std::string(v && *v ? v : fallback);
-  };
-  lcm_trio::EpisodeClientOptions co;
-  co.lcm_url = from_env(command.lcm_url, "PIDLAB_LCM_URL", lcm_trio::kDefaultLcmUrl);
-  co.transport.channel_prefix =
-      from_env(command.channel_prefix, "PIDLAB_CHANNEL_PREFIX", lcm_trio::kDefaultChannelPrefix);
-  co.episode_timeout_s = command.episode_timeout_s;
-  std::string error;
-  if (!co.IsValid(&error)) throw BadInput(error);
-  command.client = std::make_unique<lcm_trio::EpisodeClient>(co);  // throws runtime_error: exit 1
-  return command.client->AsRunner();
-}
 
-const CommandRegistrar registrar("tune",
-                                 "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check",
-                                 [](CLI::App* sub) { return command.Register(sub); });
 
 }  // namespace
+std::function<int()> RegisterTune(CLI::App* app) {
+  auto command = std::make_shared<TuneCommand>();
+  auto action = command->Register(app);
+  return [command, action] { return action(); };
+}
+
 }  // namespace pidlab::cli

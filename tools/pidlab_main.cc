@@ -1,18 +1,39 @@
-// pidlab: one executable, one subcommand per job (evaluate, tune, launch,
-// replay, plot, report). Each subcommand lives in its own cmd_*.cc file and
-// registers itself; this file only dispatches and applies the exit convention.
+// pidlab: one executable, one subcommand per job. The table below is the
+// whole command line; each subcommand lives in its own cmd_*.cc. This file
+// only dispatches and applies the exit convention: 2 for bad input (one line
+// naming the value), 1 for a runtime failure.
 
 #include <iostream>
 
 #include "cli_common.h"
+#include "commands.h"
+
+namespace {
+
+struct Command {
+  const char* name;
+  const char* description;
+  std::function<int()> (*register_flags)(CLI::App* app);
+};
+
+const Command kCommands[] = {
+    {"evaluate", "evaluate one gain set (IAE, poles, step metrics)", pidlab::cli::RegisterEvaluate},
+    {"launch", "start the LCM process trio (plant, controller, disturbance)", pidlab::cli::RegisterLaunch},
+    {"plot", "PNG figures of y, e, u, n from an evaluation or an LCM log", pidlab::cli::RegisterPlot},
+    {"replay", "read an LCM log: episodes, IAE, completeness, --redrive", pidlab::cli::RegisterReplay},
+    {"report", "regenerate the paper's tables and figures (report.md + PNGs)", pidlab::cli::RegisterReport},
+    {"tune", "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check", pidlab::cli::RegisterTune},
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"pidlab: PID tuning by Nelder-Mead, evaluated exactly and run as a distributed LCM system"};
   app.require_subcommand(1);
   std::vector<std::pair<CLI::App*, std::function<int()>>> actions;
-  for (const auto& command : pidlab::cli::Registry()) {
+  for (const Command& command : kCommands) {
     CLI::App* sub = app.add_subcommand(command.name, command.description);
-    actions.emplace_back(sub, command.factory(sub));
+    actions.emplace_back(sub, command.register_flags(sub));
   }
   try {
     app.parse(argc, argv);

@@ -5,8 +5,8 @@
 #include <iomanip>
 #include <sstream>
 
-#include "log_reader.h"
-#include "loop_figure.h"
+#include "pidlab/replay/replay.h"
+#include "pidlab/plot/loop_figure.h"
 
 namespace pidlab::cli {
 
@@ -98,7 +98,7 @@ bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, p
     plot::LoopTrace tr;
     std::ostringstream name;
     name << "episode " << e.episode_id << ": " << GainsLabel(e.spec.gains);
-    const DisturbanceOptions& d = e.spec.options.disturbance;
+    const DisturbanceOptions& d = e.spec.disturbance;
     if (d.kind == DisturbanceKind::kNone)
       name << ", no disturbance";
     else
@@ -107,7 +107,7 @@ bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, p
     std::string why;
     if (replay::EvaluateEpisode(e, &ev, &why)) name << std::setprecision(6) << " (IAE " << ev.iae << ")";
     tr.name = name.str();
-    const double dt = e.spec.options.dt_s, r = e.spec.reference;
+    const double dt = e.spec.dt_s, r = e.spec.reference;
     for (long k = 0; k < e.total_steps; ++k) {
       const auto i = static_cast<std::size_t>(k);
       tr.t.push_back(static_cast<double>(k) * dt);

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "pidlab/tuner/evaluation.h"
-#include "plot.h"
+#include "pidlab/plot/plot.h"
 
 namespace pidlab::cli {
 

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <string>
 
-#include "log_reader.h"
+#include "pidlab/replay/log_reader.h"
 
 int main(int argc, char** argv) {
   if (argc < 2) {

@@ -1,0 +1,80 @@
+#include "pidlab/controller/controller_role.h"
+
+#include <pidlab/lcmt_control_command.hpp>
+
+#include "pidlab/controller/pid.h"
+
+namespace pidlab::transport {
+namespace {
+int8_t ToCommandStatus(PidStatus status) {
+  switch (status) {
+    case PidStatus::kOk:
+      return pidlab::lcmt_control_command::OK;
+    case PidStatus::kSaturated:
+      return pidlab::lcmt_control_command::SATURATED;
+    case PidStatus::kInvalidInput:
+      break;
+  }
+  return pidlab::lcmt_control_command::INVALID_INPUT;
+}
+}  // namespace
+
+struct ControllerRole::Episode {
+  EpisodeSpec spec;
+  std::unique_ptr<DiscretePid<double>> pid;
+  long expected = 0;
+  pidlab::lcmt_control_command last;
+  bool have_last = false;
+};
+
+ControllerRole::ControllerRole(Transport* transport, LogFn log, bool verbose)
+    : Role(transport, "controller", std::move(log), verbose) {
+  transport_->Subscribe<pidlab::lcmt_plant_output>(
+      kPlantOutputChannel, [this](const pidlab::lcmt_plant_output& m) { OnOutput(m); });
+}
+ControllerRole::~ControllerRole() = default;
+
+void ControllerRole::StartEpisode(const EpisodeSpec& spec) {
+  auto ep = std::make_unique<Episode>();
+  ep->spec = spec;
+  PidOptions options = spec.pid;
+  options.dt_s = spec.dt_s;
+  ep->pid = std::make_unique<DiscretePid<double>>(spec.gains, options);
+  ep_ = std::move(ep);
+}
+
+void ControllerRole::OnOutput(const pidlab::lcmt_plant_output& m) {
+  if (!ep_ || m.episode_id != ep_->spec.episode_id) {
+    ++counters_.foreign;
+    return;
+  }
+  Episode& e = *ep_;
+  if (m.step == e.expected && m.step < e.spec.total_steps) {
+    double u = 0.0;
+    const PidStatus status = e.pid->Step(e.spec.reference, m.y, &u);
+    pidlab::lcmt_control_command& c = e.last;
+    c.episode_id = e.spec.episode_id;
+    c.step = m.step;
+    c.t_s = m.t_s;
+    c.r = e.spec.reference;
+    c.y = m.y;
+    c.u = u;
+    c.status = ToCommandStatus(status);
+    e.have_last = true;
+    ++e.expected;
+    transport_->Publish(kControlChannel, &c);
+    if (m.step + 1 == e.spec.total_steps) {
+      Log("episode " + std::to_string(e.spec.episode_id) + ": done, " + std::to_string(e.expected) +
+          " commands (re-answered " + std::to_string(counters_.duplicates) + ", dropped " +
+          std::to_string(transport_->counters().dropped) + ")");
+    }
+  } else if (e.have_last && m.step == e.last.step) {
+    // The plant did not get our answer: repeat it, never step the PID twice.
+    ++counters_.duplicates;
+    transport_->Publish(kControlChannel, &e.last);
+  } else {
+    ++counters_.duplicates;
+  }
+}
+
+}  // namespace pidlab::transport

@@ -1,0 +1,117 @@
+#pragma once
+// Starts the trio (pidlab-plant, pidlab-controller, pidlab-disturbance, and
+// lcm-logger when a log is asked for), waits until every process answers,
+// runs a command against them or serves, and stops everything. The library
+// behind `pidlab launch`, and what `pidlab report` uses to run its trio
+// episode in process.
+
+#include <sys/types.h>
+
+#include <csignal>
+#include <functional>
+#include <lcm/lcm-cpp.hpp>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pidlab/launcher/log_capture.h"
+#include "pidlab/launcher/supervisor.h"
+#include "pidlab/transport/transport.h"
+
+namespace pidlab::launcher {
+
+/// Puts this process (and every child it starts later) in a private network
+/// namespace with multicast routed over its loopback: nothing it sends leaves
+/// the namespace. Needs root (CAP_SYS_ADMIN). Call it before any thread that
+/// uses the network starts. False with *error if it cannot.
+bool EnterIsolatedNetwork(std::string* error);
+
+/// The directory of this executable, with a trailing '/'.
+std::string SelfDirectory();
+
+struct LaunchOptions {
+  /// LCM URL of the trio; empty: transport::kDefaultLcmUrl with a 4 MB
+  /// receive buffer.
+  std::string lcm_url;
+  std::string channel_prefix = transport::kDefaultChannelPrefix;
+  /// Where pidlab-plant, pidlab-controller and pidlab-disturbance are; empty:
+  /// this executable's directory.
+  std::string bin_dir;
+  /// Record every message with lcm-logger into this file (empty: no log).
+  std::string log_file;
+  /// Fault injection in each process: fraction in [0, 1) of received
+  /// messages thrown away (seeds 1, 2, 3).
+  double drop_rate = 0.0;
+  /// How long the processes have to answer PING, s.
+  double ready_timeout_s = 5.0;
+  bool verbose = false;
+  /// The processes append their stderr to this file (empty: ours).
+  std::string stderr_path;
+
+  bool IsValid(std::string* error) const;
+  std::string EffectiveLcmUrl() const;
+};
+
+enum class LaunchStatus {
+  kReady,        // every process answered (and the logger wrote its first marker)
+  kChildDied,    // a process ended before it was ready
+  kNotReady,     // not every process answered within ready_timeout_s
+  kLoggerSilent, // lcm-logger did not record anything
+  kInterrupted,  // *stop became true
+};
+
+class Launcher {
+ public:
+  /// Where the launcher reports (one line each; "pidlab launch: " is not
+  /// included). May be empty.
+  using NoteFn = std::function<void(const std::string& line)>;
+
+  /// Throws std::invalid_argument for invalid options and
+  /// std::runtime_error if LCM cannot start on the URL.
+  Launcher(const LaunchOptions& options, NoteFn note);
+  ~Launcher();
+
+  /// Starts the logger (if any) and the three processes and waits until all
+  /// are ready. Anything else than kReady comes with *error (one line).
+  LaunchStatus Start(const volatile std::sig_atomic_t* stop, std::string* error);
+
+  /// PIDLAB_LCM_URL, PIDLAB_CHANNEL_PREFIX, PIDLAB_{PLANT,CONTROLLER,
+  /// DISTURBANCE,LOGGER}_PID and PATH with this executable's directory first.
+  std::map<std::string, std::string> CommandEnvironment() const;
+
+  /// Runs `command` with CommandEnvironment() until it ends and returns its
+  /// exit code (128 + signal if killed). *stop forwards SIGINT to it (2 s to
+  /// finish). With an empty command, serves until *stop (returns 0) or until
+  /// a process dies (returns 1).
+  int Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop);
+
+  /// After Run, with a log: confirms that the log is complete (end marker)
+  /// and repairs it. Returns false if it is not known complete; the reasons
+  /// went to the note function.
+  bool FinishLog(bool interrupted);
+
+  /// Stops the logger (SIGINT, so it closes the file) and every process.
+  void Stop();
+
+  const std::string& lcm_url() const { return url_; }
+  pid_t pid_of(const std::string& role) const;
+
+ private:
+  void Note(const std::string& line) const;
+  LaunchStatus WaitReady(const volatile std::sig_atomic_t* stop, std::string* error);
+  void StartRoles();
+
+  LaunchOptions options_;
+  NoteFn note_;
+  std::string url_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::unique_ptr<transport::Transport> transport_;
+  std::unique_ptr<Supervisor> supervisor_;
+  std::unique_ptr<LogCapture> log_;
+  std::map<std::string, pid_t> roles_;  // "plant" -> pid
+  std::map<std::string, int32_t> alive_;
+  pid_t logger_ = -1;
+};
+
+}  // namespace pidlab::launcher

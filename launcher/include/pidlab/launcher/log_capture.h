@@ -1,0 +1,96 @@
+#pragma once
+// A complete log of the trio's traffic: lcm-logger under supervision, an end
+// marker that proves everything published before it is on disk, and repair of
+// whatever the logger still lost from the plant's trajectory chunks.
+
+#include <sys/types.h>
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pidlab/launcher/supervisor.h"
+#include "pidlab/replay/log_reader.h"
+#include "pidlab/transport/transport.h"
+
+namespace pidlab::launcher {
+
+/// Union of the missing steps of the three streams of an episode, as sorted
+/// disjoint inclusive ranges.
+std::vector<std::pair<long, long>> MissingSteps(const replay::Episode& episode);
+/// "3,5-9,..." (at most max_ranges ranges, then a count).
+std::string RangesText(const std::vector<std::pair<long, long>>& ranges, std::size_t max_ranges = 8);
+long CountSteps(const std::vector<std::pair<long, long>>& ranges);
+
+enum class RepairStatus {
+  kComplete,    // nothing was missing
+  kRepaired,    // steps were missing and the plant's chunks filled them
+  kIncomplete,  // still missing after every round (see the summary's lines)
+  kUnreadable,  // the log could not be read or the logger stopped writing
+};
+
+struct RepairSummary {
+  RepairStatus status = RepairStatus::kComplete;
+  int rounds = 0;
+  std::map<int64_t, long> republished;  // episode -> steps asked for (all rounds)
+  /// One line per problem (kIncomplete, kUnreadable) or the repair (kRepaired).
+  std::vector<std::string> lines;
+};
+
+struct LogCaptureOptions {
+  std::string log_file;
+  std::string channel_prefix;
+  /// lcm-logger runs this much nicer than everyone else (negative: higher
+  /// priority), so a loaded machine starves the trio before the logger.
+  int logger_nice = -10;
+  /// Rounds of (read log, ask the plant for the missing steps, wait for the
+  /// answers to be in the log).
+  int repair_rounds = 6;
+  /// How long to wait for the logger to write a marker, s.
+  double marker_timeout_s = 10.0;
+};
+
+class LogCapture {
+ public:
+  /// `transport` and `supervisor` must outlive this object.
+  LogCapture(const LogCaptureOptions& options, transport::Transport* transport, Supervisor* supervisor);
+
+  /// Starts lcm-logger on `lcm_url` (a large receive buffer is added unless
+  /// the URL sets one). Returns its pid.
+  pid_t StartLogger(const std::string& lcm_url);
+
+  /// Publishes a MARKER until lcm-logger has written it to the log (so
+  /// everything published before it is on disk), then waits until the file
+  /// stops growing. False if the marker never appeared.
+  bool WaitForMarker(const std::string& what);
+
+  /// Makes sure the log holds every step of every episode in it: reads it
+  /// with the replay reader, asks the plant to republish each missing range
+  /// as trajectory chunks, waits until the answers are in the log, and
+  /// repeats up to repair_rounds times. Episodes the plant ended with a
+  /// FAILED summary are left as they are.
+  RepairSummary Repair();
+
+ private:
+  struct Gap {
+    int64_t id;
+    std::vector<std::pair<long, long>> ranges;
+  };
+  /// Reads the log: the gaps to fill, or false with *summary filled.
+  bool FindGaps(std::vector<Gap>* gaps, RepairSummary* summary) const;
+  void AskForGaps(const std::vector<Gap>& gaps, RepairSummary* summary);
+  void DescribeUnrepaired(const std::vector<Gap>& gaps, RepairSummary* summary) const;
+
+  LogCaptureOptions options_;
+  transport::Transport* transport_;
+  Supervisor* supervisor_;
+  bool listening_ = false;
+  /// The plant's chunks as this process hears them: (episode, first step) -> count.
+  std::map<std::pair<int64_t, int64_t>, int> answers_;
+  std::vector<std::pair<int64_t, int64_t>> asked_;
+};
+
+}  // namespace pidlab::launcher

@@ -1,0 +1,225 @@
+#include "pidlab/launcher/launcher.h"
+
+#include <sched.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <pidlab/lcmt_ready.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace pidlab::launcher {
+namespace {
+constexpr const char* kRecvBufSuffix = "&recv_buf_size=4194304";
+const char* const kRoles[] = {"plant", "controller", "disturbance"};
+}  // namespace
+
+bool EnterIsolatedNetwork(std::string* error) {
+  if (unshare(CLONE_NEWNET) != 0) {
+    if (error) *error = std::string("cannot enter a private network namespace (unshare: ") + strerror(errno) +
+                        "; root is needed)";
+    return false;
+  }
+  for (const std::vector<std::string>& args : {std::vector<std::string>{"ip", "link", "set", "lo", "up"},
+                                               {"ip", "link", "set", "lo", "multicast", "on"},
+                                               {"ip", "route", "add", "224.0.0.0/4", "dev", "lo"}}) {
+    if (!RunAndWait(args, error)) return false;
+  }
+  return true;
+}
+
+std::string SelfDirectory() {
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
+  if (n <= 0) throw std::runtime_error("cannot read /proc/self/exe");
+  const std::string exe(buf, static_cast<std::size_t>(n));
+  return exe.substr(0, exe.rfind('/') + 1);
+}
+
+bool LaunchOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  if (!(drop_rate >= 0.0 && drop_rate < 1.0))
+    os << "--drop-rate " << drop_rate << " must be in [0, 1)";
+  else if (!(ready_timeout_s > 0.0))
+    os << "--ready-timeout " << ready_timeout_s << " must be positive";
+  else {
+    transport::TransportOptions t;
+    t.channel_prefix = channel_prefix;
+    return t.IsValid(error);
+  }
+  if (error) *error = os.str();
+  return false;
+}
+
+std::string LaunchOptions::EffectiveLcmUrl() const {
+  return lcm_url.empty() ? std::string(transport::kDefaultLcmUrl) + kRecvBufSuffix : lcm_url;
+}
+
+Launcher::Launcher(const LaunchOptions& options, NoteFn note)
+    : options_(options), note_(std::move(note)), url_(options.EffectiveLcmUrl()) {
+  std::string error;
+  if (!options_.IsValid(&error)) throw std::invalid_argument(error);
+  if (options_.bin_dir.empty()) options_.bin_dir = SelfDirectory();
+  if (options_.bin_dir.back() != '/') options_.bin_dir += '/';
+  lcm_ = std::make_unique<lcm::LCM>(url_);
+  if (!lcm_->good())
+    throw std::runtime_error("cannot start LCM on '" + url_ +
+                             "': no multicast route? Add one with 'sudo ip route add 224.0.0.0/4 dev lo' or use "
+                             "--isolated (see docs/trio.md)");
+  transport::TransportOptions topt;
+  topt.channel_prefix = options_.channel_prefix;
+  transport_ = std::make_unique<transport::Transport>(lcm_.get(), topt);
+  transport_->Subscribe<pidlab::lcmt_ready>(transport::kReadyChannel, [this](const pidlab::lcmt_ready& m) {
+    if (m.state == pidlab::lcmt_ready::ALIVE) alive_[m.role] = m.pid;
+  });
+  supervisor_ = std::make_unique<Supervisor>();
+  supervisor_->RedirectStderr(options_.stderr_path);
+  if (!options_.log_file.empty()) {
+    LogCaptureOptions lopt;
+    lopt.log_file = options_.log_file;
+    lopt.channel_prefix = options_.channel_prefix;
+    log_ = std::make_unique<LogCapture>(lopt, transport_.get(), supervisor_.get());
+  }
+}
+
+Launcher::~Launcher() { Stop(); }
+
+void Launcher::Note(const std::string& line) const {
+  if (note_) note_(line);
+}
+
+pid_t Launcher::pid_of(const std::string& role) const {
+  const auto it = roles_.find(role);
+  return it == roles_.end() ? -1 : it->second;
+}
+
+void Launcher::StartRoles() {
+  int seed = 1;
+  for (const char* role : kRoles) {
+    std::vector<std::string> args = {options_.bin_dir + "pidlab-" + role, "--lcm-url", url_, "--channel-prefix",
+                                     options_.channel_prefix};
+    if (options_.drop_rate > 0.0) {
+      std::ostringstream rate;
+      rate.precision(17);
+      rate << options_.drop_rate;
+      args.insert(args.end(), {"--drop-rate", rate.str(), "--drop-seed", std::to_string(seed++)});
+    }
+    if (options_.verbose) args.push_back("--verbose");
+    roles_[role] = supervisor_->Start(std::string("pidlab-") + role, args);
+    if (options_.verbose) Note("started pidlab-" + std::string(role) + " (pid " + std::to_string(roles_[role]) + ")");
+  }
+}
+
+LaunchStatus Launcher::WaitReady(const volatile std::sig_atomic_t* stop, std::string* error) {
+  // Ready: every process answers PING with ALIVE carrying its pid.
+  const double start = transport::NowSeconds();
+  double last_ping = -1;
+  for (;;) {
+    bool all = true;
+    for (const auto& [role, pid] : roles_) all = all && alive_.count(role) && alive_[role] == pid;
+    if (all) return LaunchStatus::kReady;
+    for (const Child& c : supervisor_->Reap()) {
+      *error = c.name + " " + DescribeStatus(c.status) + " before it was ready";
+      return LaunchStatus::kChildDied;
+    }
+    if (stop && *stop) return LaunchStatus::kInterrupted;
+    if (transport::NowSeconds() - start > options_.ready_timeout_s) {
+      std::ostringstream os;
+      os << "not ready within " << options_.ready_timeout_s << " s:";
+      for (const auto& [role, pid] : roles_)
+        if (!alive_.count(role)) os << " pidlab-" << role;
+      os << " (LCM " << url_ << ": multicast route? see docs/trio.md)";
+      *error = os.str();
+      return LaunchStatus::kNotReady;
+    }
+    if (transport::NowSeconds() - last_ping > 0.1) {
+      pidlab::lcmt_ready ping;
+      ping.episode_id = 0;
+      ping.step = -1;
+      ping.state = pidlab::lcmt_ready::PING;
+      ping.role = "launch";
+      ping.pid = getpid();
+      transport_->Publish(transport::kReadyChannel, &ping);
+      last_ping = transport::NowSeconds();
+    }
+    transport_->WaitAndHandle(0.02);
+  }
+}
+
+LaunchStatus Launcher::Start(const volatile std::sig_atomic_t* stop, std::string* error) {
+  if (log_) {
+    logger_ = log_->StartLogger(url_);
+    if (options_.verbose) Note("started lcm-logger (pid " + std::to_string(logger_) + ")");
+  }
+  StartRoles();
+  const LaunchStatus status = WaitReady(stop, error);
+  if (status != LaunchStatus::kReady) {
+    supervisor_->KillAll();
+    return status;
+  }
+  if (log_ && !log_->WaitForMarker("start")) {
+    supervisor_->KillAll();
+    *error = "lcm-logger did not record anything into " + options_.log_file;
+    return LaunchStatus::kLoggerSilent;
+  }
+  return LaunchStatus::kReady;
+}
+
+std::map<std::string, std::string> Launcher::CommandEnvironment() const {
+  std::map<std::string, std::string> env = {{"PIDLAB_LCM_URL", url_},
+                                            {"PIDLAB_CHANNEL_PREFIX", options_.channel_prefix},
+                                            {"PIDLAB_PLANT_PID", std::to_string(pid_of("plant"))},
+                                            {"PIDLAB_CONTROLLER_PID", std::to_string(pid_of("controller"))},
+                                            {"PIDLAB_DISTURBANCE_PID", std::to_string(pid_of("disturbance"))}};
+  if (logger_ > 0) env["PIDLAB_LOGGER_PID"] = std::to_string(logger_);
+  // Let COMMAND find pidlab and the trio binaries next to us.
+  const char* path = std::getenv("PATH");
+  env["PATH"] = options_.bin_dir + ":" + (path ? path : "/usr/bin:/bin");
+  return env;
+}
+
+int Launcher::Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop) {
+  const pid_t cmd = command.empty() ? -1 : supervisor_->Start("COMMAND", command, CommandEnvironment());
+  for (;;) {
+    for (const Child& c : supervisor_->Reap()) {
+      if (c.pid == cmd) return ExitCodeOf(c.status);
+      Note(c.name + " (pid " + std::to_string(c.pid) + ") " + DescribeStatus(c.status));
+      if (cmd < 0) return 1;  // serving: a dead process ends the trio
+    }
+    if (stop && *stop) {
+      if (cmd < 0) return 0;  // Ctrl-C is how a serving launch ends
+      // Ctrl-C reaches COMMAND as SIGINT; it gets 2 s to finish.
+      if (!supervisor_->StopChild(cmd, SIGINT, 2.0)) supervisor_->StopChild(cmd, SIGKILL, 1.0);
+      const Child* c = supervisor_->Find(cmd);
+      return c && !c->alive ? ExitCodeOf(c->status) : 128 + static_cast<int>(*stop);
+    }
+    transport_->WaitAndHandle(0.02);
+  }
+}
+
+bool Launcher::FinishLog(bool interrupted) {
+  if (!log_) return true;
+  if (!log_->WaitForMarker("end")) {
+    Note("error: could not confirm that " + options_.log_file + " is complete");
+    return false;
+  }
+  if (interrupted) {
+    Note("interrupted: " + options_.log_file + " was not checked for completeness (check it with pidlab replay)");
+    return true;
+  }
+  const RepairSummary summary = log_->Repair();
+  const bool ok = summary.status == RepairStatus::kComplete || summary.status == RepairStatus::kRepaired;
+  for (const std::string& line : summary.lines) Note(ok ? line : "error: " + line);
+  return ok;
+}
+
+void Launcher::Stop() {
+  if (!supervisor_) return;
+  if (logger_ > 0) supervisor_->StopChild(logger_, SIGINT, 3.0);
+  supervisor_->KillAll();
+}
+
+}  // namespace pidlab::launcher

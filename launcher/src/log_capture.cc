@@ -1,0 +1,227 @@
+#include "pidlab/launcher/log_capture.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_ready.hpp>
+#include <pidlab/lcmt_trajectory_chunk.hpp>
+#include <pidlab/lcmt_trajectory_request.hpp>
+#include <random>
+#include <sstream>
+#include <thread>
+
+namespace pidlab::launcher {
+namespace {
+
+// lcm-logger's socket asks for this receive buffer (the kernel caps it at
+// net.core.rmem_max): under load the kernel drops datagrams silently when the
+// logger does not read in time.
+constexpr const char* kRecvBuf = "recv_buf_size=4194304";
+
+std::string FileTail(const std::string& path, std::size_t max_bytes) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<std::size_t>(in.tellg());
+  const std::size_t from = size > max_bytes ? size - max_bytes : 0;
+  in.seekg(static_cast<std::streamoff>(from));
+  std::string s(size - from, '\0');
+  in.read(s.data(), static_cast<std::streamsize>(s.size()));
+  return s;
+}
+
+long FileSize(const std::string& path) {
+  struct stat st;
+  return stat(path.c_str(), &st) == 0 ? static_cast<long>(st.st_size) : -1;
+}
+
+}  // namespace
+
+std::string RangesText(const std::vector<std::pair<long, long>>& ranges, std::size_t max_ranges) {
+  std::string s;
+  for (std::size_t i = 0; i < ranges.size() && i < max_ranges; ++i) {
+    s += (i ? "," : "") + std::to_string(ranges[i].first);
+    if (ranges[i].second != ranges[i].first) s += "-" + std::to_string(ranges[i].second);
+  }
+  if (ranges.size() > max_ranges) s += ",... (" + std::to_string(ranges.size()) + " ranges)";
+  return s;
+}
+
+std::vector<std::pair<long, long>> MissingSteps(const replay::Episode& e) {
+  std::vector<std::pair<long, long>> all;
+  for (const replay::StreamStats* s : {&e.outputs, &e.commands, &e.disturbances})
+    all.insert(all.end(), s->missing.begin(), s->missing.end());
+  std::sort(all.begin(), all.end());
+  std::vector<std::pair<long, long>> merged;
+  for (const auto& r : all) {
+    if (!merged.empty() && r.first <= merged.back().second + 1)
+      merged.back().second = std::max(merged.back().second, r.second);
+    else
+      merged.push_back(r);
+  }
+  return merged;
+}
+
+long CountSteps(const std::vector<std::pair<long, long>>& ranges) {
+  long n = 0;
+  for (const auto& r : ranges) n += r.second - r.first + 1;
+  return n;
+}
+
+LogCapture::LogCapture(const LogCaptureOptions& options, transport::Transport* transport, Supervisor* supervisor)
+    : options_(options), transport_(transport), supervisor_(supervisor) {}
+
+pid_t LogCapture::StartLogger(const std::string& lcm_url) {
+  std::string logger_url = lcm_url;
+  if (logger_url.find("recv_buf_size=") == std::string::npos)
+    logger_url += std::string(logger_url.find('?') == std::string::npos ? "?" : "&") + kRecvBuf;
+  return supervisor_->Start(
+      "lcm-logger", {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + logger_url, options_.log_file},
+      {}, options_.logger_nice);
+}
+
+bool LogCapture::WaitForMarker(const std::string& what) {
+  std::random_device rd;
+  const std::string nonce = "pidlab-launch-" + what + "-" + std::to_string(getpid()) + "-" + std::to_string(rd());
+  pidlab::lcmt_ready m;
+  m.episode_id = 0;
+  m.step = -1;
+  m.state = pidlab::lcmt_ready::MARKER;
+  m.role = "launch";
+  m.pid = getpid();
+  m.detail = nonce;
+  const double start = transport::NowSeconds();
+  double last = -1;
+  while (transport::NowSeconds() - start < options_.marker_timeout_s) {
+    if (FileTail(options_.log_file, 1 << 16).find(nonce) != std::string::npos) {
+      long size = FileSize(options_.log_file);
+      for (int i = 0; i < 100; ++i) {  // stable for 50 ms
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        const long now = FileSize(options_.log_file);
+        if (now == size) return true;
+        size = now;
+      }
+      return true;
+    }
+    if (transport::NowSeconds() - last > 0.2) {
+      transport_->Publish(transport::kReadyChannel, &m);
+      last = transport::NowSeconds();
+    }
+    transport_->WaitAndHandle(0.01);
+  }
+  return false;
+}
+
+bool LogCapture::FindGaps(std::vector<Gap>* gaps, RepairSummary* summary) const {
+  replay::ReadOptions read_options;
+  read_options.channel_prefix = options_.channel_prefix;
+  replay::LogContents log;
+  std::string error;
+  if (!replay::ReadLog(options_.log_file, read_options, &log, &error)) {
+    summary->status = RepairStatus::kUnreadable;
+    summary->lines.push_back("cannot read " + options_.log_file + " to check it: " + error);
+    return false;
+  }
+  gaps->clear();
+  for (const replay::Episode& e : log.episodes) {
+    if (!e.has_config) {
+      // Only its configuration can be missing (steps without it are not
+      // episodes the reader can rebuild); the plant cannot resend it.
+      summary->status = RepairStatus::kIncomplete;
+      summary->lines.push_back(options_.log_file + " is incomplete: episode " + std::to_string(e.episode_id) +
+                               ": " + e.CompletenessNote());
+      return false;
+    }
+    if (e.Complete()) continue;
+    if (e.has_summary && e.summary_status == pidlab::lcmt_episode_summary::FAILED) continue;
+    gaps->push_back({e.episode_id, MissingSteps(e)});
+  }
+  return true;
+}
+
+void LogCapture::AskForGaps(const std::vector<Gap>& gaps, RepairSummary* summary) {
+  // Every missing range, paced so that the answers (up to 48 kB each) do not
+  // overflow the logger's socket in one burst.
+  asked_.clear();
+  for (const Gap& g : gaps) {
+    summary->republished[g.id] += CountSteps(g.ranges);
+    for (const auto& r : g.ranges) {
+      for (long first = r.first; first <= r.second; first += transport::kMaxTrajectoryChunk) {
+        pidlab::lcmt_trajectory_request req;
+        req.episode_id = g.id;
+        req.step = first;
+        req.count = static_cast<int32_t>(std::min(transport::kMaxTrajectoryChunk, r.second - first + 1));
+        answers_.erase({g.id, first});
+        asked_.emplace_back(g.id, first);
+        transport_->Publish(transport::kTrajectoryRequestChannel, &req);
+        transport_->WaitAndHandle(0.005);
+      }
+    }
+  }
+  // Wait (bounded) until this process heard every answer; the caller's
+  // marker then makes sure whatever the logger received is on disk.
+  const double t0 = transport::NowSeconds();
+  for (;;) {
+    bool all = true;
+    for (const auto& key : asked_) all = all && answers_.count(key);
+    if (all || transport::NowSeconds() - t0 > 1.0) break;
+    transport_->WaitAndHandle(0.01);
+  }
+}
+
+void LogCapture::DescribeUnrepaired(const std::vector<Gap>& gaps, RepairSummary* summary) const {
+  for (const Gap& g : gaps) {
+    bool answered = true;
+    for (const auto& r : g.ranges)
+      for (long first = r.first; first <= r.second; first += transport::kMaxTrajectoryChunk)
+        answered = answered && answers_.count({g.id, first});
+    std::ostringstream os;
+    os << options_.log_file << " is incomplete: episode " << g.id << " misses " << CountSteps(g.ranges)
+       << " steps (" << RangesText(g.ranges) << ") after " << options_.repair_rounds << " repair rounds: "
+       << (answered ? "lcm-logger lost the plant's trajectory chunks every time"
+                    : "pidlab-plant did not resend them (no longer in its history, or it died)");
+    summary->lines.push_back(os.str());
+  }
+}
+
+RepairSummary LogCapture::Repair() {
+  if (!listening_) {
+    transport_->Subscribe<pidlab::lcmt_trajectory_chunk>(
+        transport::kTrajectoryChannel,
+        [this](const pidlab::lcmt_trajectory_chunk& c) { answers_[{c.episode_id, c.step}] = c.count; });
+    listening_ = true;
+  }
+  RepairSummary summary;
+  for (int round = 0;; ++round) {
+    summary.rounds = round;
+    std::vector<Gap> gaps;
+    if (!FindGaps(&gaps, &summary)) return summary;
+    if (gaps.empty()) {
+      if (summary.republished.empty()) return summary;
+      summary.status = RepairStatus::kRepaired;
+      std::ostringstream os;
+      os << "lcm-logger lost messages; repaired " << options_.log_file << " from the plant's trajectory chunks:";
+      for (const auto& [id, n] : summary.republished) os << " episode " << id << " (" << n << " steps)";
+      os << " in " << round << " round" << (round == 1 ? "" : "s");
+      summary.lines.push_back(os.str());
+      return summary;
+    }
+    if (round == options_.repair_rounds) {
+      summary.status = RepairStatus::kIncomplete;
+      DescribeUnrepaired(gaps, &summary);
+      return summary;
+    }
+    AskForGaps(gaps, &summary);
+    if (!WaitForMarker("repair" + std::to_string(round))) {
+      summary.status = RepairStatus::kUnreadable;
+      summary.lines.push_back("lcm-logger stopped writing " + options_.log_file + " during its repair");
+      return summary;
+    }
+  }
+}
+
+}  // namespace pidlab::launcher

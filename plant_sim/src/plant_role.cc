@@ -1,0 +1,287 @@
+#include "pidlab/plant_sim/plant_role.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <pidlab/lcmt_disturbance_block.hpp>
+#include <pidlab/lcmt_disturbance_request.hpp>
+#include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_trajectory_chunk.hpp>
+#include <sstream>
+
+#include "pidlab/plant_sim/discrete_plant.h"
+
+namespace pidlab::transport {
+namespace {
+constexpr int kStreamChunk = 1000;     // the plant streams its trajectory in chunks of this many steps...
+constexpr double kStreamPeriod = 0.1;  // ...or of whatever is new after this many seconds (liveness)
+constexpr int kSummaryRepeats = 5;     // a summary is repeated this often...
+constexpr double kSummaryPeriod = 0.1; // ...this many seconds apart
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+}  // namespace
+
+struct PlantRole::Episode {
+  EpisodeSpec spec;
+  std::unique_ptr<DiscretePlant> plant;
+  long k = 0;
+  bool have_u = false;
+  double u = 0;
+  std::vector<double> y_hist, u_hist, n_hist;  // n_hist[k]: n_k once its block arrived
+  std::vector<char> have_n;                    // per step
+  long n_requested_end = 0;                    // n requested for steps [0, n_requested_end)
+  long streamed = 0;                           // trajectory streamed for steps [0, streamed)
+  double stream_last_s = 0;
+  double step_start_s = 0, last_send_s = 0, start_s = 0;
+  bool finished = false;
+  pidlab::lcmt_episode_summary summary;
+  int summary_sent = 0;
+  double summary_last_s = 0;
+};
+
+PlantRole::PlantRole(Transport* transport, LogFn log, bool verbose)
+    : Role(transport, "plant", std::move(log), verbose) {
+  transport_->Subscribe<pidlab::lcmt_control_command>(
+      kControlChannel, [this](const pidlab::lcmt_control_command& m) { OnControl(m); });
+  transport_->Subscribe<pidlab::lcmt_disturbance_block>(
+      kDisturbanceBlockChannel, [this](const pidlab::lcmt_disturbance_block& m) { OnDisturbanceBlock(m); });
+  transport_->Subscribe<pidlab::lcmt_trajectory_request>(
+      kTrajectoryRequestChannel,
+      [this](const pidlab::lcmt_trajectory_request& m) { OnTrajectoryRequest(m); });
+}
+
+PlantRole::~PlantRole() = default;
+
+void PlantRole::StartEpisode(const EpisodeSpec& spec) {
+  if (ep_) {  // keep the previous trajectory for late TRAJECTORY_REQUESTs (pidlab launch --log)
+    auto bytes = [](const Episode& e) { return 3 * sizeof(double) * e.y_hist.size(); };
+    ep_->plant.reset();
+    history_bytes_ += bytes(*ep_);
+    history_.push_back(std::move(ep_));
+    while (history_.size() > 1 && history_bytes_ > kPlantHistoryBytes) {
+      history_bytes_ -= bytes(*history_.front());
+      history_.pop_front();
+    }
+  }
+  auto ep = std::make_unique<Episode>();
+  ep->spec = spec;
+  ep->plant = std::make_unique<DiscretePlant>(spec.plant.tf, spec.dt_s);
+  ep->plant->Reset();
+  const auto n = static_cast<std::size_t>(spec.total_steps);
+  ep->y_hist.assign(n + 1, kNaN);
+  ep->u_hist.assign(n + 1, kNaN);
+  ep->n_hist.assign(n + 1, kNaN);
+  ep->have_n.assign(n + 1, 0);
+  ep->y_hist[0] = ep->plant->Output();
+  ep->start_s = ep->step_start_s = ep->stream_last_s = NowSeconds();
+  ep_ = std::move(ep);
+  running_ = true;
+  ep_->n_requested_end = std::min<long>(kNoiseLookahead, spec.total_steps);
+  RequestNoise(0, ep_->n_requested_end);
+  PublishOutput();
+}
+
+void PlantRole::RequestNoise(long first, long samples) {
+  if (samples <= 0) return;
+  pidlab::lcmt_disturbance_request r;
+  r.episode_id = ep_->spec.episode_id;
+  r.step = first;
+  r.samples = static_cast<int32_t>(samples);
+  transport_->Publish(kDisturbanceRequestChannel, &r);
+}
+
+void PlantRole::PublishChunk(const Episode& ep, long first, long last) {
+  pidlab::lcmt_trajectory_chunk c;
+  c.episode_id = ep.spec.episode_id;
+  c.step = first;
+  c.count = static_cast<int32_t>(last - first);
+  c.y.assign(ep.y_hist.begin() + first, ep.y_hist.begin() + last);
+  c.u.assign(ep.u_hist.begin() + first, ep.u_hist.begin() + last);
+  c.n.assign(ep.n_hist.begin() + first, ep.n_hist.begin() + last);
+  transport_->Publish(kTrajectoryChannel, &c);
+}
+
+void PlantRole::StreamTrajectory(long upto) {
+  Episode& e = *ep_;
+  while (e.streamed < upto) {
+    const long last = std::min<long>(upto, e.streamed + kMaxTrajectoryChunk);
+    PublishChunk(e, e.streamed, last);
+    e.streamed = last;
+  }
+  e.stream_last_s = NowSeconds();
+}
+
+void PlantRole::PublishOutput() {
+  pidlab::lcmt_plant_output m;
+  m.episode_id = ep_->spec.episode_id;
+  m.step = ep_->k;
+  m.t_s = static_cast<double>(ep_->k) * ep_->spec.dt_s;
+  m.y = ep_->y_hist[static_cast<std::size_t>(ep_->k)];
+  transport_->Publish(kPlantOutputChannel, &m);
+  ep_->last_send_s = NowSeconds();
+}
+
+void PlantRole::OnControl(const pidlab::lcmt_control_command& m) {
+  if (!running_ || m.episode_id != ep_->spec.episode_id) {
+    ++counters_.foreign;
+    return;
+  }
+  if (m.step != ep_->k || ep_->have_u) {
+    ++counters_.duplicates;
+    return;
+  }
+  if (m.status == pidlab::lcmt_control_command::INVALID_INPUT || !std::isfinite(m.u)) {
+    Finish(false, "controller",
+           "pidlab-controller could not compute u at step " + std::to_string(m.step) +
+               " (invalid input or non-finite output)");
+    return;
+  }
+  ep_->u = m.u;
+  ep_->have_u = true;
+  TryAdvance();
+}
+
+void PlantRole::OnDisturbanceBlock(const pidlab::lcmt_disturbance_block& m) {
+  if (!running_ || m.episode_id != ep_->spec.episode_id) {
+    ++counters_.foreign;
+    return;
+  }
+  Episode& e = *ep_;
+  if (m.step < 0 || m.count < 0 || m.step + m.count > e.spec.total_steps ||
+      m.n.size() != static_cast<std::size_t>(m.count)) {
+    ++counters_.foreign;  // not an answer of this episode's disturbance
+    return;
+  }
+  bool fresh = false;
+  for (int32_t i = 0; i < m.count; ++i) {
+    const auto k = static_cast<std::size_t>(m.step + i);
+    if (e.have_n[k]) continue;
+    e.n_hist[k] = m.n[static_cast<std::size_t>(i)];
+    e.have_n[k] = 1;
+    fresh = true;
+  }
+  if (!fresh) {
+    ++counters_.duplicates;
+    return;
+  }
+  TryAdvance();
+}
+
+void PlantRole::TryAdvance() {
+  Episode& e = *ep_;
+  const auto k = static_cast<std::size_t>(e.k);
+  if (!e.have_u || !e.have_n[k]) return;
+  e.u_hist[k] = e.u;
+  // Same operation and order as RunSampledLoop: input = u + n, then ZOH.
+  e.plant->Step(e.u + e.n_hist[k]);
+  ++e.k;
+  e.have_u = false;
+  e.y_hist[k + 1] = e.plant->Output();
+  e.step_start_s = NowSeconds();
+  if (e.k == e.spec.total_steps) {
+    PublishOutput();
+    StreamTrajectory(e.k + 1);  // the rest, y_N too (u and n NaN there)
+    Finish(true, "", "");
+    return;
+  }
+  PublishOutput();
+  // Keep n requested ahead: one request and one block per kNoiseBlock steps.
+  if (e.n_requested_end < e.spec.total_steps && e.n_requested_end - e.k <= kNoiseLookahead - kNoiseBlock) {
+    const long samples = std::min<long>(kNoiseBlock, e.spec.total_steps - e.n_requested_end);
+    RequestNoise(e.n_requested_end, samples);
+    e.n_requested_end += samples;
+  }
+  if (e.k - e.streamed >= kStreamChunk) StreamTrajectory(e.k);
+}
+
+void PlantRole::Finish(bool ok, const std::string& silent_role, const std::string& message) {
+  Episode& e = *ep_;
+  running_ = false;
+  e.finished = true;
+  pidlab::lcmt_episode_summary& s = e.summary;
+  s.episode_id = e.spec.episode_id;
+  s.step = e.k;
+  s.status = ok ? pidlab::lcmt_episode_summary::OK : pidlab::lcmt_episode_summary::FAILED;
+  s.total_steps = e.spec.total_steps;
+  s.final_y = ok ? e.y_hist.back() : kNaN;
+  s.silent_role = silent_role;
+  s.message = message;
+  transport_->Publish(kSummaryChannel, &s);
+  e.summary_sent = 1;
+  e.summary_last_s = NowSeconds();
+  std::ostringstream os;
+  const double wall = NowSeconds() - e.start_s;
+  os << "episode " << e.spec.episode_id << ": " << (ok ? "done" : "FAILED") << ", plant " << e.spec.plant.name
+     << ", " << e.k << "/" << e.spec.total_steps << " steps in " << wall << " s";
+  if (ok) os << ", y_final " << s.final_y;
+  if (!ok) os << ": " << message;
+  os << " (resent " << counters_.retransmits << ", dropped " << transport_->counters().dropped << ")";
+  Log(os.str());
+}
+
+const PlantRole::Episode* PlantRole::FindEpisode(int64_t episode_id) const {
+  if (ep_ && ep_->spec.episode_id == episode_id) return ep_.get();
+  for (auto it = history_.rbegin(); it != history_.rend(); ++it)
+    if ((*it)->spec.episode_id == episode_id) return it->get();
+  return nullptr;
+}
+
+void PlantRole::OnTrajectoryRequest(const pidlab::lcmt_trajectory_request& m) {
+  const Episode* ep = FindEpisode(m.episode_id);
+  if (!ep) {
+    ++counters_.foreign;
+    return;
+  }
+  const long first = std::max<long>(0, static_cast<long>(m.step));
+  const long last = std::min<long>({first + std::min<long>(m.count, kMaxTrajectoryChunk), ep->k + 1});
+  if (last <= first) return;
+  PublishChunk(*ep, first, last);
+}
+
+double PlantRole::MaxWait() const {
+  if (running_) return ep_->spec.recovery.retransmit_interval_s;
+  return 0.05;
+}
+
+void PlantRole::Tick(double now_s) {
+  if (!ep_) return;
+  Episode& e = *ep_;
+  if (e.finished) {
+    if (e.summary_sent < kSummaryRepeats && now_s - e.summary_last_s >= kSummaryPeriod) {
+      transport_->Publish(kSummaryChannel, &e.summary);
+      ++e.summary_sent;
+      e.summary_last_s = now_s;
+    }
+    return;
+  }
+  const bool have_n = e.have_n[static_cast<std::size_t>(e.k)] != 0;
+  if (now_s - e.step_start_s >= e.spec.recovery.silence_deadline_s) {
+    std::string silent;
+    if (!e.have_u) silent = "controller";
+    if (!have_n) silent += silent.empty() ? "disturbance" : ",disturbance";
+    std::ostringstream os;
+    os << "no answer from pidlab-"
+       << (silent == "controller,disturbance" ? "controller and pidlab-disturbance" : silent) << " for "
+       << e.spec.recovery.silence_deadline_s << " s at step " << e.k << " of " << e.spec.total_steps;
+    Finish(false, silent, os.str());
+    return;
+  }
+  if (now_s - e.last_send_s >= e.spec.recovery.retransmit_interval_s) {
+    // Ask again only for what is missing: y_k makes the controller repeat u_k,
+    // a request makes the disturbance resend the blocks from n_k on.
+    ++counters_.retransmits;
+    Verbose(std::string("resending") + (e.have_u ? "" : " y") + (have_n ? "" : " n request") + " at step " +
+            std::to_string(e.k));
+    if (!have_n) {
+      const long samples = std::min<long>(kNoiseLookahead, e.spec.total_steps - e.k);
+      RequestNoise(e.k, samples);
+      e.n_requested_end = std::max(e.n_requested_end, e.k + samples);
+    }
+    if (!e.have_u)
+      PublishOutput();
+    else
+      e.last_send_s = now_s;
+  }
+  if (now_s - e.stream_last_s >= kStreamPeriod) StreamTrajectory(e.k);  // also the client's liveness signal
+}
+
+}  // namespace pidlab::transport

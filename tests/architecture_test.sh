@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# The house (docs/architecture.md), checked on the build's own dependency
+# graph (cmake --graphviz) and on the sources:
+#  - every pidlab library links only libraries on a lower level;
+#  - pidlab-plant, pidlab-controller and pidlab-disturbance link none of Ceres,
+#    the optimisers, the tuner, the report, the plotting code or the launcher;
+#  - no header of a higher folder is included from a lower one;
+#  - nothing in the repository reads the folder beside it (the repository
+#    stands alone).
+# usage: architecture_test.sh SOURCE_DIR BUILD_DIR
+set -uo pipefail
+src=$1 build=$2
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+(cd "$tmp" && cmake --graphviz=deps.dot "$build" >/dev/null 2>&1) || { echo "FAIL cmake --graphviz"; exit 1; }
+python3 - "$tmp/deps.dot" "$src" <<'PY'
+import os, re, subprocess, sys
+dot, src = sys.argv[1], sys.argv[2]
+# Levels of the house, bottom (0) to top. A library may link only lower levels.
+level = {
+    'pidlab_lcmtypes': 0,
+    'pidlab_plant_sim': 1, 'pidlab_controller': 1, 'pidlab_optim': 1, 'pidlab_plot': 1,
+    'pidlab_transport': 2,
+    'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_tuner': 3,
+    'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
+    'pidlab_replay': 5, 'pidlab_launcher': 5,
+    'pidlab_report': 6,
+    'pidlab': 7,
+}
+labels, edges = {}, []
+for line in open(dot):
+    m = re.match(r'\s*"(node\d+)" \[ label = "([^"\\]+)', line)
+    if m: labels[m.group(1)] = m.group(2)
+    m = re.match(r'\s*"(node\d+)" -> "(node\d+)"', line)
+    if m: edges.append((m.group(1), m.group(2)))
+deps = {}
+for a, b in edges: deps.setdefault(labels[a], set()).add(labels[b])
+failures = 0
+def fail(msg):
+    global failures
+    failures += 1
+    print('FAIL ' + msg)
+missing = [t for t in level if t not in labels.values()]
+if missing: fail('targets not in the graph: ' + ', '.join(missing))
+for a, bs in sorted(deps.items()):
+    if a not in level: continue
+    for b in sorted(bs):
+        if b.startswith('pidlab') and b in level and level[b] >= level[a]:
+            fail(f'{a} (level {level[a]}) links {b} (level {level[b]}): a dependency that does not point down')
+        if b.startswith('pidlab') and b not in level:
+            fail(f'{a} links {b}, which has no level in this test')
+def closure(t):
+    seen, todo = set(), [t]
+    while todo:
+        for d in deps.get(todo.pop(), ()):
+            if d not in seen: seen.add(d); todo.append(d)
+    return seen
+forbidden = {'Ceres::ceres', 'pidlab_optim', 'pidlab_tuner', 'pidlab_report', 'pidlab_plot', 'pidlab_launcher',
+             'pidlab_replay', 'pidlab_log_reader', 'pidlab_episode_client'}
+for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
+    if exe not in deps: fail(f'{exe} not in the graph'); continue
+    bad = sorted(closure(exe) & forbidden)
+    if bad: fail(f'{exe} links {", ".join(bad)}')
+    else: print(f'ok   {exe} links only ' + ', '.join(sorted(d for d in closure(exe) if d.startswith("pidlab"))))
+# Sources: a folder includes only headers of its own level or below.
+header_level = {'plant_sim': 1, 'controller': 1, 'transport': 2, 'tuner': 3, 'replay': 4, 'launcher': 5,
+                'plot': 1, 'report': 6}
+lib_dirs = {'transport': 2, 'tuner': 3, 'replay': 5, 'launcher': 5}
+for d, lv in lib_dirs.items():
+    for root, _, files in os.walk(os.path.join(src, d)):
+        for f in files:
+            for inc in re.findall(r'#include "pidlab/(\w+)/', open(os.path.join(root, f)).read()):
+                if header_level.get(inc, 0) > lv:
+                    fail(f'{os.path.relpath(os.path.join(root, f), src)} includes a pidlab/{inc}/ header from above')
+# plant_sim and controller models (not their roles) include no transport header.
+for d in ('plant_sim', 'controller'):
+    for root, _, files in os.walk(os.path.join(src, d)):
+        for f in files:
+            if 'role' in f or f.endswith('_main.cc'): continue
+            text = open(os.path.join(root, f)).read()
+            if re.search(r'#include "pidlab/(transport|tuner|replay|launcher)/', text) or 'lcm' in re.findall(r'#include <(\w+)', text):
+                fail(f'{os.path.relpath(os.path.join(root, f), src)} is a model but includes LCM or a higher layer')
+# Nothing in the repository names the folder beside it.
+beside = '..' + '/' + 'shared'
+hits = subprocess.run(['git', '-C', src, 'grep', '-l', '-F', beside, '--', '.'],
+                      capture_output=True, text=True).stdout.split()
+if hits: fail('these files name ' + beside + ': ' + ' '.join(hits))
+print(f'{len(deps)} targets checked, {failures} failures')
+sys.exit(1 if failures else 0)
+PY

@@ -1,0 +1,17 @@
+#pragma once
+// The subcommands of `pidlab`, one per cmd_*.cc. Each registers its flags on
+// `app` and returns the action to run after parsing (the exit status).
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace pidlab::cli {
+
+std::function<int()> RegisterEvaluate(CLI::App* app);
+std::function<int()> RegisterTune(CLI::App* app);
+std::function<int()> RegisterLaunch(CLI::App* app);
+std::function<int()> RegisterReplay(CLI::App* app);
+std::function<int()> RegisterPlot(CLI::App* app);
+std::function<int()> RegisterReport(CLI::App* app);
+
+}  // namespace pidlab::cli

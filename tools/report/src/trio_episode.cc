@@ -1,0 +1,51 @@
+#include "pidlab/report/trio_episode.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "pidlab/launcher/launcher.h"
+#include "pidlab/tuner/episode_client.h"
+
+namespace pidlab::report {
+
+bool RunTrioEpisode(const TrioEpisodeOptions& options, const Plant& plant, const PidGains& gains, double dt_s,
+                    double horizon_s, Metrics* metrics, std::string* note) {
+  std::string error;
+  if (options.isolated && !launcher::EnterIsolatedNetwork(&error)) {
+    *note = error;
+    return false;
+  }
+  auto log = std::make_shared<std::ofstream>(options.log_path, std::ios::app);
+  launcher::LaunchOptions lo;
+  lo.bin_dir = options.bin_dir;
+  lo.stderr_path = options.log_path;
+  launcher::Launcher trio(lo, [log](const std::string& line) { *log << "pidlab launch: " << line << "\n" << std::flush; });
+  if (trio.Start(nullptr, &error) != launcher::LaunchStatus::kReady) {
+    *note = "the trio did not start: " + error + " (see " + options.log_path + ")";
+    return false;
+  }
+  EpisodeClientOptions co;
+  co.lcm_url = trio.lcm_url();
+  EpisodeClient client(co);
+  LoopOptions loop;
+  loop.loop = LoopKind::kSampled;
+  loop.dt_s = dt_s;
+  loop.horizon_s = horizon_s;
+  Evaluation ev;
+  if (!Evaluate(plant, gains, loop, EvaluateOptions{}, &ev, &error, client.AsRunner())) {
+    *note = "the trio episode failed: " + error + " (see " + options.log_path + ")";
+    return false;
+  }
+  trio.Stop();
+  FillFromEvaluation(ev, metrics);
+  std::ostringstream os;
+  os.precision(17);
+  os << "one episode over the LCM trio (pidlab-plant, pidlab-controller, pidlab-disturbance) started by the "
+        "launcher library in a private network namespace, driven by the tuner's episode client: the sampled "
+        "loop at dt "
+     << dt_s << " s for " << horizon_s << " s";
+  *note = os.str();
+  return true;
+}
+
+}  // namespace pidlab::report

@@ -1,0 +1,60 @@
+#pragma once
+// The episode configuration as it travels in lcmt_episode_config: everything
+// the three processes need to run one episode of the sampled loop, so that
+// they keep no state between episodes and a log alone rebuilds the episode.
+// Built by the tuner's episode client (tuner/episode_client.h), decoded and
+// validated by every process and by a log replay.
+
+#include <cstdint>
+#include <pidlab/lcmt_episode_config.hpp>
+#include <string>
+
+#include "pidlab/controller/pid.h"
+#include "pidlab/plant_sim/disturbance.h"
+#include "pidlab/plant_sim/plants.h"
+
+namespace pidlab::transport {
+
+/// How the trio recovers from loss and when it gives up.
+struct RecoveryOptions {
+  /// Resend the last message after this long without an answer, s (> 0).
+  double retransmit_interval_s = 0.002;
+  /// Give up after this long without progress, naming the silent process, s.
+  double silence_deadline_s = 1.0;
+
+  bool IsValid(std::string* error) const;
+};
+
+/// Longest episode a process accepts: the plant keeps the whole trajectory
+/// (3 doubles a step) for resends.
+inline constexpr int64_t kMaxEpisodeSteps = 50000000;
+
+/// One episode, decoded: the sampled loop x_{k+1} = Phi x_k + Gamma (u_k + n_k),
+/// u_k = PID(reference, y_k), n_k = n(k dt_s), for k = 0..total_steps-1.
+struct EpisodeSpec {
+  int64_t episode_id = 0;
+  Plant plant;
+  PidGains gains;
+  /// Discrete PID options; pid.dt_s equals dt_s.
+  PidOptions pid;
+  DisturbanceOptions disturbance;
+  double dt_s = 1e-3;           // lockstep period, s
+  double sample_time_s = 0.05;  // spacing of the objective's samples, s (a multiple of dt_s)
+  double horizon_s = 25.0;      // last sample time, s
+  double reference = 1.0;
+  long total_steps = 0;  // horizon_s / dt_s
+  RecoveryOptions recovery;
+
+  /// False with *error naming the field (a stranger's malformed config must
+  /// not crash a process).
+  bool IsValid(std::string* error) const;
+};
+
+/// The message for an episode (utime 0; Transport::Publish stamps it).
+pidlab::lcmt_episode_config MakeEpisodeConfig(const EpisodeSpec& spec);
+
+/// Decodes and validates a configuration. Returns false with *error naming
+/// the offending field.
+bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& msg, EpisodeSpec* spec, std::string* error);
+
+}  // namespace pidlab::transport

@@ -1,0 +1,40 @@
+#pragma once
+// Starting an episode: publish its configuration until the roles that must
+// run it have acknowledged it (lcmt_ready CONFIG_ACK). Shared by the tuner's
+// episode client (all three roles) and `pidlab replay --redrive --backend lcm`
+// (the controller alone).
+
+#include <cstdint>
+#include <pidlab/lcmt_episode_config.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "pidlab/transport/transport.h"
+
+namespace pidlab::transport {
+
+/// A fresh, non-zero episode id: an identifier, not an input of the
+/// computation (random device, clock and pid mixed).
+int64_t NewEpisodeId();
+
+enum class StartStatus { kStarted, kTimedOut, kLcmError };
+
+class EpisodeStarter {
+ public:
+  /// Subscribes to READY on `transport`, which must outlive this object.
+  explicit EpisodeStarter(Transport* transport);
+
+  /// Publishes `config` every resend_period_s until every role named in
+  /// `roles` (e.g. "plant") has acknowledged this episode id, or timeout_s
+  /// has passed. On kTimedOut, *missing lists the silent roles ("pidlab-x, ...").
+  StartStatus Start(const pidlab::lcmt_episode_config& config, const std::vector<std::string>& roles,
+                    double timeout_s, std::string* missing, double resend_period_s = 0.05);
+
+ private:
+  Transport* transport_;
+  int64_t episode_id_ = 0;
+  std::set<std::string> acked_;
+};
+
+}  // namespace pidlab::transport

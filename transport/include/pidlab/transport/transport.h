@@ -1,0 +1,120 @@
+#pragma once
+// The thin layer between LCM and the trio's protocol logic: channel names
+// with a prefix, typed publish, decoding with undecodable messages counted
+// (never a crash), seeded fault injection on receipt, and bounded waits.
+// Works on any LCM URL, including memq:// for single-process tests.
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <lcm/lcm-cpp.hpp>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "pidlab/transport/protocol.h"
+
+namespace pidlab::transport {
+
+/// Microseconds since the epoch (the informative `utime` of every message).
+int64_t NowUtime();
+/// Monotonic seconds, for deadlines.
+double NowSeconds();
+
+struct TransportOptions {
+  /// Prepended to every channel name; lets several trios share one network.
+  std::string channel_prefix = kDefaultChannelPrefix;
+  /// Fault injection: fraction in [0, 1) of received messages thrown away
+  /// before decoding, as if the network had lost them.
+  double drop_rate = 0.0;
+  /// Seed of the drop decisions (std::mt19937_64).
+  uint64_t drop_seed = 1;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct TransportCounters {
+  long received = 0;     // messages that reached a subscription
+  long dropped = 0;      // thrown away by fault injection
+  long undecodable = 0;  // failed to decode (garbage, wrong type): ignored
+};
+
+class Transport {
+ public:
+  /// `lcm` must outlive the transport and be good(). Options must be valid.
+  Transport(lcm::LCM* lcm, const TransportOptions& options);
+  Transport(const Transport&) = delete;
+  Transport& operator=(const Transport&) = delete;
+
+  std::string Channel(const std::string& name) const { return options_.channel_prefix + name; }
+
+  /// Stamps utime and publishes on <prefix><name>. Returns false on a send error.
+  /// No allocation per message in the steady state: the channel name is
+  /// cached and the message is encoded into a buffer that is reused.
+  template <typename Msg>
+  bool Publish(const char* name, Msg* msg) {
+    msg->utime = NowUtime();
+    const int size = msg->getEncodedSize();
+    if (size < 0) return false;
+    if (encode_buffer_.size() < static_cast<std::size_t>(size))
+      encode_buffer_.resize(static_cast<std::size_t>(size));
+    if (msg->encode(encode_buffer_.data(), 0, size) != size) return false;
+    return lcm_->publish(CachedChannel(name), encode_buffer_.data(), static_cast<unsigned int>(size)) == 0;
+  }
+  template <typename Msg>
+  bool Publish(const std::string& name, Msg* msg) {
+    return Publish(name.c_str(), msg);
+  }
+
+  /// Calls on_message for every message on <prefix><name> that survives fault
+  /// injection and decodes as Msg.
+  template <typename Msg>
+  void Subscribe(const std::string& name, std::function<void(const Msg&)> on_message) {
+    auto sub = std::make_unique<Subscription>();
+    sub->owner = this;
+    sub->decode_and_call = [on_message](const void* data, int size) {
+      Msg msg;
+      try {
+        if (msg.decode(data, 0, size) != size) return false;
+      } catch (const std::exception&) {
+        return false;  // e.g. a negative or absurd array length
+      }
+      on_message(msg);
+      return true;
+    };
+    // The C API directly: lcm-cpp's trampoline builds a std::string of the
+    // channel name for every message received.
+    lcm_subscribe(lcm_->getUnderlyingLCM(), Channel(name).c_str(), &Subscription::HandleC, sub.get());
+    subscriptions_.push_back(std::move(sub));
+  }
+
+  /// Waits at most timeout_s for traffic and handles one message if one
+  /// arrived (callers loop). Returns the number of messages handled (0 on
+  /// timeout), -1 on an LCM error.
+  int WaitAndHandle(double timeout_s);
+
+  const TransportCounters& counters() const { return counters_; }
+  const TransportOptions& options() const { return options_; }
+  lcm::LCM* lcm() { return lcm_; }
+
+ private:
+  struct Subscription {
+    Transport* owner = nullptr;
+    std::function<bool(const void*, int)> decode_and_call;
+    static void HandleC(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
+  };
+  bool ShouldDrop();
+  const std::string& CachedChannel(const char* name);
+
+  std::deque<std::pair<std::string, std::string>> channel_cache_;  // name, prefixed name (stable refs)
+  std::vector<uint8_t> encode_buffer_;
+
+  lcm::LCM* lcm_;
+  TransportOptions options_;
+  TransportCounters counters_;
+  std::mt19937_64 drop_rng_;
+  std::vector<std::unique_ptr<Subscription>> subscriptions_;
+};
+
+}  // namespace pidlab::transport

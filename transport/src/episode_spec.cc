@@ -1,0 +1,143 @@
+#include "pidlab/transport/episode_spec.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace pidlab::transport {
+namespace {
+
+bool IsWholeMultiple(double x, double step, long* count) {
+  const double ratio = x / step;
+  const double r = std::round(ratio);
+  if (!std::isfinite(ratio) || std::abs(ratio - r) > 1e-9 * std::max(1.0, r)) return false;
+  *count = static_cast<long>(r);
+  return true;
+}
+
+bool Fail(const std::string& what, std::string* error) {
+  if (error) *error = what;
+  return false;
+}
+
+}  // namespace
+
+bool RecoveryOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  if (!(retransmit_interval_s > 0.0) || !std::isfinite(retransmit_interval_s)) {
+    os << "retransmit interval " << retransmit_interval_s << " s must be positive and finite";
+  } else if (!(silence_deadline_s > retransmit_interval_s) || !std::isfinite(silence_deadline_s)) {
+    os << "silence deadline " << silence_deadline_s
+       << " s must be finite and longer than the retransmit interval";
+  } else {
+    return true;
+  }
+  return Fail(os.str(), error);
+}
+
+bool EpisodeSpec::IsValid(std::string* error) const {
+  if (episode_id == 0) return Fail("episode id 0 is reserved", error);
+  if (!plant.tf.IsValid(error)) return false;
+  if (plant.tf.RelativeDegree() < 1)
+    return Fail("plant " + plant.tf.ToString() + " must be strictly proper", error);
+  if (!GainsAreValid(gains, error)) return false;
+  if (!std::isfinite(reference)) return Fail("reference must be finite", error);
+  std::ostringstream os;
+  long samples = 0, steps = 0;
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s))
+    os << "dt " << dt_s << " s must be positive and finite";
+  else if (!(sample_time_s > 0.0) || !IsWholeMultiple(sample_time_s, dt_s, &samples) || samples < 1)
+    os << "sample time " << sample_time_s << " s must be a whole multiple of dt " << dt_s << " s";
+  else if (!(horizon_s > 0.0) || !IsWholeMultiple(horizon_s, sample_time_s, &samples) || samples < 1)
+    os << "horizon " << horizon_s << " s must be a whole multiple of the sample time " << sample_time_s << " s";
+  else if (!IsWholeMultiple(horizon_s, dt_s, &steps) || steps != total_steps)
+    os << "total steps " << total_steps << " != horizon / dt";
+  else if (total_steps > kMaxEpisodeSteps)
+    os << "total steps " << total_steps << " is more than " << kMaxEpisodeSteps;
+  else if (pid.dt_s != dt_s)
+    os << "PID period " << pid.dt_s << " s differs from dt " << dt_s << " s";
+  if (!os.str().empty()) return Fail(os.str(), error);
+  if (!pid.IsValid(error) || !disturbance.IsValid(error)) return false;
+  return recovery.IsValid(error);
+}
+
+pidlab::lcmt_episode_config MakeEpisodeConfig(const EpisodeSpec& spec) {
+  pidlab::lcmt_episode_config m;
+  m.utime = 0;
+  m.episode_id = spec.episode_id;
+  m.step = 0;
+  m.plant_name = spec.plant.name;
+  m.num = spec.plant.tf.num;
+  m.num_size = static_cast<int32_t>(m.num.size());
+  m.den = spec.plant.tf.den;
+  m.den_size = static_cast<int32_t>(m.den.size());
+  m.kp = spec.gains.kp;
+  m.ki = spec.gains.ki;
+  m.kd = spec.gains.kd;
+  m.reference = spec.reference;
+  const PidOptions& pid = spec.pid;
+  m.derivative_filter_s = pid.derivative_filter_s;
+  m.output_min = pid.output_min;
+  m.output_max = pid.output_max;
+  m.anti_windup = ToString(pid.anti_windup);
+  m.back_calculation_gain = pid.back_calculation_gain;
+  m.derivative_on = ToString(pid.derivative_on);
+  m.integral = ToString(pid.integral);
+  m.dt_s = spec.dt_s;
+  m.sample_time_s = spec.sample_time_s;
+  m.horizon_s = spec.horizon_s;
+  m.total_steps = spec.total_steps;
+  const DisturbanceOptions& d = spec.disturbance;
+  m.disturbance_kind = ToString(d.kind);
+  m.disturbance_amplitude = d.amplitude;
+  m.disturbance_period_s = d.period_s;
+  m.disturbance_phase_s = d.phase_s;
+  m.disturbance_step_time_s = d.step_time_s;
+  m.noise_hold_s = d.noise_hold_s;
+  m.seed = static_cast<int64_t>(d.seed);
+  m.retransmit_interval_s = spec.recovery.retransmit_interval_s;
+  m.silence_deadline_s = spec.recovery.silence_deadline_s;
+  return m;
+}
+
+bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec, std::string* error) {
+  EpisodeSpec s;
+  s.episode_id = m.episode_id;
+  s.plant.name = m.plant_name;
+  s.plant.tf.num = m.num;
+  s.plant.tf.den = m.den;
+  s.gains = PidGains{m.kp, m.ki, m.kd};
+  s.reference = m.reference;
+  s.dt_s = m.dt_s;
+  s.sample_time_s = m.sample_time_s;
+  s.horizon_s = m.horizon_s;
+  s.total_steps = static_cast<long>(std::clamp<int64_t>(m.total_steps, -1, kMaxEpisodeSteps + 1));
+  PidOptions& pid = s.pid;
+  pid.dt_s = m.dt_s;
+  pid.derivative_filter_s = m.derivative_filter_s;
+  pid.output_min = m.output_min;
+  pid.output_max = m.output_max;
+  pid.back_calculation_gain = m.back_calculation_gain;
+  if (!ParseAntiWindup(m.anti_windup, &pid.anti_windup))
+    return Fail("anti-windup '" + m.anti_windup + "' unknown", error);
+  if (!ParseDerivativeOn(m.derivative_on, &pid.derivative_on))
+    return Fail("derivative-on '" + m.derivative_on + "' unknown", error);
+  if (!ParseIntegralMethod(m.integral, &pid.integral))
+    return Fail("integral '" + m.integral + "' unknown", error);
+  DisturbanceOptions& d = s.disturbance;
+  if (!ParseDisturbanceKind(m.disturbance_kind, &d.kind))
+    return Fail("disturbance '" + m.disturbance_kind + "' unknown", error);
+  d.amplitude = m.disturbance_amplitude;
+  d.period_s = m.disturbance_period_s;
+  d.phase_s = m.disturbance_phase_s;
+  d.step_time_s = m.disturbance_step_time_s;
+  d.noise_hold_s = m.noise_hold_s;
+  d.seed = static_cast<uint64_t>(m.seed);
+  s.recovery.retransmit_interval_s = m.retransmit_interval_s;
+  s.recovery.silence_deadline_s = m.silence_deadline_s;
+  if (!s.IsValid(error)) return false;
+  *spec = s;
+  return true;
+}
+
+}  // namespace pidlab::transport

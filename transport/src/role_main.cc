@@ -1,0 +1,70 @@
+#include "pidlab/transport/role_main.h"
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <iostream>
+
+namespace pidlab::transport {
+namespace {
+volatile std::sig_atomic_t g_stop = 0;
+void OnSignal(int) { g_stop = 1; }
+}  // namespace
+
+int RoleMain(int argc, char** argv, const std::string& program, const std::string& description,
+             const RoleFactory& factory) {
+  CLI::App app{description, program};
+  std::string url = kDefaultLcmUrl;
+  TransportOptions transport_options;
+  bool verbose = false;
+  app.add_option("--lcm-url", url, "LCM URL (add ?recv_buf_size=N for bursts)")->capture_default_str();
+  app.add_option("--channel-prefix", transport_options.channel_prefix, "prefix of every channel")
+      ->capture_default_str();
+  app.add_option("--drop-rate", transport_options.drop_rate,
+                 "fault injection: fraction in [0, 1) of received messages to throw away")
+      ->capture_default_str();
+  app.add_option("--drop-seed", transport_options.drop_seed, "seed of the fault injection")
+      ->capture_default_str();
+  app.add_flag("--verbose,-v", verbose, "log every resend and episode start, not only one line per episode");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << program << ": error: " << e.what() << "\n";
+    return 2;
+  }
+  std::string error;
+  if (!transport_options.IsValid(&error)) {
+    std::cerr << program << ": error: " << error << "\n";
+    return 2;
+  }
+  lcm::LCM lcm(url);
+  if (!lcm.good()) {
+    std::cerr << program << ": failed: cannot start LCM on '" << url
+              << "' (no multicast route? see docs/trio.md, or run under pidlab launch --isolated)\n";
+    return 1;
+  }
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
+  Transport transport(&lcm, transport_options);
+  LogFn log = [&program](const std::string& line) {
+    const std::string text = program + ": " + line + "\n";
+    // One write per line, so the lines of three processes never interleave.
+    if (::write(STDERR_FILENO, text.data(), text.size()) < 0) return;
+  };
+  std::unique_ptr<Role> role = factory(&transport, log, verbose);
+  if (verbose) log("serving on " + url + " with prefix " + transport_options.channel_prefix);
+  const int status = ServeRole(&transport, role.get(), &g_stop);
+  if (status != 0) std::cerr << program << ": failed: LCM receive error\n";
+  if (verbose) {
+    const TransportCounters& c = transport.counters();
+    log("received " + std::to_string(c.received) + ", dropped " + std::to_string(c.dropped) +
+        ", undecodable " + std::to_string(c.undecodable) + ", foreign " +
+        std::to_string(role->counters().foreign));
+  }
+  return status;
+}
+
+}  // namespace pidlab::transport

@@ -1,0 +1,83 @@
+#pragma once
+// Runs one episode of the sampled loop over a running trio: the LCM backend of
+// `pidlab evaluate`. Publishes the configuration until the plant, controller
+// and disturbance acknowledge it, records y, u and n of every step from the
+// trajectory chunks the plant streams (it does not wake for every lockstep
+// message), asks the plant to resend whatever it missed, and reports a silent
+// process by name.
+
+#include <lcm/lcm-cpp.hpp>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pidlab/transport/episode_spec.h"
+#include "pidlab/transport/episode_start.h"
+#include "pidlab/transport/transport.h"
+#include "pidlab/tuner/evaluation.h"
+
+namespace pidlab {
+
+/// The episode of `options` (a sampled loop) under `disturbance`, as the trio
+/// runs it. Throws std::invalid_argument if it is not a valid episode.
+transport::EpisodeSpec MakeEpisodeSpec(int64_t episode_id, const Plant& plant, const PidGains& gains,
+                                       const LoopOptions& options, const DisturbanceOptions& disturbance,
+                                       const transport::RecoveryOptions& recovery);
+
+/// The sampled loop options of an episode (for Evaluate on a logged episode).
+LoopOptions SampledLoopOptions(const transport::EpisodeSpec& spec);
+
+struct EpisodeClientOptions {
+  std::string lcm_url = transport::kDefaultLcmUrl;
+  transport::TransportOptions transport;
+  transport::RecoveryOptions recovery;
+  /// How long to wait for all three acknowledgements, s.
+  double start_timeout_s = 3.0;
+  /// Upper bound on one episode, s.
+  double episode_timeout_s = 600.0;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct EpisodeClientStats {
+  long episodes = 0;
+  long steps = 0;         // lockstep steps run
+  double seconds = 0.0;   // wall time from the first acknowledgement to the last step
+  long resend_requests = 0;  // TRAJECTORY_REQUESTs for steps the client missed
+  double StepsPerSecond() const { return seconds > 0.0 ? static_cast<double>(steps) / seconds : 0.0; }
+};
+
+class EpisodeClient {
+ public:
+  /// Throws std::runtime_error if LCM cannot be initialised on the URL.
+  explicit EpisodeClient(const EpisodeClientOptions& options);
+  ~EpisodeClient();
+
+  /// A SampledRunner: y at every step k = 0..TotalSteps() in *y_all, every
+  /// step in *trajectory when not null. False with a one-line *error naming
+  /// the silent process on failure.
+  bool Run(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+           const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+           std::vector<SampledStep>* trajectory, std::string* error);
+
+  SampledRunner AsRunner();
+  const EpisodeClientStats& stats() const { return stats_; }
+  const transport::TransportCounters& counters() const;
+
+ private:
+  struct State;
+  bool StartEpisode(const pidlab::lcmt_episode_config& config, std::string* error);
+  /// Waits for every step (asking the plant again for what was missed) from
+  /// t0 on; *done_s is when the last step was heard.
+  bool FollowEpisode(double t0, double* done_s, long* requests, std::string* error);
+  std::string Where() const;
+
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::unique_ptr<transport::Transport> transport_;
+  std::unique_ptr<transport::EpisodeStarter> starter_;
+  std::unique_ptr<State> state_;
+  EpisodeClientOptions options_;
+  EpisodeClientStats stats_;
+};
+
+}  // namespace pidlab

@@ -1,0 +1,281 @@
+#include "pidlab/tuner/episode_client.h"
+
+#include <algorithm>
+#include <cmath>
+#include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_trajectory_chunk.hpp>
+#include <pidlab/lcmt_trajectory_request.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "pidlab/transport/episode_start.h"
+
+namespace pidlab {
+namespace {
+using transport::NowSeconds;
+}  // namespace
+
+transport::EpisodeSpec MakeEpisodeSpec(int64_t episode_id, const Plant& plant, const PidGains& gains,
+                                       const LoopOptions& options, const DisturbanceOptions& disturbance,
+                                       const transport::RecoveryOptions& recovery) {
+  transport::EpisodeSpec spec;
+  spec.episode_id = episode_id;
+  spec.plant = plant;
+  spec.gains = gains;
+  spec.pid = options.pid;
+  spec.pid.dt_s = options.dt_s;
+  spec.disturbance = disturbance;
+  spec.dt_s = options.dt_s;
+  spec.sample_time_s = options.sample_time_s;
+  spec.horizon_s = options.horizon_s;
+  spec.reference = 1.0;
+  spec.total_steps = options.TotalSteps();
+  spec.recovery = recovery;
+  std::string error;
+  if (!spec.IsValid(&error)) throw std::invalid_argument("invalid episode: " + error);
+  return spec;
+}
+
+LoopOptions SampledLoopOptions(const transport::EpisodeSpec& spec) {
+  LoopOptions o;
+  o.loop = LoopKind::kSampled;
+  o.dt_s = spec.dt_s;
+  o.sample_time_s = spec.sample_time_s;
+  o.horizon_s = spec.horizon_s;
+  o.pid = spec.pid;
+  o.disturbance = spec.disturbance;
+  return o;
+}
+
+bool EpisodeClientOptions::IsValid(std::string* error) const {
+  if (!transport.IsValid(error) || !recovery.IsValid(error)) return false;
+  std::ostringstream os;
+  if (!(start_timeout_s > 0.0) || !std::isfinite(start_timeout_s))
+    os << "start timeout " << start_timeout_s << " s must be positive and finite";
+  else if (!(episode_timeout_s > 0.0))
+    os << "episode timeout " << episode_timeout_s << " s must be positive";
+  else
+    return true;
+  if (error) *error = os.str();
+  return false;
+}
+
+/// What the client has heard of the current episode.
+struct EpisodeClient::State {
+  int64_t episode_id = 0;
+  long total = 0;
+  std::vector<double> y, u, n;
+  std::vector<char> have_y, have_u, have_n;
+  long max_step = -1;  // highest y step seen
+  double last_progress_s = 0;
+  bool summary = false;
+  pidlab::lcmt_episode_summary last_summary;
+
+  void Reset(int64_t id, long total_steps) {
+    *this = State();
+    episode_id = id;
+    total = total_steps;
+    const auto size = static_cast<std::size_t>(total + 1);
+    y.assign(size, 0.0);
+    u.assign(size, 0.0);
+    n.assign(size, 0.0);
+    have_y.assign(size, 0);
+    have_u.assign(size, 0);
+    have_n.assign(size, 0);
+  }
+  bool Mine(int64_t id) const { return episode_id != 0 && id == episode_id; }
+  void OnChunk(const pidlab::lcmt_trajectory_chunk& m) {
+    if (!Mine(m.episode_id) || m.step < 0 || m.count < 0 || m.step + m.count > total + 1) return;
+    for (int32_t i = 0; i < m.count; ++i) {
+      const auto k = static_cast<std::size_t>(m.step + i);
+      if (!have_y[k]) y[k] = m.y[i], have_y[k] = 1;
+      if (static_cast<long>(k) < total) {
+        if (!have_u[k] && std::isfinite(m.u[i])) u[k] = m.u[i], have_u[k] = 1;
+        if (!have_n[k] && std::isfinite(m.n[i])) n[k] = m.n[i], have_n[k] = 1;
+      }
+    }
+    const long last = static_cast<long>(m.step) + m.count - 1;
+    if (m.count > 0 && last > max_step) {
+      max_step = last;
+      last_progress_s = NowSeconds();
+    }
+  }
+  /// First step with something missing, or -1.
+  long FirstMissing() const {
+    for (long k = 0; k <= total; ++k) {
+      if (!have_y[k] || (k < total && (!have_u[k] || !have_n[k]))) return k;
+    }
+    return -1;
+  }
+  bool Failed() const { return summary && last_summary.status == pidlab::lcmt_episode_summary::FAILED; }
+  bool AtEnd() const {
+    return max_step == total || (summary && last_summary.status == pidlab::lcmt_episode_summary::OK);
+  }
+};
+
+EpisodeClient::EpisodeClient(const EpisodeClientOptions& options) : options_(options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument(error);
+  lcm_ = std::make_unique<lcm::LCM>(options.lcm_url);
+  if (!lcm_->good())
+    throw std::runtime_error("cannot start LCM on '" + options.lcm_url +
+                             "' (see docs/trio.md: multicast route)");
+  transport_ = std::make_unique<transport::Transport>(lcm_.get(), options.transport);
+  starter_ = std::make_unique<transport::EpisodeStarter>(transport_.get());
+  state_ = std::make_unique<State>();
+  State* s = state_.get();
+  // The client does not follow the per-step traffic (PLANT_OUTPUT, CONTROL):
+  // the plant streams its trajectory in TRAJECTORY chunks (every 1000 steps or
+  // 0.1 s), which are also its liveness signal. Whatever chunk is lost is asked
+  // for again at the end (TRAJECTORY_REQUEST).
+  transport_->Subscribe<pidlab::lcmt_trajectory_chunk>(
+      transport::kTrajectoryChannel, [s](const pidlab::lcmt_trajectory_chunk& m) { s->OnChunk(m); });
+  transport_->Subscribe<pidlab::lcmt_episode_summary>(transport::kSummaryChannel,
+                                                      [s](const pidlab::lcmt_episode_summary& m) {
+                                                        if (!s->Mine(m.episode_id)) return;
+                                                        s->summary = true;
+                                                        s->last_summary = m;
+                                                      });
+}
+
+EpisodeClient::~EpisodeClient() = default;
+
+const transport::TransportCounters& EpisodeClient::counters() const { return transport_->counters(); }
+
+SampledRunner EpisodeClient::AsRunner() {
+  return [this](const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                std::vector<SampledStep>* trajectory, std::string* error) {
+    return Run(plant, gains, options, disturbance, y_all, trajectory, error);
+  };
+}
+
+std::string EpisodeClient::Where() const {
+  return " (LCM " + options_.lcm_url + ", prefix " + options_.transport.channel_prefix + ")";
+}
+
+bool EpisodeClient::StartEpisode(const pidlab::lcmt_episode_config& config, std::string* error) {
+  std::string missing;
+  switch (starter_->Start(config, {"plant", "controller", "disturbance"}, options_.start_timeout_s, &missing)) {
+    case transport::StartStatus::kStarted:
+      return true;
+    case transport::StartStatus::kLcmError:
+      *error = "LCM receive error" + Where();
+      return false;
+    case transport::StartStatus::kTimedOut:
+      break;
+  }
+  std::ostringstream os;
+  os << "no answer from " << missing << " within " << options_.start_timeout_s << " s" << Where()
+     << ": is the trio running (pidlab launch)?";
+  *error = os.str();
+  return false;
+}
+
+bool EpisodeClient::FollowEpisode(double t0, double* done_s, long* requests, std::string* error) {
+  State& s = *state_;
+  const double plant_deadline = options_.recovery.silence_deadline_s + 0.5;
+  double last_request = -1e9;
+  for (;;) {
+    const double now = NowSeconds();
+    if (s.Failed()) {
+      *error = "episode failed: " + s.last_summary.message + Where();
+      return false;
+    }
+    if (now - t0 > options_.episode_timeout_s) {
+      std::ostringstream os;
+      os << "episode timeout " << options_.episode_timeout_s << " s at step " << s.max_step << " of " << s.total;
+      *error = os.str();
+      return false;
+    }
+    const bool at_end = s.AtEnd();
+    if (at_end && *done_s < 0) *done_s = now;
+    if (!at_end && now - s.last_progress_s > plant_deadline) {
+      // A client that was itself starved of CPU may have the plant's progress
+      // queued unread: read everything waiting before blaming the plant.
+      int handled = 0;
+      while ((handled = transport_->WaitAndHandle(0.0)) > 0) {
+      }
+      if (handled < 0) {
+        *error = "LCM receive error" + Where();
+        return false;
+      }
+      if (NowSeconds() - s.last_progress_s <= plant_deadline) continue;
+      std::ostringstream os;
+      os << "no answer from pidlab-plant for " << plant_deadline << " s at step " << s.max_step + 1 << " of "
+         << s.total << Where();
+      *error = os.str();
+      return false;
+    }
+    if (at_end) {
+      const long first = s.FirstMissing();
+      if (first < 0) return true;
+      if (now - *done_s > plant_deadline + 1.0) {
+        std::ostringstream os;
+        os << "pidlab-plant did not resend step " << first << " of episode " << s.episode_id << Where();
+        *error = os.str();
+        return false;
+      }
+      if (now - last_request >= 10 * options_.recovery.retransmit_interval_s) {
+        pidlab::lcmt_trajectory_request r;
+        r.episode_id = s.episode_id;
+        r.step = first;
+        r.count = static_cast<int32_t>(std::min<long>(transport::kMaxTrajectoryChunk, s.total + 1 - first));
+        transport_->Publish(transport::kTrajectoryRequestChannel, &r);
+        last_request = now;
+        ++*requests;
+      }
+    }
+    if (transport_->WaitAndHandle(at_end ? options_.recovery.retransmit_interval_s : 0.05) < 0) {
+      *error = "LCM receive error" + Where();
+      return false;
+    }
+  }
+}
+
+bool EpisodeClient::Run(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                        const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                        std::vector<SampledStep>* trajectory, std::string* error) {
+  std::string why;
+  transport::EpisodeSpec spec;
+  try {
+    spec = MakeEpisodeSpec(transport::NewEpisodeId(), plant, gains, options, disturbance, options_.recovery);
+  } catch (const std::invalid_argument& e) {
+    if (error) *error = e.what();
+    return false;
+  }
+  const pidlab::lcmt_episode_config config = transport::MakeEpisodeConfig(spec);
+  State& s = *state_;
+  s.Reset(spec.episode_id, spec.total_steps);
+  // 1. Configuration until all three acknowledge; 2. follow the lockstep
+  // until the last y, then fetch whatever was missed.
+  double done_s = -1;
+  long requests = 0;
+  const bool ok = StartEpisode(config, &why) && [&] {
+    const double t0 = NowSeconds();
+    s.last_progress_s = t0;
+    if (!FollowEpisode(t0, &done_s, &requests, &why)) return false;
+    ++stats_.episodes;
+    stats_.steps += s.total;
+    stats_.seconds += (done_s > 0 ? done_s : NowSeconds()) - t0;
+    stats_.resend_requests += requests;
+    return true;
+  }();
+  s.episode_id = 0;
+  if (!ok) {
+    if (error) *error = why;
+    return false;
+  }
+  y_all->assign(s.y.begin(), s.y.end());
+  if (trajectory) {
+    trajectory->clear();
+    trajectory->reserve(static_cast<std::size_t>(s.total));
+    for (long k = 0; k < s.total; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      trajectory->push_back({k, static_cast<double>(k) * spec.dt_s, spec.reference, s.y[i], s.u[i], s.n[i]});
+    }
+  }
+  return true;
+}
+
+}  // namespace pidlab
