@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Logs and replay end to end (issue 5): one episode with a disturbance under
+# Logs and replay end to end: one episode with a disturbance under
 # `pidlab launch --isolated --log`, then `pidlab replay` must reproduce the
 # live IAE exactly and call the log complete, --redrive must pass, `pidlab plot
 # --log` must draw the logged data, and damaged copies of the log (cut tail,
