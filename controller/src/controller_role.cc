@@ -1,5 +1,6 @@
 #include "pidlab/controller/controller_role.h"
 
+#include <cstring>
 #include <pidlab/lcmt_control_command.hpp>
 
 #include "pidlab/controller/pid.h"
@@ -69,6 +70,15 @@ void ControllerRole::OnOutput(const pidlab::lcmt_plant_output& m) {
           std::to_string(transport_->counters().dropped) + ")");
     }
   } else if (e.have_last && m.step == e.last.step) {
+    if (std::memcmp(&m.y, &e.last.y, sizeof m.y) != 0) {
+      // A second, different y for a step already answered: not the plant's
+      // resend. Never compute from it; repeat our answer, which carries the y
+      // it was computed from, so the plant can tell which of the two it
+      // published and fail the episode naming the conflict.
+      ++counters_.conflicts;
+      transport_->Publish(kControlChannel, &e.last);
+      return;
+    }
     // The plant did not get our answer: repeat it, never step the PID twice.
     ++counters_.duplicates;
     transport_->Publish(kControlChannel, &e.last);

@@ -35,9 +35,13 @@ void DisturbanceRole::OnRequest(const pidlab::lcmt_disturbance_request& m) {
   }
   Episode& e = *ep_;
   const long total = e.spec.total_steps;
+  if (m.step < 0 || m.step >= total || m.samples <= 0) {
+    ++counters_.foreign;
+    return;
+  }
   const long first = static_cast<long>(m.step);
   const long end = std::min<long>(total, first + std::min<long>(m.samples, kMaxNoiseRequest));
-  if (first < 0 || end <= first) {
+  if (end <= first) {
     ++counters_.duplicates;
     return;
   }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <iomanip>
 #include <limits>
 #include <pidlab/lcmt_disturbance_block.hpp>
 #include <pidlab/lcmt_disturbance_request.hpp>
@@ -18,6 +20,14 @@ constexpr double kStreamPeriod = 0.1;  // ...or of whatever is new after this ma
 constexpr int kSummaryRepeats = 5;     // a summary is repeated this often...
 constexpr double kSummaryPeriod = 0.1; // ...this many seconds apart
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+std::string Bits(double v) {
+  std::ostringstream os;
+  os << std::setprecision(17) << v;
+  return os.str();
+}
 }  // namespace
 
 struct PlantRole::Episode {
@@ -125,7 +135,27 @@ void PlantRole::OnControl(const pidlab::lcmt_control_command& m) {
     ++counters_.foreign;
     return;
   }
-  if (m.step != ep_->k || ep_->have_u) {
+  Episode& e = *ep_;
+  if (m.step < 0 || m.step > e.k) {  // no controller answers a y the plant has not published
+    ++counters_.foreign;
+    return;
+  }
+  const auto k = static_cast<std::size_t>(m.step);
+  // The command says which y it was computed from: anything but the y this
+  // plant published means a second PLANT_OUTPUT for that step reached the
+  // controller (a forged or corrupted one).
+  if (!SameBits(m.y, e.y_hist[k])) {
+    Conflict(kPlantOutputChannel, m.step, "the controller answered y = " + Bits(m.y) + ", the plant published y = " +
+                                              Bits(e.y_hist[k]));
+    return;
+  }
+  const bool used = m.step < e.k || e.have_u;
+  if (used) {
+    const double kept = m.step < e.k ? e.u_hist[k] : e.u;
+    if (!SameBits(m.u, kept)) {
+      Conflict(kControlChannel, m.step, "u = " + Bits(kept) + " and u = " + Bits(m.u));
+      return;
+    }
     ++counters_.duplicates;
     return;
   }
@@ -135,9 +165,17 @@ void PlantRole::OnControl(const pidlab::lcmt_control_command& m) {
                " (invalid input or non-finite output)");
     return;
   }
-  ep_->u = m.u;
-  ep_->have_u = true;
+  e.u = m.u;
+  e.have_u = true;
   TryAdvance();
+}
+
+void PlantRole::Conflict(const char* channel, int64_t step, const std::string& detail) {
+  ++counters_.conflicts;
+  Finish(false, "",
+         "conflicting " + std::string(channel) + " messages for step " + std::to_string(step) + " of episode " +
+             std::to_string(ep_->spec.episode_id) + ": " + detail +
+             " (a forged or corrupted message on the network; see docs/security.md)");
 }
 
 void PlantRole::OnDisturbanceBlock(const pidlab::lcmt_disturbance_block& m) {
@@ -146,7 +184,7 @@ void PlantRole::OnDisturbanceBlock(const pidlab::lcmt_disturbance_block& m) {
     return;
   }
   Episode& e = *ep_;
-  if (m.step < 0 || m.count < 0 || m.step + m.count > e.spec.total_steps ||
+  if (m.step < 0 || m.count < 0 || m.step > e.spec.total_steps - m.count ||
       m.n.size() != static_cast<std::size_t>(m.count)) {
     ++counters_.foreign;  // not an answer of this episode's disturbance
     return;
@@ -154,8 +192,15 @@ void PlantRole::OnDisturbanceBlock(const pidlab::lcmt_disturbance_block& m) {
   bool fresh = false;
   for (int32_t i = 0; i < m.count; ++i) {
     const auto k = static_cast<std::size_t>(m.step + i);
-    if (e.have_n[k]) continue;
-    e.n_hist[k] = m.n[static_cast<std::size_t>(i)];
+    const double n = m.n[static_cast<std::size_t>(i)];
+    if (e.have_n[k]) {
+      if (!SameBits(n, e.n_hist[k])) {
+        Conflict(kDisturbanceBlockChannel, m.step + i, "n = " + Bits(e.n_hist[k]) + " and n = " + Bits(n));
+        return;
+      }
+      continue;
+    }
+    e.n_hist[k] = n;
     e.have_n[k] = 1;
     fresh = true;
   }
@@ -231,8 +276,12 @@ void PlantRole::OnTrajectoryRequest(const pidlab::lcmt_trajectory_request& m) {
     ++counters_.foreign;
     return;
   }
-  const long first = std::max<long>(0, static_cast<long>(m.step));
-  const long last = std::min<long>({first + std::min<long>(m.count, kMaxTrajectoryChunk), ep->k + 1});
+  if (m.step < 0 || m.step > ep->k || m.count <= 0) {
+    ++counters_.foreign;
+    return;
+  }
+  const long first = static_cast<long>(m.step);
+  const long last = std::min<long>(first + std::min<long>(m.count, kMaxTrajectoryChunk), ep->k + 1);
   if (last <= first) return;
   PublishChunk(*ep, first, last);
 }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <iomanip>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <pidlab/lcmt_trajectory_request.hpp>
@@ -70,6 +72,7 @@ struct EpisodeClient::State {
   double last_progress_s = 0;
   bool summary = false;
   pidlab::lcmt_episode_summary last_summary;
+  std::string conflict;  // set once two chunks disagree on a step
 
   void Reset(int64_t id, long total_steps) {
     *this = State();
@@ -85,19 +88,34 @@ struct EpisodeClient::State {
   }
   bool Mine(int64_t id) const { return episode_id != 0 && id == episode_id; }
   void OnChunk(const pidlab::lcmt_trajectory_chunk& m) {
-    if (!Mine(m.episode_id) || m.step < 0 || m.count < 0 || m.step + m.count > total + 1) return;
-    for (int32_t i = 0; i < m.count; ++i) {
+    if (!Mine(m.episode_id) || m.step < 0 || m.count < 0 || m.step > total + 1 - m.count) return;
+    for (int32_t i = 0; i < m.count && conflict.empty(); ++i) {
       const auto k = static_cast<std::size_t>(m.step + i);
-      if (!have_y[k]) y[k] = m.y[i], have_y[k] = 1;
+      Take(m.y[i], &y[k], &have_y[k], "y", k, true);
       if (static_cast<long>(k) < total) {
-        if (!have_u[k] && std::isfinite(m.u[i])) u[k] = m.u[i], have_u[k] = 1;
-        if (!have_n[k] && std::isfinite(m.n[i])) n[k] = m.n[i], have_n[k] = 1;
+        Take(m.u[i], &u[k], &have_u[k], "u", k, std::isfinite(m.u[i]));
+        Take(m.n[i], &n[k], &have_n[k], "n", k, std::isfinite(m.n[i]));
       }
     }
     const long last = static_cast<long>(m.step) + m.count - 1;
     if (m.count > 0 && last > max_step) {
       max_step = last;
       last_progress_s = NowSeconds();
+    }
+  }
+  /// The first value of a step is kept; a different one later is a conflict
+  /// (a forged or corrupted chunk), never silently ignored.
+  void Take(double value, double* kept, char* have, const char* what, std::size_t k, bool usable) {
+    if (!usable) return;
+    if (!*have) {
+      *kept = value;
+      *have = 1;
+    } else if (std::memcmp(kept, &value, sizeof value) != 0) {
+      std::ostringstream os;
+      os << std::setprecision(17) << "conflicting TRAJECTORY messages for step " << k << " of episode "
+         << episode_id << ": " << what << " = " << *kept << " and " << what << " = " << value
+         << " (a forged or corrupted message on the network; see docs/security.md)";
+      conflict = os.str();
     }
   }
   /// First step with something missing, or -1.
@@ -178,8 +196,13 @@ bool EpisodeClient::FollowEpisode(double t0, double* done_s, long* requests, std
   double last_request = -1e9;
   for (;;) {
     const double now = NowSeconds();
+    if (!s.conflict.empty()) {
+      *error = "episode failed: " + s.conflict + Where();
+      return false;
+    }
     if (s.Failed()) {
-      *error = "episode failed: " + s.last_summary.message + Where();
+      // Text off the wire: escaped and cut before anyone prints it.
+      *error = "episode failed: " + transport::EscapeWireText(s.last_summary.message) + Where();
       return false;
     }
     if (now - t0 > options_.episode_timeout_s) {

@@ -51,6 +51,9 @@ class PlantRole : public Role {
   void TryAdvance();
   void PublishOutput();
   void Finish(bool ok, const std::string& silent_role, const std::string& message);
+  /// Two different payloads for the same episode, channel and step: the
+  /// episode fails naming them (never silently the first one wins).
+  void Conflict(const char* channel, int64_t step, const std::string& detail);
 
   const Episode* FindEpisode(int64_t episode_id) const;
   std::unique_ptr<Episode> ep_;

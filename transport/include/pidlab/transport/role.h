@@ -26,6 +26,7 @@ struct RoleCounters {
   long duplicates = 0;   // repeated or out-of-order steps, ignored or re-answered
   long bad_configs = 0;  // configurations that failed validation
   long retransmits = 0;  // messages resent after a silence
+  long conflicts = 0;    // two different payloads for the same episode, channel and step
 };
 
 /// Common part: answers PING with ALIVE, acknowledges configurations.

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "pidlab/transport/protocol.h"
+#include "pidlab/transport/wire.h"
 
 namespace pidlab::transport {
 
@@ -74,6 +75,7 @@ class Transport {
     auto sub = std::make_unique<Subscription>();
     sub->owner = this;
     sub->decode_and_call = [on_message](const void* data, int size) {
+      if (!WireLayoutOk(Msg::getHash(), data, size)) return false;  // before the decoder allocates
       Msg msg;
       try {
         if (msg.decode(data, 0, size) != size) return false;
