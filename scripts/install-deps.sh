@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev libceres-dev
   liblcm-dev liblcm-bin libglib2.0-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libcli11-dev nlohmann-json3-dev
+  libcli11-dev nlohmann-json3-dev libsodium-dev
   gnuplot-nox
   iproute2 util-linux python3 bc
   default-jdk-headless liblcm-java

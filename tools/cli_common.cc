@@ -21,6 +21,9 @@ void LcmFlags::Register(CLI::App* app) {
                   "--backend lcm: channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
   app->add_option("--episode-timeout", episode_timeout_s, "--backend lcm: give up on an episode after this many s")
       ->capture_default_str();
+  app->add_option("--auth-key", auth_key_file,
+                  "--backend lcm: authenticate every message with the key in this file (docs/security.md; default "
+                  "$PIDLAB_AUTH_KEY_FILE)");
 }
 
 std::unique_ptr<EpisodeClient> LcmFlags::MakeClient() const {
@@ -29,6 +32,12 @@ std::unique_ptr<EpisodeClient> LcmFlags::MakeClient() const {
   co.transport.channel_prefix = FromEnv(channel_prefix, "PIDLAB_CHANNEL_PREFIX", transport::kDefaultChannelPrefix);
   co.episode_timeout_s = episode_timeout_s;
   std::string error;
+  const std::string key_file = FromEnv(auth_key_file, transport::kAuthKeyFileEnv, "");
+  if (!key_file.empty()) {
+    transport::AuthKey key;
+    if (!transport::LoadAuthKey(key_file, &key, &error)) throw BadInput(error);
+    co.transport.auth_key = key;
+  }
   if (!co.IsValid(&error)) throw BadInput(error);
   return std::make_unique<EpisodeClient>(co);  // throws runtime_error: exit 1
 }

@@ -28,7 +28,8 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
   auto flags = std::make_shared<Flags>();
   launcher::LaunchOptions& o = flags->options;
   app->description(
-      "Start pidlab-plant, pidlab-controller and pidlab-disturbance (and lcm-logger with --log), wait until all "
+      "Start pidlab-plant, pidlab-controller and pidlab-disturbance (and lcm-logger with --log), wait until "
+      "all "
       "are ready, then run COMMAND against them and stop everything, returning COMMAND's status; without "
       "COMMAND, serve until Ctrl-C. COMMAND sees PIDLAB_LCM_URL, PIDLAB_CHANNEL_PREFIX and "
       "PIDLAB_{PLANT,CONTROLLER,DISTURBANCE}_PID.");
@@ -44,6 +45,10 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--ready-timeout", o.ready_timeout_s, "seconds to wait for the trio to be ready")
       ->capture_default_str();
+  app->add_option(
+      "--auth-key", o.auth_key_file,
+      "authenticate every message with the key in this file (HMAC-SHA256, docs/security.md); passed "
+      "to the processes and to COMMAND as $PIDLAB_AUTH_KEY_FILE");
   app->add_flag("--verbose,-v", o.verbose, "verbose processes and launcher");
   app->add_option("command", flags->command, "COMMAND [ARGS...] after --");
   return [flags] {
@@ -55,7 +60,13 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
     sigemptyset(&sa.sa_mask);
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
 
-    launcher::Launcher trio(flags->options, Note);
+    std::unique_ptr<launcher::Launcher> launched;
+    try {
+      launched = std::make_unique<launcher::Launcher>(flags->options, Note);
+    } catch (const std::invalid_argument& bad) {
+      throw BadInput(bad.what());
+    }
+    launcher::Launcher& trio = *launched;
     if (trio.Start(&g_signal, &error) != launcher::LaunchStatus::kReady) {
       if (g_signal) return 128 + static_cast<int>(g_signal);
       throw std::runtime_error(error);

@@ -19,8 +19,9 @@ const char* const kRoles[] = {"plant", "controller", "disturbance"};
 
 bool EnterIsolatedNetwork(std::string* error) {
   if (unshare(CLONE_NEWNET) != 0) {
-    if (error) *error = std::string("cannot enter a private network namespace (unshare: ") + strerror(errno) +
-                        "; root is needed)";
+    if (error)
+      *error = std::string("cannot enter a private network namespace (unshare: ") + strerror(errno) +
+               "; root is needed)";
     return false;
   }
   for (const std::vector<std::string>& args : {std::vector<std::string>{"ip", "link", "set", "lo", "up"},
@@ -62,15 +63,29 @@ Launcher::Launcher(const LaunchOptions& options, NoteFn note)
     : options_(options), note_(std::move(note)), url_(options.EffectiveLcmUrl()) {
   std::string error;
   if (!options_.IsValid(&error)) throw std::invalid_argument(error);
+  if (!options_.auth_key_file.empty()) {
+    // The processes are started from other directories' points of view too.
+    char* real = realpath(options_.auth_key_file.c_str(), nullptr);
+    if (real) {
+      options_.auth_key_file = real;
+      std::free(real);
+    }
+  }
   if (options_.bin_dir.empty()) options_.bin_dir = SelfDirectory();
   if (options_.bin_dir.back() != '/') options_.bin_dir += '/';
   lcm_ = std::make_unique<lcm::LCM>(url_);
   if (!lcm_->good())
-    throw std::runtime_error("cannot start LCM on '" + url_ +
-                             "': no multicast route? Add one with 'sudo ip route add 224.0.0.0/4 dev lo' or use "
-                             "--isolated (see docs/trio.md)");
+    throw std::runtime_error(
+        "cannot start LCM on '" + url_ +
+        "': no multicast route? Add one with 'sudo ip route add 224.0.0.0/4 dev lo' or use "
+        "--isolated (see docs/trio.md)");
   transport::TransportOptions topt;
   topt.channel_prefix = options_.channel_prefix;
+  if (!options_.auth_key_file.empty()) {
+    transport::AuthKey key;
+    if (!transport::LoadAuthKey(options_.auth_key_file, &key, &error)) throw std::invalid_argument(error);
+    topt.auth_key = key;
+  }
   transport_ = std::make_unique<transport::Transport>(lcm_.get(), topt);
   transport_->Subscribe<pidlab::lcmt_ready>(transport::kReadyChannel, [this](const pidlab::lcmt_ready& m) {
     if (m.state == pidlab::lcmt_ready::ALIVE) alive_[m.role] = m.pid;
@@ -99,8 +114,8 @@ pid_t Launcher::pid_of(const std::string& role) const {
 void Launcher::StartRoles() {
   int seed = 1;
   for (const char* role : kRoles) {
-    std::vector<std::string> args = {options_.bin_dir + "pidlab-" + role, "--lcm-url", url_, "--channel-prefix",
-                                     options_.channel_prefix};
+    std::vector<std::string> args = {options_.bin_dir + "pidlab-" + role, "--lcm-url", url_,
+                                     "--channel-prefix", options_.channel_prefix};
     if (options_.drop_rate > 0.0) {
       std::ostringstream rate;
       rate.precision(17);
@@ -108,8 +123,10 @@ void Launcher::StartRoles() {
       args.insert(args.end(), {"--drop-rate", rate.str(), "--drop-seed", std::to_string(seed++)});
     }
     if (options_.verbose) args.push_back("--verbose");
+    if (!options_.auth_key_file.empty()) args.insert(args.end(), {"--auth-key", options_.auth_key_file});
     roles_[role] = supervisor_->Start(std::string("pidlab-") + role, args);
-    if (options_.verbose) Note("started pidlab-" + std::string(role) + " (pid " + std::to_string(roles_[role]) + ")");
+    if (options_.verbose)
+      Note("started pidlab-" + std::string(role) + " (pid " + std::to_string(roles_[role]) + ")");
   }
 }
 
@@ -169,12 +186,14 @@ LaunchStatus Launcher::Start(const volatile std::sig_atomic_t* stop, std::string
 }
 
 std::map<std::string, std::string> Launcher::CommandEnvironment() const {
-  std::map<std::string, std::string> env = {{"PIDLAB_LCM_URL", url_},
-                                            {"PIDLAB_CHANNEL_PREFIX", options_.channel_prefix},
-                                            {"PIDLAB_PLANT_PID", std::to_string(pid_of("plant"))},
-                                            {"PIDLAB_CONTROLLER_PID", std::to_string(pid_of("controller"))},
-                                            {"PIDLAB_DISTURBANCE_PID", std::to_string(pid_of("disturbance"))}};
+  std::map<std::string, std::string> env = {
+      {"PIDLAB_LCM_URL", url_},
+      {"PIDLAB_CHANNEL_PREFIX", options_.channel_prefix},
+      {"PIDLAB_PLANT_PID", std::to_string(pid_of("plant"))},
+      {"PIDLAB_CONTROLLER_PID", std::to_string(pid_of("controller"))},
+      {"PIDLAB_DISTURBANCE_PID", std::to_string(pid_of("disturbance"))}};
   if (logger_ > 0) env["PIDLAB_LOGGER_PID"] = std::to_string(logger_);
+  if (!options_.auth_key_file.empty()) env[transport::kAuthKeyFileEnv] = options_.auth_key_file;
   // Let COMMAND find pidlab and the trio binaries next to us.
   const char* path = std::getenv("PATH");
   env["PATH"] = options_.bin_dir + ":" + (path ? path : "/usr/bin:/bin");
@@ -207,7 +226,8 @@ bool Launcher::FinishLog(bool interrupted) {
     return false;
   }
   if (interrupted) {
-    Note("interrupted: " + options_.log_file + " was not checked for completeness (check it with pidlab replay)");
+    Note("interrupted: " + options_.log_file +
+         " was not checked for completeness (check it with pidlab replay)");
     return true;
   }
   const RepairSummary summary = log_->Repair();

@@ -72,7 +72,8 @@ long CountSteps(const std::vector<std::pair<long, long>>& ranges) {
   return n;
 }
 
-LogCapture::LogCapture(const LogCaptureOptions& options, transport::Transport* transport, Supervisor* supervisor)
+LogCapture::LogCapture(const LogCaptureOptions& options, transport::Transport* transport,
+                       Supervisor* supervisor)
     : options_(options), transport_(transport), supervisor_(supervisor) {}
 
 pid_t LogCapture::StartLogger(const std::string& lcm_url) {
@@ -80,13 +81,15 @@ pid_t LogCapture::StartLogger(const std::string& lcm_url) {
   if (logger_url.find("recv_buf_size=") == std::string::npos)
     logger_url += std::string(logger_url.find('?') == std::string::npos ? "?" : "&") + kRecvBuf;
   return supervisor_->Start(
-      "lcm-logger", {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + logger_url, options_.log_file},
-      {}, options_.logger_nice);
+      "lcm-logger",
+      {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + logger_url, options_.log_file}, {},
+      options_.logger_nice);
 }
 
 bool LogCapture::WaitForMarker(const std::string& what) {
   std::random_device rd;
-  const std::string nonce = "pidlab-launch-" + what + "-" + std::to_string(getpid()) + "-" + std::to_string(rd());
+  const std::string nonce =
+      "pidlab-launch-" + what + "-" + std::to_string(getpid()) + "-" + std::to_string(rd());
   pidlab::lcmt_ready m;
   m.episode_id = 0;
   m.step = -1;
@@ -190,9 +193,10 @@ void LogCapture::DescribeUnrepaired(const std::vector<Gap>& gaps, RepairSummary*
 
 RepairSummary LogCapture::Repair() {
   if (!listening_) {
-    transport_->Subscribe<pidlab::lcmt_trajectory_chunk>(
-        transport::kTrajectoryChannel,
-        [this](const pidlab::lcmt_trajectory_chunk& c) { answers_[{c.episode_id, c.step}] = c.count; });
+    transport_->Subscribe<pidlab::lcmt_trajectory_chunk>(transport::kTrajectoryChannel,
+                                                         [this](const pidlab::lcmt_trajectory_chunk& c) {
+                                                           answers_[{c.episode_id, c.step}] = c.count;
+                                                         });
     listening_ = true;
   }
   RepairSummary summary;
@@ -204,7 +208,8 @@ RepairSummary LogCapture::Repair() {
       if (summary.republished.empty()) return summary;
       summary.status = RepairStatus::kRepaired;
       std::ostringstream os;
-      os << "lcm-logger lost messages; repaired " << options_.log_file << " from the plant's trajectory chunks:";
+      os << "lcm-logger lost messages; repaired " << options_.log_file
+         << " from the plant's trajectory chunks:";
       for (const auto& [id, n] : summary.republished) os << " episode " << id << " (" << n << " steps)";
       os << " in " << round << " round" << (round == 1 ? "" : "s");
       summary.lines.push_back(os.str());

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <csignal>
+#include <cstdlib>
 #include <iostream>
 
 namespace pidlab::transport {
@@ -26,6 +27,10 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
       ->capture_default_str();
   app.add_option("--drop-seed", transport_options.drop_seed, "seed of the fault injection")
       ->capture_default_str();
+  std::string auth_key_file;
+  app.add_option("--auth-key", auth_key_file,
+                 "authenticate every message with the key in this file (HMAC-SHA256; docs/security.md); "
+                 "default $PIDLAB_AUTH_KEY_FILE");
   app.add_flag("--verbose,-v", verbose, "log every resend and episode start, not only one line per episode");
   try {
     app.parse(argc, argv);
@@ -36,6 +41,18 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
     return 2;
   }
   std::string error;
+  if (auth_key_file.empty()) {
+    const char* env = std::getenv(kAuthKeyFileEnv);
+    if (env && *env) auth_key_file = env;
+  }
+  if (!auth_key_file.empty()) {
+    AuthKey key;
+    if (!LoadAuthKey(auth_key_file, &key, &error)) {
+      std::cerr << program << ": error: " << error << "\n";
+      return 2;
+    }
+    transport_options.auth_key = key;
+  }
   if (!transport_options.IsValid(&error)) {
     std::cerr << program << ": error: " << error << "\n";
     return 2;
@@ -61,8 +78,10 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
   if (verbose) {
     const TransportCounters& c = transport.counters();
     log("received " + std::to_string(c.received) + ", dropped " + std::to_string(c.dropped) +
-        ", undecodable " + std::to_string(c.undecodable) + ", foreign " +
-        std::to_string(role->counters().foreign));
+        ", undecodable " + std::to_string(c.undecodable) + ", unauthenticated " +
+        std::to_string(c.unauthenticated) + ", replayed " + std::to_string(c.replayed) + ", foreign " +
+        std::to_string(role->counters().foreign) + ", conflicts " +
+        std::to_string(role->counters().conflicts));
   }
   return status;
 }

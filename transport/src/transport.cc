@@ -61,7 +61,23 @@ void Transport::Subscription::HandleC(const lcm_recv_buf_t* rbuf, const char* /*
     ++c.dropped;
     return;
   }
-  if (!sub->decode_and_call(rbuf->data, static_cast<int>(rbuf->data_size))) ++c.undecodable;
+  int size = static_cast<int>(rbuf->data_size);
+  Transport* owner = sub->owner;
+  if (owner->options_.auth_key) {
+    switch (owner->replay_guard_.Check(*owner->options_.auth_key, sub->channel, rbuf->data, rbuf->data_size,
+                                       NowUtime(), NowSeconds())) {
+      case AuthResult::kAccepted:
+        size -= static_cast<int>(kAuthTagBytes);
+        break;
+      case AuthResult::kUnauthenticated:
+        ++c.unauthenticated;
+        return;
+      case AuthResult::kReplayed:
+        ++c.replayed;
+        return;
+    }
+  }
+  if (!sub->decode_and_call(rbuf->data, size)) ++c.undecodable;
 }
 
 int Transport::WaitAndHandle(double timeout_s) {

@@ -31,7 +31,8 @@ class LayoutCheck {
   }
   LayoutCheck& String() {
     int32_t len = 0;
-    if (!ReadInt32(&len) || len < 1 || len > kMaxStringBytes || len > size_ - pos_ || data_[pos_ + len - 1] != 0)
+    if (!ReadInt32(&len) || len < 1 || len > kMaxStringBytes || len > size_ - pos_ ||
+        data_[pos_ + len - 1] != 0)
       ok_ = false;
     else
       pos_ += len;

@@ -48,17 +48,21 @@ struct LaunchOptions {
   bool verbose = false;
   /// The processes append their stderr to this file (empty: ours).
   std::string stderr_path;
+  /// Authenticate every message with the key in this file (empty: no key):
+  /// passed to the processes with --auth-key and to COMMAND as
+  /// $PIDLAB_AUTH_KEY_FILE; the launcher's own messages carry it too.
+  std::string auth_key_file;
 
   bool IsValid(std::string* error) const;
   std::string EffectiveLcmUrl() const;
 };
 
 enum class LaunchStatus {
-  kReady,        // every process answered (and the logger wrote its first marker)
-  kChildDied,    // a process ended before it was ready
-  kNotReady,     // not every process answered within ready_timeout_s
-  kLoggerSilent, // lcm-logger did not record anything
-  kInterrupted,  // *stop became true
+  kReady,         // every process answered (and the logger wrote its first marker)
+  kChildDied,     // a process ended before it was ready
+  kNotReady,      // not every process answered within ready_timeout_s
+  kLoggerSilent,  // lcm-logger did not record anything
+  kInterrupted,   // *stop became true
 };
 
 class Launcher {
@@ -67,7 +71,8 @@ class Launcher {
   /// included). May be empty.
   using NoteFn = std::function<void(const std::string& line)>;
 
-  /// Throws std::invalid_argument for invalid options and
+  /// Throws std::invalid_argument for invalid options (a key file that cannot
+  /// be read included) and
   /// std::runtime_error if LCM cannot start on the URL.
   Launcher(const LaunchOptions& options, NoteFn note);
   ~Launcher();
@@ -77,7 +82,8 @@ class Launcher {
   LaunchStatus Start(const volatile std::sig_atomic_t* stop, std::string* error);
 
   /// PIDLAB_LCM_URL, PIDLAB_CHANNEL_PREFIX, PIDLAB_{PLANT,CONTROLLER,
-  /// DISTURBANCE,LOGGER}_PID and PATH with this executable's directory first.
+  /// DISTURBANCE,LOGGER}_PID, PIDLAB_AUTH_KEY_FILE (with a key) and PATH with
+  /// this executable's directory first.
   std::map<std::string, std::string> CommandEnvironment() const;
 
   /// Runs `command` with CommandEnvironment() until it ends and returns its

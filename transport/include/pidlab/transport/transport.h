@@ -4,15 +4,18 @@
 // (never a crash), seeded fault injection on receipt, and bounded waits.
 // Works on any LCM URL, including memq:// for single-process tests.
 
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "pidlab/transport/auth.h"
 #include "pidlab/transport/protocol.h"
 #include "pidlab/transport/wire.h"
 
@@ -31,14 +34,19 @@ struct TransportOptions {
   double drop_rate = 0.0;
   /// Seed of the drop decisions (std::mt19937_64).
   uint64_t drop_seed = 1;
+  /// With a key, every message sent carries an HMAC-SHA256 tag and every
+  /// message received must carry a valid, fresh one (auth.h).
+  std::optional<AuthKey> auth_key;
 
   bool IsValid(std::string* error) const;
 };
 
 struct TransportCounters {
-  long received = 0;     // messages that reached a subscription
-  long dropped = 0;      // thrown away by fault injection
-  long undecodable = 0;  // failed to decode (garbage, wrong type): ignored
+  long received = 0;         // messages that reached a subscription
+  long dropped = 0;          // thrown away by fault injection
+  long undecodable = 0;      // failed to decode (garbage, wrong type): ignored
+  long unauthenticated = 0;  // with a key: no tag, or a tag that does not verify (forged)
+  long replayed = 0;         // with a key: dated outside the replay window, or a repeat
 };
 
 class Transport {
@@ -58,10 +66,16 @@ class Transport {
     msg->utime = NowUtime();
     const int size = msg->getEncodedSize();
     if (size < 0) return false;
-    if (encode_buffer_.size() < static_cast<std::size_t>(size))
-      encode_buffer_.resize(static_cast<std::size_t>(size));
+    const std::size_t total = static_cast<std::size_t>(size) + (options_.auth_key ? kAuthTagBytes : 0);
+    if (encode_buffer_.size() < total) encode_buffer_.resize(total);
     if (msg->encode(encode_buffer_.data(), 0, size) != size) return false;
-    return lcm_->publish(CachedChannel(name), encode_buffer_.data(), static_cast<unsigned int>(size)) == 0;
+    const std::string& channel = CachedChannel(name);
+    if (options_.auth_key) {
+      const auto tag =
+          AuthTag(*options_.auth_key, channel, encode_buffer_.data(), static_cast<std::size_t>(size));
+      std::copy(tag.begin(), tag.end(), encode_buffer_.begin() + size);
+    }
+    return lcm_->publish(channel, encode_buffer_.data(), static_cast<unsigned int>(total)) == 0;
   }
   template <typename Msg>
   bool Publish(const std::string& name, Msg* msg) {
@@ -87,7 +101,8 @@ class Transport {
     };
     // The C API directly: lcm-cpp's trampoline builds a std::string of the
     // channel name for every message received.
-    lcm_subscribe(lcm_->getUnderlyingLCM(), Channel(name).c_str(), &Subscription::HandleC, sub.get());
+    sub->channel = Channel(name);
+    lcm_subscribe(lcm_->getUnderlyingLCM(), sub->channel.c_str(), &Subscription::HandleC, sub.get());
     subscriptions_.push_back(std::move(sub));
   }
 
@@ -103,6 +118,7 @@ class Transport {
  private:
   struct Subscription {
     Transport* owner = nullptr;
+    std::string channel;  // prefixed
     std::function<bool(const void*, int)> decode_and_call;
     static void HandleC(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
   };
@@ -116,6 +132,7 @@ class Transport {
   TransportOptions options_;
   TransportCounters counters_;
   std::mt19937_64 drop_rng_;
+  ReplayGuard replay_guard_;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
 };
 
