@@ -79,14 +79,16 @@ TEST(Report, MarkdownListsEveryTableTuningAndSection) {
   for (const Tuning& t : data.tunings) {
     if (t.method != TuneMethod::kZieglerNichols) continue;
     EXPECT_EQ(t.ok, t.plant == "stepper_motor") << t.plant << ": " << t.message;
-    if (t.ok)
-      EXPECT_EQ(t.summary.refine.verdict, "not run");
-    else
+    if (t.ok) {
+      EXPECT_EQ(t.summary.refine.verdict, RefineVerdict::kNotRun);
+    } else {
       EXPECT_NE(t.message.find("no finite ultimate gain"), std::string::npos) << t.message;
+    }
   }
   for (const Tuning& t : data.tunings) {
-    if (t.ok && t.method != TuneMethod::kZieglerNichols)
+    if (t.ok && t.method != TuneMethod::kZieglerNichols) {
       EXPECT_TRUE(t.summary.refine.ran) << ToString(t.method);
+    }
   }
   EXPECT_NE(md.find("## Stepper motor on the sampled loop"), std::string::npos);
   EXPECT_NE(md.find("The LCM trio run was not available"), std::string::npos);  // no runner in this test

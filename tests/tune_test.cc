@@ -42,7 +42,7 @@ TEST_P(TuneBeatsPaper, DefaultNelderMeadBeatsThePapersIaeWithAStrictlyStableLoop
     EXPECT_LE(g, 30.0);
   }
   EXPECT_TRUE(dut.refine.ran);
-  EXPECT_NE(dut.refine.verdict, "not run");
+  EXPECT_NE(dut.refine.verdict, RefineVerdict::kNotRun);
 }
 
 INSTANTIATE_TEST_SUITE_P(Plants, TuneBeatsPaper,
@@ -95,7 +95,7 @@ TEST(RefineWithCeres, SaysTheSearchStoppedShortWhenNelderMeadIsStoppedEarly) {
   ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
   ASSERT_TRUE(dut.stable);
   ASSERT_TRUE(dut.refine.ran);
-  EXPECT_EQ(dut.refine.verdict, "nelder-mead stopped short");
+  EXPECT_EQ(dut.refine.verdict, RefineVerdict::kSearchStoppedShort);
   EXPECT_LT(dut.refine.objective, dut.search_objective * (1.0 - options.agree_tolerance));
   EXPECT_GT(dut.refine.relative_improvement, options.agree_tolerance);
   // The better gains are returned, and re-evaluate to the reported objective.
@@ -109,7 +109,8 @@ TEST(RefineWithCeres, AgreesWithAConvergedNelderMead) {
   TuneOptions options;
   TuneSummary dut;
   ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
-  EXPECT_EQ(dut.refine.verdict, "agree");
+  EXPECT_EQ(dut.refine.verdict, RefineVerdict::kAgree);
+  EXPECT_EQ(dut.refine.termination, RefineTermination::kConvergence);
   EXPECT_LE(std::abs(dut.refine.relative_improvement), options.agree_tolerance);
 }
 
@@ -125,7 +126,35 @@ TEST(RefineWithCeres, WorksOnTheSampledLoopToo) {
   const RefineSummary dut = RefineWithCeres(plant, options, start, f0);
   ASSERT_TRUE(dut.ran);
   EXPECT_LT(dut.objective, f0);
-  EXPECT_EQ(dut.verdict, "nelder-mead stopped short");
+  EXPECT_EQ(dut.verdict, RefineVerdict::kSearchStoppedShort);
+}
+
+TEST(RefineVerdict, PrintsTheTextOfTheJsonVerdictKey) {
+  EXPECT_EQ(ToString(RefineVerdict::kNotRun, TuneMethod::kNelderMead), "not run");
+  EXPECT_EQ(ToString(RefineVerdict::kAgree, TuneMethod::kGeneticAlgorithm), "agree");
+  EXPECT_EQ(ToString(RefineVerdict::kSearchStoppedShort, TuneMethod::kNelderMead),
+            "nelder-mead stopped short");
+  EXPECT_EQ(ToString(RefineVerdict::kSearchStoppedShort, TuneMethod::kPaperNelderMead),
+            "paper-nm stopped short");
+  EXPECT_EQ(ToString(RefineVerdict::kSearchBetter, TuneMethod::kPsoGsa), "search better");
+}
+
+TEST(RefineTermination, PrintsCeresNamesAndNothingWhenNotRun) {
+  EXPECT_EQ(ToString(RefineTermination::kNotRun), "");
+  EXPECT_EQ(ToString(RefineTermination::kConvergence), "CONVERGENCE");
+  EXPECT_EQ(ToString(RefineTermination::kNoConvergence), "NO_CONVERGENCE");
+  EXPECT_EQ(ToString(RefineTermination::kFailure), "FAILURE");
+}
+
+TEST(RefineWithCeres, IsNotRunOnTheContinuousIae) {
+  TuneOptions options;
+  options.objective = ObjectiveKind::kIaeContinuous;
+  const RefineSummary dut =
+      RefineWithCeres(MakeBuiltin("double_integrator"), options, PidGains{10.0, 1.0, 5.0}, 1.0);
+  EXPECT_FALSE(dut.ran);
+  EXPECT_EQ(dut.verdict, RefineVerdict::kNotRun);
+  EXPECT_EQ(dut.termination, RefineTermination::kNotRun);
+  EXPECT_NE(dut.message.find("iae-continuous"), std::string::npos) << dut.message;
 }
 
 TEST(Tune, ZieglerNicholsOnTheDoubleIntegratorSaysItDoesNotApply) {

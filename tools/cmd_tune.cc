@@ -153,8 +153,8 @@ struct TuneCommand {
                      {"gains", ToJson(s.refine.gains)},
                      {"objective", JsonNumber(s.refine.objective)},
                      {"iae", JsonNumber(o.objective == ObjectiveKind::kIae ? s.refine.objective : NAN)},
-                     {"verdict", s.refine.verdict},
-                     {"termination", s.refine.termination},
+                     {"verdict", ToString(s.refine.verdict, s.method)},
+                     {"termination", ToString(s.refine.termination)},
                      {"iterations", s.refine.iterations},
                      {"relative_improvement", JsonNumber(s.refine.relative_improvement)},
                      {"message", s.refine.message}};
@@ -178,9 +178,9 @@ struct TuneCommand {
       if (s.refine.ran)
         std::cout << "ceres            kp = " << s.refine.gains.kp << ", ki = " << s.refine.gains.ki
                   << ", kd = " << s.refine.gains.kd << "  objective " << s.refine.objective << "  ("
-                  << s.refine.termination << ", " << s.refine.iterations << " iterations)\n";
-      std::cout << "verdict          " << s.refine.verdict << (s.refine.message.empty() ? "" : ": ")
-                << s.refine.message << "\n";
+                  << ToString(s.refine.termination) << ", " << s.refine.iterations << " iterations)\n";
+      std::cout << "verdict          " << ToString(s.refine.verdict, s.method)
+                << (s.refine.message.empty() ? "" : ": ") << s.refine.message << "\n";
       std::cout << "wall time        " << s.wall_time_s << " s\n\n";
       std::cout << FormatEvaluation(ev);
     }
@@ -203,9 +203,6 @@ struct TuneCommand {
     return client->AsRunner();
   }
 };
-
-
-
 
 }  // namespace
 std::function<int()> RegisterTune(CLI::App* app) {

@@ -12,6 +12,8 @@
 #include <ceres/ceres.h>
 
 #include <cmath>
+#include <memory>
+#include <string>
 
 #include "pidlab/tuner/tune.h"
 
@@ -71,21 +73,26 @@ struct ErrorResiduals {
   }
 };
 
-}  // namespace
+RefineTermination FromCeres(ceres::TerminationType type) {
+  switch (type) {
+    case ceres::CONVERGENCE:
+      return RefineTermination::kConvergence;
+    case ceres::NO_CONVERGENCE:
+      return RefineTermination::kNoConvergence;
+    case ceres::FAILURE:
+      return RefineTermination::kFailure;
+    case ceres::USER_SUCCESS:
+      return RefineTermination::kUserSuccess;
+    case ceres::USER_FAILURE:
+      return RefineTermination::kUserFailure;
+  }
+  return RefineTermination::kFailure;
+}
 
-RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, const PidGains& start,
-                              double start_objective) {
-  RefineSummary summary;
-  summary.gains = start;
-  summary.objective = start_objective;
-  if (options.objective == ObjectiveKind::kIaeContinuous) {
-    summary.message = "not run: iae-continuous has no sample least-squares form";
-    return summary;
-  }
-  if (!std::isfinite(start_objective)) {
-    summary.message = "not run: the search found no stable loop";
-    return summary;
-  }
+// Runs the bound-constrained least-squares problem from `start`; the solution
+// is left in *refined, Ceres's termination and iteration count in *summary.
+void SolveLeastSquares(const Plant& plant, const TuneOptions& options, const PidGains& start,
+                       PidGains* refined, RefineSummary* summary) {
   const StateSpace realization = Realize(plant.tf);
   std::unique_ptr<DiscretePlant> discrete;
   if (options.loop.loop == LoopKind::kSampled)
@@ -110,32 +117,57 @@ RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, co
   solver.num_threads = 1;
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver, &problem, &ceres_summary);
-  summary.ran = true;
-  summary.termination = ceres::TerminationTypeToString(ceres_summary.termination_type);
-  summary.iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
-  const PidGains refined{x[0], x[1], x[2]};
-  ObjectiveEvaluator exact(plant, options.loop, options.objective);
-  const double f = exact(refined);
-  summary.relative_improvement = (start_objective - f) / start_objective;
+  summary->ran = true;
+  summary->termination = FromCeres(ceres_summary.termination_type);
+  summary->iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+  *refined = PidGains{x[0], x[1], x[2]};
+}
+
+// The verdict on Ceres's point, whose exact objective is f, against the
+// search's start_objective; keeps Ceres's gains where they are better.
+void Judge(const TuneOptions& options, const PidGains& refined, double f, double start_objective,
+           RefineSummary* summary) {
+  summary->relative_improvement = (start_objective - f) / start_objective;
   if (std::isfinite(f) && f < start_objective * (1.0 - options.agree_tolerance)) {
-    summary.verdict = ToString(options.method) + " stopped short";
-    summary.gains = refined;
-    summary.objective = f;
-    summary.message = "Ceres lowered the objective by " +
-                      std::to_string(100.0 * summary.relative_improvement) + " %; its gains are returned";
+    summary->verdict = RefineVerdict::kSearchStoppedShort;
+    summary->gains = refined;
+    summary->objective = f;
+    summary->message = "Ceres lowered the objective by " +
+                       std::to_string(100.0 * summary->relative_improvement) + " %; its gains are returned";
   } else if (std::isfinite(f) && std::abs(f - start_objective) <= options.agree_tolerance * start_objective) {
-    summary.verdict = "agree";
+    summary->verdict = RefineVerdict::kAgree;
     if (f < start_objective) {
-      summary.gains = refined;
-      summary.objective = f;
+      summary->gains = refined;
+      summary->objective = f;
     }
-    summary.message =
+    summary->message =
         "Ceres and the search agree within " + std::to_string(100.0 * options.agree_tolerance) + " %";
   } else {
-    summary.verdict = "search better";
-    summary.message = "Ceres's smooth least-squares optimum is worse on the exact objective (" +
-                      std::to_string(f) + "); the search result stands";
+    summary->verdict = RefineVerdict::kSearchBetter;
+    summary->message = "Ceres's smooth least-squares optimum is worse on the exact objective (" +
+                       std::to_string(f) + "); the search result stands";
   }
+}
+
+}  // namespace
+
+RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, const PidGains& start,
+                              double start_objective) {
+  RefineSummary summary;
+  summary.gains = start;
+  summary.objective = start_objective;
+  if (options.objective == ObjectiveKind::kIaeContinuous) {
+    summary.message = "not run: iae-continuous has no sample least-squares form";
+    return summary;
+  }
+  if (!std::isfinite(start_objective)) {
+    summary.message = "not run: the search found no stable loop";
+    return summary;
+  }
+  PidGains refined;
+  SolveLeastSquares(plant, options, start, &refined, &summary);
+  const ObjectiveEvaluator exact(plant, options.loop, options.objective);
+  Judge(options, refined, exact(refined), start_objective, &summary);
   return summary;
 }
 

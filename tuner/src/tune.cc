@@ -43,6 +43,38 @@ std::string ToString(TuneMethod method) {
   return "nelder-mead";
 }
 
+std::string ToString(RefineTermination termination) {
+  switch (termination) {
+    case RefineTermination::kNotRun:
+      return "";
+    case RefineTermination::kConvergence:
+      return "CONVERGENCE";
+    case RefineTermination::kNoConvergence:
+      return "NO_CONVERGENCE";
+    case RefineTermination::kFailure:
+      return "FAILURE";
+    case RefineTermination::kUserSuccess:
+      return "USER_SUCCESS";
+    case RefineTermination::kUserFailure:
+      return "USER_FAILURE";
+  }
+  return "";
+}
+
+std::string ToString(RefineVerdict verdict, TuneMethod method) {
+  switch (verdict) {
+    case RefineVerdict::kNotRun:
+      return "not run";
+    case RefineVerdict::kAgree:
+      return "agree";
+    case RefineVerdict::kSearchStoppedShort:
+      return ToString(method) + " stopped short";
+    case RefineVerdict::kSearchBetter:
+      return "search better";
+  }
+  return "not run";
+}
+
 bool TuneOptions::IsValid(std::string* error) const {
   std::ostringstream os;
   if (!std::isfinite(lower) || !std::isfinite(upper) || lower < 0.0 || !(lower < upper))
@@ -70,7 +102,8 @@ bool TuneOptions::IsValid(std::string* error) const {
 std::string TuneSummary::BriefReport() const {
   std::ostringstream os;
   os << ToString(method) << ": kp=" << gains.kp << " ki=" << gains.ki << " kd=" << gains.kd
-     << " objective=" << objective << " evaluations=" << evaluations << " refine=" << refine.verdict;
+     << " objective=" << objective << " evaluations=" << evaluations
+     << " refine=" << ToString(refine.verdict, method);
   return os.str();
 }
 

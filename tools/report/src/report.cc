@@ -81,7 +81,6 @@ LoopOptions PaperLoop(double amplitude) {
   return o;
 }
 
-
 // The one-line explanations of published figures pidlab does not reproduce.
 std::vector<std::string> ExplainDifferences(const PaperRow& row, const Metrics& m) {
   std::vector<std::string> out;
@@ -495,8 +494,9 @@ void NearlyMarginalNotes(std::ostream& os, const std::vector<Tuning>& tunings, c
 std::string Verdict(const Tuning& t) {
   if (t.method == TuneMethod::kZieglerNichols) return "not run (closed-form rule)";
   const RefineSummary& r = t.summary.refine;
-  if (!r.ran) return r.verdict;
-  std::string v = r.verdict + " (Ceres IAE " + Num(r.objective) + ", " + std::to_string(r.iterations) + " it";
+  const std::string verdict = ToString(r.verdict, t.method);
+  if (!r.ran) return verdict;
+  std::string v = verdict + " (Ceres IAE " + Num(r.objective) + ", " + std::to_string(r.iterations) + " it";
   if (r.relative_improvement > 0) v += ", " + Num(100 * r.relative_improvement, 3) + " % better";
   return v + ")";
 }
@@ -869,14 +869,13 @@ std::string RenderMarkdown(const ReportData& data) {
     const bool identical = a.stable == b.stable && a.iae == b.iae && a.rise_time_s == b.rise_time_s &&
                            a.overshoot_pct == b.overshoot_pct && a.settling_time_s == b.settling_time_s;
     if (s.trio_horizon_s < s.horizon_s) {
-      os << " The episode covers " << Num(s.trio_horizon_s) << " s instead of the paper's " << Num(s.horizon_s)
-         << " s; the slow tail after it adds "
+      os << " The episode covers " << Num(s.trio_horizon_s) << " s instead of the paper's "
+         << Num(s.horizon_s) << " s; the slow tail after it adds "
          << Num(std::abs(s.sampled_in_process.iae - s.sampled_trio_horizon.iae), 3) << " to the IAE.";
     } else {
       os << " The episode covers the paper's full " << Num(s.trio_horizon_s) << " s horizon.";
     }
-    os
-       << (identical
+    os << (identical
                ? std::string(" Its IAE and step metrics equal the in-process sampled loop's on the same "
                              "horizon bit for bit.")
                : " **Its results differ from the in-process sampled loop's** (IAE " + Num(a.iae, 17) +

@@ -52,13 +52,47 @@ struct TuneOptions {
   double max_settling_time_s = std::numeric_limits<double>::infinity();
   /// Run the Ceres cross-check after the search.
   bool refine = true;
-  /// Verdict "agree" when |f_ceres - f_search| <= agree_tolerance * f_search.
+  /// RefineVerdict::kAgree when |f_ceres - f_search| <= agree_tolerance * f_search.
   double agree_tolerance = 1e-3;
   /// Ziegler-Nichols rule (ziegler-nichols only).
   ZieglerNicholsRule zn_rule = ZieglerNicholsRule::kClassic;
 
   bool IsValid(std::string* error) const;
 };
+
+/// How Ceres's solver ended (its ceres::TerminationType), or kNotRun.
+enum class RefineTermination {
+  kNotRun,         // "": the cross-check did not run
+  kConvergence,    // "CONVERGENCE": a function, gradient or parameter tolerance was met
+  kNoConvergence,  // "NO_CONVERGENCE": the iteration budget ran out first
+  kFailure,        // "FAILURE": the solver stopped on an error; the start point is kept
+  kUserSuccess,    // "USER_SUCCESS": stopped by an iteration callback (pidlab sets none)
+  kUserFailure,    // "USER_FAILURE": stopped by an iteration callback (pidlab sets none)
+};
+/// The text in the quotes above (Ceres's own names; "" for kNotRun).
+std::string ToString(RefineTermination termination);
+
+/// What the cross-check concluded, after re-evaluating Ceres's point with the
+/// exact objective f (f_search: the search result's objective).
+enum class RefineVerdict {
+  /// "not run": --refine none, ziegler-nichols (never refined), the
+  /// iae-continuous objective (no sample least-squares form), or no stable
+  /// loop to start from; RefineSummary::message says which of the last two.
+  kNotRun,
+  /// "agree": |f - f_search| <= agree_tolerance * f_search; Ceres's gains are
+  /// returned only if f < f_search.
+  kAgree,
+  /// "<method> stopped short" (e.g. "nelder-mead stopped short"):
+  /// f < (1 - agree_tolerance) f_search; Ceres's gains are returned.
+  kSearchStoppedShort,
+  /// "search better": f > (1 + agree_tolerance) f_search, or f is not finite
+  /// (Ceres's smooth optimum is worse on the exact objective); the search
+  /// result stands.
+  kSearchBetter,
+};
+/// The text of `verdict` for a search by `method`, as in the quotes above
+/// (the JSON "verdict" key, `pidlab tune` and the report print it).
+std::string ToString(RefineVerdict verdict, TuneMethod method);
 
 /// The Ceres cross-check: starting from the search result, a bound-constrained
 /// least-squares problem whose minimum is the same objective, with derivatives
@@ -67,13 +101,13 @@ struct RefineSummary {
   bool ran = false;
   PidGains gains;
   double objective = std::numeric_limits<double>::infinity();  // re-evaluated exactly
-  std::string termination;                                     // Ceres's termination type
+  RefineTermination termination = RefineTermination::kNotRun;
   int iterations = 0;
-  /// "agree", "nelder-mead stopped short" (Ceres found better; its gains are
-  /// returned), or "not run".
-  std::string verdict = "not run";
+  RefineVerdict verdict = RefineVerdict::kNotRun;
   /// (f_search - f_ceres) / f_search.
   double relative_improvement = 0.0;
+  /// One line on the verdict, or why the cross-check did not run ("" when it
+  /// was not asked for).
   std::string message;
 };
 
