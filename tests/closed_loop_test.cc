@@ -302,6 +302,69 @@ TEST(SampledLoop, FirstSamplesFollowTheLockstepOrder) {
   EXPECT_NEAR(y[2], y[1] + v1 * dt + u1 * dt * dt / 2.0, 1e-14);
 }
 
+// 1/(s - 100) under kp = 200 with output limits +/-1: stable by the linear
+// test (which ignores the limits), but the saturated loop runs away and y
+// overflows about 7 s in.
+struct RunawayLoop {
+  static constexpr double kDt = 1e-3;
+  static constexpr long kSteps = 10000;  // 10 s
+  DiscretePlant plant{{{1.0}, {1.0, -100.0}}, kDt};
+  PidOptions pid;
+  RunawayLoop() {
+    pid.dt_s = kDt;
+    pid.output_min = -1.0;
+    pid.output_max = 1.0;
+  }
+};
+
+TEST(SampledLoop, ReportsInvalidInputOnceTheLoopDivergesAndStillRunsEveryStep) {
+  const RunawayLoop loop;
+  ASSERT_TRUE(SampledStability(loop.plant, PidGains{200.0, 0.0, 0.0}, loop.pid, 0.0).stable);
+  std::vector<double> y;
+  std::vector<SampledStep> trajectory;
+  const PidStatus dut =
+      RunSampledLoop<double>(loop.plant, PidGains{200.0, 0.0, 0.0}, loop.pid,
+                             Disturbance(DisturbanceOptions{}), RunawayLoop::kSteps, 100, &y, &trajectory);
+  EXPECT_EQ(dut, PidStatus::kInvalidInput);
+  ASSERT_EQ(y.size(), static_cast<std::size_t>(RunawayLoop::kSteps / 100 + 1));
+  ASSERT_EQ(trajectory.size(), static_cast<std::size_t>(RunawayLoop::kSteps));
+  EXPECT_TRUE(std::isfinite(y[1]));
+  EXPECT_FALSE(std::isfinite(y.back()));
+  // Where y is not finite the PID answers u = 0, like pidlab-controller.
+  const SampledStep& last = trajectory.back();
+  EXPECT_FALSE(std::isfinite(last.y));
+  EXPECT_EQ(last.u, 0.0);
+  EXPECT_EQ(last.k, RunawayLoop::kSteps - 1);
+}
+
+TEST(SampledLoop, ReportsOkForASaturatedLoopThatStaysFinite) {
+  const double dt = 1e-3;
+  const DiscretePlant plant({{1.0}, {1.0, 1.0}}, dt);
+  PidOptions pid;
+  pid.dt_s = dt;
+  pid.output_min = -0.5;
+  pid.output_max = 0.5;  // kp = 10 asks for u = 10 at first: saturated
+  std::vector<double> y;
+  EXPECT_EQ(RunSampledLoop<double>(plant, PidGains{10.0, 1.0, 0.0}, pid, Disturbance(DisturbanceOptions{}),
+                                   2000, 1, &y),
+            PidStatus::kOk);
+  EXPECT_EQ(y.size(), 2001u);
+}
+
+TEST(ObjectiveEvaluator, RejectsASampledLoopThatDiverges) {
+  const RunawayLoop loop;
+  LoopOptions options;
+  options.loop = LoopKind::kSampled;
+  options.dt_s = RunawayLoop::kDt;
+  options.horizon_s = 10.0;
+  options.stability_margin = 0.0;
+  options.pid = loop.pid;
+  for (ObjectiveKind kind : {ObjectiveKind::kIae, ObjectiveKind::kIaeContinuous}) {
+    const ObjectiveEvaluator dut(Plant{"custom", {{1.0}, {1.0, -100.0}}}, options, kind);
+    EXPECT_EQ(dut(PidGains{200.0, 0.0, 0.0}), std::numeric_limits<double>::infinity()) << ToString(kind);
+  }
+}
+
 // ---- LoopOptions ----
 
 TEST(LoopOptions, DefaultsAreValidAndGiveThePapersSampleCount) {

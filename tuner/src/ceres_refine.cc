@@ -50,7 +50,9 @@ struct ErrorResiduals {
       PidOptions pid = loop->pid;
       pid.dt_s = loop->dt_s;
       if (!SampledStability(*discrete, gd, pid, loop->stability_margin).stable) return false;
-      RunSampledLoop<T>(*discrete, g, pid, disturbance, loop->TotalSteps(), loop->StepsPerSample(), &y);
+      if (RunSampledLoop<T>(*discrete, g, pid, disturbance, loop->TotalSteps(), loop->StepsPerSample(), &y) ==
+          PidStatus::kInvalidInput)
+        return false;  // the loop diverged: no residuals at this point
     }
     for (std::size_t m = 0; m < y.size(); ++m) {
       const T e = T(1.0) - y[m];

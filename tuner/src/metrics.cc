@@ -365,6 +365,8 @@ bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const Lo
   PidOptions pid = options.pid;
   pid.dt_s = options.dt_s;
   const DiscretePlant discrete(plant.tf, options.dt_s);
+  // A diverged loop (PidStatus::kInvalidInput) is not an error here: its
+  // non-finite samples make every objective +inf, as for an unstable loop.
   RunSampledLoop<double>(discrete, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
                          trajectory);
   return true;
@@ -492,8 +494,9 @@ double ObjectiveEvaluator::operator()(const PidGains& gains) const {
       std::string error;
       if (!runner_(plant_, gains, options_, options_.disturbance, &y_, nullptr, &error))
         throw std::runtime_error("sampled-loop runner failed: " + error);
-    } else {
-      RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(), 1, &y_);
+    } else if (RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(), 1,
+                                      &y_) == PidStatus::kInvalidInput) {
+      return kInf;
     }
     if (kind_ != ObjectiveKind::kIaeContinuous) {
       std::vector<double> samples;
@@ -506,8 +509,9 @@ double ObjectiveEvaluator::operator()(const PidGains& gains) const {
       integral += 0.5 * options_.dt_s * (std::abs(1.0 - y_[k]) + std::abs(1.0 - y_[k - 1]));
     return integral;
   }
-  RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(),
-                         options_.StepsPerSample(), &y_);
+  if (RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(),
+                             options_.StepsPerSample(), &y_) == PidStatus::kInvalidInput)
+    return kInf;
   return ObjectiveFromSamples(kind_, y_, ts);
 }
 

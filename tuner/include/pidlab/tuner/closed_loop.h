@@ -193,8 +193,12 @@ struct SampledStep {
 
 /// Runs the sampled loop for total_steps steps and returns y at every
 /// steps_per_sample-th step (including step 0 and the last). If `trajectory`
-/// is not null, every step is recorded there (double only). Returns the last
-/// PidStatus that was not kOk/kSaturated, or kOk.
+/// is not null, every step is recorded there (double only). Always runs every
+/// step: where y is not finite (a loop that diverged, e.g. under output
+/// limits that the linear stability test ignores) the PID leaves u = 0, as
+/// pidlab-controller answers, and the step is still taken and recorded.
+/// Returns the last PidStatus that was not kOk/kSaturated (kInvalidInput,
+/// the only such status), or kOk; saturation alone is not reported.
 template <typename T>
 PidStatus RunSampledLoop(const DiscretePlant& plant, const PidGainsT<T>& gains, const PidOptions& pid_options,
                          const Disturbance& disturbance, long total_steps, int steps_per_sample,
@@ -213,7 +217,7 @@ PidStatus RunSampledLoop(const DiscretePlant& plant, const PidGainsT<T>& gains, 
     const double n = disturbance.Value(t);
     T u = T(0.0);
     const PidStatus s = pid.Step(T(1.0), y, &u);
-    if (s == PidStatus::kInvalidInput) return s;
+    if (s != PidStatus::kOk && s != PidStatus::kSaturated) status = s;
     if (trajectory) {
       trajectory->push_back({k, t, 1.0, ToDouble(y), ToDouble(u), n});
     }
