@@ -1,3 +1,7 @@
+// Evaluation of a PID loop (evaluation.h): the objectives, Evaluate, the
+// tuner's ObjectiveEvaluator and MATLAB-stepinfo metrics, continuous ones on
+// an adaptive grid that follows the fastest live pole.
+
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -112,6 +116,100 @@ double Bisect(const std::function<double(double)>& g, double a, double b) {
   return 0.5 * (a + b);
 }
 
+// The loop without its exosystem input: the undisturbed step response y1.
+ContinuousClosedLoop<double> UndisturbedLoop(const ContinuousClosedLoop<double>& loop) {
+  ContinuousClosedLoop<double> y1 = loop;
+  if (loop.exo_size > 0) {
+    const int size = loop.plant_order + 2;
+    y1.m = loop.m.topLeftCorner(size, size);
+    y1.w0 = loop.w0.head(size);
+    y1.exo_size = 0;
+  }
+  return y1;
+}
+
+// A response on the walker's grid (times ts, outputs ys, states ws), with
+// exact values between grid points.
+struct GridResponse {
+  const ContinuousClosedLoop<double>& loop;
+  const AdaptiveWalker& walker;
+  std::vector<double> ts, ys;
+  std::vector<Eigen::VectorXd> ws;
+
+  /// y(t) for t at or after ts[i], propagated exactly from ws[i].
+  double At(std::size_t i, double t) const { return loop.Output(walker.Propagate(ws[i], t - ts[i])); }
+};
+
+// First time y reaches `level` (a fraction of the final value yf) from the
+// side of 0, refined by bisection; NaN if it never does.
+double FirstCrossing(const GridResponse& r, double level, double yf) {
+  for (std::size_t i = 0; i < r.ys.size(); ++i) {
+    if ((r.ys[i] - level) * (yf > 0 ? 1 : -1) >= 0.0) {
+      if (i == 0) return r.ts[0];
+      return Bisect([&](double t) { return (r.At(i - 1, t) - level) * (yf > 0 ? 1 : -1); }, r.ts[i - 1],
+                    r.ts[i]);
+    }
+  }
+  return kNaN;
+}
+
+// The largest |y| on the grid, refined by golden-section search on the exact
+// response over the neighbouring intervals.
+void FindPeak(const GridResponse& r, double* peak, double* peak_t) {
+  std::size_t ip = 0;
+  for (std::size_t i = 1; i < r.ys.size(); ++i)
+    if (std::abs(r.ys[i]) > std::abs(r.ys[ip])) ip = i;
+  *peak = std::abs(r.ys[ip]);
+  *peak_t = r.ts[ip];
+  if (ip == 0 || ip + 1 >= r.ys.size()) return;
+  double a = r.ts[ip - 1], b = r.ts[ip + 1];
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  auto f = [&](double t) { return -std::abs(r.At(ip - 1, t)); };
+  double c = b - g * (b - a), d = a + g * (b - a), fc = f(c), fd = f(d);
+  for (int it = 0; it < 100 && b - a > 1e-15 * std::max(1.0, b); ++it) {
+    if (fc < fd) {
+      b = d;
+      d = c;
+      fd = fc;
+      c = b - g * (b - a);
+      fc = f(c);
+    } else {
+      a = c;
+      c = d;
+      fc = fd;
+      d = a + g * (b - a);
+      fd = f(d);
+    }
+  }
+  const double tp = 0.5 * (a + b), yp = -f(tp);
+  if (yp > *peak) {
+    *peak = yp;
+    *peak_t = tp;
+  }
+}
+
+// The 2 % settling time: the last exit from the band, refined on the exact
+// response (0 if y never leaves it). False if y is still outside the band at
+// the end of the grid.
+bool SettlingTime(const GridResponse& r, double yf, double* settling_time_s) {
+  const double band = 0.02 * std::abs(yf);
+  std::size_t last_out = r.ys.size();
+  for (std::size_t i = r.ys.size(); i-- > 0;) {
+    if (std::abs(r.ys[i] - yf) > band) {
+      last_out = i;
+      break;
+    }
+  }
+  if (last_out == r.ys.size()) {
+    *settling_time_s = 0.0;
+    return true;
+  }
+  if (last_out + 1 == r.ys.size()) return false;
+  *settling_time_s = Bisect([&](double t) { return std::abs(r.At(last_out, t) - yf) - band; }, r.ts[last_out],
+                            r.ts[last_out + 1]);
+  return true;
+}
+
 }  // namespace
 
 bool ParseObjectiveKind(const std::string& s, ObjectiveKind* kind) {
@@ -176,26 +274,19 @@ StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stab
     info.note = "unstable loop: no step metrics";
     return info;
   }
-  // The undisturbed step response: same loop without exosystem input.
-  ContinuousClosedLoop<double> y1 = loop;
-  if (loop.exo_size > 0) {
-    const int size = loop.plant_order + 2;
-    y1.m = loop.m.topLeftCorner(size, size);
-    y1.w0 = loop.w0.head(size);
-    y1.exo_size = 0;
-  }
+  const ContinuousClosedLoop<double> y1 = UndisturbedLoop(loop);
   const double yf = ContinuousFinalValue(y1);
   info.final_value = yf;
+  // Walk until the slowest mode has died out.
   double slowest = kInf;
   for (const auto& p : stability.poles) slowest = std::min(slowest, -p.real());
   const double t_end = -kDeadExponent / slowest;
-  std::vector<double> ts, ys;
-  std::vector<Eigen::VectorXd> ws;
   AdaptiveWalker walker(y1, nullptr, stability);
+  GridResponse response{y1, walker, {}, {}, {}};
   const bool complete = walker.Run(t_end, [&](double t, const Eigen::VectorXd& w) {
-    ts.push_back(t);
-    ys.push_back(y1.Output(w));
-    ws.push_back(w);
+    response.ts.push_back(t);
+    response.ys.push_back(y1.Output(w));
+    response.ws.push_back(w);
   });
   if (!complete) {
     info.note = "response too slow to settle within the grid budget";
@@ -205,72 +296,12 @@ StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stab
     info.note = "final value is zero: stepinfo is undefined";
     return info;
   }
-  auto y_at = [&](std::size_t i, double t) { return y1.Output(walker.Propagate(ws[i], t - ts[i])); };
-  // Crossing of level (a fraction of yf) from below, first time.
-  auto first_crossing = [&](double level) {
-    for (std::size_t i = 0; i < ys.size(); ++i) {
-      if ((ys[i] - level) * (yf > 0 ? 1 : -1) >= 0.0) {
-        if (i == 0) return ts[0];
-        return Bisect([&](double t) { return (y_at(i - 1, t) - level) * (yf > 0 ? 1 : -1); }, ts[i - 1],
-                      ts[i]);
-      }
-    }
-    return kNaN;
-  };
-  const double t10 = first_crossing(0.1 * yf), t90 = first_crossing(0.9 * yf);
-  info.rise_time_s = t90 - t10;
-  // Peak: the largest |y| on the grid, refined by golden-section search on
-  // the exact response over the neighbouring intervals.
-  std::size_t ip = 0;
-  for (std::size_t i = 1; i < ys.size(); ++i)
-    if (std::abs(ys[i]) > std::abs(ys[ip])) ip = i;
-  double peak = std::abs(ys[ip]), peak_t = ts[ip];
-  if (ip > 0 && ip + 1 < ys.size()) {
-    double a = ts[ip - 1], b = ts[ip + 1];
-    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-    auto f = [&](double t) { return -std::abs(y_at(ip - 1, t)); };
-    double c = b - g * (b - a), d = a + g * (b - a), fc = f(c), fd = f(d);
-    for (int it = 0; it < 100 && b - a > 1e-15 * std::max(1.0, b); ++it) {
-      if (fc < fd) {
-        b = d;
-        d = c;
-        fd = fc;
-        c = b - g * (b - a);
-        fc = f(c);
-      } else {
-        a = c;
-        c = d;
-        fc = fd;
-        d = a + g * (b - a);
-        fd = f(d);
-      }
-    }
-    const double tp = 0.5 * (a + b), yp = -f(tp);
-    if (yp > peak) {
-      peak = yp;
-      peak_t = tp;
-    }
-  }
-  info.peak = peak;
-  info.peak_time_s = peak_t;
-  info.overshoot_pct = std::max(0.0, 100.0 * (peak - std::abs(yf)) / std::abs(yf));
-  // Settling: the last exit from the 2 % band, refined on the exact response.
-  const double band = 0.02 * std::abs(yf);
-  std::size_t last_out = ys.size();
-  for (std::size_t i = ys.size(); i-- > 0;) {
-    if (std::abs(ys[i] - yf) > band) {
-      last_out = i;
-      break;
-    }
-  }
-  if (last_out == ys.size()) {
-    info.settling_time_s = 0.0;
-  } else if (last_out + 1 == ys.size()) {
+  info.rise_time_s = FirstCrossing(response, 0.9 * yf, yf) - FirstCrossing(response, 0.1 * yf, yf);
+  FindPeak(response, &info.peak, &info.peak_time_s);
+  info.overshoot_pct = std::max(0.0, 100.0 * (info.peak - std::abs(yf)) / std::abs(yf));
+  if (!SettlingTime(response, yf, &info.settling_time_s)) {
     info.note = "response not settled at the end of the grid";
     return info;
-  } else {
-    info.settling_time_s = Bisect([&](double t) { return std::abs(y_at(last_out, t) - yf) - band; },
-                                  ts[last_out], ts[last_out + 1]);
   }
   info.valid = std::isfinite(info.rise_time_s);
   if (!info.valid) info.note = "response never reaches 90 % of its final value";

@@ -28,7 +28,7 @@ std::string ToString(ObjectiveKind kind);
 /// |y - y_final| <= 2 % of |y_final| for good.
 struct StepInfo {
   bool valid = false;
-  std::string note;  // why not valid, or what limited accuracy
+  std::string note;  // why not valid; empty when valid or not computed
   double final_value = 0, rise_time_s = 0, overshoot_pct = 0, settling_time_s = 0;
   double peak = 0, peak_time_s = 0;
 };
