@@ -84,6 +84,149 @@ std::string FirstLines(const std::string& path, int max_lines) {
   return out;
 }
 
+// The folder for the data files and the script: figure.data_dir (created if
+// needed), or a new temporary folder that *temp removes afterwards.
+bool MakeDataDir(const Figure& figure, TempDir* temp, std::string* dir, std::string* error) {
+  *dir = figure.data_dir;
+  std::error_code ec;
+  if (dir->empty()) {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/pidlab-plot-XXXXXX";
+    std::vector<char> buf(pattern.begin(), pattern.end());
+    buf.push_back('\0');
+    if (!mkdtemp(buf.data())) {
+      *error = "cannot create a temporary folder: " + std::string(std::strerror(errno));
+      return false;
+    }
+    *dir = temp->path = buf.data();
+  } else if (!fs::create_directories(*dir, ec) && ec) {
+    *error = "cannot create data folder " + *dir + ": " + ec.message();
+    return false;
+  }
+  return true;
+}
+
+// Writes every series to dir/p<panel>_s<series>.dat; (*files)[p][s] is the
+// file name of series s of panel p.
+bool WriteDataFiles(const Figure& figure, const std::string& dir,
+                    std::vector<std::vector<std::string>>* files, std::string* error) {
+  files->assign(figure.panels.size(), {});
+  for (std::size_t p = 0; p < figure.panels.size(); ++p) {
+    for (std::size_t s = 0; s < figure.panels[p].series.size(); ++s) {
+      const Series& se = figure.panels[p].series[s];
+      const std::string name = "p" + std::to_string(p) + "_s" + std::to_string(s) + ".dat";
+      std::FILE* f = std::fopen((dir + "/" + name).c_str(), "w");
+      if (!f) {
+        *error = "cannot write " + dir + "/" + name + ": " + std::strerror(errno);
+        return false;
+      }
+      std::fprintf(f, "# %s\n", se.name.c_str());
+      for (std::size_t i = 0; i < se.x.size(); ++i) {
+        const double x = se.x[i], y = se.y[i];
+        if (std::isfinite(x) && std::isfinite(y))
+          std::fprintf(f, "%.17g %.17g\n", x, y);
+        else if (std::isfinite(x))
+          std::fprintf(f, "%.17g NaN\n", x);
+        else
+          std::fprintf(f, "NaN NaN\n");
+      }
+      if (std::fclose(f) != 0) {
+        *error = "cannot write " + dir + "/" + name;
+        return false;
+      }
+      (*files)[p].push_back(name);
+    }
+  }
+  return true;
+}
+
+// The "set ... / plot ..." lines of one panel.
+void PanelScript(const Figure& figure, std::size_t p, const std::string& abs_dir,
+                 const std::vector<std::string>& files, std::ostream& gp) {
+  const Panel& panel = figure.panels[p];
+  if (figure.panels.size() > 1)
+    gp << "set title " << Quote(panel.title) << "\n";
+  else if (!panel.title.empty() && figure.title.empty())
+    gp << "set title " << Quote(panel.title) << "\n";
+  gp << "set xlabel " << Quote(panel.x_label) << "\n";
+  gp << "set ylabel " << Quote(panel.y_label) << "\n";
+  gp << "set yrange [" << RangeEnd(panel.y_min) << ":" << RangeEnd(panel.y_max) << "]\n";
+  gp << "plot ";
+  for (std::size_t s = 0; s < panel.series.size(); ++s) {
+    const Series& se = panel.series[s];
+    if (s) gp << ", \\\n     ";
+    gp << Quote(abs_dir + "/" + files[s]) << " using 1:2 " << StyleClause(se);
+    if (se.name.empty())
+      gp << " notitle";
+    else
+      gp << " title " << Quote(se.name);
+  }
+  gp << "\n";
+}
+
+// The gnuplot script drawing `figure` from the data files in abs_dir to abs_out.
+std::string GnuplotScript(const Figure& figure, const std::string& abs_dir, const std::string& abs_out,
+                          const std::vector<std::vector<std::string>>& files) {
+  const std::string size = std::to_string(figure.width_px) + "," + std::to_string(figure.height_px);
+  std::ostringstream gp;
+  gp << "# pidlab figure: gnuplot " << Quote(abs_dir + "/figure.gp") << "\n";
+  gp << "if (strstrt(GPVAL_TERMINALS, \"pngcairo\") > 0) {\n"
+     << "  set terminal pngcairo size " << size << " noenhanced font \"sans,10\" linewidth 1\n"
+     << "} else {\n"
+     << "  set terminal png size " << size << " noenhanced\n"
+     << "}\n";
+  gp << "set output " << Quote(abs_out) << "\n";
+  gp << "set grid\nset key top right opaque box\nset autoscale xfixmin\nset autoscale xfixmax\n";
+  const bool multi = figure.panels.size() > 1;
+  if (multi) {
+    gp << "set multiplot layout " << figure.panels.size() << ",1";
+    if (!figure.title.empty()) gp << " title " << Quote(figure.title) << " font \",12\"";
+    gp << "\n";
+  } else if (!figure.title.empty()) {
+    gp << "set title " << Quote(figure.title) << " font ',12'\n";
+  }
+  for (std::size_t p = 0; p < figure.panels.size(); ++p) PanelScript(figure, p, abs_dir, files[p], gp);
+  if (multi) gp << "unset multiplot\n";
+  gp << "set output\n";
+  return gp.str();
+}
+
+// Runs gnuplot on `script` with its output in `log`; false with *error
+// (quoting the log's first lines) unless it exits 0.
+bool RunGnuplot(const std::string& script, const std::string& log, std::string* error) {
+  const char* env_gnuplot = std::getenv("PIDLAB_GNUPLOT");
+  const std::string gnuplot = env_gnuplot && *env_gnuplot ? env_gnuplot : "gnuplot";
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  std::vector<char*> argv = {const_cast<char*>(gnuplot.c_str()), const_cast<char*>(script.c_str()), nullptr};
+  pid_t pid = 0;
+  const int spawn_rc = posix_spawnp(&pid, gnuplot.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawn_rc != 0) {
+    *error = "cannot run " + gnuplot + " (" + std::strerror(spawn_rc) +
+             "); install Debian's gnuplot-nox or set PIDLAB_GNUPLOT";
+    return false;
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) {
+      *error = "waiting for gnuplot failed: " + std::string(std::strerror(errno));
+      return false;
+    }
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::string why = WIFEXITED(status) ? "exit status " + std::to_string(WEXITSTATUS(status))
+                                        : "signal " + std::to_string(WTERMSIG(status));
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 127) why += " (gnuplot not found?)";
+    *error = gnuplot + " failed with " + why + ": " + FirstLines(log, 3);
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool Figure::IsValid(std::string* error) const {
@@ -113,130 +256,38 @@ bool Figure::IsValid(std::string* error) const {
 }
 
 bool DrawPng(const Figure& figure, std::string* error) {
-  auto fail = [error](const std::string& message) {
-    if (error) *error = message;
+  if (!figure.IsValid(error)) return false;
+  std::string e;
+  auto fail = [&]() {
+    if (error) *error = e;
     return false;
   };
-  if (!figure.IsValid(error)) return false;
-
   TempDir temp;
-  std::string dir = figure.data_dir;
-  std::error_code ec;
-  if (dir.empty()) {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/pidlab-plot-XXXXXX";
-    std::vector<char> buf(pattern.begin(), pattern.end());
-    buf.push_back('\0');
-    if (!mkdtemp(buf.data()))
-      return fail("cannot create a temporary folder: " + std::string(std::strerror(errno)));
-    dir = temp.path = buf.data();
-  } else if (!fs::create_directories(dir, ec) && ec) {
-    return fail("cannot create data folder " + dir + ": " + ec.message());
-  }
+  std::string dir;
+  if (!MakeDataDir(figure, &temp, &dir, &e)) return fail();
+  std::vector<std::vector<std::string>> files;
+  if (!WriteDataFiles(figure, dir, &files, &e)) return fail();
 
-  // Data files.
-  std::vector<std::vector<std::string>> files(figure.panels.size());
-  for (std::size_t p = 0; p < figure.panels.size(); ++p) {
-    for (std::size_t s = 0; s < figure.panels[p].series.size(); ++s) {
-      const Series& se = figure.panels[p].series[s];
-      const std::string name = "p" + std::to_string(p) + "_s" + std::to_string(s) + ".dat";
-      std::FILE* f = std::fopen((dir + "/" + name).c_str(), "w");
-      if (!f) return fail("cannot write " + dir + "/" + name + ": " + std::strerror(errno));
-      std::fprintf(f, "# %s\n", se.name.c_str());
-      for (std::size_t i = 0; i < se.x.size(); ++i) {
-        const double x = se.x[i], y = se.y[i];
-        if (std::isfinite(x) && std::isfinite(y))
-          std::fprintf(f, "%.17g %.17g\n", x, y);
-        else if (std::isfinite(x))
-          std::fprintf(f, "%.17g NaN\n", x);
-        else
-          std::fprintf(f, "NaN NaN\n");
-      }
-      if (std::fclose(f) != 0) return fail("cannot write " + dir + "/" + name);
-      files[p].push_back(name);
-    }
-  }
-
-  // Script. Paths are absolute so gnuplot's working folder does not matter.
+  // Paths are absolute so gnuplot's working folder does not matter.
   const std::string abs_dir = fs::absolute(dir).string();
   const std::string abs_out = fs::absolute(figure.output_path).string();
+  std::error_code ec;
   fs::remove(abs_out, ec);  // a stale PNG must not pass for a new one
-  const std::string size = std::to_string(figure.width_px) + "," + std::to_string(figure.height_px);
-  std::ostringstream gp;
-  gp << "# pidlab figure: gnuplot " << Quote(abs_dir + "/figure.gp") << "\n";
-  gp << "if (strstrt(GPVAL_TERMINALS, \"pngcairo\") > 0) {\n"
-     << "  set terminal pngcairo size " << size << " noenhanced font \"sans,10\" linewidth 1\n"
-     << "} else {\n"
-     << "  set terminal png size " << size << " noenhanced\n"
-     << "}\n";
-  gp << "set output " << Quote(abs_out) << "\n";
-  gp << "set grid\nset key top right opaque box\nset autoscale xfixmin\nset autoscale xfixmax\n";
-  const bool multi = figure.panels.size() > 1;
-  if (multi) {
-    gp << "set multiplot layout " << figure.panels.size() << ",1";
-    if (!figure.title.empty()) gp << " title " << Quote(figure.title) << " font \",12\"";
-    gp << "\n";
-  } else if (!figure.title.empty()) {
-    gp << "set title " << Quote(figure.title) << " font ',12'\n";
-  }
-  for (std::size_t p = 0; p < figure.panels.size(); ++p) {
-    const Panel& panel = figure.panels[p];
-    if (multi)
-      gp << "set title " << Quote(panel.title) << "\n";
-    else if (!panel.title.empty() && figure.title.empty())
-      gp << "set title " << Quote(panel.title) << "\n";
-    gp << "set xlabel " << Quote(panel.x_label) << "\n";
-    gp << "set ylabel " << Quote(panel.y_label) << "\n";
-    gp << "set yrange [" << RangeEnd(panel.y_min) << ":" << RangeEnd(panel.y_max) << "]\n";
-    gp << "plot ";
-    for (std::size_t s = 0; s < panel.series.size(); ++s) {
-      const Series& se = panel.series[s];
-      if (s) gp << ", \\\n     ";
-      gp << Quote(abs_dir + "/" + files[p][s]) << " using 1:2 " << StyleClause(se);
-      if (se.name.empty())
-        gp << " notitle";
-      else
-        gp << " title " << Quote(se.name);
-    }
-    gp << "\n";
-  }
-  if (multi) gp << "unset multiplot\n";
-  gp << "set output\n";
   const std::string script = abs_dir + "/figure.gp";
   {
     std::ofstream f(script);
-    f << gp.str();
-    if (!f) return fail("cannot write " + script);
+    f << GnuplotScript(figure, abs_dir, abs_out, files);
+    if (!f) {
+      e = "cannot write " + script;
+      return fail();
+    }
   }
-
-  // Run gnuplot with its output captured for the error message.
-  const char* env_gnuplot = std::getenv("PIDLAB_GNUPLOT");
-  const std::string gnuplot = env_gnuplot && *env_gnuplot ? env_gnuplot : "gnuplot";
-  const std::string log = abs_dir + "/gnuplot.log";
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  std::vector<char*> argv = {const_cast<char*>(gnuplot.c_str()), const_cast<char*>(script.c_str()), nullptr};
-  pid_t pid = 0;
-  const int spawn_rc = posix_spawnp(&pid, gnuplot.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawn_rc != 0)
-    return fail("cannot run " + gnuplot + " (" + std::strerror(spawn_rc) +
-                "); install Debian's gnuplot-nox or set PIDLAB_GNUPLOT");
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return fail("waiting for gnuplot failed: " + std::string(std::strerror(errno)));
-  }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::string why = WIFEXITED(status) ? "exit status " + std::to_string(WEXITSTATUS(status))
-                                        : "signal " + std::to_string(WTERMSIG(status));
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 127) why += " (gnuplot not found?)";
-    return fail(gnuplot + " failed with " + why + ": " + FirstLines(log, 3));
-  }
+  if (!RunGnuplot(script, abs_dir + "/gnuplot.log", &e)) return fail();
   int w = 0, h = 0;
-  if (!ReadPngSize(abs_out, &w, &h)) return fail("gnuplot ran but wrote no PNG file at " + abs_out);
+  if (!ReadPngSize(abs_out, &w, &h)) {
+    e = "gnuplot ran but wrote no PNG file at " + abs_out;
+    return fail();
+  }
   return true;
 }
 
