@@ -69,6 +69,29 @@ struct TuneCommand {
 
   int Run() {
     const Plant p = plant.Build();
+    const TuneOptions o = BuildOptions();
+    const SampledRunner runner = MakeRunner(o);
+    const bool tty = isatty(STDERR_FILENO) != 0;
+    TuneSummary s;
+    std::string error;
+    if (!Tune(p, o, &s, &error, MakeProgress(tty), runner)) throw BadInput(error);
+    if (tty) std::fprintf(stderr, "\r%70s\r", "");
+    if (!trace.empty()) WriteTrace(s);
+    Evaluation ev;
+    if (s.stable) {
+      EvaluateOptions what;
+      Evaluate(p, s.gains, o.loop, what, &ev, &error);
+    }
+    if (json) {
+      std::cout << ToJson(p, o, s, ev).dump() << "\n";
+    } else {
+      PrintText(o, s, ev);
+    }
+    return s.stable ? 0 : 1;
+  }
+
+  // The tuning options of the flags; throws BadInput.
+  TuneOptions BuildOptions() const {
     TuneOptions o;
     o.loop = loop.Build();
     if (!ParseTuneMethod(method, &o.method))
@@ -95,96 +118,97 @@ struct TuneCommand {
     o.agree_tolerance = agree_tolerance;
     std::string error;
     if (!o.IsValid(&error)) throw BadInput(error);
-    SampledRunner runner = RunSampledLoopInProcess;
-    if (backend == "lcm") {
-      if (o.loop.loop != LoopKind::kSampled)
-        throw BadInput("--backend lcm runs the sampled loop: add --loop sampled");
-      runner = MakeLcmRunner();
-    } else if (backend != "local") {
-      throw BadInput("--backend '" + backend + "' must be local or lcm");
-    }
+    return o;
+  }
 
-    const bool tty = isatty(STDERR_FILENO) != 0;
-    // Progress on a terminal, at most ten lines a second; silent otherwise.
-    auto last = std::chrono::steady_clock::now() - std::chrono::seconds(1);
-    ProgressCallback progress = [tty, &last](const TracePoint& tp) {
+  // The sampled-loop runner of --backend; throws BadInput.
+  SampledRunner MakeRunner(const TuneOptions& o) {
+    if (backend == "local") return RunSampledLoopInProcess;
+    if (backend != "lcm") throw BadInput("--backend '" + backend + "' must be local or lcm");
+    if (o.loop.loop != LoopKind::kSampled)
+      throw BadInput("--backend lcm runs the sampled loop: add --loop sampled");
+    client = lcm.MakeClient();
+    return client->AsRunner();
+  }
+
+  // Progress on a terminal, at most ten lines a second; silent otherwise.
+  static ProgressCallback MakeProgress(bool tty) {
+    auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now() -
+                                                                        std::chrono::seconds(1));
+    return [tty, last](const TracePoint& tp) {
       if (!tty) return;
       const auto now = std::chrono::steady_clock::now();
-      if (now - last < std::chrono::milliseconds(100)) return;
-      last = now;
+      if (now - *last < std::chrono::milliseconds(100)) return;
+      *last = now;
       std::fprintf(stderr, "\r  iteration %5d  evaluations %6d  best %.6g   ", tp.iteration, tp.evaluations,
                    tp.best_f);
       std::fflush(stderr);
     };
-    TuneSummary s;
-    if (!Tune(p, o, &s, &error, progress, runner)) throw BadInput(error);
-    if (tty) std::fprintf(stderr, "\r%70s\r", "");
-    if (!trace.empty()) WriteTrace(s);
-    Evaluation ev;
-    if (s.stable) {
-      EvaluateOptions what;
-      Evaluate(p, s.gains, o.loop, what, &ev, &error);
+  }
+
+  // The --json object; `ev` is the evaluation of s.gains (unused if !s.stable).
+  nlohmann::json ToJson(const Plant& p, const TuneOptions& o, const TuneSummary& s,
+                        const Evaluation& ev) const {
+    nlohmann::json j;
+    j["plant"] = p.name;
+    j["method"] = ToString(o.method);
+    j["objective_kind"] = ToString(o.objective);
+    j["backend"] = backend;
+    j["loop"] = ToString(o.loop.loop);
+    j["gains"] = cli::ToJson(s.gains);
+    j["objective"] = JsonNumber(s.objective);
+    j["iae"] = s.stable ? JsonNumber(ev.iae) : nlohmann::json(nullptr);
+    j["stable"] = s.stable && ev.stability.stable;
+    j["closed_loop_poles"] = s.stable ? cli::ToJson(ev)["closed_loop_poles"] : nlohmann::json::array();
+    j["rise_time_s"] = s.stable ? cli::ToJson(ev)["rise_time_s"] : nlohmann::json(nullptr);
+    j["overshoot_pct"] = s.stable ? cli::ToJson(ev)["overshoot_pct"] : nlohmann::json(nullptr);
+    j["settling_time_s"] = s.stable ? cli::ToJson(ev)["settling_time_s"] : nlohmann::json(nullptr);
+    j["search"] = {{"gains", cli::ToJson(s.search_gains)},
+                   {"objective", JsonNumber(s.search_objective)},
+                   {"termination", ToString(s.optimizer.termination)},
+                   {"message", s.optimizer.message}};
+    j["evaluations"] = s.evaluations;
+    j["rejected_evaluations"] = s.optimizer.rejected_evaluations;
+    j["iterations"] = s.iterations;
+    j["seed"] = o.seed;
+    j["wall_time_s"] = s.wall_time_s;
+    j["refine"] = {{"ran", s.refine.ran},
+                   {"gains", cli::ToJson(s.refine.gains)},
+                   {"objective", JsonNumber(s.refine.objective)},
+                   {"iae", JsonNumber(o.objective == ObjectiveKind::kIae ? s.refine.objective : NAN)},
+                   {"verdict", ToString(s.refine.verdict, s.method)},
+                   {"termination", ToString(s.refine.termination)},
+                   {"iterations", s.refine.iterations},
+                   {"relative_improvement", JsonNumber(s.refine.relative_improvement)},
+                   {"message", s.refine.message}};
+    if (o.method == TuneMethod::kZieglerNichols)
+      j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},
+                              {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
+                              {"rule", ToString(o.zn_rule)}};
+    return j;
+  }
+
+  // The human-readable result; `ev` as for ToJson.
+  static void PrintText(const TuneOptions& o, const TuneSummary& s, const Evaluation& ev) {
+    std::cout << std::setprecision(6);
+    std::cout << "method           " << ToString(o.method) << " on " << ToString(o.objective) << ", box ["
+              << o.lower << ", " << o.upper << "]^3, seed " << o.seed << "\n";
+    if (!s.stable) {
+      std::cout << "result           " << s.message << "\n";
+      return;
     }
-    if (json) {
-      nlohmann::json j;
-      j["plant"] = p.name;
-      j["method"] = ToString(o.method);
-      j["objective_kind"] = ToString(o.objective);
-      j["backend"] = backend;
-      j["loop"] = ToString(o.loop.loop);
-      j["gains"] = ToJson(s.gains);
-      j["objective"] = JsonNumber(s.objective);
-      j["iae"] = s.stable ? JsonNumber(ev.iae) : nlohmann::json(nullptr);
-      j["stable"] = s.stable && ev.stability.stable;
-      j["closed_loop_poles"] = s.stable ? ToJson(ev)["closed_loop_poles"] : nlohmann::json::array();
-      j["rise_time_s"] = s.stable ? ToJson(ev)["rise_time_s"] : nlohmann::json(nullptr);
-      j["overshoot_pct"] = s.stable ? ToJson(ev)["overshoot_pct"] : nlohmann::json(nullptr);
-      j["settling_time_s"] = s.stable ? ToJson(ev)["settling_time_s"] : nlohmann::json(nullptr);
-      j["search"] = {{"gains", ToJson(s.search_gains)},
-                     {"objective", JsonNumber(s.search_objective)},
-                     {"termination", ToString(s.optimizer.termination)},
-                     {"message", s.optimizer.message}};
-      j["evaluations"] = s.evaluations;
-      j["rejected_evaluations"] = s.optimizer.rejected_evaluations;
-      j["iterations"] = s.iterations;
-      j["seed"] = o.seed;
-      j["wall_time_s"] = s.wall_time_s;
-      j["refine"] = {{"ran", s.refine.ran},
-                     {"gains", ToJson(s.refine.gains)},
-                     {"objective", JsonNumber(s.refine.objective)},
-                     {"iae", JsonNumber(o.objective == ObjectiveKind::kIae ? s.refine.objective : NAN)},
-                     {"verdict", ToString(s.refine.verdict, s.method)},
-                     {"termination", ToString(s.refine.termination)},
-                     {"iterations", s.refine.iterations},
-                     {"relative_improvement", JsonNumber(s.refine.relative_improvement)},
-                     {"message", s.refine.message}};
-      if (o.method == TuneMethod::kZieglerNichols)
-        j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},
-                                {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
-                                {"rule", ToString(o.zn_rule)}};
-      std::cout << j.dump() << "\n";
-    } else {
-      std::cout << std::setprecision(6);
-      std::cout << "method           " << ToString(o.method) << " on " << ToString(o.objective) << ", box ["
-                << o.lower << ", " << o.upper << "]^3, seed " << o.seed << "\n";
-      if (!s.stable) {
-        std::cout << "result           " << s.message << "\n";
-        return 1;
-      }
-      std::cout << "search           kp = " << s.search_gains.kp << ", ki = " << s.search_gains.ki
-                << ", kd = " << s.search_gains.kd << "  objective " << s.search_objective << "  ("
-                << s.evaluations << " evaluations, " << s.optimizer.rejected_evaluations << " rejected, "
-                << ToString(s.optimizer.termination) << ")\n";
-      if (s.refine.ran)
-        std::cout << "ceres            kp = " << s.refine.gains.kp << ", ki = " << s.refine.gains.ki
-                  << ", kd = " << s.refine.gains.kd << "  objective " << s.refine.objective << "  ("
-                  << ToString(s.refine.termination) << ", " << s.refine.iterations << " iterations)\n";
-      std::cout << "verdict          " << ToString(s.refine.verdict, s.method)
-                << (s.refine.message.empty() ? "" : ": ") << s.refine.message << "\n";
-      std::cout << "wall time        " << s.wall_time_s << " s\n\n";
-      std::cout << FormatEvaluation(ev);
-    }
-    return s.stable ? 0 : 1;
+    std::cout << "search           kp = " << s.search_gains.kp << ", ki = " << s.search_gains.ki
+              << ", kd = " << s.search_gains.kd << "  objective " << s.search_objective << "  ("
+              << s.evaluations << " evaluations, " << s.optimizer.rejected_evaluations << " rejected, "
+              << ToString(s.optimizer.termination) << ")\n";
+    if (s.refine.ran)
+      std::cout << "ceres            kp = " << s.refine.gains.kp << ", ki = " << s.refine.gains.ki
+                << ", kd = " << s.refine.gains.kd << "  objective " << s.refine.objective << "  ("
+                << ToString(s.refine.termination) << ", " << s.refine.iterations << " iterations)\n";
+    std::cout << "verdict          " << ToString(s.refine.verdict, s.method)
+              << (s.refine.message.empty() ? "" : ": ") << s.refine.message << "\n";
+    std::cout << "wall time        " << s.wall_time_s << " s\n\n";
+    std::cout << FormatEvaluation(ev);
   }
 
   void WriteTrace(const TuneSummary& s) const {
@@ -196,11 +220,6 @@ struct TuneCommand {
       for (int i = 0; i < 3; ++i) f << "," << (tp.best_x.size() == 3 ? tp.best_x(i) : NAN);
       f << "\n";
     }
-  }
-
-  SampledRunner MakeLcmRunner() {
-    client = lcm.MakeClient();
-    return client->AsRunner();
   }
 };
 
