@@ -11,6 +11,9 @@
 #include <iomanip>
 #include <map>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "pidlab/plot/plot.h"
 
@@ -32,6 +35,77 @@ std::vector<std::string> SplitCsv(const std::string& line) {
   while (std::getline(is, cell, ',')) out.push_back(Trim(cell));
   if (!line.empty() && line.back() == ',') out.push_back("");
   return out;
+}
+
+// Column name -> index in paper_tables.csv.
+using Columns = std::map<std::string, std::size_t>;
+
+// The header line's columns; false with *error if a required one is missing.
+bool ParseHeader(const std::string& line, const std::string& path, Columns* col, std::string* error) {
+  const std::vector<std::string> header = SplitCsv(line);
+  for (std::size_t i = 0; i < header.size(); ++i) (*col)[header[i]] = i;
+  const char* required[] = {"table",
+                            "plant",
+                            "method",
+                            "disturbance_amplitude",
+                            "kp",
+                            "ki",
+                            "kd",
+                            "paper_rise_time_s",
+                            "paper_overshoot_pct",
+                            "paper_settling_time_s",
+                            "paper_iae",
+                            "ref_rise_time_s",
+                            "ref_overshoot_pct",
+                            "ref_settling_time_s",
+                            "ref_iae"};
+  for (const char* name : required) {
+    if (!col->count(name)) {
+      *error = path + ": missing column " + name;
+      return false;
+    }
+  }
+  return true;
+}
+
+// One data line (line `number` of `path`); throws std::invalid_argument
+// naming the line and column of a cell that is not a number.
+PaperRow ParseRow(const std::vector<std::string>& cells, const Columns& col, const std::string& path,
+                  int number) {
+  auto text = [&](const char* name) {
+    const std::size_t i = col.at(name);
+    return i < cells.size() ? cells[i] : std::string();
+  };
+  auto value = [&](const char* name, double fallback, bool allow_empty) {
+    const std::string s = text(name);
+    if (s.empty() && allow_empty) return fallback;
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != s.size() || s.empty())
+      throw std::invalid_argument(path + " line " + std::to_string(number) + ": column " + name + " = '" + s +
+                                  "' is not a number");
+    return v;
+  };
+  PaperRow r;
+  r.table = text("table");
+  r.plant = text("plant");
+  r.method = text("method");
+  r.disturbance_amplitude = value("disturbance_amplitude", 0.0, true);
+  r.gains = {value("kp", 0, false), value("ki", 0, false), value("kd", 0, false)};
+  r.paper_rise_time_s = value("paper_rise_time_s", 0, false);
+  r.paper_overshoot_pct = value("paper_overshoot_pct", 0, false);
+  r.paper_settling_time_s = value("paper_settling_time_s", 0, false);
+  r.paper_iae = value("paper_iae", 0, false);
+  r.ref_rise_time_s = value("ref_rise_time_s", 0, false);
+  r.ref_overshoot_pct = value("ref_overshoot_pct", 0, false);
+  r.ref_settling_time_s = value("ref_settling_time_s", 0, false);
+  r.ref_iae = value("ref_iae", 0, false);
+  return r;
 }
 
 // Significant digits, plain or scientific as the value needs.
@@ -238,6 +312,16 @@ const Tuning* FindTuning(const std::vector<Tuning>& tunings, const std::string& 
   return nullptr;
 }
 
+// Grid step of a figure over [0, horizon]: 1001 points (401 with --quick).
+double FigureStep(const ReportData& data, double horizon) {
+  const int points = data.options.quick ? 401 : 1001;
+  return horizon / (points - 1);
+}
+
+std::string OutPath(const ReportData& data, const std::string& file) {
+  return (std::filesystem::path(data.options.out_dir) / file).string();
+}
+
 bool Draw(const plot::Figure& fig, ReportData* data, const std::string& caption, std::string* error) {
   std::string e;
   if (!plot::DrawPng(fig, &e)) {
@@ -264,7 +348,7 @@ bool DrawStepFigure(ReportData* data, const std::string& plant_name, const std::
     traces.push_back(std::move(tr));
   }
   for (const Tuning& t : data->tunings) {
-    if (t.plant != plant_name || t.disturbance_amplitude != 0.0 || !t.ok) continue;
+    if (t.plant != plant_name || t.disturbance_amplitude != 0.0 || !t.Tuned()) continue;
     Trace tr;
     if (!Simulate(plant, t.summary.gains, 0.0, ts, horizon, "pidlab " + ToString(t.method), &tr, error))
       return false;
@@ -272,16 +356,15 @@ bool DrawStepFigure(ReportData* data, const std::string& plant_name, const std::
   }
   plot::Figure fig;
   fig.title = "Step response and error, " + PlantTitle(plant_name);
-  fig.output_path = (std::filesystem::path(data->options.out_dir) / file).string();
+  fig.output_path = OutPath(*data, file);
   fig.panels.push_back(MakePanel(traces, Signal::kY1, time_scale, t_label, "y(t)", true, false));
   fig.panels.push_back(MakePanel(traces, Signal::kE1, time_scale, t_label, "e(t) = 1 - y(t)", false, band));
   return Draw(fig, data, caption, error);
 }
 
-bool DrawFigures(ReportData* data, std::string* error) {
-  const bool q = data->options.quick;
-  const int points = q ? 401 : 1001;
-  auto ts_for = [&](double horizon) { return horizon / (points - 1); };
+// Figs 9-14: the step figure of each plant, and the stepper's slow tail.
+bool DrawStepFigures(ReportData* data, std::string* error) {
+  auto ts_for = [&](double horizon) { return FigureStep(*data, horizon); };
   if (!DrawStepFigure(data, "double_integrator", "fig09_10_double_integrator.png", 10.0, ts_for(10.0), 1.0,
                       "t [s]", false,
                       "Figs 9-10: step response y(t) and error e(t) of 1/s^2 under the paper's gains and "
@@ -296,14 +379,16 @@ bool DrawFigures(ReportData* data, std::string* error) {
   if (!DrawStepFigure(data, "stepper_motor", "fig13_14_stepper_motor.png", 0.05, ts_for(0.05), 1e3, "t [ms]",
                       false, "Figs 13-14: stepper-motor step response and error, first 50 ms.", error))
     return false;
-  if (!DrawStepFigure(
-          data, "stepper_motor", "fig13_14_stepper_motor_tail.png", 10.0, ts_for(10.0), 1.0, "t [s]", true,
-          "Figs 13-14, continued to 10 s with the +/-2 % band: the slow tail that sets the 2 % settling "
-          "times (about 1.5 s for the paper's Nelder-Mead gains, not the paper's ~1 ms).",
-          error))
-    return false;
+  return DrawStepFigure(
+      data, "stepper_motor", "fig13_14_stepper_motor_tail.png", 10.0, ts_for(10.0), 1.0, "t [s]", true,
+      "Figs 13-14, continued to 10 s with the +/-2 % band: the slow tail that sets the 2 % settling "
+      "times (about 1.5 s for the paper's Nelder-Mead gains, not the paper's ~1 ms).",
+      error);
+}
 
-  // Figs 16-19: the paper's gains for each square-wave amplitude.
+// Figs 16-19: the paper's stepper-motor Nelder-Mead gains for each
+// square-wave amplitude of Tables IV-VI, first 5 ms (y1) and 10 s (y2, y, n).
+bool DrawDisturbanceFigures(ReportData* data, std::string* error) {
   const Plant stepper = BuiltinPlant("stepper_motor");
   std::vector<Trace> fast, slow;
   for (double a : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6}) {
@@ -313,68 +398,69 @@ bool DrawFigures(ReportData* data, std::string* error) {
     if (!row) continue;
     const std::string name = "+/-" + Num(a, 2);
     Trace tf, tsl;
-    if (!Simulate(stepper, row->gains, a, ts_for(0.005), 0.005, name, &tf, error)) return false;
-    if (!Simulate(stepper, row->gains, a, ts_for(10.0), 10.0, name, &tsl, error)) return false;
+    if (!Simulate(stepper, row->gains, a, FigureStep(*data, 0.005), 0.005, name, &tf, error)) return false;
+    if (!Simulate(stepper, row->gains, a, FigureStep(*data, 10.0), 10.0, name, &tsl, error)) return false;
     fast.push_back(std::move(tf));
     slow.push_back(std::move(tsl));
   }
-  {
-    plot::Figure fig;
-    fig.title = "Stepper motor, paper's Nelder-Mead gains per disturbance: y1(t) and its error (first 5 ms)";
-    fig.output_path = (std::filesystem::path(data->options.out_dir) / "fig16_18_disturbance_y1.png").string();
-    fig.panels.push_back(MakePanel(fast, Signal::kY1, 1e3, "t [ms]", "y1(t) [rad]", true, false));
-    fig.panels.push_back(
-        MakePanel(fast, Signal::kE1, 1e3, "t [ms]", "e1(t) = 1 - y1(t) [rad]", false, false));
-    if (!Draw(fig, data,
-              "Figs 16 and 18: y1, the response to the reference alone (eq. 17), and its error, for the "
-              "gains of "
-              "Tables IV-VI (one per square-wave amplitude).",
-              error))
-      return false;
-  }
-  {
-    plot::Figure fig;
-    fig.title = "Stepper motor under +/-0.1 ... +/-0.6 square waves (period 2 s): y2(t) and y(t)";
-    fig.output_path =
-        (std::filesystem::path(data->options.out_dir) / "fig17_19_disturbance_y2_y.png").string();
-    fig.panels.push_back(MakePanel(slow, Signal::kY2, 1.0, "t [s]", "y2(t) [rad]", false, false));
-    fig.panels.push_back(MakePanel(slow, Signal::kY, 1.0, "t [s]", "y(t) = y1 + y2 [rad]", true, false));
-    fig.panels.push_back(MakePanel(slow, Signal::kN, 1.0, "t [s]", "n(t)", false, false));
-    if (!Draw(fig, data,
+  plot::Figure y1;
+  y1.title = "Stepper motor, paper's Nelder-Mead gains per disturbance: y1(t) and its error (first 5 ms)";
+  y1.output_path = OutPath(*data, "fig16_18_disturbance_y1.png");
+  y1.panels.push_back(MakePanel(fast, Signal::kY1, 1e3, "t [ms]", "y1(t) [rad]", true, false));
+  y1.panels.push_back(MakePanel(fast, Signal::kE1, 1e3, "t [ms]", "e1(t) = 1 - y1(t) [rad]", false, false));
+  if (!Draw(y1, data,
+            "Figs 16 and 18: y1, the response to the reference alone (eq. 17), and its error, for the "
+            "gains of "
+            "Tables IV-VI (one per square-wave amplitude).",
+            error))
+    return false;
+  plot::Figure y2;
+  y2.title = "Stepper motor under +/-0.1 ... +/-0.6 square waves (period 2 s): y2(t) and y(t)";
+  y2.output_path = OutPath(*data, "fig17_19_disturbance_y2_y.png");
+  y2.panels.push_back(MakePanel(slow, Signal::kY2, 1.0, "t [s]", "y2(t) [rad]", false, false));
+  y2.panels.push_back(MakePanel(slow, Signal::kY, 1.0, "t [s]", "y(t) = y1 + y2 [rad]", true, false));
+  y2.panels.push_back(MakePanel(slow, Signal::kN, 1.0, "t [s]", "n(t)", false, false));
+  return Draw(y2, data,
               "Figs 17 and 19: y2, the response to the disturbance alone (eq. 18), and y = y1 + y2, with the "
               "square waves n(t).",
-              error))
-      return false;
-  }
+              error);
+}
 
-  // Fig. 21: +/-1 square wave against the PSO-GSA and GA gains.
+// Fig. 21: a +/-1 square wave against the paper's Table IV gains and
+// pidlab's Nelder-Mead tuned under that wave.
+bool DrawVeryHighDisturbanceFigure(ReportData* data, std::string* error) {
+  const Plant stepper = BuiltinPlant("stepper_motor");
+  const double ts = FigureStep(*data, 10.0);
   std::vector<Trace> very_high;
   for (const char* method : {"nelder_mead", "pso_gsa", "genetic_algorithm", "ziegler_nichols"}) {
     const PaperRow* row = FindRow(data->rows, "IV", "stepper_motor", method);
     if (!row) continue;
     Trace tr;
-    if (!Simulate(stepper, row->gains, 1.0, ts_for(10.0), 10.0, "paper " + MethodTitle(method), &tr, error))
+    if (!Simulate(stepper, row->gains, 1.0, ts, 10.0, "paper " + MethodTitle(method), &tr, error))
       return false;
     very_high.push_back(std::move(tr));
   }
   if (const Tuning* t = FindTuning(data->tunings, "stepper_motor", TuneMethod::kNelderMead, 1.0);
-      t && t->ok) {
+      t && t->Tuned()) {
     Trace tr;
-    if (!Simulate(stepper, t->summary.gains, 1.0, ts_for(10.0), 10.0, "pidlab nelder-mead tuned at +/-1", &tr,
-                  error))
+    if (!Simulate(stepper, t->summary.gains, 1.0, ts, 10.0, "pidlab nelder-mead tuned at +/-1", &tr, error))
       return false;
     very_high.push_back(std::move(tr));
   }
   plot::Figure fig;
   fig.title = "Stepper motor under a +/-1 square-wave disturbance (period 2 s)";
-  fig.output_path =
-      (std::filesystem::path(data->options.out_dir) / "fig21_very_high_disturbance.png").string();
+  fig.output_path = OutPath(*data, "fig21_very_high_disturbance.png");
   fig.panels.push_back(MakePanel(very_high, Signal::kY, 1.0, "t [s]", "y(t) [rad]", true, false));
   fig.panels.push_back(MakePanel(very_high, Signal::kE, 1.0, "t [s]", "e(t) = 1 - y(t) [rad]", false, false));
   return Draw(fig, data,
               "Fig. 21: the paper's Nelder-Mead gains (Table IV) against its PSO-GSA, GA and Ziegler-Nichols "
               "gains, and pidlab's Nelder-Mead tuned under the +/-1 wave itself.",
               error);
+}
+
+bool DrawFigures(ReportData* data, std::string* error) {
+  return DrawStepFigures(data, error) && DrawDisturbanceFigures(data, error) &&
+         DrawVeryHighDisturbanceFigure(data, error);
 }
 
 // ---------------------------------------------------------------- markdown
@@ -387,8 +473,8 @@ std::string MetricsCells(const Metrics& m) {
 
 std::string Mark(double paper, double ours, double rel) { return RelClose(paper, ours, rel) ? "" : " **≠**"; }
 
-void RenderPaperTable(std::ostream& os, const ReportData& data, const std::string& table,
-                      const std::string& title) {
+// The published rows of `table`, in the order of its columns.
+std::vector<const RowResult*> TableRows(const ReportData& data, const std::string& table) {
   std::vector<const RowResult*> rows;
   for (const RowResult& r : data.rows)
     if (r.paper.table == table) rows.push_back(&r);
@@ -402,7 +488,12 @@ void RenderPaperTable(std::ostream& os, const ReportData& data, const std::strin
       return a->paper.disturbance_amplitude < b->paper.disturbance_amplitude;
     });
   }
-  if (rows.empty()) return;
+  return rows;
+}
+
+// The table's heading and column headers: a paper and a pidlab column per row.
+void RenderTableHeader(std::ostream& os, const std::vector<const RowResult*>& rows, const std::string& table,
+                       const std::string& title) {
   os << "### Table " << table << ": " << title << "\n\n";
   os << "| | ";
   for (const RowResult* r : rows) {
@@ -414,6 +505,11 @@ void RenderPaperTable(std::ostream& os, const ReportData& data, const std::strin
   os << "\n|---|";
   for (std::size_t i = 0; i < rows.size(); ++i) os << "---:|---:|";
   os << "\n";
+}
+
+// The gains, the step metrics and the IAE, paper against pidlab, with **≠**
+// where pidlab does not reproduce the published figure.
+void RenderTableLines(std::ostream& os, const std::vector<const RowResult*>& rows) {
   auto line = [&](const std::string& name, auto paper_of, auto ours_of, double rel, bool mark) {
     os << "| " << name << " | ";
     for (const RowResult* r : rows) {
@@ -451,6 +547,10 @@ void RenderPaperTable(std::ostream& os, const ReportData& data, const std::strin
     os << "\n";
   }
   os << "\n";
+}
+
+// One line per published figure pidlab does not reproduce.
+void RenderDifferences(std::ostream& os, const std::vector<const RowResult*>& rows) {
   bool any = false;
   for (const RowResult* r : rows) {
     for (const std::string& d : r->differences) {
@@ -462,6 +562,15 @@ void RenderPaperTable(std::ostream& os, const ReportData& data, const std::strin
     }
   }
   if (!any) os << "Every published figure is reproduced.\n";
+}
+
+void RenderPaperTable(std::ostream& os, const ReportData& data, const std::string& table,
+                      const std::string& title) {
+  const std::vector<const RowResult*> rows = TableRows(data, table);
+  if (rows.empty()) return;
+  RenderTableHeader(os, rows, table, title);
+  RenderTableLines(os, rows);
+  RenderDifferences(os, rows);
   if (table == "V") {
     os << "\nTable V's +/-0.2 column repeats Table IV's Nelder-Mead gains; the paper prints 3.1799e-4 s and "
           "15.4589 % there but 3.1796e-4 s and 15.4599 % in Table IV (the CSV, and this table, hold Table "
@@ -476,7 +585,7 @@ void NearlyMarginalNotes(std::ostream& os, const std::vector<Tuning>& tunings, c
                          double amplitude) {
   bool any = false;
   for (const Tuning& t : tunings) {
-    if (t.plant != plant || std::abs(t.disturbance_amplitude - amplitude) > 1e-9 || !t.ok) continue;
+    if (t.plant != plant || std::abs(t.disturbance_amplitude - amplitude) > 1e-9 || !t.Tuned()) continue;
     if (!t.metrics.NearlyMarginal()) continue;
     if (!any) os << "Nearly marginal loops (**!**):\n\n";
     any = true;
@@ -507,7 +616,7 @@ void RenderTunings(std::ostream& os, const ReportData& data, const std::string& 
         "evaluations | Ceres cross-check |\n|---|---|---:|---:|---:|---:|---:|---:|---|\n";
   for (const Tuning& t : data.tunings) {
     if (t.plant != plant || std::abs(t.disturbance_amplitude - amplitude) > 1e-9) continue;
-    if (!t.ok) {
+    if (!t.Tuned()) {
       os << "| " << ToString(t.method) << " | not applicable: " << t.message << " | | | | | | | |\n";
       continue;
     }
@@ -521,6 +630,297 @@ void RenderTunings(std::ostream& os, const ReportData& data, const std::string& 
   }
   os << "\n";
   NearlyMarginalNotes(os, data.tunings, plant, amplitude);
+}
+
+// Title, paper, loop, metric definitions and how to read the tables.
+void RenderIntroduction(std::ostream& os, const ReportData& data) {
+  os << "# pidlab report: Nelder-Mead PID tuning of a stepper motor, regenerated\n\n"
+     << "Paper: W. Assawinchaichote and V. Sinlapakun, *Optimization Design of PID Controller Parameters "
+        "Based on Nelder Mead Algorithm for Stepper Motors*. Generated by `pidlab report` (seed "
+     << data.options.seed << (data.options.quick ? ", **quick mode: reduced budgets**" : "")
+     << "). See docs/report.md for how to read it.\n\n"
+     << "Loop: the paper's continuous loop (ideal PID of eq. 2, unit step, exact matrix-exponential "
+        "solution), Error(K) = sum of |1 - y1(t)| at t = 0, 0.05, ..., 25 s (eq. 4), where y1 is the "
+        "response to the reference alone (eq. 17). Metrics use MATLAB-stepinfo definitions on the exact "
+        "response: rise time 10 % -> 90 % of the final value, overshoot in % of the final value, settling "
+        "time into a 2 % band for good. Disturbances are square waves of period "
+     << Num(kSquarePeriodS) << " s (pidlab's choice; the paper does not state the period).\n\n"
+     << "In the tables, *paper* is the published figure and *pidlab* is pidlab's re-evaluation of the "
+        "published gains; **≠** marks a published figure pidlab does not reproduce (IAE within 0.1 %, "
+        "others within 3 %), explained in one line below the table.\n\n";
+}
+
+// Every method on each plant, undisturbed, against the paper's Nelder-Mead.
+void RenderOwnTunings(std::ostream& os, const ReportData& data) {
+  os << "## pidlab's own tunings\n\n"
+     << "Same objective, box [0, 30]^3 and seed for every method: `nelder-mead` (proper 4-point simplex, "
+        "multi-start), `paper-nm` (the paper's three-point variant, which cannot leave the plane of its "
+        "first triangle), `ziegler-nichols` (classic rule on the exact ultimate gain), `ga`, `pso-gsa`. "
+        "Each search result is cross-checked by Ceres (bound-constrained least squares with automatic "
+        "differentiation); the gains shown are the better of the two. \"< paper\" compares the IAE with "
+        "the paper's Nelder-Mead.\n\n";
+  for (const char* plant : {"double_integrator", "oscillator", "stepper_motor"}) {
+    os << "### " << PlantTitle(plant) << "\n\n";
+    const char* table = std::string(plant) == "double_integrator"
+                            ? "II"
+                            : (std::string(plant) == "oscillator" ? "III" : "IV");
+    RenderTunings(os, data, plant, 0.0, FindRow(data.rows, table, plant, "nelder_mead"));
+  }
+}
+
+// Nelder-Mead on the stepper motor tuned under each square wave.
+void RenderDisturbanceTunings(std::ostream& os, const ReportData& data) {
+  os << "### Stepper motor, Nelder-Mead tuned under each square-wave disturbance (Tables IV-VI, Fig. 21)\n\n"
+     << "The objective during these tunings is the IAE of the disturbed output y; the tables above report "
+        "the IAE of y1 for the paper's gains, so both are shown.\n\n";
+  os << "| amplitude | kp, ki, kd | rise [s] | overshoot [%] | settling [s] | IAE of y1 | IAE of y | paper's "
+        "IAE (of y1) | Ceres cross-check |\n|---:|---|---:|---:|---:|---:|---:|---:|---|\n";
+  for (const Tuning& t : data.tunings) {
+    if (t.disturbance_amplitude == 0.0) continue;
+    const PaperRow* row = nullptr;
+    for (const char* table : {"IV", "V", "VI"})
+      if (!row) row = FindRow(data.rows, table, "stepper_motor", "nelder_mead", t.disturbance_amplitude);
+    os << "| +/-" << Num(t.disturbance_amplitude, 2) << " | ";
+    if (!t.Tuned()) {
+      os << "failed: " << t.message << " | | | | | | | |\n";
+      continue;
+    }
+    os << Gains(t.summary.gains) << " | " << Num(t.metrics.rise_time_s) << " | "
+       << Num(t.metrics.overshoot_pct) << " | " << Num(t.metrics.settling_time_s) << " | "
+       << Num(t.metrics.iae) << " | " << Num(t.metrics.iae_disturbed) << " | "
+       << (row ? Num(row->paper_iae) : std::string("not in the paper")) << " | " << Verdict(t) << " |\n";
+  }
+  os << "\n";
+}
+
+void RenderSampledRow(std::ostream& os, const std::string& loop, const Metrics& m) {
+  os << "| " << loop << " | " << (m.stable ? "yes" : "no") << " | " << MetricsCells(m) << " |\n";
+}
+
+// The table of the sampled section: continuous, sampled in process, and the
+// trio's episode beside the in-process loop on its horizon.
+void RenderSampledTable(std::ostream& os, const SampledSection& s) {
+  os << "| loop | stable | rise [s] | overshoot [%] | settling [s] | IAE of y1 "
+        "|\n|---|---|---:|---:|---:|---:|\n";
+  RenderSampledRow(os, "continuous (exact)", s.continuous);
+  RenderSampledRow(os, "sampled, in-process, dt = " + Num(s.dt_s) + " s", s.sampled_in_process);
+  RenderSampledRow(os, "sampled, in-process, dt = " + Num(s.fine_dt_s) + " s", s.sampled_fine);
+  if (s.trio_ran) {
+    const std::string at = "dt = " + Num(s.dt_s) + " s, horizon " + Num(s.trio_horizon_s) + " s";
+    RenderSampledRow(os, "sampled, in-process, " + at, s.sampled_trio_horizon);
+    RenderSampledRow(os, "sampled, LCM trio, " + at, s.trio);
+  }
+  os << "\n";
+}
+
+// How the trio ran (or why not), and whether it matched the in-process loop.
+void RenderTrioNote(std::ostream& os, const SampledSection& s) {
+  os << (s.trio_ran ? "Trio run: " : "**The LCM trio run was not available**: ") << s.trio_note << ".";
+  if (s.trio_ran) {
+    const Metrics& a = s.trio;
+    const Metrics& b = s.sampled_trio_horizon;
+    const bool identical = a.stable == b.stable && a.iae == b.iae && a.rise_time_s == b.rise_time_s &&
+                           a.overshoot_pct == b.overshoot_pct && a.settling_time_s == b.settling_time_s;
+    if (s.trio_horizon_s < s.horizon_s) {
+      os << " The episode covers " << Num(s.trio_horizon_s) << " s instead of the paper's "
+         << Num(s.horizon_s) << " s; the slow tail after it adds "
+         << Num(std::abs(s.sampled_in_process.iae - s.sampled_trio_horizon.iae), 3) << " to the IAE.";
+    } else {
+      os << " The episode covers the paper's full " << Num(s.trio_horizon_s) << " s horizon.";
+    }
+    os << (identical
+               ? std::string(" Its IAE and step metrics equal the in-process sampled loop's on the same "
+                             "horizon bit for bit.")
+               : " **Its results differ from the in-process sampled loop's** (IAE " + Num(a.iae, 17) +
+                     " vs " + Num(b.iae, 17) + ").");
+  }
+  os << "\n\n";
+}
+
+// Why the sampled loop differs from the continuous one at dt, and converges
+// at the finer dt.
+void RenderSampledDiscussion(std::ostream& os, const SampledSection& s) {
+  auto rel = [](double a, double b) { return 100.0 * std::abs(a - b) / std::abs(b); };
+  os << "At dt = " << Num(s.dt_s) << " s the sampled IAE is within "
+     << Num(rel(s.sampled_in_process.iae, s.continuous.iae), 3)
+     << " % of the continuous one and the overshoot is " << Num(s.sampled_in_process.overshoot_pct, 4)
+     << " % against " << Num(s.continuous.overshoot_pct, 4) << " %: the plant's fastest pole is at "
+     << Num(s.fastest_plant_pole_re, 4) << " rad/s (time constant " << Num(-1e3 / s.fastest_plant_pole_re, 3)
+     << " ms) and the continuous rise time is " << Num(1e3 * s.continuous.rise_time_s, 3)
+     << " ms, so one sample of the discrete PID (backward-Euler integral, backward-difference derivative) "
+        "spans a large part of the transient. At dt = "
+     << Num(s.fine_dt_s) << " s the overshoot is " << Num(s.sampled_fine.overshoot_pct, 4)
+     << " %: the sampled loop converges to the continuous one as dt shrinks. The 2 % settling time, set by "
+        "the slow pole pair, is "
+     << Num(s.sampled_in_process.settling_time_s, 4) << " s and " << Num(s.sampled_fine.settling_time_s, 4)
+     << " s against " << Num(s.continuous.settling_time_s, 4) << " s continuous.\n\n";
+}
+
+// The stepper motor on the sampled loop (the LCM trio's loop).
+void RenderSampledSection(std::ostream& os, const SampledSection& s) {
+  os << "## Stepper motor on the sampled loop (the LCM trio's loop)\n\n"
+     << "The paper's Table IV Nelder-Mead gains (" << Gains(s.gains)
+     << ") on the lockstep sampled loop the process trio runs (discrete PID, ZOH plant, dt = " << Num(s.dt_s)
+     << " s) against the continuous loop. Sampled metrics use every step of the loop.\n\n";
+  RenderSampledTable(os, s);
+  RenderTrioNote(os, s);
+  RenderSampledDiscussion(os, s);
+}
+
+void RenderFigureList(std::ostream& os, const std::vector<Figure>& figures) {
+  if (figures.empty()) {
+    os << "## Figures\n\nNot drawn (--no-figures).\n\n";
+    return;
+  }
+  os << "## Figures\n\n";
+  for (const Figure& f : figures) os << "![" << f.file << "](" << f.file << ")\n\n" << f.caption << "\n\n";
+}
+
+// ---------------------------------------------------------------- computation
+
+// The paper's Table IV Nelder-Mead gains for the stepper motor (its printed
+// values if the tables lack the row).
+PidGains StepperNelderMeadGains(const std::vector<PaperRow>& paper) {
+  PidGains gains{20.8836, 26.607, 12.4866};
+  for (const PaperRow& row : paper)
+    if (row.table == "IV" && row.plant == "stepper_motor" && row.method == "nelder_mead") gains = row.gains;
+  return gains;
+}
+
+// The trio episode of the sampled section, run on its own thread from
+// construction (if options.trio_runner is set); waited for on destruction.
+class BackgroundTrio {
+ public:
+  BackgroundTrio(const ReportOptions& options, const SampledSection& s) {
+    if (!options.trio_runner) return;
+    episode_ = std::async(std::launch::async, [this, &options, gains = s.gains, dt_s = s.dt_s,
+                                               horizon_s = s.trio_horizon_s] {
+      try {
+        return options.trio_runner(BuiltinPlant("stepper_motor"), gains, dt_s, horizon_s, &metrics_, &note_);
+      } catch (const std::exception& e) {
+        note_ = e.what();
+        return false;
+      }
+    });
+  }
+  BackgroundTrio(const BackgroundTrio&) = delete;
+  BackgroundTrio& operator=(const BackgroundTrio&) = delete;
+  ~BackgroundTrio() {
+    if (episode_.valid()) episode_.wait();
+  }
+
+  /// Waits for the episode and fills the trio fields of *s; without a runner,
+  /// the note says why (absent_note).
+  void Collect(const std::string& absent_note, SampledSection* s) {
+    if (!episode_.valid()) {
+      s->trio_note = absent_note;
+      return;
+    }
+    s->trio_ran = episode_.get();
+    s->trio = metrics_;
+    s->trio_note = note_;
+  }
+
+ private:
+  Metrics metrics_;
+  std::string note_;
+  std::future<bool> episode_;  // last: destroyed (after the wait) first
+};
+
+// Every published row re-evaluated. Tables report y1, the undisturbed
+// response, even for gains tuned under a disturbance; the disturbed IAE is
+// kept beside it.
+bool EvaluatePaperRows(const std::vector<PaperRow>& paper, ReportData* data, std::string* error) {
+  for (const PaperRow& row : paper) {
+    RowResult r;
+    r.paper = row;
+    if (!EvaluateMetrics(BuiltinPlant(row.plant), row.gains, row.disturbance_amplitude, &r.pidlab, error))
+      return false;
+    r.differences = ExplainDifferences(row, r.pidlab);
+    data->rows.push_back(std::move(r));
+  }
+  return true;
+}
+
+// One of pidlab's own tunings: `method` on `plant_name` under the paper's
+// loop with a +/-amplitude square wave (0: none), with the tuner's acceptance
+// margin. False only if the metrics of the tuned gains cannot be evaluated.
+bool RunTuning(const ReportOptions& options, const std::string& plant_name, TuneMethod method,
+               double amplitude, Tuning* t, std::string* error) {
+  t->plant = plant_name;
+  t->method = method;
+  t->disturbance_amplitude = amplitude;
+  TuneOptions o;
+  o.method = method;
+  o.seed = options.seed;
+  o.loop = PaperLoop(amplitude);
+  o.loop.stability_margin = TuneOptions::DefaultTuneLoop().stability_margin;
+  if (options.quick) {
+    o.starts = 1;
+    if (method == TuneMethod::kGeneticAlgorithm || method == TuneMethod::kPsoGsa) o.max_evaluations = 400;
+  }
+  const Plant plant = BuiltinPlant(plant_name);
+  std::string why;
+  if (!Tune(plant, o, &t->summary, &why)) {
+    t->status = TuningStatus::kNotApplicable;
+    t->message = why;
+  } else if (!t->summary.stable) {
+    t->status = TuningStatus::kNoStableLoop;
+    t->message = t->summary.message;
+  } else {
+    if (!EvaluateMetrics(plant, t->summary.gains, amplitude, &t->metrics, error)) return false;
+    t->status = TuningStatus::kTuned;
+    t->message = t->summary.message;
+  }
+  return true;
+}
+
+// pidlab's own tunings: every method on every plant, then Nelder-Mead under
+// each disturbance of Tables IV-VI and Fig. 21.
+bool RunTunings(const ReportOptions& options, ReportData* data, std::string* error) {
+  auto tune = [&](const std::string& plant_name, TuneMethod method, double amplitude) {
+    Tuning t;
+    if (!RunTuning(options, plant_name, method, amplitude, &t, error)) return false;
+    data->tunings.push_back(std::move(t));
+    return true;
+  };
+  const TuneMethod methods[] = {TuneMethod::kNelderMead, TuneMethod::kPaperNelderMead,
+                                TuneMethod::kZieglerNichols, TuneMethod::kGeneticAlgorithm,
+                                TuneMethod::kPsoGsa};
+  for (const char* plant : {"double_integrator", "oscillator", "stepper_motor"})
+    for (TuneMethod m : methods)
+      if (!tune(plant, m, 0.0)) return false;
+  for (double a : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 1.0})
+    if (!tune("stepper_motor", TuneMethod::kNelderMead, a)) return false;
+  return true;
+}
+
+// The in-process part of the sampled section: the continuous loop, the
+// sampled loop at dt and at the finer dt, the sampled loop over the trio's
+// horizon, and the plant's fastest pole.
+bool EvaluateSampledLoops(SampledSection* s, std::string* error) {
+  const Plant stepper = BuiltinPlant("stepper_motor");
+  if (!EvaluateMetrics(stepper, s->gains, 0.0, &s->continuous, error)) return false;
+  LoopOptions sampled = PaperLoop(0.0);
+  sampled.loop = LoopKind::kSampled;
+  sampled.dt_s = s->dt_s;
+  EvaluateOptions what;
+  what.compute_iae_continuous = false;
+  Evaluation ev;
+  if (!Evaluate(stepper, s->gains, sampled, what, &ev, error)) return false;
+  FillFromEvaluation(ev, &s->sampled_in_process);
+  LoopOptions short_horizon = sampled;
+  short_horizon.horizon_s = s->trio_horizon_s;
+  Evaluation same_as_trio;
+  if (!Evaluate(stepper, s->gains, short_horizon, what, &same_as_trio, error)) return false;
+  FillFromEvaluation(same_as_trio, &s->sampled_trio_horizon);
+  sampled.dt_s = s->fine_dt_s;
+  Evaluation fine;
+  if (!Evaluate(stepper, s->gains, sampled, what, &fine, error)) return false;
+  FillFromEvaluation(fine, &s->sampled_fine);
+  for (const auto& p : PolynomialRoots(stepper.tf.den))
+    s->fastest_plant_pole_re = std::min(s->fastest_plant_pole_re, p.real());
+  return true;
 }
 
 }  // namespace
@@ -562,72 +962,19 @@ bool ParsePaperTables(const std::string& csv, const std::string& path, std::vect
     *error = path + " is empty";
     return false;
   }
-  const std::vector<std::string> header = SplitCsv(line);
-  std::map<std::string, std::size_t> col;
-  for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
-  const char* required[] = {"table",
-                            "plant",
-                            "method",
-                            "disturbance_amplitude",
-                            "kp",
-                            "ki",
-                            "kd",
-                            "paper_rise_time_s",
-                            "paper_overshoot_pct",
-                            "paper_settling_time_s",
-                            "paper_iae",
-                            "ref_rise_time_s",
-                            "ref_overshoot_pct",
-                            "ref_settling_time_s",
-                            "ref_iae"};
-  for (const char* name : required) {
-    if (!col.count(name)) {
-      *error = path + ": missing column " + name;
-      return false;
-    }
-  }
+  Columns col;
+  if (!ParseHeader(line, path, &col, error)) return false;
   rows->clear();
   int number = 1;
   while (std::getline(in, line)) {
     ++number;
     if (Trim(line).empty()) continue;
-    const std::vector<std::string> cells = SplitCsv(line);
-    auto text = [&](const char* name) { return col[name] < cells.size() ? cells[col[name]] : std::string(); };
-    auto value = [&](const char* name, double fallback, bool allow_empty) {
-      const std::string s = text(name);
-      if (s.empty() && allow_empty) return fallback;
-      std::size_t used = 0;
-      double v = 0;
-      try {
-        v = std::stod(s, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != s.size() || s.empty())
-        throw std::invalid_argument(path + " line " + std::to_string(number) + ": column " + name + " = '" +
-                                    s + "' is not a number");
-      return v;
-    };
-    PaperRow r;
     try {
-      r.table = text("table");
-      r.plant = text("plant");
-      r.method = text("method");
-      r.disturbance_amplitude = value("disturbance_amplitude", 0.0, true);
-      r.gains = {value("kp", 0, false), value("ki", 0, false), value("kd", 0, false)};
-      r.paper_rise_time_s = value("paper_rise_time_s", 0, false);
-      r.paper_overshoot_pct = value("paper_overshoot_pct", 0, false);
-      r.paper_settling_time_s = value("paper_settling_time_s", 0, false);
-      r.paper_iae = value("paper_iae", 0, false);
-      r.ref_rise_time_s = value("ref_rise_time_s", 0, false);
-      r.ref_overshoot_pct = value("ref_overshoot_pct", 0, false);
-      r.ref_settling_time_s = value("ref_settling_time_s", 0, false);
-      r.ref_iae = value("ref_iae", 0, false);
+      rows->push_back(ParseRow(SplitCsv(line), col, path, number));
     } catch (const std::invalid_argument& e) {
       *error = e.what();
       return false;
     }
-    rows->push_back(r);
   }
   if (rows->empty()) {
     *error = path + " has no rows";
@@ -652,116 +999,17 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
   const auto start = std::chrono::steady_clock::now();
   *data = ReportData{};
   data->options = options;
-  // The trio episode (about 30 s of lockstep LCM traffic) runs beside the
-  // in-process work.
   SampledSection& s = data->sampled;
   s.dt_s = 1e-4;
-  s.gains = PidGains{20.8836, 26.607, 12.4866};
-  for (const PaperRow& row : paper)
-    if (row.table == "IV" && row.plant == "stepper_motor" && row.method == "nelder_mead") s.gains = row.gains;
-  std::future<bool> trio;
-  Metrics trio_metrics;
-  std::string trio_note;
-  if (options.trio_runner) {
-    trio = std::async(std::launch::async, [&] {
-      try {
-        return options.trio_runner(BuiltinPlant("stepper_motor"), s.gains, s.dt_s, s.trio_horizon_s,
-                                   &trio_metrics, &trio_note);
-      } catch (const std::exception& e) {
-        trio_note = e.what();
-        return false;
-      }
-    });
-  }
-  struct JoinTrio {
-    std::future<bool>* f;
-    ~JoinTrio() {
-      if (f->valid()) f->wait();
-    }
-  } join_trio{&trio};
+  s.gains = StepperNelderMeadGains(paper);
+  // The trio episode (250,000 lockstep steps over LCM) runs beside the
+  // in-process work.
+  BackgroundTrio trio(options, s);
   try {
-    for (const PaperRow& row : paper) {
-      RowResult r;
-      r.paper = row;
-      // Tables report y1, the undisturbed response, even for gains tuned under
-      // a disturbance; the disturbed IAE is shown beside it.
-      if (!EvaluateMetrics(BuiltinPlant(row.plant), row.gains, row.disturbance_amplitude, &r.pidlab, error))
-        return false;
-      r.differences = ExplainDifferences(row, r.pidlab);
-      data->rows.push_back(std::move(r));
-    }
-
-    // pidlab's own tunings: every method on every plant, then Nelder-Mead
-    // under each disturbance of Tables IV-VI and Fig. 21.
-    auto tune = [&](const std::string& plant_name, TuneMethod method, double amplitude) {
-      Tuning t;
-      t.plant = plant_name;
-      t.method = method;
-      t.disturbance_amplitude = amplitude;
-      TuneOptions o;
-      o.method = method;
-      o.seed = options.seed;
-      o.loop = PaperLoop(amplitude);
-      o.loop.stability_margin =
-          TuneOptions::DefaultTuneLoop().stability_margin;  // the tuner's acceptance margin
-      if (options.quick) {
-        o.starts = 1;
-        if (method == TuneMethod::kGeneticAlgorithm || method == TuneMethod::kPsoGsa) o.max_evaluations = 400;
-      }
-      const Plant plant = BuiltinPlant(plant_name);
-      std::string why;
-      t.ok = Tune(plant, o, &t.summary, &why);
-      if (t.ok && !t.summary.stable) {
-        t.ok = false;
-        why = t.summary.message;
-      }
-      if (t.ok) {
-        if (!EvaluateMetrics(plant, t.summary.gains, amplitude, &t.metrics, error)) return false;
-        t.message = t.summary.message;
-      } else {
-        t.message = why;
-      }
-      data->tunings.push_back(std::move(t));
-      return true;
-    };
-    const TuneMethod methods[] = {TuneMethod::kNelderMead, TuneMethod::kPaperNelderMead,
-                                  TuneMethod::kZieglerNichols, TuneMethod::kGeneticAlgorithm,
-                                  TuneMethod::kPsoGsa};
-    for (const char* plant : {"double_integrator", "oscillator", "stepper_motor"})
-      for (TuneMethod m : methods)
-        if (!tune(plant, m, 0.0)) return false;
-    for (double a : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 1.0})
-      if (!tune("stepper_motor", TuneMethod::kNelderMead, a)) return false;
-
-    // The sampled loop of the trio against the continuous loop.
-    const Plant stepper = BuiltinPlant("stepper_motor");
-    if (!EvaluateMetrics(stepper, s.gains, 0.0, &s.continuous, error)) return false;
-    LoopOptions sampled = PaperLoop(0.0);
-    sampled.loop = LoopKind::kSampled;
-    sampled.dt_s = s.dt_s;
-    EvaluateOptions what;
-    what.compute_iae_continuous = false;
-    Evaluation ev;
-    if (!Evaluate(stepper, s.gains, sampled, what, &ev, error)) return false;
-    FillFromEvaluation(ev, &s.sampled_in_process);
-    LoopOptions short_horizon = sampled;
-    short_horizon.horizon_s = s.trio_horizon_s;
-    Evaluation same_as_trio;
-    if (!Evaluate(stepper, s.gains, short_horizon, what, &same_as_trio, error)) return false;
-    FillFromEvaluation(same_as_trio, &s.sampled_trio_horizon);
-    sampled.dt_s = s.fine_dt_s;
-    Evaluation fine;
-    if (!Evaluate(stepper, s.gains, sampled, what, &fine, error)) return false;
-    FillFromEvaluation(fine, &s.sampled_fine);
-    for (const auto& p : PolynomialRoots(stepper.tf.den))
-      s.fastest_plant_pole_re = std::min(s.fastest_plant_pole_re, p.real());
-    if (trio.valid()) {
-      s.trio_ran = trio.get();
-      s.trio = trio_metrics;
-      s.trio_note = trio_note;
-    } else {
-      s.trio_note = options.trio_absent_note;
-    }
+    if (!EvaluatePaperRows(paper, data, error)) return false;
+    if (!RunTunings(options, data, error)) return false;
+    if (!EvaluateSampledLoops(&s, error)) return false;
+    trio.Collect(options.trio_absent_note, &s);
   } catch (const std::exception& e) {
     *error = e.what();
     return false;
@@ -772,140 +1020,17 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
 
 std::string RenderMarkdown(const ReportData& data) {
   std::ostringstream os;
-  os << "# pidlab report: Nelder-Mead PID tuning of a stepper motor, regenerated\n\n"
-     << "Paper: W. Assawinchaichote and V. Sinlapakun, *Optimization Design of PID Controller Parameters "
-        "Based on "
-        "Nelder Mead Algorithm for Stepper Motors*. Generated by `pidlab report` (seed "
-     << data.options.seed << (data.options.quick ? ", **quick mode: reduced budgets**" : "")
-     << "). See docs/report.md for how to read it.\n\n"
-     << "Loop: the paper's continuous loop (ideal PID of eq. 2, unit step, exact matrix-exponential "
-        "solution), "
-        "Error(K) = sum of |1 - y1(t)| at t = 0, 0.05, ..., 25 s (eq. 4), where y1 is the response to the "
-        "reference alone (eq. 17). Metrics use MATLAB-stepinfo definitions on the exact response: rise time "
-        "10 % -> 90 % of the final value, overshoot in % of the final value, settling time into a 2 % band "
-        "for good. "
-        "Disturbances are square waves of period "
-     << Num(kSquarePeriodS) << " s (pidlab's choice; the paper does not state the period).\n\n"
-     << "In the tables, *paper* is the published figure and *pidlab* is pidlab's re-evaluation of the "
-        "published "
-        "gains; **≠** marks a published figure pidlab does not reproduce (IAE within 0.1 %, others within 3 "
-        "%), "
-        "explained in one line below the table.\n\n";
-
+  RenderIntroduction(os, data);
   os << "## Tables II-VI: the paper's gains re-evaluated\n\n";
   RenderPaperTable(os, data, "II", "1/s^2, Ziegler-Nichols and Nelder-Mead");
   RenderPaperTable(os, data, "III", "1/(s^2+1), Ziegler-Nichols and Nelder-Mead");
   RenderPaperTable(os, data, "IV", "stepper motor, four methods");
   RenderPaperTable(os, data, "V", "stepper motor, Nelder-Mead under low disturbance");
   RenderPaperTable(os, data, "VI", "stepper motor, Nelder-Mead under high disturbance");
-
-  os << "## pidlab's own tunings\n\n"
-     << "Same objective, box [0, 30]^3 and seed for every method: `nelder-mead` (proper 4-point simplex, "
-        "multi-start), `paper-nm` (the paper's three-point variant, which cannot leave the plane of its "
-        "first "
-        "triangle), `ziegler-nichols` (classic rule on the exact ultimate gain), `ga`, `pso-gsa`. Each "
-        "search "
-        "result is cross-checked by Ceres (bound-constrained least squares with automatic differentiation); "
-        "the "
-        "gains shown are the better of the two. \"< paper\" compares the IAE with the paper's "
-        "Nelder-Mead.\n\n";
-  for (const char* plant : {"double_integrator", "oscillator", "stepper_motor"}) {
-    os << "### " << PlantTitle(plant) << "\n\n";
-    const char* table = std::string(plant) == "double_integrator"
-                            ? "II"
-                            : (std::string(plant) == "oscillator" ? "III" : "IV");
-    RenderTunings(os, data, plant, 0.0, FindRow(data.rows, table, plant, "nelder_mead"));
-  }
-  os << "### Stepper motor, Nelder-Mead tuned under each square-wave disturbance (Tables IV-VI, Fig. 21)\n\n"
-     << "The objective during these tunings is the IAE of the disturbed output y; the tables above report "
-        "the "
-        "IAE of y1 for the paper's gains, so both are shown.\n\n";
-  os << "| amplitude | kp, ki, kd | rise [s] | overshoot [%] | settling [s] | IAE of y1 | IAE of y | paper's "
-        "IAE "
-        "(of y1) | Ceres cross-check |\n|---:|---|---:|---:|---:|---:|---:|---:|---|\n";
-  for (const Tuning& t : data.tunings) {
-    if (t.disturbance_amplitude == 0.0) continue;
-    const PaperRow* row = nullptr;
-    for (const char* table : {"IV", "V", "VI"})
-      if (!row) row = FindRow(data.rows, table, "stepper_motor", "nelder_mead", t.disturbance_amplitude);
-    os << "| +/-" << Num(t.disturbance_amplitude, 2) << " | ";
-    if (!t.ok) {
-      os << "failed: " << t.message << " | | | | | | | |\n";
-      continue;
-    }
-    os << Gains(t.summary.gains) << " | " << Num(t.metrics.rise_time_s) << " | "
-       << Num(t.metrics.overshoot_pct) << " | " << Num(t.metrics.settling_time_s) << " | "
-       << Num(t.metrics.iae) << " | " << Num(t.metrics.iae_disturbed) << " | "
-       << (row ? Num(row->paper_iae) : std::string("not in the paper")) << " | " << Verdict(t) << " |\n";
-  }
-  os << "\n";
-
-  const SampledSection& s = data.sampled;
-  os << "## Stepper motor on the sampled loop (the LCM trio's loop)\n\n"
-     << "The paper's Table IV Nelder-Mead gains (" << Gains(s.gains)
-     << ") on the lockstep sampled loop the "
-        "process trio runs (discrete PID, ZOH plant, dt = "
-     << Num(s.dt_s) << " s) against the continuous loop. Sampled metrics use every step of the loop.\n\n"
-     << "| loop | stable | rise [s] | overshoot [%] | settling [s] | IAE of y1 "
-        "|\n|---|---|---:|---:|---:|---:|\n"
-     << "| continuous (exact) | " << (s.continuous.stable ? "yes" : "no") << " | "
-     << MetricsCells(s.continuous) << " |\n"
-     << "| sampled, in-process, dt = " << Num(s.dt_s) << " s | "
-     << (s.sampled_in_process.stable ? "yes" : "no") << " | " << MetricsCells(s.sampled_in_process) << " |\n"
-     << "| sampled, in-process, dt = " << Num(s.fine_dt_s) << " s | "
-     << (s.sampled_fine.stable ? "yes" : "no") << " | " << MetricsCells(s.sampled_fine) << " |\n";
-  if (s.trio_ran) {
-    os << "| sampled, in-process, dt = " << Num(s.dt_s) << " s, horizon " << Num(s.trio_horizon_s) << " s | "
-       << (s.sampled_trio_horizon.stable ? "yes" : "no") << " | " << MetricsCells(s.sampled_trio_horizon)
-       << " |\n"
-       << "| sampled, LCM trio, dt = " << Num(s.dt_s) << " s, horizon " << Num(s.trio_horizon_s) << " s | "
-       << (s.trio.stable ? "yes" : "no") << " | " << MetricsCells(s.trio) << " |\n";
-  }
-  os << "\n"
-     << (s.trio_ran ? "Trio run: " : "**The LCM trio run was not available**: ") << s.trio_note << ".";
-  if (s.trio_ran) {
-    const Metrics& a = s.trio;
-    const Metrics& b = s.sampled_trio_horizon;
-    const bool identical = a.stable == b.stable && a.iae == b.iae && a.rise_time_s == b.rise_time_s &&
-                           a.overshoot_pct == b.overshoot_pct && a.settling_time_s == b.settling_time_s;
-    if (s.trio_horizon_s < s.horizon_s) {
-      os << " The episode covers " << Num(s.trio_horizon_s) << " s instead of the paper's "
-         << Num(s.horizon_s) << " s; the slow tail after it adds "
-         << Num(std::abs(s.sampled_in_process.iae - s.sampled_trio_horizon.iae), 3) << " to the IAE.";
-    } else {
-      os << " The episode covers the paper's full " << Num(s.trio_horizon_s) << " s horizon.";
-    }
-    os << (identical
-               ? std::string(" Its IAE and step metrics equal the in-process sampled loop's on the same "
-                             "horizon bit for bit.")
-               : " **Its results differ from the in-process sampled loop's** (IAE " + Num(a.iae, 17) +
-                     " vs " + Num(b.iae, 17) + ").");
-  }
-  os << "\n\n";
-  auto rel = [](double a, double b) { return 100.0 * std::abs(a - b) / std::abs(b); };
-  os << "At dt = " << Num(s.dt_s) << " s the sampled IAE is within "
-     << Num(rel(s.sampled_in_process.iae, s.continuous.iae), 3)
-     << " % of the continuous one and the overshoot is " << Num(s.sampled_in_process.overshoot_pct, 4)
-     << " % against " << Num(s.continuous.overshoot_pct, 4) << " %: the plant's fastest pole is at "
-     << Num(s.fastest_plant_pole_re, 4) << " rad/s (time constant " << Num(-1e3 / s.fastest_plant_pole_re, 3)
-     << " ms) and the continuous rise time is " << Num(1e3 * s.continuous.rise_time_s, 3)
-     << " ms, so one sample of the discrete PID (backward-Euler integral, backward-difference derivative) "
-        "spans "
-        "a large part of the transient. At dt = "
-     << Num(s.fine_dt_s) << " s the overshoot is " << Num(s.sampled_fine.overshoot_pct, 4)
-     << " %: the sampled loop converges to the continuous one as dt shrinks. The 2 % settling time, set by "
-        "the "
-        "slow pole pair, is "
-     << Num(s.sampled_in_process.settling_time_s, 4) << " s and " << Num(s.sampled_fine.settling_time_s, 4)
-     << " s against " << Num(s.continuous.settling_time_s, 4) << " s continuous.\n\n";
-
-  if (!data.figures.empty()) {
-    os << "## Figures\n\n";
-    for (const Figure& f : data.figures)
-      os << "![" << f.file << "](" << f.file << ")\n\n" << f.caption << "\n\n";
-  } else {
-    os << "## Figures\n\nNot drawn (--no-figures).\n\n";
-  }
+  RenderOwnTunings(os, data);
+  RenderDisturbanceTunings(os, data);
+  RenderSampledSection(os, data.sampled);
+  RenderFigureList(os, data.figures);
   return os.str();
 }
 

@@ -1,11 +1,14 @@
 #pragma once
 // The paper report (`pidlab report`): Tables II-VI of Assawinchaichote &
 // Sinlapakun regenerated from their published gains, pidlab's own tunings of
-// the same plants, and PNG figures equivalent to Figs 9-21.
+// the same plants, the stepper motor on the sampled loop (in process, and as
+// one episode over the LCM trio when ReportOptions::trio_runner is set; see
+// trio_episode.h), and PNG figures equivalent to Figs 9-21.
 //
 // Three steps, so that tests can check the numbers without parsing Markdown:
 //   ReadPaperTables  -> the published rows (paper_tables.csv)
-//   ComputeReport    -> every evaluation and tuning (no files written)
+//   ComputeReport    -> every evaluation and tuning, and the trio episode
+//                       beside them (no files written)
 //   WriteReport      -> DIR/report.md and the figures beside it
 // Deterministic for a given seed: report.md holds no wall-clock times.
 
@@ -65,15 +68,23 @@ struct RowResult {
   std::vector<std::string> differences;
 };
 
+/// How one of pidlab's own tunings ended.
+enum class TuningStatus {
+  kTuned,          // gains found: summary.gains and metrics are set
+  kNotApplicable,  // Tune refused: the method does not apply (Ziegler-Nichols on 1/s^2 or 1/(s^2+1))
+  kNoStableLoop,   // the search found no strictly stable loop in the box
+};
+
 /// One of pidlab's own tunings.
 struct Tuning {
   std::string plant;
   TuneMethod method = TuneMethod::kNelderMead;
   double disturbance_amplitude = 0.0;  // square wave during tuning (0: none)
-  bool ok = false;                     // false: method not applicable / failed
-  std::string message;                 // why not, or the summary
+  TuningStatus status = TuningStatus::kNotApplicable;
+  std::string message;  // kTuned: the search's summary; otherwise why not
   TuneSummary summary;
-  Metrics metrics;  // of summary.gains
+  Metrics metrics;  // of summary.gains (kTuned only)
+  bool Tuned() const { return status == TuningStatus::kTuned; }
 };
 
 /// The sampled loop (the LCM trio's lockstep loop) against the continuous one
