@@ -119,21 +119,14 @@ Options WithBudget(Options o, const TuneOptions& t, int Options::*iterations) {
   return o;
 }
 
-}  // namespace
-
-bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
-          const ProgressCallback& progress, const SampledRunner& runner) {
-  if (!options.IsValid(error)) return false;
-  const auto start_time = std::chrono::steady_clock::now();
-  *summary = TuneSummary();
-  summary->method = options.method;
-  const bool custom_runner = options.loop.loop == LoopKind::kSampled && runner &&
-                             runner.target<decltype(&RunSampledLoopInProcess)>() == nullptr;
-  const ObjectiveEvaluator evaluator(plant, options.loop, options.objective,
-                                     custom_runner ? runner : SampledRunner(nullptr));
+// The function the search minimises: the evaluator's objective, or +inf
+// where the undisturbed step response breaks the overshoot or settling
+// constraint of `options`.
+ObjectiveFunction ConstrainedObjective(const Plant& plant, const TuneOptions& options,
+                                       const ObjectiveEvaluator& evaluator) {
   const bool constrained =
       std::isfinite(options.max_overshoot_pct) || std::isfinite(options.max_settling_time_s);
-  const ObjectiveFunction f = [&](const Eigen::VectorXd& x) {
+  return [&plant, &options, &evaluator, constrained](const Eigen::VectorXd& x) {
     const PidGains g{x(0), x(1), x(2)};
     const double value = evaluator(g);
     if (!std::isfinite(value) || !constrained) return value;
@@ -147,6 +140,14 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
     if (ev.step.settling_time_s > options.max_settling_time_s) return HUGE_VAL;
     return value;
   };
+}
+
+// Runs options.method on f over the gain box into summary->optimizer
+// (Ziegler-Nichols: its rule's gains, evaluated once). False with *error if
+// Ziegler-Nichols does not apply.
+bool Search(const Plant& plant, const TuneOptions& options, const ObjectiveFunction& f,
+            const ObjectiveEvaluator& evaluator, const ProgressCallback& progress, TuneSummary* summary,
+            std::string* error) {
   Bounds bounds{Eigen::VectorXd::Constant(3, options.lower), Eigen::VectorXd::Constant(3, options.upper)};
   OptimizerSummary& opt = summary->optimizer;
   switch (options.method) {
@@ -184,6 +185,27 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
       break;
     }
   }
+  return true;
+}
+
+}  // namespace
+
+bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
+          const ProgressCallback& progress, const SampledRunner& runner) {
+  if (!options.IsValid(error)) return false;
+  const auto start_time = std::chrono::steady_clock::now();
+  *summary = TuneSummary();
+  summary->method = options.method;
+  // The in-process sampled loop is run by the evaluator itself; only another
+  // runner (the LCM trio) is handed to it.
+  const bool custom_runner = options.loop.loop == LoopKind::kSampled && runner &&
+                             runner.target<decltype(&RunSampledLoopInProcess)>() == nullptr;
+  const ObjectiveEvaluator evaluator(plant, options.loop, options.objective,
+                                     custom_runner ? runner : SampledRunner(nullptr));
+  if (!Search(plant, options, ConstrainedObjective(plant, options, evaluator), evaluator, progress, summary,
+              error))
+    return false;
+  const OptimizerSummary& opt = summary->optimizer;
   summary->evaluations = opt.evaluations;
   summary->iterations = opt.iterations;
   if (opt.termination == TerminationType::kInvalidOptions) {

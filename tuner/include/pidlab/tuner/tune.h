@@ -24,7 +24,7 @@ struct TuneOptions {
   ObjectiveKind objective = ObjectiveKind::kIae;
   /// The loop the objective is evaluated on (default: the paper's continuous
   /// loop, ts = 0.05 s, n = 25 s, no disturbance). Its stability_margin is the
-  /// acceptance margin of candidates; TuneOptions() raises it to 0.01, because
+  /// acceptance margin of candidates; DefaultTuneLoop() raises it to 0.01, because
   /// with a margin near zero the search parks poles a hair left of the
   /// imaginary axis where the sampled objective cannot see them.
   LoopOptions loop = DefaultTuneLoop();
@@ -99,12 +99,16 @@ std::string ToString(RefineVerdict verdict, TuneMethod method);
 /// by automatic differentiation through the templated loop.
 struct RefineSummary {
   bool ran = false;
+  /// The better of the start and Ceres's point by the verdict: Ceres's for
+  /// kSearchStoppedShort (and kAgree when lower), else the start. The
+  /// objective is the exact one, not the smoothed least-squares cost.
   PidGains gains;
-  double objective = std::numeric_limits<double>::infinity();  // re-evaluated exactly
+  double objective = std::numeric_limits<double>::infinity();
   RefineTermination termination = RefineTermination::kNotRun;
   int iterations = 0;
   RefineVerdict verdict = RefineVerdict::kNotRun;
-  /// (f_search - f_ceres) / f_search.
+  /// (f_search - f_ceres) / f_search, f_ceres the exact objective of Ceres's
+  /// point (0 when not run).
   double relative_improvement = 0.0;
   /// One line on the verdict, or why the cross-check did not run ("" when it
   /// was not asked for).
@@ -119,19 +123,26 @@ struct TuneSummary {
   /// The search method's own result before the cross-check.
   PidGains search_gains;
   double search_objective = std::numeric_limits<double>::infinity();
+  /// A strictly stable loop was found (false: every candidate was rejected,
+  /// the gains stay 0 and message says why).
   bool stable = false;
   int evaluations = 0;
   int iterations = 0;
   double wall_time_s = 0.0;
-  OptimizerSummary optimizer;            // empty for ziegler-nichols
+  /// The search's summary; for ziegler-nichols the rule's gains as one
+  /// converged evaluation.
+  OptimizerSummary optimizer;
   ZieglerNicholsResult ziegler_nichols;  // ziegler-nichols only
   RefineSummary refine;
+  /// The search's one-line summary, or why no strictly stable loop was found.
   std::string message;
+  /// One line: method, gains, objective, evaluations and the refine verdict.
   std::string BriefReport() const;
 };
 
 /// Tunes the PID for `plant`. Returns false with *error for invalid input or
-/// when the method does not apply (e.g. Ziegler-Nichols on 1/s^2).
+/// when the method does not apply (e.g. Ziegler-Nichols on 1/s^2); true
+/// otherwise, with summary->stable false if no strictly stable loop was found.
 /// `runner` evaluates the sampled loop (in-process, or episodes over the LCM trio).
 bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
           const ProgressCallback& progress = nullptr, const SampledRunner& runner = RunSampledLoopInProcess);
