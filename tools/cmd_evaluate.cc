@@ -104,7 +104,6 @@ struct EvaluateCommand {
   }
 };
 
-
 }  // namespace
 std::function<int()> RegisterEvaluate(CLI::App* app) {
   auto command = std::make_shared<EvaluateCommand>();

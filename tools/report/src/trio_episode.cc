@@ -19,7 +19,9 @@ bool RunTrioEpisode(const TrioEpisodeOptions& options, const Plant& plant, const
   launcher::LaunchOptions lo;
   lo.bin_dir = options.bin_dir;
   lo.stderr_path = options.log_path;
-  launcher::Launcher trio(lo, [log](const std::string& line) { *log << "pidlab launch: " << line << "\n" << std::flush; });
+  launcher::Launcher trio(lo, [log](const std::string& line) {
+    *log << "pidlab launch: " << line << "\n" << std::flush;
+  });
   if (trio.Start(nullptr, &error) != launcher::LaunchStatus::kReady) {
     *note = "the trio did not start: " + error + " (see " + options.log_path + ")";
     return false;

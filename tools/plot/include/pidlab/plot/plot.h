@@ -7,8 +7,9 @@
 // of its Series. DrawPng writes every series to a whitespace-separated data
 // file "p<panel>_s<series>.dat" (columns x y, 17 significant digits; NaN
 // and infinite values are written as NaN, which gnuplot leaves out), writes
-// the gnuplot script "figure.gp" next to them, runs gnuplot, checks its exit
-// status and checks that the output is a PNG file.
+// the gnuplot script "figure.gp" next to them, runs gnuplot (its output goes
+// to "gnuplot.log" there), checks its exit status and checks that the output
+// is a PNG file.
 //
 // Terminal: pngcairo if gnuplot has it, plain png otherwise. The gnuplot
 // executable is $PIDLAB_GNUPLOT if set, else "gnuplot" on the PATH.
