@@ -87,11 +87,19 @@ int main(int argc, char** argv) {
   pidlab::EpisodeClientOptions co;
   co.lcm_url = url;
   if (const char* p = std::getenv("PIDLAB_CHANNEL_PREFIX")) co.transport.channel_prefix = p;
+  std::string error;
+  if (const char* key_file = std::getenv(pidlab::transport::kAuthKeyFileEnv); key_file && *key_file) {
+    pidlab::transport::AuthKey key;
+    if (!pidlab::transport::LoadAuthKey(key_file, &key, &error)) {
+      std::fprintf(stderr, "trio_bench: %s\n", error.c_str());
+      return 2;
+    }
+    co.transport.auth_key = key;
+  }
 
   const double raw = RoundTripsPerSecond(url, trips);
 
   pidlab::Plant plant;
-  std::string error;
   pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant, &error);
   pidlab::LoopOptions options;
   options.loop = pidlab::LoopKind::kSampled;
@@ -106,7 +114,7 @@ int main(int argc, char** argv) {
     }
   }
   const double steps = client.stats().StepsPerSecond();
-  std::printf("url                 %s\n", url.c_str());
+  std::printf("url                 %s%s\n", url.c_str(), co.transport.auth_key ? " (authenticated)" : "");
   std::printf("raw round trip      %.0f /s  (%ld publish/handle round trips, echo process)\n", raw, trips);
   std::printf("lockstep trio       %.0f steps/s  (%ld steps in %ld episodes)\n", steps, client.stats().steps,
               client.stats().episodes);

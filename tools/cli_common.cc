@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
+#include <iostream>
 #include <sstream>
 
 namespace pidlab::cli {
@@ -21,6 +22,12 @@ void LcmFlags::Register(CLI::App* app) {
                   "--backend lcm: channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
   app->add_option("--episode-timeout", episode_timeout_s, "--backend lcm: give up on an episode after this many s")
       ->capture_default_str();
+  app->add_option("--silence-deadline", silence_deadline_s,
+                  "--backend lcm: an episode fails after this many s without progress, naming the silent process")
+      ->capture_default_str();
+  app->add_option("--max-attempts", max_attempts,
+                  "--backend lcm: run a failed episode again (as a new episode) up to this many attempts in all")
+      ->capture_default_str();
   app->add_option("--auth-key", auth_key_file,
                   "--backend lcm: authenticate every message with the key in this file (docs/security.md; default "
                   "$PIDLAB_AUTH_KEY_FILE)");
@@ -31,6 +38,9 @@ std::unique_ptr<EpisodeClient> LcmFlags::MakeClient() const {
   co.lcm_url = FromEnv(lcm_url, "PIDLAB_LCM_URL", transport::kDefaultLcmUrl);
   co.transport.channel_prefix = FromEnv(channel_prefix, "PIDLAB_CHANNEL_PREFIX", transport::kDefaultChannelPrefix);
   co.episode_timeout_s = episode_timeout_s;
+  co.recovery.silence_deadline_s = silence_deadline_s;
+  co.max_attempts = max_attempts;
+  co.on_note = [](const std::string& note) { std::cerr << "pidlab: note: " << note << "\n"; };
   std::string error;
   const std::string key_file = FromEnv(auth_key_file, transport::kAuthKeyFileEnv, "");
   if (!key_file.empty()) {

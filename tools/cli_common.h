@@ -25,10 +25,13 @@ struct BadInput : std::runtime_error {
 /// exports to its COMMAND), else the fallback.
 std::string FromEnv(const std::string& flag, const char* env, const char* fallback);
 
-/// --lcm-url, --channel-prefix, --episode-timeout and --auth-key of the LCM backend.
+/// --lcm-url, --channel-prefix, --episode-timeout, --silence-deadline,
+/// --max-attempts and --auth-key of the LCM backend.
 struct LcmFlags {
   std::string lcm_url, channel_prefix, auth_key_file;
   double episode_timeout_s = 600.0;
+  double silence_deadline_s = transport::RecoveryOptions{}.silence_deadline_s;
+  int max_attempts = EpisodeClientOptions{}.max_attempts;
   void Register(CLI::App* app);
   /// An episode client on the trio these flags (or $PIDLAB_LCM_URL,
   /// $PIDLAB_CHANNEL_PREFIX and $PIDLAB_AUTH_KEY_FILE) name. Throws BadInput for bad flags,

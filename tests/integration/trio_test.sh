@@ -2,7 +2,7 @@
 # Integration tests of the LCM trio. Run by ctest as
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
-# ever sent outside its loopback. CASE: identity | faults | kill | stranger | log | log_repair.
+# ever sent outside its loopback. CASE: identity | faults | kill | sigstop | stranger | log | log_repair.
 set -u
 BIN=$1
 CASE=$2
@@ -78,10 +78,12 @@ case $CASE in
       exit $fail' || fail=1
     ;;
   kill)
-    # Kill the controller mid-episode: the episode must end with an error
-    # naming it within 2 s, and launch must return (no hang, no orphans).
+    # Kill the controller mid-episode: with a 1 s silence deadline and no
+    # re-run, the episode must end with an error naming it within 2 s, and
+    # launch must return (no hang, no orphans).
     "$PIDLAB" launch --lcm-url "$URL" -- bash -c '
-      pidlab evaluate --backend lcm --plant double_integrator --gains 2,1,1.5 --horizon 200 >/dev/null 2>'"$TMP"'/err &
+      pidlab evaluate --backend lcm --silence-deadline 1 --max-attempts 1 --plant double_integrator --gains 2,1,1.5 \
+        --horizon 200 >/dev/null 2>'"$TMP"'/err &
       e=$!
       sleep 1.5
       kill -9 $PIDLAB_CONTROLLER_PID
@@ -91,6 +93,23 @@ case $CASE in
       echo "evaluate exit $rc after $(echo "$t1 - $t0" | bc) s: $(cat '"$TMP"'/err)"
       [ $rc -eq 1 ] && grep -q "pidlab-controller" '"$TMP"'/err && [ "$(echo "$t1 - $t0 < 2.0" | bc)" = 1 ]' ||
       fail=1
+    ;;
+  sigstop)
+    # A controller stopped for 3 s mid-tune: the tune must go on (default
+    # silence deadline) and give exactly the local sampled tune's result.
+    TUNE="--plant double_integrator --loop sampled --horizon 2 --max-evals 30 --starts 1 --seed 3 --refine none --json"
+    "$PIDLAB" tune $TUNE | sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' > "$TMP/tune.local.json" || fail=1
+    export TUNE
+    "$PIDLAB" launch --lcm-url "$URL" -- bash -c '
+      pidlab tune --backend lcm $TUNE > '"$TMP"'/tune.lcm.raw 2>'"$TMP"'/tune.err & t=$!
+      sleep 2; kill -STOP $PIDLAB_CONTROLLER_PID; sleep 3; kill -CONT $PIDLAB_CONTROLLER_PID
+      wait $t' || { echo "FAIL tune over the trio with a stopped controller: $(grep -v "^pidlab-" "$TMP/tune.err" | head -3)"; fail=1; }
+    sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' "$TMP/tune.lcm.raw" > "$TMP/tune.lcm.json"
+    if cmp -s "$TMP/tune.local.json" "$TMP/tune.lcm.json"; then
+      echo "ok   tune with the controller stopped 3 s equals the local tune: $(grep -o '"iae":[^,]*' "$TMP/tune.lcm.json" | head -1)"
+    else
+      echo "FAIL tune with a stopped controller differs from the local tune"; diff <(tr , '\n' < "$TMP/tune.local.json") <(tr , '\n' < "$TMP/tune.lcm.json") | head -10; fail=1
+    fi
     ;;
   log)
     rm -f "$TMP/run.lcmlog"

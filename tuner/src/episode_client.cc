@@ -56,6 +56,8 @@ bool EpisodeClientOptions::IsValid(std::string* error) const {
     os << "start timeout " << start_timeout_s << " s must be positive and finite";
   else if (!(episode_timeout_s > 0.0))
     os << "episode timeout " << episode_timeout_s << " s must be positive";
+  else if (max_attempts < 1 || max_attempts > 100)
+    os << "max attempts " << max_attempts << " must be in [1, 100]";
   else
     return true;
   if (error) *error = os.str();
@@ -256,10 +258,37 @@ bool EpisodeClient::FollowEpisode(double t0, double* done_s, long* requests, std
   }
 }
 
+bool EpisodeClient::RunOnce(const transport::EpisodeSpec& spec, std::string* error, bool* retryable) {
+  const pidlab::lcmt_episode_config config = transport::MakeEpisodeConfig(spec);
+  State& s = *state_;
+  s.Reset(spec.episode_id, spec.total_steps);
+  double done_s = -1;
+  long requests = 0;
+  *retryable = true;
+  // 1. Configuration until all three acknowledge; 2. follow the lockstep
+  // until the last y, then fetch whatever was missed.
+  const bool ok = StartEpisode(config, error) && [&] {
+    const double t0 = NowSeconds();
+    s.last_progress_s = t0;
+    if (!FollowEpisode(t0, &done_s, &requests, error)) return false;
+    ++stats_.episodes;
+    stats_.steps += s.total;
+    stats_.seconds += (done_s > 0 ? done_s : NowSeconds()) - t0;
+    stats_.resend_requests += requests;
+    return true;
+  }();
+  // Only silence (a dead, stopped or starved process) is worth a re-run: a
+  // conflict is tampering, and any other failure the plant reports (e.g. a
+  // non-finite control) is deterministic.
+  if (!ok && (!s.conflict.empty() || (s.Failed() && s.last_summary.message.rfind("no answer from", 0) != 0)))
+    *retryable = false;
+  s.episode_id = 0;
+  return ok;
+}
+
 bool EpisodeClient::Run(const Plant& plant, const PidGains& gains, const LoopOptions& options,
                         const DisturbanceOptions& disturbance, std::vector<double>* y_all,
                         std::vector<SampledStep>* trajectory, std::string* error) {
-  std::string why;
   transport::EpisodeSpec spec;
   try {
     spec = MakeEpisodeSpec(transport::NewEpisodeId(), plant, gains, options, disturbance, options_.recovery);
@@ -267,28 +296,21 @@ bool EpisodeClient::Run(const Plant& plant, const PidGains& gains, const LoopOpt
     if (error) *error = e.what();
     return false;
   }
-  const pidlab::lcmt_episode_config config = transport::MakeEpisodeConfig(spec);
-  State& s = *state_;
-  s.Reset(spec.episode_id, spec.total_steps);
-  // 1. Configuration until all three acknowledge; 2. follow the lockstep
-  // until the last y, then fetch whatever was missed.
-  double done_s = -1;
-  long requests = 0;
-  const bool ok = StartEpisode(config, &why) && [&] {
-    const double t0 = NowSeconds();
-    s.last_progress_s = t0;
-    if (!FollowEpisode(t0, &done_s, &requests, &why)) return false;
-    ++stats_.episodes;
-    stats_.steps += s.total;
-    stats_.seconds += (done_s > 0 ? done_s : NowSeconds()) - t0;
-    stats_.resend_requests += requests;
-    return true;
-  }();
-  s.episode_id = 0;
-  if (!ok) {
-    if (error) *error = why;
-    return false;
+  std::string why;
+  for (int attempt = 1;; ++attempt) {
+    bool retryable = true;
+    if (RunOnce(spec, &why, &retryable)) break;
+    if (!retryable || attempt >= options_.max_attempts) {
+      if (error) *error = attempt > 1 ? why + " (after " + std::to_string(attempt) + " attempts)" : why;
+      return false;
+    }
+    ++stats_.reruns;
+    if (options_.on_note)
+      options_.on_note("episode " + std::to_string(spec.episode_id) + " failed (" + why + "); running it again (attempt " +
+                       std::to_string(attempt + 1) + " of " + std::to_string(options_.max_attempts) + ")");
+    spec.episode_id = transport::NewEpisodeId();
   }
+  const State& s = *state_;
   y_all->assign(s.y.begin(), s.y.end());
   if (trajectory) {
     trajectory->clear();

@@ -20,7 +20,9 @@ struct RecoveryOptions {
   /// Resend the last message after this long without an answer, s (> 0).
   double retransmit_interval_s = 0.002;
   /// Give up after this long without progress, naming the silent process, s.
-  double silence_deadline_s = 1.0;
+  /// Long enough that a loaded machine does not trip it (a process starved
+  /// of CPU for a second is not dead); independent of the resend timer.
+  double silence_deadline_s = 5.0;
 
   bool IsValid(std::string* error) const;
 };

@@ -7,6 +7,7 @@
 // process by name.
 
 #include <lcm/lcm-cpp.hpp>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,6 +36,13 @@ struct EpisodeClientOptions {
   double start_timeout_s = 3.0;
   /// Upper bound on one episode, s.
   double episode_timeout_s = 600.0;
+  /// An episode that fails (a silent or dead process, a timeout) is run again
+  /// as a new episode, up to this many attempts in all. Episodes are
+  /// deterministic, so a re-run gives the result the first run would have.
+  /// Conflicting messages (a forgery, docs/security.md) are never re-run.
+  int max_attempts = 3;
+  /// Where a re-run is noted (one line each). May be empty.
+  std::function<void(const std::string& note)> on_note;
 
   bool IsValid(std::string* error) const;
 };
@@ -44,6 +52,7 @@ struct EpisodeClientStats {
   long steps = 0;         // lockstep steps run
   double seconds = 0.0;   // wall time from the first acknowledgement to the last step
   long resend_requests = 0;  // TRAJECTORY_REQUESTs for steps the client missed
+  long reruns = 0;           // episodes run again after a failure
   double StepsPerSecond() const { return seconds > 0.0 ? static_cast<double>(steps) / seconds : 0.0; }
 };
 
@@ -70,6 +79,9 @@ class EpisodeClient {
   /// Waits for every step (asking the plant again for what was missed) from
   /// t0 on; *done_s is when the last step was heard.
   bool FollowEpisode(double t0, double* done_s, long* requests, std::string* error);
+  /// One attempt: a fresh episode id, start, follow. *retryable is false for
+  /// failures a re-run cannot mend (invalid episode, conflicting messages).
+  bool RunOnce(const transport::EpisodeSpec& spec, std::string* error, bool* retryable);
   std::string Where() const;
 
   std::unique_ptr<lcm::LCM> lcm_;
