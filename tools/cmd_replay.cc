@@ -97,11 +97,37 @@ struct ReplayCommand {
 
   int Run() {
     if (backend == "lcm" && !redrive) throw BadInput("--backend lcm applies to --redrive only");
+    const replay::LogContents log = ReadTheLog();
+    const std::vector<const replay::Episode*> selected = SelectEpisodes(log);
+    std::ofstream csv_file;
+    if (!csv.empty()) OpenCsv(&csv_file);
+    nlohmann::json out = LogJson(log);
+    std::ostringstream table;
+    TableHeader(log, &table);
+    int status = 0;
+    for (const replay::Episode* e : selected) {
+      if (!ReportEpisode(*e, &out["episodes"], &table)) status = 1;
+      if (csv_file.is_open()) WriteCsv(*e, &csv_file);
+    }
+    if (selected.empty()) table << "(no episode in the log)\n";
+    if (json)
+      std::cout << out.dump() << "\n";
+    else
+      std::cout << table.str();
+    return status;
+  }
+
+  replay::LogContents ReadTheLog() const {
     replay::ReadOptions options;
     options.channel_prefix = channel_prefix;
     replay::LogContents log;
     std::string error;
     if (!replay::ReadLog(log_path, options, &log, &error)) throw BadInput(error);
+    return log;
+  }
+
+  // The episodes of --episode (all without it); an id not in the log is bad input.
+  std::vector<const replay::Episode*> SelectEpisodes(const replay::LogContents& log) const {
     std::vector<const replay::Episode*> selected;
     for (const auto& e : log.episodes) {
       if (episodes.empty() || std::find(episodes.begin(), episodes.end(), e.episode_id) != episodes.end())
@@ -112,7 +138,12 @@ struct ReplayCommand {
       for (const auto* e : selected) found = found || e->episode_id == id;
       if (!found) throw BadInput("--episode " + std::to_string(id) + " is not in " + log_path);
     }
+    return selected;
+  }
 
+  // ---- JSON output
+
+  nlohmann::json LogJson(const replay::LogContents& log) const {
     nlohmann::json out;
     out["log"] = log_path;
     out["events"] = log.events;
@@ -128,118 +159,143 @@ struct ReplayCommand {
     out["file_bytes"] = log.file_bytes;
     out["notes"] = log.notes;
     out["episodes"] = nlohmann::json::array();
+    return out;
+  }
 
-    std::ostringstream table;
-    table << "log " << log_path << ": " << log.events << " events, " << log.pidlab_messages
-          << " pidlab messages, " << (log.clean_end ? "read to the end" : "NOT read cleanly to the end")
-          << " (" << log.file_bytes << " bytes)\n";
-    for (const auto& n : log.notes) table << "note: " << n << "\n";
-    table << std::left << std::setw(21) << "episode" << std::setw(10) << "prefix" << std::setw(19) << "plant"
-          << std::setw(26) << "gains kp,ki,kd" << std::setw(8) << "steps" << std::setw(24) << "IAE"
-          << "log\n";
-
-    int status = 0;
-    std::ofstream csv_file;
-    if (!csv.empty()) {
-      csv_file.open(csv);
-      if (!csv_file) throw BadInput("--csv '" + csv + "' cannot be written");
-      csv_file << std::setprecision(17) << "episode,k,t,r,y,u,n,e\n";
+  // The episode without its evaluation and redrive.
+  static nlohmann::json EpisodeJson(const replay::Episode& e) {
+    nlohmann::json j;
+    j["prefix"] = e.prefix;
+    j["episode_id"] = e.episode_id;
+    j["complete"] = e.Complete();
+    j["completeness"] = e.Complete() ? "complete" : e.CompletenessNote();
+    j["total_steps"] = e.total_steps;
+    j["plant_outputs"] = ToJson(e.outputs);
+    j["commands"] = ToJson(e.commands);
+    j["disturbance_samples"] = ToJson(e.disturbances);
+    if (e.has_summary)
+      j["summary"] = {{"status", e.summary_status == 0 ? "ok" : "failed"},
+                      {"step", e.summary_step},
+                      {"message", e.summary_message}};
+    if (e.has_config) {
+      j["plant"] = e.spec.plant.name;
+      j["gains"] = cli::ToJson(e.spec.gains);
+      j["dt_s"] = e.spec.dt_s;
+      j["disturbance"] = ToString(e.spec.disturbance.kind);
+    } else {
+      j["config_error"] = e.config_error;
     }
-    for (const replay::Episode* e : selected) {
-      nlohmann::json j;
-      j["prefix"] = e->prefix;
-      j["episode_id"] = e->episode_id;
-      j["complete"] = e->Complete();
-      j["completeness"] = e->Complete() ? "complete" : e->CompletenessNote();
-      j["total_steps"] = e->total_steps;
-      j["plant_outputs"] = ToJson(e->outputs);
-      j["commands"] = ToJson(e->commands);
-      j["disturbance_samples"] = ToJson(e->disturbances);
-      if (e->has_summary)
-        j["summary"] = {{"status", e->summary_status == 0 ? "ok" : "failed"},
-                        {"step", e->summary_step},
-                        {"message", e->summary_message}};
-      std::string plant = "?", gains = "?", iae = "-";
-      if (e->has_config) {
-        plant = e->spec.plant.name;
-        std::ostringstream g;
-        g << std::setprecision(6) << e->spec.gains.kp << "," << e->spec.gains.ki << "," << e->spec.gains.kd;
-        gains = g.str();
-        j["plant"] = plant;
-        j["gains"] = cli::ToJson(e->spec.gains);
-        j["dt_s"] = e->spec.dt_s;
-        j["disturbance"] = ToString(e->spec.disturbance.kind);
-      } else {
-        j["config_error"] = e->config_error;
-      }
-      Evaluation ev;
-      std::string why;
-      if (replay::EvaluateEpisode(*e, &ev, &why)) {
-        j["evaluation"] = cli::ToJson(ev);
-        iae = Full(ev.iae);
-      } else {
-        j["evaluation"] = nullptr;
-        j["evaluation_error"] = why;
-      }
-      table << std::left << std::setw(21) << e->episode_id << std::setw(10)
-            << (e->prefix.empty() ? "-" : e->prefix) << std::setw(19) << plant << std::setw(26) << gains
-            << std::setw(8) << e->total_steps << std::setw(24) << iae
-            << (e->Complete() ? "complete" : "INCOMPLETE: " + e->CompletenessNote()) << "\n";
-      std::ostringstream details;
-      auto stream = [&details](const char* what, const replay::StreamStats& s) {
-        if (s.duplicates || s.conflicts || s.out_of_order || s.beyond_end || s.filled_from_chunks) {
-          details << "    " << what << ": " << s.received << "/" << s.expected << " received";
-          if (s.duplicates) details << ", " << s.duplicates << " duplicates (retransmissions)";
-          if (s.conflicts) details << ", " << s.conflicts << " CONFLICTING duplicates (first kept)";
-          if (s.out_of_order) details << ", " << s.out_of_order << " out of order";
-          if (s.beyond_end) details << ", " << s.beyond_end << " outside 0..total_steps";
-          if (s.filled_from_chunks)
-            details << ", " << s.filled_from_chunks << " filled from trajectory chunks";
-          details << "\n";
-        }
-      };
-      stream("plant outputs", e->outputs);
-      stream("commands", e->commands);
-      stream("disturbance samples", e->disturbances);
-      if (e->has_summary && e->summary_status != 0)
-        details << "    episode FAILED live: " << e->summary_message << "\n";
-      if (j["evaluation"].is_null() && e->has_config && e->Complete())
-        details << "    not evaluated: " << why << "\n";
-      if (redrive) {
-        const replay::RedriveResult r =
-            backend == "lcm" ? RedriveLive(*e) : replay::Redrive(*e);
-        j["redrive"] = {{"ok", r.ok},
+    return j;
+  }
+
+  static nlohmann::json RedriveJson(const replay::RedriveResult& r) {
+    nlohmann::json j = {{"ok", r.ok},
                         {"steps_checked", r.steps_checked},
                         {"first_mismatch_step", r.first_mismatch},
                         {"message", r.message}};
-        if (r.first_mismatch >= 0) {
-          j["redrive"]["logged_u"] = r.logged_u;
-          j["redrive"]["recomputed_u"] = r.recomputed_u;
-        }
-        details << "    redrive: " << (r.ok ? "OK, " : "FAILED, ") << r.message << "\n";
-        if (!r.ok) status = 1;
-      }
-      table << details.str();
-      if (csv_file.is_open()) {
-        const double r = e->has_config ? e->spec.reference : 1.0;
-        const double dt = e->has_config ? e->spec.dt_s : std::nan("");
-        for (long k = 0; k <= e->total_steps; ++k) {
-          const auto i = static_cast<std::size_t>(k);
-          csv_file << e->episode_id << "," << k << "," << static_cast<double>(k) * dt << "," << r << ","
-                   << e->y[i] << "," << e->u[i] << "," << e->n[i] << "," << r - e->y[i] << "\n";
-        }
-      }
-      out["episodes"].push_back(j);
+    if (r.first_mismatch >= 0) {
+      j["logged_u"] = r.logged_u;
+      j["recomputed_u"] = r.recomputed_u;
     }
-    if (selected.empty()) table << "(no episode in the log)\n";
-    if (json)
-      std::cout << out.dump() << "\n";
-    else
-      std::cout << table.str();
-    return status;
+    return j;
+  }
+
+  // ---- Table output
+
+  void TableHeader(const replay::LogContents& log, std::ostream* table) const {
+    *table << "log " << log_path << ": " << log.events << " events, " << log.pidlab_messages
+           << " pidlab messages, " << (log.clean_end ? "read to the end" : "NOT read cleanly to the end")
+           << " (" << log.file_bytes << " bytes)\n";
+    for (const auto& n : log.notes) *table << "note: " << n << "\n";
+    *table << std::left << std::setw(21) << "episode" << std::setw(10) << "prefix" << std::setw(19) << "plant"
+           << std::setw(26) << "gains kp,ki,kd" << std::setw(8) << "steps" << std::setw(24) << "IAE"
+           << "log\n";
+  }
+
+  static void TableRow(const replay::Episode& e, const std::string& iae, std::ostream* table) {
+    std::string plant = "?", gains = "?";
+    if (e.has_config) {
+      plant = e.spec.plant.name;
+      std::ostringstream g;
+      g << std::setprecision(6) << e.spec.gains.kp << "," << e.spec.gains.ki << "," << e.spec.gains.kd;
+      gains = g.str();
+    }
+    *table << std::left << std::setw(21) << e.episode_id << std::setw(10)
+           << (e.prefix.empty() ? "-" : e.prefix) << std::setw(19) << plant << std::setw(26) << gains
+           << std::setw(8) << e.total_steps << std::setw(24) << iae
+           << (e.Complete() ? "complete" : "INCOMPLETE: " + e.CompletenessNote()) << "\n";
+  }
+
+  // One line per stream with anything besides clean arrivals.
+  static void StreamDetails(const char* what, const replay::StreamStats& s, std::ostream* details) {
+    if (!(s.duplicates || s.conflicts || s.out_of_order || s.beyond_end || s.filled_from_chunks)) return;
+    *details << "    " << what << ": " << s.received << "/" << s.expected << " received";
+    if (s.duplicates) *details << ", " << s.duplicates << " duplicates (retransmissions)";
+    if (s.conflicts) *details << ", " << s.conflicts << " CONFLICTING duplicates (first kept)";
+    if (s.out_of_order) *details << ", " << s.out_of_order << " out of order";
+    if (s.beyond_end) *details << ", " << s.beyond_end << " outside 0..total_steps";
+    if (s.filled_from_chunks) *details << ", " << s.filled_from_chunks << " filled from trajectory chunks";
+    *details << "\n";
+  }
+
+  // ---- One episode: evaluation, table row and details, JSON, redrive
+
+  // Appends the episode's JSON to *episodes_json and its lines to *table;
+  // false if --redrive found a mismatch.
+  bool ReportEpisode(const replay::Episode& e, nlohmann::json* episodes_json, std::ostream* table) const {
+    nlohmann::json j = EpisodeJson(e);
+    Evaluation ev;
+    std::string why;
+    const bool evaluated = replay::EvaluateEpisode(e, &ev, &why);
+    if (evaluated) {
+      j["evaluation"] = cli::ToJson(ev);
+    } else {
+      j["evaluation"] = nullptr;
+      j["evaluation_error"] = why;
+    }
+    TableRow(e, evaluated ? Full(ev.iae) : "-", table);
+    StreamDetails("plant outputs", e.outputs, table);
+    StreamDetails("commands", e.commands, table);
+    StreamDetails("disturbance samples", e.disturbances, table);
+    if (e.has_summary && e.summary_status != 0)
+      *table << "    episode FAILED live: " << e.summary_message << "\n";
+    if (!evaluated && e.has_config && e.Complete()) *table << "    not evaluated: " << why << "\n";
+    const bool ok = !redrive || RedriveEpisode(e, &j, table);
+    episodes_json->push_back(j);
+    return ok;
+  }
+
+  // ---- --redrive
+
+  // Re-drives the episode in process or against the live controller; false
+  // on a mismatch.
+  bool RedriveEpisode(const replay::Episode& e, nlohmann::json* j, std::ostream* table) const {
+    const replay::RedriveResult r = backend == "lcm" ? RedriveLive(e) : replay::Redrive(e);
+    (*j)["redrive"] = RedriveJson(r);
+    *table << "    redrive: " << (r.ok ? "OK, " : "FAILED, ") << r.message << "\n";
+    return r.ok;
+  }
+
+  // ---- CSV
+
+  void OpenCsv(std::ofstream* file) const {
+    file->open(csv);
+    if (!*file) throw BadInput("--csv '" + csv + "' cannot be written");
+    *file << std::setprecision(17) << "episode,k,t,r,y,u,n,e\n";
+  }
+
+  // Steps 0..total_steps of an episode with a configuration (an episode
+  // without one has no per-step data).
+  static void WriteCsv(const replay::Episode& e, std::ofstream* file) {
+    const double r = e.has_config ? e.spec.reference : 1.0;
+    const double dt = e.has_config ? e.spec.dt_s : std::nan("");
+    for (std::size_t i = 0; i < e.y.size(); ++i) {
+      const auto k = static_cast<long>(i);
+      *file << e.episode_id << "," << k << "," << static_cast<double>(k) * dt << "," << r << "," << e.y[i]
+            << "," << e.u[i] << "," << e.n[i] << "," << r - e.y[i] << "\n";
+    }
   }
 };
-
 
 }  // namespace
 std::function<int()> RegisterReplay(CLI::App* app) {

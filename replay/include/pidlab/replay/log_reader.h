@@ -10,7 +10,11 @@
 // not in the log, a cut-off or corrupt tail.
 //
 // Pure library: no printing, no global state. Notes for the user are returned
-// as one-line strings.
+// as one-line strings. ReadLog composes three pieces with headers of their
+// own: EventReader (event_reader.h: lcm-logger's format, lengths checked
+// before anything is allocated), DecoderTable (decoder_table.h: fingerprint
+// -> type and a decoder that bounds every array first) and EpisodeAssembler
+// (episode_assembler.h: episodes sized by their configuration only).
 
 #include <cstdint>
 #include <map>
@@ -29,7 +33,7 @@ struct StreamStats {
   long duplicates = 0;          // repeats of a step with bit-identical content (retransmissions)
   long conflicts = 0;           // repeats of a step with different content (the first is kept)
   long out_of_order = 0;        // first arrivals of a step below one already seen
-  long beyond_end = 0;          // steps outside 0..total_steps (ignored)
+  long beyond_end = 0;          // steps outside 0..total_steps, ignored (see episode_assembler.h)
   long filled_from_chunks = 0;  // missing steps filled from the plant's trajectory chunks
   /// Missing steps as inclusive ranges [first, last] (after filling).
   std::vector<std::pair<long, long>> missing;
@@ -42,8 +46,11 @@ struct Episode {
   bool has_config = false;
   std::string config_error;  // set if a config was logged but is invalid
   transport::EpisodeSpec spec;
+  /// The configuration's total_steps; without a valid configuration, the
+  /// highest step logged within 0..transport::kMaxEpisodeSteps (listing only).
   long total_steps = 0;
-  /// Per step k = 0..total_steps (u, n, status: 0..total_steps-1 used).
+  /// Per step k = 0..total_steps (u, n, status: 0..total_steps-1 used); empty
+  /// for an episode without a valid configuration (never sized by a message).
   std::vector<double> y, u, n;
   std::vector<double> u_input_y;  // the y each command says it was computed from
   std::vector<int> status;        // command status, -1 if unknown
