@@ -64,6 +64,9 @@ Supervisor::~Supervisor() { KillAll(); }
 pid_t Supervisor::Start(const std::string& name, const std::vector<std::string>& args,
                         const std::map<std::string, std::string>& env, int nice) {
   std::vector<std::string> copy = args;
+  // A group whose every process has ended cannot be joined (setpgid fails and
+  // the child would stay in ours, out of KillAll's reach): start a new one.
+  if (pgid_ > 0 && kill(-pgid_, 0) != 0 && errno == ESRCH) pgid_ = -1;
   const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");

@@ -136,11 +136,24 @@ struct EpisodeClient::State {
 EpisodeClient::EpisodeClient(const EpisodeClientOptions& options) : options_(options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
-  lcm_ = std::make_unique<lcm::LCM>(options.lcm_url);
-  if (!lcm_->good())
+  own_lcm_ = std::make_unique<lcm::LCM>(options.lcm_url);
+  if (!own_lcm_->good())
     throw std::runtime_error("cannot start LCM on '" + options.lcm_url +
                              "' (see docs/trio.md: multicast route)");
-  transport_ = std::make_unique<transport::Transport>(lcm_.get(), options.transport);
+  transport_ = std::make_unique<transport::Transport>(own_lcm_.get(), options.transport);
+  Listen();
+}
+
+EpisodeClient::EpisodeClient(const EpisodeClientOptions& options, lcm::LCM* lcm) : options_(options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument(error);
+  if (!lcm || !lcm->good())
+    throw std::runtime_error("the LCM instance given for " + options.lcm_url + " is not good");
+  transport_ = std::make_unique<transport::Transport>(lcm, options.transport);
+  Listen();
+}
+
+void EpisodeClient::Listen() {
   starter_ = std::make_unique<transport::EpisodeStarter>(transport_.get());
   state_ = std::make_unique<State>();
   State* s = state_.get();

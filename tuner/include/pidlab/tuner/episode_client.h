@@ -60,6 +60,13 @@ class EpisodeClient {
  public:
   /// Throws std::runtime_error if LCM cannot be initialised on the URL.
   explicit EpisodeClient(const EpisodeClientOptions& options);
+  /// On `lcm` (not owned: it must outlive the client, and not be handled
+  /// once the client is gone, as a Transport does not unsubscribe) instead of
+  /// an instance of its own on options.lcm_url, which then only names it in
+  /// messages. For roles run in this process (tests): every memq:// instance
+  /// is a queue of its own, so they must share the client's, whose waits then
+  /// handle their messages too.
+  EpisodeClient(const EpisodeClientOptions& options, lcm::LCM* lcm);
   ~EpisodeClient();
 
   /// A SampledRunner: y at every step k = 0..TotalSteps() in *y_all, every
@@ -83,8 +90,10 @@ class EpisodeClient {
   /// failures a re-run cannot mend (invalid episode, conflicting messages).
   bool RunOnce(const transport::EpisodeSpec& spec, std::string* error, bool* retryable);
   std::string Where() const;
+  /// The starter, the state and the subscriptions on transport_.
+  void Listen();
 
-  std::unique_ptr<lcm::LCM> lcm_;
+  std::unique_ptr<lcm::LCM> own_lcm_;
   std::unique_ptr<transport::Transport> transport_;
   std::unique_ptr<transport::EpisodeStarter> starter_;
   std::unique_ptr<State> state_;
