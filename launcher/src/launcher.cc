@@ -232,6 +232,7 @@ bool Launcher::FinishLog(bool interrupted) {
   }
   const RepairSummary summary = log_->Repair();
   const bool ok = summary.status == RepairStatus::kComplete || summary.status == RepairStatus::kRepaired;
+  for (const std::string& line : summary.notes) Note("note: " + line);
   for (const std::string& line : summary.lines) Note(ok ? line : "error: " + line);
   return ok;
 }

@@ -130,18 +130,26 @@ bool LogCapture::FindGaps(std::vector<Gap>* gaps, RepairSummary* summary) const 
     return false;
   }
   gaps->clear();
+  long orphans = 0;
   for (const replay::Episode& e : log.episodes) {
     if (!e.has_config) {
-      // Only its configuration can be missing (steps without it are not
-      // episodes the reader can rebuild); the plant cannot resend it.
-      summary->status = RepairStatus::kIncomplete;
-      summary->lines.push_back(options_.log_file + " is incomplete: episode " + std::to_string(e.episode_id) +
-                               ": " + e.CompletenessNote());
-      return false;
+      // Steps without a configuration in the log: a stranger's messages, or
+      // an episode whose every configuration copy the logger lost (the
+      // client repeats it until all three roles acknowledge). Either way the
+      // plant cannot resend a configuration, and a stranger must not be able
+      // to make the log fail: noted, not repaired.
+      ++orphans;
+      continue;
     }
     if (e.Complete()) continue;
     if (e.has_summary && e.summary_status == pidlab::lcmt_episode_summary::FAILED) continue;
     gaps->push_back({e.episode_id, MissingSteps(e)});
+  }
+  if (orphans > 0 && !noted_orphans_) {
+    noted_orphans_ = true;
+    summary->notes.push_back(std::to_string(orphans) + " episode id(s) in " + options_.log_file +
+                             " have no configuration there (a stranger's messages, or a configuration the "
+                             "logger lost); left as they are (pidlab replay lists them)");
   }
   return true;
 }

@@ -25,7 +25,12 @@ bool TransportOptions::IsValid(std::string* error) const {
   if (!(drop_rate >= 0.0 && drop_rate < 1.0)) {
     os << "drop rate " << drop_rate << " must be in [0, 1)";
   } else if (channel_prefix.find_first_of(" \t\n") != std::string::npos) {
-    os << "channel prefix '" << channel_prefix << "' must not contain white space";
+    os << "channel prefix '" << channel_prefix.substr(0, 80) << "' must not contain white space";
+  } else if (channel_prefix.size() > kMaxChannelPrefixBytes) {
+    // LCM refuses channel names longer than 63 bytes; the longest pidlab
+    // channel name (DISTURBANCE_REQUEST) is 19.
+    os << "channel prefix '" << channel_prefix.substr(0, 80) << "' is longer than " << kMaxChannelPrefixBytes
+       << " bytes";
   } else {
     return true;
   }

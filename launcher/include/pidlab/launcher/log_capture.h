@@ -38,6 +38,8 @@ struct RepairSummary {
   std::map<int64_t, long> republished;  // episode -> steps asked for (all rounds)
   /// One line per problem (kIncomplete, kUnreadable) or the repair (kRepaired).
   std::vector<std::string> lines;
+  /// Informative lines whatever the status (e.g. episodes without a configuration).
+  std::vector<std::string> notes;
 };
 
 struct LogCaptureOptions {
@@ -88,6 +90,7 @@ class LogCapture {
   transport::Transport* transport_;
   Supervisor* supervisor_;
   bool listening_ = false;
+  mutable bool noted_orphans_ = false;
   /// The plant's chunks as this process hears them: (episode, first step) -> count.
   std::map<std::pair<int64_t, int64_t>, int> answers_;
   std::vector<std::pair<int64_t, int64_t>> asked_;

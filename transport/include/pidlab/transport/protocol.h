@@ -13,11 +13,15 @@
 // trajectory (TRAJECTORY chunks) and answers TRAJECTORY_REQUEST. See
 // docs/trio.md for loss recovery.
 
+#include <cstddef>
+
 namespace pidlab::transport {
 
 /// Default LCM URL of a trio (multicast, never leaves the host: ttl=0).
 inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
 inline constexpr const char* kDefaultChannelPrefix = "PIDLAB_";
+/// LCM's channel names are at most 63 bytes; the longest pidlab channel name is 19.
+inline constexpr std::size_t kMaxChannelPrefixBytes = 44;
 
 /// Channel names (without the prefix). See lcmtypes/README.md.
 inline constexpr const char* kEpisodeConfigChannel = "EPISODE_CONFIG";
