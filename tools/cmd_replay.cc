@@ -46,6 +46,7 @@ struct ReplayCommand {
   std::string log_path;
   std::vector<long> episodes;
   std::string channel_prefix;
+  std::string auth_key_file;
   bool json = false;
   std::string csv;
   bool redrive = false;
@@ -64,6 +65,8 @@ struct ReplayCommand {
     app->add_option("--episode", episodes, "only these episode ids (repeatable)")->take_all();
     app->add_option("--channel-prefix", channel_prefix, "only this channel prefix (default: every prefix)");
     app->add_flag("--json", json, "print one JSON object instead of the table");
+    app->add_option("--auth-key", auth_key_file,
+                    "the trio's key (default $PIDLAB_AUTH_KEY_FILE): use only messages whose tag verifies");
     app->add_option("--csv", csv, "write episode,k,t,r,y,u,n,e of the selected episodes to this CSV file");
     app->add_flag(
         "--redrive", redrive,
@@ -120,6 +123,13 @@ struct ReplayCommand {
   replay::LogContents ReadTheLog() const {
     replay::ReadOptions options;
     options.channel_prefix = channel_prefix;
+    const std::string key_file = FromEnv(auth_key_file, transport::kAuthKeyFileEnv, "");
+    if (!key_file.empty()) {
+      transport::AuthKey key;
+      std::string why;
+      if (!transport::LoadAuthKey(key_file, &key, &why)) throw BadInput(why);
+      options.auth_key = key;
+    }
     replay::LogContents log;
     std::string error;
     if (!replay::ReadLog(log_path, options, &log, &error)) throw BadInput(error);
@@ -152,6 +162,8 @@ struct ReplayCommand {
     out["foreign_events"] = log.foreign;
     out["unknown_type_events"] = log.unknown_type;
     out["decode_failures"] = log.decode_failures;
+    out["unauthenticated_events"] = log.unauthenticated;
+    out["unverified_events"] = log.unverified;
     out["other_prefix_events"] = log.other_prefix;
     out["eventnum_gaps"] = log.eventnum_gaps;
     out["clean_end"] = log.clean_end;

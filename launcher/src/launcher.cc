@@ -96,6 +96,7 @@ Launcher::Launcher(const LaunchOptions& options, NoteFn note)
     LogCaptureOptions lopt;
     lopt.log_file = options_.log_file;
     lopt.channel_prefix = options_.channel_prefix;
+    lopt.auth_key = topt.auth_key;
     log_ = std::make_unique<LogCapture>(lopt, transport_.get(), supervisor_.get());
   }
 }

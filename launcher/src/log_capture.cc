@@ -122,6 +122,7 @@ bool LogCapture::WaitForMarker(const std::string& what) {
 bool LogCapture::FindGaps(std::vector<Gap>* gaps, RepairSummary* summary) const {
   replay::ReadOptions read_options;
   read_options.channel_prefix = options_.channel_prefix;
+  read_options.auth_key = options_.auth_key;
   replay::LogContents log;
   std::string error;
   if (!replay::ReadLog(options_.log_file, read_options, &log, &error)) {

@@ -1,5 +1,7 @@
 #include "pidlab/replay/log_reader.h"
 
+#include <algorithm>
+
 #include <cstdio>
 #include <set>
 #include <sstream>
@@ -67,6 +69,25 @@ void CountUnknown(const DecoderTable& table, const LogEvent& ev, Tallies* t) {
   }
 }
 
+enum class Decoded { kOk, kUnverified, kUnauthenticated, kFailed };
+
+// A message as the trio sent it: with a key, only a payload whose tag (the
+// last 32 bytes) verifies; without one, a tagged payload is used unverified.
+Decoded DecodeAuthenticated(const MessageType& type, const ReadOptions& options, const LogEvent& ev,
+                            PidlabMessage* message) {
+  const uint8_t* data = ev.data.data();
+  const std::size_t size = ev.data.size();
+  const bool tagged = size > transport::kAuthTagBytes && type.decode(data, size - transport::kAuthTagBytes, message);
+  if (!options.auth_key) {
+    if (tagged) return Decoded::kUnverified;
+    return type.decode(data, size, message) ? Decoded::kOk : Decoded::kFailed;
+  }
+  if (!tagged) return type.decode(data, size, message) ? Decoded::kUnauthenticated : Decoded::kFailed;
+  const std::size_t payload = size - transport::kAuthTagBytes;
+  const auto tag = transport::AuthTag(*options.auth_key, ev.channel, data, payload);
+  return std::equal(tag.begin(), tag.end(), data + payload) ? Decoded::kOk : Decoded::kUnauthenticated;
+}
+
 // One event: self-test, foreign, unknown, another prefix, undecodable, or a
 // pidlab message for the assembler.
 void HandleEvent(const DecoderTable& table, const ReadOptions& options, const LogEvent& ev,
@@ -89,9 +110,18 @@ void HandleEvent(const DecoderTable& table, const ReadOptions& options, const Lo
     return;
   }
   PidlabMessage message;
-  if (!type->decode(ev.data.data(), ev.data.size(), &message)) {
-    t->decode_failed.Add(ev.channel + " (" + type->name + ", " + std::to_string(ev.data.size()) + " bytes)");
-    return;
+  switch (DecodeAuthenticated(*type, options, ev, &message)) {
+    case Decoded::kOk:
+      break;
+    case Decoded::kUnverified:
+      ++out->unverified;
+      break;
+    case Decoded::kUnauthenticated:
+      ++out->unauthenticated;
+      return;
+    case Decoded::kFailed:
+      t->decode_failed.Add(ev.channel + " (" + type->name + ", " + std::to_string(ev.data.size()) + " bytes)");
+      return;
   }
   ++out->pidlab_messages;
   assembler->Add(prefix, message);
@@ -127,6 +157,12 @@ void RecordTallies(const Tallies& t, LogContents* out) {
   note(t.decode_failed, "pidlab events that do not decode (corrupt payload) ignored");
   note(t.other_prefix, "pidlab events of other channel prefixes skipped");
   note(t.orphans, "episodes whose configuration is not in the log (listed, not evaluated)");
+  if (out->unauthenticated)
+    out->notes.push_back(std::to_string(out->unauthenticated) +
+                         " pidlab events without a valid tag for the key given (forged or unauthenticated) dropped");
+  if (out->unverified)
+    out->notes.push_back(std::to_string(out->unverified) +
+                         " pidlab events carry an authentication tag that was not checked (give --auth-key)");
   note(t.unreadable, "unreadable stretches skipped, reading resumed at the next event marker");
   if (out->self_test) out->notes.push_back(std::to_string(out->self_test) + " LCM self-test events ignored");
 }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -53,6 +54,8 @@ struct LogCaptureOptions {
   int repair_rounds = 6;
   /// How long to wait for the logger to write a marker, s.
   double marker_timeout_s = 10.0;
+  /// The trio's key, if it has one: the log is read with it.
+  std::optional<transport::AuthKey> auth_key;
 };
 
 class LogCapture {

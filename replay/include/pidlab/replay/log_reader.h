@@ -18,9 +18,11 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "pidlab/transport/auth.h"
 #include "pidlab/transport/episode_spec.h"
 
 namespace pidlab::replay {
@@ -71,6 +73,10 @@ struct Episode {
 struct ReadOptions {
   /// Only this channel prefix (empty: every prefix).
   std::string channel_prefix;
+  /// The trio's key (`--auth-key`): a message is used only if its tag
+  /// verifies; untagged and badly tagged ones are counted as unauthenticated.
+  /// Without a key, tagged messages are used unverified (and counted).
+  std::optional<transport::AuthKey> auth_key;
 };
 
 struct LogContents {
@@ -82,6 +88,8 @@ struct LogContents {
   long decode_failures = 0;  // known fingerprint, payload does not decode
   long other_prefix = 0;     // pidlab messages skipped by ReadOptions::channel_prefix
   long orphan_messages = 0;  // episode data without a configuration in the log
+  long unauthenticated = 0;  // with a key: messages without a valid tag, dropped
+  long unverified = 0;       // without a key: tagged messages used without checking their tag
   long eventnum_gaps = 0;    // jumps in the logger's event counter (events lost or corrupted)
   bool clean_end = true;     // the whole file was read
   long long bytes_read = 0, file_bytes = 0;
