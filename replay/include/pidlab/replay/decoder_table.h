@@ -66,8 +66,10 @@ class DecoderTable {
 
 /// True if `data` has the wire layout of the pidlab type `fingerprint`: every
 /// string and array it declares fits in the payload (no more bytes than
-/// present, no negative count). Types without variable-length fields only
-/// need their fixed size (the decoder checks it). False for an unknown type.
+/// present, no negative count) and within the protocol's limits
+/// (transport::WireLayoutOk, the live transport's own check). Types without
+/// variable-length fields only need their fixed size (the decoder checks
+/// it). False for an unknown type.
 bool PayloadLayoutOk(int64_t fingerprint, const uint8_t* data, std::size_t size);
 
 }  // namespace pidlab::replay
