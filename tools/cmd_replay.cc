@@ -113,10 +113,13 @@ struct ReplayCommand {
       if (csv_file.is_open()) WriteCsv(*e, &csv_file);
     }
     if (selected.empty()) table << "(no episode in the log)\n";
-    if (json)
-      std::cout << out.dump() << "\n";
-    else
+    if (json) {
+      // Channel names and texts come from the log: bytes that are not UTF-8
+      // are replaced (U+FFFD) rather than making the dump throw.
+      std::cout << out.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+    } else {
       std::cout << table.str();
+    }
     return status;
   }
 
