@@ -440,6 +440,78 @@ TEST(LoopOptions, RejectsAnInvalidDisturbance) {
   EXPECT_NE(error.find("-2"), std::string::npos) << error;
 }
 
+TEST(LoopOptions, RejectsMoreThanFiftyMillionSampledSteps) {
+  LoopOptions dut;
+  dut.loop = LoopKind::kSampled;
+  dut.dt_s = 1e-7;  // 2.5e8 steps
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("more than 5e7"), std::string::npos) << error;
+  dut.dt_s = 5e-7;  // 5e7 steps: the limit
+  EXPECT_TRUE(dut.IsValid(&error)) << error;
+  EXPECT_EQ(dut.TotalSteps(), kMaxLoopSteps);
+  dut.dt_s = 1e-300;  // a ratio far beyond a long
+  EXPECT_FALSE(dut.IsValid(&error));
+}
+
+TEST(LoopOptions, RejectsMoreThanTenMillionSamples) {
+  LoopOptions dut;
+  dut.sample_time_s = 1e-7;
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("more than 1e7"), std::string::npos) << error;
+  dut.sample_time_s = 1e-300;
+  EXPECT_FALSE(dut.IsValid(&error));
+}
+
+TEST(LoopOptions, RejectsMoreThanAMillionDisturbanceSwitchesOnTheContinuousLoop) {
+  LoopOptions dut;
+  dut.disturbance.kind = DisturbanceKind::kSquare;
+  dut.disturbance.amplitude = 1.0;
+  dut.disturbance.period_s = 1e-6;  // 5e7 switches in 25 s
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("more than 1e6"), std::string::npos) << error;
+  dut.loop = LoopKind::kSampled;  // sampled: one value a step, no switches to follow
+  EXPECT_TRUE(dut.IsValid(&error)) << error;
+  dut.loop = LoopKind::kContinuous;
+  dut.disturbance.kind = DisturbanceKind::kNoise;
+  dut.disturbance.noise_hold_s = 1e-9;
+  EXPECT_FALSE(dut.IsValid(&error));
+  dut.disturbance.noise_hold_s = 0.01;
+  EXPECT_TRUE(dut.IsValid(&error)) << error;
+  EXPECT_DOUBLE_EQ(dut.DisturbanceBreakpoints(), 2501.0);
+  EXPECT_DOUBLE_EQ(dut.StepsPerEvaluation(), 501.0 + kStepsPerBreakpoint * 2501.0);
+}
+
+TEST(LoopOptions, RejectsAHugeDisturbancePhase) {
+  LoopOptions dut;
+  dut.disturbance.kind = DisturbanceKind::kSquare;
+  dut.disturbance.amplitude = 1.0;
+  dut.disturbance.phase_s = 1e300;
+  std::string error;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_NE(error.find("phase 1e+300"), std::string::npos) << error;
+}
+
+TEST(SampleContinuousLoop, EndsOnABreakpointThatDoesNotAdvance) {
+  // Unvalidated: with a phase of 1e300 every breakpoint rounds to t itself,
+  // and the sub-step loop used to spin there.
+  DisturbanceOptions d;
+  d.kind = DisturbanceKind::kSquare;
+  d.amplitude = 1.0;
+  d.phase_s = 1e300;
+  const Disturbance disturbance(d);
+  ContinuousClosedLoop<double> loop;
+  std::string error;
+  ASSERT_TRUE(BuildContinuousClosedLoop<double>(Realize({{1.0}, {1.0, 1.0}}), PidGains{1.0, 1.0, 0.0},
+                                                disturbance, &loop, &error))
+      << error;
+  std::vector<double> y;
+  SampleContinuousLoop<double>(loop, disturbance, 0.05, 11, &y);
+  EXPECT_EQ(y.size(), 11u);
+}
+
 TEST(Evaluate, RejectsANegativeGainAsBadInput) {
   Evaluation ev;
   std::string error;

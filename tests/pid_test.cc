@@ -312,5 +312,14 @@ TEST(PidGains, AcceptsZeroGains) {
   EXPECT_TRUE(GainsAreValid({0.0, 0.0, 0.0}, &error)) << error;
 }
 
+TEST(PidGains, AcceptsGainsUpToTheLimitAndRejectsLargerOnes) {
+  std::string error;
+  EXPECT_TRUE(GainsAreValid({kMaxGain, kMaxGain, kMaxGain}, &error)) << error;
+  EXPECT_FALSE(GainsAreValid({1.0, 1e13, 1.0}, &error));
+  EXPECT_NE(error.find("ki = 1e+13"), std::string::npos) << error;
+  EXPECT_FALSE(GainsAreValid({1e308, 1e308, 1e308}, &error));
+  EXPECT_NE(error.find("kp = 1e+308"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace pidlab

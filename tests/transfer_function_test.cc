@@ -133,6 +133,66 @@ TEST(TransferFunction, RejectsAnInfiniteDenominatorCoefficientNamingIt) {
   EXPECT_NE(error.find("denominator"), std::string::npos) << error;
 }
 
+TEST(TransferFunction, AcceptsAtMostSixtyFourCoefficients) {
+  std::string error;
+  const std::vector<double> ones(kMaxTransferFunctionCoefficients, 1.0);
+  EXPECT_TRUE((TransferFunction{{1.0}, ones}.IsValid(&error))) << error;
+  std::vector<double> too_many = ones;
+  too_many.push_back(1.0);
+  EXPECT_FALSE((TransferFunction{{1.0}, too_many}.IsValid(&error)));
+  EXPECT_NE(error.find("denominator has 65 coefficients, more than 64"), std::string::npos) << error;
+  EXPECT_FALSE((TransferFunction{too_many, too_many}.IsValid(&error)));
+  EXPECT_NE(error.find("numerator has 65"), std::string::npos) << error;
+  EXPECT_FALSE((TransferFunction{{1.0}, std::vector<double>(20000, 1.0)}.IsValid(&error)));
+  EXPECT_NE(error.find("20000"), std::string::npos) << error;
+}
+
+TEST(TransferFunction, RejectsCoefficientsBeyondTheMagnitudeLimitsNamingThem) {
+  std::string error;
+  EXPECT_TRUE((TransferFunction{{1e12}, {1e-12, 0.0, -1e12}}.IsValid(&error))) << error;
+  EXPECT_FALSE((TransferFunction{{1.0}, {1.0, 1e13, 1.0}}.IsValid(&error)));
+  EXPECT_NE(error.find("denominator coefficient 1e+13"), std::string::npos) << error;
+  EXPECT_FALSE((TransferFunction{{-1e308}, {1.0, 1.0}}.IsValid(&error)));
+  EXPECT_NE(error.find("numerator coefficient -1e+308"), std::string::npos) << error;
+  // A tiny leading coefficient would overflow the realisation (1e12 / 1e-300).
+  EXPECT_FALSE((TransferFunction{{1.0}, {1e-300, 1e12, 1.0}}.IsValid(&error)));
+  EXPECT_NE(error.find("1e-300"), std::string::npos) << error;
+}
+
+TEST(BalanceInPlace, TerminatesOnAMatrixWithInfiniteEntries) {
+  // Row 1 has an infinite column norm against a finite row norm: halving inf
+  // never balanced it, and this call spun forever.
+  Eigen::MatrixXd a(2, 2);
+  a << 0.0, kInf, 1.0, 0.0;
+  BalanceInPlace(&a);
+  Eigen::MatrixXd b = Eigen::MatrixXd::Constant(3, 3, kNaN);
+  BalanceInPlace(&b);
+  Eigen::MatrixXd c(3, 3);
+  c << 1e308, 1e308, 1e308, 1e-308, 0.0, kInf, 1.0, -kInf, 1.0;
+  const Eigen::VectorXd d = BalanceInPlace(&c);
+  EXPECT_EQ(d.size(), 3);
+}
+
+TEST(MatrixExp, ReturnsOnAnInfiniteMatrix) {
+  Eigen::MatrixXd a(2, 2);
+  a << 0.0, kInf, 1.0, 0.0;
+  const Eigen::MatrixXd e = MatrixExp<double>(a);
+  EXPECT_FALSE(e.allFinite());
+}
+
+TEST(MakePlant, RejectsStepperParametersWhoseCoefficientsAreOutOfRange) {
+  StepperMotorParameters p;
+  p.inertia_kg_m2 = 1e-300;
+  Plant plant;
+  std::string error;
+  EXPECT_FALSE(MakePlant("stepper", p, &plant, &error));
+  EXPECT_NE(error.find("stepper motor parameters"), std::string::npos) << error;
+  p = StepperMotorParameters{};
+  p.rotor_teeth = 1e13;
+  EXPECT_FALSE(MakePlant("stepper", p, &plant, &error));
+  EXPECT_NE(error.find("rotor_teeth"), std::string::npos) << error;
+}
+
 TEST(TransferFunction, RejectsAnImproperTransferFunctionNamingTheDegrees) {
   const TransferFunction dut{{1.0, 0.0, 0.0, 1.0}, {1.0, 2.0, 1.0}};
   std::string error;

@@ -196,6 +196,30 @@ TEST(TuneOptions, RejectsNegativeLowerBound) {
   EXPECT_NE(error.find("-1"), std::string::npos);
 }
 
+TEST(TuneOptions, BoundsLoopStepsTimesTheEvaluationBudget) {
+  TuneOptions options;
+  options.loop.loop = LoopKind::kSampled;
+  options.loop.dt_s = 1e-5;  // 2.5e6 steps x 5000 evaluations
+  std::string error;
+  EXPECT_EQ(options.EvaluationBudget(), 5000);
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("more than 5e9"), std::string::npos) << error;
+  options.max_evaluations = 1000;  // 2.5e9 steps
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+  options.max_evaluations = 0;
+  options.method = TuneMethod::kZieglerNichols;  // one evaluation
+  EXPECT_EQ(options.EvaluationBudget(), 1);
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+}
+
+TEST(TuneOptions, RejectsAnUpperBoundAboveTheGainLimit) {
+  TuneOptions options;
+  options.upper = 1e13;
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("1e+13"), std::string::npos) << error;
+}
+
 TEST(TuneOptions, RejectsZeroStarts) {
   TuneOptions options;
   options.starts = 0;

@@ -1,14 +1,129 @@
 #include "cli_common.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
 
+#include "pidlab/transport/wire.h"
+
 namespace pidlab::cli {
+
+// The CLI's limits agree with the wire format's (the libraries below cannot
+// see each other's headers).
+static_assert(kMaxTransferFunctionCoefficients == transport::kMaxPolynomialCoefficients,
+              "plant_sim and transport disagree on the longest polynomial");
+static_assert(kMaxLoopSteps == transport::kMaxEpisodeSteps,
+              "the sampled loop and the trio disagree on the longest episode");
+static_assert(kMaxGain == kMaxInputMagnitude && kMaxCoefficientMagnitude == kMaxInputMagnitude &&
+                  kMaxDisturbanceMagnitude == kMaxInputMagnitude,
+              "one magnitude limit for every number typed");
+
+std::string Truncate(const std::string& text, std::size_t max_chars) {
+  const std::string marker = "...(" + std::to_string(text.size()) + " chars)";
+  const std::size_t keep = max_chars > marker.size() ? max_chars - marker.size() : 0;
+  std::string out;
+  std::size_t head = 0;  // the longest prefix of whole pieces that leaves room for the marker
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c < 0x20 || c == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    } else {
+      out += ch;
+    }
+    if (out.size() <= keep) head = out.size();
+    if (out.size() > max_chars) return out.substr(0, head) + marker;
+  }
+  return out;
+}
+
+std::string Quote(const std::string& text) { return "'" + Truncate(text) + "'"; }
+
+namespace {
+
+// "" if `text` is a finite number within kMaxInputMagnitude, else why not.
+std::string CheckNumberText(const std::string& text, bool allow_infinite) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(begin, &end);
+  if (text.empty() || end == begin || *end != '\0' || std::isnan(v)) return Quote(text) + " is not a number";
+  if (std::isinf(v) && allow_infinite && errno != ERANGE) return "";
+  if (errno == ERANGE || !std::isfinite(v) || std::abs(v) > kMaxInputMagnitude) {
+    std::ostringstream os;
+    os << Quote(text) << " is out of range: numbers must be finite and at most " << kMaxInputMagnitude
+       << " in magnitude";
+    return os.str();
+  }
+  return "";
+}
+
+}  // namespace
+
+// The validators have no description, so that --help is unchanged.
+CLI::Validator FiniteNumber() {
+  return CLI::Validator([](std::string& text) { return CheckNumberText(text, false); }, "", "finite number");
+}
+
+CLI::Validator NumberOrInfinity() {
+  return CLI::Validator([](std::string& text) { return CheckNumberText(text, true); }, "", "number or inf");
+}
+
+CLI::Validator WholeNumber() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        const bool digits =
+            !text.empty() && text.size() <= 20 && text.find_first_not_of("0123456789") == std::string::npos;
+        errno = 0;
+        if (digits) std::strtoull(text.c_str(), nullptr, 10);
+        if (!digits || errno == ERANGE)
+          return Quote(text) + " must be a whole number from 0 to 18446744073709551615";
+        return "";
+      },
+      "", "whole number");
+}
+
+void CheckOutputFile(const std::string& path, const std::string& flag) {
+  if (path.empty()) return;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw BadInput(flag + " " + Quote(path) + " is a folder, not a file");
+  const bool existed = std::filesystem::exists(std::filesystem::symlink_status(path, ec));
+  // O_NONBLOCK: a FIFO without a reader fails with ENXIO instead of blocking.
+  const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_NONBLOCK | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    if (errno == ENXIO) return;
+    throw BadInput(flag + " " + Quote(path) + " cannot be written: " + std::strerror(errno));
+  }
+  ::close(fd);
+  if (!existed) std::remove(path.c_str());
+}
+
+void PrepareOutputDir(const std::string& dir, const std::string& flag) {
+  if (dir.empty()) throw BadInput(flag + " must name a folder");
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw BadInput(flag + " " + Quote(dir) + " cannot be created: " + ec.message());
+  if (!std::filesystem::is_directory(dir, ec)) throw BadInput(flag + " " + Quote(dir) + " is not a folder");
+  std::string probe = (std::filesystem::path(dir) / ".pidlab-write-test-XXXXXX").string();
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0) throw BadInput(flag + " " + Quote(dir) + " cannot be written: " + std::strerror(errno));
+  ::close(fd);
+  std::remove(probe.c_str());
+}
 
 std::string FromEnv(const std::string& flag, const char* env, const char* fallback) {
   if (!flag.empty()) return flag;
@@ -17,26 +132,34 @@ std::string FromEnv(const std::string& flag, const char* env, const char* fallba
 }
 
 void LcmFlags::Register(CLI::App* app) {
-  app->add_option("--lcm-url", lcm_url, "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's)");
+  app->add_option("--lcm-url", lcm_url,
+                  "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's)");
   app->add_option("--channel-prefix", channel_prefix,
                   "--backend lcm: channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
-  app->add_option("--episode-timeout", episode_timeout_s, "--backend lcm: give up on an episode after this many s")
+  app->add_option("--episode-timeout", episode_timeout_s,
+                  "--backend lcm: give up on an episode after this many s")
+      ->check(FiniteNumber())
       ->capture_default_str();
-  app->add_option("--silence-deadline", silence_deadline_s,
-                  "--backend lcm: an episode fails after this many s without progress, naming the silent process")
+  app->add_option(
+         "--silence-deadline", silence_deadline_s,
+         "--backend lcm: an episode fails after this many s without progress, naming the silent process")
+      ->check(FiniteNumber())
       ->capture_default_str();
-  app->add_option("--max-attempts", max_attempts,
-                  "--backend lcm: run a failed episode again (as a new episode) up to this many attempts in all")
+  app->add_option(
+         "--max-attempts", max_attempts,
+         "--backend lcm: run a failed episode again (as a new episode) up to this many attempts in all")
       ->capture_default_str();
-  app->add_option("--auth-key", auth_key_file,
-                  "--backend lcm: authenticate every message with the key in this file (docs/security.md; default "
-                  "$PIDLAB_AUTH_KEY_FILE)");
+  app->add_option(
+      "--auth-key", auth_key_file,
+      "--backend lcm: authenticate every message with the key in this file (docs/security.md; default "
+      "$PIDLAB_AUTH_KEY_FILE)");
 }
 
 std::unique_ptr<EpisodeClient> LcmFlags::MakeClient() const {
   EpisodeClientOptions co;
   co.lcm_url = FromEnv(lcm_url, "PIDLAB_LCM_URL", transport::kDefaultLcmUrl);
-  co.transport.channel_prefix = FromEnv(channel_prefix, "PIDLAB_CHANNEL_PREFIX", transport::kDefaultChannelPrefix);
+  co.transport.channel_prefix =
+      FromEnv(channel_prefix, "PIDLAB_CHANNEL_PREFIX", transport::kDefaultChannelPrefix);
   co.episode_timeout_s = episode_timeout_s;
   co.recovery.silence_deadline_s = silence_deadline_s;
   co.max_attempts = max_attempts;
@@ -52,29 +175,25 @@ std::unique_ptr<EpisodeClient> LcmFlags::MakeClient() const {
   return std::make_unique<EpisodeClient>(co);  // throws runtime_error: exit 1
 }
 
-double ParseDouble(const std::string& text, const std::string& what) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(begin, &end);
-  if (text.empty() || end == begin || *end != '\0' || errno == ERANGE)
-    throw BadInput(what + " '" + text + "' is not a number");
-  return v;
+double ParseDouble(const std::string& text, const std::string& what, bool allow_infinite) {
+  const std::string why = CheckNumberText(text, allow_infinite);
+  if (!why.empty()) throw BadInput(what + " " + why);
+  return std::strtod(text.c_str(), nullptr);
 }
 
-std::vector<double> ParseList(const std::string& text, const std::string& what) {
+std::vector<double> ParseList(const std::string& text, const std::string& what, bool allow_infinite) {
   std::vector<double> out;
   std::stringstream ss(text);
   std::string item;
-  while (std::getline(ss, item, ',')) out.push_back(ParseDouble(item, what));
+  while (std::getline(ss, item, ',')) out.push_back(ParseDouble(item, what, allow_infinite));
   if (out.empty() || (!text.empty() && text.back() == ','))
-    throw BadInput(what + " '" + text + "' must be a comma-separated list of numbers");
+    throw BadInput(what + " " + Quote(text) + " must be a comma-separated list of numbers");
   return out;
 }
 
 PidGains ParseGains(const std::string& text) {
   const auto v = ParseList(text, "--gains");
-  if (v.size() != 3) throw BadInput("--gains '" + text + "' must be three numbers KP,KI,KD");
+  if (v.size() != 3) throw BadInput("--gains " + Quote(text) + " must be three numbers KP,KI,KD");
   const PidGains g{v[0], v[1], v[2]};
   std::string error;
   if (!GainsAreValid(g, &error)) throw BadInput(error);
@@ -102,8 +221,8 @@ Plant PlantFlags::Build() const {
   Plant p;
   const bool custom = !num.empty() || !den.empty();
   if (custom && !plant.empty() && plant != "custom")
-    throw BadInput("--plant '" + plant +
-                   "' cannot be combined with --num/--den (use --plant custom or omit it)");
+    throw BadInput("--plant " + Quote(plant) +
+                   " cannot be combined with --num/--den (use --plant custom or omit it)");
   if (custom) {
     if (num.empty() || den.empty()) throw BadInput("a custom plant needs both --num and --den");
     if (!MakeCustomPlant(ParseList(num, "--num"), ParseList(den, "--den"), &p, &error)) throw BadInput(error);
@@ -114,9 +233,8 @@ Plant PlantFlags::Build() const {
   StepperMotorParameters sp;
   for (const auto& kv : stepper_overrides) {
     const auto eq = kv.find('=');
-    if (eq == std::string::npos) throw BadInput("--stepper '" + kv + "' must be NAME=VALUE");
+    if (eq == std::string::npos) throw BadInput("--stepper " + Quote(kv) + " must be NAME=VALUE");
     const std::string name = kv.substr(0, eq);
-    const double v = ParseDouble(kv.substr(eq + 1), "--stepper " + name);
     double* field = nullptr;
     if (name == "resistance_ohm")
       field = &sp.resistance_ohm;
@@ -137,12 +255,14 @@ Plant PlantFlags::Build() const {
     else if (name == "flux_linkage")
       field = &sp.flux_linkage;
     else
-      throw BadInput("--stepper parameter '" + name + "' is unknown");
-    *field = v;
+      throw BadInput("--stepper parameter " + Quote(name) + " is unknown");
+    *field = ParseDouble(kv.substr(eq + 1), "--stepper " + name);
   }
   if (!stepper_overrides.empty() && plant != "stepper_motor" && plant != "stepper")
-    throw BadInput("--stepper overrides apply only to --plant stepper_motor, not '" + plant + "'");
-  if (!MakePlant(plant, sp, &p, &error)) throw BadInput(error);
+    throw BadInput("--stepper overrides apply only to --plant stepper_motor, not " + Quote(plant));
+  // A plant name is printable and short, so Truncate leaves every valid one
+  // as it is, and MakePlant's "unknown plant '...'" echoes at most 200 chars.
+  if (!MakePlant(Truncate(plant), sp, &p, &error)) throw BadInput(error);
   return p;
 }
 
@@ -151,31 +271,43 @@ void LoopFlags::Register(CLI::App* app) {
                   "continuous (exact, ideal PID) or sampled (discrete PID at --dt, ZOH plant)")
       ->capture_default_str();
   app->add_option("--dt", dt_s, "sampled-loop period in s; --sample-time must be a multiple")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option("--sample-time", sample_time_s, "ts of eq. (4): spacing of the error samples in s")
+      ->check(FiniteNumber())
       ->capture_default_str();
-  app->add_option("--horizon", horizon_s, "n of eq. (4): last sample time in s")->capture_default_str();
+  app->add_option("--horizon", horizon_s, "n of eq. (4): last sample time in s")
+      ->check(FiniteNumber())
+      ->capture_default_str();
   app->add_option("--stability-margin", stability_margin,
                   "strict stability: Re p < -margin*max(1,|p|), p = s-plane pole (sampled: p = log(z)/dt)")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option(
       "--disturbance", disturbance,
       "none|square|step|sine|noise at the plant input (default: square if an amplitude is given)");
   app->add_option("--disturbance-amplitude", disturbance_amplitude,
                   "square +/-A, step height, sine peak or noise std deviation")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option("--disturbance-period", disturbance_period_s, "square/sine period in s")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option("--disturbance-phase", disturbance_phase_s, "time shift of the disturbance in s")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option("--disturbance-step-time", disturbance_step_time_s, "step disturbance time in s")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option("--noise-hold", noise_hold_s, "noise is held constant over this interval in s")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option("--seed", seed, "seed of the noise disturbance (and of the search, for tune)")
+      ->check(WholeNumber())
       ->capture_default_str();
   app->add_option("--derivative-filter", derivative_filter_s,
                   "sampled PID: derivative filter time constant in s")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option("--output-limits", output_limits, "sampled PID: output limits LO,HI");
   app->add_option("--anti-windup", anti_windup, "sampled PID: none|clamping|back-calculation")
@@ -187,7 +319,8 @@ void LoopFlags::Register(CLI::App* app) {
 
 LoopOptions LoopFlags::Build() const {
   LoopOptions o;
-  if (!ParseLoopKind(loop, &o.loop)) throw BadInput("--loop '" + loop + "' must be continuous or sampled");
+  if (!ParseLoopKind(loop, &o.loop))
+    throw BadInput("--loop " + Quote(loop) + " must be continuous or sampled");
   o.dt_s = dt_s;
   o.sample_time_s = sample_time_s;
   o.horizon_s = horizon_s;
@@ -196,7 +329,7 @@ LoopOptions LoopFlags::Build() const {
   if (disturbance.empty()) {
     d.kind = disturbance_amplitude != 0.0 ? DisturbanceKind::kSquare : DisturbanceKind::kNone;
   } else if (!ParseDisturbanceKind(disturbance, &d.kind)) {
-    throw BadInput("--disturbance '" + disturbance + "' must be none, square, step, sine or noise");
+    throw BadInput("--disturbance " + Quote(disturbance) + " must be none, square, step, sine or noise");
   }
   d.amplitude = disturbance_amplitude;
   d.period_s = disturbance_period_s;
@@ -207,17 +340,17 @@ LoopOptions LoopFlags::Build() const {
   o.pid.dt_s = dt_s;
   o.pid.derivative_filter_s = derivative_filter_s;
   if (!output_limits.empty()) {
-    const auto v = ParseList(output_limits, "--output-limits");
-    if (v.size() != 2) throw BadInput("--output-limits '" + output_limits + "' must be LO,HI");
+    const auto v = ParseList(output_limits, "--output-limits", /*allow_infinite=*/true);  // inf: no limit
+    if (v.size() != 2) throw BadInput("--output-limits " + Quote(output_limits) + " must be LO,HI");
     o.pid.output_min = v[0];
     o.pid.output_max = v[1];
   }
   if (!ParseAntiWindup(anti_windup, &o.pid.anti_windup))
-    throw BadInput("--anti-windup '" + anti_windup + "' must be none, clamping or back-calculation");
+    throw BadInput("--anti-windup " + Quote(anti_windup) + " must be none, clamping or back-calculation");
   if (!ParseDerivativeOn(derivative_on, &o.pid.derivative_on))
-    throw BadInput("--derivative-on '" + derivative_on + "' must be error or measurement");
+    throw BadInput("--derivative-on " + Quote(derivative_on) + " must be error or measurement");
   if (!ParseIntegralMethod(integral, &o.pid.integral))
-    throw BadInput("--integral '" + integral + "' must be backward-euler, forward-euler or trapezoidal");
+    throw BadInput("--integral " + Quote(integral) + " must be backward-euler, forward-euler or trapezoidal");
   std::string error;
   if (!o.IsValid(&error)) throw BadInput(error);
   return o;
@@ -315,10 +448,12 @@ std::string FormatEvaluation(const Evaluation& ev) {
 
 void WriteSamplesCsv(const Evaluation& ev, const std::string& path) {
   std::ofstream f(path);
-  if (!f) throw std::runtime_error("cannot write " + path);
+  if (!f) throw BadInput("--samples-csv " + Quote(path) + " cannot be written");
   f << std::setprecision(17) << "t,r,y,e,n\n";
   for (std::size_t m = 0; m < ev.y.size(); ++m)
     f << ev.t[m] << ",1," << ev.y[m] << "," << 1.0 - ev.y[m] << "," << ev.n[m] << "\n";
+  f.close();
+  if (!f) throw std::runtime_error("writing " + path + " failed");
 }
 
 }  // namespace pidlab::cli

@@ -17,9 +17,41 @@
 namespace pidlab::cli {
 
 /// Thrown for bad user input; main prints "pidlab <cmd>: error: <what>" and exits 2.
+/// Bad input is anything the user typed, an output path that cannot be
+/// written included; a runtime failure (LCM, gnuplot, a full disk) exits 1.
 struct BadInput : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// Every number typed on the command line is finite and at most this in
+/// magnitude (README.md, "Exit status and limits").
+inline constexpr double kMaxInputMagnitude = 1e12;
+/// The most points `plot` draws over all its curves, and the most rows of
+/// `evaluate --trajectory-csv` (every step is kept in memory first).
+inline constexpr long kMaxRecordedPoints = 10000000;
+/// The most characters of a user's value an error message echoes.
+inline constexpr std::size_t kMaxEchoedChars = 120;
+
+/// `text` made printable on one line (control characters escaped as \n,
+/// \xHH) and cut to at most `max_chars`, the cut marked "...(N chars)".
+std::string Truncate(const std::string& text, std::size_t max_chars = kMaxEchoedChars);
+/// 'Truncate(text)': how every error message quotes a user's value.
+std::string Quote(const std::string& text);
+
+/// CLI11 check of a floating-point flag: a finite number of magnitude at most
+/// kMaxInputMagnitude.
+CLI::Validator FiniteNumber();
+/// The same, or +/-inf where infinity means "none" (tune --max-overshoot).
+CLI::Validator NumberOrInfinity();
+/// CLI11 check of an unsigned flag (--seed): digits only, so "-1" is refused
+/// instead of wrapping around to 2^64 - 1.
+CLI::Validator WholeNumber();
+
+/// Bad input unless `path` can be opened for writing (created if absent, then
+/// removed again; an existing file is left as it is). Run before any work.
+void CheckOutputFile(const std::string& path, const std::string& flag);
+/// Creates the folder `dir` if needed; bad input unless a file can be written in it.
+void PrepareOutputDir(const std::string& dir, const std::string& flag);
 
 /// A flag's value, else the environment variable's (what `pidlab launch`
 /// exports to its COMMAND), else the fallback.
@@ -39,10 +71,11 @@ struct LcmFlags {
   std::unique_ptr<EpisodeClient> MakeClient() const;
 };
 
-/// Strict number parsing: the whole string must be a finite-or-not double.
-double ParseDouble(const std::string& text, const std::string& what);
+/// Strict number parsing: the whole string must be a number, finite and at
+/// most kMaxInputMagnitude in magnitude (or +/-inf if `allow_infinite`).
+double ParseDouble(const std::string& text, const std::string& what, bool allow_infinite = false);
 /// "a,b,c" -> {a, b, c}; throws BadInput naming `what`.
-std::vector<double> ParseList(const std::string& text, const std::string& what);
+std::vector<double> ParseList(const std::string& text, const std::string& what, bool allow_infinite = false);
 PidGains ParseGains(const std::string& text);
 
 /// --plant / --num / --den / --stepper NAME=VALUE.
@@ -74,7 +107,7 @@ nlohmann::json ToJson(const PidGains& g);
 std::string FormatPoles(const std::vector<std::complex<double>>& poles);
 /// Human-readable report of one evaluation.
 std::string FormatEvaluation(const Evaluation& ev);
-/// CSV of the sample times: t,r,y,e,n.
+/// CSV of the sample times: t,r,y,e,n. BadInput if `path` cannot be opened.
 void WriteSamplesCsv(const Evaluation& ev, const std::string& path);
 
 }  // namespace pidlab::cli

@@ -54,12 +54,19 @@ struct EvaluateCommand {
     what.record_trajectory = !trajectory_csv.empty();
     if (what.record_trajectory && options.loop != LoopKind::kSampled && backend == "local")
       throw BadInput("--trajectory-csv needs --loop sampled");
+    if (what.record_trajectory && options.TotalSteps() + 1 > kMaxRecordedPoints)
+      throw BadInput(
+          "--trajectory-csv would have horizon / dt + 1 = " + std::to_string(options.TotalSteps() + 1) +
+          " rows, more than 1e7: use a coarser --dt or a shorter --horizon");
+    // Unwritable output is bad input, found before any work.
+    CheckOutputFile(samples_csv, "--samples-csv");
+    CheckOutputFile(trajectory_csv, "--trajectory-csv");
     Evaluation ev;
     std::string error;
     std::unique_ptr<EpisodeClient> client;
     if (backend == "lcm") {
       if (app_->count("--loop") > 0 && options.loop != LoopKind::kSampled)
-        throw BadInput("--backend lcm runs the sampled loop, not --loop " + loop.loop);
+        throw BadInput("--backend lcm runs the sampled loop, not --loop " + Quote(loop.loop));
       options.loop = LoopKind::kSampled;
       client = lcm.MakeClient();
       std::string runner_error;
@@ -96,7 +103,7 @@ struct EvaluateCommand {
 
   static void WriteTrajectoryCsv(const Evaluation& ev, const std::string& path) {
     FILE* f = std::fopen(path.c_str(), "w");
-    if (!f) throw BadInput("cannot write --trajectory-csv " + path);
+    if (!f) throw BadInput("--trajectory-csv " + Quote(path) + " cannot be written");
     std::fprintf(f, "k,t,r,y,u,n\n");
     for (const SampledStep& s : ev.trajectory)
       std::fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.k, s.t, s.r, s.y, s.u, s.n);

@@ -42,8 +42,10 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
                 "loopback: nothing leaves the machine");
   app->add_option("--drop-rate", o.drop_rate,
                   "fault injection in each process: fraction of received messages thrown away")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option("--ready-timeout", o.ready_timeout_s, "seconds to wait for the trio to be ready")
+      ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option(
       "--auth-key", o.auth_key_file,
@@ -54,6 +56,8 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
   return [flags] {
     std::string error;
     if (!flags->options.IsValid(&error)) throw BadInput(error);
+    // An unwritable --log is bad input (exit 2), found before anything starts.
+    CheckOutputFile(flags->options.log_file, "--log");
     if (flags->isolated && !launcher::EnterIsolatedNetwork(&error)) throw std::runtime_error(error);
     struct sigaction sa {};
     sa.sa_handler = OnSignal;

@@ -51,6 +51,7 @@ struct PlotCommand {
     if (!log_path.empty()) {
       if (!gains.empty() || !plant.plant.empty() || !plant.num.empty())
         throw BadInput("--log cannot be combined with --plant/--gains (the log carries its own)");
+      PrepareOutputDir(out_dir, "--out");  // bad input before any work
       std::string report;
       if (!LogFigure(log_path, episodes, &figure, &report, &error)) throw BadInput(error);
       if (!report.empty()) std::cerr << report;
@@ -62,14 +63,18 @@ struct PlotCommand {
       const LoopOptions options = loop.Build();
       std::vector<PidGains> sets;
       for (const auto& g : gains) sets.push_back(ParseGains(g));
+      const long points = options.loop == LoopKind::kSampled ? options.TotalSteps() : options.NumSamples();
+      if (static_cast<double>(points) * static_cast<double>(sets.size()) > kMaxRecordedPoints)
+        throw BadInput(
+            std::to_string(sets.size()) + " curve(s) of " + std::to_string(points) +
+            " points each are more than 1e7 points: use a coarser --dt or --sample-time, a shorter "
+            "--horizon or fewer --gains");
+      PrepareOutputDir(out_dir, "--out");  // bad input before any work
       if (!EvaluationFigure(p, sets, options, &figure, &error)) throw BadInput(error);
       if (name.empty()) name = "evaluation";
     }
     if (name.empty() || name.find('/') != std::string::npos)
-      throw BadInput("--name '" + name + "' must be a plain file name stem");
-    std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
-    if (ec) throw BadInput("--out '" + out_dir + "' cannot be created: " + ec.message());
+      throw BadInput("--name " + Quote(name) + " must be a plain file name stem");
     figure.output_path = out_dir + "/" + name + ".png";
     figure.data_dir = out_dir + "/" + name + "_data";
     if (!figure.IsValid(&error)) throw BadInput(error);
@@ -78,7 +83,6 @@ struct PlotCommand {
     return 0;
   }
 };
-
 
 }  // namespace
 std::function<int()> RegisterPlot(CLI::App* app) {

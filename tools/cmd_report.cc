@@ -33,12 +33,14 @@ struct ReportCommand {
     app->add_option("--out", out_dir, "output folder (created if needed)")->capture_default_str();
     app->add_option("--paper-tables", paper_tables,
                     "the paper's tables (CSV); default: the copy of data/paper_tables.csv built into pidlab");
-    app->add_option("--seed", seed, "seed of every stochastic tuner")->capture_default_str();
+    app->add_option("--seed", seed, "seed of every stochastic tuner")
+        ->check(WholeNumber())
+        ->capture_default_str();
     app->add_flag("--quick", quick, "reduced tuning budgets (one start; smoke tests)");
     app->add_flag("--no-figures", no_figures, "write report.md only");
     app->add_flag("--no-trio", no_trio,
-                  "skip the LCM trio episode (25 s of lockstep, under 20 s here; --quick skips it too); the section then shows the "
-                  "in-process sampled loop only");
+                  "skip the LCM trio episode (25 s of lockstep, under 20 s here; --quick skips it too); the "
+                  "section then shows the in-process sampled loop only");
     return [this] { return Run(); };
   }
 
@@ -49,7 +51,6 @@ struct ReportCommand {
     options.seed = seed;
     options.quick = quick;
     options.figures = !no_figures;
-    std::filesystem::create_directories(out_dir);
     options.trio_absent_note = no_trio ? "skipped (--no-trio)" : "skipped (--quick)";
     if (!no_trio && !quick) {
       const std::string log = (std::filesystem::path(out_dir) / "trio.log").string();
@@ -63,14 +64,16 @@ struct ReportCommand {
     std::vector<report::PaperRow> paper;
     std::string error;
     if (options.paper_tables.empty()) {
-      if (!report::ParsePaperTables(report::BuiltinPaperTablesCsv(), "data/paper_tables.csv (built in)", &paper,
-                                    &error))
+      if (!report::ParsePaperTables(report::BuiltinPaperTablesCsv(), "data/paper_tables.csv (built in)",
+                                    &paper, &error))
         throw std::runtime_error(error);
     } else {
       if (!std::filesystem::is_regular_file(options.paper_tables))
-        throw BadInput("paper tables not found: " + options.paper_tables + " (use --paper-tables FILE)");
+        throw BadInput("paper tables not found: " + Quote(options.paper_tables) +
+                       " (use --paper-tables FILE)");
       if (!report::ReadPaperTables(options.paper_tables, &paper, &error)) throw BadInput(error);
     }
+    PrepareOutputDir(out_dir, "--out");  // an unwritable folder is bad input (exit 2), before the work
     report::ReportData data;
     if (!report::ComputeReport(options, paper, &data, &error)) throw std::runtime_error(error);
     if (!report::WriteReport(&data, &error)) throw std::runtime_error(error);
@@ -81,7 +84,6 @@ struct ReportCommand {
     return 0;
   }
 };
-
 
 }  // namespace
 std::function<int()> RegisterReport(CLI::App* app) {

@@ -56,9 +56,12 @@ struct TuneCommand {
     app->add_option("--refine", refine, "ceres | none: the least-squares cross-check")->capture_default_str();
     app->add_option("--agree-tolerance", agree_tolerance,
                     "relative objective difference for the 'agree' verdict")
+        ->check(FiniteNumber())
         ->capture_default_str();
-    app->add_option("--max-overshoot", max_overshoot_pct, "reject candidates overshooting more (%)");
-    app->add_option("--max-settling", max_settling_time_s, "reject candidates settling later (s)");
+    app->add_option("--max-overshoot", max_overshoot_pct, "reject candidates overshooting more (%)")
+        ->check(NumberOrInfinity());
+    app->add_option("--max-settling", max_settling_time_s, "reject candidates settling later (s)")
+        ->check(NumberOrInfinity());
     app->add_option("--zn-rule", zn_rule, "classic | pessen | some-overshoot | no-overshoot")
         ->capture_default_str();
     app->add_option("--trace", trace, "write the best-so-far trajectory of the search to this CSV file");
@@ -70,6 +73,7 @@ struct TuneCommand {
   int Run() {
     const Plant p = plant.Build();
     const TuneOptions o = BuildOptions();
+    CheckOutputFile(trace, "--trace");  // before the search, not after it
     const SampledRunner runner = MakeRunner(o);
     const bool tty = isatty(STDERR_FILENO) != 0;
     TuneSummary s;
@@ -95,18 +99,19 @@ struct TuneCommand {
     TuneOptions o;
     o.loop = loop.Build();
     if (!ParseTuneMethod(method, &o.method))
-      throw BadInput("--method '" + method +
-                     "' must be nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
+      throw BadInput("--method " + Quote(method) +
+                     " must be nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
     if (!ParseObjectiveKind(objective, &o.objective))
-      throw BadInput("--objective '" + objective + "' must be iae, ise, itae or iae-continuous");
+      throw BadInput("--objective " + Quote(objective) + " must be iae, ise, itae or iae-continuous");
     if (!ParseZieglerNicholsRule(zn_rule, &o.zn_rule))
-      throw BadInput("--zn-rule '" + zn_rule + "' must be classic, pessen, some-overshoot or no-overshoot");
+      throw BadInput("--zn-rule " + Quote(zn_rule) +
+                     " must be classic, pessen, some-overshoot or no-overshoot");
     const auto b = ParseList(bounds, "--bounds");
-    if (b.size() != 2) throw BadInput("--bounds '" + bounds + "' must be LO,HI");
+    if (b.size() != 2) throw BadInput("--bounds " + Quote(bounds) + " must be LO,HI");
     o.lower = b[0];
     o.upper = b[1];
     if (refine != "ceres" && refine != "none")
-      throw BadInput("--refine '" + refine + "' must be ceres or none");
+      throw BadInput("--refine " + Quote(refine) + " must be ceres or none");
     o.refine = refine == "ceres";
     o.max_iterations = max_iterations;
     o.max_evaluations = max_evaluations;
@@ -124,7 +129,7 @@ struct TuneCommand {
   // The sampled-loop runner of --backend; throws BadInput.
   SampledRunner MakeRunner(const TuneOptions& o) {
     if (backend == "local") return RunSampledLoopInProcess;
-    if (backend != "lcm") throw BadInput("--backend '" + backend + "' must be local or lcm");
+    if (backend != "lcm") throw BadInput("--backend " + Quote(backend) + " must be local or lcm");
     if (o.loop.loop != LoopKind::kSampled)
       throw BadInput("--backend lcm runs the sampled loop: add --loop sampled");
     client = lcm.MakeClient();
@@ -213,7 +218,7 @@ struct TuneCommand {
 
   void WriteTrace(const TuneSummary& s) const {
     std::ofstream f(trace);
-    if (!f) throw BadInput("--trace '" + trace + "' cannot be written");
+    if (!f) throw BadInput("--trace " + Quote(trace) + " cannot be written");
     f << std::setprecision(17) << "iteration,evaluations,best_objective,kp,ki,kd\n";
     for (const auto& tp : s.optimizer.trace) {
       f << tp.iteration << "," << tp.evaluations << "," << tp.best_f;

@@ -1,7 +1,9 @@
 // pidlab: one executable, one subcommand per job. The table below is the
 // whole command line; each subcommand lives in its own cmd_*.cc. This file
-// only dispatches and applies the exit convention: 2 for bad input (one line
-// naming the value), 1 for a runtime failure.
+// only dispatches and applies the exit convention (README.md, "Exit status
+// and limits"): 2 for bad input, anything the user typed (an unwritable output
+// path included), 1 for a runtime failure; either way exactly one line on
+// stderr, at most ~300 characters.
 
 #include <iostream>
 
@@ -22,8 +24,13 @@ const Command kCommands[] = {
     {"plot", "PNG figures of y, e, u, n from an evaluation or an LCM log", pidlab::cli::RegisterPlot},
     {"replay", "read an LCM log: episodes, IAE, completeness, --redrive", pidlab::cli::RegisterReplay},
     {"report", "regenerate the paper's tables and figures (report.md + PNGs)", pidlab::cli::RegisterReport},
-    {"tune", "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check", pidlab::cli::RegisterTune},
+    {"tune", "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check",
+     pidlab::cli::RegisterTune},
 };
+
+// The message of an error as one printable line of at most 270 characters
+// (after "pidlab <command>: error: "), whatever the exception carried.
+std::string OneLine(const std::string& message) { return pidlab::cli::Truncate(message, 270); }
 
 }  // namespace
 
@@ -44,7 +51,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::string where = "pidlab";
     for (const auto* sub : app.get_subcommands()) where += " " + sub->get_name();
-    std::cerr << where << ": error: " << e.what() << "\n";
+    std::cerr << where << ": error: " << OneLine(e.what()) << "\n";
     return 2;
   }
   for (auto& [sub, action] : actions) {
@@ -52,10 +59,10 @@ int main(int argc, char** argv) {
     try {
       return action();
     } catch (const pidlab::cli::BadInput& e) {
-      std::cerr << "pidlab " << sub->get_name() << ": error: " << e.what() << "\n";
+      std::cerr << "pidlab " << sub->get_name() << ": error: " << OneLine(e.what()) << "\n";
       return 2;
     } catch (const std::exception& e) {
-      std::cerr << "pidlab " << sub->get_name() << ": failed: " << e.what() << "\n";
+      std::cerr << "pidlab " << sub->get_name() << ": failed: " << OneLine(e.what()) << "\n";
       return 1;
     }
   }

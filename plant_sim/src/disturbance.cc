@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 namespace pidlab {
 namespace {
@@ -67,6 +68,18 @@ std::string ToString(DisturbanceKind kind) {
 
 bool DisturbanceOptions::IsValid(std::string* error) const {
   std::ostringstream os;
+  const std::pair<const char*, double> fields[] = {{"disturbance amplitude ", amplitude},
+                                                   {"disturbance period ", period_s},
+                                                   {"disturbance phase ", phase_s},
+                                                   {"disturbance step time ", step_time_s},
+                                                   {"noise hold ", noise_hold_s}};
+  for (const auto& [name, v] : fields) {
+    if (std::isfinite(v) && std::abs(v) > kMaxDisturbanceMagnitude) {
+      os << name << v << " must be at most " << kMaxDisturbanceMagnitude << " in magnitude";
+      if (error) *error = os.str();
+      return false;
+    }
+  }
   if (!std::isfinite(amplitude))
     os << "disturbance amplitude " << amplitude << " must be finite";
   else if (kind == DisturbanceKind::kNoise && amplitude < 0.0)

@@ -17,11 +17,12 @@ bool StepperMotorParameters::IsValid(std::string* error) const {
                                                    {"stationary_current_a", stationary_current_a},
                                                    {"flux_linkage", flux_linkage}};
   for (const auto& [name, v] : fields) {
-    if (!std::isfinite(v) || v < 0.0 ||
+    if (!std::isfinite(v) || v < 0.0 || v > kMaxCoefficientMagnitude ||
         (v == 0.0 && std::string(name) != "mutual_inductance_h" && std::string(name) != "viscous_friction")) {
       if (error) {
         std::ostringstream os;
-        os << "stepper motor " << name << " = " << v << " must be finite and positive";
+        os << "stepper motor " << name << " = " << v << " must be finite, positive and at most "
+           << kMaxCoefficientMagnitude;
         *error = os.str();
       }
       return false;
@@ -68,6 +69,11 @@ bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, P
   } else if (name == "stepper_motor" || name == "stepper") {
     if (!stepper.IsValid(error)) return false;
     *plant = {"stepper_motor", StepperMotorTransferFunction(stepper)};
+    std::string why;
+    if (!plant->tf.IsValid(&why)) {
+      if (error) *error = "these stepper motor parameters give G(s) = " + plant->tf.ToString() + ": " + why;
+      return false;
+    }
   } else {
     if (error)
       *error = "unknown plant '" + name +

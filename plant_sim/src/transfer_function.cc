@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace pidlab {
 namespace {
@@ -37,15 +38,20 @@ Eigen::VectorXd BalanceInPlace(Eigen::MatrixXd* a) {
         c += std::abs((*a)(j, i));
         r += std::abs((*a)(i, j));
       }
-      if (c == 0.0 || r == 0.0) continue;
+      // Not finite (inf or NaN in A): halving and doubling would never
+      // balance inf against a finite norm, so leave the row alone.
+      if (c == 0.0 || r == 0.0 || !std::isfinite(c) || !std::isfinite(r)) continue;
       double f = 1.0;
       const double s = c + r;
-      while (c < r / 2.0) {
+      // Each step moves c / r by a factor 4; finite positive norms are within
+      // 2^2100 of each other, so kMaxSteps is never reached for them.
+      constexpr int kMaxSteps = 1100;
+      for (int step = 0; step < kMaxSteps && c < r / 2.0; ++step) {
         c *= 2.0;
         r /= 2.0;
         f *= 2.0;
       }
-      while (c >= r * 2.0) {
+      for (int step = 0; step < kMaxSteps && c >= r * 2.0; ++step) {
         c /= 2.0;
         r *= 2.0;
         f /= 2.0;
@@ -68,10 +74,24 @@ bool TransferFunction::IsValid(std::string* error) const {
   };
   if (den.empty()) return fail("denominator is empty");
   if (num.empty()) return fail("numerator is empty");
-  for (double v : num)
-    if (!std::isfinite(v)) return fail("numerator coefficient " + std::to_string(v) + " is not finite");
-  for (double v : den)
-    if (!std::isfinite(v)) return fail("denominator coefficient " + std::to_string(v) + " is not finite");
+  const std::pair<const char*, const std::vector<double>*> polys[] = {{"numerator", &num},
+                                                                      {"denominator", &den}};
+  for (const auto& [name, poly] : polys) {
+    if (poly->size() > static_cast<std::size_t>(kMaxTransferFunctionCoefficients))
+      return fail(std::string(name) + " has " + std::to_string(poly->size()) + " coefficients, more than " +
+                  std::to_string(kMaxTransferFunctionCoefficients));
+    for (double v : *poly) {
+      std::ostringstream os;
+      os << name << " coefficient " << v;
+      if (!std::isfinite(v)) return fail(os.str() + " is not finite");
+      const double a = std::abs(v);
+      if (v != 0.0 && (a > kMaxCoefficientMagnitude || a < kMinCoefficientMagnitude)) {
+        os << " must be 0 or of magnitude between " << kMinCoefficientMagnitude << " and "
+           << kMaxCoefficientMagnitude;
+        return fail(os.str());
+      }
+    }
+  }
   const auto d = StripLeadingZeros(den);
   const auto n = StripLeadingZeros(num);
   if (d.size() == 1 && d[0] == 0.0) return fail("denominator is zero");

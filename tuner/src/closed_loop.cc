@@ -32,30 +32,34 @@ std::string ToString(LoopKind kind) { return kind == LoopKind::kContinuous ? "co
 bool LoopOptions::IsValid(std::string* error) const {
   std::ostringstream os;
   long count = 0;
+  // Ratios are compared with the limits as doubles before any conversion.
   if (!(sample_time_s > 0.0) || !std::isfinite(sample_time_s))
     os << "sample time " << sample_time_s << " s must be positive and finite";
   else if (!(horizon_s > 0.0) || !std::isfinite(horizon_s))
     os << "horizon " << horizon_s << " s must be positive and finite";
+  else if (horizon_s / sample_time_s > kMaxLoopSamples + 0.5)
+    os << "horizon / sample time = " << horizon_s / sample_time_s << " samples is more than 1e7";
   else if (!IsMultiple(horizon_s, sample_time_s, &count) || count < 1)
     os << "horizon " << horizon_s << " s must be a whole multiple of the sample time " << sample_time_s
        << " s";
-  else if (count > 10000000)
-    os << "horizon / sample time = " << count << " samples is more than 1e7";
   else if (!(stability_margin >= 0.0) || !(stability_margin < 1.0))
     os << "stability margin " << stability_margin << " must be in [0, 1)";
   else if (!(dt_s > 0.0) || !std::isfinite(dt_s))  // a bad --dt is an error even if the loop ignores it
     os << "dt " << dt_s << " s must be positive and finite";
   else if (!disturbance.IsValid(error))
     return false;
+  else if (loop == LoopKind::kContinuous && DisturbanceBreakpoints() > kMaxDisturbanceBreakpoints)
+    os << "the " << ToString(disturbance.kind) << " disturbance switches " << DisturbanceBreakpoints()
+       << " times within the horizon of the continuous loop, more than 1e6: use a longer period or noise "
+          "hold";
   else if (loop == LoopKind::kSampled) {
     PidOptions p = pid;
     p.dt_s = dt_s;
-    if (!(dt_s > 0.0) || !std::isfinite(dt_s))
-      os << "dt " << dt_s << " s must be positive and finite";
+    if (horizon_s / dt_s > kMaxLoopSteps + 0.5)
+      os << "horizon " << horizon_s << " s / dt " << dt_s << " s = " << horizon_s / dt_s
+         << " steps is more than 5e7";
     else if (!IsMultiple(sample_time_s, dt_s, &count) || count < 1)
       os << "sample time " << sample_time_s << " s must be a whole multiple of dt " << dt_s << " s";
-    else if (!IsMultiple(horizon_s, dt_s, &count) || count > 2000000000L)
-      os << "horizon " << horizon_s << " s / dt " << dt_s << " s is too many steps";
     else if (!p.IsValid(error))
       return false;
     else
@@ -70,6 +74,26 @@ bool LoopOptions::IsValid(std::string* error) const {
 int LoopOptions::NumSamples() const { return static_cast<int>(std::lround(horizon_s / sample_time_s)) + 1; }
 int LoopOptions::StepsPerSample() const { return static_cast<int>(std::lround(sample_time_s / dt_s)); }
 long LoopOptions::TotalSteps() const { return std::lround(horizon_s / dt_s); }
+
+double LoopOptions::DisturbanceBreakpoints() const {
+  switch (disturbance.kind) {
+    case DisturbanceKind::kSquare:
+      return std::floor(horizon_s / (disturbance.period_s / 2.0)) + 1.0;
+    case DisturbanceKind::kNoise:
+      return std::floor(horizon_s / disturbance.noise_hold_s) + 1.0;
+    case DisturbanceKind::kStep:
+      return 1.0;
+    case DisturbanceKind::kNone:
+    case DisturbanceKind::kSine:
+      break;
+  }
+  return 0.0;
+}
+
+double LoopOptions::StepsPerEvaluation() const {
+  if (loop == LoopKind::kSampled) return horizon_s / dt_s;
+  return horizon_s / sample_time_s + 1.0 + kStepsPerBreakpoint * DisturbanceBreakpoints();
+}
 
 int EffectiveLoopOrder(const ContinuousClosedLoop<double>& loop) {
   // With ki = 0 the integrator state z never reaches u: its pole at s = 0 is

@@ -77,8 +77,8 @@ std::string ToString(RefineVerdict verdict, TuneMethod method) {
 
 bool TuneOptions::IsValid(std::string* error) const {
   std::ostringstream os;
-  if (!std::isfinite(lower) || !std::isfinite(upper) || lower < 0.0 || !(lower < upper))
-    os << "bounds [" << lower << ", " << upper << "] must be finite with 0 <= lower < upper";
+  if (!std::isfinite(lower) || !std::isfinite(upper) || lower < 0.0 || !(lower < upper) || upper > kMaxGain)
+    os << "bounds [" << lower << ", " << upper << "] must be finite with 0 <= lower < upper <= " << kMaxGain;
   else if (max_iterations < 0)
     os << "max iterations " << max_iterations << " must be >= 0";
   else if (max_evaluations < 0)
@@ -93,10 +93,33 @@ bool TuneOptions::IsValid(std::string* error) const {
     os << "agree tolerance " << agree_tolerance << " must be in (0, 1)";
   else if (!loop.IsValid(error))
     return false;
+  else if (EvaluationBudget() * loop.StepsPerEvaluation() > kMaxTuneSteps)
+    os << EvaluationBudget() << " evaluations x " << loop.StepsPerEvaluation()
+       << " loop steps each = " << EvaluationBudget() * loop.StepsPerEvaluation()
+       << " steps is more than 5e9: use a coarser dt or sample time, a shorter horizon, a slower disturbance "
+          "or fewer evaluations";
   else
     return true;
   if (error) *error = os.str();
   return false;
+}
+
+int TuneOptions::EvaluationBudget() const {
+  if (method == TuneMethod::kZieglerNichols) return 1;
+  if (max_evaluations > 0) return max_evaluations;
+  switch (method) {
+    case TuneMethod::kNelderMead:
+      return NelderMeadOptions{}.max_evaluations;
+    case TuneMethod::kPaperNelderMead:
+      return PaperNelderMeadOptions{}.max_evaluations;
+    case TuneMethod::kGeneticAlgorithm:
+      return GeneticAlgorithmOptions{}.max_evaluations;
+    case TuneMethod::kPsoGsa:
+      return PsoGsaOptions{}.max_evaluations;
+    case TuneMethod::kZieglerNichols:
+      break;
+  }
+  return 1;
 }
 
 std::string TuneSummary::BriefReport() const {

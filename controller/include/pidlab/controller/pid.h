@@ -38,14 +38,19 @@ struct PidGainsT {
 };
 using PidGains = PidGainsT<double>;
 
-/// Gains must be finite and >= 0 (the paper's search box is [0, 30]^3).
+/// The largest gain GainsAreValid accepts (README.md, "Exit status and
+/// limits"): larger gains only overflow the closed loop's matrices.
+inline constexpr double kMaxGain = 1e12;
+
+/// Gains must be finite, >= 0 and at most kMaxGain (the paper's search box is
+/// [0, 30]^3).
 inline bool GainsAreValid(const PidGains& g, std::string* error) {
   const std::pair<const char*, double> f[] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
   for (const auto& [name, v] : f) {
-    if (!std::isfinite(v) || v < 0.0) {
+    if (!std::isfinite(v) || v < 0.0 || v > kMaxGain) {
       if (error) {
         std::ostringstream os;
-        os << "gain " << name << " = " << v << " must be finite and >= 0";
+        os << "gain " << name << " = " << v << " must be finite, >= 0 and at most " << kMaxGain;
         *error = os.str();
       }
       return false;

@@ -13,6 +13,11 @@ enum class DisturbanceKind { kNone, kSquare, kStep, kSine, kNoise };
 bool ParseDisturbanceKind(const std::string& s, DisturbanceKind* kind);
 std::string ToString(DisturbanceKind kind);
 
+/// Bound on |amplitude|, period, |phase|, step time and noise hold (README.md,
+/// "Exit status and limits"): beyond it t + phase loses the precision the
+/// breakpoints need.
+inline constexpr double kMaxDisturbanceMagnitude = 1e12;
+
 struct DisturbanceOptions {
   DisturbanceKind kind = DisturbanceKind::kNone;
   /// Square: +/-amplitude. Step: final value. Sine: peak. Noise: std deviation.
@@ -29,6 +34,9 @@ struct DisturbanceOptions {
   /// Seed of the noise; the value at t depends only on (seed, t).
   std::uint64_t seed = 1;
 
+  /// Finite amplitude and phase, a positive finite period (square, sine),
+  /// step time >= 0 (step) or hold (noise), and no finite value beyond
+  /// kMaxDisturbanceMagnitude. Names the offending value on failure.
   bool IsValid(std::string* error) const;
 };
 

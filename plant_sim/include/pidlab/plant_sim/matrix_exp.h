@@ -3,6 +3,7 @@
 // the scalar so the same code runs on double and on ceres::Jet.
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 
 namespace pidlab {
@@ -32,8 +33,10 @@ MatrixX<T> MatrixExp(const MatrixX<T>& a) {
     for (Eigen::Index j = 0; j < n; ++j) row += std::abs(ToDouble(a(i, j)));
     norm = std::max(norm, row);
   }
+  // At most 1100 squarings (2^1100 > any finite norm / 0.5): an infinite norm
+  // gives a non-finite result rather than an out-of-range cast.
   int squarings = 0;
-  if (norm > 0.5) squarings = static_cast<int>(std::ceil(std::log2(norm / 0.5)));
+  if (norm > 0.5) squarings = static_cast<int>(std::min(1100.0, std::ceil(std::log2(norm / 0.5))));
   const MatrixX<T> scaled = a * T(std::ldexp(1.0, -squarings));
   MatrixX<T> result = MatrixX<T>::Identity(n, n);
   MatrixX<T> term = MatrixX<T>::Identity(n, n);

@@ -22,7 +22,8 @@ struct StepperMotorParameters {
   double stationary_current_a = 0.15;                      // I_o
   double flux_linkage = 1.2e-3;                            // n Phi_M, T m^2
 
-  /// All finite and positive, L > M, and cos(N_r lambda / 2) > 0.
+  /// All finite, positive (M and D may be 0) and at most
+  /// kMaxCoefficientMagnitude, L > M, and cos(N_r lambda / 2) > 0.
   bool IsValid(std::string* error) const;
 };
 
@@ -42,7 +43,9 @@ std::vector<std::string> BuiltinPlantNames();
 
 /// Builds a built-in plant by name or alias: double_integrator (linear) = 1/s^2,
 /// oscillator (nonlinear) = 1/(s^2+1), stepper_motor (stepper) = eq. (3) with
-/// `stepper`. Returns false and sets *error naming the value for an unknown name.
+/// `stepper`. Returns false and sets *error naming the value for an unknown name,
+/// invalid stepper parameters, or parameters whose G(s) is not a valid
+/// TransferFunction (a coefficient out of the limits).
 bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, Plant* plant,
                std::string* error);
 

@@ -29,6 +29,19 @@
 
 namespace pidlab {
 
+/// Work limits of one evaluation (README.md, "Exit status and limits"),
+/// enforced by LoopOptions::IsValid: horizon / dt steps of the sampled loop
+/// (transport::kMaxEpisodeSteps, which agrees: checked in tools/cli_common.cc),
+inline constexpr long kMaxLoopSteps = 50000000;
+/// sample intervals horizon / sample time,
+inline constexpr long kMaxLoopSamples = 10000000;
+/// and switches of a square or noise disturbance within the horizon of the
+/// continuous loop (each one costs a matrix exponential).
+inline constexpr long kMaxDisturbanceBreakpoints = 1000000;
+/// What one continuous-loop disturbance breakpoint costs in loop steps, for
+/// LoopOptions::StepsPerEvaluation (measured: about a hundred sampled steps).
+inline constexpr double kStepsPerBreakpoint = 100.0;
+
 enum class LoopKind { kContinuous, kSampled };
 bool ParseLoopKind(const std::string& s, LoopKind* kind);
 std::string ToString(LoopKind kind);
@@ -50,6 +63,8 @@ struct LoopOptions {
   /// the sampled objective with poles on the imaginary axis.
   double stability_margin = 1e-9;
 
+  /// Positive finite times, horizon a multiple of ts (and ts of dt for the
+  /// sampled loop), a valid disturbance and PID, and the work limits above.
   bool IsValid(std::string* error) const;
   /// 1 + horizon / ts: 501 for the paper.
   int NumSamples() const;
@@ -57,6 +72,12 @@ struct LoopOptions {
   int StepsPerSample() const;
   /// horizon / dt (sampled loop).
   long TotalSteps() const;
+  /// Switches of the disturbance in (0, horizon] (square and noise; step: 1).
+  double DisturbanceBreakpoints() const;
+  /// The cost of one evaluation in loop steps: TotalSteps() (sampled), or
+  /// NumSamples() + kStepsPerBreakpoint * DisturbanceBreakpoints()
+  /// (continuous). Bounds the work of a tuning (TuneOptions::IsValid).
+  double StepsPerEvaluation() const;
 };
 
 /// Closed-loop poles and strict stability.
@@ -167,8 +188,10 @@ void SampleContinuousLoop(const ContinuousClosedLoop<T>& loop, const Disturbance
     const double t0 = (k - 1) * ts, t1 = k * ts;
     double t = t0;
     if (piecewise) {
-      // Exact sub-steps at breakpoints strictly inside (t0, t1).
-      for (double tb = disturbance.NextBreakpoint(t); tb < t1 - 1e-9; tb = disturbance.NextBreakpoint(t)) {
+      // Exact sub-steps at breakpoints strictly inside (t0, t1). A breakpoint
+      // that does not advance (lost precision, e.g. a huge phase) ends them.
+      for (double tb = disturbance.NextBreakpoint(t); tb < t1 - 1e-9 && tb > t;
+           tb = disturbance.NextBreakpoint(t)) {
         w = (MatrixExp<T>(MatrixX<T>(loop.m * T(tb - t))) * w).eval();
         t = tb;
         w(ie) = T(disturbance.Value(t));
