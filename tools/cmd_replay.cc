@@ -99,6 +99,7 @@ struct ReplayCommand {
   }
 
   int Run() {
+    if (!csv.empty()) CheckOutputFile(csv, "--csv");  // before reading the log
     if (backend == "lcm" && !redrive) throw BadInput("--backend lcm applies to --redrive only");
     const replay::LogContents log = ReadTheLog();
     const std::vector<const replay::Episode*> selected = SelectEpisodes(log);
@@ -149,7 +150,7 @@ struct ReplayCommand {
     for (long id : episodes) {
       bool found = false;
       for (const auto* e : selected) found = found || e->episode_id == id;
-      if (!found) throw BadInput("--episode " + std::to_string(id) + " is not in " + log_path);
+      if (!found) throw BadInput("--episode " + std::to_string(id) + " is not in " + Quote(log_path));
     }
     return selected;
   }
@@ -295,7 +296,7 @@ struct ReplayCommand {
 
   void OpenCsv(std::ofstream* file) const {
     file->open(csv);
-    if (!*file) throw BadInput("--csv '" + csv + "' cannot be written");
+    if (!*file) throw BadInput("--csv " + Quote(csv) + " cannot be written");
     *file << std::setprecision(17) << "episode,k,t,r,y,u,n,e\n";
   }
 
