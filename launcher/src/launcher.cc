@@ -11,6 +11,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pidlab/transport/episode_start.h"
+
 namespace pidlab::launcher {
 namespace {
 constexpr const char* kRecvBufSuffix = "&recv_buf_size=4194304";
@@ -154,12 +156,7 @@ LaunchStatus Launcher::WaitReady(const volatile std::sig_atomic_t* stop, std::st
       return LaunchStatus::kNotReady;
     }
     if (transport::NowSeconds() - last_ping > 0.1) {
-      pidlab::lcmt_ready ping;
-      ping.episode_id = 0;
-      ping.step = -1;
-      ping.state = pidlab::lcmt_ready::PING;
-      ping.role = "launch";
-      ping.pid = getpid();
+      pidlab::lcmt_ready ping = transport::MakeReady(pidlab::lcmt_ready::PING, "launch");
       transport_->Publish(transport::kReadyChannel, &ping);
       last_ping = transport::NowSeconds();
     }

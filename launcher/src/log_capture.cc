@@ -14,6 +14,8 @@
 #include <sstream>
 #include <thread>
 
+#include "pidlab/transport/episode_start.h"
+
 namespace pidlab::launcher {
 namespace {
 
@@ -90,13 +92,7 @@ bool LogCapture::WaitForMarker(const std::string& what) {
   std::random_device rd;
   const std::string nonce =
       "pidlab-launch-" + what + "-" + std::to_string(getpid()) + "-" + std::to_string(rd());
-  pidlab::lcmt_ready m;
-  m.episode_id = 0;
-  m.step = -1;
-  m.state = pidlab::lcmt_ready::MARKER;
-  m.role = "launch";
-  m.pid = getpid();
-  m.detail = nonce;
+  pidlab::lcmt_ready m = transport::MakeReady(pidlab::lcmt_ready::MARKER, "launch", 0, nonce);
   const double start = transport::NowSeconds();
   double last = -1;
   while (transport::NowSeconds() - start < options_.marker_timeout_s) {

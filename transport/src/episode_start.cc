@@ -8,6 +8,18 @@
 
 namespace pidlab::transport {
 
+pidlab::lcmt_ready MakeReady(int8_t state, const std::string& role, int64_t episode_id,
+                             const std::string& detail) {
+  pidlab::lcmt_ready r;
+  r.episode_id = episode_id;
+  r.step = -1;
+  r.state = state;
+  r.role = role;
+  r.pid = static_cast<int32_t>(getpid());
+  r.detail = detail;
+  return r;
+}
+
 int64_t NewEpisodeId() {
   std::random_device rd;
   const uint64_t a = (static_cast<uint64_t>(rd()) << 32) ^ rd();
@@ -24,8 +36,9 @@ EpisodeStarter::EpisodeStarter(Transport* transport) : transport_(transport) {
   });
 }
 
-StartStatus EpisodeStarter::Start(const pidlab::lcmt_episode_config& config, const std::vector<std::string>& roles,
-                                  double timeout_s, std::string* missing, double resend_period_s) {
+StartStatus EpisodeStarter::Start(const pidlab::lcmt_episode_config& config,
+                                  const std::vector<std::string>& roles, double timeout_s,
+                                  std::string* missing, double resend_period_s) {
   pidlab::lcmt_episode_config message = config;
   episode_id_ = config.episode_id;
   acked_.clear();

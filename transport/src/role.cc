@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include "pidlab/transport/episode_start.h"
+
 namespace pidlab::transport {
 
 Role::Role(Transport* transport, std::string role, LogFn log, bool verbose)
@@ -20,12 +22,8 @@ void Role::Verbose(const std::string& line) const {
 }
 
 void Role::Ack(int64_t episode_id) {
-  pidlab::lcmt_ready r;
-  r.episode_id = episode_id;
-  r.step = -1;
-  r.state = episode_id == 0 ? pidlab::lcmt_ready::ALIVE : pidlab::lcmt_ready::CONFIG_ACK;
-  r.role = role_;
-  r.pid = static_cast<int32_t>(getpid());
+  pidlab::lcmt_ready r = MakeReady(
+      episode_id == 0 ? pidlab::lcmt_ready::ALIVE : pidlab::lcmt_ready::CONFIG_ACK, role_, episode_id);
   transport_->Publish(kReadyChannel, &r);
 }
 
@@ -54,7 +52,6 @@ void Role::OnConfig(const pidlab::lcmt_episode_config& m) {
           std::to_string(spec.total_steps) + " steps");
 }
 
-
 int ServeRole(Transport* transport, Role* role, const volatile std::sig_atomic_t* stop) {
   while (!*stop) {
     if (transport->WaitAndHandle(role->MaxWait()) < 0) return 1;
@@ -62,6 +59,5 @@ int ServeRole(Transport* transport, Role* role, const volatile std::sig_atomic_t
   }
   return 0;
 }
-
 
 }  // namespace pidlab::transport

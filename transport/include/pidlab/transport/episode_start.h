@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <pidlab/lcmt_episode_config.hpp>
+#include <pidlab/lcmt_ready.hpp>
 #include <set>
 #include <string>
 #include <vector>
@@ -13,6 +14,11 @@
 #include "pidlab/transport/transport.h"
 
 namespace pidlab::transport {
+
+/// A READY message from this process (its pid), step -1: PING, ALIVE,
+/// CONFIG_ACK (with the episode id) or MARKER (with a nonce in `detail`).
+pidlab::lcmt_ready MakeReady(int8_t state, const std::string& role, int64_t episode_id = 0,
+                             const std::string& detail = "");
 
 /// A fresh, non-zero episode id: an identifier, not an input of the
 /// computation (random device, clock and pid mixed).
