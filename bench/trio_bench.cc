@@ -1,19 +1,28 @@
 // trio_bench: lockstep steps per second of the LCM trio next to a raw LCM
-// publish/handle round trip measured in the same run on the same URL.
+// publish/handle round trip measured in the same run on the same URL, and
+// the CPU each costs: CPU-seconds per step of every process of the trio
+// (from /proc/PID/stat of $PIDLAB_{PLANT,CONTROLLER,DISTURBANCE,LOGGER}_PID,
+// and this client's own) against the CPU of one raw round trip (this
+// process and its echo child).
 // Run it against a trio, inside a private network namespace:
 //   pidlab launch --isolated -- trio_bench [ROUND_TRIPS] [HORIZON_S]
 
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
-#include "pidlab/tuner/episode_client.h"
 #include "pidlab/transport/transport.h"
+#include "pidlab/tuner/episode_client.h"
 
 namespace {
 
@@ -43,7 +52,38 @@ class Pong {
   int64_t last = -1;
 };
 
-double RoundTripsPerSecond(const std::string& url, long n) {
+double Seconds(const timeval& t) {
+  return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+}
+
+/// User + system CPU seconds of this process.
+double SelfCpu() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return Seconds(u.ru_utime) + Seconds(u.ru_stime);
+}
+
+/// User + system CPU seconds of another process (/proc/PID/stat), -1 if gone.
+double ProcessCpu(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return -1.0;
+  std::istringstream rest(line.substr(line.rfind(')') + 2));  // fields from 3 (state) on
+  std::string field;
+  double utime = 0, stime = 0;
+  for (int i = 3; i <= 15 && rest >> field; ++i) {
+    if (i == 14) utime = std::atof(field.c_str());
+    if (i == 15) stime = std::atof(field.c_str());
+  }
+  return (utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+struct RoundTrips {
+  double per_second = 0;
+  double cpu_per_trip_s = 0;  // this process and the echo
+};
+
+RoundTrips MeasureRoundTrips(const std::string& url, long n) {
   const pid_t child = fork();
   if (child == 0) {
     prctl(PR_SET_PDEATHSIG, SIGKILL);
@@ -63,6 +103,7 @@ double RoundTripsPerSecond(const std::string& url, long n) {
     if (pong.last == seq) break;
   }
   const double t0 = NowSeconds();
+  const double self0 = SelfCpu(), echo0 = ProcessCpu(child);
   for (int64_t seq = 0; seq < n; ++seq) {
     lcm.publish("BENCH_PING", &seq, sizeof(seq));
     while (pong.last != seq) {
@@ -71,10 +112,12 @@ double RoundTripsPerSecond(const std::string& url, long n) {
       }
     }
   }
-  const double rate = static_cast<double>(n) / (NowSeconds() - t0);
+  RoundTrips r;
+  r.per_second = static_cast<double>(n) / (NowSeconds() - t0);
+  r.cpu_per_trip_s = (SelfCpu() - self0 + ProcessCpu(child) - echo0) / static_cast<double>(n);
   kill(child, SIGKILL);
   waitpid(child, nullptr, 0);
-  return rate;
+  return r;
 }
 
 }  // namespace
@@ -97,7 +140,16 @@ int main(int argc, char** argv) {
     co.transport.auth_key = key;
   }
 
-  const double raw = RoundTripsPerSecond(url, trips);
+  const RoundTrips raw = MeasureRoundTrips(url, trips);
+  // The trio's processes, as pidlab launch exports them.
+  std::vector<std::pair<std::string, pid_t>> processes;
+  for (const char* role : {"PLANT", "CONTROLLER", "DISTURBANCE", "LOGGER"}) {
+    const char* pid = std::getenv((std::string("PIDLAB_") + role + "_PID").c_str());
+    if (pid && std::atol(pid) > 0) processes.emplace_back(role, static_cast<pid_t>(std::atol(pid)));
+  }
+  std::vector<double> cpu0;
+  for (const auto& p : processes) cpu0.push_back(ProcessCpu(p.second));
+  const double client0 = SelfCpu();
 
   pidlab::Plant plant;
   pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant, &error);
@@ -113,11 +165,23 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  const double client_cpu = SelfCpu() - client0;
   const double steps = client.stats().StepsPerSecond();
+  const auto n_steps = static_cast<double>(client.stats().steps);
   std::printf("url                 %s%s\n", url.c_str(), co.transport.auth_key ? " (authenticated)" : "");
-  std::printf("raw round trip      %.0f /s  (%ld publish/handle round trips, echo process)\n", raw, trips);
+  std::printf("raw round trip      %.0f /s  (%ld publish/handle round trips, echo process)\n", raw.per_second,
+              trips);
   std::printf("lockstep trio       %.0f steps/s  (%ld steps in %ld episodes)\n", steps, client.stats().steps,
               client.stats().episodes);
-  std::printf("ratio               %.2f  (target >= 0.8)\n", steps / raw);
+  std::printf("ratio               %.2f  (target >= 0.8)\n", steps / raw.per_second);
+  double total = client_cpu;
+  std::printf("CPU per step        client %.1f us", 1e6 * client_cpu / n_steps);
+  for (std::size_t i = 0; i < processes.size(); ++i) {
+    const double used = ProcessCpu(processes[i].second) - cpu0[i];
+    total += used;
+    std::printf(", %s %.1f us", processes[i].first.c_str(), 1e6 * used / n_steps);
+  }
+  std::printf("\nCPU per step, all   %.1f us  (raw round trip: %.1f us; ratio %.2f, target <= 1)\n",
+              1e6 * total / n_steps, 1e6 * raw.cpu_per_trip_s, total / n_steps / raw.cpu_per_trip_s);
   return 0;
 }

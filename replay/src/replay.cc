@@ -1,12 +1,12 @@
 #include "pidlab/replay/replay.h"
 
 #include <cstring>
+#include <iomanip>
 #include <lcm/lcm-cpp.hpp>
 #include <pidlab/lcmt_control_command.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
-#include <stdexcept>
-#include <iomanip>
 #include <sstream>
+#include <stdexcept>
 
 #include "pidlab/transport/episode_start.h"
 #include "pidlab/tuner/episode_client.h"
@@ -114,6 +114,7 @@ RedriveResult RedriveOverLcm(const Episode& e, const std::string& url, const std
   if (!lcm.good()) throw std::invalid_argument("--lcm-url '" + url + "': LCM cannot start");
   transport::TransportOptions topt;
   topt.channel_prefix = prefix;
+  topt.step_lane_base_url = url;
   transport::Transport transport(&lcm, topt);
   const int64_t id = transport::NewEpisodeId();  // a fresh episode, never the logged one
   long answered_step = -1;

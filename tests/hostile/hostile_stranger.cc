@@ -24,6 +24,7 @@
 #include <deque>
 #include <lcm/lcm-cpp.hpp>
 #include <limits>
+#include <memory>
 #include <pidlab/lcmt_control_command.hpp>
 #include <pidlab/lcmt_disturbance_block.hpp>
 #include <pidlab/lcmt_disturbance_request.hpp>
@@ -37,16 +38,18 @@
 #include <thread>
 #include <vector>
 
+#include "pidlab/transport/transport.h"
 #include "pidlab/transport/wire.h"
 
 namespace {
 
 constexpr int kTag = 32;  // an HMAC tag after the payload, when the trio has a key
-const char* const kClasses[] = {"fuzz",        "huge-arrays", "absurd-steps",  "forge-control", "forge-disturbance",
-                                "forge-output", "forge-chunk", "forge-summary", "replay"};
-const char* const kChannels[] = {"EPISODE_CONFIG",     "READY",      "PLANT_OUTPUT",        "CONTROL",
-                                 "DISTURBANCE",        "SUMMARY",    "TRAJECTORY_REQUEST",  "TRAJECTORY",
-                                 "DISTURBANCE_REQUEST", "DISTURBANCE_BLOCK"};
+const char* const kClasses[] = {"fuzz",          "huge-arrays",       "absurd-steps",
+                                "forge-control", "forge-disturbance", "forge-output",
+                                "forge-chunk",   "forge-summary",     "replay"};
+const char* const kChannels[] = {
+    "EPISODE_CONFIG",     "READY",      "PLANT_OUTPUT",        "CONTROL",          "DISTURBANCE", "SUMMARY",
+    "TRAJECTORY_REQUEST", "TRAJECTORY", "DISTURBANCE_REQUEST", "DISTURBANCE_BLOCK"};
 
 /// Decodes a message whether or not a tag follows it (the layout checked
 /// first: the stranger hears its own huge arrays too).
@@ -54,20 +57,22 @@ template <typename Msg>
 bool DecodeEither(const lcm::ReceiveBuffer* rbuf, Msg* m) {
   const int size = static_cast<int>(rbuf->data_size);
   for (int n : {size, size - kTag})
-    if (n > 0 && pidlab::transport::WireLayoutOk(Msg::getHash(), rbuf->data, n) && m->decode(rbuf->data, 0, n) == n)
+    if (n > 0 && pidlab::transport::WireLayoutOk(Msg::getHash(), rbuf->data, n) &&
+        m->decode(rbuf->data, 0, n) == n)
       return true;
   return false;
 }
 
 struct Stranger {
   lcm::LCM* lcm = nullptr;
+  lcm::LCM* lanes[3] = {nullptr, nullptr, nullptr};  // the trio's step lanes (transport.h), [0] = lcm
   std::string prefix;
   std::string attack;
   long budget = 0;
   long sent = 0;
   std::mt19937_64 rng;
-  int64_t episode = 0;  // the live episode seen last
-  pidlab::lcmt_plant_output last_output{};  // the plant output seen last
+  int64_t episode = 0;                                            // the live episode seen last
+  pidlab::lcmt_plant_output last_output{};                        // the plant output seen last
   std::deque<std::pair<std::string, std::vector<uint8_t>>> seen;  // recent real datagrams
 
   bool Spent() const { return sent >= budget; }
@@ -75,13 +80,18 @@ struct Stranger {
   template <typename Msg>
   void Send(const std::string& channel, Msg* m) {
     if (Spent()) return;
-    lcm->publish(prefix + channel, m);
+    For(channel)->publish(prefix + channel, m);
     ++sent;
   }
   void SendRaw(const std::string& channel, const std::vector<uint8_t>& bytes) {
     if (Spent()) return;
-    lcm->publish(prefix + channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+    For(channel)->publish(prefix + channel, bytes.data(), static_cast<unsigned>(bytes.size()));
     ++sent;
+  }
+  /// Where the trio listens for a channel: the per-step channels on their lanes.
+  lcm::LCM* For(const std::string& channel) const {
+    lcm::LCM* lane = lanes[pidlab::transport::LaneOf(channel.c_str())];
+    return lane ? lane : lcm;
   }
   bool Is(const char* cls) const { return attack == cls; }
 
@@ -216,9 +226,11 @@ struct Stranger {
 
   std::vector<uint8_t> Header(int64_t hash) const {
     std::vector<uint8_t> d;
-    for (int i = 0; i < 8; ++i) d.push_back(static_cast<uint8_t>(static_cast<uint64_t>(hash) >> (56 - 8 * i)));
+    for (int i = 0; i < 8; ++i)
+      d.push_back(static_cast<uint8_t>(static_cast<uint64_t>(hash) >> (56 - 8 * i)));
     for (int i = 0; i < 8; ++i) d.push_back(0);  // utime
-    for (int i = 0; i < 8; ++i) d.push_back(static_cast<uint8_t>(static_cast<uint64_t>(episode) >> (56 - 8 * i)));
+    for (int i = 0; i < 8; ++i)
+      d.push_back(static_cast<uint8_t>(static_cast<uint64_t>(episode) >> (56 - 8 * i)));
     for (int i = 0; i < 8; ++i) d.push_back(0);  // step
     return d;
   }
@@ -230,7 +242,8 @@ struct Stranger {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"hostile_stranger: attacks a live pidlab trio with one class of hostile messages (tests only)"};
+  CLI::App app{
+      "hostile_stranger: attacks a live pidlab trio with one class of hostile messages (tests only)"};
   std::string url, prefix = "PIDLAB_", attack = "all";
   long messages = 20000;
   double seconds = 30.0;
@@ -257,20 +270,29 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hostile_stranger: cannot start LCM on %s\n", url.c_str());
     return 1;
   }
+  // The per-step channels travel on the trio's step lanes (transport.h).
+  std::unique_ptr<lcm::LCM> lane_instances[3];
+  for (int lane : {pidlab::transport::kPlantOutputLane, pidlab::transport::kControlLane}) {
+    const std::string lane_url = pidlab::transport::StepLaneUrl(url, lane);
+    if (!lane_url.empty()) lane_instances[lane] = std::make_unique<lcm::LCM>(lane_url);
+  }
   Stranger s;
   s.lcm = &lcm;
+  for (int lane = 0; lane < 3; ++lane)
+    s.lanes[lane] = lane_instances[lane] ? lane_instances[lane].get() : &lcm;
   s.prefix = prefix;
   s.attack = classes[0];
   s.budget = messages;
   s.rng.seed(seed);
-  lcm.subscribeFunction(
-      prefix + "PLANT_OUTPUT",
-      +[](const lcm::ReceiveBuffer* rbuf, const std::string& ch, Stranger* st) {
-        st->Remember(ch, rbuf);
-        pidlab::lcmt_plant_output m{};
-        if (DecodeEither(rbuf, &m)) st->OnOutput(m);
-      },
-      &s);
+  s.For("PLANT_OUTPUT")
+      ->subscribeFunction(
+          prefix + "PLANT_OUTPUT",
+          +[](const lcm::ReceiveBuffer* rbuf, const std::string& ch, Stranger* st) {
+            st->Remember(ch, rbuf);
+            pidlab::lcmt_plant_output m{};
+            if (DecodeEither(rbuf, &m)) st->OnOutput(m);
+          },
+          &s);
   lcm.subscribeFunction(
       prefix + "DISTURBANCE_REQUEST",
       +[](const lcm::ReceiveBuffer* rbuf, const std::string& ch, Stranger* st) {
@@ -288,8 +310,9 @@ int main(int argc, char** argv) {
       },
       &s);
   for (const char* ch : {"CONTROL", "DISTURBANCE_BLOCK", "EPISODE_CONFIG", "READY", "SUMMARY"})
-    lcm.subscribeFunction(
-        prefix + ch, +[](const lcm::ReceiveBuffer* rbuf, const std::string& c, Stranger* st) { st->Remember(c, rbuf); },
+    s.For(ch)->subscribeFunction(
+        prefix + ch,
+        +[](const lcm::ReceiveBuffer* rbuf, const std::string& c, Stranger* st) { st->Remember(c, rbuf); },
         &s);
   const auto start = std::chrono::steady_clock::now();
   const auto end = start + std::chrono::duration<double>(seconds);
@@ -298,7 +321,10 @@ int main(int argc, char** argv) {
     s.attack = classes[i];
     s.budget = i + 1 == classes.size() ? messages : per_class * static_cast<long>(i + 1);
     while (!s.Spent() && std::chrono::steady_clock::now() < end) {
-      for (int n = 0; n < 256 && lcm.handleTimeout(0) > 0;) ++n;  // what arrived meanwhile
+      for (int lane = 0; lane < 3; ++lane) {  // what arrived meanwhile, on the base URL and the lanes
+        if (lane > 0 && s.lanes[lane] == &lcm) continue;
+        for (int n = 0; n < 256 && s.lanes[lane]->handleTimeout(0) > 0;) ++n;
+      }
       s.Unsolicited();
       std::this_thread::sleep_for(std::chrono::microseconds(200));
     }

@@ -1,6 +1,9 @@
 // Test helper: copies an LCM log, damaging it on purpose.
-//   replay_log_tamper IN OUT alter-command STEP   u of every CONTROL message of step STEP (of the
-//                                                 episode with a disturbance) moved up by one ulp
+//   replay_log_tamper IN OUT alter-command STEP   u of step STEP (of the episode with a disturbance)
+//                                                 moved up by one ulp in every CONTROL message and
+//                                                 TRAJECTORY chunk that holds it (the CONTROL
+//                                                 messages travel on a step lane that lcm-logger on
+//                                                 the trio's URL does not hear: the chunks carry u)
 //   replay_log_tamper IN OUT inject-garbage       foreign, unknown-type and undecodable events
 //                                                 between the events of the episode
 #include <cmath>
@@ -9,6 +12,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <pidlab/lcmt_control_command.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
+#include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <random>
 #include <string>
 #include <vector>
@@ -67,8 +71,22 @@ int main(int argc, char** argv) {
       ++altered;
       continue;
     }
+    pidlab::lcmt_trajectory_chunk chunk;
+    if (step >= 0 && chunk.decode(ev->data, 0, ev->datalen) == ev->datalen &&
+        chunk.episode_id == disturbed_episode && chunk.step <= step && step < chunk.step + chunk.count &&
+        static_cast<std::size_t>(step - chunk.step) < chunk.u.size()) {
+      double& u = chunk.u[static_cast<std::size_t>(step - chunk.step)];
+      u = std::nextafter(u, HUGE_VAL);
+      std::vector<uint8_t> buf(static_cast<std::size_t>(chunk.getEncodedSize()));
+      chunk.encode(buf.data(), 0, static_cast<int>(buf.size()));
+      lcm::LogEvent copy = *ev;
+      copy.data = buf.data();
+      Put(&out, copy, &num);
+      ++altered;
+      continue;
+    }
     Put(&out, *ev, &num);
-    if (mode == "inject-garbage" && events % 5000 == 0) {
+    if (mode == "inject-garbage" && events % 50 == 0) {
       std::vector<uint8_t> junk(40);
       for (auto& b : junk) b = static_cast<uint8_t>(rng());
       PutBytes(&out, "STRANGER_POSE", junk, &num);

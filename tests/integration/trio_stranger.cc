@@ -17,6 +17,8 @@
 #include <thread>
 #include <vector>
 
+#include "pidlab/transport/transport.h"
+
 int main(int argc, char** argv) {
   if (argc < 4) {
     std::fprintf(stderr, "usage: trio_stranger URL PREFIX SECONDS\n");
@@ -24,6 +26,11 @@ int main(int argc, char** argv) {
   }
   lcm::LCM lcm(argv[1]);
   if (!lcm.good()) return 1;
+  // The per-step channels travel on the trio's step lanes (transport.h).
+  const std::string y_url = pidlab::transport::StepLaneUrl(argv[1], pidlab::transport::kPlantOutputLane);
+  const std::string u_url = pidlab::transport::StepLaneUrl(argv[1], pidlab::transport::kControlLane);
+  lcm::LCM lcm_y(y_url.empty() ? argv[1] : y_url), lcm_u(u_url.empty() ? argv[1] : u_url);
+  if (!lcm_y.good() || !lcm_u.good()) return 1;
   const std::string p = argv[2];
   const double seconds = std::atof(argv[3]);
   std::mt19937 rng(1234);
@@ -37,6 +44,7 @@ int main(int argc, char** argv) {
     std::vector<unsigned char> junk(1 + rng() % 200);
     for (auto& b : junk) b = static_cast<unsigned char>(rng());
     lcm.publish(p + channels[i % 10], junk.data(), static_cast<unsigned>(junk.size()));
+    (i % 2 ? lcm_y : lcm_u).publish(p + channels[i % 10], junk.data(), static_cast<unsigned>(junk.size()));
     // Well-formed messages of a foreign episode, with plausible steps.
     const int64_t foreign = 777000 + (i % 5);
     pidlab::lcmt_plant_output y{};
@@ -44,11 +52,13 @@ int main(int argc, char** argv) {
     y.step = i % 50;
     y.y = 1e6;
     lcm.publish(p + "PLANT_OUTPUT", &y);
+    lcm_y.publish(p + "PLANT_OUTPUT", &y);
     pidlab::lcmt_control_command u{};
     u.episode_id = foreign;
     u.step = i % 50;
     u.u = -1e6;
     lcm.publish(p + "CONTROL", &u);
+    lcm_u.publish(p + "CONTROL", &u);
     pidlab::lcmt_disturbance_sample n{};
     n.episode_id = foreign;
     n.step = i % 50;

@@ -53,6 +53,7 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
     }
     transport_options.auth_key = key;
   }
+  transport_options.step_lane_base_url = url;
   if (!transport_options.IsValid(&error)) {
     std::cerr << program << ": error: " << error << "\n";
     return 2;

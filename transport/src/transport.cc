@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
 
 namespace pidlab::transport {
 
@@ -26,6 +27,10 @@ bool TransportOptions::IsValid(std::string* error) const {
     os << "drop rate " << drop_rate << " must be in [0, 1)";
   } else if (channel_prefix.find_first_of(" \t\n") != std::string::npos) {
     os << "channel prefix '" << channel_prefix.substr(0, 80) << "' must not contain white space";
+  } else if (!step_lane_base_url.empty() && step_lane_base_url.rfind("udpm://", 0) == 0 &&
+             StepLaneUrl(step_lane_base_url, kControlLane).empty()) {
+    os << "LCM URL '" << step_lane_base_url.substr(0, 120)
+       << "': its port must be a number at most 65533 (the step lanes use the next two)";
   } else if (channel_prefix.size() > kMaxChannelPrefixBytes) {
     // LCM refuses channel names longer than 63 bytes; the longest pidlab
     // channel name (DISTURBANCE_REQUEST) is 19.
@@ -38,8 +43,47 @@ bool TransportOptions::IsValid(std::string* error) const {
   return false;
 }
 
+int LaneOf(const char* name) {
+  if (std::strcmp(name, kPlantOutputChannel) == 0) return kPlantOutputLane;
+  if (std::strcmp(name, kControlChannel) == 0) return kControlLane;
+  return 0;
+}
+
+std::string StepLaneUrl(const std::string& base_url, int lane) {
+  const std::string scheme = "udpm://";
+  if (base_url.rfind(scheme, 0) != 0) return "";
+  const std::size_t query = base_url.find('?');
+  const std::string address =
+      base_url.substr(scheme.size(), query == std::string::npos ? std::string::npos : query - scheme.size());
+  const std::string rest = query == std::string::npos ? "" : base_url.substr(query);
+  const std::size_t colon = address.rfind(':');
+  long port = 7667;  // LCM's default
+  std::string group = address;
+  if (colon != std::string::npos) {
+    group = address.substr(0, colon);
+    const std::string digits = address.substr(colon + 1);
+    if (digits.empty() || digits.size() > 5 || digits.find_first_not_of("0123456789") != std::string::npos)
+      return "";
+    port = std::stol(digits);
+  }
+  if (group.empty() || port < 1 || port + lane > 65535) return "";
+  return scheme + group + ":" + std::to_string(port + lane) + rest;
+}
+
 Transport::Transport(lcm::LCM* lcm, const TransportOptions& options)
     : lcm_(lcm), options_(options), drop_rng_(options.drop_seed) {}
+
+lcm::LCM* Transport::LcmFor(int lane) {
+  if (lane == 0) return lcm_;
+  auto& instance = lanes_[lane];
+  if (!instance) {
+    const std::string url = StepLaneUrl(options_.step_lane_base_url, lane);
+    if (url.empty()) return lcm_;  // no lanes: everything on the base instance
+    instance = std::make_unique<lcm::LCM>(url);
+    if (!instance->good()) throw std::runtime_error("cannot start LCM on the step lane '" + url + "'");
+  }
+  return instance.get();
+}
 
 bool Transport::ShouldDrop() {
   if (options_.drop_rate <= 0.0) return false;
@@ -48,14 +92,14 @@ bool Transport::ShouldDrop() {
   return r < options_.drop_rate;
 }
 
-const std::string& Transport::CachedChannel(const char* name) {
+const Transport::CachedName& Transport::CachedChannel(const char* name) {
   // A handful of short names: a linear strcmp is cheaper than building the
   // prefixed name (a heap allocation) for every message.
   for (const auto& entry : channel_cache_)
-    if (std::strcmp(entry.first.c_str(), name) == 0) return entry.second;
+    if (std::strcmp(entry.name.c_str(), name) == 0) return entry;
   if (channel_cache_.size() >= 64) channel_cache_.clear();  // bounded, whatever the callers pass
-  channel_cache_.emplace_back(name, Channel(name));
-  return channel_cache_.back().second;
+  channel_cache_.push_back(CachedName{name, Channel(name), LaneOf(name)});
+  return channel_cache_.back();
 }
 
 void Transport::Subscription::HandleC(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
@@ -86,16 +130,27 @@ void Transport::Subscription::HandleC(const lcm_recv_buf_t* rbuf, const char* /*
 }
 
 int Transport::WaitAndHandle(double timeout_s) {
-  const int fd = lcm_->getFileno();
   const double wait = timeout_s > 0.0 ? timeout_s : 0.0;
-  // One poll and one handle per message: no extra zero-timeout poll to drain
-  // the queue (the caller's loop comes straight back here).
-  pollfd pfd{fd, POLLIN, 0};
-  const int ready = poll(&pfd, 1, static_cast<int>(std::ceil(wait * 1000.0)));
+  // One poll and one handle per ready instance: no extra zero-timeout poll
+  // to drain the queue (the caller's loop comes straight back here).
+  pollfd pfd[3];
+  lcm::LCM* instance[3];
+  int n = 0;
+  for (int lane = 0; lane < 3; ++lane) {
+    if (lane > 0 && !(listening_[lane] && lanes_[lane])) continue;
+    instance[n] = lane == 0 ? lcm_ : lanes_[lane].get();
+    pfd[n] = pollfd{instance[n]->getFileno(), POLLIN, 0};
+    ++n;
+  }
+  const int ready = poll(pfd, static_cast<nfds_t>(n), static_cast<int>(std::ceil(wait * 1000.0)));
   if (ready < 0) return errno == EINTR ? 0 : -1;
-  if (ready == 0) return 0;
-  if (lcm_handle(lcm_->getUnderlyingLCM()) != 0) return -1;
-  return 1;
+  int handled = 0;
+  for (int i = 0; i < n && ready > 0; ++i) {
+    if (!(pfd[i].revents & POLLIN)) continue;
+    if (lcm_handle(instance[i]->getUnderlyingLCM()) != 0) return -1;
+    ++handled;
+  }
+  return handled;
 }
 
 }  // namespace pidlab::transport

@@ -37,9 +37,28 @@ struct TransportOptions {
   /// With a key, every message sent carries an HMAC-SHA256 tag and every
   /// message received must carry a valid, fresh one (auth.h).
   std::optional<AuthKey> auth_key;
+  /// The trio's LCM URL, for its step lanes: with a udpm:// URL the per-step
+  /// channels travel on ports of their own in the same group (StepLaneUrl),
+  /// so that a y_k wakes only the controller and a u_k only the plant, not
+  /// every process of the trio. Empty, or not udpm://: every channel on the
+  /// LCM instance given to the transport (memq:// tests).
+  std::string step_lane_base_url;
 
   bool IsValid(std::string* error) const;
 };
+
+/// The step lanes: PLANT_OUTPUT on the base port + 1, CONTROL on the base
+/// port + 2 (kPlantOutputLane, kControlLane), same group and options. Every
+/// other channel stays on the base URL, where lcm-logger and lcm-spy listen;
+/// the plant's TRAJECTORY chunks carry every y_k, u_k and n_k there.
+inline constexpr int kPlantOutputLane = 1;
+inline constexpr int kControlLane = 2;
+/// The lane of a channel name (without prefix): 0 for the base URL.
+int LaneOf(const char* name);
+/// `base_url` with its port moved up by `lane` (udpm://GROUP[:PORT][?OPTS],
+/// LCM's default port 7667); empty if base_url is not udpm:// or the port
+/// would pass 65535.
+std::string StepLaneUrl(const std::string& base_url, int lane);
 
 struct TransportCounters {
   long received = 0;         // messages that reached a subscription
@@ -69,13 +88,15 @@ class Transport {
     const std::size_t total = static_cast<std::size_t>(size) + (options_.auth_key ? kAuthTagBytes : 0);
     if (encode_buffer_.size() < total) encode_buffer_.resize(total);
     if (msg->encode(encode_buffer_.data(), 0, size) != size) return false;
-    const std::string& channel = CachedChannel(name);
+    const CachedName& cached = CachedChannel(name);
+    const std::string& channel = cached.prefixed;
     if (options_.auth_key) {
       const auto tag =
           AuthTag(*options_.auth_key, channel, encode_buffer_.data(), static_cast<std::size_t>(size));
       std::copy(tag.begin(), tag.end(), encode_buffer_.begin() + size);
     }
-    return lcm_->publish(channel, encode_buffer_.data(), static_cast<unsigned int>(total)) == 0;
+    return LcmFor(cached.lane)->publish(channel, encode_buffer_.data(), static_cast<unsigned int>(total)) ==
+           0;
   }
   template <typename Msg>
   bool Publish(const std::string& name, Msg* msg) {
@@ -102,13 +123,16 @@ class Transport {
     // The C API directly: lcm-cpp's trampoline builds a std::string of the
     // channel name for every message received.
     sub->channel = Channel(name);
-    lcm_subscribe(lcm_->getUnderlyingLCM(), sub->channel.c_str(), &Subscription::HandleC, sub.get());
+    const int lane = LaneOf(name.c_str());
+    lcm_subscribe(LcmFor(lane)->getUnderlyingLCM(), sub->channel.c_str(), &Subscription::HandleC, sub.get());
+    listening_[static_cast<std::size_t>(lane)] = true;
     subscriptions_.push_back(std::move(sub));
   }
 
-  /// Waits at most timeout_s for traffic and handles one message if one
-  /// arrived (callers loop). Returns the number of messages handled (0 on
-  /// timeout), -1 on an LCM error.
+  /// Waits at most timeout_s for traffic and handles one message of each
+  /// LCM instance (base URL and step lanes) that has one (callers loop).
+  /// Returns the number of messages handled (0 on timeout), -1 on an LCM
+  /// error.
   int WaitAndHandle(double timeout_s);
 
   const TransportCounters& counters() const { return counters_; }
@@ -122,10 +146,18 @@ class Transport {
     std::function<bool(const void*, int)> decode_and_call;
     static void HandleC(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
   };
+  struct CachedName {
+    std::string name, prefixed;
+    int lane = 0;
+  };
   bool ShouldDrop();
-  const std::string& CachedChannel(const char* name);
+  const CachedName& CachedChannel(const char* name);
+  /// The LCM instance of a lane (0: the one given), created on first use: a
+  /// lane only published on never opens a receive socket (LCM 1.3.1 sets
+  /// that up on the first subscribe).
+  lcm::LCM* LcmFor(int lane);
 
-  std::deque<std::pair<std::string, std::string>> channel_cache_;  // name, prefixed name (stable refs)
+  std::deque<CachedName> channel_cache_;  // stable references
   std::vector<uint8_t> encode_buffer_;
 
   lcm::LCM* lcm_;
@@ -134,6 +166,8 @@ class Transport {
   std::mt19937_64 drop_rng_;
   ReplayGuard replay_guard_;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
+  std::unique_ptr<lcm::LCM> lanes_[3];  // [0] unused: lane 0 is lcm_
+  bool listening_[3] = {false, false, false};
 };
 
 }  // namespace pidlab::transport
