@@ -19,6 +19,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -26,6 +27,7 @@
 #include <iostream>
 #include <iterator>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -317,6 +319,45 @@ TEST(MissingSteps, RangesTextStopsAfterMaxRangesWithACount) {
   EXPECT_EQ(CountSteps(ranges), 1 + 3 + 1 + 10);
 }
 
+// ---- LaunchOptions::roles (no network: validation only)
+
+TEST(LaunchOptions, RolesAreANonEmptySetOfPlantControllerDisturbance) {
+  LaunchOptions o;
+  EXPECT_EQ(o.roles, (std::vector<std::string>{"plant", "controller", "disturbance"}));
+  EXPECT_EQ(o.roles, ln::AllRoles());
+  std::string error;
+  EXPECT_TRUE(o.IsValid(&error)) << error;
+  for (const std::vector<std::string>& subset :
+       std::vector<std::vector<std::string>>{{"plant"},
+                                             {"controller"},
+                                             {"disturbance"},
+                                             {"controller", "plant"},
+                                             {"disturbance", "plant", "controller"}}) {
+    o.roles = subset;
+    EXPECT_TRUE(o.IsValid(&error)) << error;
+  }
+  // Each invalid set: one line naming the value.
+  const std::vector<std::pair<std::vector<std::string>, std::string>> bad = {
+      {{}, "--roles names no role"},
+      {{"plant", "foo"}, "--roles: 'foo' is not a role (plant, controller, disturbance)"},
+      {{"Plant"}, "--roles: 'Plant' is not a role"},
+      {{""}, "--roles: '' is not a role"},
+      {{"plant", "logger"}, "'logger' is not a role"},
+      {{"plant", "controller", "plant"}, "--roles: 'plant' is named twice"},
+      {{"disturbance", "disturbance"}, "'disturbance' is named twice"},
+  };
+  for (const auto& [roles, message] : bad) {
+    o.roles = roles;
+    error.clear();
+    EXPECT_FALSE(o.IsValid(&error)) << message;
+    EXPECT_TRUE(Contains(error, message)) << error;
+    EXPECT_FALSE(Contains(error, "\n")) << error;
+  }
+  o.roles = {std::string(1000, 'x')};  // a long value is cut
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_LT(error.size(), 200u) << error;
+}
+
 // ---- The launcher and its log capture on real processes
 
 /// Enters a private network namespace once per process; every test that
@@ -426,6 +467,96 @@ TEST_F(Launcher, StartReachesReadyWithEveryRoleAlive) {
   EXPECT_FALSE(Alive(controller));
 }
 
+/// The names (/proc/PID/comm, at most 15 characters) of this process's
+/// living children.
+std::multiset<std::string> ChildNames() {
+  std::multiset<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
+    const std::string pid = entry.path().filename();
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    const std::string stat = ReadFile(entry.path().string() + "/stat");
+    const std::size_t paren = stat.rfind(')');
+    if (paren == std::string::npos) continue;
+    char state = 0;
+    int ppid = 0;
+    if (std::sscanf(stat.c_str() + paren + 1, " %c %d", &state, &ppid) != 2) continue;
+    if (ppid != getpid() || state == 'Z' || state == 'X') continue;
+    std::string comm = ReadFile(entry.path().string() + "/comm");
+    if (!comm.empty() && comm.back() == '\n') comm.pop_back();
+    names.insert(comm);
+  }
+  return names;
+}
+
+TEST_F(Launcher, StartsOnlyTheRolesNamedAndExportsOnlyTheirPids) {
+  LaunchOptions o = Options();
+  o.roles = {"controller", "plant"};  // any order
+  ln::Launcher l(o, Notes());
+  std::string error;
+  ASSERT_EQ(l.Start(nullptr, &error), LaunchStatus::kReady) << error;
+  EXPECT_TRUE(Alive(l.pid_of("plant")));
+  EXPECT_TRUE(Alive(l.pid_of("controller")));
+  EXPECT_EQ(l.pid_of("disturbance"), -1);
+  // Exactly those two processes (comm is cut at 15 characters).
+  EXPECT_EQ(ChildNames(), (std::multiset<std::string>{"pidlab-plant", "pidlab-controll"}));
+  std::map<std::string, std::string> env = l.CommandEnvironment();
+  EXPECT_EQ(env["PIDLAB_PLANT_PID"], std::to_string(l.pid_of("plant")));
+  EXPECT_EQ(env["PIDLAB_CONTROLLER_PID"], std::to_string(l.pid_of("controller")));
+  EXPECT_EQ(env.count("PIDLAB_DISTURBANCE_PID"), 0u);
+  EXPECT_EQ(env["PIDLAB_LCM_URL"], kUrl);
+  EXPECT_EQ(
+      l.Run({"sh", "-c", "test -z \"${PIDLAB_DISTURBANCE_PID+set}\" && test \"$PIDLAB_PLANT_PID\" -gt 0"},
+            nullptr),
+      0);
+  l.Stop();
+  EXPECT_FALSE(Alive(l.pid_of("plant")));
+  EXPECT_FALSE(Alive(l.pid_of("controller")));
+  EXPECT_TRUE(ChildNames().empty());
+}
+
+TEST_F(Launcher, TwoLaunchersWithDisjointRolesMakeOneTrioThatMatchesAWholeOne) {
+  // The plant and the controller from one launcher, the disturbance from
+  // another (as on two hosts), on one prefix; a whole trio on another.
+  LaunchOptions split = Options();
+  split.roles = {"plant", "controller"};
+  LaunchOptions other = split;
+  other.roles = {"disturbance"};
+  const LaunchOptions whole = Options();
+  ln::Launcher first(split, Notes());
+  ln::Launcher second(other, Notes());
+  ln::Launcher third(whole, Notes());
+  std::string error;
+  ASSERT_EQ(first.Start(nullptr, &error), LaunchStatus::kReady) << error;
+  ASSERT_EQ(second.Start(nullptr, &error), LaunchStatus::kReady) << error;
+  ASSERT_EQ(third.Start(nullptr, &error), LaunchStatus::kReady) << error;
+  EXPECT_EQ(second.pid_of("plant"), -1);
+  EXPECT_GT(second.pid_of("disturbance"), 0);
+  std::vector<double> y_split, y_whole;
+  ASSERT_TRUE(RunEpisode(first, split.channel_prefix, 1.0, &y_split, &error)) << error;
+  ASSERT_TRUE(RunEpisode(third, whole.channel_prefix, 1.0, &y_whole, &error)) << error;
+  EXPECT_EQ(y_split.size(), 1001u);  // y_0 to y_1000
+  EXPECT_EQ(y_split, y_whole);       // bit for bit
+}
+
+TEST_F(Launcher, ARoleThatNeverAnswersIsNamedWhenNotReady) {
+  // Only the controller, from a directory whose pidlab-controller never
+  // answers a PING: the error names it and nothing else.
+  TempDir bin;
+  const std::string fake = bin.File("pidlab-controller");
+  std::ofstream(fake) << "#!/bin/sh\nexec sleep 30\n";
+  ASSERT_EQ(chmod(fake.c_str(), 0755), 0);
+  LaunchOptions o = Options();
+  o.roles = {"controller"};
+  o.bin_dir = bin.File("");
+  o.ready_timeout_s = 0.5;
+  ln::Launcher l(o, Notes());
+  std::string error;
+  ASSERT_EQ(l.Start(nullptr, &error), LaunchStatus::kNotReady) << error;
+  EXPECT_TRUE(Contains(error, "not ready within 0.5 s: pidlab-controller (")) << error;
+  EXPECT_FALSE(Contains(error, "pidlab-plant")) << error;
+  EXPECT_FALSE(Contains(error, "pidlab-disturbance")) << error;
+}
+
 TEST_F(Launcher, CommandEnvironmentNamesTheUrlPrefixPidsAndPath) {
   const LaunchOptions o = Options();
   ln::Launcher l(o, Notes());
@@ -531,6 +662,11 @@ TEST_F(Launcher, InvalidOptionsThrowNamingTheValue) {
   o = Options();
   o.auth_key_file = dir_.File("no-such-key");
   EXPECT_TRUE(Contains(what(o), "no-such-key")) << what(o);
+  o = Options();
+  o.roles = {"plant", "foo"};
+  EXPECT_TRUE(Contains(what(o), "--roles: 'foo'")) << what(o);
+  o.roles = {};
+  EXPECT_TRUE(Contains(what(o), "--roles")) << what(o);
   std::string error;
   EXPECT_TRUE(Options().IsValid(&error)) << error;
 }

@@ -1,6 +1,7 @@
 // pidlab launch: flags -> LaunchOptions -> pidlab::launcher::Launcher
-// (launcher/launcher.h): start the trio (and lcm-logger), run COMMAND or
-// serve, check and repair the log, stop everything.
+// (launcher/launcher.h): start the trio, or the --roles named (and
+// lcm-logger), run COMMAND or serve, check and repair the log, stop
+// everything.
 
 #include <csignal>
 #include <iostream>
@@ -17,24 +18,55 @@ void OnSignal(int sig) { g_signal = sig; }
 
 void Note(const std::string& line) { std::cerr << "pidlab launch: " << line << "\n"; }
 
+/// "a,b,c" -> {"a", "b", "c"}; "" -> {} (no role: invalid); empty names are
+/// kept (an invalid role '').
+std::vector<std::string> SplitRoles(const std::string& text) {
+  std::vector<std::string> roles;
+  if (text.empty()) return roles;
+  std::size_t begin = 0;
+  for (;;) {
+    const std::size_t comma = text.find(',', begin);
+    roles.push_back(text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin));
+    if (comma == std::string::npos) return roles;
+    begin = comma + 1;
+  }
+}
+
+/// "trio" for all three roles, else the names: "plant, controller".
+std::string Started(const std::vector<std::string>& roles) {
+  if (roles.size() == launcher::AllRoles().size()) return "trio";
+  std::string text;
+  for (const std::string& role : launcher::AllRoles())
+    for (const std::string& r : roles)
+      if (r == role) text += (text.empty() ? "" : ", ") + role;
+  return text;
+}
+
 }  // namespace
 
 std::function<int()> RegisterLaunch(CLI::App* app) {
   struct Flags {
     launcher::LaunchOptions options;
     bool isolated = false;
+    std::string roles;
     std::vector<std::string> command;
   };
   auto flags = std::make_shared<Flags>();
   launcher::LaunchOptions& o = flags->options;
   app->description(
-      "Start pidlab-plant, pidlab-controller and pidlab-disturbance (and lcm-logger with --log), wait until "
-      "all "
-      "are ready, then run COMMAND against them and stop everything, returning COMMAND's status; without "
-      "COMMAND, serve until Ctrl-C. COMMAND sees PIDLAB_LCM_URL, PIDLAB_CHANNEL_PREFIX and "
-      "PIDLAB_{PLANT,CONTROLLER,DISTURBANCE}_PID.");
-  app->add_option("--lcm-url", o.lcm_url,
-                  "LCM URL (default: udpm://239.255.76.67:7667?ttl=0 with a 4 MB receive buffer)");
+      "Start pidlab-plant, pidlab-controller and pidlab-disturbance, or only the --roles named (and "
+      "lcm-logger with --log), wait until all are ready, then run COMMAND against them and stop "
+      "everything, returning COMMAND's status; without COMMAND, serve until Ctrl-C. COMMAND sees "
+      "PIDLAB_LCM_URL, PIDLAB_CHANNEL_PREFIX and PIDLAB_{PLANT,CONTROLLER,DISTURBANCE}_PID of the roles "
+      "started here.");
+  auto* roles = app->add_option(
+      "--roles", flags->roles,
+      "the roles to start on this host, comma-separated (default: plant,controller,disturbance); the "
+      "others run on other hosts on the same --lcm-url (ttl=1 on a LAN, docs/trio.md)");
+  app->add_option(
+      "--lcm-url", o.lcm_url,
+      "LCM URL (default: udpm://239.255.76.67:7667?ttl=0 with a 4 MB receive buffer, which stays on "
+      "this host; roles on several hosts need ttl=1)");
   app->add_option("--channel-prefix", o.channel_prefix, "channel prefix of this trio")->capture_default_str();
   app->add_option("--log", o.log_file, "record every message with lcm-logger into this file (overwritten)");
   app->add_flag("--isolated", flags->isolated,
@@ -53,8 +85,9 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
       "to the processes and to COMMAND as $PIDLAB_AUTH_KEY_FILE");
   app->add_flag("--verbose,-v", o.verbose, "verbose processes and launcher");
   app->add_option("command", flags->command, "COMMAND [ARGS...] after --");
-  return [flags] {
+  return [flags, roles] {
     std::string error;
+    if (roles->count() > 0) flags->options.roles = SplitRoles(flags->roles);
     if (!flags->options.IsValid(&error)) throw BadInput(error);
     // An unwritable --log is bad input (exit 2), found before anything starts.
     CheckOutputFile(flags->options.log_file, "--log");
@@ -76,8 +109,8 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
       throw std::runtime_error(error);
     }
     const launcher::LaunchOptions& opt = flags->options;
-    std::cerr << "pidlab launch: trio ready on " << trio.lcm_url() << " prefix " << opt.channel_prefix
-              << (opt.log_file.empty() ? "" : ", logging to " + opt.log_file) << "\n";
+    std::cerr << "pidlab launch: " << Started(opt.roles) << " ready on " << trio.lcm_url() << " prefix "
+              << opt.channel_prefix << (opt.log_file.empty() ? "" : ", logging to " + opt.log_file) << "\n";
     int result = trio.Run(flags->command, &g_signal);
     if (!trio.FinishLog(g_signal != 0) && result == 0) result = 1;
     trio.Stop();

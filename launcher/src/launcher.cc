@@ -4,6 +4,8 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -16,8 +18,16 @@
 namespace pidlab::launcher {
 namespace {
 constexpr const char* kRecvBufSuffix = "&recv_buf_size=4194304";
-const char* const kRoles[] = {"plant", "controller", "disturbance"};
+
+bool Started(const std::vector<std::string>& roles, const std::string& role) {
+  return std::find(roles.begin(), roles.end(), role) != roles.end();
+}
 }  // namespace
+
+const std::vector<std::string>& AllRoles() {
+  static const std::vector<std::string> roles = {"plant", "controller", "disturbance"};
+  return roles;
+}
 
 bool EnterIsolatedNetwork(std::string* error) {
   if (unshare(CLONE_NEWNET) != 0) {
@@ -44,7 +54,19 @@ std::string SelfDirectory() {
 
 bool LaunchOptions::IsValid(std::string* error) const {
   std::ostringstream os;
-  if (!(drop_rate >= 0.0 && drop_rate < 1.0))
+  std::string role_error;  // the first role named that is not one, or twice
+  for (const std::string& role : roles) {
+    if (!Started(AllRoles(), role))
+      role_error = "'" + role.substr(0, 120) + "' is not a role (plant, controller, disturbance)";
+    else if (std::count(roles.begin(), roles.end(), role) > 1)
+      role_error = "'" + role + "' is named twice";
+    if (!role_error.empty()) break;
+  }
+  if (roles.empty())
+    os << "--roles names no role: name at least one of plant, controller, disturbance";
+  else if (!role_error.empty())
+    os << "--roles: " << role_error;
+  else if (!(drop_rate >= 0.0 && drop_rate < 1.0))
     os << "--drop-rate " << drop_rate << " must be in [0, 1)";
   else if (!(ready_timeout_s > 0.0))
     os << "--ready-timeout " << ready_timeout_s << " must be positive";
@@ -115,21 +137,22 @@ pid_t Launcher::pid_of(const std::string& role) const {
 }
 
 void Launcher::StartRoles() {
-  int seed = 1;
-  for (const char* role : kRoles) {
+  int seed = 0;
+  for (const std::string& role : AllRoles()) {
+    ++seed;  // each role's own drop seed (1, 2, 3), wherever the others run
+    if (!Started(options_.roles, role)) continue;
     std::vector<std::string> args = {options_.bin_dir + "pidlab-" + role, "--lcm-url", url_,
                                      "--channel-prefix", options_.channel_prefix};
     if (options_.drop_rate > 0.0) {
       std::ostringstream rate;
       rate.precision(17);
       rate << options_.drop_rate;
-      args.insert(args.end(), {"--drop-rate", rate.str(), "--drop-seed", std::to_string(seed++)});
+      args.insert(args.end(), {"--drop-rate", rate.str(), "--drop-seed", std::to_string(seed)});
     }
     if (options_.verbose) args.push_back("--verbose");
     if (!options_.auth_key_file.empty()) args.insert(args.end(), {"--auth-key", options_.auth_key_file});
-    roles_[role] = supervisor_->Start(std::string("pidlab-") + role, args);
-    if (options_.verbose)
-      Note("started pidlab-" + std::string(role) + " (pid " + std::to_string(roles_[role]) + ")");
+    roles_[role] = supervisor_->Start("pidlab-" + role, args);
+    if (options_.verbose) Note("started pidlab-" + role + " (pid " + std::to_string(roles_[role]) + ")");
   }
 }
 
@@ -184,12 +207,13 @@ LaunchStatus Launcher::Start(const volatile std::sig_atomic_t* stop, std::string
 }
 
 std::map<std::string, std::string> Launcher::CommandEnvironment() const {
-  std::map<std::string, std::string> env = {
-      {"PIDLAB_LCM_URL", url_},
-      {"PIDLAB_CHANNEL_PREFIX", options_.channel_prefix},
-      {"PIDLAB_PLANT_PID", std::to_string(pid_of("plant"))},
-      {"PIDLAB_CONTROLLER_PID", std::to_string(pid_of("controller"))},
-      {"PIDLAB_DISTURBANCE_PID", std::to_string(pid_of("disturbance"))}};
+  std::map<std::string, std::string> env = {{"PIDLAB_LCM_URL", url_},
+                                            {"PIDLAB_CHANNEL_PREFIX", options_.channel_prefix}};
+  for (const auto& [role, pid] : roles_) {
+    std::string upper = role;
+    for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    env["PIDLAB_" + upper + "_PID"] = std::to_string(pid);
+  }
   if (logger_ > 0) env["PIDLAB_LOGGER_PID"] = std::to_string(logger_);
   if (!options_.auth_key_file.empty()) env[transport::kAuthKeyFileEnv] = options_.auth_key_file;
   // Let COMMAND find pidlab and the trio binaries next to us.

@@ -96,6 +96,11 @@ bad "--output-limits 1e13" "1e13" evaluate --plant linear --gains 1,1,1 --loop s
 bad "--bounds 0,1e13" "1e13" tune --plant linear --bounds 0,1e13
 bad "--episode-timeout 1e308" "1e308" evaluate --plant linear --gains 1,1,1 --backend lcm --episode-timeout 1e308
 bad "--drop-rate inf" "inf" launch --drop-rate inf -- true
+# launch --roles: a subset of plant,controller,disturbance, each once (before anything starts).
+bad "launch --roles plant,foo" "'foo' is not a role" launch --roles plant,foo -- true
+bad "launch --roles ''" "--roles names no role" launch --roles '' -- true
+bad "launch --roles plant,,controller" "'' is not a role" launch --roles plant,,controller -- true
+bad "launch --roles plant,plant" "'plant' is named twice" launch --roles plant,plant -- true
 good "gain 1e12 at the limit" evaluate --plant linear --gains 1e12,0,0
 good "--output-limits -inf,5 (inf: no limit)" evaluate --plant linear --gains 1,1,1 --loop sampled --output-limits -inf,5
 

@@ -3,7 +3,8 @@
 // lcm-logger when a log is asked for), waits until every process answers,
 // runs a command against them or serves, and stops everything. The library
 // behind `pidlab launch`, and what `pidlab report` uses to run its trio
-// episode in process.
+// episode in process. LaunchOptions::roles starts only some of the three on
+// this host (the others run on other hosts on the same LCM URL).
 
 #include <sys/types.h>
 
@@ -30,7 +31,14 @@ bool EnterIsolatedNetwork(std::string* error);
 /// The directory of this executable, with a trailing '/'.
 std::string SelfDirectory();
 
+/// The three roles, in the order they are started: "plant", "controller",
+/// "disturbance".
+const std::vector<std::string>& AllRoles();
+
 struct LaunchOptions {
+  /// The roles started on this host: a non-empty subset of AllRoles(), each
+  /// named once (any order; they start in AllRoles() order).
+  std::vector<std::string> roles = AllRoles();
   /// LCM URL of the trio; empty: transport::kDefaultLcmUrl with a 4 MB
   /// receive buffer.
   std::string lcm_url;
@@ -41,7 +49,8 @@ struct LaunchOptions {
   /// Record every message with lcm-logger into this file (empty: no log).
   std::string log_file;
   /// Fault injection in each process: fraction in [0, 1) of received
-  /// messages thrown away (seeds 1, 2, 3).
+  /// messages thrown away (seeds 1, 2, 3 for plant, controller, disturbance,
+  /// whichever are started).
   double drop_rate = 0.0;
   /// How long the processes have to answer PING, s.
   double ready_timeout_s = 5.0;
@@ -77,13 +86,14 @@ class Launcher {
   Launcher(const LaunchOptions& options, NoteFn note);
   ~Launcher();
 
-  /// Starts the logger (if any) and the three processes and waits until all
-  /// are ready. Anything else than kReady comes with *error (one line).
+  /// Starts the logger (if any) and the processes of options.roles and waits
+  /// until all of them are ready. Anything else than kReady comes with *error (one line).
   LaunchStatus Start(const volatile std::sig_atomic_t* stop, std::string* error);
 
   /// PIDLAB_LCM_URL, PIDLAB_CHANNEL_PREFIX, PIDLAB_{PLANT,CONTROLLER,
-  /// DISTURBANCE,LOGGER}_PID, PIDLAB_AUTH_KEY_FILE (with a key) and PATH with
-  /// this executable's directory first.
+  /// DISTURBANCE}_PID of the roles started here, PIDLAB_LOGGER_PID (with a
+  /// log), PIDLAB_AUTH_KEY_FILE (with a key) and PATH with this executable's
+  /// directory first.
   std::map<std::string, std::string> CommandEnvironment() const;
 
   /// Runs `command` with CommandEnvironment() until it ends and returns its
@@ -101,6 +111,7 @@ class Launcher {
   void Stop();
 
   const std::string& lcm_url() const { return url_; }
+  /// The pid of a role started here; -1 for a role not started here.
   pid_t pid_of(const std::string& role) const;
 
  private:
