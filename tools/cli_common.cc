@@ -133,7 +133,9 @@ std::string FromEnv(const std::string& flag, const char* env, const char* fallba
 
 void LcmFlags::Register(CLI::App* app) {
   app->add_option("--lcm-url", lcm_url,
-                  "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's)");
+                  "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's); tune: one or "
+                  "several trios, comma-separated (default: every trio of 'pidlab launch --trios K', "
+                  "$PIDLAB_LCM_URLS)");
   app->add_option("--channel-prefix", channel_prefix,
                   "--backend lcm: channel prefix of the trio (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
   app->add_option("--episode-timeout", episode_timeout_s,
@@ -156,8 +158,32 @@ void LcmFlags::Register(CLI::App* app) {
 }
 
 std::unique_ptr<EpisodeClient> LcmFlags::MakeClient() const {
+  return std::make_unique<EpisodeClient>(ClientOptions(Url()));  // throws runtime_error: exit 1
+}
+
+std::string LcmFlags::Url() const {
+  const std::vector<std::string> urls =
+      SplitUrlList(FromEnv(lcm_url, "PIDLAB_LCM_URL", transport::kDefaultLcmUrl));
+  if (urls.empty()) throw BadInput("--lcm-url " + Quote(lcm_url) + " names no URL");
+  return urls.front();
+}
+
+std::unique_ptr<EpisodePool> LcmFlags::MakePool() const {
+  // --lcm-url (one URL or several), else every trio of `pidlab launch
+  // --trios K` ($PIDLAB_LCM_URLS), else $PIDLAB_LCM_URL, else LCM's.
+  std::string list = lcm_url;
+  if (list.empty()) list = FromEnv("", "PIDLAB_LCM_URLS", "");
+  if (list.empty()) list = FromEnv("", "PIDLAB_LCM_URL", transport::kDefaultLcmUrl);
+  const std::vector<std::string> urls = SplitUrlList(list);
+  if (urls.empty()) throw BadInput("--lcm-url " + Quote(lcm_url) + " names no URL");
+  std::vector<EpisodeClientOptions> trios;
+  for (const std::string& url : urls) trios.push_back(ClientOptions(url));
+  return std::make_unique<EpisodePool>(trios);  // throws runtime_error: exit 1
+}
+
+EpisodeClientOptions LcmFlags::ClientOptions(const std::string& url) const {
   EpisodeClientOptions co;
-  co.lcm_url = FromEnv(lcm_url, "PIDLAB_LCM_URL", transport::kDefaultLcmUrl);
+  co.lcm_url = url;
   co.transport.channel_prefix =
       FromEnv(channel_prefix, "PIDLAB_CHANNEL_PREFIX", transport::kDefaultChannelPrefix);
   co.episode_timeout_s = episode_timeout_s;
@@ -172,7 +198,7 @@ std::unique_ptr<EpisodeClient> LcmFlags::MakeClient() const {
     co.transport.auth_key = key;
   }
   if (!co.IsValid(&error)) throw BadInput(error);
-  return std::make_unique<EpisodeClient>(co);  // throws runtime_error: exit 1
+  return co;
 }
 
 double ParseDouble(const std::string& text, const std::string& what, bool allow_infinite) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pidlab/tuner/episode_client.h"
+#include "pidlab/tuner/episode_pool.h"
 #include "pidlab/tuner/evaluation.h"
 
 namespace pidlab::cli {
@@ -69,6 +70,12 @@ struct LcmFlags {
   /// $PIDLAB_CHANNEL_PREFIX and $PIDLAB_AUTH_KEY_FILE) name. Throws BadInput for bad flags,
   /// std::runtime_error if LCM cannot start.
   std::unique_ptr<EpisodeClient> MakeClient() const;
+  /// The trios of tune: --lcm-url (comma-separated URLs), else
+  /// $PIDLAB_LCM_URLS (pidlab launch --trios K), else $PIDLAB_LCM_URL.
+  std::unique_ptr<EpisodePool> MakePool() const;
+  /// The first URL of --lcm-url, else $PIDLAB_LCM_URL, else LCM's.
+  std::string Url() const;
+  EpisodeClientOptions ClientOptions(const std::string& url) const;
 };
 
 /// Strict number parsing: the whole string must be a number, finite and at

@@ -49,6 +49,7 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
     launcher::LaunchOptions options;
     bool isolated = false;
     std::string roles;
+    int trios = 1;
     std::vector<std::string> command;
   };
   auto flags = std::make_shared<Flags>();
@@ -58,7 +59,8 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
       "lcm-logger with --log), wait until all are ready, then run COMMAND against them and stop "
       "everything, returning COMMAND's status; without COMMAND, serve until Ctrl-C. COMMAND sees "
       "PIDLAB_LCM_URL, PIDLAB_CHANNEL_PREFIX and PIDLAB_{PLANT,CONTROLLER,DISTURBANCE}_PID of the roles "
-      "started here.");
+      "started here; with --trios K also PIDLAB_TRIOS, PIDLAB_LCM_URLS (the K URLs) and "
+      "PIDLAB_TRIO<i>_{PLANT,CONTROLLER,DISTURBANCE}_PID.");
   auto* roles = app->add_option(
       "--roles", flags->roles,
       "the roles to start on this host, comma-separated (default: plant,controller,disturbance); the "
@@ -68,6 +70,11 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
       "LCM URL (default: udpm://239.255.76.67:7667?ttl=0 with a 4 MB receive buffer, which stays on "
       "this host; roles on several hosts need ttl=1)");
   app->add_option("--channel-prefix", o.channel_prefix, "channel prefix of this trio")->capture_default_str();
+  app->add_option("--trios", flags->trios,
+                  "start K independent trios, trio i on the --lcm-url port + 3(i-1) (each uses its port and "
+                  "the two above); 'pidlab tune --backend lcm' runs its starts on all of them. With --log, "
+                  "trio i > 1 logs into FILE.trio<i>")
+      ->capture_default_str();
   app->add_option("--log", o.log_file, "record every message with lcm-logger into this file (overwritten)");
   app->add_flag("--isolated", flags->isolated,
                 "run everything in a private network namespace (root) with multicast over its "
@@ -97,20 +104,23 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
     sigemptyset(&sa.sa_mask);
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
 
-    std::unique_ptr<launcher::Launcher> launched;
+    std::unique_ptr<launcher::TrioSet> launched;
     try {
-      launched = std::make_unique<launcher::Launcher>(flags->options, Note);
+      launched = std::make_unique<launcher::TrioSet>(flags->options, flags->trios, Note);
     } catch (const std::invalid_argument& bad) {
       throw BadInput(bad.what());
     }
-    launcher::Launcher& trio = *launched;
+    launcher::TrioSet& trio = *launched;
     if (trio.Start(&g_signal, &error) != launcher::LaunchStatus::kReady) {
       if (g_signal) return 128 + static_cast<int>(g_signal);
       throw std::runtime_error(error);
     }
     const launcher::LaunchOptions& opt = flags->options;
-    std::cerr << "pidlab launch: " << Started(opt.roles) << " ready on " << trio.lcm_url() << " prefix "
-              << opt.channel_prefix << (opt.log_file.empty() ? "" : ", logging to " + opt.log_file) << "\n";
+    std::string where;
+    for (const std::string& url : trio.urls()) where += (where.empty() ? "" : ", ") + url;
+    std::cerr << "pidlab launch: " << (trio.size() > 1 ? std::to_string(trio.size()) + " x " : "")
+              << Started(opt.roles) << " ready on " << where << " prefix " << opt.channel_prefix
+              << (opt.log_file.empty() ? "" : ", logging to " + opt.log_file) << "\n";
     int result = trio.Run(flags->command, &g_signal);
     if (!trio.FinishLog(g_signal != 0) && result == 0) result = 1;
     trio.Stop();

@@ -26,7 +26,7 @@ struct TuneCommand {
   double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3;
   bool json = false, adaptive = false;
   LcmFlags lcm;
-  std::unique_ptr<EpisodeClient> client;
+  std::unique_ptr<EpisodePool> pool;
 
   // The tuner's acceptance margin: with the evaluation's 1e-9 the search games
   // the sampled objective by parking poles a hair left of the imaginary axis
@@ -72,9 +72,10 @@ struct TuneCommand {
 
   int Run() {
     const Plant p = plant.Build();
-    const TuneOptions o = BuildOptions();
+    TuneOptions o = BuildOptions();
     CheckOutputFile(trace, "--trace");  // before the search, not after it
     const SampledRunner runner = MakeRunner(o);
+    if (pool) o.parallel_for = pool->AsParallelFor();  // the starts on idle trios
     const bool tty = isatty(STDERR_FILENO) != 0;
     TuneSummary s;
     std::string error;
@@ -132,8 +133,8 @@ struct TuneCommand {
     if (backend != "lcm") throw BadInput("--backend " + Quote(backend) + " must be local or lcm");
     if (o.loop.loop != LoopKind::kSampled)
       throw BadInput("--backend lcm runs the sampled loop: add --loop sampled");
-    client = lcm.MakeClient();
-    return client->AsRunner();
+    pool = lcm.MakePool();
+    return pool->AsRunner();
   }
 
   // Progress on a terminal, at most ten lines a second; silent otherwise.

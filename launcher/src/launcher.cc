@@ -223,7 +223,12 @@ std::map<std::string, std::string> Launcher::CommandEnvironment() const {
 }
 
 int Launcher::Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop) {
-  const pid_t cmd = command.empty() ? -1 : supervisor_->Start("COMMAND", command, CommandEnvironment());
+  return Run(command, stop, CommandEnvironment());
+}
+
+int Launcher::Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop,
+                  const std::map<std::string, std::string>& environment) {
+  const pid_t cmd = command.empty() ? -1 : supervisor_->Start("COMMAND", command, environment);
   for (;;) {
     for (const Child& c : supervisor_->Reap()) {
       if (c.pid == cmd) return ExitCodeOf(c.status);
@@ -263,6 +268,82 @@ void Launcher::Stop() {
   if (!supervisor_) return;
   if (logger_ > 0) supervisor_->StopChild(logger_, SIGINT, 3.0);
   supervisor_->KillAll();
+}
+
+std::string TrioUrl(const std::string& base_url, int index) {
+  if (index == 0) return base_url;
+  // The step lanes' port arithmetic: trio i's port is the base port + 3 i.
+  return transport::StepLaneUrl(base_url, 3 * index);
+}
+
+TrioSet::TrioSet(const LaunchOptions& options, int trios, Launcher::NoteFn note) {
+  if (trios < 1 || trios > kMaxTrios)
+    throw std::invalid_argument("--trios " + std::to_string(trios) + " must be in [1, " +
+                                std::to_string(kMaxTrios) + "]");
+  const std::string base = options.EffectiveLcmUrl();
+  for (int i = 0; i < trios; ++i) {
+    LaunchOptions o = options;
+    o.lcm_url = TrioUrl(base, i);
+    if (o.lcm_url.empty() || transport::StepLaneUrl(o.lcm_url, transport::kControlLane).empty())
+      throw std::invalid_argument("--trios " + std::to_string(trios) + " needs ports up to 3 x " +
+                                  std::to_string(trios) + " above the port of '" + base +
+                                  "' (a udpm:// URL with a port at most " +
+                                  std::to_string(65533 - 3 * (trios - 1)) + ")");
+    if (i > 0 && !o.log_file.empty()) o.log_file += ".trio" + std::to_string(i + 1);
+    Launcher::NoteFn trio_note = note;
+    if (trios > 1 && note)
+      trio_note = [note, i](const std::string& line) { note("trio " + std::to_string(i + 1) + ": " + line); };
+    trios_.push_back(std::make_unique<Launcher>(o, trio_note));
+  }
+}
+
+LaunchStatus TrioSet::Start(const volatile std::sig_atomic_t* stop, std::string* error) {
+  for (std::size_t i = 0; i < trios_.size(); ++i) {
+    const LaunchStatus status = trios_[i]->Start(stop, error);
+    if (status != LaunchStatus::kReady) {
+      if (trios_.size() > 1 && error) *error = "trio " + std::to_string(i + 1) + ": " + *error;
+      return status;
+    }
+  }
+  return LaunchStatus::kReady;
+}
+
+std::vector<std::string> TrioSet::urls() const {
+  std::vector<std::string> urls;
+  for (const auto& trio : trios_) urls.push_back(trio->lcm_url());
+  return urls;
+}
+
+std::map<std::string, std::string> TrioSet::CommandEnvironment() const {
+  std::map<std::string, std::string> env = trios_.front()->CommandEnvironment();
+  env["PIDLAB_TRIOS"] = std::to_string(trios_.size());
+  std::string list;
+  for (const std::string& url : urls()) list += (list.empty() ? "" : " ") + url;
+  env["PIDLAB_LCM_URLS"] = list;
+  for (std::size_t i = 0; i < trios_.size(); ++i) {
+    for (const std::string& role : AllRoles()) {
+      const pid_t pid = trios_[i]->pid_of(role);
+      if (pid <= 0) continue;
+      std::string upper = role;
+      for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+      env["PIDLAB_TRIO" + std::to_string(i + 1) + "_" + upper + "_PID"] = std::to_string(pid);
+    }
+  }
+  return env;
+}
+
+int TrioSet::Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop) {
+  return trios_.front()->Run(command, stop, CommandEnvironment());
+}
+
+bool TrioSet::FinishLog(bool interrupted) {
+  bool ok = true;
+  for (const auto& trio : trios_) ok = trio->FinishLog(interrupted) && ok;
+  return ok;
+}
+
+void TrioSet::Stop() {
+  for (const auto& trio : trios_) trio->Stop();
 }
 
 }  // namespace pidlab::launcher

@@ -189,7 +189,8 @@ std::string EpisodeClient::Where() const {
 
 bool EpisodeClient::StartEpisode(const pidlab::lcmt_episode_config& config, std::string* error) {
   std::string missing;
-  switch (starter_->Start(config, {"plant", "controller", "disturbance"}, options_.start_timeout_s, &missing)) {
+  switch (
+      starter_->Start(config, {"plant", "controller", "disturbance"}, options_.start_timeout_s, &missing)) {
     case transport::StartStatus::kStarted:
       return true;
     case transport::StartStatus::kLcmError:
@@ -222,7 +223,8 @@ bool EpisodeClient::FollowEpisode(double t0, double* done_s, long* requests, std
     }
     if (now - t0 > options_.episode_timeout_s) {
       std::ostringstream os;
-      os << "episode timeout " << options_.episode_timeout_s << " s at step " << s.max_step << " of " << s.total;
+      os << "episode timeout " << options_.episode_timeout_s << " s at step " << s.max_step << " of "
+         << s.total;
       *error = os.str();
       return false;
     }
@@ -314,13 +316,15 @@ bool EpisodeClient::Run(const Plant& plant, const PidGains& gains, const LoopOpt
     bool retryable = true;
     if (RunOnce(spec, &why, &retryable)) break;
     if (!retryable || attempt >= options_.max_attempts) {
+      last_failure_retryable_ = retryable;
       if (error) *error = attempt > 1 ? why + " (after " + std::to_string(attempt) + " attempts)" : why;
       return false;
     }
     ++stats_.reruns;
     if (options_.on_note)
-      options_.on_note("episode " + std::to_string(spec.episode_id) + " failed (" + why + "); running it again (attempt " +
-                       std::to_string(attempt + 1) + " of " + std::to_string(options_.max_attempts) + ")");
+      options_.on_note("episode " + std::to_string(spec.episode_id) + " failed (" + why +
+                       "); running it again (attempt " + std::to_string(attempt + 1) + " of " +
+                       std::to_string(options_.max_attempts) + ")");
     spec.episode_id = transport::NewEpisodeId();
   }
   const State& s = *state_;

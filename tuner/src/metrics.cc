@@ -507,6 +507,7 @@ ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& op
 
 double ObjectiveEvaluator::operator()(const PidGains& gains) const {
   ++evaluations_;
+  thread_local std::vector<double> y;  // reused: no allocation per evaluation
   if (!GainsAreValid(gains, nullptr)) return kInf;
   const double ts = options_.sample_time_s;
   if (options_.loop == LoopKind::kContinuous) {
@@ -516,34 +517,34 @@ double ObjectiveEvaluator::operator()(const PidGains& gains) const {
     if (!s.stable) return kInf;
     if (kind_ == ObjectiveKind::kIaeContinuous)
       return ContinuousIntegralAbsError(loop, disturbance_, s, options_.horizon_s);
-    SampleContinuousLoop<double>(loop, disturbance_, ts, options_.NumSamples(), &y_);
-    return ObjectiveFromSamples(kind_, y_, ts);
+    SampleContinuousLoop<double>(loop, disturbance_, ts, options_.NumSamples(), &y);
+    return ObjectiveFromSamples(kind_, y, ts);
   }
   if (!SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable) return kInf;
   if (runner_ || kind_ == ObjectiveKind::kIaeContinuous) {
     if (runner_) {
       std::string error;
-      if (!runner_(plant_, gains, options_, options_.disturbance, &y_, nullptr, &error))
+      if (!runner_(plant_, gains, options_, options_.disturbance, &y, nullptr, &error))
         throw std::runtime_error("sampled-loop runner failed: " + error);
     } else if (RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(), 1,
-                                      &y_) == PidStatus::kInvalidInput) {
+                                      &y) == PidStatus::kInvalidInput) {
       return kInf;
     }
     if (kind_ != ObjectiveKind::kIaeContinuous) {
       std::vector<double> samples;
       const int per = options_.StepsPerSample();
-      for (std::size_t k = 0; k < y_.size(); k += static_cast<std::size_t>(per)) samples.push_back(y_[k]);
+      for (std::size_t k = 0; k < y.size(); k += static_cast<std::size_t>(per)) samples.push_back(y[k]);
       return ObjectiveFromSamples(kind_, samples, ts);
     }
     double integral = 0.0;
-    for (std::size_t k = 1; k < y_.size(); ++k)
-      integral += 0.5 * options_.dt_s * (std::abs(1.0 - y_[k]) + std::abs(1.0 - y_[k - 1]));
+    for (std::size_t k = 1; k < y.size(); ++k)
+      integral += 0.5 * options_.dt_s * (std::abs(1.0 - y[k]) + std::abs(1.0 - y[k - 1]));
     return integral;
   }
   if (RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(),
-                             options_.StepsPerSample(), &y_) == PidStatus::kInvalidInput)
+                             options_.StepsPerSample(), &y) == PidStatus::kInvalidInput)
     return kInf;
-  return ObjectiveFromSamples(kind_, y_, ts);
+  return ObjectiveFromSamples(kind_, y, ts);
 }
 
 }  // namespace pidlab

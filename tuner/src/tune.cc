@@ -178,6 +178,7 @@ bool Search(const Plant& plant, const TuneOptions& options, const ObjectiveFunct
       NelderMeadOptions o = WithBudget(NelderMeadOptions{}, options, &NelderMeadOptions::max_iterations);
       o.starts = options.starts;
       o.adaptive = options.adaptive;
+      o.parallel_for = options.parallel_for;
       NelderMead(f, bounds, o, &opt, progress);
       break;
     }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <numeric>
 #include <sstream>
 #include <vector>
@@ -263,6 +264,32 @@ bool NelderMeadOptions::IsValid(std::string* error) const {
   return true;
 }
 
+namespace {
+
+// The random stream of start s: start 0 keeps the seed itself (one start
+// draws exactly what it always did), the others a SplitMix64 of it.
+std::uint64_t StartSeed(std::uint64_t seed, int s) {
+  if (s == 0) return seed;
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(s);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+// Start s's fixed share of the evaluation budget.
+int StartBudget(int max_evaluations, int starts, int s) {
+  return max_evaluations / starts + (s < max_evaluations % starts ? 1 : 0);
+}
+
+struct StartRun {
+  OptimizerSummary part;  // this start's counters, best point and trace
+  StartResult result{TerminationType::kNoFeasiblePoint, "no feasible point"};
+  bool out_of_budget = false;
+  std::exception_ptr error;
+};
+
+}  // namespace
+
 void NelderMead(const ObjectiveFunction& f, const Bounds& bounds, const NelderMeadOptions& options,
                 OptimizerSummary* summary, const ProgressCallback& progress) {
   if (summary == nullptr) return;
@@ -273,39 +300,67 @@ void NelderMead(const ObjectiveFunction& f, const Bounds& bounds, const NelderMe
     return;
   }
 
-  Evaluator evaluator(f, bounds, options.max_evaluations, progress, summary);
-  Rng rng(options.seed);
-  NelderMeadStart start(options, &evaluator, &rng);
-  StartResult best{TerminationType::kNoFeasiblePoint, "no start found a feasible point"};
-  int best_start = 0;
-  summary->starts = 0;
-  try {
-    for (int s = 0; s < options.starts; ++s) {
-      summary->starts = s + 1;
-      const double f_before = summary->f;
+  const int starts = std::min(options.starts, options.max_evaluations);
+  std::vector<StartRun> runs(static_cast<std::size_t>(starts));
+  RunParallel(options.parallel_for, starts, [&](int s) {
+    StartRun& run = runs[static_cast<std::size_t>(s)];
+    const ProgressCallback no_progress;  // the merge below reports progress
+    Evaluator evaluator(f, bounds, StartBudget(options.max_evaluations, starts, s), no_progress, &run.part);
+    Rng rng(StartSeed(options.seed, s));
+    NelderMeadStart start(options, &evaluator, &rng);
+    try {
       const bool use_x0 = s == 0 && options.x0.size() > 0;
-      StartResult result = start.Run(use_x0 ? &options.x0 : nullptr);
-      if (summary->f < f_before) {
-        best = result;
-        best_start = s + 1;
-      }
+      run.result = start.Run(use_x0 ? &options.x0 : nullptr);
+    } catch (const EvaluationBudgetExhausted&) {
+      run.out_of_budget = true;
+    } catch (...) {
+      run.error = std::current_exception();
     }
-  } catch (const EvaluationBudgetExhausted&) {
-    std::ostringstream os;
-    os << "max_evaluations = " << options.max_evaluations << " reached during start " << summary->starts
-       << " of " << options.starts;
-    optim_internal::Finish(TerminationType::kMaxEvaluations, os.str(), summary);
-    return;
+  });
+  for (const StartRun& run : runs)
+    if (run.error) std::rethrow_exception(run.error);
+
+  // Merge in start order.
+  int best_start = 0;
+  summary->starts = starts;
+  for (int s = 0; s < starts; ++s) {
+    const OptimizerSummary& part = runs[static_cast<std::size_t>(s)].part;
+    for (const TracePoint& point : part.trace) {
+      TracePoint merged = point;
+      merged.iteration = ++summary->iterations;
+      merged.evaluations = summary->evaluations + point.evaluations;
+      if (!(point.best_f < summary->f)) {  // the earlier starts' best stands
+        merged.best_f = summary->f;
+        merged.best_x = summary->x;
+      }
+      summary->trace.push_back(merged);
+      if (progress) progress(summary->trace.back());
+    }
+    summary->evaluations += part.evaluations;
+    summary->rejected_evaluations += part.rejected_evaluations;
+    if (part.f < summary->f) {
+      summary->f = part.f;
+      summary->x = part.x;
+      best_start = s + 1;
+    }
   }
   std::ostringstream os;
   if (best_start == 0) {
-    os << "the initial simplex of each of the " << options.starts << " starts had no feasible vertex";
+    os << "the initial simplex of each of the " << starts << " starts had no feasible vertex";
     optim_internal::Finish(TerminationType::kNoFeasiblePoint, os.str(), summary);
     return;
   }
-  os << "best of " << options.starts << (options.starts == 1 ? " start" : " starts") << " from start "
-     << best_start << ", which " << best.detail;
-  optim_internal::Finish(best.type, os.str(), summary);
+  const StartRun& best = runs[static_cast<std::size_t>(best_start - 1)];
+  os << "best of " << starts << (starts == 1 ? " start" : " starts") << " from start " << best_start
+     << ", which ";
+  if (best.out_of_budget) {
+    os << "used up its share of max_evaluations = " << options.max_evaluations << " ("
+       << StartBudget(options.max_evaluations, starts, best_start - 1) << " of them)";
+    optim_internal::Finish(TerminationType::kMaxEvaluations, os.str(), summary);
+    return;
+  }
+  os << best.result.detail;
+  optim_internal::Finish(best.result.type, os.str(), summary);
 }
 
 }  // namespace pidlab

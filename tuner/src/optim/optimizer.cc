@@ -104,4 +104,13 @@ void Finish(TerminationType type, const std::string& message, OptimizerSummary* 
 }
 
 }  // namespace optim_internal
+void RunParallel(const ParallelFor& parallel_for, int count, const std::function<void(int index)>& body) {
+  if (count <= 0) return;
+  if (parallel_for) {
+    parallel_for(count, body);
+    return;
+  }
+  for (int i = 0; i < count; ++i) body(i);
+}
+
 }  // namespace pidlab

@@ -101,6 +101,9 @@ class Launcher {
   /// finish). With an empty command, serves until *stop (returns 0) or until
   /// a process dies (returns 1).
   int Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop);
+  /// The same with this environment for COMMAND instead of CommandEnvironment().
+  int Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop,
+          const std::map<std::string, std::string>& environment);
 
   /// After Run, with a log: confirms that the log is complete (end marker)
   /// and repairs it. Returns false if it is not known complete; the reasons
@@ -129,6 +132,46 @@ class Launcher {
   std::map<std::string, pid_t> roles_;  // "plant" -> pid
   std::map<std::string, int32_t> alive_;
   pid_t logger_ = -1;
+};
+
+/// The LCM URL of trio `index` (0-based) of `pidlab launch --trios K`: the
+/// base URL with its port moved up by 3 index (each trio also uses the two
+/// ports above its own for its step lanes, transport.h). Empty if the URL is
+/// not udpm:// or a port would pass 65535.
+std::string TrioUrl(const std::string& base_url, int index);
+
+/// `pidlab launch --trios K`: K independent trios (each a Launcher with the
+/// same options on TrioUrl(base, i)), so that K episodes run at the same
+/// time without any process receiving another trio's datagrams. With a log,
+/// trio 1 logs into the file named and trio i into FILE.trio<i>.
+class TrioSet {
+ public:
+  /// At most this many trios.
+  static constexpr int kMaxTrios = 64;
+  /// Throws std::invalid_argument for invalid options or a trio count out
+  /// of [1, kMaxTrios] or ports past 65535, std::runtime_error if LCM
+  /// cannot start.
+  TrioSet(const LaunchOptions& options, int trios, Launcher::NoteFn note);
+
+  /// Starts every trio in turn; stops at the first that is not ready.
+  LaunchStatus Start(const volatile std::sig_atomic_t* stop, std::string* error);
+  /// Trio 1's environment, plus PIDLAB_TRIOS (K), PIDLAB_LCM_URLS (the K
+  /// URLs, separated by spaces) and PIDLAB_TRIO<i>_{PLANT,CONTROLLER,
+  /// DISTURBANCE}_PID for i = 1..K.
+  std::map<std::string, std::string> CommandEnvironment() const;
+  /// Runs COMMAND (or serves) as Launcher::Run does, under trio 1's
+  /// supervision; a process of another trio that dies is reported when the
+  /// trios stop (a tune moves its episodes to the trios still alive).
+  int Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop);
+  /// FinishLog of every trio; false if any log is not known complete.
+  bool FinishLog(bool interrupted);
+  void Stop();
+
+  int size() const { return static_cast<int>(trios_.size()); }
+  std::vector<std::string> urls() const;
+
+ private:
+  std::vector<std::unique_ptr<Launcher>> trios_;
 };
 
 }  // namespace pidlab::launcher

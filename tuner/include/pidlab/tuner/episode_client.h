@@ -6,8 +6,8 @@
 // message), asks the plant to resend whatever it missed, and reports a silent
 // process by name.
 
-#include <lcm/lcm-cpp.hpp>
 #include <functional>
+#include <lcm/lcm-cpp.hpp>
 #include <memory>
 #include <string>
 #include <vector>
@@ -49,8 +49,8 @@ struct EpisodeClientOptions {
 
 struct EpisodeClientStats {
   long episodes = 0;
-  long steps = 0;         // lockstep steps run
-  double seconds = 0.0;   // wall time from the first acknowledgement to the last step
+  long steps = 0;            // lockstep steps run
+  double seconds = 0.0;      // wall time from the first acknowledgement to the last step
   long resend_requests = 0;  // TRAJECTORY_REQUESTs for steps the client missed
   long reruns = 0;           // episodes run again after a failure
   double StepsPerSecond() const { return seconds > 0.0 ? static_cast<double>(steps) / seconds : 0.0; }
@@ -78,6 +78,11 @@ class EpisodeClient {
 
   SampledRunner AsRunner();
   const EpisodeClientStats& stats() const { return stats_; }
+  /// After Run failed: true if the trio went silent or died (the episode may
+  /// run elsewhere), false if the episode itself failed (a conflict, a
+  /// FAILED summary): it would fail anywhere.
+  bool last_failure_retryable() const { return last_failure_retryable_; }
+  const EpisodeClientOptions& options() const { return options_; }
   const transport::TransportCounters& counters() const;
 
  private:
@@ -99,6 +104,7 @@ class EpisodeClient {
   std::unique_ptr<State> state_;
   EpisodeClientOptions options_;
   EpisodeClientStats stats_;
+  bool last_failure_retryable_ = false;
 };
 
 }  // namespace pidlab

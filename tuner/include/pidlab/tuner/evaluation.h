@@ -2,6 +2,7 @@
 // Evaluation of a PID loop: the paper's objective (eq. 4-5), other error
 // measures, stability and MATLAB-stepinfo step metrics.
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>
@@ -90,8 +91,9 @@ class ObjectiveEvaluator {
   ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
                      SampledRunner runner = nullptr);
   double operator()(const PidGains& gains) const;
-  /// Evaluations so far (thread-compatible, not thread-safe).
-  long evaluations() const { return evaluations_; }
+  /// Evaluations so far. operator() may be called from several threads at
+  /// once (parallel starts over several trios).
+  long evaluations() const { return evaluations_.load(); }
   const LoopOptions& options() const { return options_; }
   const Plant& plant() const { return plant_; }
   ObjectiveKind kind() const { return kind_; }
@@ -104,8 +106,7 @@ class ObjectiveEvaluator {
   Disturbance disturbance_;
   std::unique_ptr<DiscretePlant> discrete_;
   SampledRunner runner_;
-  mutable long evaluations_ = 0;
-  mutable std::vector<double> y_;
+  mutable std::atomic<long> evaluations_{0};
 };
 
 /// Objective from output samples y_m at t_m = m ts (not kIaeContinuous).

@@ -47,15 +47,25 @@
 // rebuilt around the best vertex with the initial step, up to
 // restarts_on_convergence times, which guards against premature collapse.
 //
-// Multi-start: `starts` independent runs, all drawn from one seeded random
-// stream; the first uses x0 when given. The result is the best feasible point
-// over all starts. max_iterations applies to each start, max_evaluations to
-// the whole call.
+// Multi-start: `starts` independent runs; the first uses x0 when given. Start
+// s draws from a random stream of its own (seeded from seed and s; start 0
+// from seed itself) and gets a fixed share of max_evaluations: floor(max /
+// starts), plus one for the first max % starts starts (a start whose share
+// is 0 is not run). A start that converges early leaves its share unused.
+// So the starts are independent: `parallel_for` may run them at the same
+// time (one per LCM trio) and the result is bit for bit the same however
+// they run. They are merged in start order: the result is the best feasible
+// point over all starts (ties: the earlier start), evaluations and
+// iterations are summed, the trace is start 1's iterations, then start 2's,
+// and so on, and progress is reported as the starts are merged. There is no
+// speculation inside a start (no reflection, expansion and contraction
+// evaluated together): it would cost up to 3 evaluations per iteration for
+// about 1.5 used, for a speed-up only while trios are idle.
 //
-// Termination: kConverged if the start that produced the best point converged,
-// kMaxIterations if it ran out of iterations, kMaxEvaluations whenever the
-// evaluation budget stopped the call (the best point so far is still
-// returned), kNoFeasiblePoint if no evaluated point was feasible.
+// Termination: that of the start that produced the best point: kConverged if
+// it converged, kMaxIterations if it ran out of iterations, kMaxEvaluations
+// if its share of the evaluation budget stopped it (its best point is still
+// returned); kNoFeasiblePoint if no evaluated point was feasible.
 
 #include <cstdint>
 #include <string>
@@ -72,7 +82,8 @@ struct NelderMeadOptions {
   double initial_step_fraction = 0.1;
   /// Iteration budget of each start (restarts included), >= 1.
   int max_iterations = 1000;
-  /// Hard cap on objective calls over all starts, >= 1.
+  /// Hard cap on objective calls over all starts, >= 1, shared out between
+  /// the starts in fixed parts (see above).
   int max_evaluations = 5000;
   /// Converged when the simplex diameter, relative to the bound widths, is at
   /// most this; finite, >= 0.
@@ -87,8 +98,10 @@ struct NelderMeadOptions {
   int restarts_on_convergence = 1;
   /// Extra tries for a rejected initial vertex, >= 0.
   int max_initial_redraws = 10;
-  /// Seed of the random stream (initial points).
+  /// Seed of the random streams (initial points).
   std::uint64_t seed = 1;
+  /// Runs the starts (empty: one after the other). Never changes the result.
+  ParallelFor parallel_for;
 
   /// Checks every field; on failure names the field, its value and the rule.
   /// x0 is checked against the bounds by NelderMead itself.

@@ -63,6 +63,16 @@ struct TracePoint {
 /// Optional observer, called once per completed iteration with the new trace point.
 using ProgressCallback = std::function<void(const TracePoint&)>;
 
+/// Runs body(0), ..., body(count - 1), in any order and possibly at the same
+/// time (e.g. one thread per LCM trio), and returns when all are done. An
+/// exception thrown by a body is rethrown (the one of the lowest index).
+/// Empty: one after the other on the calling thread. The optimisers make
+/// their results independent of it: the same bits whatever runs the bodies.
+using ParallelFor = std::function<void(int count, const std::function<void(int index)>& body)>;
+
+/// Runs a ParallelFor, or the loop when it is empty.
+void RunParallel(const ParallelFor& parallel_for, int count, const std::function<void(int index)>& body);
+
 struct OptimizerSummary {
   Eigen::VectorXd x;  // Best feasible point (inside the bounds); empty if none was found.
   double f = std::numeric_limits<double>::infinity();  // Objective at x; +inf if none.

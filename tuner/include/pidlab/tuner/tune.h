@@ -62,6 +62,10 @@ struct TuneOptions {
   double agree_tolerance = 1e-3;
   /// Ziegler-Nichols rule (ziegler-nichols only).
   ZieglerNicholsRule zn_rule = ZieglerNicholsRule::kClassic;
+  /// Runs independent evaluations at the same time (e.g. one thread per LCM
+  /// trio): the starts of multi-start Nelder-Mead. Empty: one after the
+  /// other. The result is the same bits either way.
+  ParallelFor parallel_for;
 
   /// Valid bounds, budgets, constraints and loop, and at most kMaxTuneSteps
   /// loop steps over EvaluationBudget().
