@@ -2,7 +2,8 @@
 # Integration tests of the LCM trio. Run by ctest as
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
-# ever sent outside its loopback. CASE: identity | faults | kill | sigstop | stranger | log | log_repair.
+# ever sent outside its loopback. CASE: identity | faults | kill | sigstop | trios | trio_killed | stranger |
+# log | log_repair.
 set -u
 BIN=$1
 CASE=$2
@@ -109,6 +110,43 @@ case $CASE in
       echo "ok   tune with the controller stopped 3 s equals the local tune: $(grep -o '"iae":[^,]*' "$TMP/tune.lcm.json" | head -1)"
     else
       echo "FAIL tune with a stopped controller differs from the local tune"; diff <(tr , '\n' < "$TMP/tune.local.json") <(tr , '\n' < "$TMP/tune.lcm.json") | head -10; fail=1
+    fi
+    ;;
+  trios)
+    # The same tune over 1 and 3 trios (pidlab launch --trios K) and in
+    # process: identical gains, objective, evaluations, trace, bit for bit.
+    TUNE="--plant double_integrator --loop sampled --horizon 1 --max-evals 36 --starts 6 --seed 3 --refine none --json"
+    "$PIDLAB" tune $TUNE | sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' > "$TMP/tune.local.json" || fail=1
+    for k in 1 3; do
+      "$PIDLAB" launch --lcm-url "$URL" --trios $k -- bash -c '
+        [ "$PIDLAB_TRIOS" = '$k' ] && [ $(echo $PIDLAB_LCM_URLS | wc -w) -eq '$k' ] || { echo "bad PIDLAB_TRIOS/PIDLAB_LCM_URLS: $PIDLAB_TRIOS / $PIDLAB_LCM_URLS" >&2; exit 1; }
+        pidlab tune --backend lcm '"$TUNE"'' > "$TMP/tune.k$k.raw" 2> "$TMP/tune.k$k.err" ||
+        { echo "FAIL tune over $k trios: $(grep -v "^pidlab-" "$TMP/tune.k$k.err" | head -3)"; fail=1; }
+      sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' "$TMP/tune.k$k.raw" > "$TMP/tune.k$k.json"
+      if cmp -s "$TMP/tune.local.json" "$TMP/tune.k$k.json"; then
+        echo "ok   tune over $k trio(s) equals the local tune: $(grep -o '"evaluations":[^,]*' "$TMP/tune.k$k.json" | head -1), $(grep -o '"iae":[^,]*' "$TMP/tune.k$k.json" | head -1)"
+      else
+        echo "FAIL tune over $k trios differs from the local tune"; diff <(tr , '\n' < "$TMP/tune.local.json") <(tr , '\n' < "$TMP/tune.k$k.json") | head -10; fail=1
+      fi
+    done
+    ;;
+  trio_killed)
+    # Trio 2 of 2 loses its plant (SIGKILL) mid-tune: the tune names it, runs
+    # its episode on trio 1 and ends with the local tune's result.
+    TUNE="--plant double_integrator --loop sampled --horizon 4 --max-evals 24 --starts 4 --seed 3 --refine none --json --silence-deadline 1 --max-attempts 2"
+    "$PIDLAB" tune $TUNE | sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' > "$TMP/tune.local.json" || fail=1
+    export TUNE
+    "$PIDLAB" launch --lcm-url "$URL" --trios 2 -- bash -c '
+      pidlab tune --backend lcm $TUNE > '"$TMP"'/tune.lcm.raw 2>'"$TMP"'/tune.err & t=$!
+      sleep 1; kill -KILL $PIDLAB_TRIO2_PLANT_PID
+      wait $t' 2> "$TMP/launch.err" || { echo "FAIL tune with trio 2 killed: $(grep -v "^pidlab-" "$TMP/tune.err" | head -3)"; fail=1; }
+    sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' "$TMP/tune.lcm.raw" > "$TMP/tune.lcm.json"
+    if ! grep -q "trio 2 (.*) left out" "$TMP/tune.err"; then
+      echo "FAIL the killed trio was not named: $(grep -v "^pidlab-" "$TMP/tune.err" | head -3) $(tail -3 "$TMP/launch.err")"; fail=1
+    elif cmp -s "$TMP/tune.local.json" "$TMP/tune.lcm.json"; then
+      echo "ok   tune with trio 2 killed mid-tune equals the local tune; $(grep -o "trio 2 (.*) left out[^;]*" "$TMP/tune.err" | head -1 | cut -c1-160)"
+    else
+      echo "FAIL tune with trio 2 killed differs from the local tune"; diff <(tr , '\n' < "$TMP/tune.local.json") <(tr , '\n' < "$TMP/tune.lcm.json") | head -10; fail=1
     fi
     ;;
   log)
