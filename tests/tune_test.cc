@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <functional>
+#include <thread>
+#include <vector>
 
 namespace pidlab {
 namespace {
@@ -62,6 +66,63 @@ TEST(Tune, IsDeterministicForASeed) {
   EXPECT_EQ(a.gains.ki, b.gains.ki);
   EXPECT_EQ(a.gains.kd, b.gains.kd);
   EXPECT_EQ(a.evaluations, b.evaluations);
+}
+
+// A ParallelFor with three threads taking indices as they come, like
+// EpisodePool's workers: the bodies run at the same time in any order.
+void ThreeThreads(int count, const std::function<void(int)>& body) {
+  std::atomic<int> next{0};
+  std::vector<std::thread> workers;
+  for (int w = 0; w < 3; ++w)
+    workers.emplace_back([&] {
+      for (int i; (i = next.fetch_add(1)) < count;) body(i);
+    });
+  for (auto& t : workers) t.join();
+}
+
+class TuneInParallel : public ::testing::TestWithParam<TuneMethod> {};
+
+TEST_P(TuneInParallel, GivesTheSameBitsAsOneEvaluationAfterTheOther) {
+  TuneOptions options;
+  options.method = GetParam();
+  options.loop.loop = LoopKind::kSampled;
+  options.loop.horizon_s = 2.0;
+  options.max_evaluations = 90;
+  options.starts = 5;
+  options.seed = 7;
+  options.refine = false;
+  TuneSummary one, parallel;
+  std::string error;
+  ASSERT_TRUE(Tune(MakeBuiltin("double_integrator"), options, &one, &error)) << error;
+  options.parallel_for = ThreeThreads;
+  ASSERT_TRUE(Tune(MakeBuiltin("double_integrator"), options, &parallel, &error)) << error;
+  EXPECT_EQ(parallel.evaluations, one.evaluations);
+  EXPECT_EQ(parallel.iterations, one.iterations);
+  EXPECT_EQ(parallel.objective, one.objective);  // bit for bit
+  EXPECT_EQ(parallel.gains.kp, one.gains.kp);
+  EXPECT_EQ(parallel.gains.ki, one.gains.ki);
+  EXPECT_EQ(parallel.gains.kd, one.gains.kd);
+  ASSERT_EQ(parallel.optimizer.trace.size(), one.optimizer.trace.size());
+  for (std::size_t i = 0; i < one.optimizer.trace.size(); ++i)
+    EXPECT_EQ(parallel.optimizer.trace[i].best_f, one.optimizer.trace[i].best_f) << "iteration " << i + 1;
+  EXPECT_EQ(parallel.optimizer.message, one.optimizer.message);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, TuneInParallel,
+                         ::testing::Values(TuneMethod::kNelderMead, TuneMethod::kGeneticAlgorithm,
+                                           TuneMethod::kPsoGsa));
+
+TEST(NelderMeadStarts, ShareMaxEvaluationsInFixedPartsWhateverRunsThem) {
+  TuneOptions options;
+  options.max_evaluations = 10;
+  options.starts = 4;  // shares 3, 3, 2, 2
+  options.refine = false;
+  options.parallel_for = ThreeThreads;
+  TuneSummary s;
+  std::string error;
+  ASSERT_TRUE(Tune(MakeBuiltin("double_integrator"), options, &s, &error)) << error;
+  EXPECT_EQ(s.evaluations, 10);
+  EXPECT_EQ(s.optimizer.starts, 4);
 }
 
 TEST(Tune, NeverAcceptsALoopThatIsNotStrictlyStable) {

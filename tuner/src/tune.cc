@@ -189,15 +189,19 @@ bool Search(const Plant& plant, const TuneOptions& options, const ObjectiveFunct
       PaperNelderMead(f, bounds, o, &opt, progress);
       break;
     }
-    case TuneMethod::kGeneticAlgorithm:
-      GeneticAlgorithm(
-          f, bounds,
-          WithBudget(GeneticAlgorithmOptions{}, options, &GeneticAlgorithmOptions::max_generations), &opt,
-          progress);
+    case TuneMethod::kGeneticAlgorithm: {
+      GeneticAlgorithmOptions o =
+          WithBudget(GeneticAlgorithmOptions{}, options, &GeneticAlgorithmOptions::max_generations);
+      o.parallel_for = options.parallel_for;
+      GeneticAlgorithm(f, bounds, o, &opt, progress);
       break;
-    case TuneMethod::kPsoGsa:
-      PsoGsa(f, bounds, WithBudget(PsoGsaOptions{}, options, &PsoGsaOptions::max_iterations), &opt, progress);
+    }
+    case TuneMethod::kPsoGsa: {
+      PsoGsaOptions o = WithBudget(PsoGsaOptions{}, options, &PsoGsaOptions::max_iterations);
+      o.parallel_for = options.parallel_for;
+      PsoGsa(f, bounds, o, &opt, progress);
       break;
+    }
     case TuneMethod::kZieglerNichols: {
       if (!ZieglerNicholsTune(plant.tf, options.zn_rule, &summary->ziegler_nichols, error)) return false;
       const PidGains& g = summary->ziegler_nichols.gains;

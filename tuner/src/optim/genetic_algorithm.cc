@@ -169,9 +169,15 @@ void GeneticAlgorithm(const ObjectiveFunction& f, const Bounds& bounds,
   const std::size_t elites = static_cast<std::size_t>(options.elite_count);
   int generation = 0;
   try {
+    // Each generation's points are drawn first and evaluated together
+    // (Prefetch: at the same time on several trios); drawing never depends
+    // on the new values, so the draws and the result are those of
+    // evaluating one by one.
+    std::vector<Eigen::VectorXd> points;
+    for (std::size_t i = 0; i < size; ++i) points.push_back(rng.PointIn(bounds));
+    evaluator.Prefetch(points, options.parallel_for);
     std::vector<Individual> population;
-    for (std::size_t i = 0; i < size; ++i) {
-      Eigen::VectorXd x = rng.PointIn(bounds);
+    for (Eigen::VectorXd& x : points) {
       const double fx = evaluator.Evaluate(&x);
       population.push_back({std::move(x), fx});
     }
@@ -180,16 +186,22 @@ void GeneticAlgorithm(const ObjectiveFunction& f, const Bounds& bounds,
                        [](const Individual& a, const Individual& b) { return a.f < b.f; });
       std::vector<Individual> next(population.begin(),
                                    population.begin() + static_cast<std::ptrdiff_t>(elites));
-      while (next.size() < size) {
+      std::vector<Eigen::VectorXd> offspring;
+      while (next.size() + offspring.size() < size) {
         const Eigen::VectorXd& p1 = breeder.Select(population).x;
         const Eigen::VectorXd& p2 = breeder.Select(population).x;
         Eigen::VectorXd children[2];
         breeder.Breed(p1, p2, &children[0], &children[1]);
         for (Eigen::VectorXd& child : children) {
-          if (next.size() == size) break;  // Odd number of places: the second child is dropped unevaluated.
-          const double fc = evaluator.Evaluate(&child);
-          next.push_back({std::move(child), fc});
+          // Odd number of places: the second child is dropped unevaluated.
+          if (next.size() + offspring.size() == size) break;
+          offspring.push_back(std::move(child));
         }
+      }
+      evaluator.Prefetch(offspring, options.parallel_for);
+      for (Eigen::VectorXd& child : offspring) {
+        const double fc = evaluator.Evaluate(&child);
+        next.push_back({std::move(child), fc});
       }
       population.swap(next);
       evaluator.EndIteration();

@@ -2,12 +2,15 @@
 // Implementation details shared by the optimisers; not part of the public API.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pidlab/tuner/optimizer.h"
 
@@ -64,7 +67,12 @@ class Evaluator {
     *x = Project(bounds_, *x);
     if (summary_->evaluations >= max_evaluations_) throw EvaluationBudgetExhausted{};
     ++summary_->evaluations;
-    double value = f_(*x);
+    double value;
+    if (next_ < prefetched_.size() && prefetched_[next_].first == *x) {
+      value = prefetched_[next_++].second;  // computed by Prefetch, in this order
+    } else {
+      value = f_(*x);
+    }
     if (!std::isfinite(value)) {
       ++summary_->rejected_evaluations;
       value = kInfinity;
@@ -73,6 +81,25 @@ class Evaluator {
       summary_->x = *x;
     }
     return value;
+  }
+
+  /// With a ParallelFor: evaluates the points the optimiser is about to pass
+  /// to Evaluate, in this order, all at once (as many as the budget still
+  /// allows), so that those Evaluate calls only count and record. The
+  /// counters, best point, trace and result are exactly those of calling
+  /// Evaluate alone. Without one: nothing.
+  void Prefetch(const std::vector<Eigen::VectorXd>& points, const ParallelFor& parallel_for) {
+    prefetched_.clear();
+    next_ = 0;
+    if (!parallel_for) return;
+    const std::size_t room = static_cast<std::size_t>(std::max(0, max_evaluations_ - summary_->evaluations));
+    const std::size_t n = std::min(points.size(), room);
+    prefetched_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) prefetched_[i].first = Project(bounds_, points[i]);
+    RunParallel(parallel_for, static_cast<int>(n), [this](int i) {
+      auto& entry = prefetched_[static_cast<std::size_t>(i)];
+      entry.second = f_(entry.first);
+    });
   }
 
   /// Counts a completed iteration, appends its trace point and reports it.
@@ -100,6 +127,8 @@ class Evaluator {
   const int max_evaluations_;
   const ProgressCallback& progress_;
   OptimizerSummary* summary_;
+  std::vector<std::pair<Eigen::VectorXd, double>> prefetched_;
+  std::size_t next_ = 0;
 };
 
 /// Resets *summary and checks the problem (objective and bounds). On failure

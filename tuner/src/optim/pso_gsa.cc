@@ -28,9 +28,20 @@ class SwarmEvaluator {
       : lower_(bounds.lower), width_(bounds.upper - bounds.lower), evaluator_(evaluator) {}
 
   double Evaluate(const Eigen::VectorXd& z) {
-    Eigen::VectorXd x = lower_ + z.cwiseProduct(width_);
+    Eigen::VectorXd x = Denormalised(z);
     return evaluator_->Evaluate(&x);
   }
+  /// Evaluates the swarm's positions in order (at the same time with a
+  /// ParallelFor: Evaluator::Prefetch).
+  void EvaluateAll(const std::vector<Eigen::VectorXd>& z, std::vector<double>* f,
+                   const ParallelFor& parallel_for) {
+    std::vector<Eigen::VectorXd> points;
+    for (const Eigen::VectorXd& zi : z) points.push_back(Denormalised(zi));
+    evaluator_->Prefetch(points, parallel_for);
+    f->resize(z.size());
+    for (std::size_t i = 0; i < z.size(); ++i) (*f)[i] = Evaluate(z[i]);
+  }
+  Eigen::VectorXd Denormalised(const Eigen::VectorXd& z) const { return lower_ + z.cwiseProduct(width_); }
   Eigen::VectorXd Normalised(const Eigen::VectorXd& x) const {
     return ((x - lower_).array() / width_.array()).matrix();
   }
@@ -112,18 +123,21 @@ void PsoGsa(const ObjectiveFunction& f, const Bounds& bounds, const PsoGsaOption
   int t = 0;
   try {
     Swarm swarm;
+    // The positions of an iteration are all drawn first, then evaluated
+    // together (no draw depends on a new value): the draws and the result
+    // are those of evaluating one by one.
     for (std::size_t i = 0; i < agents; ++i) {
       swarm.z.push_back(UniformUnit(n, &rng));
       swarm.v.push_back(Eigen::VectorXd::Zero(n));
-      swarm.f.push_back(swarm_evaluator.Evaluate(swarm.z.back()));
     }
+    swarm_evaluator.EvaluateAll(swarm.z, &swarm.f, options.parallel_for);
     for (t = 1; t <= options.max_iterations; ++t) {
       if (!evaluator.HasFeasiblePoint()) {
         for (std::size_t i = 0; i < agents; ++i) {
           swarm.z[i] = UniformUnit(n, &rng);
           swarm.v[i].setZero();
-          swarm.f[i] = swarm_evaluator.Evaluate(swarm.z[i]);
         }
+        swarm_evaluator.EvaluateAll(swarm.z, &swarm.f, options.parallel_for);
         evaluator.EndIteration();
         continue;
       }
@@ -158,8 +172,8 @@ void PsoGsa(const ObjectiveFunction& f, const Bounds& bounds, const PsoGsaOption
             v = 0.0;
           }
         }
-        swarm.f[i] = swarm_evaluator.Evaluate(swarm.z[i]);
       }
+      swarm_evaluator.EvaluateAll(swarm.z, &swarm.f, options.parallel_for);
       evaluator.EndIteration();
     }
   } catch (const EvaluationBudgetExhausted&) {

@@ -63,6 +63,9 @@ struct GeneticAlgorithmOptions {
   int elite_count = 2;
   /// Seed of the random stream.
   std::uint64_t seed = 1;
+  /// Evaluates each generation's new points together (e.g. one per LCM
+  /// trio); empty: one after the other. Never changes the result.
+  ParallelFor parallel_for;
 
   /// Checks every field; on failure names the field, its value and the rule.
   bool IsValid(std::string* error) const;

@@ -70,6 +70,9 @@ struct PsoGsaOptions {
   double epsilon = 1e-10;
   /// Seed of the random stream.
   std::uint64_t seed = 1;
+  /// Evaluates each generation's new points together (e.g. one per LCM
+  /// trio); empty: one after the other. Never changes the result.
+  ParallelFor parallel_for;
 
   /// Checks every field; on failure names the field, its value and the rule.
   bool IsValid(std::string* error) const;

@@ -63,8 +63,9 @@ struct TuneOptions {
   /// Ziegler-Nichols rule (ziegler-nichols only).
   ZieglerNicholsRule zn_rule = ZieglerNicholsRule::kClassic;
   /// Runs independent evaluations at the same time (e.g. one thread per LCM
-  /// trio): the starts of multi-start Nelder-Mead. Empty: one after the
-  /// other. The result is the same bits either way.
+  /// trio): the starts of multi-start Nelder-Mead, each generation of GA and
+  /// PSO-GSA. Empty: one after the other. The result is the same bits either
+  /// way.
   ParallelFor parallel_for;
 
   /// Valid bounds, budgets, constraints and loop, and at most kMaxTuneSteps
