@@ -217,8 +217,13 @@ bool EpisodeClient::FollowEpisode(double t0, double* done_s, long* requests, std
       return false;
     }
     if (s.Failed()) {
-      // Text off the wire: escaped and cut before anyone prints it.
-      *error = "episode failed: " + transport::EscapeWireText(s.last_summary.message) + Where();
+      // Text off the wire: escaped and cut before anyone prints it. Without a
+      // key the summary's sender cannot be known: say so, so a forged FAILED
+      // summary is a loud failure, never mistaken for the plant's verdict.
+      *error =
+          std::string(options_.transport.auth_key ? "episode failed: "
+                                                  : "episode failed (SUMMARY not authenticated, no key): ") +
+          transport::EscapeWireText(s.last_summary.message) + Where();
       return false;
     }
     if (now - t0 > options_.episode_timeout_s) {
