@@ -42,6 +42,12 @@ std::string Full(double v) {
   return os.str();
 }
 
+// Text of the table that came from the log (channel prefixes and names in the
+// notes, a configuration's strings, a summary's message) with its control
+// characters escaped: a log can send no escape sequence to the terminal and
+// forge no table line. The JSON output escapes them itself.
+std::string FromLog(const std::string& text) { return Truncate(text, std::string::npos); }
+
 struct ReplayCommand {
   std::string log_path;
   std::vector<long> episodes;
@@ -136,7 +142,12 @@ struct ReplayCommand {
     }
     replay::LogContents log;
     std::string error;
-    if (!replay::ReadLog(log_path, options, &log, &error)) throw BadInput(error);
+    if (!replay::ReadLog(log_path, options, &log, &error)) {
+      // A file that opened but holds no LCM event is damaged content (exit 1),
+      // not a path the user mistyped (exit 2).
+      if (log.file_bytes > 0) throw std::runtime_error(error);
+      throw BadInput(error);
+    }
     return log;
   }
 
@@ -222,7 +233,7 @@ struct ReplayCommand {
     *table << "log " << log_path << ": " << log.events << " events, " << log.pidlab_messages
            << " pidlab messages, " << (log.clean_end ? "read to the end" : "NOT read cleanly to the end")
            << " (" << log.file_bytes << " bytes)\n";
-    for (const auto& n : log.notes) *table << "note: " << n << "\n";
+    for (const auto& n : log.notes) *table << "note: " << FromLog(n) << "\n";
     *table << std::left << std::setw(21) << "episode" << std::setw(10) << "prefix" << std::setw(19) << "plant"
            << std::setw(26) << "gains kp,ki,kd" << std::setw(8) << "steps" << std::setw(24) << "IAE"
            << "log\n";
@@ -231,15 +242,15 @@ struct ReplayCommand {
   static void TableRow(const replay::Episode& e, const std::string& iae, std::ostream* table) {
     std::string plant = "?", gains = "?";
     if (e.has_config) {
-      plant = e.spec.plant.name;
+      plant = FromLog(e.spec.plant.name);
       std::ostringstream g;
       g << std::setprecision(6) << e.spec.gains.kp << "," << e.spec.gains.ki << "," << e.spec.gains.kd;
       gains = g.str();
     }
     *table << std::left << std::setw(21) << e.episode_id << std::setw(10)
-           << (e.prefix.empty() ? "-" : e.prefix) << std::setw(19) << plant << std::setw(26) << gains
+           << (e.prefix.empty() ? "-" : FromLog(e.prefix)) << std::setw(19) << plant << std::setw(26) << gains
            << std::setw(8) << e.total_steps << std::setw(24) << iae
-           << (e.Complete() ? "complete" : "INCOMPLETE: " + e.CompletenessNote()) << "\n";
+           << (e.Complete() ? "complete" : "INCOMPLETE: " + FromLog(e.CompletenessNote())) << "\n";
   }
 
   // One line per stream with anything besides clean arrivals.
@@ -274,8 +285,8 @@ struct ReplayCommand {
     StreamDetails("commands", e.commands, table);
     StreamDetails("disturbance samples", e.disturbances, table);
     if (e.has_summary && e.summary_status != 0)
-      *table << "    episode FAILED live: " << e.summary_message << "\n";
-    if (!evaluated && e.has_config && e.Complete()) *table << "    not evaluated: " << why << "\n";
+      *table << "    episode FAILED live: " << FromLog(e.summary_message) << "\n";
+    if (!evaluated && e.has_config && e.Complete()) *table << "    not evaluated: " << FromLog(why) << "\n";
     const bool ok = !redrive || RedriveEpisode(e, &j, table);
     episodes_json->push_back(j);
     return ok;
@@ -288,7 +299,7 @@ struct ReplayCommand {
   bool RedriveEpisode(const replay::Episode& e, nlohmann::json* j, std::ostream* table) const {
     const replay::RedriveResult r = backend == "lcm" ? RedriveLive(e) : replay::Redrive(e);
     (*j)["redrive"] = RedriveJson(r);
-    *table << "    redrive: " << (r.ok ? "OK, " : "FAILED, ") << r.message << "\n";
+    *table << "    redrive: " << (r.ok ? "OK, " : "FAILED, ") << FromLog(r.message) << "\n";
     return r.ok;
   }
 

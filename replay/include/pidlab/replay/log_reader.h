@@ -100,7 +100,8 @@ struct LogContents {
 };
 
 /// Reads the log at `path`. Returns false with *error only if the file
-/// cannot be opened or is not an LCM log at all; anything wrong inside a
+/// cannot be opened or is not an LCM log at all (then contents->file_bytes >
+/// 0 and contents->events == 0: the file opened); anything wrong inside a
 /// readable log is reported in *contents.
 bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* contents, std::string* error);
 
