@@ -10,8 +10,8 @@ packages=(
   liblcm-dev liblcm-bin libglib2.0-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libsodium-dev
-  gnuplot-nox
-  iproute2 util-linux python3 bc
+  gnuplot-nox libboost-dev pybind11-dev python3-dev
+  iproute2 util-linux python3 python3-numpy python3-scipy bc
   default-jdk-headless liblcm-java
 )
 no_java=0
