@@ -26,6 +26,7 @@ function(pidlab_lcm_cpp)
   add_custom_target(${ARG_TARGET}_gen DEPENDS ${headers})
   add_library(${ARG_TARGET} INTERFACE)
   add_dependencies(${ARG_TARGET} ${ARG_TARGET}_gen)
-  target_include_directories(${ARG_TARGET} SYSTEM INTERFACE ${out_dir})
+  target_include_directories(${ARG_TARGET} SYSTEM INTERFACE $<BUILD_INTERFACE:${out_dir}>
+                             $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(${ARG_TARGET} INTERFACE PkgConfig::LCM)
 endfunction()

@@ -1,0 +1,45 @@
+# Install helpers. Every library is installed into the export set
+# pidlabTargets (static archives, so the libraries they link privately are
+# exported too) and appears to users as pidlab::<export name>, the same name
+# as its alias in this build; its include/ tree goes to <prefix>/include.
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+set(PIDLAB_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/pidlab)
+
+# pidlab_install_library(<target> <export name> [<include dir>])
+function(pidlab_install_library target export_name)
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${export_name})
+  install(TARGETS ${target} EXPORT pidlabTargets
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  if(ARGC GREATER 2)
+    install(DIRECTORY ${ARGV2}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.h")
+  endif()
+endfunction()
+
+# pidlab_install_package(): the CMake package (pidlabConfig.cmake, its
+# version file, pidlabTargets.cmake with the pidlab:: namespace) and
+# pidlab.pc. Called once, after every folder has installed its targets.
+function(pidlab_install_package)
+  install(EXPORT pidlabTargets NAMESPACE pidlab:: FILE pidlabTargets.cmake
+          DESTINATION ${PIDLAB_INSTALL_CMAKEDIR})
+  configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/pidlabConfig.cmake.in
+                                ${PROJECT_BINARY_DIR}/pidlabConfig.cmake
+                                INSTALL_DESTINATION ${PIDLAB_INSTALL_CMAKEDIR})
+  # 0.x: a minor version may break the API.
+  write_basic_package_version_file(${PROJECT_BINARY_DIR}/pidlabConfigVersion.cmake
+                                   VERSION ${PROJECT_VERSION} COMPATIBILITY SameMinorVersion)
+  install(FILES ${PROJECT_BINARY_DIR}/pidlabConfig.cmake ${PROJECT_BINARY_DIR}/pidlabConfigVersion.cmake
+          DESTINATION ${PIDLAB_INSTALL_CMAKEDIR})
+  # The libraries in link order (each before what it links); lcmtypes is
+  # headers only.
+  set(PIDLAB_PC_LIBS "-lpidlab_report -lpidlab_plot -lpidlab_launcher -lpidlab_replay")
+  string(APPEND PIDLAB_PC_LIBS " -lpidlab_episode_client -lpidlab_log_reader -lpidlab_tuner -lpidlab_optim")
+  string(APPEND PIDLAB_PC_LIBS " -lpidlab_role_main -lpidlab_plant_roles -lpidlab_controller_role")
+  string(APPEND PIDLAB_PC_LIBS " -lpidlab_transport -lpidlab_plant_sim -lpidlab_controller")
+  file(RELATIVE_PATH PIDLAB_PC_PREFIX /p/${CMAKE_INSTALL_LIBDIR}/pkgconfig /p)
+  string(REGEX REPLACE "/$" "" PIDLAB_PC_PREFIX "${PIDLAB_PC_PREFIX}")
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/pidlab.pc.in ${PROJECT_BINARY_DIR}/pidlab.pc @ONLY)
+  install(FILES ${PROJECT_BINARY_DIR}/pidlab.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+endfunction()
