@@ -23,7 +23,8 @@ int main() {
   }
   const pidlab::PidGains paper_nm{29.6558, 0.4977, 28.3216};
   pidlab::Evaluation evaluation;
-  if (!pidlab::Evaluate(plant, paper_nm, pidlab::LoopOptions{}, pidlab::EvaluateOptions{}, &evaluation, &error)) {
+  if (!pidlab::Evaluate(plant, paper_nm, pidlab::LoopOptions{}, pidlab::EvaluateOptions{}, &evaluation,
+                        &error)) {
     std::fprintf(stderr, "consumer: %s\n", error.c_str());
     return 2;
   }
