@@ -30,3 +30,27 @@ function(pidlab_lcm_cpp)
                              $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(${ARG_TARGET} INTERFACE PkgConfig::LCM)
 endfunction()
+
+# pidlab_lcm_python(TARGET <name> OUT_DIR <dir> FILES a.lcm b.lcm ...)
+#
+# Generates the Python classes with lcm-gen --python at build time (part of
+# `all`): <dir>/<package>/lcmt_*.py and lcm-gen's __init__.py. They need only
+# Python's struct module, not the LCM Python binding (Debian 12 has none).
+function(pidlab_lcm_python)
+  cmake_parse_arguments(ARG "" "TARGET;PACKAGE;OUT_DIR" "FILES" ${ARGN})
+  set(outputs ${ARG_OUT_DIR}/${ARG_PACKAGE}/__init__.py)
+  set(abs_files)
+  foreach(f ${ARG_FILES})
+    get_filename_component(stem ${f} NAME_WE)
+    list(APPEND outputs ${ARG_OUT_DIR}/${ARG_PACKAGE}/${stem}.py)
+    list(APPEND abs_files ${CMAKE_CURRENT_SOURCE_DIR}/${f})
+  endforeach()
+  add_custom_command(
+    OUTPUT ${outputs}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${ARG_OUT_DIR}
+    COMMAND ${LCM_GEN_EXECUTABLE} --python --ppath ${ARG_OUT_DIR} ${abs_files}
+    DEPENDS ${abs_files}
+    COMMENT "lcm-gen --python ${ARG_PACKAGE}"
+    VERBATIM)
+  add_custom_target(${ARG_TARGET} ALL DEPENDS ${outputs})
+endfunction()

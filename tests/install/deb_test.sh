@@ -36,7 +36,8 @@ dpkg-deb --contents "$deb" | awk '{print $6}' >"$tmp/contents"
 for f in ./usr/bin/pidlab ./usr/bin/pidlab-plant ./usr/bin/pidlab-controller ./usr/bin/pidlab-disturbance \
          ./usr/lib/libpidlab_tuner.a ./usr/include/pidlab/tuner/tune.h ./usr/include/pidlab/lcmt_plant_output.hpp \
          ./usr/share/pidlab/lcmtypes/lcmt_plant_output.lcm ./usr/lib/cmake/pidlab/pidlabConfig.cmake \
-         ./usr/lib/cmake/pidlab/pidlabTargets.cmake ./usr/lib/pkgconfig/pidlab.pc; do
+         ./usr/lib/cmake/pidlab/pidlabTargets.cmake ./usr/lib/pkgconfig/pidlab.pc \
+         ./usr/lib/python3/dist-packages/pidlab/lcmt_plant_output.py ./usr/share/pidlab/examples/python_controller.py; do
   check "contents hold $f" "grep -qx '$f' '$tmp/contents'"
 done
 check "contents hold nothing outside /usr" "! grep -v '^\./usr/\|^\./$' '$tmp/contents' | grep -q ."

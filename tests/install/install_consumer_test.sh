@@ -18,13 +18,18 @@ for f in bin/pidlab bin/pidlab-plant bin/pidlab-controller bin/pidlab-disturbanc
          lib/libpidlab_tuner.a lib/libpidlab_transport.a include/pidlab/tuner/tune.h \
          include/pidlab/transport/protocol.h include/pidlab/lcmt_control_command.hpp \
          share/pidlab/lcmtypes/lcmt_control_command.lcm lib/cmake/pidlab/pidlabConfig.cmake \
-         lib/cmake/pidlab/pidlabConfigVersion.cmake lib/cmake/pidlab/pidlabTargets.cmake lib/pkgconfig/pidlab.pc; do
+         lib/cmake/pidlab/pidlabConfigVersion.cmake lib/cmake/pidlab/pidlabTargets.cmake lib/pkgconfig/pidlab.pc \
+         lib/python3/dist-packages/pidlab/lcmt_control_command.py share/pidlab/examples/python_controller.py \
+         share/pidlab/examples/consumer/main.cc; do
   check "installs $f" "[ -e '$prefix/$f' ]"
 done
 check "the exported targets carry the pidlab:: namespace" \
   "grep -q 'add_library(pidlab::tuner STATIC IMPORTED)' '$prefix/lib/cmake/pidlab/pidlabTargets.cmake'"
 check "the installed headers name no build or source directory" \
   "! grep -rqF -e '$src' -e '$build' '$prefix/include' '$prefix/lib/cmake' '$prefix/lib/pkgconfig'"
+
+check "the installed Python messages encode and decode with /usr/bin/python3" \
+  "PYTHONPATH='$prefix/lib/python3/dist-packages' /usr/bin/python3 -c 'from pidlab.lcmt_plant_output import lcmt_plant_output as M; m = M(); m.y = 0.5; assert M.decode(m.encode()).y == 0.5'"
 
 # The CLI of the install gives the reference numbers.
 "$prefix/bin/pidlab" evaluate --plant double_integrator --gains 29.6558,0.4977,28.3216 --json >"$tmp/eval.json"
