@@ -305,6 +305,11 @@ void LoopFlags::Register(CLI::App* app) {
   app->add_option("--horizon", horizon_s, "n of eq. (4): last sample time in s")
       ->check(FiniteNumber())
       ->capture_default_str();
+  app->add_option("--reference", reference,
+                  "size A of the reference step r(t) = A (1 = the paper's unit step); e = A - y in every "
+                  "objective, step metrics relative to the final value")
+      ->check(FiniteNumber())
+      ->capture_default_str();
   app->add_option("--stability-margin", stability_margin,
                   "strict stability: Re p < -margin*max(1,|p|), p = s-plane pole (sampled: p = log(z)/dt)")
       ->check(FiniteNumber())
@@ -351,6 +356,7 @@ LoopOptions LoopFlags::Build() const {
   o.sample_time_s = sample_time_s;
   o.horizon_s = horizon_s;
   o.stability_margin = stability_margin;
+  o.reference = reference;
   DisturbanceOptions& d = o.disturbance;
   if (disturbance.empty()) {
     d.kind = disturbance_amplitude != 0.0 ? DisturbanceKind::kSquare : DisturbanceKind::kNone;
@@ -395,6 +401,7 @@ nlohmann::json ToJson(const Evaluation& ev) {
   j["gains"] = ToJson(ev.gains);
   j["loop"] = ToString(ev.options.loop);
   if (ev.options.loop == LoopKind::kSampled) j["dt_s"] = ev.options.dt_s;
+  j["reference"] = ev.options.reference;
   j["sample_time_s"] = ev.options.sample_time_s;
   j["horizon_s"] = ev.options.horizon_s;
   j["samples"] = ev.options.NumSamples();
@@ -405,6 +412,7 @@ nlohmann::json ToJson(const Evaluation& ev) {
   j["closed_loop_poles"] = poles;
   j["pole_domain"] = ev.options.loop == LoopKind::kSampled ? "z" : "s";
   j["iae"] = JsonNumber(ev.iae);
+  j["iae_per_unit"] = JsonNumber(ev.iae_per_unit);
   j["iae_undisturbed"] = JsonNumber(ev.iae_undisturbed);
   j["ise"] = JsonNumber(ev.ise);
   j["itae"] = JsonNumber(ev.itae);
@@ -448,6 +456,8 @@ std::string FormatEvaluation(const Evaluation& ev) {
   if (ev.options.loop == LoopKind::kSampled) os << " (dt = " << ev.options.dt_s << " s)";
   os << ", ts = " << ev.options.sample_time_s << " s, n = " << ev.options.horizon_s << " s, "
      << ev.options.NumSamples() << " samples\n";
+  if (ev.options.reference != 1.0)
+    os << "reference        step of A = " << ev.options.reference << " (e = A - y)\n";
   if (ev.options.disturbance.kind != DisturbanceKind::kNone)
     os << "disturbance      " << ToString(ev.options.disturbance.kind) << " +/-"
        << ev.options.disturbance.amplitude << ", period " << ev.options.disturbance.period_s
@@ -456,6 +466,7 @@ std::string FormatEvaluation(const Evaluation& ev) {
   os << "closed-loop poles " << (ev.options.loop == LoopKind::kSampled ? "(z) " : "(s) ")
      << FormatPoles(ev.stability.poles) << "\n";
   os << "IAE (eq. 4)      " << num(ev.iae) << "\n";
+  if (ev.options.reference != 1.0) os << "IAE / A          " << num(ev.iae_per_unit) << "\n";
   if (ev.options.disturbance.kind != DisturbanceKind::kNone)
     os << "IAE undisturbed  " << num(ev.iae_undisturbed) << "\n";
   os << "ISE              " << num(ev.ise) << "\n";
@@ -477,7 +488,8 @@ void WriteSamplesCsv(const Evaluation& ev, const std::string& path) {
   if (!f) throw BadInput("--samples-csv " + Quote(path) + " cannot be written");
   f << std::setprecision(17) << "t,r,y,e,n\n";
   for (std::size_t m = 0; m < ev.y.size(); ++m)
-    f << ev.t[m] << ",1," << ev.y[m] << "," << 1.0 - ev.y[m] << "," << ev.n[m] << "\n";
+    f << ev.t[m] << "," << ev.options.reference << "," << ev.y[m] << "," << ev.options.reference - ev.y[m]
+      << "," << ev.n[m] << "\n";
   f.close();
   if (!f) throw std::runtime_error("writing " + path + " failed");
 }

@@ -98,6 +98,7 @@ struct PlantFlags {
 struct LoopFlags {
   std::string loop = "continuous";
   double dt_s = 1e-3, sample_time_s = 0.05, horizon_s = 25.0, stability_margin = 1e-9;
+  double reference = 1.0;  // --reference A: size of the reference step
   std::string disturbance;  // empty: square if an amplitude is given
   double disturbance_amplitude = 0.0, disturbance_period_s = 2.0, disturbance_phase_s = 0.0;
   double disturbance_step_time_s = 0.0, noise_hold_s = 0.01;

@@ -163,7 +163,9 @@ struct TuneCommand {
     j["loop"] = ToString(o.loop.loop);
     j["gains"] = cli::ToJson(s.gains);
     j["objective"] = JsonNumber(s.objective);
+    j["reference"] = o.loop.reference;
     j["iae"] = s.stable ? JsonNumber(ev.iae) : nlohmann::json(nullptr);
+    j["iae_per_unit"] = s.stable ? JsonNumber(ev.iae_per_unit) : nlohmann::json(nullptr);
     j["stable"] = s.stable && ev.stability.stable;
     j["closed_loop_poles"] = s.stable ? cli::ToJson(ev)["closed_loop_poles"] : nlohmann::json::array();
     j["rise_time_s"] = s.stable ? cli::ToJson(ev)["rise_time_s"] : nlohmann::json(nullptr);

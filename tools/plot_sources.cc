@@ -51,8 +51,8 @@ bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, co
       tr.t = ev.t;
       tr.y = ev.y;
       tr.n = ev.n;
-      tr.r.assign(ev.t.size(), 1.0);
-      for (double y : ev.y) tr.e.push_back(1.0 - y);
+      tr.r.assign(ev.t.size(), options.reference);
+      for (double y : ev.y) tr.e.push_back(options.reference - y);
     }
     traces.push_back(std::move(tr));
   }

@@ -156,6 +156,29 @@ bad "--loop bogus" "bogus" evaluate --plant linear --gains 1,2,3 --loop bogus
 bad "unknown flag" "--bogus" evaluate --plant linear --gains 1,2,3 --bogus
 bad "malformed --dt" "abc" evaluate --plant linear --gains 1,2,3 --dt abc
 bad "improper custom plant" "strictly proper" evaluate --num 1,0 --den 1,1 --gains 1,2,3
+bad "--reference 0" "reference 0" evaluate --plant linear --gains 1,2,3 --reference 0
+bad "--reference nan" "nan" evaluate --plant linear --gains 1,2,3 --reference nan
+
+# ---- --reference A: iae_per_unit = iae / A, a linear loop scales with A ----
+status=0
+"$pidlab" evaluate --plant stepper_motor --gains 20.8836,26.607,12.4866 --json >ref1.json 2>/dev/null || status=$?
+"$pidlab" evaluate --plant stepper_motor --gains 20.8836,26.607,12.4866 --reference 0.01 --json \
+  >ref001.json 2>/dev/null || status=$?
+if [[ $status -eq 0 ]] && python3 - ref1.json ref001.json <<'PY'
+import json, sys
+one, dut = (json.load(open(f)) for f in sys.argv[1:3])
+assert one["reference"] == 1.0 and dut["reference"] == 0.01, (one["reference"], dut["reference"])
+assert one["iae_per_unit"] == one["iae"], one
+assert abs(dut["iae_per_unit"] - dut["iae"] / 0.01) <= 1e-12 * dut["iae_per_unit"], dut
+assert abs(dut["iae"] - 0.01 * one["iae"]) <= 1e-12 * dut["iae"], (dut["iae"], one["iae"])
+assert abs(dut["final_value"] - 0.01) <= 1e-9, dut["final_value"]
+assert abs(dut["overshoot_pct"] - one["overshoot_pct"]) <= 1e-6
+PY
+then
+  pass "--reference 0.01: reference and iae_per_unit in the JSON, IAE = 0.01 x IAE(1), same overshoot"
+else
+  fail "--reference 0.01 (exit $status)"
+fi
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

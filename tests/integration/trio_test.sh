@@ -55,6 +55,7 @@ run_all_plants() {
   compare osc_clean --plant oscillator --gains 3,1,1 --horizon 10
   compare osc_noise --plant oscillator --gains 3,1,1 --horizon 10 --disturbance noise --disturbance-amplitude 0.1 --seed 7
   compare stepper_clean --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5
+  compare stepper_reference --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --reference 0.0123
   compare stepper_sine --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --disturbance sine --disturbance-amplitude 0.5 --disturbance-period 0.2
 }
 

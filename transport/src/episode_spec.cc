@@ -41,7 +41,8 @@ bool EpisodeSpec::IsValid(std::string* error) const {
   if (plant.tf.RelativeDegree() < 1)
     return Fail("plant " + plant.tf.ToString() + " must be strictly proper", error);
   if (!GainsAreValid(gains, error)) return false;
-  if (!std::isfinite(reference)) return Fail("reference must be finite", error);
+  if (!std::isfinite(reference) || reference == 0.0 || std::abs(reference) > kMaxCoefficientMagnitude)
+    return Fail("reference must be finite, nonzero and at most 1e12 in magnitude", error);
   std::ostringstream os;
   long samples = 0, steps = 0;
   if (!(dt_s > 0.0) || !std::isfinite(dt_s))

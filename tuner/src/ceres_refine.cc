@@ -41,21 +41,23 @@ struct ErrorResiduals {
     const double ts = loop->sample_time_s;
     if (loop->loop == LoopKind::kContinuous) {
       ContinuousClosedLoop<T> cl;
-      if (!BuildContinuousClosedLoop<T>(*realization, g, disturbance, &cl, nullptr)) return false;
+      if (!BuildContinuousClosedLoop<T>(*realization, g, disturbance, &cl, nullptr, loop->reference))
+        return false;
       ContinuousClosedLoop<double> cld;
-      if (!BuildContinuousClosedLoop<double>(*realization, gd, disturbance, &cld, nullptr)) return false;
+      if (!BuildContinuousClosedLoop<double>(*realization, gd, disturbance, &cld, nullptr, loop->reference))
+        return false;
       if (!ContinuousStability(cld, loop->stability_margin).stable) return false;
       SampleContinuousLoop<T>(cl, disturbance, ts, loop->NumSamples(), &y);
     } else {
       PidOptions pid = loop->pid;
       pid.dt_s = loop->dt_s;
       if (!SampledStability(*discrete, gd, pid, loop->stability_margin).stable) return false;
-      if (RunSampledLoop<T>(*discrete, g, pid, disturbance, loop->TotalSteps(), loop->StepsPerSample(), &y) ==
-          PidStatus::kInvalidInput)
+      if (RunSampledLoop<T>(*discrete, g, pid, disturbance, loop->TotalSteps(), loop->StepsPerSample(), &y,
+                            nullptr, loop->reference) == PidStatus::kInvalidInput)
         return false;  // the loop diverged: no residuals at this point
     }
     for (std::size_t m = 0; m < y.size(); ++m) {
-      const T e = T(1.0) - y[m];
+      const T e = T(loop->reference) - y[m];
       switch (kind) {
         case ObjectiveKind::kIse:
           residuals[m] = e;

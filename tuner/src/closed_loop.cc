@@ -42,6 +42,9 @@ bool LoopOptions::IsValid(std::string* error) const {
   else if (!IsMultiple(horizon_s, sample_time_s, &count) || count < 1)
     os << "horizon " << horizon_s << " s must be a whole multiple of the sample time " << sample_time_s
        << " s";
+  else if (!std::isfinite(reference) || reference == 0.0 || std::abs(reference) > kMaxCoefficientMagnitude)
+    os << "reference " << reference << " must be finite, nonzero and at most " << kMaxCoefficientMagnitude
+       << " in magnitude";
   else if (!(stability_margin >= 0.0) || !(stability_margin < 1.0))
     os << "stability margin " << stability_margin << " must be in [0, 1)";
   else if (!(dt_s > 0.0) || !std::isfinite(dt_s))  // a bad --dt is an error even if the loop ignores it

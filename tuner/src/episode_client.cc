@@ -30,7 +30,7 @@ transport::EpisodeSpec MakeEpisodeSpec(int64_t episode_id, const Plant& plant, c
   spec.dt_s = options.dt_s;
   spec.sample_time_s = options.sample_time_s;
   spec.horizon_s = options.horizon_s;
-  spec.reference = 1.0;
+  spec.reference = options.reference;
   spec.total_steps = options.TotalSteps();
   spec.recovery = recovery;
   std::string error;
@@ -46,6 +46,7 @@ LoopOptions SampledLoopOptions(const transport::EpisodeSpec& spec) {
   o.horizon_s = spec.horizon_s;
   o.pid = spec.pid;
   o.disturbance = spec.disturbance;
+  o.reference = spec.reference;
   return o;
 }
 

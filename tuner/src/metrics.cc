@@ -240,10 +240,10 @@ std::string ToString(ObjectiveKind kind) {
   return "iae";
 }
 
-double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, double ts) {
+double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, double ts, double reference) {
   double sum = 0.0;
   for (std::size_t m = 0; m < y.size(); ++m) {
-    const double e = 1.0 - y[m];
+    const double e = reference - y[m];
     switch (kind) {
       case ObjectiveKind::kIae:
         sum += std::abs(e);
@@ -265,7 +265,7 @@ double ContinuousFinalValue(const ContinuousClosedLoop<double>& loop) {
   const int n = EffectiveLoopOrder(loop);
   const int ir = loop.plant_order + 1;  // the reference state
   const Eigen::VectorXd w = loop.m.topLeftCorner(n, n).partialPivLu().solve(-loop.m.block(0, ir, n, 1));
-  return loop.c.dot(w.head(loop.plant_order));
+  return loop.reference * loop.c.dot(w.head(loop.plant_order));
 }
 
 StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stability& stability) {
@@ -315,7 +315,7 @@ double ContinuousIntegralAbsError(const ContinuousClosedLoop<double>& loop, cons
   double sum = 0.0, t_prev = 0.0, e_prev = 0.0;
   bool first = true;
   const bool ok = walker.Run(horizon_s, [&](double t, const Eigen::VectorXd& w) {
-    const double e = 1.0 - loop.Output(w);
+    const double e = loop.reference - loop.Output(w);
     if (!first) {
       const double h = t - t_prev;
       if ((e > 0) == (e_prev > 0) || e == 0.0 || e_prev == 0.0) {
@@ -399,7 +399,7 @@ bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const Lo
   // A diverged loop (PidStatus::kInvalidInput) is not an error here: its
   // non-finite samples make every objective +inf, as for an unstable loop.
   RunSampledLoop<double>(discrete, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
-                         trajectory);
+                         trajectory, options.reference);
   return true;
 }
 
@@ -426,7 +426,8 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
   }
   const StateSpace ss = Realize(plant.tf);
   ContinuousClosedLoop<double> loop;
-  if (!BuildContinuousClosedLoop<double>(ss, gains, disturbance, &loop, error)) return false;
+  const double a = options.reference;
+  if (!BuildContinuousClosedLoop<double>(ss, gains, disturbance, &loop, error, a)) return false;
   const Stability continuous_stability = ContinuousStability(loop, options.stability_margin);
   const bool has_disturbance = options.disturbance.kind != DisturbanceKind::kNone;
 
@@ -436,10 +437,10 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
       SampleContinuousLoop<double>(loop, disturbance, ts, num, &ev->y);
       if (has_disturbance) {
         ContinuousClosedLoop<double> clean;
-        BuildContinuousClosedLoop<double>(ss, gains, none, &clean, error);
+        BuildContinuousClosedLoop<double>(ss, gains, none, &clean, error, a);
         std::vector<double> y1;
         SampleContinuousLoop<double>(clean, none, ts, num, &y1);
-        ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1, ts);
+        ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1, ts, a);
       }
       if (what.compute_iae_continuous)
         ev->iae_continuous = ContinuousIntegralAbsError(loop, disturbance, ev->stability, options.horizon_s);
@@ -459,30 +460,31 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
       for (int m = 0; m < num; ++m) ev->y.push_back(y_all[static_cast<std::size_t>(m) * per]);
       double integral = 0.0;
       for (std::size_t k = 1; k < y_all.size(); ++k)
-        integral += 0.5 * options.dt_s * (std::abs(1.0 - y_all[k]) + std::abs(1.0 - y_all[k - 1]));
+        integral += 0.5 * options.dt_s * (std::abs(a - y_all[k]) + std::abs(a - y_all[k - 1]));
       ev->iae_continuous = integral;
       std::vector<double> y1 = y_all;
       if (has_disturbance) {
         if (!runner(plant, gains, options, none.options(), &y1, nullptr, error)) return false;
         std::vector<double> y1s;
         for (int m = 0; m < num; ++m) y1s.push_back(y1[static_cast<std::size_t>(m) * per]);
-        ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1s, ts);
+        ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1s, ts, a);
       }
       if (what.compute_step_info) {
         std::vector<double> t_all(y1.size());
         for (std::size_t k = 0; k < t_all.size(); ++k) t_all[k] = static_cast<double>(k) * options.dt_s;
-        const double yf = continuous_stability.stable ? ContinuousFinalValue(loop) : 1.0;
+        const double yf = continuous_stability.stable ? ContinuousFinalValue(loop) : a;
         ev->step = SampledStepInfo(t_all, y1, yf);
       }
     }
   }
   if (ev->stability.stable) {
-    ev->iae = ObjectiveFromSamples(ObjectiveKind::kIae, ev->y, ts);
-    ev->ise = ObjectiveFromSamples(ObjectiveKind::kIse, ev->y, ts);
-    ev->itae = ObjectiveFromSamples(ObjectiveKind::kItae, ev->y, ts);
+    ev->iae = ObjectiveFromSamples(ObjectiveKind::kIae, ev->y, ts, a);
+    ev->ise = ObjectiveFromSamples(ObjectiveKind::kIse, ev->y, ts, a);
+    ev->itae = ObjectiveFromSamples(ObjectiveKind::kItae, ev->y, ts, a);
+    ev->iae_per_unit = ev->iae / std::abs(a);
     if (!has_disturbance) ev->iae_undisturbed = ev->iae;
   } else {
-    ev->iae = ev->ise = ev->itae = ev->iae_continuous = ev->iae_undisturbed = kInf;
+    ev->iae = ev->ise = ev->itae = ev->iae_continuous = ev->iae_undisturbed = ev->iae_per_unit = kInf;
     ev->step.note = "unstable loop: no step metrics";
   }
   return true;
@@ -512,13 +514,15 @@ double ObjectiveEvaluator::operator()(const PidGains& gains) const {
   const double ts = options_.sample_time_s;
   if (options_.loop == LoopKind::kContinuous) {
     ContinuousClosedLoop<double> loop;
-    if (!BuildContinuousClosedLoop<double>(realization_, gains, disturbance_, &loop, nullptr)) return kInf;
+    if (!BuildContinuousClosedLoop<double>(realization_, gains, disturbance_, &loop, nullptr,
+                                           options_.reference))
+      return kInf;
     const Stability s = ContinuousStability(loop, options_.stability_margin);
     if (!s.stable) return kInf;
     if (kind_ == ObjectiveKind::kIaeContinuous)
       return ContinuousIntegralAbsError(loop, disturbance_, s, options_.horizon_s);
     SampleContinuousLoop<double>(loop, disturbance_, ts, options_.NumSamples(), &y);
-    return ObjectiveFromSamples(kind_, y, ts);
+    return ObjectiveFromSamples(kind_, y, ts, options_.reference);
   }
   if (!SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable) return kInf;
   if (runner_ || kind_ == ObjectiveKind::kIaeContinuous) {
@@ -527,24 +531,26 @@ double ObjectiveEvaluator::operator()(const PidGains& gains) const {
       if (!runner_(plant_, gains, options_, options_.disturbance, &y, nullptr, &error))
         throw std::runtime_error("sampled-loop runner failed: " + error);
     } else if (RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(), 1,
-                                      &y) == PidStatus::kInvalidInput) {
+                                      &y, nullptr, options_.reference) == PidStatus::kInvalidInput) {
       return kInf;
     }
     if (kind_ != ObjectiveKind::kIaeContinuous) {
       std::vector<double> samples;
       const int per = options_.StepsPerSample();
       for (std::size_t k = 0; k < y.size(); k += static_cast<std::size_t>(per)) samples.push_back(y[k]);
-      return ObjectiveFromSamples(kind_, samples, ts);
+      return ObjectiveFromSamples(kind_, samples, ts, options_.reference);
     }
     double integral = 0.0;
     for (std::size_t k = 1; k < y.size(); ++k)
-      integral += 0.5 * options_.dt_s * (std::abs(1.0 - y[k]) + std::abs(1.0 - y[k - 1]));
+      integral += 0.5 * options_.dt_s *
+                  (std::abs(options_.reference - y[k]) + std::abs(options_.reference - y[k - 1]));
     return integral;
   }
   if (RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(),
-                             options_.StepsPerSample(), &y) == PidStatus::kInvalidInput)
+                             options_.StepsPerSample(), &y, nullptr,
+                             options_.reference) == PidStatus::kInvalidInput)
     return kInf;
-  return ObjectiveFromSamples(kind_, y, ts);
+  return ObjectiveFromSamples(kind_, y, ts, options_.reference);
 }
 
 }  // namespace pidlab

@@ -12,7 +12,8 @@
 
 namespace pidlab {
 
-/// Objectives over the error samples e_m = 1 - y(m ts), m = 0..M:
+/// Objectives over the error samples e_m = A - y(m ts), m = 0..M, A the size
+/// of the reference step (LoopOptions::reference, 1 in the paper):
 ///   iae  = sum |e_m|          (eq. 4, the paper's Error(K); not scaled by ts)
 ///   ise  = sum e_m^2
 ///   itae = sum t_m |e_m|
@@ -43,6 +44,9 @@ struct Evaluation {
   std::vector<double> t, y, n;
   /// Objectives of y (with the disturbance if one is set). +inf if unstable.
   double iae = 0, ise = 0, itae = 0, iae_continuous = 0;
+  /// iae / |A| (A = options.reference): the IAE per unit of step, so that
+  /// moves of different sizes compare. +inf if unstable.
+  double iae_per_unit = 0;
   /// IAE of the undisturbed response y1 (equals iae without a disturbance).
   double iae_undisturbed = 0;
   StepInfo step;
@@ -109,22 +113,24 @@ class ObjectiveEvaluator {
   mutable std::atomic<long> evaluations_{0};
 };
 
-/// Objective from output samples y_m at t_m = m ts (not kIaeContinuous).
-double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, double ts);
+/// Objective from output samples y_m at t_m = m ts (not kIaeContinuous), with
+/// e_m = reference - y_m.
+double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, double ts,
+                            double reference = 1.0);
 
 /// MATLAB stepinfo on the exact continuous step response (no disturbance),
 /// on a grid whose step follows the fastest pole still alive, with crossings
 /// and the peak refined by exact propagation.
 StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stability& stability);
 
-/// \int_0^horizon |1 - y(t)| dt of the continuous loop (with its disturbance).
+/// \int_0^horizon |A - y(t)| dt of the continuous loop (with its disturbance), A = loop.reference.
 double ContinuousIntegralAbsError(const ContinuousClosedLoop<double>& loop, const Disturbance& disturbance,
                                   const Stability& stability, double horizon_s);
 
 /// stepinfo on a sampled response (linear interpolation at crossings).
 StepInfo SampledStepInfo(const std::vector<double>& t, const std::vector<double>& y, double final_value);
 
-/// Final value of the unit step response of a stable continuous loop.
+/// Final value of the step response (step of size loop.reference) of a stable continuous loop.
 double ContinuousFinalValue(const ContinuousClosedLoop<double>& loop);
 
 }  // namespace pidlab
