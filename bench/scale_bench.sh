@@ -16,7 +16,7 @@ bin=$(realpath "${1:-build/bin}")
 shift || true
 ks=("$@")
 [ ${#ks[@]} -gt 0 ] || ks=(1 2 4 8)
-tune_args=${TUNE_ARGS:---plant double_integrator --loop sampled --horizon 5 --max-evals 80 --seed 3 --refine none --json}
+tune_args=${TUNE_ARGS:---plant double_integrator --loop sampled --horizon 5 --method nelder-mead --max-evals 80 --seed 3 --refine none --json}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 key() { python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); print(j["gains"], j["iae"], j["evaluations"])' "$1"; }

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <thread>
 #include <vector>
 
@@ -25,7 +26,7 @@ struct PaperCase {
 
 class TuneBeatsPaper : public ::testing::TestWithParam<PaperCase> {};
 
-TEST_P(TuneBeatsPaper, DefaultNelderMeadBeatsThePapersIaeWithAStrictlyStableLoop) {
+TEST_P(TuneBeatsPaper, DefaultTuneBeatsThePapersIaeWithAStrictlyStableLoop) {
   const PaperCase& c = GetParam();
   const Plant plant = MakeBuiltin(c.plant);
   TuneOptions options;
@@ -109,11 +110,74 @@ TEST_P(TuneInParallel, GivesTheSameBitsAsOneEvaluationAfterTheOther) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, TuneInParallel,
-                         ::testing::Values(TuneMethod::kNelderMead, TuneMethod::kGeneticAlgorithm,
-                                           TuneMethod::kPsoGsa));
+                         ::testing::Values(TuneMethod::kMultiStart, TuneMethod::kNelderMead,
+                                           TuneMethod::kGeneticAlgorithm, TuneMethod::kPsoGsa));
+
+// The done-when: for seeds 1-20 the default tune of each plant
+// reaches the same objective to 0.1 %, and that objective is no worse (to
+// 0.1 %) than the best the other methods find. The reference runs every other
+// method (nelder-mead, paper-nm, ga, pso-gsa, each with the Ceres
+// cross-check) with seed 1 only: over seeds 1-20 of all four
+// (bench/tune_seeds.sh, docs/tuning.md) the best per plant is already one of
+// these seed-1 runs (paper-nm on 1/s^2 and the stepper, nelder-mead on
+// 1/(s^2+1)), and 80 tunes per plant would take minutes under ASan.
+class DefaultTuneOverSeeds : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(DefaultTuneOverSeeds, ReachesTheSameObjectiveForEverySeedAndNoWorseThanAnyOtherMethod) {
+  const Plant plant = MakeBuiltin(GetParam());
+  double reference = std::numeric_limits<double>::infinity();
+  std::string reference_method;
+  for (TuneMethod method : {TuneMethod::kNelderMead, TuneMethod::kPaperNelderMead,
+                            TuneMethod::kGeneticAlgorithm, TuneMethod::kPsoGsa}) {
+    TuneOptions options;
+    options.method = method;
+    TuneSummary other;
+    std::string error;
+    ASSERT_TRUE(Tune(plant, options, &other, &error)) << error;
+    if (other.stable && other.objective < reference) {
+      reference = other.objective;
+      reference_method = ToString(method);
+    }
+  }
+  ASSERT_TRUE(std::isfinite(reference));
+  double lowest = std::numeric_limits<double>::infinity(), highest = 0.0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    TuneOptions options;  // the default: multi-start, Ceres from the best minima
+    options.seed = seed;
+    TuneSummary dut;
+    std::string error;
+    ASSERT_TRUE(Tune(plant, options, &dut, &error)) << error;
+    ASSERT_TRUE(dut.stable) << "seed " << seed;
+    EXPECT_LE(dut.objective, reference * 1.001)
+        << "seed " << seed << ": " << dut.BriefReport() << " vs " << reference_method << " " << reference;
+    lowest = std::min(lowest, dut.objective);
+    highest = std::max(highest, dut.objective);
+  }
+  EXPECT_LE(highest, lowest * 1.001) << "seeds 1-20 range over [" << lowest << ", " << highest << "]";
+}
+
+INSTANTIATE_TEST_SUITE_P(Plants, DefaultTuneOverSeeds,
+                         ::testing::Values("double_integrator", "oscillator", "stepper_motor"));
+
+TEST(MultiStart, RefinesFromSeveralDistinctPolishedMinimaAndKeepsTheBest) {
+  const Plant plant = MakeBuiltin("stepper_motor");
+  TuneOptions options;
+  TuneSummary dut;
+  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  ASSERT_TRUE(dut.stable);
+  ASSERT_GE(dut.local_minima.size(), 2u);
+  for (std::size_t i = 1; i < dut.local_minima.size(); ++i)
+    EXPECT_LE(dut.local_minima[i - 1].f, dut.local_minima[i].f);
+  EXPECT_EQ(dut.search_objective, dut.local_minima.front().f);
+  EXPECT_EQ(dut.refine.runs, options.refine_starts);
+  EXPECT_LE(dut.objective, dut.search_objective);
+  const ObjectiveEvaluator exact(plant, options.loop, ObjectiveKind::kIae);
+  EXPECT_EQ(exact(dut.gains), dut.objective);
+}
 
 TEST(NelderMeadStarts, ShareMaxEvaluationsInFixedPartsWhateverRunsThem) {
   TuneOptions options;
+  options.method = TuneMethod::kNelderMead;
   options.max_evaluations = 10;
   options.starts = 4;  // shares 3, 3, 2, 2
   options.refine = false;
@@ -150,6 +214,7 @@ TEST(ObjectiveEvaluator, ReturnsInfinityForMarginalAndUnstableLoops) {
 TEST(RefineWithCeres, SaysTheSearchStoppedShortWhenNelderMeadIsStoppedEarly) {
   const Plant plant = MakeBuiltin("double_integrator");
   TuneOptions options;
+  options.method = TuneMethod::kNelderMead;
   options.starts = 1;
   options.max_evaluations = 8;  // a handful of evaluations: far from a minimum
   TuneSummary dut;
@@ -168,6 +233,7 @@ TEST(RefineWithCeres, SaysTheSearchStoppedShortWhenNelderMeadIsStoppedEarly) {
 TEST(RefineWithCeres, AgreesWithAConvergedNelderMead) {
   const Plant plant = MakeBuiltin("stepper_motor");
   TuneOptions options;
+  options.method = TuneMethod::kNelderMead;
   TuneSummary dut;
   ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
   EXPECT_EQ(dut.refine.verdict, RefineVerdict::kAgree);
@@ -230,6 +296,7 @@ TEST(Tune, ZieglerNicholsOnTheDoubleIntegratorSaysItDoesNotApply) {
 TEST(Tune, RespectsAnOvershootConstraint) {
   const Plant plant = MakeBuiltin("stepper_motor");
   TuneOptions options;
+  options.method = TuneMethod::kNelderMead;
   options.max_overshoot_pct = 0.5;
   options.refine = false;
   TuneSummary dut;
@@ -260,9 +327,9 @@ TEST(TuneOptions, RejectsNegativeLowerBound) {
 TEST(TuneOptions, BoundsLoopStepsTimesTheEvaluationBudget) {
   TuneOptions options;
   options.loop.loop = LoopKind::kSampled;
-  options.loop.dt_s = 1e-5;  // 2.5e6 steps x 5000 evaluations
+  options.loop.dt_s = 1e-5;  // 2.5e6 steps x 20000 evaluations
   std::string error;
-  EXPECT_EQ(options.EvaluationBudget(), 5000);
+  EXPECT_EQ(options.EvaluationBudget(), 20000);
   EXPECT_FALSE(options.IsValid(&error));
   EXPECT_NE(error.find("more than 5e9"), std::string::npos) << error;
   options.max_evaluations = 1000;  // 2.5e9 steps
@@ -281,12 +348,27 @@ TEST(TuneOptions, RejectsAnUpperBoundAboveTheGainLimit) {
   EXPECT_NE(error.find("1e+13"), std::string::npos) << error;
 }
 
-TEST(TuneOptions, RejectsZeroStarts) {
+TEST(TuneOptions, RejectsNegativeStartsAndTakesZeroForTheMethodsDefault) {
   TuneOptions options;
-  options.starts = 0;
+  options.starts = -1;
   std::string error;
   EXPECT_FALSE(options.IsValid(&error));
   EXPECT_NE(error.find("starts"), std::string::npos);
+  options.starts = 0;
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+  EXPECT_EQ(options.StartCount(), kMultiStartStarts);
+  options.method = TuneMethod::kNelderMead;
+  EXPECT_EQ(options.StartCount(), 4);
+}
+
+TEST(TuneOptions, MultiStartNeedsTwoEvaluations) {
+  TuneOptions options;
+  options.max_evaluations = 1;
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("at least 2 evaluations"), std::string::npos) << error;
+  options.max_evaluations = 2;
+  EXPECT_TRUE(options.IsValid(&error)) << error;
 }
 
 }  // namespace

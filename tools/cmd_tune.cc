@@ -1,5 +1,6 @@
-// pidlab tune: Nelder-Mead (or a baseline) on the paper's objective, with a
-// Ceres least-squares cross-check.
+// pidlab tune: a multi-start from a space-filling design (or Nelder-Mead, the
+// paper's variant, a baseline) on the paper's objective, with a Ceres
+// least-squares cross-check.
 
 #include <unistd.h>
 
@@ -20,9 +21,10 @@ namespace {
 struct TuneCommand {
   PlantFlags plant;
   LoopFlags loop;
-  std::string method = "nelder-mead", objective = "iae", backend = "local", bounds = "0,30";
+  std::string method = "multi-start", objective = "iae", backend = "local", bounds = "0,30";
   std::string refine = "ceres", trace, zn_rule = "classic";
-  int max_iterations = 0, max_evaluations = 0, starts = 4;
+  int max_iterations = 0, max_evaluations = 0, starts = 0, design_points = kMultiStartDesignPoints,
+      refine_starts = 2;
   double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3;
   bool json = false, adaptive = false;
   LcmFlags lcm;
@@ -37,11 +39,14 @@ struct TuneCommand {
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
-        "Tune PID gains on the paper's objective (IAE of the unit-step response, eq. 4) by Nelder-Mead or a "
-        "baseline, rejecting every loop that is not strictly stable, then cross-check with Ceres.");
+        "Tune PID gains on the paper's objective (IAE of the unit-step response, eq. 4) by a multi-start "
+        "from a space-filling design (default), Nelder-Mead or a baseline, rejecting every loop that is not "
+        "strictly stable, then cross-check with Ceres.");
     plant.Register(app);
     loop.Register(app);
-    app->add_option("--method", method, "nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa")
+    app->add_option("--method", method,
+                    "multi-start (Sobol' design + Nelder-Mead polish) | nelder-mead | paper-nm | "
+                    "ziegler-nichols | ga | pso-gsa")
         ->capture_default_str();
     app->add_option("--objective", objective, "iae | ise | itae | iae-continuous")->capture_default_str();
     app->add_option("--backend", backend, "local (in-process) or lcm (episodes over a running trio)")
@@ -51,8 +56,16 @@ struct TuneCommand {
         ->capture_default_str();
     app->add_option("--max-evals", max_evaluations, "evaluation budget over all starts (0 = method default)")
         ->capture_default_str();
-    app->add_option("--starts", starts, "seeded starts (nelder-mead, paper-nm)")->capture_default_str();
-    app->add_flag("--adaptive", adaptive, "nelder-mead: Gao & Han's adaptive coefficients");
+    app->add_option("--starts", starts,
+                    "seeded starts (nelder-mead, paper-nm; 0 = 4) or polished starts (multi-start; 0 = 16)")
+        ->capture_default_str();
+    app->add_option("--design-points", design_points,
+                    "multi-start: Sobol' points of the design (at most half of --max-evals when given)")
+        ->capture_default_str();
+    app->add_option("--refine-starts", refine_starts,
+                    "multi-start: Ceres from this many distinct polished minima, best first")
+        ->capture_default_str();
+    app->add_flag("--adaptive", adaptive, "nelder-mead, multi-start: Gao & Han's adaptive coefficients");
     app->add_option("--refine", refine, "ceres | none: the least-squares cross-check")->capture_default_str();
     app->add_option("--agree-tolerance", agree_tolerance,
                     "relative objective difference for the 'agree' verdict")
@@ -101,7 +114,7 @@ struct TuneCommand {
     o.loop = loop.Build();
     if (!ParseTuneMethod(method, &o.method))
       throw BadInput("--method " + Quote(method) +
-                     " must be nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
+                     " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
     if (!ParseObjectiveKind(objective, &o.objective))
       throw BadInput("--objective " + Quote(objective) + " must be iae, ise, itae or iae-continuous");
     if (!ParseZieglerNicholsRule(zn_rule, &o.zn_rule))
@@ -117,6 +130,8 @@ struct TuneCommand {
     o.max_iterations = max_iterations;
     o.max_evaluations = max_evaluations;
     o.starts = starts;
+    o.design_points = design_points;
+    o.refine_starts = refine_starts;
     o.adaptive = adaptive;
     o.seed = loop.seed;
     o.max_overshoot_pct = max_overshoot_pct;
@@ -174,6 +189,7 @@ struct TuneCommand {
     j["search"] = {{"gains", cli::ToJson(s.search_gains)},
                    {"objective", JsonNumber(s.search_objective)},
                    {"termination", ToString(s.optimizer.termination)},
+                   {"starts", s.optimizer.starts},
                    {"message", s.optimizer.message}};
     j["evaluations"] = s.evaluations;
     j["rejected_evaluations"] = s.optimizer.rejected_evaluations;
@@ -188,6 +204,8 @@ struct TuneCommand {
                    {"termination", ToString(s.refine.termination)},
                    {"iterations", s.refine.iterations},
                    {"relative_improvement", JsonNumber(s.refine.relative_improvement)},
+                   {"runs", s.refine.runs},
+                   {"start_index", s.refine.start_index},
                    {"message", s.refine.message}};
     if (o.method == TuneMethod::kZieglerNichols)
       j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},

@@ -17,6 +17,8 @@ for k in ['kp', 'ki', 'kd']:
     assert k in j['gains'] and k in j['refine']['gains'], k
 assert 'iae' in j['refine'] and 'verdict' in j['refine']
 assert j['stable'] is True and j['iae'] < 1.9151, j['iae']
+assert j['method'] == 'multi-start' and j['search']['starts'] == 16, (j['method'], j['search'])
+assert j['refine']['runs'] == 2 and j['refine']['start_index'] in (0, 1), j['refine']
 PY"
 check "tune --trace writes a CSV whose best objective never increases" "python3 - \"$tmp/trace.csv\" <<'PY'
 import csv, sys
@@ -35,7 +37,10 @@ bad() {
 bad "unknown method" --plant linear --method simplex
 bad "bad bounds" --plant linear --bounds 5,1
 bad "bad objective" --plant linear --objective mse
-bad "zero starts" --plant linear --starts 0
+bad "negative starts" --plant linear --starts -1
+bad "zero design points" --plant linear --design-points 0
+bad "zero refine starts" --plant linear --refine-starts 0
+bad "multi-start with one evaluation" --plant linear --max-evals 1
 bad "zn on 1/s^2" --plant linear --method ziegler-nichols
 "$pidlab" tune --plant stepper --adaptive --json > "$tmp/adaptive.json"
 check "tune --adaptive beats the paper's stepper IAE 1.9751" "python3 -c \"import json; j = json.load(open('$tmp/adaptive.json')); assert j['stable'] and j['iae'] < 1.9751, j['iae']\""

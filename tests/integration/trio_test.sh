@@ -101,7 +101,7 @@ case $CASE in
   sigstop)
     # A controller stopped for 3 s mid-tune: the tune must go on (default
     # silence deadline) and give exactly the local sampled tune's result.
-    TUNE="--plant double_integrator --loop sampled --horizon 2 --max-evals 30 --starts 1 --seed 3 --refine none --json"
+    TUNE="--method nelder-mead --plant double_integrator --loop sampled --horizon 2 --max-evals 30 --starts 1 --seed 3 --refine none --json"
     "$PIDLAB" tune $TUNE | sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' > "$TMP/tune.local.json" || fail=1
     export TUNE
     "$PIDLAB" launch --lcm-url "$URL" -- bash -c '
@@ -118,7 +118,7 @@ case $CASE in
   trios)
     # The same tune over 1 and 3 trios (pidlab launch --trios K) and in
     # process: identical gains, objective, evaluations, trace, bit for bit.
-    TUNE="--plant double_integrator --loop sampled --horizon 1 --max-evals 36 --starts 6 --seed 3 --refine none --json"
+    TUNE="--method nelder-mead --plant double_integrator --loop sampled --horizon 1 --max-evals 36 --starts 6 --seed 3 --refine none --json"
     "$PIDLAB" tune $TUNE | sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' > "$TMP/tune.local.json" || fail=1
     for k in 1 3; do
       "$PIDLAB" launch --lcm-url "$URL" --trios $k -- bash -c '
@@ -136,7 +136,7 @@ case $CASE in
   trio_killed)
     # Trio 2 of 2 loses its plant (SIGKILL) mid-tune: the tune names it, runs
     # its episode on trio 1 and ends with the local tune's result.
-    TUNE="--plant double_integrator --loop sampled --horizon 4 --max-evals 24 --starts 4 --seed 3 --refine none --json --silence-deadline 1 --max-attempts 2"
+    TUNE="--method nelder-mead --plant double_integrator --loop sampled --horizon 4 --max-evals 24 --starts 4 --seed 3 --refine none --json --silence-deadline 1 --max-attempts 2"
     "$PIDLAB" tune $TUNE | sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' > "$TMP/tune.local.json" || fail=1
     export TUNE
     "$PIDLAB" launch --lcm-url "$URL" --trios 2 -- bash -c '

@@ -5,7 +5,7 @@
 set -uo pipefail
 pidlab="$1"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-args=(tune --plant linear --loop sampled --dt 1e-3 --horizon 5 --max-evals 8 --starts 1 --refine none --json)
+args=(tune --method nelder-mead --plant linear --loop sampled --dt 1e-3 --horizon 5 --max-evals 8 --starts 1 --refine none --json)
 "$pidlab" launch --isolated -- "$pidlab" "${args[@]}" --backend lcm > "$tmp/lcm.json" 2> "$tmp/lcm.err"
 rc=$?
 "$pidlab" "${args[@]}" --backend local > "$tmp/local.json"

@@ -12,6 +12,7 @@
 #include <ceres/ceres.h>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -155,23 +156,78 @@ void Judge(const TuneOptions& options, const PidGains& refined, double f, double
 
 }  // namespace
 
+namespace {
+
+// Why the cross-check cannot run from `start_objective` ("" when it can).
+std::string WhyNotRun(const TuneOptions& options, double start_objective) {
+  if (options.objective == ObjectiveKind::kIaeContinuous)
+    return "not run: iae-continuous has no sample least-squares form";
+  if (!std::isfinite(start_objective)) return "not run: the search found no stable loop";
+  return "";
+}
+
+// Ceres from `start`: its point in *refined and that point's exact objective.
+double SolveAndEvaluate(const Plant& plant, const TuneOptions& options, const PidGains& start,
+                        PidGains* refined, RefineSummary* summary) {
+  SolveLeastSquares(plant, options, start, refined, summary);
+  const ObjectiveEvaluator exact(plant, options.loop, options.objective);
+  return exact(*refined);
+}
+
+}  // namespace
+
 RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, const PidGains& start,
                               double start_objective) {
   RefineSummary summary;
   summary.gains = start;
   summary.objective = start_objective;
-  if (options.objective == ObjectiveKind::kIaeContinuous) {
-    summary.message = "not run: iae-continuous has no sample least-squares form";
-    return summary;
-  }
-  if (!std::isfinite(start_objective)) {
-    summary.message = "not run: the search found no stable loop";
-    return summary;
-  }
+  summary.message = WhyNotRun(options, start_objective);
+  if (!summary.message.empty()) return summary;
   PidGains refined;
-  SolveLeastSquares(plant, options, start, &refined, &summary);
-  const ObjectiveEvaluator exact(plant, options.loop, options.objective);
-  Judge(options, refined, exact(refined), start_objective, &summary);
+  const double f = SolveAndEvaluate(plant, options, start, &refined, &summary);
+  summary.runs = 1;
+  Judge(options, refined, f, start_objective, &summary);
+  return summary;
+}
+
+RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options,
+                              const std::vector<PidGains>& starts,
+                              const std::vector<double>& start_objectives) {
+  RefineSummary summary;
+  if (starts.empty() || starts.size() != start_objectives.size()) {
+    summary.message = "not run: no start";
+    return summary;
+  }
+  const double f_search = start_objectives[0];
+  summary.gains = starts[0];
+  summary.objective = f_search;
+  summary.message = WhyNotRun(options, f_search);
+  if (!summary.message.empty()) return summary;
+  // Every run from its start; the lowest finite exact objective wins (ties:
+  // the earlier start), its termination and iterations are reported.
+  PidGains best_point;
+  double best_f = std::numeric_limits<double>::infinity();
+  RefineSummary best_run;
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    if (!std::isfinite(start_objectives[k])) continue;
+    RefineSummary run;
+    PidGains refined;
+    const double f = SolveAndEvaluate(plant, options, starts[k], &refined, &run);
+    ++summary.runs;
+    if (k == 0 || (std::isfinite(f) && f < best_f)) {
+      best_f = f;
+      best_point = refined;
+      best_run = run;
+      summary.start_index = static_cast<int>(k);
+    }
+  }
+  summary.ran = true;
+  summary.termination = best_run.termination;
+  summary.iterations = best_run.iterations;
+  Judge(options, best_point, best_f, f_search, &summary);
+  if (summary.start_index > 0)
+    summary.message += " (Ceres from polished minimum " + std::to_string(summary.start_index + 1) + " of " +
+                       std::to_string(starts.size()) + ")";
   return summary;
 }
 

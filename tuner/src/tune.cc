@@ -1,10 +1,12 @@
 #include "pidlab/tuner/tune.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 
 #include "pidlab/tuner/genetic_algorithm.h"
+#include "pidlab/tuner/multi_start.h"
 #include "pidlab/tuner/nelder_mead.h"
 #include "pidlab/tuner/paper_nelder_mead.h"
 #include "pidlab/tuner/pso_gsa.h"
@@ -12,7 +14,9 @@
 namespace pidlab {
 
 bool ParseTuneMethod(const std::string& s, TuneMethod* method) {
-  if (s == "nelder-mead")
+  if (s == "multi-start")
+    *method = TuneMethod::kMultiStart;
+  else if (s == "nelder-mead")
     *method = TuneMethod::kNelderMead;
   else if (s == "paper-nm")
     *method = TuneMethod::kPaperNelderMead;
@@ -29,6 +33,8 @@ bool ParseTuneMethod(const std::string& s, TuneMethod* method) {
 
 std::string ToString(TuneMethod method) {
   switch (method) {
+    case TuneMethod::kMultiStart:
+      return "multi-start";
     case TuneMethod::kNelderMead:
       return "nelder-mead";
     case TuneMethod::kPaperNelderMead:
@@ -40,7 +46,7 @@ std::string ToString(TuneMethod method) {
     case TuneMethod::kPsoGsa:
       return "pso-gsa";
   }
-  return "nelder-mead";
+  return "multi-start";
 }
 
 std::string ToString(RefineTermination termination) {
@@ -83,8 +89,15 @@ bool TuneOptions::IsValid(std::string* error) const {
     os << "max iterations " << max_iterations << " must be >= 0";
   else if (max_evaluations < 0)
     os << "max evaluations " << max_evaluations << " must be >= 0";
-  else if (starts < 1)
-    os << "starts " << starts << " must be >= 1";
+  else if (starts < 0)
+    os << "starts " << starts << " must be >= 0 (0: the method's default)";
+  else if (method == TuneMethod::kMultiStart && (design_points < 1 || design_points > (1 << 20)))
+    os << "design points " << design_points << " must be in [1, 1048576]";
+  else if (method == TuneMethod::kMultiStart && EvaluationBudget() < 2)
+    os << "multi-start needs at least 2 evaluations (a design point and a polish), not "
+       << EvaluationBudget();
+  else if (refine_starts < 1)
+    os << "refine starts " << refine_starts << " must be >= 1";
   else if (std::isnan(max_overshoot_pct) || max_overshoot_pct < 0.0)
     os << "max overshoot " << max_overshoot_pct << " % must be >= 0";
   else if (std::isnan(max_settling_time_s) || !(max_settling_time_s > 0.0))
@@ -108,6 +121,8 @@ int TuneOptions::EvaluationBudget() const {
   if (method == TuneMethod::kZieglerNichols) return 1;
   if (max_evaluations > 0) return max_evaluations;
   switch (method) {
+    case TuneMethod::kMultiStart:
+      return kMultiStartEvaluations;
     case TuneMethod::kNelderMead:
       return NelderMeadOptions{}.max_evaluations;
     case TuneMethod::kPaperNelderMead:
@@ -120,6 +135,11 @@ int TuneOptions::EvaluationBudget() const {
       break;
   }
   return 1;
+}
+
+int TuneOptions::StartCount() const {
+  if (starts > 0) return starts;
+  return method == TuneMethod::kMultiStart ? kMultiStartStarts : 4;
 }
 
 std::string TuneSummary::BriefReport() const {
@@ -174,9 +194,25 @@ bool Search(const Plant& plant, const TuneOptions& options, const ObjectiveFunct
   Bounds bounds{Eigen::VectorXd::Constant(3, options.lower), Eigen::VectorXd::Constant(3, options.upper)};
   OptimizerSummary& opt = summary->optimizer;
   switch (options.method) {
+    case TuneMethod::kMultiStart: {
+      MultiStartOptions o;
+      o.seed = options.seed;
+      o.max_evaluations = options.EvaluationBudget();
+      o.design_points = options.max_evaluations > 0
+                            ? std::max(1, std::min(options.design_points, o.max_evaluations / 2))
+                            : options.design_points;
+      o.starts = options.StartCount();
+      o.warp = kGainWarp;
+      o.min_separation = kMultiStartSeparation;
+      if (options.max_iterations > 0) o.polish.max_iterations = options.max_iterations;
+      o.polish.adaptive = options.adaptive;
+      o.parallel_for = options.parallel_for;
+      MultiStart(f, bounds, o, &opt, progress, &summary->local_minima);
+      break;
+    }
     case TuneMethod::kNelderMead: {
       NelderMeadOptions o = WithBudget(NelderMeadOptions{}, options, &NelderMeadOptions::max_iterations);
-      o.starts = options.starts;
+      o.starts = options.StartCount();
       o.adaptive = options.adaptive;
       o.parallel_for = options.parallel_for;
       NelderMead(f, bounds, o, &opt, progress);
@@ -185,7 +221,7 @@ bool Search(const Plant& plant, const TuneOptions& options, const ObjectiveFunct
     case TuneMethod::kPaperNelderMead: {
       PaperNelderMeadOptions o =
           WithBudget(PaperNelderMeadOptions{}, options, &PaperNelderMeadOptions::max_iterations);
-      o.starts = options.starts;
+      o.starts = options.StartCount();
       PaperNelderMead(f, bounds, o, &opt, progress);
       break;
     }
@@ -214,6 +250,24 @@ bool Search(const Plant& plant, const TuneOptions& options, const ObjectiveFunct
     }
   }
   return true;
+}
+
+// Adds the polished minima that differ from every start so far (by more than
+// 1e-4 of the box width in some gain), best first, up to refine_starts starts.
+void AddDistinctMinima(const TuneOptions& options, const std::vector<LocalMinimum>& minima,
+                       std::vector<PidGains>* starts, std::vector<double>* objectives) {
+  const double tolerance = 1e-4 * (options.upper - options.lower);
+  for (const LocalMinimum& m : minima) {
+    if (static_cast<int>(starts->size()) >= options.refine_starts) break;
+    if (m.x.size() != 3 || !std::isfinite(m.f)) continue;
+    const PidGains g{m.x(0), m.x(1), m.x(2)};
+    const bool distinct = std::all_of(starts->begin(), starts->end(), [&](const PidGains& s) {
+      return std::max({std::abs(s.kp - g.kp), std::abs(s.ki - g.ki), std::abs(s.kd - g.kd)}) > tolerance;
+    });
+    if (!distinct) continue;
+    starts->push_back(g);
+    objectives->push_back(m.f);
+  }
 }
 
 }  // namespace
@@ -252,7 +306,16 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   summary->objective = summary->search_objective;
   summary->stable = true;
   summary->message = opt.message;
-  if (options.refine && options.method != TuneMethod::kZieglerNichols) {
+  if (options.refine && options.method == TuneMethod::kMultiStart) {
+    std::vector<PidGains> starts{summary->search_gains};
+    std::vector<double> objectives{summary->search_objective};
+    AddDistinctMinima(options, summary->local_minima, &starts, &objectives);
+    summary->refine = RefineWithCeres(plant, options, starts, objectives);
+    if (summary->refine.objective < summary->objective) {
+      summary->gains = summary->refine.gains;
+      summary->objective = summary->refine.objective;
+    }
+  } else if (options.refine && options.method != TuneMethod::kZieglerNichols) {
     summary->refine = RefineWithCeres(plant, options, summary->search_gains, summary->search_objective);
     if (summary->refine.objective < summary->objective) {
       summary->gains = summary->refine.gains;

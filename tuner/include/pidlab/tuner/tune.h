@@ -1,7 +1,9 @@
 #pragma once
 // PID tuning: a search method on the paper's objective (or ISE/ITAE/
 // continuous IAE), over the gain box, followed by a Ceres least-squares
-// cross-check of the result.
+// cross-check of the result. The default search is a multi-start from a
+// space-filling design (multi_start.h), whose result does not depend on the
+// seed's luck.
 
 #include <cstdint>
 #include <limits>
@@ -9,6 +11,7 @@
 #include <vector>
 
 #include "pidlab/tuner/evaluation.h"
+#include "pidlab/tuner/multi_start.h"
 #include "pidlab/tuner/optimizer.h"
 #include "pidlab/tuner/ziegler_nichols.h"
 
@@ -20,13 +23,34 @@ namespace pidlab {
 /// steps, is 40 times below it. The Ceres cross-check comes on top.
 inline constexpr double kMaxTuneSteps = 5e9;
 
-enum class TuneMethod { kNelderMead, kPaperNelderMead, kZieglerNichols, kGeneticAlgorithm, kPsoGsa };
-/// nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa
+enum class TuneMethod {
+  kMultiStart,
+  kNelderMead,
+  kPaperNelderMead,
+  kZieglerNichols,
+  kGeneticAlgorithm,
+  kPsoGsa
+};
+/// multi-start | nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa
 bool ParseTuneMethod(const std::string& s, TuneMethod* method);
 std::string ToString(TuneMethod method);
 
+/// The multi-start's defaults (docs/optimisers.md, "MultiStart"): the design
+/// of 1024 scrambled Sobol' points warped by ln(10^4), 16 polished starts at
+/// least 0.2 apart in the warped cube, 20000 evaluations in all, Ceres from the
+/// best 2 distinct polished minima. Chosen so that seeds 1-20 all reach the
+/// best objective any method finds on the three plants (tune_test).
+inline constexpr int kMultiStartDesignPoints = 1024;
+inline constexpr int kMultiStartStarts = 16;
+inline constexpr int kMultiStartEvaluations = 20000;
+inline constexpr double kMultiStartSeparation = 0.2;
+/// ln(10^4): as many design points in the first 10^-4 of each gain's range
+/// as in its upper half, because good gains span decades (the stepper's
+/// optimum has kp = 0.05 and kd = 0.05 in a box of width 30).
+inline constexpr double kGainWarp = 9.210340371976184;
+
 struct TuneOptions {
-  TuneMethod method = TuneMethod::kNelderMead;
+  TuneMethod method = TuneMethod::kMultiStart;
   ObjectiveKind objective = ObjectiveKind::kIae;
   /// The loop the objective is evaluated on (default: the paper's continuous
   /// loop, ts = 0.05 s, n = 25 s, no disturbance). Its stability_margin is the
@@ -46,8 +70,15 @@ struct TuneOptions {
   int max_iterations = 0;
   /// Evaluation budget over all starts; 0 = the method's default.
   int max_evaluations = 0;
-  /// Independent seeded starts (nelder-mead, paper-nm).
-  int starts = 4;
+  /// Independent seeded starts (nelder-mead, paper-nm: 0 = 4), or polished
+  /// starts (multi-start: 0 = kMultiStartStarts); >= 0.
+  int starts = 0;
+  /// multi-start: points of the space-filling design; with max_evaluations
+  /// set, at most half of it.
+  int design_points = kMultiStartDesignPoints;
+  /// multi-start: Ceres runs from this many distinct polished minima, best
+  /// first (>= 1); the best exact result is kept.
+  int refine_starts = 2;
   /// nelder-mead: Gao & Han's dimension-dependent coefficients instead of
   /// (1, 2, 1/2, 1/2).
   bool adaptive = false;
@@ -72,8 +103,11 @@ struct TuneOptions {
   /// loop steps over EvaluationBudget().
   bool IsValid(std::string* error) const;
   /// The search's evaluation budget: max_evaluations, else the method's
-  /// default (5000); 1 for ziegler-nichols, which evaluates its rule once.
+  /// default (5000; multi-start 20000); 1 for ziegler-nichols, which
+  /// evaluates its rule once.
   int EvaluationBudget() const;
+  /// starts, or the method's default when 0.
+  int StartCount() const;
 };
 
 /// How Ceres's solver ended (its ceres::TerminationType), or kNotRun.
@@ -129,6 +163,11 @@ struct RefineSummary {
   /// One line on the verdict, or why the cross-check did not run ("" when it
   /// was not asked for).
   std::string message;
+  /// The start the returned run began from (several starts: 0 = the search
+  /// result, k = the k-th other polished minimum).
+  int start_index = 0;
+  /// Ceres runs made (several starts).
+  int runs = 0;
 };
 
 struct TuneSummary {
@@ -148,6 +187,8 @@ struct TuneSummary {
   /// The search's summary; for ziegler-nichols the rule's gains as one
   /// converged evaluation.
   OptimizerSummary optimizer;
+  /// multi-start: the polished starts, best first.
+  std::vector<LocalMinimum> local_minima;
   ZieglerNicholsResult ziegler_nichols;  // ziegler-nichols only
   RefineSummary refine;
   /// The search's one-line summary, or why no strictly stable loop was found.
@@ -166,5 +207,13 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
 /// The Ceres cross-check alone, from `start` (used by Tune).
 RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, const PidGains& start,
                               double start_objective);
+
+/// The cross-check from several starts (multi-start: the search result first,
+/// then other polished minima): Ceres from each, the best exact objective
+/// judged against starts[0]'s objective as RefineWithCeres would. Its
+/// start_index says which start it came from.
+RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options,
+                              const std::vector<PidGains>& starts,
+                              const std::vector<double>& start_objectives);
 
 }  // namespace pidlab
