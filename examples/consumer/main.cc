@@ -31,8 +31,9 @@ int main() {
   std::printf("evaluate %s iae=%.17g overshoot_pct=%.17g stable=%d\n", plant.name.c_str(), evaluation.iae,
               evaluation.step.overshoot_pct, evaluation.stability.stable ? 1 : 0);
 
-  // 2. A plant from its coefficients, tuned by Nelder-Mead (4 seeded
-  //    starts, at most 400 evaluations), then cross-checked by Ceres.
+  // 2. A plant from its coefficients, tuned by the default multi-start (at
+  //    most 400 evaluations: 200 Sobol' design points, then 16 Nelder-Mead
+  //    polishes), then cross-checked by Ceres.
   pidlab::Plant oscillator;
   if (!pidlab::MakeCustomPlant({1.0}, {1.0, 0.0, 1.0}, &oscillator, &error)) {
     std::fprintf(stderr, "consumer: %s\n", error.c_str());
