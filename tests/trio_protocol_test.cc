@@ -8,10 +8,11 @@
 #include <pidlab/lcmt_plant_output.hpp>
 #include <random>
 
-#include "pidlab/transport/episode_spec.h"
 #include "pidlab/controller/controller_role.h"
 #include "pidlab/plant_sim/disturbance_role.h"
 #include "pidlab/plant_sim/plant_role.h"
+#include "pidlab/transport/episode_spec.h"
+#include "pidlab/transport/rtt.h"
 #include "pidlab/transport/transport.h"
 #include "pidlab/tuner/episode_client.h"
 #include "pidlab/tuner/evaluation.h"
@@ -81,9 +82,15 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
   auto config = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
   client_t.Publish(kEpisodeConfigChannel, &config);
   const double start = NowSeconds();
+  double config_sent = start;
   while (!rec->summary && NowSeconds() - start < 20.0) {
     client_t.WaitAndHandle(0.001);
     const double now = NowSeconds();
+    if (drop_rate > 0 &&
+        now - config_sent > 0.01) {  // as the episode client does: a role may have dropped it
+      client_t.Publish(kEpisodeConfigChannel, &config);
+      config_sent = now;
+    }
     plant.Tick(now);
     if (controller) controller->Tick(now);
     if (disturbance) disturbance->Tick(now);
@@ -246,6 +253,111 @@ TEST(Trio, NamesTheSilentDisturbanceAfterTheDeadline) {
   EXPECT_EQ(rec.last.silent_role, "disturbance");
   EXPECT_NE(rec.last.message.find("pidlab-disturbance"), std::string::npos) << rec.last.message;
   EXPECT_EQ(rec.last.step, 0);
+}
+
+TEST(Trio, RecoversFromTwentyPercentDropsInEveryProcessWithIdenticalResults) {
+  const Episode e = DoubleIntegrator();
+  Recorder rec;
+  RoleCounters controller;
+  ASSERT_TRUE(RunOnMemq(e, 0.2, &rec, &controller)) << rec.last.message;
+  EXPECT_GT(controller.duplicates, 0);  // the plant resent y_k, the controller re-answered with its u_k
+  const std::vector<double> expected = Reference(e);
+  for (std::size_t k = 0; k < expected.size(); ++k) ASSERT_EQ(rec.y[k], expected[k]) << "step " << k;
+}
+
+TEST(RttEstimator, UsesTheInitialTimeoutUntilTheFirstSample) {
+  RttOptions o;
+  o.initial_s = 0.002;
+  RttEstimator rtt(o);
+  EXPECT_FALSE(rtt.has_sample());
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 0.002);
+}
+
+TEST(RttEstimator, FollowsRfc6298ForTheFirstAndLaterSamples) {
+  RttOptions o;
+  o.floor_s = 1e-6;
+  RttEstimator rtt(o);
+  rtt.Sample(100e-6);  // SRTT = R, RTTVAR = R / 2, RTO = SRTT + 4 RTTVAR
+  EXPECT_DOUBLE_EQ(rtt.srtt_s(), 100e-6);
+  EXPECT_DOUBLE_EQ(rtt.rttvar_s(), 50e-6);
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 300e-6);
+  rtt.Sample(200e-6);  // RTTVAR = 3/4 50 + 1/4 |100 - 200|, then SRTT = 7/8 100 + 1/8 200
+  EXPECT_DOUBLE_EQ(rtt.rttvar_s(), 0.75 * 50e-6 + 0.25 * 100e-6);
+  EXPECT_DOUBLE_EQ(rtt.srtt_s(), 0.875 * 100e-6 + 0.125 * 200e-6);
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), rtt.srtt_s() + 4 * rtt.rttvar_s());
+}
+
+TEST(RttEstimator, KeepsTheTimeoutBetweenFloorAndCeiling) {
+  RttOptions o;
+  o.floor_s = 150e-6;
+  o.ceiling_s = 0.1;
+  RttEstimator rtt(o);
+  for (int i = 0; i < 100; ++i) rtt.Sample(10e-6);  // RTTVAR collapses: the floor holds
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 150e-6);
+  rtt.Sample(1.0);
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 0.1);
+  rtt.Sample(-1.0);  // ignored
+  rtt.Sample(std::nan(""));
+  EXPECT_EQ(rtt.samples(), 101);
+}
+
+TEST(RttEstimator, DoublesPerBackoffUpToTheCeilingAndResetsOnASampleOrProgress) {
+  RttOptions o;
+  o.floor_s = 200e-6;
+  o.ceiling_s = 1e-3;
+  RttEstimator rtt(o);
+  for (int i = 0; i < 50; ++i) rtt.Sample(20e-6);
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 200e-6);
+  rtt.Backoff();
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 400e-6);
+  rtt.Backoff();
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 800e-6);
+  rtt.Backoff();
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 1e-3);
+  for (int i = 0; i < 40; ++i) rtt.Backoff();
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 1e-3);
+  rtt.EndBackoff();
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 200e-6);
+  rtt.Backoff();
+  rtt.Sample(20e-6);
+  EXPECT_DOUBLE_EQ(rtt.Timeout(), 200e-6);
+}
+
+TEST(RttEstimator, RejectsAFloorAboveTheCeiling) {
+  RttOptions o;
+  o.floor_s = 0.2;
+  o.ceiling_s = 0.1;
+  std::string error;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("ceiling"), std::string::npos) << error;
+}
+
+TEST(Trio, PlantLearnsTheRoundTripWithoutSamplesFromResentExchanges) {
+  // Karn's rule: an estimate exists after a clean episode, and the timeout
+  // it gives is between the floor and the ceiling.
+  const Episode e = DoubleIntegrator(0.5);
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  Transport plant_t(&lcm, {}), controller_t(&lcm, {}), disturbance_t(&lcm, {}), client_t(&lcm, {});
+  PlantRole plant(&plant_t);
+  ControllerRole controller(&controller_t);
+  DisturbanceRole disturbance(&disturbance_t);
+  bool done = false;
+  client_t.Subscribe<pidlab::lcmt_episode_summary>(kSummaryChannel,
+                                                   [&](const pidlab::lcmt_episode_summary&) { done = true; });
+  auto config = transport::MakeEpisodeConfig(
+      pidlab::MakeEpisodeSpec(5, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  client_t.Publish(kEpisodeConfigChannel, &config);
+  const double start = NowSeconds();
+  while (!done && NowSeconds() - start < 20.0) {
+    client_t.WaitAndHandle(0.001);
+    plant.Tick(NowSeconds());
+  }
+  ASSERT_TRUE(done);
+  EXPECT_GE(plant.rtt().samples(), 1);
+  EXPECT_LE(plant.rtt().samples(), e.options.TotalSteps());
+  EXPECT_GE(plant.rtt().Timeout(), plant.rtt().options().floor_s);
+  EXPECT_LE(plant.rtt().Timeout(), plant.rtt().options().ceiling_s);
 }
 
 }  // namespace

@@ -19,6 +19,7 @@ constexpr int kStreamChunk = 1000;     // the plant streams its trajectory in ch
 constexpr double kStreamPeriod = 0.1;  // ...or of whatever is new after this many seconds (liveness)
 constexpr int kSummaryRepeats = 5;     // a summary is repeated this often...
 constexpr double kSummaryPeriod = 0.1; // ...this many seconds apart
+constexpr long kNoiseCheckSteps = 32;  // every this many steps the plant re-requests n it lacks (below)
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
@@ -39,9 +40,13 @@ struct PlantRole::Episode {
   std::vector<double> y_hist, u_hist, n_hist;  // n_hist[k]: n_k once its block arrived
   std::vector<char> have_n;                    // per step
   long n_requested_end = 0;                    // n requested for steps [0, n_requested_end)
+  long n_check_end = 0;                        // n_requested_end at the last gap check
   long streamed = 0;                           // trajectory streamed for steps [0, streamed)
   double stream_last_s = 0;
   double step_start_s = 0, last_send_s = 0, start_s = 0;
+  double y_sent_s = 0;    // first transmission of y_k
+  bool y_resent = false;  // y_k (or a request at step k) was resent: no round-trip sample (Karn)
+  int resends = 0;        // resends at step k
   bool finished = false;
   pidlab::lcmt_episode_summary summary;
   int summary_sent = 0;
@@ -85,9 +90,19 @@ void PlantRole::StartEpisode(const EpisodeSpec& spec) {
   ep->start_s = ep->step_start_s = ep->stream_last_s = NowSeconds();
   ep_ = std::move(ep);
   running_ = true;
+  if (!rtt_.has_sample()) {
+    // The estimate carries over from episode to episode (it measures the
+    // network, not the episode); before the first round trip the episode's
+    // retransmit interval is the timeout.
+    RttOptions o;
+    o.initial_s = spec.recovery.retransmit_interval_s;
+    o.ceiling_s = std::max(o.ceiling_s, o.initial_s);
+    rtt_ = RttEstimator(o);
+  }
   ep_->n_requested_end = std::min<long>(kNoiseLookahead, spec.total_steps);
   RequestNoise(0, ep_->n_requested_end);
   PublishOutput();
+  ep_->y_sent_s = ep_->last_send_s;
 }
 
 void PlantRole::RequestNoise(long first, long samples) {
@@ -167,6 +182,7 @@ void PlantRole::OnControl(const pidlab::lcmt_control_command& m) {
   }
   e.u = m.u;
   e.have_u = true;
+  if (!e.y_resent) rtt_.Sample(NowSeconds() - e.y_sent_s);  // Karn: only exchanges sent once
   TryAdvance();
 }
 
@@ -222,6 +238,9 @@ void PlantRole::TryAdvance() {
   e.have_u = false;
   e.y_hist[k + 1] = e.plant->Output();
   e.step_start_s = NowSeconds();
+  e.y_resent = false;
+  e.resends = 0;
+  rtt_.EndBackoff();  // progress: the path works again
   if (e.k == e.spec.total_steps) {
     PublishOutput();
     StreamTrajectory(e.k + 1);  // the rest, y_N too (u and n NaN there)
@@ -229,11 +248,27 @@ void PlantRole::TryAdvance() {
     return;
   }
   PublishOutput();
+  e.y_sent_s = e.last_send_s;
   // Keep n requested ahead: one request and one block per kNoiseBlock steps.
   if (e.n_requested_end < e.spec.total_steps && e.n_requested_end - e.k <= kNoiseLookahead - kNoiseBlock) {
     const long samples = std::min<long>(kNoiseBlock, e.spec.total_steps - e.n_requested_end);
     RequestNoise(e.n_requested_end, samples);
     e.n_requested_end += samples;
+  }
+  // A block lost on the way would stall the step that needs it by a resend
+  // timeout: every kNoiseCheckSteps steps, ask again for n still missing
+  // among the steps requested at the previous check (long enough ago for
+  // any answer to have arrived), before the lockstep reaches them.
+  if (e.k % kNoiseCheckSteps == 0) {
+    const long end = std::min<long>(e.n_check_end, e.spec.total_steps);
+    for (long s = e.k; s < end; ++s) {
+      if (e.have_n[static_cast<std::size_t>(s)]) continue;
+      ++counters_.retransmits;
+      Verbose("asking again for n from step " + std::to_string(s) + " at step " + std::to_string(e.k));
+      RequestNoise(s, std::min<long>(end - s, kMaxNoiseRequest));
+      break;
+    }
+    e.n_check_end = e.n_requested_end;
   }
   if (e.k - e.streamed >= kStreamChunk) StreamTrajectory(e.k);
 }
@@ -259,7 +294,9 @@ void PlantRole::Finish(bool ok, const std::string& silent_role, const std::strin
      << ", " << e.k << "/" << e.spec.total_steps << " steps in " << wall << " s";
   if (ok) os << ", y_final " << s.final_y;
   if (!ok) os << ": " << message;
-  os << " (resent " << counters_.retransmits << ", dropped " << transport_->counters().dropped << ")";
+  os << " (resent " << counters_.retransmits << ", dropped " << transport_->counters().dropped
+     << ", round trip " << std::lround(rtt_.srtt_s() * 1e6) << " us, resend timeout "
+     << std::lround(rtt_.BaseTimeout() * 1e6) << " us)";
   Log(os.str());
 }
 
@@ -287,8 +324,11 @@ void PlantRole::OnTrajectoryRequest(const pidlab::lcmt_trajectory_request& m) {
 }
 
 double PlantRole::MaxWait() const {
-  if (running_) return ep_->spec.recovery.retransmit_interval_s;
-  return 0.05;
+  if (!running_) return 0.05;
+  const Episode& e = *ep_;
+  const double next = std::min({e.last_send_s + rtt_.Timeout(), e.stream_last_s + kStreamPeriod,
+                                e.step_start_s + e.spec.recovery.silence_deadline_s});
+  return std::clamp(next - NowSeconds(), 0.0, 0.05);
 }
 
 void PlantRole::Tick(double now_s) {
@@ -314,12 +354,18 @@ void PlantRole::Tick(double now_s) {
     Finish(false, silent, os.str());
     return;
   }
-  if (now_s - e.last_send_s >= e.spec.recovery.retransmit_interval_s) {
+  if (now_s - e.last_send_s >= rtt_.Timeout()) {
     // Ask again only for what is missing: y_k makes the controller repeat u_k,
-    // a request makes the disturbance resend the blocks from n_k on.
+    // a request makes the disturbance resend the blocks from n_k on. From the
+    // second resend of the same step on, the timeout doubles (up to the
+    // ceiling) until the step completes: a lost message is chance here, not
+    // congestion, so a single loss waits one timeout, a double loss two, and a
+    // dead peer is asked at most about 10 times a second.
     ++counters_.retransmits;
+    e.y_resent = true;
+    if (e.resends++ >= 1) rtt_.Backoff();
     Verbose(std::string("resending") + (e.have_u ? "" : " y") + (have_n ? "" : " n request") + " at step " +
-            std::to_string(e.k));
+            std::to_string(e.k) + " after " + std::to_string(std::lround(rtt_.Timeout() * 1e6)) + " us");
     if (!have_n) {
       const long samples = std::min<long>(kNoiseLookahead, e.spec.total_steps - e.k);
       RequestNoise(e.k, samples);

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <pidlab/lcmt_ready.hpp>
 #include <random>
@@ -49,6 +50,7 @@ StartStatus EpisodeStarter::Start(const pidlab::lcmt_episode_config& config,
   };
   const double start = NowSeconds();
   double last_sent = -1e9;
+  int sent = 0;
   StartStatus status = StartStatus::kStarted;
   while (!all_acked()) {
     const double now = NowSeconds();
@@ -56,11 +58,17 @@ StartStatus EpisodeStarter::Start(const pidlab::lcmt_episode_config& config,
       status = StartStatus::kTimedOut;
       break;
     }
-    if (now - last_sent >= resend_period_s) {
+    // The first repeats come quickly (5, 10, 20, 40 ms, then every
+    // resend_period_s): a lost configuration or acknowledgement costs a few
+    // ms, not a whole period, and a process that is still starting is not
+    // flooded.
+    const double period = std::min(resend_period_s, 0.005 * static_cast<double>(1 << std::min(sent, 10)));
+    if (now - last_sent >= period) {
       transport_->Publish(kEpisodeConfigChannel, &message);
       last_sent = now;
+      ++sent;
     }
-    if (transport_->WaitAndHandle(std::min(0.01, resend_period_s)) < 0) {
+    if (transport_->WaitAndHandle(std::min({0.005, period, last_sent + period - NowSeconds()})) < 0) {
       status = StartStatus::kLcmError;
       break;
     }

@@ -1,5 +1,6 @@
 #include "pidlab/transport/role_main.h"
 
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -64,6 +65,9 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
               << "' (no multicast route? see docs/trio.md, or run under pidlab launch --isolated)\n";
     return 1;
   }
+  // The resend timer is a few hundred microseconds (rtt.h): without this, a
+  // non-real-time thread's waits end up to 50 us late (the default timer slack).
+  prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   Transport transport(&lcm, transport_options);

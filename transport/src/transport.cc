@@ -1,6 +1,7 @@
 #include "pidlab/transport/transport.h"
 
 #include <poll.h>
+#include <time.h>
 
 #include <cerrno>
 #include <chrono>
@@ -142,7 +143,12 @@ int Transport::WaitAndHandle(double timeout_s) {
     pfd[n] = pollfd{instance[n]->getFileno(), POLLIN, 0};
     ++n;
   }
-  const int ready = poll(pfd, static_cast<nfds_t>(n), static_cast<int>(std::ceil(wait * 1000.0)));
+  // ppoll: the resend timer is a few hundred microseconds (rtt.h), below
+  // poll's millisecond resolution.
+  const double whole = std::floor(wait);
+  timespec ts{static_cast<time_t>(whole), static_cast<long>((wait - whole) * 1e9)};
+  if (ts.tv_nsec > 999999999L) ts.tv_nsec = 999999999L;
+  const int ready = ppoll(pfd, static_cast<nfds_t>(n), &ts, nullptr);
   if (ready < 0) return errno == EINTR ? 0 : -1;
   int handled = 0;
   for (int i = 0; i < n && ready > 0; ++i) {

@@ -211,6 +211,7 @@ bool EpisodeClient::FollowEpisode(double t0, double* done_s, long* requests, std
   State& s = *state_;
   const double plant_deadline = options_.recovery.silence_deadline_s + 0.5;
   double last_request = -1e9;
+  long last_first = -1;
   for (;;) {
     const double now = NowSeconds();
     if (!s.conflict.empty()) {
@@ -262,17 +263,21 @@ bool EpisodeClient::FollowEpisode(double t0, double* done_s, long* requests, std
         *error = os.str();
         return false;
       }
-      if (now - last_request >= 10 * options_.recovery.retransmit_interval_s) {
+      // Ask at once when the previous answer arrived (the first missing step
+      // moved on), else again after 10 retransmit intervals.
+      if (first != last_first || now - last_request >= 10 * options_.recovery.retransmit_interval_s) {
         pidlab::lcmt_trajectory_request r;
         r.episode_id = s.episode_id;
         r.step = first;
         r.count = static_cast<int32_t>(std::min<long>(transport::kMaxTrajectoryChunk, s.total + 1 - first));
         transport_->Publish(transport::kTrajectoryRequestChannel, &r);
         last_request = now;
+        last_first = first;
         ++*requests;
       }
     }
-    if (transport_->WaitAndHandle(at_end ? options_.recovery.retransmit_interval_s : 0.05) < 0) {
+    if (transport_->WaitAndHandle(at_end ? std::min(0.001, options_.recovery.retransmit_interval_s) : 0.05) <
+        0) {
       *error = "LCM receive error" + Where();
       return false;
     }

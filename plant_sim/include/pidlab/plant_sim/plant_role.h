@@ -4,19 +4,24 @@
 // in blocks: DISTURBANCE_REQUEST / DISTURBANCE_BLOCK), then steps
 // x_{k+1} = Phi x_k + Gamma (u_k + n_k). It streams its trajectory (TRAJECTORY
 // chunks, every 1000 steps or 0.1 s) and answers TRAJECTORY_REQUEST.
-// Loss: after retransmit_interval_s without u_k it resends y_k, without n_k it
-// requests n again. After silence_deadline_s without progress it publishes a
-// FAILED summary naming the silent process(es). See docs/trio.md.
+// Loss: after a resend timeout without u_k it resends y_k, without n_k it
+// requests n again; the timeout comes from the measured round trips
+// (RttEstimator, rtt.h: RFC 6298, Karn's rule, exponential backoff; the
+// episode's retransmit_interval_s only until the first round trip), and n
+// still missing a while after its request is asked for again before the
+// lockstep reaches it. After silence_deadline_s without progress it publishes
+// a FAILED summary naming the silent process(es). See docs/trio.md.
 
 #include <cstddef>
 #include <deque>
 #include <memory>
 #include <pidlab/lcmt_control_command.hpp>
-#include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_disturbance_block.hpp>
+#include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_trajectory_request.hpp>
 
 #include "pidlab/transport/role.h"
+#include "pidlab/transport/rtt.h"
 
 namespace pidlab::transport {
 
@@ -35,6 +40,8 @@ class PlantRole : public Role {
   void Tick(double now_s) override;
   double MaxWait() const override;
   bool running() const { return running_; }
+  /// The resend timer (measured round trips of y_k -> u_k).
+  const RttEstimator& rtt() const { return rtt_; }
 
  protected:
   void StartEpisode(const EpisodeSpec& spec) override;
@@ -60,6 +67,7 @@ class PlantRole : public Role {
   std::deque<std::unique_ptr<Episode>> history_;  // finished or abandoned episodes, oldest first
   std::size_t history_bytes_ = 0;
   bool running_ = false;
+  RttEstimator rtt_;
 };
 
 }  // namespace pidlab::transport

@@ -17,7 +17,8 @@ namespace pidlab::transport {
 
 /// How the trio recovers from loss and when it gives up.
 struct RecoveryOptions {
-  /// Resend the last message after this long without an answer, s (> 0).
+  /// The resend timeout before the plant has measured a round trip, s (> 0);
+  /// after that the timeout follows the measured round trips (rtt.h).
   double retransmit_interval_s = 0.002;
   /// Give up after this long without progress, naming the silent process, s.
   /// Long enough that a loaded machine does not trip it (a process starved

@@ -31,7 +31,8 @@ class EpisodeStarter {
   /// Subscribes to READY on `transport`, which must outlive this object.
   explicit EpisodeStarter(Transport* transport);
 
-  /// Publishes `config` every resend_period_s until every role named in
+  /// Publishes `config` (again after 5, 10, 20 and 40 ms, then every
+  /// resend_period_s at most) until every role named in
   /// `roles` (e.g. "plant") has acknowledged this episode id, or timeout_s
   /// has passed. On kTimedOut, *missing lists the silent roles ("pidlab-x, ...").
   StartStatus Start(const pidlab::lcmt_episode_config& config, const std::vector<std::string>& roles,
