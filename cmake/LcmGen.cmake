@@ -34,7 +34,8 @@ endfunction()
 # pidlab_lcm_python(TARGET <name> OUT_DIR <dir> FILES a.lcm b.lcm ...)
 #
 # Generates the Python classes with lcm-gen --python at build time (part of
-# `all`): <dir>/<package>/lcmt_*.py and lcm-gen's __init__.py. They need only
+# `all`): <dir>/<package>/lcmt_*.py and lcm-gen's __init__.py, with
+# cmake/python_package_init.py appended (the package's C++ module). They need only
 # Python's struct module, not the LCM Python binding (Debian 12 has none).
 function(pidlab_lcm_python)
   cmake_parse_arguments(ARG "" "TARGET;PACKAGE;OUT_DIR" "FILES" ${ARGN})
@@ -49,7 +50,9 @@ function(pidlab_lcm_python)
     OUTPUT ${outputs}
     COMMAND ${CMAKE_COMMAND} -E make_directory ${ARG_OUT_DIR}
     COMMAND ${LCM_GEN_EXECUTABLE} --python --ppath ${ARG_OUT_DIR} ${abs_files}
-    DEPENDS ${abs_files}
+    COMMAND ${CMAKE_COMMAND} -DTARGET_FILE=${ARG_OUT_DIR}/${ARG_PACKAGE}/__init__.py
+            -DTAIL_FILE=${PROJECT_SOURCE_DIR}/cmake/python_package_init.py -P ${PROJECT_SOURCE_DIR}/cmake/AppendFile.cmake
+    DEPENDS ${abs_files} ${PROJECT_SOURCE_DIR}/cmake/python_package_init.py
     COMMENT "lcm-gen --python ${ARG_PACKAGE}"
     VERBATIM)
   add_custom_target(${ARG_TARGET} ALL DEPENDS ${outputs})

@@ -28,7 +28,11 @@ set(CPACK_DEBIAN_PACKAGE_DEPENDS
     "libc6 (>= 2.35), libstdc++6 (>= 12), libgcc-s1 (>= 4.0), liblcm1, libsodium23 (>= 0.6.0), libgoogle-glog0v6 (>= 0.6.0), libcholmod3 (>= 1:4.5.2), libcxsparse3 (>= 1:4.5.2), liblapack3 | liblapack.so.3, libatlas3-base")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
     "liblcm-bin, gnuplot-nox | gnuplot, liblcm-dev, libeigen3-dev, libceres-dev, libsodium-dev, libcli11-dev, nlohmann-json3-dev, pkg-config, cmake")
-set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3, default-jre-headless, liblcm-java")
+if(PIDLAB_BUILD_PYTHON)
+  # The Python module is built for Debian 12's python3 (3.11).
+  string(APPEND CPACK_DEBIAN_PACKAGE_RECOMMENDS ", python3 (>= 3.11), python3 (<< 3.12)")
+endif()
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-matplotlib, default-jre-headless, liblcm-java")
 set(CPACK_DEBIAN_COMPRESSION_TYPE gzip)
 set(CPACK_STRIP_FILES ON)
 include(CPack)

@@ -388,46 +388,6 @@ LoopOptions LoopFlags::Build() const {
   return o;
 }
 
-nlohmann::json JsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-nlohmann::json ToJson(const PidGains& g) { return {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}}; }
-
-nlohmann::json ToJson(const Evaluation& ev) {
-  nlohmann::json poles = nlohmann::json::array();
-  for (const auto& p : ev.stability.poles) poles.push_back({{"re", p.real()}, {"im", p.imag()}});
-  nlohmann::json j;
-  j["plant"] = ev.plant.name;
-  j["plant_tf"] = {{"num", ev.plant.tf.num}, {"den", ev.plant.tf.den}};
-  j["gains"] = ToJson(ev.gains);
-  j["loop"] = ToString(ev.options.loop);
-  if (ev.options.loop == LoopKind::kSampled) j["dt_s"] = ev.options.dt_s;
-  j["reference"] = ev.options.reference;
-  j["sample_time_s"] = ev.options.sample_time_s;
-  j["horizon_s"] = ev.options.horizon_s;
-  j["samples"] = ev.options.NumSamples();
-  j["disturbance"] = {{"kind", ToString(ev.options.disturbance.kind)},
-                      {"amplitude", ev.options.disturbance.amplitude},
-                      {"period_s", ev.options.disturbance.period_s}};
-  j["stable"] = ev.stability.stable;
-  j["closed_loop_poles"] = poles;
-  j["pole_domain"] = ev.options.loop == LoopKind::kSampled ? "z" : "s";
-  j["iae"] = JsonNumber(ev.iae);
-  j["iae_per_unit"] = JsonNumber(ev.iae_per_unit);
-  j["iae_undisturbed"] = JsonNumber(ev.iae_undisturbed);
-  j["ise"] = JsonNumber(ev.ise);
-  j["itae"] = JsonNumber(ev.itae);
-  j["iae_continuous"] = JsonNumber(ev.iae_continuous);
-  const bool v = ev.step.valid;
-  j["rise_time_s"] = v ? JsonNumber(ev.step.rise_time_s) : nlohmann::json(nullptr);
-  j["overshoot_pct"] = v ? JsonNumber(ev.step.overshoot_pct) : nlohmann::json(nullptr);
-  j["settling_time_s"] = v ? JsonNumber(ev.step.settling_time_s) : nlohmann::json(nullptr);
-  j["peak"] = v ? JsonNumber(ev.step.peak) : nlohmann::json(nullptr);
-  j["peak_time_s"] = v ? JsonNumber(ev.step.peak_time_s) : nlohmann::json(nullptr);
-  j["final_value"] = v ? JsonNumber(ev.step.final_value) : nlohmann::json(nullptr);
-  if (!ev.step.note.empty()) j["step_info_note"] = ev.step.note;
-  return j;
-}
-
 std::string FormatPoles(const std::vector<std::complex<double>>& poles) {
   std::ostringstream os;
   os << std::setprecision(6);

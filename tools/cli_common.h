@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/json/results_json.h"
 #include "pidlab/tuner/episode_client.h"
 #include "pidlab/tuner/episode_pool.h"
 #include "pidlab/tuner/evaluation.h"
@@ -109,9 +110,10 @@ struct LoopFlags {
   LoopOptions Build() const;  // throws BadInput
 };
 
-nlohmann::json JsonNumber(double v);  // null for NaN/inf
-nlohmann::json ToJson(const Evaluation& ev);
-nlohmann::json ToJson(const PidGains& g);
+// JsonNumber (null for NaN/inf), ToJson(Evaluation), ToJson(PidGains): the
+// JSON objects live in a library the Python module shares (tools/json/).
+using json::JsonNumber;
+using json::ToJson;
 std::string FormatPoles(const std::vector<std::complex<double>>& poles);
 /// Human-readable report of one evaluation.
 std::string FormatEvaluation(const Evaluation& ev);

@@ -101,7 +101,7 @@ struct TuneCommand {
       Evaluate(p, s.gains, o.loop, what, &ev, &error);
     }
     if (json) {
-      std::cout << ToJson(p, o, s, ev).dump() << "\n";
+      std::cout << json::TuneJson(p, o, s, ev, backend).dump() << "\n";
     } else {
       PrintText(o, s, ev);
     }
@@ -165,53 +165,6 @@ struct TuneCommand {
                    tp.best_f);
       std::fflush(stderr);
     };
-  }
-
-  // The --json object; `ev` is the evaluation of s.gains (unused if !s.stable).
-  nlohmann::json ToJson(const Plant& p, const TuneOptions& o, const TuneSummary& s,
-                        const Evaluation& ev) const {
-    nlohmann::json j;
-    j["plant"] = p.name;
-    j["method"] = ToString(o.method);
-    j["objective_kind"] = ToString(o.objective);
-    j["backend"] = backend;
-    j["loop"] = ToString(o.loop.loop);
-    j["gains"] = cli::ToJson(s.gains);
-    j["objective"] = JsonNumber(s.objective);
-    j["reference"] = o.loop.reference;
-    j["iae"] = s.stable ? JsonNumber(ev.iae) : nlohmann::json(nullptr);
-    j["iae_per_unit"] = s.stable ? JsonNumber(ev.iae_per_unit) : nlohmann::json(nullptr);
-    j["stable"] = s.stable && ev.stability.stable;
-    j["closed_loop_poles"] = s.stable ? cli::ToJson(ev)["closed_loop_poles"] : nlohmann::json::array();
-    j["rise_time_s"] = s.stable ? cli::ToJson(ev)["rise_time_s"] : nlohmann::json(nullptr);
-    j["overshoot_pct"] = s.stable ? cli::ToJson(ev)["overshoot_pct"] : nlohmann::json(nullptr);
-    j["settling_time_s"] = s.stable ? cli::ToJson(ev)["settling_time_s"] : nlohmann::json(nullptr);
-    j["search"] = {{"gains", cli::ToJson(s.search_gains)},
-                   {"objective", JsonNumber(s.search_objective)},
-                   {"termination", ToString(s.optimizer.termination)},
-                   {"starts", s.optimizer.starts},
-                   {"message", s.optimizer.message}};
-    j["evaluations"] = s.evaluations;
-    j["rejected_evaluations"] = s.optimizer.rejected_evaluations;
-    j["iterations"] = s.iterations;
-    j["seed"] = o.seed;
-    j["wall_time_s"] = s.wall_time_s;
-    j["refine"] = {{"ran", s.refine.ran},
-                   {"gains", cli::ToJson(s.refine.gains)},
-                   {"objective", JsonNumber(s.refine.objective)},
-                   {"iae", JsonNumber(o.objective == ObjectiveKind::kIae ? s.refine.objective : NAN)},
-                   {"verdict", ToString(s.refine.verdict, s.method)},
-                   {"termination", ToString(s.refine.termination)},
-                   {"iterations", s.refine.iterations},
-                   {"relative_improvement", JsonNumber(s.refine.relative_improvement)},
-                   {"runs", s.refine.runs},
-                   {"start_index", s.refine.start_index},
-                   {"message", s.refine.message}};
-    if (o.method == TuneMethod::kZieglerNichols)
-      j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},
-                              {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
-                              {"rule", ToString(o.zn_rule)}};
-    return j;
   }
 
   // The human-readable result; `ev` as for ToJson.

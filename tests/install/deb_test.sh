@@ -40,6 +40,7 @@ for f in ./usr/bin/pidlab ./usr/bin/pidlab-plant ./usr/bin/pidlab-controller ./u
          ./usr/lib/python3/dist-packages/pidlab/lcmt_plant_output.py ./usr/share/pidlab/examples/python_controller.py; do
   check "contents hold $f" "grep -qx '$f' '$tmp/contents'"
 done
+check "contents hold the Python module" "grep -q '^./usr/lib/python3/dist-packages/pidlab/_pidlab\..*\.so$' '$tmp/contents'"
 check "contents hold nothing outside /usr" "! grep -v '^\./usr/\|^\./$' '$tmp/contents' | grep -q ."
 
 dpkg -x "$deb" "$tmp/root"
@@ -63,6 +64,12 @@ check "unpacked pidlab evaluate exits 0" "[ $? -eq 0 ]"
 "$build/bin/pidlab" "${args[@]}" >"$tmp/build.json"
 check "its JSON equals the build tree's, IAE $(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["iae"])' "$tmp/deb.json" 2>/dev/null)" \
   "cmp -s '$tmp/deb.json' '$tmp/build.json'"
+
+PYTHONPATH=$tmp/root/usr/lib/python3/dist-packages /usr/bin/python3 -c '
+import json, sys, pidlab
+assert pidlab.evaluate("double_integrator", (29.6558, 0.4977, 28.3216)) == json.load(open(sys.argv[1]))' \
+  "$tmp/build.json" 2>"$tmp/py.err"
+check "the unpacked Python module evaluates like pidlab" "[ $? -eq 0 ]" || cat "$tmp/py.err"
 
 # Its own trio: pidlab launch starts pidlab-plant, -controller and
 # -disturbance from the unpacked usr/bin, in this private namespace.

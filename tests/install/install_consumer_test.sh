@@ -36,6 +36,12 @@ check "the installed Python messages encode and decode with /usr/bin/python3" \
 check "installed pidlab evaluate --json exits 0" "[ $? -eq 0 ]"
 "$prefix/bin/pidlab" tune --num 1 --den 1,0,1 --max-evals 400 --json >"$tmp/tune.json" 2>/dev/null
 check "installed pidlab tune --json exits 0" "[ $? -eq 0 ]"
+PYTHONPATH="$prefix/lib/python3/dist-packages" /usr/bin/python3 -c '
+import json, sys, pidlab
+ev = pidlab.evaluate("double_integrator", (29.6558, 0.4977, 28.3216))
+assert ev == json.load(open(sys.argv[1])), "differs"' "$tmp/eval.json" 2>"$tmp/py.err"
+check "the installed Python module evaluates like the installed CLI" "[ $? -eq 0 ]" || cat "$tmp/py.err"
+
 compare() {  # compare NAME OUTPUT_FILE
   python3 - "$tmp/eval.json" "$tmp/tune.json" "$2" <<'PY'
 import json, re, sys

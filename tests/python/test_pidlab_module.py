@@ -1,0 +1,120 @@
+"""The Python module (tools/python/) against the command line: pidlab.evaluate
+and pidlab.tune must return the same keys and the same numbers, bit for bit,
+as `pidlab evaluate --json` and `pidlab tune --json` of the same case.
+
+Run by ctest (python.module) as
+    PYTHONPATH=<build>/python PIDLAB=<build>/bin/pidlab /usr/bin/python3 -m unittest test_pidlab_module
+"""
+
+import json
+import os
+import subprocess
+import unittest
+
+import pidlab
+
+PIDLAB = os.environ["PIDLAB"]
+PAPER_NM_GAINS = (29.6558, 0.4977, 28.3216)  # Table II, 1/s^2
+
+
+def cli(*args):
+    out = subprocess.run([PIDLAB, *args, "--json"], check=True, capture_output=True, text=True).stdout
+    return json.loads(out)
+
+
+class Evaluate(unittest.TestCase):
+    def assertSameResult(self, got, want, ignore=()):
+        self.assertEqual(sorted(got), sorted(want))
+        for key in want:
+            if key not in ignore:
+                self.assertEqual(got[key], want[key], key)
+
+    def test_a_plant_by_name_equals_the_cli_json(self):
+        got = pidlab.evaluate("double_integrator", PAPER_NM_GAINS)
+        want = cli("evaluate", "--plant", "double_integrator", "--gains", "29.6558,0.4977,28.3216")
+        self.assertSameResult(got, want)
+        self.assertEqual(got["iae"], 1.9151491935602585)
+
+    def test_a_plant_by_coefficients_equals_the_cli_json(self):
+        got = pidlab.evaluate(([1.0], [1.0, 0.0, 1.0]), (2, 1, 1.5), loop="sampled", horizon=5)
+        want = cli("evaluate", "--num", "1", "--den", "1,0,1", "--gains", "2,1,1.5", "--loop", "sampled",
+                   "--horizon", "5")
+        self.assertSameResult(got, want)
+        self.assertEqual(got["plant"], "custom")
+
+    def test_custom_with_num_and_den_keywords_is_the_same_plant(self):
+        a = pidlab.evaluate("custom", (2, 1, 1.5), num=[1], den=[1, 0, 1])
+        b = pidlab.evaluate(([1], [1, 0, 1]), (2, 1, 1.5))
+        self.assertEqual(a, b)
+
+    def test_disturbance_and_pid_options_equal_the_cli_json(self):
+        got = pidlab.evaluate("oscillator", (2, 1, 1.5), loop="sampled", horizon=4, disturbance="square",
+                              disturbance_amplitude=0.2, disturbance_period=1, output_limits=(-1, 1.5),
+                              anti_windup="back-calculation", derivative_filter=0.01,
+                              derivative_on="measurement", integral="trapezoidal")
+        want = cli("evaluate", "--plant", "oscillator", "--gains", "2,1,1.5", "--loop", "sampled", "--horizon",
+                   "4", "--disturbance", "square", "--disturbance-amplitude", "0.2", "--disturbance-period", "1",
+                   "--output-limits", "-1,1.5", "--anti-windup", "back-calculation", "--derivative-filter",
+                   "0.01", "--derivative-on", "measurement", "--integral", "trapezoidal")
+        self.assertSameResult(got, want)
+
+    def test_a_reference_step_equals_the_cli_json(self):
+        got = pidlab.evaluate("stepper", (20.8836, 26.607, 12.4866), reference=2.5)
+        want = cli("evaluate", "--plant", "stepper", "--gains", "20.8836,26.607,12.4866", "--reference", "2.5")
+        self.assertSameResult(got, want)
+        self.assertEqual(got["reference"], 2.5)
+
+    def test_bad_input_raises_value_error_naming_the_value(self):
+        with self.assertRaisesRegex(ValueError, "nope"):
+            pidlab.evaluate("nope", (1, 2, 3))
+        with self.assertRaisesRegex(ValueError, "kp"):
+            pidlab.evaluate("oscillator", (-1, 2, 3))
+        with self.assertRaisesRegex(ValueError, "gains"):
+            pidlab.evaluate("oscillator", (1, 2))
+        with self.assertRaisesRegex(ValueError, "loop"):
+            pidlab.evaluate("oscillator", (1, 2, 3), loop="discrete")
+
+
+class Tune(unittest.TestCase):
+    def assertSameTune(self, got, want):
+        self.assertEqual(sorted(got), sorted(want))
+        for key in want:
+            if key != "wall_time_s":  # the one value that is not a result
+                self.assertEqual(got[key], want[key], key)
+
+    def test_the_default_tune_equals_the_cli_json(self):
+        got = pidlab.tune("oscillator", max_evals=400)
+        want = cli("tune", "--plant", "oscillator", "--max-evals", "400")
+        self.assertSameTune(got, want)
+        self.assertTrue(got["stable"])
+        self.assertEqual(got["refine"]["verdict"], want["refine"]["verdict"])
+
+    def test_a_method_seed_and_coefficients_equal_the_cli_json(self):
+        got = pidlab.tune(([1], [1, 0, 0]), method="paper-nm", seed=5, refine=False, bounds=(0, 20))
+        want = cli("tune", "--num", "1", "--den", "1,0,0", "--method", "paper-nm", "--seed", "5", "--refine",
+                   "none", "--bounds", "0,20")
+        self.assertSameTune(got, want)
+
+    def test_ziegler_nichols_carries_its_rule(self):
+        got = pidlab.tune("stepper", method="ziegler-nichols", zn_rule="pessen")
+        want = cli("tune", "--plant", "stepper", "--method", "ziegler-nichols", "--zn-rule", "pessen")
+        self.assertSameTune(got, want)
+        self.assertEqual(got["ziegler_nichols"]["rule"], "pessen")
+
+    def test_bad_options_raise_value_error(self):
+        with self.assertRaisesRegex(ValueError, "simplex"):
+            pidlab.tune("oscillator", method="simplex")
+        with self.assertRaises(ValueError):
+            pidlab.tune("oscillator", bounds=(5, 1))
+
+
+class Messages(unittest.TestCase):
+    def test_the_package_also_holds_the_lcm_messages(self):
+        m = pidlab.lcmt_control_command()
+        m.step, m.u = 7, -0.25
+        back = pidlab.lcmt_control_command.decode(m.encode())
+        self.assertEqual((back.step, back.u), (7, -0.25))
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,27 @@
+#pragma once
+// The JSON objects of `pidlab evaluate --json` and `pidlab tune --json`,
+// built in one place so that the command line and the Python module
+// (tools/python/) give the same keys and the same numbers.
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "pidlab/tuner/evaluation.h"
+#include "pidlab/tuner/tune.h"
+
+namespace pidlab::json {
+
+/// v, or null for NaN and +-inf (JSON has no such numbers).
+nlohmann::json JsonNumber(double v);
+/// {"kp", "ki", "kd"}.
+nlohmann::json ToJson(const PidGains& g);
+/// The object of `pidlab evaluate --json` without "backend" (README.md,
+/// docs/tuning.md list the keys).
+nlohmann::json ToJson(const Evaluation& ev);
+/// The object of `pidlab tune --json`: plant `p`, options `o`, summary `s`,
+/// and `ev`, the evaluation of s.gains on o.loop (unused unless s.stable);
+/// `backend` is "local" or "lcm".
+nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary& s, const Evaluation& ev,
+                        const std::string& backend);
+
+}  // namespace pidlab::json

@@ -1,0 +1,93 @@
+#include "pidlab/json/results_json.h"
+
+#include <cmath>
+
+namespace pidlab::json {
+
+nlohmann::json JsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json ToJson(const PidGains& g) { return {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}}; }
+
+nlohmann::json ToJson(const Evaluation& ev) {
+  nlohmann::json poles = nlohmann::json::array();
+  for (const auto& p : ev.stability.poles) poles.push_back({{"re", p.real()}, {"im", p.imag()}});
+  nlohmann::json j;
+  j["plant"] = ev.plant.name;
+  j["plant_tf"] = {{"num", ev.plant.tf.num}, {"den", ev.plant.tf.den}};
+  j["gains"] = ToJson(ev.gains);
+  j["loop"] = ToString(ev.options.loop);
+  if (ev.options.loop == LoopKind::kSampled) j["dt_s"] = ev.options.dt_s;
+  j["reference"] = ev.options.reference;
+  j["sample_time_s"] = ev.options.sample_time_s;
+  j["horizon_s"] = ev.options.horizon_s;
+  j["samples"] = ev.options.NumSamples();
+  j["disturbance"] = {{"kind", ToString(ev.options.disturbance.kind)},
+                      {"amplitude", ev.options.disturbance.amplitude},
+                      {"period_s", ev.options.disturbance.period_s}};
+  j["stable"] = ev.stability.stable;
+  j["closed_loop_poles"] = poles;
+  j["pole_domain"] = ev.options.loop == LoopKind::kSampled ? "z" : "s";
+  j["iae"] = JsonNumber(ev.iae);
+  j["iae_per_unit"] = JsonNumber(ev.iae_per_unit);
+  j["iae_undisturbed"] = JsonNumber(ev.iae_undisturbed);
+  j["ise"] = JsonNumber(ev.ise);
+  j["itae"] = JsonNumber(ev.itae);
+  j["iae_continuous"] = JsonNumber(ev.iae_continuous);
+  const bool v = ev.step.valid;
+  j["rise_time_s"] = v ? JsonNumber(ev.step.rise_time_s) : nlohmann::json(nullptr);
+  j["overshoot_pct"] = v ? JsonNumber(ev.step.overshoot_pct) : nlohmann::json(nullptr);
+  j["settling_time_s"] = v ? JsonNumber(ev.step.settling_time_s) : nlohmann::json(nullptr);
+  j["peak"] = v ? JsonNumber(ev.step.peak) : nlohmann::json(nullptr);
+  j["peak_time_s"] = v ? JsonNumber(ev.step.peak_time_s) : nlohmann::json(nullptr);
+  j["final_value"] = v ? JsonNumber(ev.step.final_value) : nlohmann::json(nullptr);
+  if (!ev.step.note.empty()) j["step_info_note"] = ev.step.note;
+  return j;
+}
+
+nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary& s, const Evaluation& ev,
+                        const std::string& backend) {
+  nlohmann::json j;
+  j["plant"] = p.name;
+  j["method"] = ToString(o.method);
+  j["objective_kind"] = ToString(o.objective);
+  j["backend"] = backend;
+  j["loop"] = ToString(o.loop.loop);
+  j["gains"] = ToJson(s.gains);
+  j["objective"] = JsonNumber(s.objective);
+  j["reference"] = o.loop.reference;
+  j["iae"] = s.stable ? JsonNumber(ev.iae) : nlohmann::json(nullptr);
+  j["iae_per_unit"] = s.stable ? JsonNumber(ev.iae_per_unit) : nlohmann::json(nullptr);
+  j["stable"] = s.stable && ev.stability.stable;
+  j["closed_loop_poles"] = s.stable ? ToJson(ev)["closed_loop_poles"] : nlohmann::json::array();
+  j["rise_time_s"] = s.stable ? ToJson(ev)["rise_time_s"] : nlohmann::json(nullptr);
+  j["overshoot_pct"] = s.stable ? ToJson(ev)["overshoot_pct"] : nlohmann::json(nullptr);
+  j["settling_time_s"] = s.stable ? ToJson(ev)["settling_time_s"] : nlohmann::json(nullptr);
+  j["search"] = {{"gains", ToJson(s.search_gains)},
+                 {"objective", JsonNumber(s.search_objective)},
+                 {"termination", ToString(s.optimizer.termination)},
+                 {"starts", s.optimizer.starts},
+                 {"message", s.optimizer.message}};
+  j["evaluations"] = s.evaluations;
+  j["rejected_evaluations"] = s.optimizer.rejected_evaluations;
+  j["iterations"] = s.iterations;
+  j["seed"] = o.seed;
+  j["wall_time_s"] = s.wall_time_s;
+  j["refine"] = {{"ran", s.refine.ran},
+                 {"gains", ToJson(s.refine.gains)},
+                 {"objective", JsonNumber(s.refine.objective)},
+                 {"iae", JsonNumber(o.objective == ObjectiveKind::kIae ? s.refine.objective : NAN)},
+                 {"verdict", ToString(s.refine.verdict, s.method)},
+                 {"termination", ToString(s.refine.termination)},
+                 {"iterations", s.refine.iterations},
+                 {"relative_improvement", JsonNumber(s.refine.relative_improvement)},
+                 {"runs", s.refine.runs},
+                 {"start_index", s.refine.start_index},
+                 {"message", s.refine.message}};
+  if (o.method == TuneMethod::kZieglerNichols)
+    j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},
+                            {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
+                            {"rule", ToString(o.zn_rule)}};
+  return j;
+}
+
+}  // namespace pidlab::json
