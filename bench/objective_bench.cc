@@ -1,9 +1,13 @@
 // Evaluations per second of the paper's objective (IAE, eq. 4: 501 exact
 // samples of the continuous loop, stability check included): the inner loop
-// of every tuner. Also the sampled loop at the dt each plant needs.
+// of every tuner, on ObjectiveEvaluator's fast path (fast_objective.h) and on
+// the general path it falls back to (BM_GeneralPathContinuous: eigenvalues,
+// dynamic matrices; what a disturbance or a plant above order 6 costs). Also
+// the sampled loop at the dt each plant needs.
 //
 //   build/bin/objective_bench            (items_per_second = evaluations/s;
 //                                         BM_TuneDefault = one whole `pidlab tune`)
+//   bench/peers.sh                       (the same objective in scipy, ratio)
 
 #include <benchmark/benchmark.h>
 
@@ -32,6 +36,23 @@ void BM_PaperObjectiveContinuous(benchmark::State& state) {
   state.SetLabel(c.plant);
 }
 BENCHMARK(BM_PaperObjectiveContinuous)->DenseRange(0, 2)->Unit(benchmark::kMicrosecond);
+
+void BM_GeneralPathContinuous(benchmark::State& state) {
+  const Case& c = kCases[state.range(0)];
+  pidlab::Plant plant;
+  pidlab::MakePlant(c.plant, {}, &plant, nullptr);
+  const pidlab::StateSpace realization = pidlab::Realize(plant.tf);
+  const pidlab::Disturbance none(pidlab::DisturbanceOptions{});
+  const pidlab::LoopOptions options;
+  for (auto _ : state) {
+    const double iae =
+        pidlab::GeneralContinuousObjective(realization, none, options, pidlab::ObjectiveKind::kIae, c.gains);
+    benchmark::DoNotOptimize(&iae);
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(c.plant);
+}
+BENCHMARK(BM_GeneralPathContinuous)->DenseRange(0, 2)->Unit(benchmark::kMicrosecond);
 
 void BM_PaperObjectiveSampled(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];

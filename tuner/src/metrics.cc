@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "pidlab/tuner/evaluation.h"
+#include "pidlab/tuner/fast_objective.h"
 
 namespace pidlab {
 namespace {
@@ -505,6 +506,22 @@ ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& op
     options_.pid.dt_s = options.dt_s;
     discrete_ = std::make_unique<DiscretePlant>(plant.tf, options.dt_s);
   }
+  if (FastContinuousObjective::Covers(plant.tf, options_, kind_))
+    fast_ = std::make_shared<const FastContinuousObjective>(plant.tf, realization_, options_, kind_);
+}
+
+double GeneralContinuousObjective(const StateSpace& realization, const Disturbance& disturbance,
+                                  const LoopOptions& options, ObjectiveKind kind, const PidGains& gains) {
+  thread_local std::vector<double> y;  // reused: no allocation per evaluation
+  ContinuousClosedLoop<double> loop;
+  if (!BuildContinuousClosedLoop<double>(realization, gains, disturbance, &loop, nullptr, options.reference))
+    return kInf;
+  const Stability s = ContinuousStability(loop, options.stability_margin);
+  if (!s.stable) return kInf;
+  if (kind == ObjectiveKind::kIaeContinuous)
+    return ContinuousIntegralAbsError(loop, disturbance, s, options.horizon_s);
+  SampleContinuousLoop<double>(loop, disturbance, options.sample_time_s, options.NumSamples(), &y);
+  return ObjectiveFromSamples(kind, y, options.sample_time_s, options.reference);
 }
 
 double ObjectiveEvaluator::operator()(const PidGains& gains) const {
@@ -512,18 +529,9 @@ double ObjectiveEvaluator::operator()(const PidGains& gains) const {
   thread_local std::vector<double> y;  // reused: no allocation per evaluation
   if (!GainsAreValid(gains, nullptr)) return kInf;
   const double ts = options_.sample_time_s;
-  if (options_.loop == LoopKind::kContinuous) {
-    ContinuousClosedLoop<double> loop;
-    if (!BuildContinuousClosedLoop<double>(realization_, gains, disturbance_, &loop, nullptr,
-                                           options_.reference))
-      return kInf;
-    const Stability s = ContinuousStability(loop, options_.stability_margin);
-    if (!s.stable) return kInf;
-    if (kind_ == ObjectiveKind::kIaeContinuous)
-      return ContinuousIntegralAbsError(loop, disturbance_, s, options_.horizon_s);
-    SampleContinuousLoop<double>(loop, disturbance_, ts, options_.NumSamples(), &y);
-    return ObjectiveFromSamples(kind_, y, ts, options_.reference);
-  }
+  if (fast_) return (*fast_)(gains);
+  if (options_.loop == LoopKind::kContinuous)
+    return GeneralContinuousObjective(realization_, disturbance_, options_, kind_, gains);
   if (!SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable) return kInf;
   if (runner_ || kind_ == ObjectiveKind::kIaeContinuous) {
     if (runner_) {

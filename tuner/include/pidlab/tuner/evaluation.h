@@ -86,6 +86,17 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
               const EvaluateOptions& what, Evaluation* evaluation, std::string* error,
               const SampledRunner& runner = RunSampledLoopInProcess);
 
+/// The continuous-loop objective of `gains` by the general path:
+/// BuildContinuousClosedLoop, ContinuousStability (eigenvalues), then
+/// SampleContinuousLoop and ObjectiveFromSamples, or
+/// ContinuousIntegralAbsError. +inf when the loop is ill-posed or not strictly
+/// stable. ObjectiveEvaluator falls back to it for what
+/// FastContinuousObjective does not cover.
+double GeneralContinuousObjective(const StateSpace& realization, const Disturbance& disturbance,
+                                  const LoopOptions& options, ObjectiveKind kind, const PidGains& gains);
+
+class FastContinuousObjective;
+
 /// The tuner's inner loop: the objective of one gain vector, +inf for any loop
 /// that is not strictly stable. Realisation and discretisation are done once.
 class ObjectiveEvaluator {
@@ -101,6 +112,9 @@ class ObjectiveEvaluator {
   const LoopOptions& options() const { return options_; }
   const Plant& plant() const { return plant_; }
   ObjectiveKind kind() const { return kind_; }
+  /// True when operator() runs FastContinuousObjective (the continuous loop
+  /// in the cases it covers), false on the general path.
+  bool fast_path() const { return fast_ != nullptr; }
 
  private:
   Plant plant_;
@@ -109,6 +123,7 @@ class ObjectiveEvaluator {
   StateSpace realization_;
   Disturbance disturbance_;
   std::unique_ptr<DiscretePlant> discrete_;
+  std::shared_ptr<const FastContinuousObjective> fast_;  // null where it does not cover the case
   SampledRunner runner_;
   mutable std::atomic<long> evaluations_{0};
 };
