@@ -11,6 +11,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <string>
+
 #include "pidlab/tuner/tune.h"
 
 namespace {
@@ -28,12 +31,15 @@ void BM_PaperObjectiveContinuous(benchmark::State& state) {
   pidlab::Plant plant;
   pidlab::MakePlant(c.plant, {}, &plant, nullptr);
   const pidlab::ObjectiveEvaluator dut(plant, pidlab::LoopOptions{}, pidlab::ObjectiveKind::kIae);
+  double iae = 0.0;
   for (auto _ : state) {
-    const double iae = dut(c.gains);
+    iae = dut(c.gains);
     benchmark::DoNotOptimize(&iae);
   }
   state.SetItemsProcessed(state.iterations());
-  state.SetLabel(c.plant);
+  char label[96];
+  std::snprintf(label, sizeof label, "%s iae=%.17g", c.plant, iae);  // bench/peers.sh checks it against scipy
+  state.SetLabel(label);
 }
 BENCHMARK(BM_PaperObjectiveContinuous)->DenseRange(0, 2)->Unit(benchmark::kMicrosecond);
 
@@ -100,6 +106,32 @@ BENCHMARK(BM_TuneDefault)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
 
+// Polynomial coefficients, descending, to 17 digits.
+std::string Coefficients(const std::vector<double>& p) {
+  std::string out;
+  for (double v : p) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%.17g", out.empty() ? "" : ",", v);
+    out += buf;
+  }
+  return out;
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  // Every plant and its gains in the JSON context, so that bench/peers.sh
+  // runs the same objective elsewhere: "num=...;den=...;gains=kp,ki,kd".
+  for (const Case& c : kCases) {
+    pidlab::Plant plant;
+    pidlab::MakePlant(c.plant, {}, &plant, nullptr);
+    benchmark::AddCustomContext(std::string("plant.") + c.plant,
+                                "num=" + Coefficients(plant.tf.num) + ";den=" + Coefficients(plant.tf.den) +
+                                    ";gains=" + Coefficients({c.gains.kp, c.gains.ki, c.gains.kd}));
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
