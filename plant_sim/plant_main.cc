@@ -6,8 +6,12 @@
 
 int main(int argc, char** argv) {
   using namespace pidlab::transport;
+  RealtimeFlags realtime;
   return RoleMain(
       argc, argv, "pidlab-plant",
       "pidlab-plant: publishes y_k, waits for u_k and n_k, steps x_{k+1} = Phi x_k + Gamma (u_k + n_k)",
-      [](Transport* t, LogFn log, bool verbose) { return std::make_unique<PlantRole>(t, log, verbose); });
+      [&realtime](Transport* t, LogFn log, bool verbose) {
+        return std::make_unique<PlantRole>(t, log, verbose, realtime.factor);
+      },
+      &realtime);
 }

@@ -12,6 +12,7 @@
 #include "pidlab/plant_sim/disturbance_role.h"
 #include "pidlab/plant_sim/plant_role.h"
 #include "pidlab/transport/episode_spec.h"
+#include "pidlab/transport/pacing.h"
 #include "pidlab/transport/rtt.h"
 #include "pidlab/transport/transport.h"
 #include "pidlab/tuner/episode_client.h"
@@ -358,6 +359,74 @@ TEST(Trio, PlantLearnsTheRoundTripWithoutSamplesFromResentExchanges) {
   EXPECT_LE(plant.rtt().samples(), e.options.TotalSteps());
   EXPECT_GE(plant.rtt().Timeout(), plant.rtt().options().floor_s);
   EXPECT_LE(plant.rtt().Timeout(), plant.rtt().options().ceiling_s);
+}
+
+TEST(Trio, PacedEpisodeIsBitIdenticalAndReportsBoundedStatistics) {
+  // 0.2 s at dt = 1 ms, FACTOR 1: the same y as unpaced, every step 1..N
+  // counted, 0 <= p50 <= p99 <= max, and never faster than the schedule.
+  const Episode e = DoubleIntegrator(0.2);
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  Transport plant_t(&lcm, {}), controller_t(&lcm, {}), disturbance_t(&lcm, {}), client_t(&lcm, {});
+  PlantRole plant(&plant_t, {}, false, /*realtime_factor=*/1.0);
+  ControllerRole controller(&controller_t);
+  DisturbanceRole disturbance(&disturbance_t);
+  const long total = e.options.TotalSteps();
+  std::vector<double> y(static_cast<std::size_t>(total + 1), 0.0);
+  bool done = false;
+  pidlab::lcmt_episode_summary summary;
+  client_t.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel, [&](const pidlab::lcmt_plant_output& m) {
+    if (m.step >= 0 && m.step <= total) y[static_cast<std::size_t>(m.step)] = m.y;
+  });
+  client_t.Subscribe<pidlab::lcmt_episode_summary>(kSummaryChannel,
+                                                   [&](const pidlab::lcmt_episode_summary& m) {
+                                                     done = true;
+                                                     summary = m;
+                                                   });
+  auto config = transport::MakeEpisodeConfig(
+      pidlab::MakeEpisodeSpec(6, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  client_t.Publish(kEpisodeConfigChannel, &config);
+  const double start = NowSeconds();
+  while (!done && NowSeconds() - start < 20.0) {
+    client_t.WaitAndHandle(0.001);
+    plant.Tick(NowSeconds());
+  }
+  ASSERT_TRUE(done);
+  ASSERT_EQ(summary.status, pidlab::lcmt_episode_summary::OK) << summary.message;
+  EXPECT_GE(NowSeconds() - start, 0.2);  // step N starts no earlier than t0 + N dt
+  EXPECT_EQ(y, Reference(e));
+  const RealtimeStats rt = RealtimeFromSummary(summary);
+  ASSERT_TRUE(rt.paced());
+  EXPECT_EQ(rt.factor, 1.0);
+  EXPECT_GE(rt.missed_deadlines, 0);
+  EXPECT_LE(rt.missed_deadlines, total);
+  EXPECT_GE(rt.lateness_p50_s, 0.0);
+  EXPECT_LE(rt.lateness_p50_s, rt.lateness_p99_s);
+  EXPECT_LE(rt.lateness_p99_s, rt.lateness_max_s);
+  EXPECT_GT(rt.rate_hz, 0.0);
+  EXPECT_LE(rt.rate_hz, 1000.0 * (1 + 1e-9));
+}
+
+TEST(Realtime, CombinesEpisodesSummingMissesAndKeepingTheWorstFigures) {
+  RealtimeStats a, b;
+  a.factor = b.factor = 1.0;
+  a.missed_deadlines = 2;
+  b.missed_deadlines = 3;
+  a.lateness_p99_s = 1e-4;
+  b.lateness_p99_s = 2e-4;
+  a.rate_hz = 999.0;
+  b.rate_hz = 998.0;
+  const RealtimeStats c = CombineRealtime(a, b);
+  EXPECT_EQ(c.missed_deadlines, 5);
+  EXPECT_EQ(c.lateness_p99_s, 2e-4);
+  EXPECT_EQ(c.rate_hz, 998.0);
+  EXPECT_EQ(CombineRealtime(RealtimeStats{}, a).missed_deadlines, 2);
+  EXPECT_FALSE(RealtimeFromSummary(pidlab::lcmt_episode_summary{}).paced());
+  std::string error;
+  EXPECT_FALSE(RealtimeFactorIsValid(0.0, &error));
+  EXPECT_NE(error.find("--realtime 0"), std::string::npos) << error;
+  EXPECT_FALSE(RealtimeFactorIsValid(std::nan(""), &error));
+  EXPECT_TRUE(RealtimeFactorIsValid(2.5, &error));
 }
 
 }  // namespace

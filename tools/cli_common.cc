@@ -454,4 +454,12 @@ void WriteSamplesCsv(const Evaluation& ev, const std::string& path) {
   if (!f) throw std::runtime_error("writing " + path + " failed");
 }
 
+nlohmann::json RealtimeJson(const transport::RealtimeStats& s) {
+  return {{"missed_deadlines", s.missed_deadlines},
+          {"lateness_p50_s", JsonNumber(s.lateness_p50_s)},
+          {"lateness_p99_s", JsonNumber(s.lateness_p99_s)},
+          {"lateness_max_s", JsonNumber(s.lateness_max_s)},
+          {"rate_hz", JsonNumber(s.rate_hz)}};
+}
+
 }  // namespace pidlab::cli

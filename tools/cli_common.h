@@ -114,6 +114,9 @@ struct LoopFlags {
 // JSON objects live in a library the Python module shares (tools/json/).
 using json::JsonNumber;
 using json::ToJson;
+/// The `realtime` object of a paced episode: exactly missed_deadlines,
+/// lateness_p50_s, lateness_p99_s, lateness_max_s, rate_hz.
+nlohmann::json RealtimeJson(const transport::RealtimeStats& stats);
 std::string FormatPoles(const std::vector<std::complex<double>>& poles);
 /// Human-readable report of one evaluation.
 std::string FormatEvaluation(const Evaluation& ev);

@@ -90,12 +90,15 @@ struct EvaluateCommand {
       nlohmann::json j = ToJson(ev);
       j["backend"] = backend;
       if (client) j["steps_per_second"] = JsonNumber(client->stats().StepsPerSecond());
+      if (client && client->stats().realtime.paced()) j["realtime"] = RealtimeJson(client->stats().realtime);
       std::cout << j.dump() << "\n";
     } else {
       std::cout << FormatEvaluation(ev);
       if (client) {
         std::printf("backend: lcm, %ld steps in %ld episode(s), %.0f steps/s\n", client->stats().steps,
                     client->stats().episodes, client->stats().StepsPerSecond());
+        if (client->stats().realtime.paced())
+          std::printf("realtime: %s\n", transport::DescribeRealtime(client->stats().realtime).c_str());
       }
     }
     return 0;

@@ -9,6 +9,7 @@
 #include "cli_common.h"
 #include "commands.h"
 #include "pidlab/launcher/launcher.h"
+#include "pidlab/transport/pacing.h"
 
 namespace pidlab::cli {
 namespace {
@@ -90,10 +91,23 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
       "--auth-key", o.auth_key_file,
       "authenticate every message with the key in this file (HMAC-SHA256, docs/security.md); passed "
       "to the processes and to COMMAND as $PIDLAB_AUTH_KEY_FILE");
+  auto* realtime =
+      app->add_option(
+             "--realtime", o.realtime_factor,
+             "pace the plant: step k starts no earlier than t0 + k dt / FACTOR on CLOCK_MONOTONIC (FACTOR "
+             "1 without a value: wall-clock period dt); episodes report missed deadlines, lateness and "
+             "the rate achieved (docs/trio.md)")
+          ->expected(0, 1)
+          ->default_str("1");
+  app->add_option(
+      "--rt-priority", o.rt_priority,
+      "run the plant SCHED_FIFO at this priority (1-99) if the system allows it (it says so if not)");
   app->add_flag("--verbose,-v", o.verbose, "verbose processes and launcher");
   app->add_option("command", flags->command, "COMMAND [ARGS...] after --");
-  return [flags, roles] {
+  return [flags, roles, realtime] {
     std::string error;
+    if (realtime->count() > 0 && !transport::RealtimeFactorIsValid(flags->options.realtime_factor, &error))
+      throw BadInput(error);
     if (roles->count() > 0) flags->options.roles = SplitRoles(flags->roles);
     if (!flags->options.IsValid(&error)) throw BadInput(error);
     // An unwritable --log is bad input (exit 2), found before anything starts.

@@ -204,6 +204,7 @@ struct ReplayCommand {
       j["summary"] = {{"status", e.summary_status == 0 ? "ok" : "failed"},
                       {"step", e.summary_step},
                       {"message", e.summary_message}};
+    if (e.realtime.paced()) j["realtime"] = cli::RealtimeJson(e.realtime);
     if (e.has_config) {
       j["plant"] = e.spec.plant.name;
       j["gains"] = cli::ToJson(e.spec.gains);
@@ -286,6 +287,7 @@ struct ReplayCommand {
     StreamDetails("disturbance samples", e.disturbances, table);
     if (e.has_summary && e.summary_status != 0)
       *table << "    episode FAILED live: " << FromLog(e.summary_message) << "\n";
+    if (e.realtime.paced()) *table << "    " << transport::DescribeRealtime(e.realtime) << "\n";
     if (!evaluated && e.has_config && e.Complete()) *table << "    not evaluated: " << FromLog(why) << "\n";
     const bool ok = !redrive || RedriveEpisode(e, &j, table);
     episodes_json->push_back(j);

@@ -9,11 +9,13 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <iomanip>
 #include <pidlab/lcmt_ready.hpp>
 #include <sstream>
 #include <stdexcept>
 
 #include "pidlab/transport/episode_start.h"
+#include "pidlab/transport/pacing.h"
 
 namespace pidlab::launcher {
 namespace {
@@ -70,6 +72,10 @@ bool LaunchOptions::IsValid(std::string* error) const {
     os << "--drop-rate " << drop_rate << " must be in [0, 1)";
   else if (!(ready_timeout_s > 0.0))
     os << "--ready-timeout " << ready_timeout_s << " must be positive";
+  else if (realtime_factor != 0.0 && !transport::RealtimeFactorIsValid(realtime_factor, error))
+    return false;
+  else if (rt_priority < 0 || rt_priority > 99)
+    os << "--rt-priority " << rt_priority << " must be in 1..99";
   else {
     transport::TransportOptions t;
     t.channel_prefix = channel_prefix;
@@ -150,6 +156,13 @@ void Launcher::StartRoles() {
       args.insert(args.end(), {"--drop-rate", rate.str(), "--drop-seed", std::to_string(seed)});
     }
     if (options_.verbose) args.push_back("--verbose");
+    if (role == "plant" && options_.realtime_factor > 0.0) {
+      std::ostringstream factor;
+      factor << std::setprecision(17) << options_.realtime_factor;
+      args.insert(args.end(), {"--realtime", factor.str()});
+    }
+    if (role == "plant" && options_.rt_priority > 0)
+      args.insert(args.end(), {"--rt-priority", std::to_string(options_.rt_priority)});
     if (!options_.auth_key_file.empty()) args.insert(args.end(), {"--auth-key", options_.auth_key_file});
     roles_[role] = supervisor_->Start("pidlab-" + role, args);
     if (options_.verbose) Note("started pidlab-" + role + " (pid " + std::to_string(roles_[role]) + ")");

@@ -48,13 +48,14 @@ struct PlantRole::Episode {
   bool y_resent = false;  // y_k (or a request at step k) was resent: no round-trip sample (Karn)
   int resends = 0;        // resends at step k
   bool finished = false;
+  std::unique_ptr<Pacer> pacer;  // with --realtime
   pidlab::lcmt_episode_summary summary;
   int summary_sent = 0;
   double summary_last_s = 0;
 };
 
-PlantRole::PlantRole(Transport* transport, LogFn log, bool verbose)
-    : Role(transport, "plant", std::move(log), verbose) {
+PlantRole::PlantRole(Transport* transport, LogFn log, bool verbose, double realtime_factor)
+    : Role(transport, "plant", std::move(log), verbose), realtime_factor_(realtime_factor) {
   transport_->Subscribe<pidlab::lcmt_control_command>(
       kControlChannel, [this](const pidlab::lcmt_control_command& m) { OnControl(m); });
   transport_->Subscribe<pidlab::lcmt_disturbance_block>(
@@ -101,6 +102,10 @@ void PlantRole::StartEpisode(const EpisodeSpec& spec) {
   }
   ep_->n_requested_end = std::min<long>(kNoiseLookahead, spec.total_steps);
   RequestNoise(0, ep_->n_requested_end);
+  if (realtime_factor_ > 0.0) {
+    ep_->pacer = std::make_unique<Pacer>(realtime_factor_, spec.dt_s, spec.total_steps);
+    ep_->pacer->Start();  // step 0 starts now: t0
+  }
   PublishOutput();
   ep_->y_sent_s = ep_->last_send_s;
 }
@@ -237,6 +242,7 @@ void PlantRole::TryAdvance() {
   ++e.k;
   e.have_u = false;
   e.y_hist[k + 1] = e.plant->Output();
+  if (e.pacer) e.pacer->WaitForStep(e.k);  // step k starts no earlier than t0 + k dt / factor
   e.step_start_s = NowSeconds();
   e.y_resent = false;
   e.resends = 0;
@@ -285,6 +291,8 @@ void PlantRole::Finish(bool ok, const std::string& silent_role, const std::strin
   s.final_y = ok ? e.y_hist.back() : kNaN;
   s.silent_role = silent_role;
   s.message = message;
+  const RealtimeStats realtime = e.pacer ? e.pacer->Stats() : RealtimeStats{};
+  SetRealtime(realtime, &s);
   transport_->Publish(kSummaryChannel, &s);
   e.summary_sent = 1;
   e.summary_last_s = NowSeconds();
@@ -297,6 +305,7 @@ void PlantRole::Finish(bool ok, const std::string& silent_role, const std::strin
   os << " (resent " << counters_.retransmits << ", dropped " << transport_->counters().dropped
      << ", round trip " << std::lround(rtt_.srtt_s() * 1e6) << " us, resend timeout "
      << std::lround(rtt_.BaseTimeout() * 1e6) << " us)";
+  if (realtime.paced()) os << "; " << DescribeRealtime(realtime);
   Log(os.str());
 }
 

@@ -226,6 +226,7 @@ void EpisodeAssembler::On(const std::string& prefix, const pidlab::lcmt_episode_
   e.summary_status = m.status;
   e.summary_step = static_cast<long>(m.step);
   e.summary_message = m.message;
+  e.realtime = transport::RealtimeFromSummary(m);
 }
 
 void EpisodeAssembler::On(const std::string& prefix, const pidlab::lcmt_trajectory_chunk& m) {

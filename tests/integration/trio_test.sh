@@ -2,7 +2,7 @@
 # Integration tests of the LCM trio. Run by ctest as
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
-# ever sent outside its loopback. CASE: identity | faults | drop20 | kill | sigstop | trios | trio_killed | stranger |
+# ever sent outside its loopback. CASE: identity | faults | drop20 | realtime | kill | sigstop | trios | trio_killed | stranger |
 # log | log_repair.
 set -u
 BIN=$1
@@ -81,6 +81,54 @@ case $CASE in
       compare osc_noise20 --plant oscillator --gains 3,1,1 --horizon 2 --disturbance noise --disturbance-amplitude 0.1 --seed 7
       compare stepper_sine20 --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.2 --disturbance sine --disturbance-amplitude 0.5 --disturbance-period 0.2
       exit $fail' || fail=1
+    ;;
+  realtime)
+    # A paced episode (2 s at dt = 1 ms, FACTOR 1, SCHED_FIFO asked for): the
+    # same results as unpaced, bit for bit, and the pacing statistics present
+    # in evaluate's JSON and in the log (replay), with exactly their keys and
+    # bounded (not timed against a hard number): 0 <= p50 <= p99 <= max, at
+    # most every step missed, and never faster than the schedule.
+    ep=(--plant double_integrator --gains 2,1,1.5 --horizon 2 --dt 1e-3)
+    "$PIDLAB" evaluate --loop sampled --json "${ep[@]}" >"$TMP/local.json" || { echo "FAIL realtime: local evaluate failed"; fail=1; }
+    "$PIDLAB" launch --lcm-url "$URL" --realtime --rt-priority 10 --log "$TMP/rt.lcmlog" -- \
+      pidlab evaluate --backend lcm --json "${ep[@]}" >"$TMP/rt.json" 2>"$TMP/rt.err" ||
+      { echo "FAIL realtime: paced evaluate failed"; cat "$TMP/rt.err"; fail=1; }
+    "$PIDLAB" launch --lcm-url "$URL" -- pidlab evaluate --backend lcm --json "${ep[@]}" >"$TMP/unpaced.json" ||
+      { echo "FAIL realtime: unpaced evaluate failed"; fail=1; }
+    a=$(jq -S 'del(.backend, .steps_per_second)' "$TMP/local.json")
+    b=$(jq -S 'del(.backend, .steps_per_second, .realtime)' "$TMP/rt.json")
+    c=$(jq -S 'del(.backend, .steps_per_second)' "$TMP/unpaced.json")
+    bounded='(keys == ["lateness_max_s","lateness_p50_s","lateness_p99_s","missed_deadlines","rate_hz"])
+      and .missed_deadlines >= 0 and .missed_deadlines <= 2000
+      and .lateness_p50_s >= 0 and .lateness_p50_s <= .lateness_p99_s and .lateness_p99_s <= .lateness_max_s
+      and .lateness_max_s < 60 and .rate_hz > 0 and .rate_hz <= 1000 * (1 + 1e-9)'
+    if [ "$a" != "$b" ] || [ "$a" != "$c" ]; then
+      echo "FAIL realtime: paced, unpaced and in-process results differ"; diff <(echo "$a") <(echo "$b") | head -5; fail=1
+    elif jq -e 'has("realtime")' "$TMP/unpaced.json" >/dev/null; then
+      echo "FAIL realtime: an unpaced episode reports a realtime object"; fail=1
+    elif ! jq -e ".realtime | $bounded" "$TMP/rt.json" >/dev/null; then
+      echo "FAIL realtime: statistics missing or out of bounds: $(jq -c .realtime "$TMP/rt.json")"; fail=1
+    elif ! "$PIDLAB" replay --json "$TMP/rt.lcmlog" >"$TMP/replay.json" ||
+      ! jq -e "[.episodes[] | select(.realtime != null)] | length == 1 and (.[0].realtime | $bounded)" "$TMP/replay.json" >/dev/null; then
+      echo "FAIL realtime: replay does not report the paced episode's statistics"; fail=1
+    else
+      echo "ok   realtime: iae $(jq .iae "$TMP/rt.json") identical paced and unpaced, $(jq -c .realtime "$TMP/rt.json")"
+    fi
+    # SCHED_FIFO refused (no CAP_SYS_NICE, RLIMIT_RTPRIO 0): said once on stderr, and the plant serves on.
+    setpriv --inh-caps=-sys_nice --bounding-set=-sys_nice prlimit --rtprio=0 \
+      "$BIN/pidlab-plant" --lcm-url "$URL" --rt-priority 10 2>"$TMP/refused.err" &
+    pid=$!
+    sleep 0.5
+    if ! kill -0 $pid 2>/dev/null; then
+      echo "FAIL realtime: the plant stopped when SCHED_FIFO was refused: $(cat "$TMP/refused.err")"; fail=1
+    else
+      kill -INT $pid; wait $pid
+      if [ "$(grep -c 'SCHED_FIFO refused' "$TMP/refused.err")" != 1 ]; then
+        echo "FAIL realtime: no single 'SCHED_FIFO refused' line: $(cat "$TMP/refused.err")"; fail=1
+      else
+        echo "ok   realtime: refused SCHED_FIFO said once: $(cat "$TMP/refused.err")"
+      fi
+    fi
     ;;
   stranger)
     export -f compare

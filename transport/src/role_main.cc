@@ -1,12 +1,17 @@
 #include "pidlab/transport/role_main.h"
 
+#include <sched.h>
 #include <sys/prctl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <csignal>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
+
+#include "pidlab/transport/pacing.h"
 
 namespace pidlab::transport {
 namespace {
@@ -15,7 +20,7 @@ void OnSignal(int) { g_stop = 1; }
 }  // namespace
 
 int RoleMain(int argc, char** argv, const std::string& program, const std::string& description,
-             const RoleFactory& factory) {
+             const RoleFactory& factory, RealtimeFlags* realtime) {
   CLI::App app{description, program};
   std::string url = kDefaultLcmUrl;
   TransportOptions transport_options;
@@ -33,6 +38,19 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
                  "authenticate every message with the key in this file (HMAC-SHA256; docs/security.md); "
                  "default $PIDLAB_AUTH_KEY_FILE");
   app.add_flag("--verbose,-v", verbose, "log every resend and episode start, not only one line per episode");
+  CLI::Option* realtime_option = nullptr;
+  if (realtime) {
+    realtime_option =
+        app.add_option(
+               "--realtime", realtime->factor,
+               "pace every episode: step k starts no earlier than t0 + k dt / FACTOR on CLOCK_MONOTONIC "
+               "(FACTOR 1 without a value: wall-clock period dt); the SUMMARY reports missed deadlines, "
+               "lateness and the rate achieved (docs/trio.md)")
+            ->expected(0, 1)
+            ->default_str("1");
+    app.add_option("--rt-priority", realtime->rt_priority,
+                   "ask for SCHED_FIFO at this priority (1-99); if the system refuses, say so and continue");
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -53,6 +71,27 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
       return 2;
     }
     transport_options.auth_key = key;
+  }
+  if (realtime_option && realtime_option->count() > 0 && !RealtimeFactorIsValid(realtime->factor, &error)) {
+    std::cerr << program << ": error: " << error << "\n";
+    return 2;
+  }
+  if (realtime && (realtime->rt_priority < 0 || realtime->rt_priority > 99)) {
+    std::cerr << program << ": error: --rt-priority " << realtime->rt_priority << " must be in 1..99\n";
+    return 2;
+  }
+  if (realtime && realtime->rt_priority > 0) {
+    // Before LCM starts its receive thread, which inherits the policy.
+    sched_param param{};
+    param.sched_priority = realtime->rt_priority;
+    if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
+      const int err = errno;
+      std::cerr << program << ": note: --rt-priority " << realtime->rt_priority << ": SCHED_FIFO refused ("
+                << std::strerror(err) << "; needs root, CAP_SYS_NICE or an RLIMIT_RTPRIO); running at normal "
+                << "priority\n";
+    } else if (verbose) {
+      std::cerr << program << ": running SCHED_FIFO at priority " << realtime->rt_priority << "\n";
+    }
   }
   transport_options.step_lane_base_url = url;
   if (!transport_options.IsValid(&error)) {

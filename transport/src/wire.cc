@@ -89,7 +89,7 @@ bool WireLayoutOk(int64_t fingerprint, const void* data, int size) {
   } else if (fingerprint == pidlab::lcmt_ready::getHash()) {
     c.Fixed(1).String().Fixed(4).String();
   } else if (fingerprint == pidlab::lcmt_episode_summary::getHash()) {
-    c.Fixed(1).Fixed(8).Fixed(8).String().String();
+    c.Fixed(1).Fixed(8).Fixed(8).String().String().Fixed(6 * 8);
   } else if (fingerprint == pidlab::lcmt_trajectory_chunk::getHash()) {
     c.Array(3 * 8, kMaxTrajectoryChunk);
   } else if (fingerprint == pidlab::lcmt_disturbance_block::getHash()) {

@@ -256,8 +256,10 @@ bool EpisodeClient::FollowEpisode(double t0, double* done_s, long* requests, std
     }
     if (at_end) {
       const long first = s.FirstMissing();
-      if (first < 0) return true;
-      if (now - *done_s > plant_deadline + 1.0) {
+      // Complete: also wait a little for the SUMMARY (it carries the pacing
+      // statistics; the plant repeats it 5 times, 0.1 s apart).
+      if (first < 0 && (s.summary || now - *done_s > 0.45)) return true;
+      if (first >= 0 && now - *done_s > plant_deadline + 1.0) {
         std::ostringstream os;
         os << "pidlab-plant did not resend step " << first << " of episode " << s.episode_id << Where();
         *error = os.str();
@@ -265,7 +267,8 @@ bool EpisodeClient::FollowEpisode(double t0, double* done_s, long* requests, std
       }
       // Ask at once when the previous answer arrived (the first missing step
       // moved on), else again after 10 retransmit intervals.
-      if (first != last_first || now - last_request >= 10 * options_.recovery.retransmit_interval_s) {
+      if (first >= 0 &&
+          (first != last_first || now - last_request >= 10 * options_.recovery.retransmit_interval_s)) {
         pidlab::lcmt_trajectory_request r;
         r.episode_id = s.episode_id;
         r.step = first;
@@ -301,6 +304,9 @@ bool EpisodeClient::RunOnce(const transport::EpisodeSpec& spec, std::string* err
     stats_.steps += s.total;
     stats_.seconds += (done_s > 0 ? done_s : NowSeconds()) - t0;
     stats_.resend_requests += requests;
+    if (s.summary)
+      stats_.realtime =
+          transport::CombineRealtime(stats_.realtime, transport::RealtimeFromSummary(s.last_summary));
     return true;
   }();
   // Only silence (a dead, stopped or starved process) is worth a re-run: a

@@ -55,6 +55,11 @@ struct LaunchOptions {
   /// How long the processes have to answer PING, s.
   double ready_timeout_s = 5.0;
   bool verbose = false;
+  /// Real-time pacing of the plant (pidlab-plant --realtime FACTOR,
+  /// transport/pacing.h): 0 off, else positive and finite.
+  double realtime_factor = 0.0;
+  /// pidlab-plant --rt-priority N (SCHED_FIFO), 0 off, else 1..99.
+  int rt_priority = 0;
   /// The processes append their stderr to this file (empty: ours).
   std::string stderr_path;
   /// Authenticate every message with the key in this file (empty: no key):

@@ -20,6 +20,7 @@
 #include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_trajectory_request.hpp>
 
+#include "pidlab/transport/pacing.h"
 #include "pidlab/transport/role.h"
 #include "pidlab/transport/rtt.h"
 
@@ -35,7 +36,9 @@ inline constexpr std::size_t kPlantHistoryBytes = std::size_t{64} << 20;
 
 class PlantRole : public Role {
  public:
-  PlantRole(Transport* transport, LogFn log = {}, bool verbose = false);
+  /// realtime_factor > 0 paces every episode: step k starts no earlier than
+  /// t0 + k dt / realtime_factor (pacing.h); 0: as fast as the loop goes.
+  PlantRole(Transport* transport, LogFn log = {}, bool verbose = false, double realtime_factor = 0.0);
   ~PlantRole() override;
   void Tick(double now_s) override;
   double MaxWait() const override;
@@ -68,6 +71,7 @@ class PlantRole : public Role {
   std::size_t history_bytes_ = 0;
   bool running_ = false;
   RttEstimator rtt_;
+  double realtime_factor_ = 0.0;
 };
 
 }  // namespace pidlab::transport

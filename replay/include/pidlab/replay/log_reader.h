@@ -24,6 +24,7 @@
 
 #include "pidlab/transport/auth.h"
 #include "pidlab/transport/episode_spec.h"
+#include "pidlab/transport/pacing.h"
 
 namespace pidlab::replay {
 
@@ -62,6 +63,8 @@ struct Episode {
   int summary_status = -1;  // lcmt_episode_summary::OK / FAILED
   long summary_step = 0;
   std::string summary_message;
+  /// The pacing statistics of the SUMMARY (unpaced: factor 0).
+  transport::RealtimeStats realtime;
 
   /// Config present and valid, every y of 0..total_steps, every u and n of
   /// 0..total_steps-1.

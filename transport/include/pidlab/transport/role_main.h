@@ -12,9 +12,17 @@ namespace pidlab::transport {
 
 using RoleFactory = std::function<std::unique_ptr<Role>(Transport* transport, LogFn log, bool verbose)>;
 
+/// The pacing flags of pidlab-plant (pacing.h), parsed before the factory runs.
+struct RealtimeFlags {
+  double factor = 0.0;  // --realtime [FACTOR] (1 without a value); 0: not paced
+  int rt_priority = 0;  // --rt-priority N: SCHED_FIFO priority N; 0: normal scheduling
+};
+
 /// Exit status: 0 after a signal, 2 for bad flags (one line on stderr),
-/// 1 if LCM cannot start or fails.
+/// 1 if LCM cannot start or fails. With `realtime`, the process also takes
+/// --realtime [FACTOR] and --rt-priority N; a refused SCHED_FIFO is said on
+/// stderr once, and the process continues at normal priority.
 int RoleMain(int argc, char** argv, const std::string& program, const std::string& description,
-             const RoleFactory& factory);
+             const RoleFactory& factory, RealtimeFlags* realtime = nullptr);
 
 }  // namespace pidlab::transport

@@ -14,6 +14,7 @@
 
 #include "pidlab/transport/episode_spec.h"
 #include "pidlab/transport/episode_start.h"
+#include "pidlab/transport/pacing.h"
 #include "pidlab/transport/transport.h"
 #include "pidlab/tuner/evaluation.h"
 
@@ -53,6 +54,9 @@ struct EpisodeClientStats {
   double seconds = 0.0;      // wall time from the first acknowledgement to the last step
   long resend_requests = 0;  // TRAJECTORY_REQUESTs for steps the client missed
   long reruns = 0;           // episodes run again after a failure
+  /// Of the paced episodes (pidlab-plant --realtime), as their SUMMARYs
+  /// reported them, combined (CombineRealtime); unpaced: factor 0.
+  transport::RealtimeStats realtime;
   double StepsPerSecond() const { return seconds > 0.0 ? static_cast<double>(steps) / seconds : 0.0; }
 };
 
