@@ -203,6 +203,7 @@ LaunchStatus Launcher::WaitReady(const volatile std::sig_atomic_t* stop, std::st
 LaunchStatus Launcher::Start(const volatile std::sig_atomic_t* stop, std::string* error) {
   if (log_) {
     logger_ = log_->StartLogger(url_);
+    log_->StartLaneLoggers(url_);
     if (options_.verbose) Note("started lcm-logger (pid " + std::to_string(logger_) + ")");
   }
   StartRoles();
@@ -280,6 +281,9 @@ bool Launcher::FinishLog(bool interrupted) {
 void Launcher::Stop() {
   if (!supervisor_) return;
   if (logger_ > 0) supervisor_->StopChild(logger_, SIGINT, 3.0);
+  std::string error;
+  if (log_ && !log_->MergeLanes(&error))
+    Note("error: " + error + " (" + options_.log_file + " holds the base port's events only)");
   supervisor_->KillAll();
 }
 

@@ -1,10 +1,13 @@
 #include "pidlab/launcher/log_capture.h"
 
+#include <lcm/eventlog.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
+#include <cstdio>
 #include <fstream>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_ready.hpp>
@@ -86,6 +89,75 @@ pid_t LogCapture::StartLogger(const std::string& lcm_url) {
       "lcm-logger",
       {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + logger_url, options_.log_file}, {},
       options_.logger_nice);
+}
+
+void LogCapture::StartLaneLoggers(const std::string& lcm_url) {
+  for (int lane : {transport::kPlantOutputLane, transport::kControlLane}) {
+    std::string url = transport::StepLaneUrl(lcm_url, lane);
+    if (url.empty()) continue;  // memq:// and the like: every channel is on the base URL
+    if (url.find("recv_buf_size=") == std::string::npos)
+      url += std::string(url.find('?') == std::string::npos ? "?" : "&") + kRecvBuf;
+    const std::string file = options_.log_file + ".lane" + std::to_string(lane);
+    const pid_t pid = supervisor_->Start(
+        "lcm-logger", {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + url, file}, {},
+        options_.logger_nice);
+    lane_loggers_.emplace_back(pid, file);
+  }
+}
+
+bool LogCapture::MergeLanes(std::string* error) {
+  if (lane_loggers_.empty()) return true;
+  for (const auto& [pid, file] : lane_loggers_)
+    if (pid > 0 && !supervisor_->StopChild(pid, SIGINT, 3.0)) supervisor_->StopChild(pid, SIGKILL, 1.0);
+  std::vector<std::string> inputs{options_.log_file};
+  for (const auto& lane : lane_loggers_) inputs.push_back(lane.second);
+  const std::string merged = options_.log_file + ".merging";
+  std::vector<lcm_eventlog_t*> logs;
+  bool ok = true;
+  for (const std::string& f : inputs) {
+    lcm_eventlog_t* l = lcm_eventlog_create(f.c_str(), "r");
+    if (!l) {
+      if (f == options_.log_file) {
+        ok = false;
+        if (error) *error = "cannot open " + f + " to merge the step lanes into it";
+      }
+      continue;  // a lane logger that wrote nothing: nothing to merge
+    }
+    logs.push_back(l);
+  }
+  lcm_eventlog_t* out = ok ? lcm_eventlog_create(merged.c_str(), "w") : nullptr;
+  if (ok && !out) {
+    ok = false;
+    if (error) *error = "cannot write " + merged;
+  }
+  if (ok) {
+    // A k-way merge by timestamp; each input is in time order already. A
+    // truncated tail (a logger killed mid-write) ends that input.
+    std::vector<lcm_eventlog_event_t*> head(logs.size(), nullptr);
+    for (std::size_t i = 0; i < logs.size(); ++i) head[i] = lcm_eventlog_read_next_event(logs[i]);
+    for (;;) {
+      std::size_t best = logs.size();
+      for (std::size_t i = 0; i < logs.size(); ++i)
+        if (head[i] && (best == logs.size() || head[i]->timestamp < head[best]->timestamp)) best = i;
+      if (best == logs.size()) break;
+      if (ok && lcm_eventlog_write_event(out, head[best]) != 0) {
+        ok = false;
+        if (error) *error = "cannot write " + merged;
+      }
+      lcm_eventlog_free_event(head[best]);
+      head[best] = lcm_eventlog_read_next_event(logs[best]);
+    }
+    lcm_eventlog_destroy(out);
+  }
+  for (lcm_eventlog_t* l : logs) lcm_eventlog_destroy(l);
+  if (ok && std::rename(merged.c_str(), options_.log_file.c_str()) != 0) {
+    ok = false;
+    if (error) *error = "cannot rename " + merged + " to " + options_.log_file;
+  }
+  if (!ok) std::remove(merged.c_str());
+  for (const auto& lane : lane_loggers_) std::remove(lane.second.c_str());
+  lane_loggers_.clear();
+  return ok;
 }
 
 bool LogCapture::WaitForMarker(const std::string& what) {

@@ -67,6 +67,18 @@ class LogCapture {
   /// the URL sets one). Returns its pid.
   pid_t StartLogger(const std::string& lcm_url);
 
+  /// Starts one more lcm-logger per step lane of `lcm_url` (PLANT_OUTPUT on
+  /// port + 1, CONTROL on port + 2; none for URLs without lanes), each into a
+  /// file of its own beside the log (FILE.lane1, FILE.lane2).
+  void StartLaneLoggers(const std::string& lcm_url);
+
+  /// Stops the lane loggers and merges their events into the log by
+  /// timestamp (the base port's events first on a tie), so the log holds the
+  /// per-step datagrams too and lcm-logplayer can drive a controller from it.
+  /// Call after the base logger stopped. False with *error if it failed (the
+  /// log is then left as the base logger wrote it).
+  bool MergeLanes(std::string* error);
+
   /// Publishes a MARKER until lcm-logger has written it to the log (so
   /// everything published before it is on disk), then waits until the file
   /// stops growing. False if the marker never appeared.
@@ -97,6 +109,7 @@ class LogCapture {
   /// The plant's chunks as this process hears them: (episode, first step) -> count.
   std::map<std::pair<int64_t, int64_t>, int> answers_;
   std::vector<std::pair<int64_t, int64_t>> asked_;
+  std::vector<std::pair<pid_t, std::string>> lane_loggers_;  // pid, file
 };
 
 }  // namespace pidlab::launcher

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# lcm-logplayer round trip: a log written by `pidlab launch --log` (2 s at
+# dt = 1 ms), played back by lcm-logplayer into a network namespace where only
+# pidlab-controller runs (plus lcm-logger on the CONTROL lane), must drive the
+# controller to the same commands: every step's u bit for bit (logplayer_check).
+# The commands are the ones of docs/logs.md, "Driving a controller from a log
+# with lcm-logplayer".
+# Run as: unshare -n bash logplayer_test.sh BIN_DIR   (ctest does this)
+set -uo pipefail
+
+bin=$(realpath -- "${1:?usage: logplayer_test.sh BIN_DIR}")
+export PATH=$bin:$PATH
+
+# Never let LCM traffic leave this machine: we must be in a private network
+# namespace holding nothing but a loopback.
+if [[ $(ip -o link show | wc -l) -ne 1 ]]; then
+  echo "FAIL not in a private network namespace (run under unshare -n)"
+  exit 1
+fi
+ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || {
+  echo "FAIL cannot set up multicast on the namespace's loopback"
+  exit 1
+}
+
+work=$(mktemp -d)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+  wait 2>/dev/null
+  rm -rf "$work"
+}
+trap cleanup EXIT
+cd "$work"
+
+# ---- the live episode, logged (in a namespace of its own: --isolated) ----
+if ! pidlab launch --isolated --log run.lcmlog -- \
+    pidlab evaluate --backend lcm --plant oscillator --gains 2,1,1.5 --loop sampled --dt 0.001 --horizon 2 \
+    >live.txt 2>launch.err; then
+  echo "FAIL launch failed: $(grep -v '^pidlab-' launch.err | tail -3)"
+  exit 1
+fi
+if ! pidlab replay run.lcmlog >replay.txt 2>&1 || grep -q INCOMPLETE replay.txt; then
+  echo "FAIL launch handed over an incomplete log: $(head -5 replay.txt)"
+  exit 1
+fi
+echo "PASS launch --log wrote a complete log"
+
+# ---- playback: only pidlab-controller, in this (empty) namespace ----
+url=udpm://239.255.76.67:7667
+lane1=udpm://239.255.76.67:7668   # PLANT_OUTPUT
+lane2=udpm://239.255.76.67:7669   # CONTROL
+lcm-logger -q -f "--lcm-url=$lane2?recv_buf_size=4194304" control.lcmlog & pids+=($!)
+pidlab-controller --lcm-url "$url" 2>controller.err & ctl=$!; pids+=($ctl)
+sleep 0.5
+kill -0 "$ctl" 2>/dev/null || { echo "FAIL pidlab-controller did not start: $(tail -2 controller.err)"; exit 1; }
+# Both players pace from the log's first event: started together, the
+# configuration reaches the controller before the first y, as it did live.
+lcm-logplayer -s 0.5 -e '^PIDLAB_EPISODE_CONFIG$' -l "$url" run.lcmlog 2>>players.err & a=$!
+lcm-logplayer -s 0.5 -e '^PIDLAB_PLANT_OUTPUT$' -l "$lane1" run.lcmlog 2>>players.err & b=$!
+wait "$a" "$b"
+sleep 0.5
+kill -INT "${pids[0]}"; wait "${pids[0]}" 2>/dev/null
+
+if out=$(logplayer_check run.lcmlog control.lcmlog); then
+  echo "PASS the played-back log drove pidlab-controller to the same commands: $out"
+else
+  echo "FAIL the controller's commands differ from the log's: $out"
+  tail -5 controller.err
+  exit 1
+fi
