@@ -284,6 +284,10 @@ void Launcher::Stop() {
   std::string error;
   if (log_ && !log_->MergeLanes(&error))
     Note("error: " + error + " (" + options_.log_file + " holds the base port's events only)");
+  else if (log_ && log_->rebuilt_outputs() > 0)
+    Note("note: lcm-logger lost " + std::to_string(log_->rebuilt_outputs()) +
+         " PLANT_OUTPUT datagrams on the step lane; written into " + options_.log_file +
+         " from the trajectory chunks");
   supervisor_->KillAll();
 }
 

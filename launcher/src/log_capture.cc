@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <pidlab/lcmt_trajectory_request.hpp>
@@ -105,12 +106,90 @@ void LogCapture::StartLaneLoggers(const std::string& lcm_url) {
   }
 }
 
+std::vector<std::pair<int64_t, std::vector<uint8_t>>> LogCapture::MissingLaneOutputs(
+    const std::string& lane_file) const {
+  // The outputs the PLANT_OUTPUT lane's logger lost, rebuilt from the base
+  // log (its trajectory chunks, complete after Repair()): a controller driven
+  // from the log by lcm-logplayer waits for y_k forever if y_k is missing.
+  // Authenticated runs are left as they are (the rebuilt messages would carry
+  // no tag).
+  std::vector<std::pair<int64_t, std::vector<uint8_t>>> out;
+  if (options_.auth_key) return out;
+  replay::ReadOptions read_options;
+  read_options.channel_prefix = options_.channel_prefix;
+  replay::LogContents log;
+  std::string error;
+  if (!replay::ReadLog(options_.log_file, read_options, &log, &error)) return out;
+  std::map<std::pair<int64_t, int64_t>, int64_t> seen;  // (episode, step) -> timestamp
+  const std::string channel = options_.channel_prefix + transport::kPlantOutputChannel;
+  if (lcm_eventlog_t* l = lcm_eventlog_create(lane_file.c_str(), "r")) {
+    while (lcm_eventlog_event_t* ev = lcm_eventlog_read_next_event(l)) {
+      pidlab::lcmt_plant_output m;
+      if (channel == ev->channel && m.decode(ev->data, 0, static_cast<int>(ev->datalen)) >= 0)
+        seen.emplace(std::make_pair(m.episode_id, m.step), ev->timestamp);
+      lcm_eventlog_free_event(ev);
+    }
+    lcm_eventlog_destroy(l);
+  }
+  for (const replay::Episode& e : log.episodes) {
+    if (!e.Complete()) continue;
+    // A lost output takes a timestamp between its logged neighbours', spread
+    // evenly, so the player paces it as the plant did (no burst).
+    // Never before the step before it (logged or rebuilt): the controller
+    // answers y_k only after y_(k-1).
+    int64_t previous = -1;
+    for (long k = 0; k < e.total_steps; ++k) {
+      if (const auto it = seen.find({e.episode_id, k}); it != seen.end()) {
+        previous = it->second;
+        continue;
+      }
+      const auto next = seen.lower_bound({e.episode_id, k});
+      const bool has_next = next != seen.end() && next->first.first == e.episode_id;
+      auto prev = next;
+      const bool has_prev = prev != seen.begin() && (--prev)->first.first == e.episode_id;
+      if (!has_prev && !has_next) break;  // the lane logger heard nothing of this episode
+      int64_t ts;
+      if (has_prev && has_next) {
+        const double f = static_cast<double>(k - prev->first.second) /
+                         static_cast<double>(next->first.second - prev->first.second);
+        ts = prev->second + static_cast<int64_t>(f * static_cast<double>(next->second - prev->second));
+      } else if (has_prev) {
+        ts = prev->second + static_cast<int64_t>((k - prev->first.second) * e.spec.dt_s * 1e6);
+      } else {
+        ts = next->second - static_cast<int64_t>((next->first.second - k) * e.spec.dt_s * 1e6);
+      }
+      if (previous >= 0 && ts <= previous) ts = previous + 1;
+      previous = ts;
+      pidlab::lcmt_plant_output m;
+      m.utime = ts;
+      m.episode_id = e.episode_id;
+      m.step = k;
+      m.t_s = static_cast<double>(k) * e.spec.dt_s;
+      m.y = e.y[static_cast<std::size_t>(k)];
+      std::vector<uint8_t> data(static_cast<std::size_t>(m.getEncodedSize()));
+      m.encode(data.data(), 0, static_cast<int>(data.size()));
+      out.emplace_back(ts, std::move(data));
+    }
+  }
+  return out;
+}
+
 bool LogCapture::MergeLanes(std::string* error) {
+  rebuilt_outputs_ = 0;
   if (lane_loggers_.empty()) return true;
   for (const auto& [pid, file] : lane_loggers_)
     if (pid > 0 && !supervisor_->StopChild(pid, SIGINT, 3.0)) supervisor_->StopChild(pid, SIGKILL, 1.0);
   std::vector<std::string> inputs{options_.log_file};
   for (const auto& lane : lane_loggers_) inputs.push_back(lane.second);
+  std::vector<std::pair<int64_t, std::vector<uint8_t>>> rebuilt;
+  for (const auto& lane : lane_loggers_)
+    if (lane.second == options_.log_file + ".lane" + std::to_string(transport::kPlantOutputLane))
+      rebuilt = MissingLaneOutputs(lane.second);
+  std::stable_sort(rebuilt.begin(), rebuilt.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  rebuilt_outputs_ = static_cast<long>(rebuilt.size());
+  std::string rebuilt_channel = options_.channel_prefix + transport::kPlantOutputChannel;
+  std::size_t next_rebuilt = 0;
   const std::string merged = options_.log_file + ".merging";
   std::vector<lcm_eventlog_t*> logs;
   bool ok = true;
@@ -139,6 +218,22 @@ bool LogCapture::MergeLanes(std::string* error) {
       std::size_t best = logs.size();
       for (std::size_t i = 0; i < logs.size(); ++i)
         if (head[i] && (best == logs.size() || head[i]->timestamp < head[best]->timestamp)) best = i;
+      // A rebuilt output goes before any logged event of a later timestamp.
+      if (next_rebuilt < rebuilt.size() &&
+          (best == logs.size() || rebuilt[next_rebuilt].first < head[best]->timestamp)) {
+        auto& r = rebuilt[next_rebuilt++];
+        lcm_eventlog_event_t ev{};
+        ev.timestamp = r.first;
+        ev.channellen = static_cast<int32_t>(rebuilt_channel.size());
+        ev.datalen = static_cast<int32_t>(r.second.size());
+        ev.channel = rebuilt_channel.data();
+        ev.data = r.second.data();
+        if (ok && lcm_eventlog_write_event(out, &ev) != 0) {
+          ok = false;
+          if (error) *error = "cannot write " + merged;
+        }
+        continue;
+      }
       if (best == logs.size()) break;
       if (ok && lcm_eventlog_write_event(out, head[best]) != 0) {
         ok = false;

@@ -1,11 +1,12 @@
 // logplayer_check ORIGINAL PLAYBACK [PREFIX]: compares the CONTROL commands
-// of two lcm-logger files, read with the project's event reader: ORIGINAL is
-// the log of a live episode (`pidlab launch --log`), PLAYBACK what a lone
-// pidlab-controller answered when lcm-logplayer played ORIGINAL to it. Every
-// (episode, step) commanded in ORIGINAL must be in PLAYBACK, and every copy of
-// it in either file (resends, re-answered duplicates) must carry the same u,
-// bit for bit. Prints the counts; exit 0 if all agree, 1 if not, 2 if a file
-// cannot be read.
+// of two lcm-logger files: ORIGINAL is the log of a live run (`pidlab launch
+// --log`), PLAYBACK what a lone pidlab-controller answered when lcm-logplayer
+// played ORIGINAL to it. The commands of ORIGINAL are every u of every
+// complete episode as `pidlab replay` reads them (pidlab_logreader: CONTROL
+// events and the plant's trajectory chunks); PLAYBACK's are its CONTROL
+// events (event reader). Every step must be in PLAYBACK, and every copy of it
+// there (re-answered duplicates) must carry the same u, bit for bit. Prints
+// the counts; exit 0 if all agree, 1 if not, 2 if a file cannot be read.
 
 #include <cstdio>
 #include <cstring>
@@ -15,6 +16,7 @@
 #include <utility>
 
 #include "pidlab/replay/event_reader.h"
+#include "pidlab/replay/log_reader.h"
 
 namespace {
 struct Commands {
@@ -54,7 +56,27 @@ int main(int argc, char** argv) {
   }
   const std::string channel = std::string(argc > 3 ? argv[3] : "PIDLAB_") + "CONTROL";
   Commands original, playback;
-  if (!Read(argv[1], channel, &original) || !Read(argv[2], channel, &playback)) return 2;
+  pidlab::replay::ReadOptions options;
+  options.channel_prefix = argc > 3 ? argv[3] : "PIDLAB_";
+  pidlab::replay::LogContents log;
+  std::string error;
+  if (!pidlab::replay::ReadLog(argv[1], options, &log, &error)) {
+    std::fprintf(stderr, "cannot read %s: %s\n", argv[1], error.c_str());
+    return 2;
+  }
+  long incomplete = 0;
+  for (const auto& e : log.episodes) {
+    if (!e.Complete()) {
+      ++incomplete;
+      continue;
+    }
+    for (long k = 0; k < e.total_steps; ++k) {
+      uint64_t bits;
+      std::memcpy(&bits, &e.u[static_cast<std::size_t>(k)], sizeof bits);
+      original.u.emplace(std::make_pair(e.episode_id, k), bits);
+    }
+  }
+  if (!Read(argv[2], channel, &playback)) return 2;
   long missing = 0, different = 0, extra = 0;
   for (const auto& [key, bits] : original.u) {
     const auto it = playback.u.find(key);
@@ -65,11 +87,12 @@ int main(int argc, char** argv) {
   }
   for (const auto& entry : playback.u) extra += original.u.count(entry.first) ? 0 : 1;
   std::printf(
-      "original: %zu steps commanded (%ld CONTROL events, %ld repeats, %ld disagreeing); playback: %zu steps "
-      "(%ld events, %ld repeats, %ld disagreeing); missing %ld, different u %ld, not in the original %ld\n",
-      original.u.size(), original.events, original.copies, original.disagreeing, playback.u.size(),
-      playback.events, playback.copies, playback.disagreeing, missing, different, extra);
-  const bool ok = !original.u.empty() && missing == 0 && different == 0 && extra == 0 &&
-                  original.disagreeing == 0 && playback.disagreeing == 0;
+      "original: %zu steps commanded in %zu episodes (%ld incomplete); playback: %zu steps "
+      "(%ld CONTROL events, %ld repeats, %ld disagreeing); missing %ld, different u %ld, not in the original "
+      "%ld\n",
+      original.u.size(), log.episodes.size(), incomplete, playback.u.size(), playback.events, playback.copies,
+      playback.disagreeing, missing, different, extra);
+  const bool ok = !original.u.empty() && missing == 0 && different == 0 && extra == 0 && incomplete == 0 &&
+                  playback.disagreeing == 0;
   return ok ? 0 : 1;
 }

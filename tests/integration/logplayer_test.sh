@@ -50,7 +50,7 @@ url=udpm://239.255.76.67:7667
 lane1=udpm://239.255.76.67:7668   # PLANT_OUTPUT
 lane2=udpm://239.255.76.67:7669   # CONTROL
 lcm-logger -q -f "--lcm-url=$lane2?recv_buf_size=4194304" control.lcmlog & pids+=($!)
-pidlab-controller --lcm-url "$url" 2>controller.err & ctl=$!; pids+=($ctl)
+pidlab-controller --lcm-url "$url?recv_buf_size=4194304" 2>controller.err & ctl=$!; pids+=($ctl)
 sleep 0.5
 kill -0 "$ctl" 2>/dev/null || { echo "FAIL pidlab-controller did not start: $(tail -2 controller.err)"; exit 1; }
 # Both players pace from the log's first event: started together, the

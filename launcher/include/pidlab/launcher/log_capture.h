@@ -77,7 +77,10 @@ class LogCapture {
   /// per-step datagrams too and lcm-logplayer can drive a controller from it.
   /// Call after the base logger stopped. False with *error if it failed (the
   /// log is then left as the base logger wrote it).
+  /// Outputs the PLANT_OUTPUT lane's logger lost are rebuilt from the
+  /// trajectory chunks (not for authenticated runs); rebuilt_outputs() counts them.
   bool MergeLanes(std::string* error);
+  long rebuilt_outputs() const { return rebuilt_outputs_; }
 
   /// Publishes a MARKER until lcm-logger has written it to the log (so
   /// everything published before it is on disk), then waits until the file
@@ -99,6 +102,10 @@ class LogCapture {
   /// Reads the log: the gaps to fill, or false with *summary filled.
   bool FindGaps(std::vector<Gap>* gaps, RepairSummary* summary) const;
   void AskForGaps(const std::vector<Gap>& gaps, RepairSummary* summary);
+  /// (timestamp, encoded lcmt_plant_output) for every step of a complete
+  /// episode whose PLANT_OUTPUT is not in `lane_file`.
+  std::vector<std::pair<int64_t, std::vector<uint8_t>>> MissingLaneOutputs(
+      const std::string& lane_file) const;
   void DescribeUnrepaired(const std::vector<Gap>& gaps, RepairSummary* summary) const;
 
   LogCaptureOptions options_;
@@ -110,6 +117,7 @@ class LogCapture {
   std::map<std::pair<int64_t, int64_t>, int> answers_;
   std::vector<std::pair<int64_t, int64_t>> asked_;
   std::vector<std::pair<pid_t, std::string>> lane_loggers_;  // pid, file
+  long rebuilt_outputs_ = 0;
 };
 
 }  // namespace pidlab::launcher
