@@ -101,7 +101,8 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
           ->default_str("1");
   app->add_option(
       "--rt-priority", o.rt_priority,
-      "run the plant SCHED_FIFO at this priority (1-99) if the system allows it (it says so if not)");
+      "run the plant, controller and disturbance SCHED_FIFO at this priority (1-99) with their memory "
+      "locked, if the system allows it (each says so if not)");
   app->add_flag("--verbose,-v", o.verbose, "verbose processes and launcher");
   app->add_option("command", flags->command, "COMMAND [ARGS...] after --");
   return [flags, roles, realtime] {

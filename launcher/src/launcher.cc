@@ -161,7 +161,7 @@ void Launcher::StartRoles() {
       factor << std::setprecision(17) << options_.realtime_factor;
       args.insert(args.end(), {"--realtime", factor.str()});
     }
-    if (role == "plant" && options_.rt_priority > 0)
+    if (options_.rt_priority > 0)  // the whole lockstep loop: a paced plant waits for the others
       args.insert(args.end(), {"--rt-priority", std::to_string(options_.rt_priority)});
     if (!options_.auth_key_file.empty()) args.insert(args.end(), {"--auth-key", options_.auth_key_file});
     roles_[role] = supervisor_->Start("pidlab-" + role, args);

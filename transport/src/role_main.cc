@@ -1,6 +1,7 @@
 #include "pidlab/transport/role_main.h"
 
 #include <sched.h>
+#include <sys/mman.h>
 #include <sys/prctl.h>
 #include <unistd.h>
 
@@ -48,9 +49,13 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
                "lateness and the rate achieved (docs/trio.md)")
             ->expected(0, 1)
             ->default_str("1");
-    app.add_option("--rt-priority", realtime->rt_priority,
-                   "ask for SCHED_FIFO at this priority (1-99); if the system refuses, say so and continue");
   }
+  // Every role takes --rt-priority: in lockstep a paced plant waits for the
+  // controller and the disturbance, so all three need the same policy.
+  int rt_priority = 0;
+  app.add_option("--rt-priority", rt_priority,
+                 "ask for SCHED_FIFO at this priority (1-99) and lock the process's memory; if the system "
+                 "refuses, say so and continue");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -76,21 +81,31 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
     std::cerr << program << ": error: " << error << "\n";
     return 2;
   }
-  if (realtime && (realtime->rt_priority < 0 || realtime->rt_priority > 99)) {
-    std::cerr << program << ": error: --rt-priority " << realtime->rt_priority << " must be in 1..99\n";
+  if (rt_priority < 0 || rt_priority > 99) {
+    std::cerr << program << ": error: --rt-priority " << rt_priority << " must be in 1..99\n";
     return 2;
   }
-  if (realtime && realtime->rt_priority > 0) {
+  if (realtime) realtime->rt_priority = rt_priority;
+  if (rt_priority > 0) {
     // Before LCM starts its receive thread, which inherits the policy.
     sched_param param{};
-    param.sched_priority = realtime->rt_priority;
+    param.sched_priority = rt_priority;
     if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
       const int err = errno;
-      std::cerr << program << ": note: --rt-priority " << realtime->rt_priority << ": SCHED_FIFO refused ("
+      std::cerr << program << ": note: --rt-priority " << rt_priority << ": SCHED_FIFO refused ("
                 << std::strerror(err) << "; needs root, CAP_SYS_NICE or an RLIMIT_RTPRIO); running at normal "
                 << "priority\n";
-    } else if (verbose) {
-      std::cerr << program << ": running SCHED_FIFO at priority " << realtime->rt_priority << "\n";
+    } else {
+      // No page fault in the loop: a real-time process keeps its pages (not
+      // under AddressSanitizer, whose shadow reserves terabytes).
+#if defined(__SANITIZE_ADDRESS__)
+      const bool locked = false;
+#else
+      const bool locked = mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+#endif
+      if (verbose)
+        std::cerr << program << ": running SCHED_FIFO at priority " << rt_priority
+                  << (locked ? ", memory locked" : ", memory not locked (mlockall refused)") << "\n";
     }
   }
   transport_options.step_lane_base_url = url;

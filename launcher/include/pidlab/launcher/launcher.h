@@ -58,7 +58,7 @@ struct LaunchOptions {
   /// Real-time pacing of the plant (pidlab-plant --realtime FACTOR,
   /// transport/pacing.h): 0 off, else positive and finite.
   double realtime_factor = 0.0;
-  /// pidlab-plant --rt-priority N (SCHED_FIFO), 0 off, else 1..99.
+  /// --rt-priority N for every role (SCHED_FIFO, memory locked), 0 off, else 1..99.
   int rt_priority = 0;
   /// The processes append their stderr to this file (empty: ours).
   std::string stderr_path;
