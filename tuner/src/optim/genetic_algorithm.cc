@@ -155,12 +155,7 @@ void GeneticAlgorithm(const ObjectiveFunction& f, const Bounds& bounds,
                       const GeneticAlgorithmOptions& options, OptimizerSummary* summary,
                       const ProgressCallback& progress) {
   if (summary == nullptr) return;
-  if (!optim_internal::StartSummary(f, bounds, summary)) return;
-  std::string error;
-  if (!options.IsValid(&error)) {
-    optim_internal::FailInvalid(error, summary);
-    return;
-  }
+  if (!optim_internal::StartRun(f, bounds, options, summary)) return;
 
   Evaluator evaluator(f, bounds, options.max_evaluations, progress, summary);
   Rng rng(options.seed);

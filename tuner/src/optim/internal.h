@@ -138,6 +138,20 @@ bool StartSummary(const ObjectiveFunction& f, const Bounds& bounds, OptimizerSum
 /// Sets kInvalidOptions with `error` as the message.
 void FailInvalid(const std::string& error, OptimizerSummary* summary);
 
+/// The start every optimiser shares: StartSummary, then options.IsValid;
+/// false (with the summary failed as invalid input) if either refuses.
+template <typename Options>
+bool StartRun(const ObjectiveFunction& f, const Bounds& bounds, const Options& options,
+              OptimizerSummary* summary) {
+  if (!StartSummary(f, bounds, summary)) return false;
+  std::string error;
+  if (!options.IsValid(&error)) {
+    FailInvalid(error, summary);
+    return false;
+  }
+  return true;
+}
+
 /// Sets the termination and message; kNoFeasiblePoint replaces `type` (and
 /// prefixes the message) when no feasible point was found.
 void Finish(TerminationType type, const std::string& message, OptimizerSummary* summary);

@@ -92,12 +92,7 @@ void MultiStart(const ObjectiveFunction& f, const Bounds& bounds, const MultiSta
                 std::vector<LocalMinimum>* minima) {
   if (minima) minima->clear();
   if (summary == nullptr) return;
-  if (!optim_internal::StartSummary(f, bounds, summary)) return;
-  std::string error;
-  if (!options.IsValid(&error)) {
-    optim_internal::FailInvalid(error, summary);
-    return;
-  }
+  if (!optim_internal::StartRun(f, bounds, options, summary)) return;
   const int n = static_cast<int>(bounds.lower.size());
   if (n > SobolSequence::kMaxDimensions) {
     std::ostringstream os;
