@@ -239,7 +239,44 @@ void PlantFlags::Register(CLI::App* app, bool required) {
                   "mutual_inductance_h, inertia_kg_m2, rotor_teeth, viscous_friction, tooth_pitch_rad, "
                   "stationary_current_a, flux_linkage); repeatable")
       ->take_all();
+  app->add_option("--detent-torque", detent_torque_nm,
+                  "stepper_nonlinear: detent torque amplitude T_d in N m (T_d sin(4 N_r theta))")
+      ->check(FiniteNumber());
+  app->add_option("--load-torque", load_torque_nm, "stepper_nonlinear: constant load torque in N m")
+      ->check(FiniteNumber());
+  app->add_option("--load-step", load_step_nm,
+                  "stepper_nonlinear: a further load torque step in N m at --load-step-time")
+      ->check(FiniteNumber());
+  app->add_option("--load-step-time", load_step_time_s, "stepper_nonlinear: time of the load step in s")
+      ->check(FiniteNumber());
+  app->add_option("--voltage-limit", voltage_limit_v,
+                  "stepper_nonlinear: phase-voltage limit of the drive in V (default: none)")
+      ->check(NumberOrInfinity());
+  app->add_option("--input-scale", input_scale,
+                  "stepper_nonlinear: g in phi = theta0 + g u; 0 (default) = (L-M)/L, which makes the "
+                  "linearisation eq. (3); 1 = the physical angle command")
+      ->check(FiniteNumber());
+  app->add_option("--drive", drive,
+                  "stepper_nonlinear: linear (phase voltages proportional to u, default) or microstep (sine "
+                  "table at phi = theta0 + g u, wraps every electrical period)");
   opt->check([](const std::string&) { return std::string(); });
+}
+
+NonlinearStepperOptions PlantFlags::NonlinearOptions() const {
+  NonlinearStepperOptions o;
+  o.motor = StepperParameters();
+  o.detent_torque_nm = detent_torque_nm;
+  o.load_torque_nm = load_torque_nm;
+  o.load_step_nm = load_step_nm;
+  o.load_step_time_s = load_step_time_s;
+  o.voltage_limit_v = voltage_limit_v;
+  o.input_scale = input_scale;
+  if (drive != "linear" && drive != "microstep")
+    throw BadInput("--drive " + Quote(drive) + " must be linear or microstep");
+  o.microstep_table = drive == "microstep";
+  std::string error;
+  if (!o.IsValid(&error)) throw BadInput(error);
+  return o;
 }
 
 Plant PlantFlags::Build() const {
@@ -256,6 +293,28 @@ Plant PlantFlags::Build() const {
   }
   if (plant.empty()) throw BadInput("--plant is required (or --num and --den for a custom plant)");
   if (plant == "custom") throw BadInput("--plant custom needs --num and --den");
+  const bool nonlinear = plant == "stepper_nonlinear";
+  const NonlinearStepperOptions defaults;
+  if (!nonlinear &&
+      (detent_torque_nm != 0.0 || load_torque_nm != 0.0 || load_step_nm != 0.0 || load_step_time_s != 0.0 ||
+       voltage_limit_v != defaults.voltage_limit_v || input_scale != 0.0 || drive != "linear"))
+    throw BadInput(
+        "--detent-torque, --load-torque, --load-step, --load-step-time, --voltage-limit, --input-scale and "
+        "--drive apply "
+        "only to --plant stepper_nonlinear, not " +
+        Quote(plant));
+  if (nonlinear) {
+    if (!MakeNonlinearStepperPlant(NonlinearOptions(), &p, &error)) throw BadInput(error);
+    return p;
+  }
+  const StepperMotorParameters sp = StepperParameters();
+  // A plant name is printable and short, so Truncate leaves every valid one
+  // as it is, and MakePlant's "unknown plant '...'" echoes at most 200 chars.
+  if (!MakePlant(Truncate(plant), sp, &p, &error)) throw BadInput(error);
+  return p;
+}
+
+StepperMotorParameters PlantFlags::StepperParameters() const {
   StepperMotorParameters sp;
   for (const auto& kv : stepper_overrides) {
     const auto eq = kv.find('=');
@@ -284,12 +343,13 @@ Plant PlantFlags::Build() const {
       throw BadInput("--stepper parameter " + Quote(name) + " is unknown");
     *field = ParseDouble(kv.substr(eq + 1), "--stepper " + name);
   }
-  if (!stepper_overrides.empty() && plant != "stepper_motor" && plant != "stepper")
-    throw BadInput("--stepper overrides apply only to --plant stepper_motor, not " + Quote(plant));
-  // A plant name is printable and short, so Truncate leaves every valid one
-  // as it is, and MakePlant's "unknown plant '...'" echoes at most 200 chars.
-  if (!MakePlant(Truncate(plant), sp, &p, &error)) throw BadInput(error);
-  return p;
+  if (!stepper_overrides.empty() && plant != "stepper_motor" && plant != "stepper" &&
+      plant != "stepper_nonlinear")
+    throw BadInput("--stepper overrides apply only to --plant stepper_motor or stepper_nonlinear, not " +
+                   Quote(plant));
+  std::string error;
+  if (!sp.IsValid(&error)) throw BadInput(error);
+  return sp;
 }
 
 void LoopFlags::Register(CLI::App* app) {
@@ -439,6 +499,11 @@ std::string FormatEvaluation(const Evaluation& ev) {
     os << "peak             " << num(ev.step.peak) << " at " << num(ev.step.peak_time_s) << " s\n";
   } else {
     os << "step metrics     - (" << ev.step.note << ")\n";
+  }
+  if (ev.has_motor) {
+    os << "motor            " << (ev.lost_steps ? ev.motor_note : "no steps lost") << "\n";
+    os << "peak phase       " << num(ev.motor.phase_voltage_v) << " V, " << num(ev.motor.phase_current_a)
+       << " A; peak load angle " << num(ev.motor.load_angle_rad) << " rad (electrical)\n";
   }
   return os.str();
 }

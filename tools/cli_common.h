@@ -91,7 +91,15 @@ struct PlantFlags {
   std::string plant;
   std::string num, den;
   std::vector<std::string> stepper_overrides;
+  // stepper_nonlinear options (docs/stepper.md).
+  double detent_torque_nm = 0.0, load_torque_nm = 0.0, load_step_nm = 0.0, load_step_time_s = 0.0;
+  double voltage_limit_v = HUGE_VAL, input_scale = 0.0;
+  std::string drive = "linear";
   void Register(CLI::App* app, bool required = true);
+  /// The Table I parameters with the --stepper overrides; throws BadInput.
+  StepperMotorParameters StepperParameters() const;
+  /// The stepper_nonlinear options of the flags; throws BadInput.
+  NonlinearStepperOptions NonlinearOptions() const;
   Plant Build() const;  // throws BadInput
 };
 
@@ -99,7 +107,7 @@ struct PlantFlags {
 struct LoopFlags {
   std::string loop = "continuous";
   double dt_s = 1e-3, sample_time_s = 0.05, horizon_s = 25.0, stability_margin = 1e-9;
-  double reference = 1.0;  // --reference A: size of the reference step
+  double reference = 1.0;   // --reference A: size of the reference step
   std::string disturbance;  // empty: square if an amplitude is given
   double disturbance_amplitude = 0.0, disturbance_period_s = 2.0, disturbance_phase_s = 0.0;
   double disturbance_step_time_s = 0.0, noise_hold_s = 0.01;

@@ -13,5 +13,6 @@ std::function<int()> RegisterLaunch(CLI::App* app);
 std::function<int()> RegisterReplay(CLI::App* app);
 std::function<int()> RegisterPlot(CLI::App* app);
 std::function<int()> RegisterReport(CLI::App* app);
+std::function<int()> RegisterLinearize(CLI::App* app);
 
 }  // namespace pidlab::cli

@@ -20,6 +20,8 @@ struct Command {
 
 const Command kCommands[] = {
     {"evaluate", "evaluate one gain set (IAE, poles, step metrics)", pidlab::cli::RegisterEvaluate},
+    {"linearize", "transfer function of a nonlinear plant's linearisation (stepper_nonlinear)",
+     pidlab::cli::RegisterLinearize},
     {"launch", "start the LCM process trio (plant, controller, disturbance)", pidlab::cli::RegisterLaunch},
     {"plot", "PNG figures of y, e, u, n from an evaluation or an LCM log", pidlab::cli::RegisterPlot},
     {"replay", "read an LCM log: episodes, IAE, completeness, --redrive", pidlab::cli::RegisterReplay},

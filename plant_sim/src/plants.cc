@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pidlab/plant_sim/stepper_nonlinear.h"
+
 namespace pidlab {
 
 bool StepperMotorParameters::IsValid(std::string* error) const {
@@ -57,7 +59,8 @@ TransferFunction StepperMotorTransferFunction(const StepperMotorParameters& p) {
 }
 
 std::vector<std::string> BuiltinPlantNames() {
-  return {"double_integrator", "linear", "oscillator", "nonlinear", "stepper_motor", "stepper"};
+  return {"double_integrator", "linear",  "oscillator",       "nonlinear",
+          "stepper_motor",     "stepper", "stepper_nonlinear"};
 }
 
 bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, Plant* plant,
@@ -74,13 +77,32 @@ bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, P
       if (error) *error = "these stepper motor parameters give G(s) = " + plant->tf.ToString() + ": " + why;
       return false;
     }
+  } else if (name == "stepper_nonlinear") {
+    NonlinearStepperOptions o;
+    o.motor = stepper;
+    return MakeNonlinearStepperPlant(o, plant, error);
   } else {
     if (error)
       *error = "unknown plant '" + name +
-               "' (expected double_integrator|linear, oscillator|nonlinear, stepper_motor|stepper, or custom "
-               "with --num/--den)";
+               "' (expected double_integrator|linear, oscillator|nonlinear, stepper_motor|stepper, "
+               "stepper_nonlinear, or custom with --num/--den)";
     return false;
   }
+  return true;
+}
+
+bool MakeNonlinearStepperPlant(const NonlinearStepperOptions& options, Plant* plant, std::string* error) {
+  if (!options.IsValid(error)) return false;
+  // The linearisation is taken without load (and its detent must keep the
+  // holding point an equilibrium): it is the stability gate and the reference.
+  StepperLinearization lin;
+  if (!LinearizeStepper(options, &lin, error)) return false;
+  std::string why;
+  if (!lin.tf.IsValid(&why)) {
+    if (error) *error = "the linearised stepper G(s) = " + lin.tf.ToString() + " is out of range: " + why;
+    return false;
+  }
+  *plant = {"stepper_nonlinear", lin.tf, std::make_shared<const NonlinearStepperOptions>(options)};
   return true;
 }
 

@@ -180,5 +180,39 @@ else
   fail "--reference 0.01 (exit $status)"
 fi
 
+# ---- pidlab linearize: eq. (3) from the nonlinear motor's autodiff Jacobian ----
+status=0
+"$pidlab" linearize --plant stepper_nonlinear --json >lin.json 2>lin.err || status=$?
+if [[ $status -eq 0 ]] && python3 - lin.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["den"][0] == 1.0 and len(j["den"]) == 4 and len(j["num"]) == 1, j
+for a, b in zip(j["den"] + j["num"], j["eq3"]["den"] + j["eq3"]["num"]):
+    assert abs(a - b) <= 1e-9 * abs(b), (a, b)
+PY
+then
+  pass "linearize --plant stepper_nonlinear --json is eq. (3), monic"
+else
+  fail "linearize (exit $status): $(cat lin.err)"
+fi
+bad "nonlinear plant on the continuous loop" "--loop sampled" evaluate --plant stepper_nonlinear --gains 1,1,1
+bad "nonlinear plant over LCM" "in process only" evaluate --plant stepper_nonlinear --gains 1,1,1 --backend lcm
+bad "--voltage-limit on a linear plant" "stepper_nonlinear" evaluate --plant stepper_motor --gains 1,1,1 --voltage-limit 24
+bad "linearize a linear plant" "stepper_motor" linearize --plant stepper_motor
+status=0
+"$pidlab" evaluate --plant stepper_nonlinear --loop sampled --dt 1e-4 --horizon 2 --gains 20.8836,26.607,12.4866 \
+  --reference 1 --json >lost.json 2>/dev/null || status=$?
+if [[ $status -eq 0 ]] && python3 - lost.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["status"] == "lost_steps" and j["motor"]["lost_steps"] is True, j.get("motor")
+assert "LOST STEPS" in j["motor"]["note"]
+PY
+then
+  pass "a 1 rad step of the paper's gains on the nonlinear motor is reported as lost steps"
+else
+  fail "lost steps report (exit $status)"
+fi
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

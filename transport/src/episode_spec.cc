@@ -37,6 +37,8 @@ bool RecoveryOptions::IsValid(std::string* error) const {
 
 bool EpisodeSpec::IsValid(std::string* error) const {
   if (episode_id == 0) return Fail("episode id 0 is reserved", error);
+  if (plant.nonlinear)
+    return Fail("plant " + plant.name + " runs in process only: the trio does not carry it yet", error);
   if (!plant.tf.IsValid(error)) return false;
   if (plant.tf.RelativeDegree() < 1)
     return Fail("plant " + plant.tf.ToString() + " must be strictly proper", error);

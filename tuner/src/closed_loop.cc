@@ -190,4 +190,29 @@ Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const 
   return s;
 }
 
+PidStatus RunNonlinearSampledLoop(NonlinearStepperPlant* plant, const PidGains& gains,
+                                  const PidOptions& pid_options, const Disturbance& disturbance,
+                                  long total_steps, int steps_per_sample, std::vector<double>* y_samples,
+                                  std::vector<SampledStep>* trajectory, double reference) {
+  DiscretePid<double> pid(gains, pid_options);
+  plant->Reset();
+  const double dt = pid_options.dt_s;
+  y_samples->clear();
+  y_samples->reserve(static_cast<std::size_t>(total_steps / steps_per_sample + 1));
+  PidStatus status = PidStatus::kOk;
+  for (long k = 0;; ++k) {
+    const double y = plant->Output();
+    if (k % steps_per_sample == 0) y_samples->push_back(y);
+    if (k == total_steps) break;
+    const double t = static_cast<double>(k) * dt;
+    const double n = disturbance.Value(t);
+    double u = 0.0;
+    const PidStatus s = pid.Step(reference, y, &u);
+    if (s != PidStatus::kOk && s != PidStatus::kSaturated) status = s;
+    if (trajectory) trajectory->push_back({k, t, reference, y, u, n});
+    plant->Step(u + n);
+  }
+  return status;
+}
+
 }  // namespace pidlab

@@ -187,6 +187,10 @@ bool FastContinuousObjective::Covers(const TransferFunction& tf, const LoopOptio
   return order >= 1 && order <= kMaxPlantOrder;
 }
 
+bool FastContinuousObjective::CoversPlant(const Plant& plant, const LoopOptions& options, ObjectiveKind kind) {
+  return !plant.nonlinear && Covers(plant.tf, options, kind);
+}
+
 FastContinuousObjective::FastContinuousObjective(const TransferFunction& tf, const StateSpace& realization,
                                                  const LoopOptions& options, ObjectiveKind kind)
     : realization_(realization), options_(options), kind_(kind), none_(DisturbanceOptions{}) {

@@ -6,6 +6,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 
 #include "pidlab/tuner/evaluation.h"
@@ -391,11 +392,37 @@ double Evaluation::Objective(ObjectiveKind kind) const {
   return iae;
 }
 
+namespace {
+
+// Lost steps: at the horizon the rotor is half a step angle or more away
+// from the reference (another detent, or still moving), or not finite.
+void JudgeMotor(const NonlinearStepperPlant& motor, const std::vector<double>& y_all, double reference,
+                Evaluation* ev) {
+  ev->has_motor = true;
+  ev->motor = motor.peaks();
+  ev->final_error = reference - y_all.back();
+  const double lambda = motor.options().motor.tooth_pitch_rad;
+  ev->lost_steps = !(std::abs(ev->final_error) < lambda / 2.0);
+  std::ostringstream os;
+  if (ev->lost_steps)
+    os << "LOST STEPS: the rotor ends " << ev->final_error << " rad from the reference (half a step is "
+       << lambda / 2.0 << " rad): it settled at another detent or never settled";
+  ev->motor_note = os.str();
+}
+
+}  // namespace
+
 bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
                              const DisturbanceOptions& disturbance, std::vector<double>* y_all,
                              std::vector<SampledStep>* trajectory, std::string* /*error*/) {
   PidOptions pid = options.pid;
   pid.dt_s = options.dt_s;
+  if (plant.nonlinear) {
+    NonlinearStepperPlant motor(*plant.nonlinear, options.dt_s);
+    RunNonlinearSampledLoop(&motor, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
+                            trajectory, options.reference);
+    return true;
+  }
   const DiscretePlant discrete(plant.tf, options.dt_s);
   // A diverged loop (PidStatus::kInvalidInput) is not an error here: its
   // non-finite samples make every objective +inf, as for an unstable loop.
@@ -411,6 +438,13 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
   if (!plant.tf.IsValid(error)) return false;
   if (plant.tf.RelativeDegree() < 1) {
     if (error) *error = "plant " + plant.tf.ToString() + " must be strictly proper";
+    return false;
+  }
+  if (plant.nonlinear && options.loop != LoopKind::kSampled) {
+    if (error)
+      *error = "plant " + plant.name +
+               " is nonlinear: the exact continuous loop applies to linear plants only, use --loop sampled "
+               "(with --dt 1e-4 or less)";
     return false;
   }
   *ev = Evaluation();
@@ -454,9 +488,17 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
     ev->stability = SampledStability(discrete, gains, pid, options.stability_margin);
     if (ev->stability.stable) {
       std::vector<double> y_all;
-      if (!runner(plant, gains, options, options.disturbance, &y_all,
-                  what.record_trajectory ? &ev->trajectory : nullptr, error))
+      if (plant.nonlinear) {
+        // In process (the trio runs linear plants only): the motor's peaks
+        // and whether it lost steps come with the run.
+        NonlinearStepperPlant motor(*plant.nonlinear, options.dt_s);
+        RunNonlinearSampledLoop(&motor, gains, pid, disturbance, options.TotalSteps(), 1, &y_all,
+                                what.record_trajectory ? &ev->trajectory : nullptr, a);
+        JudgeMotor(motor, y_all, a, ev);
+      } else if (!runner(plant, gains, options, options.disturbance, &y_all,
+                         what.record_trajectory ? &ev->trajectory : nullptr, error)) {
         return false;
+      }
       const int per = options.StepsPerSample();
       for (int m = 0; m < num; ++m) ev->y.push_back(y_all[static_cast<std::size_t>(m) * per]);
       double integral = 0.0;
@@ -465,7 +507,11 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
       ev->iae_continuous = integral;
       std::vector<double> y1 = y_all;
       if (has_disturbance) {
-        if (!runner(plant, gains, options, none.options(), &y1, nullptr, error)) return false;
+        if (plant.nonlinear) {
+          RunSampledLoopInProcess(plant, gains, options, none.options(), &y1, nullptr, error);
+        } else if (!runner(plant, gains, options, none.options(), &y1, nullptr, error)) {
+          return false;
+        }
         std::vector<double> y1s;
         for (int m = 0; m < num; ++m) y1s.push_back(y1[static_cast<std::size_t>(m) * per]);
         ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1s, ts, a);
@@ -502,11 +548,16 @@ ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& op
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
   if (!plant.tf.IsValid(&error)) throw std::invalid_argument(error);
   realization_ = Realize(plant.tf);
+  if (plant.nonlinear && options.loop != LoopKind::kSampled)
+    throw std::invalid_argument("plant " + plant.name +
+                                " is nonlinear: tune it on the sampled loop (--loop sampled)");
+  if (plant.nonlinear && runner_)
+    throw std::invalid_argument("plant " + plant.name + " runs in process only, not over the LCM trio");
   if (options.loop == LoopKind::kSampled) {
     options_.pid.dt_s = options.dt_s;
     discrete_ = std::make_unique<DiscretePlant>(plant.tf, options.dt_s);
   }
-  if (FastContinuousObjective::Covers(plant.tf, options_, kind_))
+  if (FastContinuousObjective::CoversPlant(plant, options_, kind_))
     fast_ = std::make_shared<const FastContinuousObjective>(plant.tf, realization_, options_, kind_);
 }
 
@@ -533,8 +584,11 @@ double ObjectiveEvaluator::operator()(const PidGains& gains) const {
   if (options_.loop == LoopKind::kContinuous)
     return GeneralContinuousObjective(realization_, disturbance_, options_, kind_, gains);
   if (!SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable) return kInf;
-  if (runner_ || kind_ == ObjectiveKind::kIaeContinuous) {
-    if (runner_) {
+  if (runner_ || kind_ == ObjectiveKind::kIaeContinuous || plant_.nonlinear) {
+    if (plant_.nonlinear) {
+      std::string error;
+      RunSampledLoopInProcess(plant_, gains, options_, options_.disturbance, &y, nullptr, &error);
+    } else if (runner_) {
       std::string error;
       if (!runner_(plant_, gains, options_, options_.disturbance, &y, nullptr, &error))
         throw std::runtime_error("sampled-loop runner failed: " + error);

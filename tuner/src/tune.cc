@@ -306,7 +306,9 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   summary->objective = summary->search_objective;
   summary->stable = true;
   summary->message = opt.message;
-  if (options.refine && options.method == TuneMethod::kMultiStart) {
+  // Ceres differentiates the linear loops only; a nonlinear plant keeps the
+  // search's result (refine "not run").
+  if (options.refine && options.method == TuneMethod::kMultiStart && !plant.nonlinear) {
     std::vector<PidGains> starts{summary->search_gains};
     std::vector<double> objectives{summary->search_objective};
     AddDistinctMinima(options, summary->local_minima, &starts, &objectives);
@@ -315,7 +317,7 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
       summary->gains = summary->refine.gains;
       summary->objective = summary->refine.objective;
     }
-  } else if (options.refine && options.method != TuneMethod::kZieglerNichols) {
+  } else if (options.refine && options.method != TuneMethod::kZieglerNichols && !plant.nonlinear) {
     summary->refine = RefineWithCeres(plant, options, summary->search_gains, summary->search_objective);
     if (summary->refine.objective < summary->objective) {
       summary->gains = summary->refine.gains;

@@ -8,6 +8,22 @@ nlohmann::json JsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v
 
 nlohmann::json ToJson(const PidGains& g) { return {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}}; }
 
+namespace {
+
+// The stepper_nonlinear verdict and peaks (docs/stepper.md): "status" and "motor".
+void AddMotor(const Evaluation& ev, nlohmann::json* j) {
+  if (!ev.has_motor) return;
+  (*j)["status"] = ev.lost_steps ? "lost_steps" : "ok";
+  (*j)["motor"] = {{"lost_steps", ev.lost_steps},
+                   {"final_error_rad", JsonNumber(ev.final_error)},
+                   {"peak_phase_voltage_v", JsonNumber(ev.motor.phase_voltage_v)},
+                   {"peak_phase_current_a", JsonNumber(ev.motor.phase_current_a)},
+                   {"peak_load_angle_rad", JsonNumber(ev.motor.load_angle_rad)}};
+  if (!ev.motor_note.empty()) (*j)["motor"]["note"] = ev.motor_note;
+}
+
+}  // namespace
+
 nlohmann::json ToJson(const Evaluation& ev) {
   nlohmann::json poles = nlohmann::json::array();
   for (const auto& p : ev.stability.poles) poles.push_back({{"re", p.real()}, {"im", p.imag()}});
@@ -41,6 +57,7 @@ nlohmann::json ToJson(const Evaluation& ev) {
   j["peak_time_s"] = v ? JsonNumber(ev.step.peak_time_s) : nlohmann::json(nullptr);
   j["final_value"] = v ? JsonNumber(ev.step.final_value) : nlohmann::json(nullptr);
   if (!ev.step.note.empty()) j["step_info_note"] = ev.step.note;
+  AddMotor(ev, &j);
   return j;
 }
 
@@ -87,6 +104,7 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
     j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},
                             {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
                             {"rule", ToString(o.zn_rule)}};
+  if (s.stable) AddMotor(ev, &j);
   return j;
 }
 

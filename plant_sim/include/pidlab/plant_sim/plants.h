@@ -1,6 +1,7 @@
 #pragma once
 // The built-in plants of the paper and user transfer functions.
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,9 +34,15 @@ TransferFunction StepperMotorTransferFunction(const StepperMotorParameters& p);
 
 /// A named plant. `name` is the canonical name (double_integrator,
 /// oscillator, stepper_motor or custom).
+struct NonlinearStepperOptions;  // stepper_nonlinear.h
+
 struct Plant {
   std::string name;
+  /// The plant, or for a nonlinear plant its linearisation at the operating
+  /// point (used for the closed-loop stability gate and as the reference).
   TransferFunction tf;
+  /// Set for stepper_nonlinear: the sampled loop integrates this model.
+  std::shared_ptr<const NonlinearStepperOptions> nonlinear = nullptr;
 };
 
 /// Canonical names and aliases accepted by MakePlant.
@@ -43,11 +50,15 @@ std::vector<std::string> BuiltinPlantNames();
 
 /// Builds a built-in plant by name or alias: double_integrator (linear) = 1/s^2,
 /// oscillator (nonlinear) = 1/(s^2+1), stepper_motor (stepper) = eq. (3) with
-/// `stepper`. Returns false and sets *error naming the value for an unknown name,
-/// invalid stepper parameters, or parameters whose G(s) is not a valid
+/// `stepper`, stepper_nonlinear = the nonlinear motor of stepper_nonlinear.h
+/// with `stepper` and default options (MakeNonlinearStepperPlant for others). Returns false and sets *error
+/// naming the value for an unknown name, invalid stepper parameters, or parameters whose G(s) is not a valid
 /// TransferFunction (a coefficient out of the limits).
 bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, Plant* plant,
                std::string* error);
+
+/// The nonlinear stepper with its options; tf is its linearisation.
+bool MakeNonlinearStepperPlant(const NonlinearStepperOptions& options, Plant* plant, std::string* error);
 
 /// A user plant from coefficient lists; must be valid and strictly proper.
 bool MakeCustomPlant(const std::vector<double>& num, const std::vector<double>& den, Plant* plant,

@@ -27,6 +27,7 @@
 #include "pidlab/plant_sim/disturbance.h"
 #include "pidlab/plant_sim/matrix_exp.h"
 #include "pidlab/plant_sim/plants.h"
+#include "pidlab/plant_sim/stepper_nonlinear.h"
 
 namespace pidlab {
 
@@ -259,6 +260,14 @@ PidStatus RunSampledLoop(const DiscretePlant& plant, const PidGainsT<T>& gains, 
   }
   return status;
 }
+
+/// RunSampledLoop's lockstep on the nonlinear stepper (double only): y_k =
+/// theta_k - theta_0, u_k = PID(A, y_k), the motor integrated over the step
+/// with u_k + n_k held. `plant` is reset first; its peaks are those of the run.
+PidStatus RunNonlinearSampledLoop(NonlinearStepperPlant* plant, const PidGains& gains,
+                                  const PidOptions& pid_options, const Disturbance& disturbance,
+                                  long total_steps, int steps_per_sample, std::vector<double>* y_samples,
+                                  std::vector<SampledStep>* trajectory, double reference);
 
 /// Eigenvalues of the sampled loop's one-step map (plant ZOH states plus the
 /// PID's integral, filtered derivative, previous error and previous signal),

@@ -50,6 +50,15 @@ struct Evaluation {
   /// IAE of the undisturbed response y1 (equals iae without a disturbance).
   double iae_undisturbed = 0;
   StepInfo step;
+  /// stepper_nonlinear only: what the motor did, and whether it lost steps
+  /// (at the horizon the rotor is lambda/2 or more from A: it settled at
+  /// another detent or never settled). A response that lost steps keeps its
+  /// IAE, but says so (status, note).
+  bool has_motor = false;
+  StepperPeaks motor;
+  bool lost_steps = false;
+  double final_error = 0.0;  // A - y at the horizon, rad
+  std::string motor_note;
   /// Every step of the sampled loop (sampled loop with record_trajectory).
   std::vector<SampledStep> trajectory;
 

@@ -57,6 +57,9 @@ class FastContinuousObjective {
   /// disturbance, any reference step A, the iae, ise or itae objective, a
   /// strictly proper plant of order 1..kMaxPlantOrder.
   static bool Covers(const TransferFunction& tf, const LoopOptions& options, ObjectiveKind kind);
+  /// Covers for a plant: never a nonlinear one (stepper_nonlinear), whose tf
+  /// is only its linearisation.
+  static bool CoversPlant(const Plant& plant, const LoopOptions& options, ObjectiveKind kind);
 
   /// `realization` is Realize(tf). Throws std::invalid_argument if !Covers.
   FastContinuousObjective(const TransferFunction& tf, const StateSpace& realization,

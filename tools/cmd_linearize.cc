@@ -1,0 +1,63 @@
+// pidlab linearize: the transfer function of the nonlinear stepper's
+// linearisation at the holding point, by automatic differentiation.
+
+#include <iomanip>
+#include <iostream>
+#include <limits>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "pidlab/plant_sim/stepper_nonlinear.h"
+
+namespace pidlab::cli {
+namespace {
+
+struct LinearizeCommand {
+  PlantFlags plant;
+  bool json = false;
+
+  std::function<int()> Register(CLI::App* app) {
+    app->description(
+        "Linearise a nonlinear plant at its operating point (stepper_nonlinear: both phases at I_o, theta = "
+        "lambda/2, at rest, no load) by automatic differentiation of the model, and print u -> y as "
+        "{\"num\": [...], \"den\": [...]} in descending powers of s with a monic denominator. With Table I "
+        "and the default --input-scale this is eq. (3) (docs/stepper.md).");
+    plant.Register(app);
+    app->add_flag("--json", json, "print one JSON object {num, den, plant, eq3} instead of text");
+    return [this] { return Run(); };
+  }
+
+  int Run() {
+    if (plant.plant != "stepper_nonlinear")
+      throw BadInput("--plant " + Quote(plant.plant) +
+                     " is not a nonlinear plant (expected stepper_nonlinear)");
+    const NonlinearStepperOptions o = plant.NonlinearOptions();
+    StepperLinearization lin;
+    std::string error;
+    if (!LinearizeStepper(o, &lin, &error)) throw BadInput(error);
+    const TransferFunction eq3 = StepperMotorTransferFunction(o.motor);
+    if (json) {
+      nlohmann::json j;
+      j["plant"] = "stepper_nonlinear";
+      j["num"] = lin.tf.num;
+      j["den"] = lin.tf.den;
+      j["eq3"] = {{"num", eq3.num}, {"den", eq3.den}};
+      j["input_scale"] = o.InputScale();
+      std::cout << std::setprecision(std::numeric_limits<double>::max_digits10) << j.dump() << "\n";
+    } else {
+      std::cout << std::setprecision(10) << "linearisation  G(s) = " << lin.tf.ToString() << "\n"
+                << "eq. (3)        G(s) = " << eq3.ToString() << "\n"
+                << "input scale g  " << o.InputScale() << " (phi = theta0 + g u)\n";
+    }
+    return 0;
+  }
+};
+
+}  // namespace
+std::function<int()> RegisterLinearize(CLI::App* app) {
+  auto command = std::make_shared<LinearizeCommand>();
+  auto action = command->Register(app);
+  return [command, action] { return action(); };
+}
+
+}  // namespace pidlab::cli
