@@ -64,6 +64,16 @@ class Evaluate(unittest.TestCase):
         self.assertSameResult(got, want)
         self.assertEqual(got["reference"], 2.5)
 
+    def test_the_nonlinear_motor_gives_the_cli_motor_object(self):
+        got = pidlab.evaluate("stepper_nonlinear", (20.8836, 26.607, 12.4866), loop="sampled", dt=1e-4,
+                              horizon=0.5, reference=0.01)
+        want = cli("evaluate", "--plant", "stepper_nonlinear", "--gains", "20.8836,26.607,12.4866", "--loop",
+                   "sampled", "--dt", "1e-4", "--horizon", "0.5", "--reference", "0.01")
+        self.assertSameResult(got, want)
+        self.assertEqual(got["status"], "ok")
+        self.assertFalse(got["motor"]["lost_steps"])
+        self.assertGreater(got["motor"]["peak_phase_voltage_v"], 0.0)
+
     def test_bad_input_raises_value_error_naming_the_value(self):
         with self.assertRaisesRegex(ValueError, "nope"):
             pidlab.evaluate("nope", (1, 2, 3))

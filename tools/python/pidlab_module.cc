@@ -231,7 +231,8 @@ PYBIND11_MODULE(_pidlab, m) {
         return EvaluatePy(plant, gains, l, num, den);
       },
       "Evaluates gains (kp, ki, kd) on a plant given by name ('double_integrator', 'oscillator', "
-      "'stepper_motor' and their aliases) or as (num, den) in descending powers of s. Returns the dict of "
+      "'stepper_motor', 'stepper_nonlinear' with Table I's defaults, and their aliases) or as (num, den) in "
+      "descending powers of s. Returns the dict of "
       "`pidlab evaluate --json`.",
       py::arg("plant"), py::arg("gains"), py::kw_only(), py::arg("loop") = "continuous", py::arg("dt") = 1e-3,
       py::arg("sample_time") = 0.05, py::arg("horizon") = 25.0, py::arg("stability_margin") = py::none(),

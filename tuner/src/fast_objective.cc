@@ -187,7 +187,8 @@ bool FastContinuousObjective::Covers(const TransferFunction& tf, const LoopOptio
   return order >= 1 && order <= kMaxPlantOrder;
 }
 
-bool FastContinuousObjective::CoversPlant(const Plant& plant, const LoopOptions& options, ObjectiveKind kind) {
+bool FastContinuousObjective::CoversPlant(const Plant& plant, const LoopOptions& options,
+                                          ObjectiveKind kind) {
   return !plant.nonlinear && Covers(plant.tf, options, kind);
 }
 
