@@ -16,6 +16,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <limits>
 #include <new>
+#include <pidlab/lcmt_episode_config_v1.hpp>
 
 #include "pidlab/replay/decoder_table.h"
 #include "pidlab/replay/episode_assembler.h"
@@ -340,7 +341,7 @@ std::vector<uint8_t> Encode(const Msg& m) {
 
 TEST(DecoderTable, FindsEveryPidlabTypeByItsFingerprint) {
   const DecoderTable table;
-  ASSERT_EQ(table.types().size(), 10u);
+  ASSERT_EQ(table.types().size(), 11u);  // ten types and the configuration of older logs
   for (const MessageType& t : table.types()) {
     const MessageType* found = table.Find(t.fingerprint);
     ASSERT_NE(found, nullptr) << t.name;
@@ -374,6 +375,59 @@ TEST(DecoderTable, DecodesAWholeMessageAndRefusesMissingOrTrailingBytes) {
   EXPECT_FALSE(type->decode(bytes.data(), bytes.size(), &message));
   bytes.resize(bytes.size() - 2);
   EXPECT_FALSE(type->decode(bytes.data(), bytes.size(), &message));
+}
+
+TEST(DecoderTable, AConfigurationOfAnOlderLogIsReadAsOneOfALinearPlant) {
+  // lcmt_episode_config before the motor's fields were appended: its own
+  // fingerprint, decoded with its own layout, read without a motor.
+  pidlab::lcmt_episode_config_v1 old{};
+  old.episode_id = 9;
+  old.plant_name = "oscillator";
+  old.num = {1.0};
+  old.num_size = 1;
+  old.den = {1.0, 0.0, 1.0};
+  old.den_size = 3;
+  old.kp = 3.0;
+  old.anti_windup = "clamping";
+  old.derivative_on = "error";
+  old.integral = "backward-euler";
+  old.disturbance_kind = "none";
+  old.silence_deadline_s = 5.0;
+  ASSERT_NE(pidlab::lcmt_episode_config_v1::getHash(), pidlab::lcmt_episode_config::getHash());
+  std::vector<uint8_t> bytes = Encode(old);
+  const DecoderTable table;
+  const MessageType* type = table.Find(pidlab::lcmt_episode_config_v1::getHash());
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->name, "lcmt_episode_config");
+  EXPECT_EQ(type->channel_suffix, "EPISODE_CONFIG");
+  PidlabMessage message;
+  ASSERT_TRUE(type->decode(bytes.data(), bytes.size(), &message));
+  const auto* config = std::get_if<pidlab::lcmt_episode_config>(&message);
+  ASSERT_NE(config, nullptr);
+  EXPECT_EQ(config->episode_id, 9);
+  EXPECT_EQ(config->plant_name, "oscillator");
+  EXPECT_EQ(config->den, old.den);
+  EXPECT_EQ(config->kp, 3.0);
+  EXPECT_EQ(config->silence_deadline_s, 5.0);
+  EXPECT_EQ(config->motor_drive, "");
+  EXPECT_EQ(config->motor_resistance_ohm, 0.0);
+  // Its layout is checked like every other: a string running past the end.
+  bytes[8 + 24] = 0x40;
+  EXPECT_FALSE(type->decode(bytes.data(), bytes.size(), &message));
+  // The new configuration cut inside the motor's fields is refused.
+  pidlab::lcmt_episode_config now{};
+  now.plant_name = now.anti_windup = now.derivative_on = now.integral = now.disturbance_kind = "x";
+  now.motor_drive = "linear";
+  std::vector<uint8_t> whole = Encode(now);
+  const MessageType* current = table.Find(pidlab::lcmt_episode_config::getHash());
+  ASSERT_NE(current, nullptr);
+  EXPECT_TRUE(current->decode(whole.data(), whole.size(), &message));
+  for (const std::size_t cut : {std::size_t{8}, std::size_t{8 + 7}, std::size_t{17 * 8}}) {
+    const std::vector<uint8_t> cut_bytes(whole.begin(), whole.end() - static_cast<std::ptrdiff_t>(cut));
+    EXPECT_FALSE(current->decode(cut_bytes.data(), cut_bytes.size(), &message)) << cut;
+  }
+  whole[whole.size() - 11] = 0x7f;  // motor_drive's length ("linear": 4 + 7 bytes): 2^31 - 1 + ...
+  EXPECT_FALSE(current->decode(whole.data(), whole.size(), &message));
 }
 
 TEST(DecoderTable, RefusesAnArrayLongerThanThePayloadBeforeTheDecoderAllocatesIt) {

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <pidlab/lcmt_control_command.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
@@ -11,6 +13,7 @@
 #include "pidlab/controller/controller_role.h"
 #include "pidlab/plant_sim/disturbance_role.h"
 #include "pidlab/plant_sim/plant_role.h"
+#include "pidlab/plant_sim/stepper_nonlinear.h"
 #include "pidlab/transport/episode_spec.h"
 #include "pidlab/transport/pacing.h"
 #include "pidlab/transport/rtt.h"
@@ -80,7 +83,8 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
   RecoveryOptions recovery;
   recovery.retransmit_interval_s = 0.001;
   recovery.silence_deadline_s = 0.2;
-  auto config = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
+  auto config = transport::MakeEpisodeConfig(
+      pidlab::MakeEpisodeSpec(id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
   client_t.Publish(kEpisodeConfigChannel, &config);
   const double start = NowSeconds();
   double config_sent = start;
@@ -115,8 +119,8 @@ TEST(EpisodeConfig, RoundTripsEveryField) {
   e.options.pid.anti_windup = AntiWindup::kBackCalculation;
   e.options.pid.integral = IntegralMethod::kTrapezoidal;
   e.options.disturbance.seed = 99;
-  const auto msg =
-      transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  const auto msg = transport::MakeEpisodeConfig(
+      pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   EpisodeSpec dut;
   std::string error;
   ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
@@ -133,7 +137,8 @@ TEST(EpisodeConfig, RoundTripsEveryField) {
 
 TEST(EpisodeConfig, RejectsMalformedFieldsByName) {
   Episode e = DoubleIntegrator();
-  auto msg = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  auto msg = transport::MakeEpisodeConfig(
+      pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   EpisodeSpec dut;
   std::string error;
   auto bad = msg;
@@ -151,6 +156,87 @@ TEST(EpisodeConfig, RejectsMalformedFieldsByName) {
   bad = msg;
   bad.episode_id = 0;
   EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+}
+
+Episode Motor(double reference, double voltage_limit_v = HUGE_VAL, bool microstep = true) {
+  Episode e;
+  NonlinearStepperOptions o;
+  o.voltage_limit_v = voltage_limit_v;
+  o.detent_torque_nm = 0.0002;
+  o.microstep_table = microstep;
+  std::string error;
+  EXPECT_TRUE(MakeNonlinearStepperPlant(o, &e.plant, &error)) << error;
+  e.gains = {20.8836, 26.607, 12.4866};
+  e.options.loop = LoopKind::kSampled;
+  e.options.dt_s = 1e-4;
+  e.options.pid.dt_s = 1e-4;
+  e.options.horizon_s = 0.1;
+  e.options.reference = reference;
+  return e;
+}
+
+TEST(EpisodeConfig, CarriesTheNonlinearMotorWithItsOptions) {
+  const Episode e = Motor(0.2, 24.0);
+  const auto msg = transport::MakeEpisodeConfig(
+      pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  EXPECT_EQ(msg.plant_name, "stepper_nonlinear");
+  EXPECT_EQ(msg.motor_drive, "microstep");
+  EpisodeSpec dut;
+  std::string error;
+  ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
+  ASSERT_TRUE(dut.plant.nonlinear);
+  EXPECT_EQ(dut.plant.tf.den, e.plant.tf.den);
+  EXPECT_EQ(dut.plant.nonlinear->voltage_limit_v, 24.0);
+  EXPECT_EQ(dut.plant.nonlinear->detent_torque_nm, 0.0002);
+  EXPECT_TRUE(dut.plant.nonlinear->microstep_table);
+  EXPECT_EQ(dut.plant.nonlinear->motor.resistance_ohm, 33.0);
+  // A linear plant's message carries no motor.
+  const Episode linear = DoubleIntegrator();
+  const auto plain = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(
+      8, linear.plant, linear.gains, linear.options, linear.options.disturbance, RecoveryOptions{}));
+  EXPECT_EQ(plain.motor_drive, "");
+  EXPECT_EQ(plain.motor_resistance_ohm, 0.0);
+  ASSERT_TRUE(ParseEpisodeConfig(plain, &dut, &error)) << error;
+  EXPECT_FALSE(dut.plant.nonlinear);
+}
+
+TEST(EpisodeConfig, RejectsABadMotorByName) {
+  const Episode e = Motor(0.2);
+  const auto msg = transport::MakeEpisodeConfig(
+      pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  EpisodeSpec dut;
+  std::string error;
+  auto bad = msg;
+  bad.motor_drive = "fullstep";
+  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_NE(error.find("fullstep"), std::string::npos) << error;
+  bad = msg;
+  bad.motor_resistance_ohm = -1.0;
+  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_NE(error.find("motor"), std::string::npos) << error;
+  bad = msg;
+  bad.motor_inertia_kg_m2 = std::nan("");
+  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  bad = msg;
+  bad.den[1] *= 1.001;  // num/den that are not the motor's linearisation
+  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_NE(error.find("linearisation"), std::string::npos) << error;
+  bad = msg;
+  bad.plant_name = "double_integrator";  // motor fields on a linear plant
+  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+}
+
+TEST(TrioProtocol, TheNonlinearMotorIsBitIdenticalToTheInProcessLoop) {
+  for (const double limit : {HUGE_VAL, 24.0}) {
+    const Episode e = Motor(0.01, limit, /*microstep=*/false);
+    Recorder rec;
+    ASSERT_TRUE(RunOnMemq(e, 0.0, &rec)) << rec.last.message;
+    const std::vector<double> want = Reference(e);
+    ASSERT_EQ(rec.y.size(), want.size());
+    for (std::size_t k = 0; k < want.size(); ++k)
+      ASSERT_EQ(std::memcmp(&rec.y[k], &want[k], sizeof(double)), 0) << "step " << k << " limit " << limit;
+    EXPECT_GT(want.back(), 0.001);  // the rotor moved toward the reference (slowly under 24 V)
+  }
 }
 
 TEST(Transport, CountsUndecodableMessagesAndIgnoresThem) {

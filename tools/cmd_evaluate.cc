@@ -64,9 +64,6 @@ struct EvaluateCommand {
     Evaluation ev;
     std::string error;
     std::unique_ptr<EpisodeClient> client;
-    if (backend == "lcm" && p.nonlinear)
-      throw BadInput("--plant " + p.name +
-                     " runs in process only (--backend local), not over the LCM trio yet");
     if (backend == "lcm") {
       if (app_->count("--loop") > 0 && options.loop != LoopKind::kSampled)
         throw BadInput("--backend lcm runs the sampled loop, not --loop " + Quote(loop.loop));

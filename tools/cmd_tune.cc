@@ -86,9 +86,6 @@ struct TuneCommand {
   int Run() {
     const Plant p = plant.Build();
     TuneOptions o = BuildOptions();
-    if (p.nonlinear && backend != "local")
-      throw BadInput("--plant " + p.name +
-                     " runs in process only (--backend local), not over the LCM trio yet");
     if (p.nonlinear && o.loop.loop != LoopKind::kSampled)
       throw BadInput("--plant " + p.name +
                      " is nonlinear: tune it on the sampled loop (--loop sampled --dt 1e-4)");

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "pidlab/plant_sim/discrete_plant.h"
+#include "pidlab/plant_sim/stepper_nonlinear.h"
 
 namespace pidlab::transport {
 namespace {
@@ -34,7 +35,10 @@ std::string Bits(double v) {
 
 struct PlantRole::Episode {
   EpisodeSpec spec;
-  std::unique_ptr<DiscretePlant> plant;
+  std::unique_ptr<DiscretePlant> plant;          // a linear plant: exact ZOH
+  std::unique_ptr<NonlinearStepperPlant> motor;  // stepper_nonlinear: the motor, integrated
+  double Output() const { return motor ? motor->Output() : plant->Output(); }
+  void Step(double input) { motor ? motor->Step(input) : plant->Step(input); }
   long k = 0;
   bool have_u = false;
   double u = 0;
@@ -81,14 +85,19 @@ void PlantRole::StartEpisode(const EpisodeSpec& spec) {
   }
   auto ep = std::make_unique<Episode>();
   ep->spec = spec;
-  ep->plant = std::make_unique<DiscretePlant>(spec.plant.tf, spec.dt_s);
-  ep->plant->Reset();
+  if (spec.plant.nonlinear) {
+    ep->motor = std::make_unique<NonlinearStepperPlant>(*spec.plant.nonlinear, spec.dt_s);
+    ep->motor->Reset();
+  } else {
+    ep->plant = std::make_unique<DiscretePlant>(spec.plant.tf, spec.dt_s);
+    ep->plant->Reset();
+  }
   const auto n = static_cast<std::size_t>(spec.total_steps);
   ep->y_hist.assign(n + 1, kNaN);
   ep->u_hist.assign(n + 1, kNaN);
   ep->n_hist.assign(n + 1, kNaN);
   ep->have_n.assign(n + 1, 0);
-  ep->y_hist[0] = ep->plant->Output();
+  ep->y_hist[0] = ep->Output();
   ep->start_s = ep->step_start_s = ep->stream_last_s = NowSeconds();
   ep_ = std::move(ep);
   running_ = true;
@@ -238,11 +247,12 @@ void PlantRole::TryAdvance() {
   const auto k = static_cast<std::size_t>(e.k);
   if (!e.have_u || !e.have_n[k]) return;
   e.u_hist[k] = e.u;
-  // Same operation and order as RunSampledLoop: input = u + n, then ZOH.
-  e.plant->Step(e.u + e.n_hist[k]);
+  // Same operation and order as RunSampledLoop (RunNonlinearSampledLoop for
+  // the motor): input = u + n, then ZOH.
+  e.Step(e.u + e.n_hist[k]);
   ++e.k;
   e.have_u = false;
-  e.y_hist[k + 1] = e.plant->Output();
+  e.y_hist[k + 1] = e.Output();
   if (e.pacer) e.pacer->WaitForStep(e.k);  // step k starts no earlier than t0 + k dt / factor
   e.step_start_s = NowSeconds();
   e.y_resent = false;

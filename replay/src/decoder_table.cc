@@ -1,22 +1,72 @@
 #include "pidlab/replay/decoder_table.h"
 
-#include "pidlab/transport/wire.h"
-
 #include <climits>
 #include <exception>
+#include <pidlab/lcmt_episode_config_v1.hpp>
+
+#include "pidlab/transport/wire.h"
 
 namespace pidlab::replay {
 namespace {
 
 template <typename Msg>
-bool Decode(const uint8_t* data, std::size_t size, PidlabMessage* message) {
+bool DecodeAs(const uint8_t* data, std::size_t size, Msg* m) {
   if (size > INT_MAX || !PayloadLayoutOk(Msg::getHash(), data, size)) return false;
-  Msg m{};
   try {
-    if (m.decode(data, 0, static_cast<int>(size)) != static_cast<int>(size)) return false;
+    if (m->decode(data, 0, static_cast<int>(size)) != static_cast<int>(size)) return false;
   } catch (const std::exception&) {
     return false;
   }
+  return true;
+}
+
+template <typename Msg>
+bool Decode(const uint8_t* data, std::size_t size, PidlabMessage* message) {
+  Msg m{};
+  if (!DecodeAs(data, size, &m)) return false;
+  *message = std::move(m);
+  return true;
+}
+
+// A configuration written before the motor's fields were appended: decoded
+// with its own layout, read as an lcmt_episode_config of a linear plant (the
+// motor's fields 0, motor_drive "").
+bool DecodeConfigV1(const uint8_t* data, std::size_t size, PidlabMessage* message) {
+  pidlab::lcmt_episode_config_v1 o{};
+  if (!DecodeAs(data, size, &o)) return false;
+  pidlab::lcmt_episode_config m{};
+  m.utime = o.utime;
+  m.episode_id = o.episode_id;
+  m.step = o.step;
+  m.plant_name = o.plant_name;
+  m.num_size = o.num_size;
+  m.num = o.num;
+  m.den_size = o.den_size;
+  m.den = o.den;
+  m.kp = o.kp;
+  m.ki = o.ki;
+  m.kd = o.kd;
+  m.reference = o.reference;
+  m.derivative_filter_s = o.derivative_filter_s;
+  m.output_min = o.output_min;
+  m.output_max = o.output_max;
+  m.anti_windup = o.anti_windup;
+  m.back_calculation_gain = o.back_calculation_gain;
+  m.derivative_on = o.derivative_on;
+  m.integral = o.integral;
+  m.dt_s = o.dt_s;
+  m.sample_time_s = o.sample_time_s;
+  m.horizon_s = o.horizon_s;
+  m.total_steps = o.total_steps;
+  m.disturbance_kind = o.disturbance_kind;
+  m.disturbance_amplitude = o.disturbance_amplitude;
+  m.disturbance_period_s = o.disturbance_period_s;
+  m.disturbance_phase_s = o.disturbance_phase_s;
+  m.disturbance_step_time_s = o.disturbance_step_time_s;
+  m.noise_hold_s = o.noise_hold_s;
+  m.seed = o.seed;
+  m.retransmit_interval_s = o.retransmit_interval_s;
+  m.silence_deadline_s = o.silence_deadline_s;
   *message = std::move(m);
   return true;
 }
@@ -40,6 +90,8 @@ std::string MessageType::PrefixOf(const std::string& channel) const {
 DecoderTable::DecoderTable()
     : types_{
           Type<pidlab::lcmt_episode_config>("lcmt_episode_config", "EPISODE_CONFIG"),
+          MessageType{"lcmt_episode_config", "EPISODE_CONFIG", pidlab::lcmt_episode_config_v1::getHash(),
+                      &DecodeConfigV1},  // older logs
           Type<pidlab::lcmt_ready>("lcmt_ready", "READY"),
           Type<pidlab::lcmt_plant_output>("lcmt_plant_output", "PLANT_OUTPUT"),
           Type<pidlab::lcmt_control_command>("lcmt_control_command", "CONTROL"),

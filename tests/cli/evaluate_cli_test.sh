@@ -196,7 +196,6 @@ else
   fail "linearize (exit $status): $(cat lin.err)"
 fi
 bad "nonlinear plant on the continuous loop" "--loop sampled" evaluate --plant stepper_nonlinear --gains 1,1,1
-bad "nonlinear plant over LCM" "in process only" evaluate --plant stepper_nonlinear --gains 1,1,1 --backend lcm
 bad "--voltage-limit on a linear plant" "stepper_nonlinear" evaluate --plant stepper_motor --gains 1,1,1 --voltage-limit 24
 bad "linearize a linear plant" "stepper_motor" linearize --plant stepper_motor
 status=0

@@ -3,7 +3,7 @@
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
 # ever sent outside its loopback. CASE: identity | faults | drop20 | realtime | kill | sigstop | trios | trio_killed | stranger |
-# log | log_repair.
+# log | log_repair | motor.
 set -u
 BIN=$1
 CASE=$2
@@ -264,6 +264,61 @@ case $CASE in
       echo "ok   unrepairable log: launch exit $rc: ${line:0:200}"
     else
       echo "FAIL unrepairable log: launch exit $rc, stderr: $(grep -v "^pidlab-" "$TMP/launch2.err" | head -5)"; fail=1
+    fi
+    ;;
+  motor)
+    # The nonlinear stepper (stepper_nonlinear, docs/stepper.md) on the trio:
+    # the JSON (IAE, status, the motor object) and y, u, n of every step
+    # bit-identical to the in-process loop; small and tooth-pitch moves, the
+    # 24 V phase-voltage limit, a 1 rad move that loses steps, the microstep
+    # drive with detent, a load step and a sine disturbance. Then pidlab
+    # replay of the log gives each live IAE exactly.
+    export -f compare
+    export TMP PIDLAB
+    M="--plant stepper_nonlinear --gains 20.8836,26.607,12.4866 --dt 1e-4"
+    export M
+    rm -f "$TMP/motor.lcmlog"
+    "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/motor.lcmlog" -- bash -c 'fail=0
+      compare motor_small $M --horizon 0.3 --reference 0.01
+      compare motor_pitch_24v $M --horizon 0.5 --reference 0.2617993877991494 --voltage-limit 24
+      compare motor_lost $M --horizon 1 --reference 1
+      compare motor_microstep $M --horizon 0.3 --reference 0.1 --drive microstep --detent-torque 0.0002 --load-step 0.0005 --load-step-time 0.1 --disturbance sine --disturbance-amplitude 0.01 --disturbance-period 0.1
+      exit $fail' || fail=1
+    # tune --backend lcm on the motor: the same search, gains and JSON as in process.
+    T="--plant stepper_nonlinear --loop sampled --dt 1e-4 --horizon 0.05 --sample-time 0.005 --reference 0.01 --method nelder-mead --starts 1 --max-evals 30 --json"
+    "$PIDLAB" tune $T >"$TMP/motor_tune.local.json" || { echo "FAIL motor tune: local tune failed"; fail=1; }
+    "$PIDLAB" launch --lcm-url "$URL" -- pidlab tune --backend lcm $T >"$TMP/motor_tune.lcm.json" ||
+      { echo "FAIL motor tune: tune --backend lcm failed"; fail=1; }
+    a=$(jq -S 'del(.backend, .wall_time_s)' "$TMP/motor_tune.local.json")
+    b=$(jq -S 'del(.backend, .wall_time_s)' "$TMP/motor_tune.lcm.json")
+    if [ -n "$a" ] && [ "$a" = "$b" ] && jq -e '.evaluations == 30 and .status == "ok"' "$TMP/motor_tune.lcm.json" >/dev/null; then
+      echo "ok   motor tune over the trio: $(jq -c .gains "$TMP/motor_tune.lcm.json") identical to in process"
+    else
+      echo "FAIL motor tune over the trio differs from in process"; diff <(echo "$a") <(echo "$b") | head -5; fail=1
+    fi
+    jq -e '.status == "lost_steps" and .motor.lost_steps' "$TMP/motor_lost.lcm.json" >/dev/null ||
+      { echo "FAIL motor_lost: the 1 rad move is not reported as lost steps over the trio"; fail=1; }
+    jq -e '.status == "ok" and .motor.peak_phase_voltage_v == 24' "$TMP/motor_pitch_24v.lcm.json" >/dev/null ||
+      { echo "FAIL motor_pitch_24v: status or the 24 V peak: $(jq -c .motor "$TMP/motor_pitch_24v.lcm.json")"; fail=1; }
+    if "$PIDLAB" replay --json "$TMP/motor.lcmlog" >"$TMP/motor.replay.json" 2>"$TMP/motor.replay.err" &&
+      python3 - "$TMP" <<'PY'
+import json, sys
+tmp = sys.argv[1]
+rep = json.load(open(tmp + "/motor.replay.json"))
+assert rep["clean_end"], "log not read cleanly to the end"
+motor = [e for e in rep["episodes"] if e["evaluation"]["plant"] == "stepper_nonlinear"]
+for e in motor:
+    assert e["complete"], e["completeness"]
+iaes = [e["evaluation"]["iae"] for e in motor]
+for name in ("motor_small", "motor_pitch_24v", "motor_lost", "motor_microstep"):
+    live = json.load(open(f"{tmp}/{name}.lcm.json"))
+    assert live["iae"] in iaes, (name, live["iae"], iaes)
+    e = motor[iaes.index(live["iae"])]["evaluation"]
+    assert e["motor"] == live["motor"], (name, e["motor"], live["motor"])
+print(f"ok   replay: {len(motor)} motor episodes, each live IAE and motor object reproduced exactly")
+PY
+    then :; else
+      echo "FAIL replay of the motor log: $(head -3 "$TMP/motor.replay.err")"; fail=1
     fi
     ;;
   *)

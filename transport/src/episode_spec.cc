@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "pidlab/plant_sim/stepper_nonlinear.h"
+
 namespace pidlab::transport {
 namespace {
 
@@ -37,8 +39,7 @@ bool RecoveryOptions::IsValid(std::string* error) const {
 
 bool EpisodeSpec::IsValid(std::string* error) const {
   if (episode_id == 0) return Fail("episode id 0 is reserved", error);
-  if (plant.nonlinear)
-    return Fail("plant " + plant.name + " runs in process only: the trio does not carry it yet", error);
+  if (plant.nonlinear && !plant.nonlinear->IsValid(error)) return false;
   if (!plant.tf.IsValid(error)) return false;
   if (plant.tf.RelativeDegree() < 1)
     return Fail("plant " + plant.tf.ToString() + " must be strictly proper", error);
@@ -52,7 +53,8 @@ bool EpisodeSpec::IsValid(std::string* error) const {
   else if (!(sample_time_s > 0.0) || !IsWholeMultiple(sample_time_s, dt_s, &samples) || samples < 1)
     os << "sample time " << sample_time_s << " s must be a whole multiple of dt " << dt_s << " s";
   else if (!(horizon_s > 0.0) || !IsWholeMultiple(horizon_s, sample_time_s, &samples) || samples < 1)
-    os << "horizon " << horizon_s << " s must be a whole multiple of the sample time " << sample_time_s << " s";
+    os << "horizon " << horizon_s << " s must be a whole multiple of the sample time " << sample_time_s
+       << " s";
   else if (!IsWholeMultiple(horizon_s, dt_s, &steps) || steps != total_steps)
     os << "total steps " << total_steps << " != horizon / dt";
   else if (total_steps > kMaxEpisodeSteps)
@@ -100,8 +102,80 @@ pidlab::lcmt_episode_config MakeEpisodeConfig(const EpisodeSpec& spec) {
   m.seed = static_cast<int64_t>(d.seed);
   m.retransmit_interval_s = spec.recovery.retransmit_interval_s;
   m.silence_deadline_s = spec.recovery.silence_deadline_s;
+  m.motor_resistance_ohm = m.motor_self_inductance_h = m.motor_mutual_inductance_h = 0.0;
+  m.motor_inertia_kg_m2 = m.motor_rotor_teeth = m.motor_viscous_friction = m.motor_tooth_pitch_rad = 0.0;
+  m.motor_stationary_current_a = m.motor_flux_linkage = m.motor_detent_torque_nm = 0.0;
+  m.motor_load_torque_nm = m.motor_load_step_nm = m.motor_load_step_time_s = 0.0;
+  m.motor_voltage_limit_v = m.motor_input_scale = m.motor_abs_tolerance = m.motor_rel_tolerance = 0.0;
+  m.motor_drive = "";
+  if (spec.plant.nonlinear) {
+    const NonlinearStepperOptions& o = *spec.plant.nonlinear;
+    const StepperMotorParameters& p = o.motor;
+    m.motor_resistance_ohm = p.resistance_ohm;
+    m.motor_self_inductance_h = p.self_inductance_h;
+    m.motor_mutual_inductance_h = p.mutual_inductance_h;
+    m.motor_inertia_kg_m2 = p.inertia_kg_m2;
+    m.motor_rotor_teeth = p.rotor_teeth;
+    m.motor_viscous_friction = p.viscous_friction;
+    m.motor_tooth_pitch_rad = p.tooth_pitch_rad;
+    m.motor_stationary_current_a = p.stationary_current_a;
+    m.motor_flux_linkage = p.flux_linkage;
+    m.motor_detent_torque_nm = o.detent_torque_nm;
+    m.motor_load_torque_nm = o.load_torque_nm;
+    m.motor_load_step_nm = o.load_step_nm;
+    m.motor_load_step_time_s = o.load_step_time_s;
+    m.motor_voltage_limit_v = o.voltage_limit_v;
+    m.motor_input_scale = o.input_scale;
+    m.motor_abs_tolerance = o.abs_tolerance;
+    m.motor_rel_tolerance = o.rel_tolerance;
+    m.motor_drive = o.microstep_table ? "microstep" : "linear";
+  }
   return m;
 }
+
+namespace {
+
+// The motor of a stepper_nonlinear configuration: its options from the
+// message, its linearisation recomputed here and checked against num/den.
+bool ParseMotor(const pidlab::lcmt_episode_config& m, Plant* plant, std::string* error) {
+  NonlinearStepperOptions o;
+  StepperMotorParameters& p = o.motor;
+  p.resistance_ohm = m.motor_resistance_ohm;
+  p.self_inductance_h = m.motor_self_inductance_h;
+  p.mutual_inductance_h = m.motor_mutual_inductance_h;
+  p.inertia_kg_m2 = m.motor_inertia_kg_m2;
+  p.rotor_teeth = m.motor_rotor_teeth;
+  p.viscous_friction = m.motor_viscous_friction;
+  p.tooth_pitch_rad = m.motor_tooth_pitch_rad;
+  p.stationary_current_a = m.motor_stationary_current_a;
+  p.flux_linkage = m.motor_flux_linkage;
+  o.detent_torque_nm = m.motor_detent_torque_nm;
+  o.load_torque_nm = m.motor_load_torque_nm;
+  o.load_step_nm = m.motor_load_step_nm;
+  o.load_step_time_s = m.motor_load_step_time_s;
+  o.voltage_limit_v = m.motor_voltage_limit_v;
+  o.input_scale = m.motor_input_scale;
+  o.abs_tolerance = m.motor_abs_tolerance;
+  o.rel_tolerance = m.motor_rel_tolerance;
+  if (m.motor_drive != "linear" && m.motor_drive != "microstep")
+    return Fail("motor drive '" + m.motor_drive + "' unknown (linear or microstep)", error);
+  o.microstep_table = m.motor_drive == "microstep";
+  std::string why;
+  if (!MakeNonlinearStepperPlant(o, plant, &why)) return Fail("motor: " + why, error);
+  // num/den are the linearisation the sender computed: the same code gives
+  // the same numbers (to rounding on another machine).
+  const auto close = [](const std::vector<double>& a, const std::vector<double>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (!(std::abs(a[i] - b[i]) <= 1e-9 * std::max(std::abs(a[i]), std::abs(b[i])))) return false;
+    return true;
+  };
+  if (!close(plant->tf.num, m.num) || !close(plant->tf.den, m.den))
+    return Fail("plant num/den are not the motor's linearisation " + plant->tf.ToString(), error);
+  return true;
+}
+
+}  // namespace
 
 bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec, std::string* error) {
   EpisodeSpec s;
@@ -109,6 +183,11 @@ bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec,
   s.plant.name = m.plant_name;
   s.plant.tf.num = m.num;
   s.plant.tf.den = m.den;
+  if (m.plant_name == "stepper_nonlinear") {
+    if (!ParseMotor(m, &s.plant, error)) return false;
+  } else if (!m.motor_drive.empty()) {
+    return Fail("motor fields on plant '" + m.plant_name + "' (only stepper_nonlinear has a motor)", error);
+  }
   s.gains = PidGains{m.kp, m.ki, m.kd};
   s.reference = m.reference;
   s.dt_s = m.dt_s;

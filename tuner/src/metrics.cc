@@ -410,6 +410,13 @@ void JudgeMotor(const NonlinearStepperPlant& motor, const std::vector<double>& y
   ev->motor_note = os.str();
 }
 
+bool IsInProcess(const SampledRunner& runner) {
+  using Fn = bool (*)(const Plant&, const PidGains&, const LoopOptions&, const DisturbanceOptions&,
+                      std::vector<double>*, std::vector<SampledStep>*, std::string*);
+  const Fn* fn = runner.target<Fn>();
+  return fn != nullptr && *fn == &RunSampledLoopInProcess;
+}
+
 }  // namespace
 
 bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
@@ -488,13 +495,35 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
     ev->stability = SampledStability(discrete, gains, pid, options.stability_margin);
     if (ev->stability.stable) {
       std::vector<double> y_all;
-      if (plant.nonlinear) {
-        // In process (the trio runs linear plants only): the motor's peaks
-        // and whether it lost steps come with the run.
+      if (plant.nonlinear && IsInProcess(runner)) {
+        // In process: the motor's peaks and whether it lost steps come with the run.
         NonlinearStepperPlant motor(*plant.nonlinear, options.dt_s);
         RunNonlinearSampledLoop(&motor, gains, pid, disturbance, options.TotalSteps(), 1, &y_all,
                                 what.record_trajectory ? &ev->trajectory : nullptr, a);
         JudgeMotor(motor, y_all, a, ev);
+      } else if (plant.nonlinear) {
+        // Over the trio (or from a log): y comes from the run; the motor's
+        // peaks from the model re-driven by the run's u_k + n_k, which must
+        // give the run's y bit for bit (the plant process integrates the same
+        // model with the same inputs).
+        std::vector<SampledStep> steps;
+        if (!runner(plant, gains, options, options.disturbance, &y_all, &steps, error)) return false;
+        NonlinearStepperPlant motor(*plant.nonlinear, options.dt_s);
+        std::size_t differ = 0;
+        for (const SampledStep& st : steps) {
+          motor.Step(st.u + st.n);
+          const auto next = static_cast<std::size_t>(st.k) + 1;
+          if (next < y_all.size() && !(motor.Output() == y_all[next])) ++differ;
+        }
+        JudgeMotor(motor, y_all, a, ev);
+        if (differ > 0) {
+          std::ostringstream os;
+          os << (ev->motor_note.empty() ? "" : "; ")
+             << "the motor model re-driven by the run's u + n differs "
+             << "from the run's y at " << differ << " steps (peaks are the model's)";
+          ev->motor_note += os.str();
+        }
+        if (what.record_trajectory) ev->trajectory = std::move(steps);
       } else if (!runner(plant, gains, options, options.disturbance, &y_all,
                          what.record_trajectory ? &ev->trajectory : nullptr, error)) {
         return false;
@@ -507,7 +536,7 @@ bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& opti
       ev->iae_continuous = integral;
       std::vector<double> y1 = y_all;
       if (has_disturbance) {
-        if (plant.nonlinear) {
+        if (plant.nonlinear && IsInProcess(runner)) {
           RunSampledLoopInProcess(plant, gains, options, none.options(), &y1, nullptr, error);
         } else if (!runner(plant, gains, options, none.options(), &y1, nullptr, error)) {
           return false;
@@ -551,8 +580,6 @@ ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& op
   if (plant.nonlinear && options.loop != LoopKind::kSampled)
     throw std::invalid_argument("plant " + plant.name +
                                 " is nonlinear: tune it on the sampled loop (--loop sampled)");
-  if (plant.nonlinear && runner_)
-    throw std::invalid_argument("plant " + plant.name + " runs in process only, not over the LCM trio");
   if (options.loop == LoopKind::kSampled) {
     options_.pid.dt_s = options.dt_s;
     discrete_ = std::make_unique<DiscretePlant>(plant.tf, options.dt_s);
@@ -585,7 +612,7 @@ double ObjectiveEvaluator::operator()(const PidGains& gains) const {
     return GeneralContinuousObjective(realization_, disturbance_, options_, kind_, gains);
   if (!SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable) return kInf;
   if (runner_ || kind_ == ObjectiveKind::kIaeContinuous || plant_.nonlinear) {
-    if (plant_.nonlinear) {
+    if (plant_.nonlinear && !runner_) {
       std::string error;
       RunSampledLoopInProcess(plant_, gains, options_, options_.disturbance, &y, nullptr, &error);
     } else if (runner_) {
