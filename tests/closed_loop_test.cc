@@ -529,3 +529,124 @@ TEST(Evaluate, RejectsABiproperPlantAsBadInput) {
 
 }  // namespace
 }  // namespace pidlab
+
+// ---- The filtered PID kp + ki/s + kd s/(tf s + 1) in the continuous loop ----
+
+namespace pidlab {
+namespace {
+
+// y(m ts) of the double integrator under the filtered PID by classic RK4 at
+// h = 1e-4 s on x1' = x2, x2' = u, z' = e, v' = (e - v)/tf,
+// u = kp e + ki z + (kd/tf)(e - v), e = 1 - x1: independent of the matrix form.
+std::vector<double> FilteredDoubleIntegratorRk4(const PidGains& g, double ts, int samples) {
+  std::array<double, 4> w{0.0, 0.0, 0.0, 0.0};  // x1, x2, z, v
+  auto f = [&](const std::array<double, 4>& s) {
+    const double e = 1.0 - s[0];
+    const double u = g.kp * e + g.ki * s[2] + g.kd / g.tf * (e - s[3]);
+    return std::array<double, 4>{s[1], u, e, (e - s[3]) / g.tf};
+  };
+  const double h = 1e-4;
+  const int per = static_cast<int>(std::lround(ts / h));
+  std::vector<double> y{w[0]};
+  for (int m = 1; m < samples; ++m) {
+    for (int k = 0; k < per; ++k) {
+      auto add = [&](const std::array<double, 4>& a, const std::array<double, 4>& b, double c) {
+        std::array<double, 4> r{};
+        for (int i = 0; i < 4; ++i) r[i] = a[i] + c * b[i];
+        return r;
+      };
+      const auto k1 = f(w), k2 = f(add(w, k1, h / 2)), k3 = f(add(w, k2, h / 2)), k4 = f(add(w, k3, h));
+      for (int i = 0; i < 4; ++i) w[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    }
+    y.push_back(w[0]);
+  }
+  return y;
+}
+
+TEST(FilteredPid, ContinuousLoopMatchesAnIndependentRk4) {
+  PidGains g{29.6558, 0.4977, 28.3216};
+  g.tf = 0.05;
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 0.0, 0.0}}, g, LoopOptions{});
+  ASSERT_TRUE(dut.stability.stable);
+  EXPECT_EQ(dut.stability.poles.size(), 4u) << "plant 2 + integral + filter";
+  const std::vector<double> ref = FilteredDoubleIntegratorRk4(g, 0.05, 501);
+  ASSERT_EQ(dut.y.size(), ref.size());
+  for (std::size_t m = 0; m < ref.size(); ++m) EXPECT_NEAR(dut.y[m], ref[m], 1e-9) << "m = " << m;
+  EXPECT_DOUBLE_EQ(dut.gains.tf, 0.05);
+}
+
+TEST(FilteredPid, TendsToTheIdealPidAsTheFilterVanishes) {
+  const PidGains ideal{29.6558, 0.4977, 28.3216};
+  PidGains g = ideal;
+  g.tf = 1e-6;
+  const TransferFunction di{{1.0}, {1.0, 0.0, 0.0}};
+  EXPECT_NEAR(EvaluateOrFail(di, g, LoopOptions{}).iae, EvaluateOrFail(di, ideal, LoopOptions{}).iae, 1e-4);
+}
+
+TEST(FilteredPid, WithoutDerivativeGainTheFilterIsAHiddenModeAndChangesNothing) {
+  PidGains g{2.0, 1.0, 0.0};
+  const Evaluation ideal = EvaluateOrFail({{1.0}, {1.0, 1.0}}, g, LoopOptions{});
+  g.tf = 7.0;  // a slow hidden filter pole at -1/7 must not show
+  const Evaluation dut = EvaluateOrFail({{1.0}, {1.0, 1.0}}, g, LoopOptions{});
+  EXPECT_EQ(dut.stability.poles.size(), ideal.stability.poles.size());
+  EXPECT_NEAR(dut.iae, ideal.iae, 1e-12);
+  EXPECT_NEAR(dut.step.final_value, 1.0, 1e-12);
+}
+
+TEST(FilteredPid, SampledLoopConvergesToTheFilteredContinuousLoop) {
+  PidGains g{29.6558, 0.4977, 28.3216};
+  g.tf = 0.05;
+  const TransferFunction di{{1.0}, {1.0, 0.0, 0.0}};
+  LoopOptions sampled;
+  sampled.loop = LoopKind::kSampled;
+  sampled.dt_s = 1e-4;
+  const double continuous = EvaluateOrFail(di, g, LoopOptions{}).iae;
+  EXPECT_NEAR(EvaluateOrFail(di, g, sampled).iae, continuous, 2e-3 * continuous);
+}
+
+TEST(FilteredPid, OptionsFilterReachesBothLoopsAndTheGainsFilterWins) {
+  const TransferFunction di{{1.0}, {1.0, 0.0, 0.0}};
+  LoopOptions o;
+  o.pid.derivative_filter_s = 0.05;
+  PidGains g{29.6558, 0.4977, 28.3216};
+  const Evaluation from_options = EvaluateOrFail(di, g, o);
+  EXPECT_DOUBLE_EQ(from_options.gains.tf, 0.05);
+  g.tf = 0.05;
+  EXPECT_EQ(from_options.iae, EvaluateOrFail(di, g, LoopOptions{}).iae);
+  o.pid.derivative_filter_s = 0.2;  // the gains' own tf is used
+  EXPECT_EQ(EvaluateOrFail(di, g, o).gains.tf, 0.05);
+}
+
+TEST(FilteredPid, RatioSetsTfToKdOverNKp) {
+  LoopOptions o;
+  o.derivative_filter_ratio = 10.0;
+  EXPECT_DOUBLE_EQ(LoopGains(PidGains{2.0, 1.0, 4.0}, o).tf, 0.2);
+  EXPECT_EQ(LoopGains(PidGains{2.0, 1.0, 0.0}, o).tf, 0.0) << "no derivative: no filter";
+  EXPECT_TRUE(std::isinf(LoopGains(PidGains{0.0, 1.0, 4.0}, o).tf));
+  Evaluation ev;
+  std::string error;
+  EXPECT_FALSE(Evaluate(Plant{"custom", {{1.0}, {1.0, 0.0, 0.0}}}, PidGains{0.0, 1.0, 4.0}, o,
+                        EvaluateOptions{}, &ev, &error));
+  EXPECT_NE(error.find("kp > 0"), std::string::npos) << error;
+  o.pid.derivative_filter_s = 0.1;
+  EXPECT_FALSE(o.IsValid(&error)) << "a time constant and a ratio at once";
+  EXPECT_NE(error.find("not both"), std::string::npos) << error;
+}
+
+TEST(FilteredPid, DiscretePidUsesTheGainsFilter) {
+  PidGains g{1.0, 0.0, 2.0};
+  g.tf = 0.1;
+  PidOptions with_gains, with_options;
+  with_gains.dt_s = with_options.dt_s = 0.01;
+  with_options.derivative_filter_s = 0.1;
+  DiscretePid<double> a(g, with_gains), b(PidGains{1.0, 0.0, 2.0}, with_options);
+  for (int k = 0; k < 20; ++k) {
+    double ua = 0, ub = 0;
+    a.Step(1.0, 0.01 * k, &ua);
+    b.Step(1.0, 0.01 * k, &ub);
+    EXPECT_EQ(ua, ub) << "k = " << k;
+  }
+}
+
+}  // namespace
+}  // namespace pidlab

@@ -397,7 +397,13 @@ void LoopFlags::Register(CLI::App* app) {
       ->check(WholeNumber())
       ->capture_default_str();
   app->add_option("--derivative-filter", derivative_filter_s,
-                  "sampled PID: derivative filter time constant in s")
+                  "derivative filter time constant Tf in s, both loops: C(s) = kp + ki/s + kd s/(Tf s + 1); "
+                  "0 = the paper's ideal PID")
+      ->check(FiniteNumber())
+      ->capture_default_str();
+  app->add_option("--derivative-filter-ratio", derivative_filter_ratio,
+                  "derivative filter by a ratio N: Tf = kd / (N kp) (Td / N), both loops; 0 = not used; "
+                  "excludes --derivative-filter")
       ->check(FiniteNumber())
       ->capture_default_str();
   app->add_option("--output-limits", output_limits, "sampled PID: output limits LO,HI");
@@ -431,6 +437,7 @@ LoopOptions LoopFlags::Build() const {
   d.seed = seed;
   o.pid.dt_s = dt_s;
   o.pid.derivative_filter_s = derivative_filter_s;
+  o.derivative_filter_ratio = derivative_filter_ratio;
   if (!output_limits.empty()) {
     const auto v = ParseList(output_limits, "--output-limits", /*allow_infinite=*/true);  // inf: no limit
     if (v.size() != 2) throw BadInput("--output-limits " + Quote(output_limits) + " must be LO,HI");
@@ -446,6 +453,86 @@ LoopOptions LoopFlags::Build() const {
   std::string error;
   if (!o.IsValid(&error)) throw BadInput(error);
   return o;
+}
+
+void BoundsFlags::Register(CLI::App* app, const std::string& what) {
+  app->add_option("--max-ms", max_ms, what + " with Ms = ||S||inf above this (e.g. 1.6)")
+      ->check(NumberOrInfinity());
+  app->add_option("--max-mt", max_mt, what + " with Mt = ||T||inf above this (e.g. 1.3)")
+      ->check(NumberOrInfinity());
+  app->add_option("--max-noise-gain", max_noise_gain,
+                  what + " with the noise gain ||C S||inf above this (the ideal derivative's is unbounded)")
+      ->check(NumberOrInfinity());
+  app->add_option("--min-phase-margin", min_phase_margin_deg, what + " with a phase margin below this (deg)")
+      ->check(FiniteNumber());
+  app->add_option("--min-gain-margin", min_gain_margin,
+                  what + " with a gain margin within this factor of 1 (> 1, e.g. 2 = 6 dB; 0 = none)")
+      ->check(FiniteNumber());
+  app->add_option("--max-time-constant", max_time_constant_s,
+                  what + " whose slowest closed-loop time constant 1/min|Re p| exceeds this (s)")
+      ->check(NumberOrInfinity());
+}
+
+LoopBounds BoundsFlags::Build() const {
+  LoopBounds b;
+  b.max_ms = max_ms;
+  b.max_mt = max_mt;
+  b.max_noise_gain = max_noise_gain;
+  b.min_phase_margin_deg = min_phase_margin_deg;
+  b.min_gain_margin = min_gain_margin;
+  b.max_time_constant_s = max_time_constant_s;
+  std::string error;
+  if (!b.IsValid(&error)) throw BadInput(error);
+  return b;
+}
+
+LoopAnalysis AnalyzeOrThrow(const Plant& plant, const PidGains& gains, const LoopOptions& options) {
+  LoopAnalysis a;
+  std::string error;
+  if (!AnalyzeLoop(plant, gains, options, LoopAnalysisOptions{}, &a, &error)) throw BadInput(error);
+  return a;
+}
+
+std::string FormatRobustness(const LoopAnalysis& a, const LoopBounds& bounds) {
+  std::ostringstream os;
+  os << std::setprecision(5);
+  auto at = [](double w) {
+    std::ostringstream s;
+    s << std::setprecision(4);
+    if (std::isinf(w))
+      s << " (w -> inf)";
+    else if (std::isfinite(w))
+      s << " at " << w << " rad/s";
+    return s.str();
+  };
+  os << "robustness       " << ToString(a.loop) << " loop"
+     << (a.loop == LoopKind::kSampled ? ", frequency response up to pi/dt" : "") << "\n";
+  if (!a.stable) {
+    os << "  margins        - (unstable loop)\n";
+  } else {
+    os << "  Ms = ||S||inf  " << a.ms << at(a.ms_rad_s) << "\n";
+    os << "  Mt = ||T||inf  " << a.mt << at(a.mt_rad_s) << "\n";
+    if (std::isfinite(a.gain_margin))
+      os << "  gain margin    " << a.gain_margin << " (" << 20.0 * std::log10(a.gain_margin) << " dB)"
+         << at(a.phase_crossover_rad_s) << "\n";
+    else
+      os << "  gain margin    inf (" << a.gain_margin_note << ")\n";
+    if (std::isfinite(a.phase_margin_deg))
+      os << "  phase margin   " << a.phase_margin_deg << " deg" << at(a.gain_crossover_rad_s)
+         << ", delay margin " << a.delay_margin_s << " s\n";
+    else
+      os << "  phase margin   inf (" << a.phase_margin_note << ")\n";
+    if (std::isfinite(a.noise_gain))
+      os << "  noise gain     " << a.noise_gain << at(a.noise_gain_rad_s) << "   (||C S||inf)\n";
+    else
+      os << "  noise gain     unbounded (" << a.noise_gain_note << ")\n";
+  }
+  os << "  slowest tau    " << a.slowest_time_constant_s << " s   (1 / min |Re p|)\n";
+  for (const Cancellation& c : a.cancellations)
+    os << "  cancellation   pole " << FormatPoles({c.pole}) << " near controller zero "
+       << FormatPoles({c.zero}) << " (" << 100.0 * c.relative_distance << " % apart)\n";
+  for (const std::string& v : LoopBoundsViolations(a, bounds)) os << "  VIOLATES       " << v << "\n";
+  return os.str();
 }
 
 std::string FormatPoles(const std::vector<std::complex<double>>& poles) {
@@ -470,8 +557,9 @@ std::string FormatEvaluation(const Evaluation& ev) {
     return s.str();
   };
   os << "plant            " << ev.plant.name << "  G(s) = " << ev.plant.tf.ToString() << "\n";
-  os << "gains            kp = " << ev.gains.kp << ", ki = " << ev.gains.ki << ", kd = " << ev.gains.kd
-     << "\n";
+  os << "gains            kp = " << ev.gains.kp << ", ki = " << ev.gains.ki << ", kd = " << ev.gains.kd;
+  if (ev.gains.tf > 0.0) os << ", tf = " << ev.gains.tf << " s (filtered derivative)";
+  os << "\n";
   os << "loop             " << ToString(ev.options.loop);
   if (ev.options.loop == LoopKind::kSampled) os << " (dt = " << ev.options.dt_s << " s)";
   os << ", ts = " << ev.options.sample_time_s << " s, n = " << ev.options.horizon_s << " s, "

@@ -4,6 +4,7 @@
 // (one line on stderr naming the value, exit status 2).
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,7 @@
 #include "pidlab/tuner/episode_client.h"
 #include "pidlab/tuner/episode_pool.h"
 #include "pidlab/tuner/evaluation.h"
+#include "pidlab/tuner/loop_analysis.h"
 
 namespace pidlab::cli {
 
@@ -112,15 +114,31 @@ struct LoopFlags {
   double disturbance_amplitude = 0.0, disturbance_period_s = 2.0, disturbance_phase_s = 0.0;
   double disturbance_step_time_s = 0.0, noise_hold_s = 0.01;
   std::uint64_t seed = 1;
-  double derivative_filter_s = 0.0;
+  double derivative_filter_s = 0.0, derivative_filter_ratio = 0.0;
   std::string output_limits, anti_windup = "clamping", derivative_on = "error", integral = "backward-euler";
   void Register(CLI::App* app);
   LoopOptions Build() const;  // throws BadInput
 };
 
+/// --max-ms, --max-mt, --max-noise-gain, --min-phase-margin,
+/// --min-gain-margin, --max-time-constant (docs/robustness.md).
+struct BoundsFlags {
+  double max_ms = HUGE_VAL, max_mt = HUGE_VAL, max_noise_gain = HUGE_VAL;
+  double min_phase_margin_deg = 0.0, min_gain_margin = 0.0, max_time_constant_s = HUGE_VAL;
+  /// `what`: "reject candidates" (tune) or "report loops" (evaluate).
+  void Register(CLI::App* app, const std::string& what);
+  LoopBounds Build() const;  // throws BadInput
+};
+
+/// The analysis as table rows (evaluate, tune).
+std::string FormatRobustness(const LoopAnalysis& a, const LoopBounds& bounds);
+/// AnalyzeLoop with the default options; throws BadInput on its error.
+LoopAnalysis AnalyzeOrThrow(const Plant& plant, const PidGains& gains, const LoopOptions& options);
+
 // JsonNumber (null for NaN/inf), ToJson(Evaluation), ToJson(PidGains): the
 // JSON objects live in a library the Python module shares (tools/json/).
 using json::JsonNumber;
+using json::RobustnessJson;
 using json::ToJson;
 /// The `realtime` object of a paced episode: exactly missed_deadlines,
 /// lateness_p50_s, lateness_p99_s, lateness_max_s, rate_hz.

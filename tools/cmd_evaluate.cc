@@ -1,5 +1,8 @@
 // pidlab evaluate: IAE, stability and step metrics of one gain set.
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -8,6 +11,7 @@
 #include "cli_common.h"
 #include "commands.h"
 #include "pidlab/tuner/episode_client.h"
+#include "pidlab/tuner/monte_carlo.h"
 
 namespace pidlab::cli {
 namespace {
@@ -16,6 +20,9 @@ struct EvaluateCommand {
   PlantFlags plant;
   LoopFlags loop;
   std::string gains;
+  BoundsFlags bounds;
+  int monte_carlo = 0;
+  std::string spread = "10%";
   bool json = false;
   std::string samples_csv;
   std::string trajectory_csv;
@@ -27,10 +34,19 @@ struct EvaluateCommand {
   std::function<int()> Register(CLI::App* app) {
     app->description(
         "Evaluate one PID gain set on a plant: the paper's IAE (eq. 4) and other error sums, closed-loop "
-        "poles and strict stability, MATLAB-stepinfo rise/overshoot/settling of the unit-step response.");
+        "poles and strict stability, MATLAB-stepinfo rise/overshoot/settling of the unit-step response, "
+        "margins, Ms, Mt, noise gain and the slowest time constant (docs/robustness.md).");
     plant.Register(app);
     loop.Register(app);
     app->add_option("--gains", gains, "KP,KI,KD (each finite and >= 0)")->required();
+    bounds.Register(app, "report loops");
+    app->add_option(
+           "--monte-carlo", monte_carlo,
+           "also evaluate the gains on N plants drawn around this one (seeded by --seed; stepper: each "
+           "Table I parameter, other plants: each coefficient, uniformly within --spread)")
+        ->capture_default_str();
+    app->add_option("--spread", spread, "--monte-carlo: relative spread, as 10% or 0.1, in [0, 1)")
+        ->capture_default_str();
     app->add_flag("--json", json, "print one JSON object instead of the table");
     app->add_option("--samples-csv", samples_csv, "write t,r,y,e,n at the sample times to this CSV file");
     app->add_option("--trajectory-csv", trajectory_csv,
@@ -48,8 +64,11 @@ struct EvaluateCommand {
 
   int Run() {
     const Plant p = plant.Build();
+    const StepperMotorParameters stepper = plant.StepperParameters();
+    const MonteCarloOptions mc = BuildMonteCarlo();
     const PidGains g = ParseGains(gains);
     LoopOptions options = loop.Build();
+    const LoopBounds loop_bounds = bounds.Build();
     EvaluateOptions what;
     what.record_trajectory = !trajectory_csv.empty();
     if (what.record_trajectory && options.loop != LoopKind::kSampled && backend == "local")
@@ -84,16 +103,36 @@ struct EvaluateCommand {
     } else if (!Evaluate(p, g, options, what, &ev, &error)) {
       throw BadInput(error);
     }
+    // Margins, peaks, noise gain and time constants of the loop evaluated.
+    const LoopAnalysis analysis = AnalyzeOrThrow(p, g, options);
+    MonteCarloSummary mc_summary;
+    if (monte_carlo > 0) {
+      if (backend == "lcm") throw BadInput("--monte-carlo runs in process: use --backend local");
+      if (p.nonlinear)
+        throw BadInput("--monte-carlo draws linear plants: it does not take --plant " + Quote(p.name));
+      const bool tty = isatty(STDERR_FILENO) != 0;
+      const auto progress = [tty](int done, int total) {
+        if (tty && (done % 10 == 0 || done == total))
+          std::fprintf(stderr, "\r  Monte Carlo %d / %d   ", done, total);
+      };
+      if (!RunMonteCarlo(p, p.name == "stepper_motor" ? &stepper : nullptr, g, options, mc, &mc_summary,
+                         &error, progress))
+        throw BadInput(error);
+      if (tty) std::fprintf(stderr, "\r%40s\r", "");
+    }
     if (!samples_csv.empty()) WriteSamplesCsv(ev, samples_csv);
     if (!trajectory_csv.empty()) WriteTrajectoryCsv(ev, trajectory_csv);
     if (json) {
       nlohmann::json j = ToJson(ev);
       j["backend"] = backend;
+      j["robustness"] = RobustnessJson(analysis, loop_bounds);
+      if (monte_carlo > 0) j["monte_carlo"] = MonteCarloJson(mc, mc_summary);
       if (client) j["steps_per_second"] = JsonNumber(client->stats().StepsPerSecond());
       if (client && client->stats().realtime.paced()) j["realtime"] = RealtimeJson(client->stats().realtime);
       std::cout << j.dump() << "\n";
     } else {
-      std::cout << FormatEvaluation(ev);
+      std::cout << FormatEvaluation(ev) << FormatRobustness(analysis, loop_bounds);
+      if (monte_carlo > 0) std::cout << FormatMonteCarlo(mc, mc_summary);
       if (client) {
         std::printf("backend: lcm, %ld steps in %ld episode(s), %.0f steps/s\n", client->stats().steps,
                     client->stats().episodes, client->stats().StepsPerSecond());
@@ -102,6 +141,62 @@ struct EvaluateCommand {
       }
     }
     return 0;
+  }
+
+  // --monte-carlo, --spread (10% or 0.1) and --seed; throws BadInput.
+  MonteCarloOptions BuildMonteCarlo() const {
+    MonteCarloOptions mc;
+    if (monte_carlo < 0) throw BadInput("--monte-carlo " + std::to_string(monte_carlo) + " must be >= 0");
+    mc.samples = std::max(monte_carlo, 1);
+    const bool percent = !spread.empty() && spread.back() == '%';
+    const double v = ParseDouble(percent ? spread.substr(0, spread.size() - 1) : spread, "--spread");
+    mc.spread = percent ? v / 100.0 : v;
+    mc.seed = loop.seed;
+    std::string error;
+    if (!mc.IsValid(&error)) throw BadInput("--spread " + Quote(spread) + " / --monte-carlo: " + error);
+    return mc;
+  }
+
+  static nlohmann::json DistributionJson(const Distribution& d) {
+    return {{"count", d.count},
+            {"min", JsonNumber(d.min)},
+            {"median", JsonNumber(d.median)},
+            {"p95", JsonNumber(d.p95)},
+            {"max", JsonNumber(d.max)}};
+  }
+
+  static nlohmann::json MonteCarloJson(const MonteCarloOptions& mc, const MonteCarloSummary& s) {
+    return {{"samples", s.samples},
+            {"spread", mc.spread},
+            {"seed", mc.seed},
+            {"perturbed", s.perturbed},
+            {"stable", s.stable},
+            {"invalid", s.invalid},
+            {"stable_fraction", s.stable_fraction},
+            {"iae", DistributionJson(s.iae)},
+            {"overshoot_pct", DistributionJson(s.overshoot_pct)},
+            {"ms", DistributionJson(s.ms)}};
+  }
+
+  static std::string FormatMonteCarlo(const MonteCarloOptions& mc, const MonteCarloSummary& s) {
+    char line[256];
+    std::string out;
+    std::snprintf(line, sizeof line, "monte carlo      %d plants, %s within +/-%g %%, seed %llu\n", s.samples,
+                  s.perturbed.c_str(), 100.0 * mc.spread, static_cast<unsigned long long>(mc.seed));
+    out += line;
+    std::snprintf(line, sizeof line, "  stable         %d of %d (%.4g %%)%s\n", s.stable, s.samples,
+                  100.0 * s.stable_fraction,
+                  s.invalid ? (" (" + std::to_string(s.invalid) + " invalid draws)").c_str() : "");
+    out += line;
+    out += "                 min          median       p95          max\n";
+    const std::pair<const char*, const Distribution*> rows[] = {
+        {"  IAE          ", &s.iae}, {"  overshoot %  ", &s.overshoot_pct}, {"  Ms           ", &s.ms}};
+    for (const auto& [name, d] : rows) {
+      std::snprintf(line, sizeof line, "%s  %-12.6g %-12.6g %-12.6g %-12.6g\n", name, d->min, d->median,
+                    d->p95, d->max);
+      out += line;
+    }
+    return out;
   }
 
   static void WriteTrajectoryCsv(const Evaluation& ev, const std::string& path) {

@@ -27,6 +27,7 @@ struct TuneCommand {
       refine_starts = 2;
   double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3;
   bool json = false, adaptive = false;
+  BoundsFlags loop_bounds;
   LcmFlags lcm;
   std::unique_ptr<EpisodePool> pool;
 
@@ -75,6 +76,7 @@ struct TuneCommand {
         ->check(NumberOrInfinity());
     app->add_option("--max-settling", max_settling_time_s, "reject candidates settling later (s)")
         ->check(NumberOrInfinity());
+    loop_bounds.Register(app, "reject candidates");
     app->add_option("--zn-rule", zn_rule, "classic | pessen | some-overshoot | no-overshoot")
         ->capture_default_str();
     app->add_option("--trace", trace, "write the best-so-far trajectory of the search to this CSV file");
@@ -99,14 +101,19 @@ struct TuneCommand {
     if (tty) std::fprintf(stderr, "\r%70s\r", "");
     if (!trace.empty()) WriteTrace(s);
     Evaluation ev;
+    LoopAnalysis analysis;
     if (s.stable) {
       EvaluateOptions what;
       Evaluate(p, s.gains, o.loop, what, &ev, &error);
+      analysis = AnalyzeOrThrow(p, s.gains, o.loop);
     }
     if (json) {
-      std::cout << json::TuneJson(p, o, s, ev, backend).dump() << "\n";
+      nlohmann::json j = json::TuneJson(p, o, s, ev, backend);
+      j["robustness"] = s.stable ? RobustnessJson(analysis, o.bounds) : nlohmann::json(nullptr);
+      std::cout << j.dump() << "\n";
     } else {
       PrintText(o, s, ev);
+      if (s.stable) std::cout << FormatRobustness(analysis, o.bounds);
     }
     return s.stable ? 0 : 1;
   }
@@ -139,6 +146,7 @@ struct TuneCommand {
     o.seed = loop.seed;
     o.max_overshoot_pct = max_overshoot_pct;
     o.max_settling_time_s = max_settling_time_s;
+    o.bounds = loop_bounds.Build();
     o.agree_tolerance = agree_tolerance;
     std::string error;
     if (!o.IsValid(&error)) throw BadInput(error);

@@ -128,14 +128,17 @@ py::object EvaluatePy(const py::object& plant, const std::vector<double>& gains,
   const LoopOptions options = loop.Build(LoopOptions{}.stability_margin);
   Evaluation ev;
   std::string error;
+  LoopAnalysis analysis;
   bool ok = false;
   {
     py::gil_scoped_release release;
-    ok = Evaluate(p, g, options, EvaluateOptions{}, &ev, &error);
+    ok = Evaluate(p, g, options, EvaluateOptions{}, &ev, &error) &&
+         AnalyzeLoop(p, g, options, LoopAnalysisOptions{}, &analysis, &error);
   }
   if (!ok) Bad(error);
   nlohmann::json j = json::ToJson(ev);
   j["backend"] = "local";
+  j["robustness"] = json::RobustnessJson(analysis, LoopBounds{});
   return ToPython(j);
 }
 
@@ -180,14 +183,20 @@ py::object TunePy(const py::object& plant, const LoopArgs& loop, const TuneArgs&
   if (!o.IsValid(&error)) Bad(error);
   TuneSummary s;
   Evaluation ev;
+  LoopAnalysis analysis;
   bool ok = false;
   {
     py::gil_scoped_release release;
     ok = Tune(p, o, &s, &error);
-    if (ok && s.stable) Evaluate(p, s.gains, o.loop, EvaluateOptions{}, &ev, &error);
+    if (ok && s.stable) {
+      Evaluate(p, s.gains, o.loop, EvaluateOptions{}, &ev, &error);
+      ok = AnalyzeLoop(p, s.gains, o.loop, LoopAnalysisOptions{}, &analysis, &error);
+    }
   }
   if (!ok) Bad(error);
-  return ToPython(json::TuneJson(p, o, s, ev, "local"));
+  nlohmann::json j = json::TuneJson(p, o, s, ev, "local");
+  j["robustness"] = s.stable ? json::RobustnessJson(analysis, o.bounds) : nlohmann::json(nullptr);
+  return ToPython(j);
 }
 
 }  // namespace

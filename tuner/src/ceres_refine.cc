@@ -35,8 +35,12 @@ struct ErrorResiduals {
 
   template <typename T>
   bool operator()(const T* const gains, T* residuals) const {
-    PidGainsT<T> g{gains[0], gains[1], gains[2]};
-    const PidGains gd{ToDouble(gains[0]), ToDouble(gains[1]), ToDouble(gains[2])};
+    // The loop's derivative filter (a ratio makes tf a function of kp and kd,
+    // differentiated with them).
+    const PidGainsT<T> g = LoopGains(PidGainsT<T>{gains[0], gains[1], gains[2]}, *loop);
+    const PidGains gd =
+        LoopGains(PidGains{ToDouble(gains[0]), ToDouble(gains[1]), ToDouble(gains[2])}, *loop);
+    if (!GainsAreValid(gd, nullptr)) return false;
     const Disturbance disturbance(loop->disturbance);
     std::vector<T> y;
     const double ts = loop->sample_time_s;

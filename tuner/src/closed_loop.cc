@@ -49,6 +49,13 @@ bool LoopOptions::IsValid(std::string* error) const {
     os << "stability margin " << stability_margin << " must be in [0, 1)";
   else if (!(dt_s > 0.0) || !std::isfinite(dt_s))  // a bad --dt is an error even if the loop ignores it
     os << "dt " << dt_s << " s must be positive and finite";
+  else if (!(derivative_filter_ratio >= 0.0) || !std::isfinite(derivative_filter_ratio))
+    os << "derivative filter ratio " << derivative_filter_ratio << " must be >= 0 and finite";
+  else if (derivative_filter_ratio > 0.0 && pid.derivative_filter_s != 0.0)
+    os << "give the derivative filter once: a time constant " << pid.derivative_filter_s << " s or a ratio "
+       << derivative_filter_ratio << ", not both";
+  else if (!(pid.derivative_filter_s >= 0.0) || !std::isfinite(pid.derivative_filter_s))
+    os << "derivative filter " << pid.derivative_filter_s << " s must be >= 0 and finite";
   else if (!disturbance.IsValid(error))
     return false;
   else if (loop == LoopKind::kContinuous && DisturbanceBreakpoints() > kMaxDisturbanceBreakpoints)
@@ -98,16 +105,37 @@ double LoopOptions::StepsPerEvaluation() const {
   return horizon_s / sample_time_s + 1.0 + kStepsPerBreakpoint * DisturbanceBreakpoints();
 }
 
+std::vector<int> LiveLoopStates(const ContinuousClosedLoop<double>& loop) {
+  // With ki = 0 the integrator state z never reaches u (with kd = 0 the
+  // filter state v neither): its pole is a hidden mode of the realisation,
+  // not of the loop.
+  const int order = loop.loop_order();
+  std::vector<int> live;
+  for (int j = 0; j < order; ++j) {
+    bool feeds = j < loop.plant_order;
+    for (int i = 0; i < order && !feeds; ++i)
+      if (i != j && loop.m(i, j) != 0.0) feeds = true;
+    if (feeds) live.push_back(j);
+  }
+  return live;
+}
+
 int EffectiveLoopOrder(const ContinuousClosedLoop<double>& loop) {
-  // With ki = 0 the integrator state z never reaches u: its pole at s = 0 is
-  // a hidden mode of the realisation, not of the loop.
-  const int np = loop.plant_order;
-  return loop.m.block(0, np, np, 1).isZero(0.0) ? np : np + 1;
+  return static_cast<int>(LiveLoopStates(loop).size());
+}
+
+Eigen::MatrixXd LiveLoopMatrix(const ContinuousClosedLoop<double>& loop) {
+  const std::vector<int> live = LiveLoopStates(loop);
+  const int n = static_cast<int>(live.size());
+  Eigen::MatrixXd m(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) m(i, j) = loop.m(live[i], live[j]);
+  return m;
 }
 
 Stability ContinuousStability(const ContinuousClosedLoop<double>& loop, double margin) {
-  const int n = EffectiveLoopOrder(loop);
-  Eigen::MatrixXd m = loop.m.topLeftCorner(n, n);
+  Eigen::MatrixXd m = LiveLoopMatrix(loop);
+  const int n = static_cast<int>(m.rows());
   BalanceInPlace(&m);
   Eigen::EigenSolver<Eigen::MatrixXd> es(m, false);
   Stability s;
@@ -133,7 +161,7 @@ Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const 
   const int n = plant.order();
   const int size = n + 4;
   const int ii = n, id = n + 1, iep = n + 2, isp = n + 3;
-  const double dt = o.dt_s, tf = o.derivative_filter_s;
+  const double dt = o.dt_s, tf = EffectiveDerivativeFilter(g, o);
   const double a = tf / (tf + dt), b = g.kd / (tf + dt);
   Eigen::RowVectorXd e_row = Eigen::RowVectorXd::Zero(size);
   e_row.head(n) = -plant.c();

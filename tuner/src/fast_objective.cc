@@ -179,6 +179,8 @@ bool FastContinuousObjective::Covers(const TransferFunction& tf, const LoopOptio
   if (options.loop != LoopKind::kContinuous) return false;
   if (options.disturbance.kind != DisturbanceKind::kNone) return false;
   if (kind == ObjectiveKind::kIaeContinuous) return false;
+  // The fast path runs the ideal PID only (tf = 0).
+  if (options.derivative_filter_ratio > 0.0 || options.pid.derivative_filter_s != 0.0) return false;
   if (!tf.IsValid(nullptr) || tf.RelativeDegree() < 1) return false;
   const int order =
       static_cast<int>(tf.den.size()) - 1 -

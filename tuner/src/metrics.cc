@@ -43,7 +43,7 @@ class AdaptiveWalker {
     Eigen::VectorXd w = loop_.w0;
     double t = 0.0, excited = 0.0;
     const bool piecewise = loop_.exo_size == 1 && disturbance_ != nullptr;
-    const int ie = loop_.plant_order + 2;
+    const int ie = loop_.exo_index();
     visit(t, w);
     long points = 1;
     while (t < t_end) {
@@ -77,7 +77,7 @@ class AdaptiveWalker {
   }
 
  private:
-  double ExoFrequency() const { return std::abs(loop_.m(loop_.plant_order + 2, loop_.plant_order + 3)); }
+  double ExoFrequency() const { return std::abs(loop_.m(loop_.exo_index(), loop_.exo_index() + 1)); }
 
   double StepAt(double tau) const {
     double fastest = 0.0;
@@ -122,7 +122,7 @@ double Bisect(const std::function<double(double)>& g, double a, double b) {
 ContinuousClosedLoop<double> UndisturbedLoop(const ContinuousClosedLoop<double>& loop) {
   ContinuousClosedLoop<double> y1 = loop;
   if (loop.exo_size > 0) {
-    const int size = loop.plant_order + 2;
+    const int size = loop.exo_index();
     y1.m = loop.m.topLeftCorner(size, size);
     y1.w0 = loop.w0.head(size);
     y1.exo_size = 0;
@@ -264,10 +264,13 @@ double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, do
 }
 
 double ContinuousFinalValue(const ContinuousClosedLoop<double>& loop) {
-  const int n = EffectiveLoopOrder(loop);
-  const int ir = loop.plant_order + 1;  // the reference state
-  const Eigen::VectorXd w = loop.m.topLeftCorner(n, n).partialPivLu().solve(-loop.m.block(0, ir, n, 1));
-  return loop.reference * loop.c.dot(w.head(loop.plant_order));
+  const std::vector<int> live = LiveLoopStates(loop);
+  const int n = static_cast<int>(live.size());
+  const int ir = loop.reference_index();
+  Eigen::VectorXd rhs(n);
+  for (int i = 0; i < n; ++i) rhs(i) = -loop.m(live[i], ir);
+  const Eigen::VectorXd w = LiveLoopMatrix(loop).partialPivLu().solve(rhs);
+  return loop.reference * loop.c.dot(w.head(loop.plant_order));  // the plant's states come first
 }
 
 StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stability& stability) {
@@ -438,10 +441,16 @@ bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const Lo
   return true;
 }
 
-bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+bool Evaluate(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
               const EvaluateOptions& what, Evaluation* ev, std::string* error, const SampledRunner& runner) {
-  if (!GainsAreValid(gains, error)) return false;
+  if (!GainsAreValid(typed_gains, error)) return false;
   if (!options.IsValid(error)) return false;
+  const PidGains gains = LoopGains(typed_gains, options);
+  if (!std::isfinite(gains.tf)) {
+    if (error) *error = "a derivative filter ratio needs kp > 0 when kd > 0 (tf = kd / (N kp))";
+    return false;
+  }
+  if (!GainsAreValid(gains, error)) return false;
   if (!plant.tf.IsValid(error)) return false;
   if (plant.tf.RelativeDegree() < 1) {
     if (error) *error = "plant " + plant.tf.ToString() + " must be strictly proper";
@@ -602,12 +611,13 @@ double GeneralContinuousObjective(const StateSpace& realization, const Disturban
   return ObjectiveFromSamples(kind, y, options.sample_time_s, options.reference);
 }
 
-double ObjectiveEvaluator::operator()(const PidGains& gains) const {
+double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {
   ++evaluations_;
   thread_local std::vector<double> y;  // reused: no allocation per evaluation
+  const PidGains gains = LoopGains(typed_gains, options_);
   if (!GainsAreValid(gains, nullptr)) return kInf;
   const double ts = options_.sample_time_s;
-  if (fast_) return (*fast_)(gains);
+  if (fast_ && gains.tf == 0.0) return (*fast_)(gains);
   if (options_.loop == LoopKind::kContinuous)
     return GeneralContinuousObjective(realization_, disturbance_, options_, kind_, gains);
   if (!SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable) return kInf;

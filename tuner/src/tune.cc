@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <sstream>
 
 #include "pidlab/tuner/genetic_algorithm.h"
@@ -102,6 +103,8 @@ bool TuneOptions::IsValid(std::string* error) const {
     os << "max overshoot " << max_overshoot_pct << " % must be >= 0";
   else if (std::isnan(max_settling_time_s) || !(max_settling_time_s > 0.0))
     os << "max settling time " << max_settling_time_s << " s must be positive";
+  else if (!bounds.IsValid(error))
+    return false;
   else if (!(agree_tolerance > 0.0) || !(agree_tolerance < 1.0))
     os << "agree tolerance " << agree_tolerance << " must be in (0, 1)";
   else if (!loop.IsValid(error))
@@ -165,14 +168,36 @@ Options WithBudget(Options o, const TuneOptions& t, int Options::*iterations) {
 // The function the search minimises: the evaluator's objective, or +inf
 // where the undisturbed step response breaks the overshoot or settling
 // constraint of `options`.
+// True if the loop of `g` meets options.bounds (cheap check, see TuneOptions).
+bool MeetsBounds(const Plant& plant, const StateSpace& realization, const TuneOptions& options,
+                 const PidGains& typed) {
+  if (!options.bounds.Any()) return true;
+  const PidGains g = LoopGains(typed, options.loop);
+  if (options.loop.loop == LoopKind::kContinuous) {
+    ContinuousClosedLoop<double> loop;
+    if (!BuildContinuousClosedLoop<double>(realization, g, Disturbance(DisturbanceOptions{}), &loop, nullptr))
+      return false;
+    return ContinuousLoopMeetsBounds(plant.tf, g, ContinuousStability(loop, options.loop.stability_margin),
+                                     options.bounds);
+  }
+  LoopAnalysisOptions coarse;
+  coarse.points_per_decade = 20.0;
+  LoopAnalysis a;
+  return AnalyzeLoop(plant, g, options.loop, coarse, &a, nullptr) &&
+         LoopBoundsViolation(a, options.bounds).empty();
+}
+
 ObjectiveFunction ConstrainedObjective(const Plant& plant, const TuneOptions& options,
                                        const ObjectiveEvaluator& evaluator) {
   const bool constrained =
       std::isfinite(options.max_overshoot_pct) || std::isfinite(options.max_settling_time_s);
-  return [&plant, &options, &evaluator, constrained](const Eigen::VectorXd& x) {
+  auto realization = std::make_shared<StateSpace>(Realize(plant.tf));
+  return [&plant, &options, &evaluator, constrained, realization](const Eigen::VectorXd& x) {
     const PidGains g{x(0), x(1), x(2)};
     const double value = evaluator(g);
-    if (!std::isfinite(value) || !constrained) return value;
+    if (!std::isfinite(value)) return value;
+    if (!MeetsBounds(plant, *realization, options, g)) return HUGE_VAL;
+    if (!constrained) return value;
     LoopOptions undisturbed = options.loop;
     undisturbed.disturbance = DisturbanceOptions{};
     Evaluation ev;
@@ -284,9 +309,8 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
                              runner.target<decltype(&RunSampledLoopInProcess)>() == nullptr;
   const ObjectiveEvaluator evaluator(plant, options.loop, options.objective,
                                      custom_runner ? runner : SampledRunner(nullptr));
-  if (!Search(plant, options, ConstrainedObjective(plant, options, evaluator), evaluator, progress, summary,
-              error))
-    return false;
+  const ObjectiveFunction f = ConstrainedObjective(plant, options, evaluator);
+  if (!Search(plant, options, f, evaluator, progress, summary, error)) return false;
   const OptimizerSummary& opt = summary->optimizer;
   summary->evaluations = opt.evaluations;
   summary->iterations = opt.iterations;
@@ -319,11 +343,21 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
     }
   } else if (options.refine && options.method != TuneMethod::kZieglerNichols && !plant.nonlinear) {
     summary->refine = RefineWithCeres(plant, options, summary->search_gains, summary->search_objective);
-    if (summary->refine.objective < summary->objective) {
+    const PidGains& r = summary->refine.gains;
+    // Ceres knows no constraint: its point is kept only if it meets them all.
+    const bool better = summary->refine.objective < summary->objective;
+    const bool feasible = better && std::isfinite(f(Eigen::Vector3d(r.kp, r.ki, r.kd)));
+    if (better && !feasible)
+      summary->refine.message += "; its gains break a constraint of the tuning, the search result stands";
+    if (feasible) {
       summary->gains = summary->refine.gains;
       summary->objective = summary->refine.objective;
     }
   }
+  // The loop's derivative filter of the gains found (tf = 0 for the ideal PID).
+  summary->gains = LoopGains(summary->gains, options.loop);
+  summary->search_gains = LoopGains(summary->search_gains, options.loop);
+  summary->refine.gains = LoopGains(summary->refine.gains, options.loop);
   summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return true;
 }

@@ -6,7 +6,7 @@ namespace pidlab::json {
 
 nlohmann::json JsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
-nlohmann::json ToJson(const PidGains& g) { return {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}}; }
+nlohmann::json ToJson(const PidGains& g) { return {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}, {"tf", g.tf}}; }
 
 namespace {
 
@@ -105,6 +105,43 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
                             {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
                             {"rule", ToString(o.zn_rule)}};
   if (s.stable) AddMotor(ev, &j);
+  return j;
+}
+
+nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds) {
+  auto complex_json = [](const std::complex<double>& c) {
+    return nlohmann::json{{"re", c.real()}, {"im", c.imag()}};
+  };
+  nlohmann::json j;
+  j["loop"] = ToString(a.loop);
+  j["stable"] = a.stable;
+  j["ms"] = JsonNumber(a.ms);
+  j["mt"] = JsonNumber(a.mt);
+  j["gain_margin"] = JsonNumber(a.gain_margin);
+  j["phase_margin_deg"] = JsonNumber(a.phase_margin_deg);
+  j["delay_margin_s"] = JsonNumber(a.delay_margin_s);
+  j["noise_gain"] = JsonNumber(a.noise_gain);
+  j["slowest_time_constant_s"] = JsonNumber(a.slowest_time_constant_s);
+  j["ms_rad_s"] = JsonNumber(a.ms_rad_s);
+  j["mt_rad_s"] = JsonNumber(a.mt_rad_s);
+  j["noise_gain_rad_s"] = JsonNumber(a.noise_gain_rad_s);
+  j["gain_crossover_rad_s"] = JsonNumber(a.gain_crossover_rad_s);
+  j["phase_crossover_rad_s"] = JsonNumber(a.phase_crossover_rad_s);
+  j["gain_crossovers_rad_s"] = a.gain_crossovers_rad_s;
+  j["phase_crossovers_rad_s"] = a.phase_crossovers_rad_s;
+  nlohmann::json cancellations = nlohmann::json::array();
+  for (const Cancellation& c : a.cancellations)
+    cancellations.push_back({{"pole", complex_json(c.pole)},
+                             {"zero", complex_json(c.zero)},
+                             {"relative_distance", c.relative_distance}});
+  j["cancellations"] = cancellations;
+  nlohmann::json notes = nlohmann::json::object();
+  if (!a.gain_margin_note.empty()) notes["gain_margin"] = a.gain_margin_note;
+  if (!a.phase_margin_note.empty()) notes["phase_margin_deg"] = notes["delay_margin_s"] = a.phase_margin_note;
+  if (!a.noise_gain_note.empty()) notes["noise_gain"] = a.noise_gain_note;
+  j["notes"] = notes;
+  j["violations"] = LoopBoundsViolations(a, bounds);
+  j["method"] = a.method;
   return j;
 }
 

@@ -2,7 +2,9 @@
 // PID controllers.
 //
 // Continuous (eq. 2 of the paper), ideal parallel form:
-//   u(t) = kp e(t) + ki \int_0^t e dt + kd de/dt,   e = r - y.
+//   u(t) = kp e(t) + ki \int_0^t e dt + kd de/dt,   e = r - y,
+// or with a first-order derivative filter of time constant tf > 0:
+//   C(s) = kp + ki / s + kd s / (tf s + 1)           (tf = 0: the ideal PID).
 //
 // Discrete, period dt, one call per sample k (t_k = k dt), u_k held over
 // [t_k, t_{k+1}):
@@ -12,7 +14,9 @@
 //       | I_{k-1} + ki dt e_{k-1}                 (forward Euler)
 //       | I_{k-1} + ki dt (e_k + e_{k-1}) / 2     (trapezoidal)
 //   D_k = tf/(tf+dt) D_{k-1} + kd/(tf+dt) (s_k - s_{k-1}),
-//         s = e (derivative on error) or s = -y (on measurement)
+//         s = e (derivative on error) or s = -y (on measurement),
+//         the backward-Euler image of kd s / (tf s + 1) with the same tf as
+//         the continuous loop (EffectiveDerivativeFilter)
 //   u_k = sat(P_k + I_k + D_k)
 // The loop is at rest before k = 0 (r = y = e = 0), so with the defaults
 // (tf = 0, derivative on error, no limits) a unit step in r gives the
@@ -35,6 +39,10 @@ struct PidGainsT {
   T kp = T(0.0);
   T ki = T(0.0);
   T kd = T(0.0);
+  /// Time constant of the derivative filter kd s / (tf s + 1), s; 0 = the
+  /// paper's ideal derivative. The same tf drives the continuous loop and the
+  /// discrete PID.
+  T tf = T(0.0);
 };
 using PidGains = PidGainsT<double>;
 
@@ -42,15 +50,18 @@ using PidGains = PidGainsT<double>;
 /// limits"): larger gains only overflow the closed loop's matrices.
 inline constexpr double kMaxGain = 1e12;
 
-/// Gains must be finite, >= 0 and at most kMaxGain (the paper's search box is
-/// [0, 30]^3).
+/// Gains (and the filter time constant tf, s) must be finite, >= 0 and at
+/// most kMaxGain (the paper's search box is [0, 30]^3).
 inline bool GainsAreValid(const PidGains& g, std::string* error) {
-  const std::pair<const char*, double> f[] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
+  const std::pair<const char*, double> f[] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}, {"tf", g.tf}};
   for (const auto& [name, v] : f) {
     if (!std::isfinite(v) || v < 0.0 || v > kMaxGain) {
       if (error) {
         std::ostringstream os;
-        os << "gain " << name << " = " << v << " must be finite, >= 0 and at most " << kMaxGain;
+        if (name[0] == 't')
+          os << "derivative filter " << v << " s (tf) must be finite, >= 0 and at most " << kMaxGain;
+        else
+          os << "gain " << name << " = " << v << " must be finite, >= 0 and at most " << kMaxGain;
         *error = os.str();
       }
       return false;
@@ -67,6 +78,8 @@ struct PidOptions {
   /// Sample period in s, > 0.
   double dt_s = 1e-3;
   /// Time constant of the first-order derivative filter in s; 0 = unfiltered.
+  /// Used where the gains carry none (PidGains::tf = 0): the field the wire
+  /// (lcmt_episode_config) carries. See EffectiveDerivativeFilter.
   double derivative_filter_s = 0.0;
   /// Output limits; lower < upper. Infinite = unlimited.
   double output_min = -std::numeric_limits<double>::infinity();
@@ -96,6 +109,14 @@ struct PidOptions {
     return false;
   }
 };
+
+/// The derivative filter time constant a PID runs with: gains.tf where it is
+/// set (> 0), else options.derivative_filter_s.
+template <typename T>
+T EffectiveDerivativeFilter(const PidGainsT<T>& gains, const PidOptions& options) {
+  if (gains.tf > T(0.0)) return gains.tf;
+  return T(options.derivative_filter_s);
+}
 
 bool ParseDerivativeOn(const std::string& s, DerivativeOn* v);
 bool ParseIntegralMethod(const std::string& s, IntegralMethod* v);
@@ -135,8 +156,9 @@ class DiscretePid {
         break;
     }
     const T signal = options_.derivative_on == DerivativeOn::kError ? e : T(-y);
-    const double tf = options_.derivative_filter_s;
-    const T d = T(tf / (tf + dt)) * derivative_ + gains_.kd * (signal - prev_signal_) * T(1.0 / (tf + dt));
+    const T tf = EffectiveDerivativeFilter(gains_, options_);
+    const T d =
+        tf / (tf + T(dt)) * derivative_ + gains_.kd * (signal - prev_signal_) * (T(1.0) / (tf + T(dt)));
     const T unsaturated = p + integral + d;
     T out = unsaturated;
     bool saturated = false;

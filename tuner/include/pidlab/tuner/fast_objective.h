@@ -55,7 +55,9 @@ class FastContinuousObjective {
 
   /// True for what the fast path computes: the continuous loop, no
   /// disturbance, any reference step A, the iae, ise or itae objective, a
-  /// strictly proper plant of order 1..kMaxPlantOrder.
+  /// strictly proper plant of order 1..kMaxPlantOrder, the ideal PID (no
+  /// derivative filter in the options; a gain with tf != 0 goes the general
+  /// path too).
   static bool Covers(const TransferFunction& tf, const LoopOptions& options, ObjectiveKind kind);
   /// Covers for a plant: never a nonlinear one (stepper_nonlinear), whose tf
   /// is only its linearisation.

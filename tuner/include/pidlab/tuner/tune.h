@@ -12,6 +12,7 @@
 
 #include "pidlab/tuner/evaluation.h"
 #include "pidlab/tuner/multi_start.h"
+#include "pidlab/tuner/loop_analysis.h"
 #include "pidlab/tuner/optimizer.h"
 #include "pidlab/tuner/ziegler_nichols.h"
 
@@ -87,6 +88,11 @@ struct TuneOptions {
   /// violating them is rejected like an unstable loop.
   double max_overshoot_pct = std::numeric_limits<double>::infinity();
   double max_settling_time_s = std::numeric_limits<double>::infinity();
+  /// Robustness bounds (Ms, Mt, noise gain, margins, time constant): a
+  /// candidate breaking one is rejected like an unstable loop, by the cheap
+  /// check ContinuousLoopMeetsBounds (continuous loop) or AnalyzeLoop
+  /// (sampled loop, 20 points a decade); the Ceres point only if it meets them.
+  LoopBounds bounds;
   /// Run the Ceres cross-check after the search.
   bool refine = true;
   /// RefineVerdict::kAgree when |f_ceres - f_search| <= agree_tolerance * f_search.

@@ -7,17 +7,23 @@
 #include <string>
 
 #include "pidlab/tuner/evaluation.h"
+#include "pidlab/tuner/loop_analysis.h"
 #include "pidlab/tuner/tune.h"
 
 namespace pidlab::json {
 
 /// v, or null for NaN and +-inf (JSON has no such numbers).
 nlohmann::json JsonNumber(double v);
-/// {"kp", "ki", "kd"}.
+/// {"kp", "ki", "kd", "tf"} (tf = 0: the ideal PID).
 nlohmann::json ToJson(const PidGains& g);
 /// The object of `pidlab evaluate --json` without "backend" (README.md,
 /// docs/tuning.md list the keys).
 nlohmann::json ToJson(const Evaluation& ev);
+/// The `robustness` object of evaluate and tune: ms, mt, gain_margin,
+/// phase_margin_deg, delay_margin_s, noise_gain, slowest_time_constant_s
+/// (null where infinite or undefined, with a note in `notes`), crossover and
+/// peak frequencies, cancellations, and the `violations` of `bounds`.
+nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds);
 /// The object of `pidlab tune --json`: plant `p`, options `o`, summary `s`,
 /// and `ev`, the evaluation of s.gains on o.loop (unused unless s.stable);
 /// `backend` is "local" or "lcm".

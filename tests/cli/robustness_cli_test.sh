@@ -1,0 +1,175 @@
+#!/usr/bin/env bash
+# pidlab evaluate's `robustness` object against an independent computation:
+# numpy evaluates C(jw) G(jw) on 400,001 log-spaced frequencies from 1e-5 to
+# 1e7 rad/s (G of the stepper rebuilt from Table I by eq. (3) in Python),
+# refines every maximum with scipy's bounded scalar search and every crossover
+# with brentq, for the paper's Nelder-Mead gains of the three plants (ideal
+# PID, and with --derivative-filter 0.01 (stepper: 1e-5) for a finite noise
+# gain). Every figure
+# must agree within 0.5 %. Also: the JSON keys, the notes of an infinite
+# margin and of the ideal derivative, --monte-carlo, and bad input.
+# Usage: robustness_cli_test.sh PIDLAB_BINARY PAPER_TABLES_CSV
+set -euo pipefail
+if [[ $# -ne 2 ]]; then
+  echo "usage: $0 PIDLAB_BINARY PAPER_TABLES_CSV" >&2
+  exit 2
+fi
+pidlab=$(realpath -- "$1")
+csv=$(realpath -- "$2")
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+
+passed=0
+failed=0
+pass() { echo "PASS: $1"; passed=$((passed + 1)); }
+fail() { echo "FAIL: $1"; failed=$((failed + 1)); }
+
+# ---- The paper's NM gains against numpy/scipy ----
+for plant in double_integrator oscillator stepper_motor; do
+  gains=$(awk -F, -v p="$plant" '$2 == p && $3 == "nelder_mead" { print $5 "," $6 "," $7; exit }' "$csv")
+  filtered=0.01
+  [[ $plant == stepper_motor ]] && filtered=1e-5  # its loop is fast: 0.01 s destabilises it
+  for tf in 0 $filtered; do
+    name="$plant gains $gains tf $tf"
+    if "$pidlab" evaluate --plant "$plant" --gains "$gains" --derivative-filter "$tf" --json >out.json 2>err.txt &&
+      /usr/bin/python3 - out.json "$plant" "$gains" "$tf" <<'PY'
+import json, math, sys
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+j = json.load(open(sys.argv[1]))
+plant, (kp, ki, kd), tf = sys.argv[2], map(float, sys.argv[3].split(",")), float(sys.argv[4])
+if plant == "double_integrator":
+    num, den = [1.0], [1.0, 0.0, 0.0]
+elif plant == "oscillator":
+    num, den = [1.0], [1.0, 0.0, 1.0]
+else:  # eq. (3) with Table I, independently of pidlab
+    r, L, M, J, Nr, D, lam, Io, flux = 33.0, 5.4e-3, 0.4e-3, 0.16e-4, 6.0, 1.35e-5, math.pi / 12, 0.15, 1.2e-3
+    Lp, half = L - M, Nr * lam / 2
+    wnp2 = 2 * Nr**2 * flux * Io * math.cos(half) / J
+    kpm = flux * math.sin(half) ** 2 / (Lp * Io * math.cos(half))
+    num = [r / L * wnp2]
+    den = [1.0, r / Lp + D / J, r / Lp * D / J + wnp2 * (1 + kpm), r / Lp * wnp2]
+
+def parts(w):
+    s = 1j * np.asarray(w, dtype=float)
+    c = kp + ki / s + kd * s / (tf * s + 1)
+    l = c * np.polyval(num, s) / np.polyval(den, s)
+    return c, l
+
+def mags(w):
+    c, l = parts(w)
+    return {"ms": np.abs(1 / (1 + l)), "mt": np.abs(l / (1 + l)), "noise_gain": np.abs(c / (1 + l))}
+
+w = np.logspace(-5, 7, 400_001)
+with np.errstate(all="ignore"):
+    grid = mags(w)
+    c, l = parts(w)
+ref = {}
+for key, v in grid.items():
+    v = np.where(np.isfinite(v), v, -np.inf)
+    i = int(np.argmax(v))
+    lo, hi = w[max(i - 2, 0)], w[min(i + 2, len(w) - 1)]
+    res = minimize_scalar(lambda x: -mags([math.exp(x)])[key][0], bounds=(math.log(lo), math.log(hi)),
+                          method="bounded", options={"xatol": 1e-12})
+    ref[key] = max(v[i], -res.fun)
+# Gain crossovers |L| = 1 and phase crossovers Im L = 0 with Re L < 0.
+g = np.log(np.abs(l))
+pms, dms, gms = [], [], []
+for k in np.nonzero(np.diff(np.sign(g)) != 0)[0]:
+    if not (np.isfinite(g[k]) and np.isfinite(g[k + 1])):
+        continue
+    wc = brentq(lambda x: math.log(abs(parts([x])[1][0])), w[k], w[k + 1], xtol=1e-14, rtol=1e-14)
+    pm = math.degrees(np.angle(parts([wc])[1][0])) + 180.0
+    pm = pm - 360.0 if pm > 180.0 else pm
+    pms.append(pm)
+    dms.append(math.radians(pm if pm > 0 else pm + 360.0) / wc)
+im = np.imag(l)
+for k in np.nonzero(np.diff(np.sign(im)) != 0)[0]:
+    if not (np.isfinite(im[k]) and np.isfinite(im[k + 1])) or abs(l[k]) > 1e12 or abs(l[k + 1]) > 1e12:
+        continue
+    wp = brentq(lambda x: np.imag(parts([x])[1][0]), w[k], w[k + 1], xtol=1e-14, rtol=1e-14)
+    lp = parts([wp])[1][0]
+    if lp.real < 0 and abs(lp) < 1e9:  # not the phase jump at a pole on the axis
+        gms.append(1.0 / abs(lp))
+ref["phase_margin_deg"] = min(pms) if pms else None
+ref["delay_margin_s"] = min(dms) if dms else None
+ref["gain_margin"] = min(gms, key=lambda x: abs(math.log(x))) if gms else None
+if tf == 0 and kd > 0:
+    ref["noise_gain"] = None  # unbounded: pidlab must say null
+rob = j["robustness"]
+bad = []
+for key, want in ref.items():
+    got = rob[key]
+    if want is None or got is None:
+        if want is not got:
+            bad.append(f"{key}: pidlab {got} numpy {want}")
+        continue
+    err = abs(got - want) / abs(want)
+    print(f"  {key:18s} pidlab {got:.6g}  numpy/scipy {want:.6g}  rel diff {err:.1e}")
+    if err > 5e-3:
+        bad.append(f"{key}: pidlab {got} numpy {want} ({err:.2%})")
+if bad:
+    print("\n".join(bad))
+    sys.exit(1)
+PY
+    then
+      pass "$name: ms, mt, margins, delay margin, noise gain within 0.5 % of numpy/scipy"
+    else
+      fail "$name: $(tail -3 err.txt 2>/dev/null)"
+    fi
+  done
+done
+
+# ---- Keys, notes, bounds reported ----
+"$pidlab" evaluate --plant double_integrator --gains 0.2999,0,30 --max-time-constant 10 --json >keys.json
+if /usr/bin/python3 - keys.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+r = j["robustness"]
+for k in ["ms", "mt", "gain_margin", "phase_margin_deg", "delay_margin_s", "noise_gain", "slowest_time_constant_s"]:
+    assert k in r, k
+assert r["noise_gain"] is None and r["notes"]["noise_gain"] == "ideal derivative: unbounded", r
+assert r["gain_margin"] is None and "infinite gain margin" in r["notes"]["gain_margin"], r
+assert len(r["cancellations"]) == 1 and 99 < r["slowest_time_constant_s"] < 101, r
+assert any(v.startswith("time constant") for v in r["violations"]), r["violations"]
+assert j["gains"]["tf"] == 0
+PY
+then pass "robustness keys, null with notes, the cancellation and a violated bound"; else fail "robustness keys"; fi
+
+"$pidlab" evaluate --plant double_integrator --gains 30,1,30 --derivative-filter-ratio 10 --json >ratio.json
+if /usr/bin/python3 -c "import json,sys; g=json.load(open('ratio.json'))['gains']; assert abs(g['tf']-0.1)<1e-15, g"; then
+  pass "--derivative-filter-ratio 10 gives tf = kd/(10 kp) in the gains"
+else fail "--derivative-filter-ratio"; fi
+
+# ---- Monte Carlo ----
+"$pidlab" evaluate --plant double_integrator --gains 1,0.95,1 --monte-carlo 100 --spread 20% --seed 3 --json >mc1.json
+"$pidlab" evaluate --plant double_integrator --gains 1,0.95,1 --monte-carlo 100 --spread 0.2 --seed 3 --json >mc2.json
+if /usr/bin/python3 - mc1.json mc2.json <<'PY'
+import json, sys
+a, b = (json.load(open(f))["monte_carlo"] for f in sys.argv[1:])
+assert a == b, "20% and 0.2 with the same seed give the same draws"
+assert 0.45 < a["stable_fraction"] < 0.8, a  # 0.625 expected (Routh: b > 0.95)
+for k in ["iae", "overshoot_pct", "ms"]:
+    d = a[k]
+    assert d["min"] <= d["median"] <= d["p95"] <= d["max"], d
+PY
+then pass "--monte-carlo: 20% = 0.2, seeded, stable fraction across the Routh boundary"; else fail "--monte-carlo"; fi
+if "$pidlab" evaluate --plant stepper --gains 20.8836,26.607,12.4866 --monte-carlo 20 | grep -q "Table I parameters"; then
+  pass "--monte-carlo on the stepper perturbs Table I parameters"
+else fail "stepper Monte Carlo table"; fi
+
+# ---- Bad input: exit 2, one line naming the value ----
+for args in "--monte-carlo 10 --spread 150%" "--monte-carlo 10 --spread abc" "--monte-carlo -1" \
+  "--max-ms 0.5" "--min-gain-margin 0.5" "--derivative-filter -1" \
+  "--derivative-filter 0.1 --derivative-filter-ratio 10"; do
+  status=0
+  # shellcheck disable=SC2086
+  "$pidlab" evaluate --plant linear --gains 1,1,1 $args >bad.out 2>bad.err || status=$?
+  if [[ $status -eq 2 && $(wc -l <bad.err) -eq 1 ]]; then pass "bad input $args: exit 2, $(cat bad.err)"; else
+    fail "bad input $args: exit $status, $(cat bad.err)"; fi
+done
+
+echo "$passed passed, $failed failed"
+[[ $failed -eq 0 ]]
