@@ -96,6 +96,50 @@ TEST(Report, MarkdownListsEveryTableTuningAndSection) {
   EXPECT_NE(md.find("2 % band"), std::string::npos);
 }
 
+TEST(Report, TheMotorItselfRunsEveryMoveWithAndWithoutTheVoltageLimitNextToEquationThree) {
+  const ReportData data = QuickReport(1);
+  const MotorSection& m = data.motor;
+  ASSERT_EQ(m.moves.size(), 4u);
+  EXPECT_EQ(m.moves[2], StepperMotorParameters{}.tooth_pitch_rad);
+  EXPECT_EQ(m.voltage_limit_v, 24.0);
+  ASSERT_EQ(m.sets.size(), 3u);  // paper's NM, pidlab's default tune, tuned on the motor
+  EXPECT_EQ(m.sets[0].gains.kp, 20.8836);
+  for (const MotorGainSet& set : m.sets) {
+    EXPECT_TRUE(set.eq3_stable) << set.name;
+    EXPECT_GT(set.eq3_iae_per_unit, 0.0) << set.name;
+    ASSERT_EQ(set.rows.size(), 8u) << set.name;
+    for (const MotorRow& r : set.rows) {
+      const std::string what =
+          set.name + " A = " + std::to_string(r.move_rad) + (r.limited ? " limited" : "");
+      ASSERT_TRUE(r.stable) << what;
+      EXPECT_TRUE(std::isfinite(r.iae_per_unit) && r.iae_per_unit > 0.0) << what;
+      EXPECT_DOUBLE_EQ(r.iae_per_unit, r.iae / r.move_rad) << what;
+      EXPECT_DOUBLE_EQ(r.ratio, r.iae_per_unit / set.eq3_iae_per_unit) << what;
+      EXPECT_GT(r.peak_phase_voltage_v, 0.0) << what;
+      EXPECT_GT(r.peak_phase_current_a, 0.0) << what;
+      if (r.limited) {
+        EXPECT_LE(r.peak_phase_voltage_v, 24.0) << what;
+      }
+    }
+  }
+  // The check: at 0.001 rad the paper's gains on the motor give
+  // eq. (3)'s IAE/A within 1 % (without a limit); through 24 V they do not.
+  const MotorRow& small = m.sets[0].rows[0];
+  ASSERT_EQ(small.move_rad, 0.001);
+  ASSERT_FALSE(small.limited);
+  EXPECT_NEAR(small.ratio, 1.0, 0.01);
+  EXPECT_GT(m.sets[0].rows[4].ratio, 2.0);  // 0.001 rad through 24 V
+  // The paper's 1 rad step loses steps on the motor through the 24 V drive.
+  EXPECT_TRUE(m.sets[0].rows[7].lost_steps);
+  EXPECT_GT(m.motor_tune.evaluations, 0);
+  EXPECT_FALSE(m.curves.empty());
+  const std::string md = RenderMarkdown(data);
+  for (const char* text : {"## The motor itself", "### Where the linear design fails", "**In short:**",
+                           "| 0.001 | none | ", "| 0.001 | 24 V | ", "(one tooth pitch) | 24 V | ",
+                           "| 1 | 24 V | ", "**LOST**", "--robust", "Tuned on the motor itself"})
+    EXPECT_NE(md.find(text), std::string::npos) << text;
+}
+
 TEST(Report, DeterministicForASeed) {
   EXPECT_EQ(RenderMarkdown(QuickReport(7)), RenderMarkdown(QuickReport(7)));
 }

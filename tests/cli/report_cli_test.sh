@@ -22,7 +22,15 @@ grep -q "bit for bit" "$md" || fail "trio result differs from the in-process sam
 
 figures=$(grep -o '](fig[^)]*\.png)' "$md" | sed 's/^](//; s/)$//')
 count=$(echo "$figures" | grep -c png)
-(( count == 7 )) || fail "expected 7 figures linked, found $count"
+(( count == 8 )) || fail "expected 8 figures linked, found $count"
+# "The motor itself": its tables hold numbers (IAE/A of the motor and of eq. (3), peaks) for every move.
+grep -q "^## The motor itself" "$md" || fail "section The motor itself missing"
+for row in "| 0.001 | none |" "| 0.01 | none |" "(one tooth pitch) | none |" "| 1 | none |" \
+           "| 0.001 | 24 V |" "| 0.01 | 24 V |" "(one tooth pitch) | 24 V |" "| 1 | 24 V |"; do
+  n=$(grep -F "$row" "$md" | grep -cE '\| [0-9.e+-]+ \| [0-9.e+-]+ \| [0-9.e+-]+ \|')
+  (( n == 3 )) || fail "motor row '$row': $n of 3 gain sets with numbers"
+done
+grep -q "fig_motor_itself.png" "$md" || fail "the motor figure is not linked"
 for f in $figures; do
   [[ -s "$out/r/$f" ]] || fail "figure $f listed but missing"
   sig=$(head -c 8 "$out/r/$f" | od -An -tx1 | tr -d ' \n')

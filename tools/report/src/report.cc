@@ -458,9 +458,17 @@ bool DrawVeryHighDisturbanceFigure(ReportData* data, std::string* error) {
               error);
 }
 
+bool DrawMotorSectionFigure(ReportData* data, std::string* error) {
+  std::string caption;
+  const std::string file = "fig_motor_itself.png";
+  if (!DrawMotorFigure(data->motor, data->options.out_dir, file, &caption, error)) return false;
+  data->figures.push_back({file, caption});
+  return true;
+}
+
 bool DrawFigures(ReportData* data, std::string* error) {
   return DrawStepFigures(data, error) && DrawDisturbanceFigures(data, error) &&
-         DrawVeryHighDisturbanceFigure(data, error);
+         DrawVeryHighDisturbanceFigure(data, error) && DrawMotorSectionFigure(data, error);
 }
 
 // ---------------------------------------------------------------- markdown
@@ -1005,11 +1013,18 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
   // The trio episode (250,000 lockstep steps over LCM) runs beside the
   // in-process work.
   BackgroundTrio trio(options, s);
+  // "The motor itself" (motor_section.h), beside the rest as well.
+  auto motor = std::async(std::launch::async, [&options, data, gains = s.gains] {
+    std::string e;
+    return ComputeMotorSection(gains, options.quick, options.seed, &data->motor, &e) ? std::string()
+                                                                                     : "motor section: " + e;
+  });
   try {
     if (!EvaluatePaperRows(paper, data, error)) return false;
     if (!RunTunings(options, data, error)) return false;
     if (!EvaluateSampledLoops(&s, error)) return false;
     trio.Collect(options.trio_absent_note, &s);
+    if (const std::string e = motor.get(); !e.empty()) throw std::runtime_error(e);
   } catch (const std::exception& e) {
     *error = e.what();
     return false;
@@ -1030,6 +1045,7 @@ std::string RenderMarkdown(const ReportData& data) {
   RenderOwnTunings(os, data);
   RenderDisturbanceTunings(os, data);
   RenderSampledSection(os, data.sampled);
+  RenderMotorSection(os, data.motor);
   RenderFigureList(os, data.figures);
   return os.str();
 }

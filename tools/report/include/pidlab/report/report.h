@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/report/motor_section.h"
 #include "pidlab/tuner/tune.h"
 
 namespace pidlab::report {
@@ -136,6 +137,7 @@ struct ReportData {
   std::vector<Tuning> tunings;
   SampledSection sampled;
   std::vector<Figure> figures;
+  MotorSection motor;  // "The motor itself" (motor_section.h)
   /// Wall time of the computation, s (printed by the command, not in report.md).
   double compute_time_s = 0, figure_time_s = 0;
 };
