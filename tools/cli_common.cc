@@ -230,7 +230,8 @@ void PlantFlags::Register(CLI::App* app, bool required) {
   auto* opt =
       app->add_option("--plant", plant,
                       "double_integrator (alias linear) = 1/s^2, oscillator (alias nonlinear) = "
-                      "1/(s^2+1), stepper_motor (alias stepper) = eq. (3), or custom with --num/--den");
+                      "1/(s^2+1), stepper_motor (alias stepper) = eq. (3), stepper_nonlinear = the nonlinear "
+                      "PM stepper (sampled loop; docs/stepper.md), or custom with --num/--den");
   (void)required;
   app->add_option("--num", num, "custom plant numerator, descending powers of s, e.g. 1");
   app->add_option("--den", den, "custom plant denominator, descending powers of s, e.g. 1,0,0");
