@@ -36,7 +36,8 @@ TEST(ObjectiveFromSamples, NonFiniteOutputGivesInfinity) {
 
 TEST(ObjectiveKind, ParsesEveryKindAndRejectsOthers) {
   for (ObjectiveKind k :
-       {ObjectiveKind::kIae, ObjectiveKind::kIse, ObjectiveKind::kItae, ObjectiveKind::kIaeContinuous}) {
+       {ObjectiveKind::kIae, ObjectiveKind::kIse, ObjectiveKind::kItae, ObjectiveKind::kIaeContinuous,
+        ObjectiveKind::kLoadIae, ObjectiveKind::kSetpointLoad}) {
     ObjectiveKind dut = ObjectiveKind::kIae;
     EXPECT_TRUE(ParseObjectiveKind(ToString(k), &dut)) << ToString(k);
     EXPECT_EQ(dut, k);

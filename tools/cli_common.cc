@@ -578,6 +578,7 @@ std::string FormatEvaluation(const Evaluation& ev) {
   if (ev.options.reference != 1.0) os << "IAE / A          " << num(ev.iae_per_unit) << "\n";
   if (ev.options.disturbance.kind != DisturbanceKind::kNone)
     os << "IAE undisturbed  " << num(ev.iae_undisturbed) << "\n";
+  os << "load IAE         " << num(ev.load_iae) << "   (unit step at the plant input, r = 0)\n";
   os << "ISE              " << num(ev.ise) << "\n";
   os << "ITAE             " << num(ev.itae) << "\n";
   os << "integral |e| dt  " << num(ev.iae_continuous) << "\n";

@@ -25,7 +25,8 @@ struct TuneCommand {
   std::string refine = "ceres", trace, zn_rule = "classic";
   int max_iterations = 0, max_evaluations = 0, starts = 0, design_points = kMultiStartDesignPoints,
       refine_starts = 2;
-  double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3;
+  double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3,
+         load_weight = 1.0;
   bool json = false, adaptive = false;
   BoundsFlags loop_bounds;
   LcmFlags lcm;
@@ -49,7 +50,13 @@ struct TuneCommand {
                     "multi-start (Sobol' design + Nelder-Mead polish) | nelder-mead | paper-nm | "
                     "ziegler-nichols | ga | pso-gsa")
         ->capture_default_str();
-    app->add_option("--objective", objective, "iae | ise | itae | iae-continuous")->capture_default_str();
+    app->add_option("--objective", objective,
+                    "iae | ise | itae | iae-continuous | load-iae (IAE of a unit step at the plant input, "
+                    "r = 0) | setpoint-load (iae + W load-iae)")
+        ->capture_default_str();
+    app->add_option("--load-weight", load_weight, "W of --objective setpoint-load (>= 0)")
+        ->check(FiniteNumber())
+        ->capture_default_str();
     app->add_option("--backend", backend, "local (in-process) or lcm (episodes over a running trio)")
         ->capture_default_str();
     app->add_option("--bounds", bounds, "gain box LO,HI for each of kp, ki, kd")->capture_default_str();
@@ -126,7 +133,11 @@ struct TuneCommand {
       throw BadInput("--method " + Quote(method) +
                      " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
     if (!ParseObjectiveKind(objective, &o.objective))
-      throw BadInput("--objective " + Quote(objective) + " must be iae, ise, itae or iae-continuous");
+      throw BadInput("--objective " + Quote(objective) +
+                     " must be iae, ise, itae, iae-continuous, load-iae or setpoint-load");
+    if (!(load_weight >= 0.0))
+      throw BadInput("--load-weight " + std::to_string(load_weight) + " must be >= 0");
+    o.load_weight = load_weight;
     if (!ParseZieglerNicholsRule(zn_rule, &o.zn_rule))
       throw BadInput("--zn-rule " + Quote(zn_rule) +
                      " must be classic, pessen, some-overshoot or no-overshoot");

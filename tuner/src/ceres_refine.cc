@@ -75,6 +75,8 @@ struct ErrorResiduals {
               T(std::sqrt(static_cast<double>(m) * ts)) * sqrt(sqrt(e * e + T(kSmoothing * kSmoothing)));
           break;
         case ObjectiveKind::kIaeContinuous:
+        case ObjectiveKind::kLoadIae:
+        case ObjectiveKind::kSetpointLoad:
           return false;
       }
     }
@@ -166,6 +168,8 @@ namespace {
 std::string WhyNotRun(const TuneOptions& options, double start_objective) {
   if (options.objective == ObjectiveKind::kIaeContinuous)
     return "not run: iae-continuous has no sample least-squares form";
+  if (options.objective == ObjectiveKind::kLoadIae || options.objective == ObjectiveKind::kSetpointLoad)
+    return "not run: " + ToString(options.objective) + " has no least-squares form in pidlab yet";
   if (!std::isfinite(start_objective)) return "not run: the search found no stable loop";
   return "";
 }
@@ -174,7 +178,7 @@ std::string WhyNotRun(const TuneOptions& options, double start_objective) {
 double SolveAndEvaluate(const Plant& plant, const TuneOptions& options, const PidGains& start,
                         PidGains* refined, RefineSummary* summary) {
   SolveLeastSquares(plant, options, start, refined, summary);
-  const ObjectiveEvaluator exact(plant, options.loop, options.objective);
+  const ObjectiveEvaluator exact(plant, options.loop, options.objective, nullptr, options.load_weight);
   return exact(*refined);
 }
 

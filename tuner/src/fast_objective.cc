@@ -178,7 +178,8 @@ bool FastContinuousObjective::Covers(const TransferFunction& tf, const LoopOptio
                                      ObjectiveKind kind) {
   if (options.loop != LoopKind::kContinuous) return false;
   if (options.disturbance.kind != DisturbanceKind::kNone) return false;
-  if (kind == ObjectiveKind::kIaeContinuous) return false;
+  if (kind != ObjectiveKind::kIae && kind != ObjectiveKind::kIse && kind != ObjectiveKind::kItae)
+    return false;
   // The fast path runs the ideal PID only (tf = 0).
   if (options.derivative_filter_ratio > 0.0 || options.pid.derivative_filter_s != 0.0) return false;
   if (!tf.IsValid(nullptr) || tf.RelativeDegree() < 1) return false;
@@ -299,7 +300,9 @@ double FastContinuousObjective::Run(const PidGains& g) const {
     case ObjectiveKind::kItae:
       return SumOfErrors<V, ObjectiveKind::kItae>(step, c_row, v, reference, ts, num_samples_);
     case ObjectiveKind::kIaeContinuous:
-      break;
+    case ObjectiveKind::kLoadIae:
+    case ObjectiveKind::kSetpointLoad:
+      break;  // not covered (Covers); never reached
   }
   return GeneralContinuousObjective(realization_, none_, options_, kind_, g);
 }

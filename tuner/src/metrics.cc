@@ -6,6 +6,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -223,6 +224,10 @@ bool ParseObjectiveKind(const std::string& s, ObjectiveKind* kind) {
     *kind = ObjectiveKind::kItae;
   else if (s == "iae-continuous")
     *kind = ObjectiveKind::kIaeContinuous;
+  else if (s == "load-iae")
+    *kind = ObjectiveKind::kLoadIae;
+  else if (s == "setpoint-load")
+    *kind = ObjectiveKind::kSetpointLoad;
   else
     return false;
   return true;
@@ -238,6 +243,10 @@ std::string ToString(ObjectiveKind kind) {
       return "itae";
     case ObjectiveKind::kIaeContinuous:
       return "iae-continuous";
+    case ObjectiveKind::kLoadIae:
+      return "load-iae";
+    case ObjectiveKind::kSetpointLoad:
+      return "setpoint-load";
   }
   return "iae";
 }
@@ -258,6 +267,9 @@ double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, do
         break;
       case ObjectiveKind::kIaeContinuous:
         throw std::logic_error("iae-continuous is not a sample sum");
+      case ObjectiveKind::kLoadIae:
+      case ObjectiveKind::kSetpointLoad:
+        throw std::logic_error(ToString(kind) + " is not a sum over one response");
     }
   }
   return std::isfinite(sum) ? sum : kInf;
@@ -381,8 +393,12 @@ StepInfo SampledStepInfo(const std::vector<double>& t, const std::vector<double>
   return info;
 }
 
-double Evaluation::Objective(ObjectiveKind kind) const {
+double Evaluation::Objective(ObjectiveKind kind, double load_weight) const {
   switch (kind) {
+    case ObjectiveKind::kLoadIae:
+      return load_iae;
+    case ObjectiveKind::kSetpointLoad:
+      return load_weight == 0.0 ? iae : iae + load_weight * load_iae;
     case ObjectiveKind::kIae:
       return iae;
     case ObjectiveKind::kIse:
@@ -421,6 +437,59 @@ bool IsInProcess(const SampledRunner& runner) {
 }
 
 }  // namespace
+
+DisturbanceOptions UnitLoadStep() {
+  DisturbanceOptions d;
+  d.kind = DisturbanceKind::kStep;
+  d.amplitude = 1.0;
+  d.step_time_s = 0.0;
+  return d;
+}
+
+namespace {
+
+// sum_m |y_L(m ts)| of the load response of a strictly stable loop: the
+// continuous loop built with r = 0 (no reference state, no derivative kick)
+// and the step as its exosystem state, or the sampled loop run with r_k = 0.
+double LoadIaeOfStableLoop(const StateSpace& realization, const DiscretePlant* discrete,
+                           const PidGains& gains, const LoopOptions& options, const Disturbance& step) {
+  thread_local std::vector<double> y;
+  if (options.loop == LoopKind::kContinuous) {
+    ContinuousClosedLoop<double> loop;
+    if (!BuildContinuousClosedLoop<double>(realization, gains, step, &loop, nullptr, 0.0)) return kInf;
+    SampleContinuousLoop<double>(loop, step, options.sample_time_s, options.NumSamples(), &y);
+  } else {
+    PidOptions pid = options.pid;
+    pid.dt_s = options.dt_s;
+    if (RunSampledLoop<double>(*discrete, gains, pid, step, options.TotalSteps(), options.StepsPerSample(),
+                               &y, nullptr, 0.0) == PidStatus::kInvalidInput)
+      return kInf;
+  }
+  double sum = 0.0;
+  for (double v : y) sum += std::abs(v);
+  return std::isfinite(sum) ? sum : kInf;
+}
+
+}  // namespace
+
+double LoadIntegralAbsError(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options) {
+  const PidGains gains = LoopGains(typed_gains, options);
+  const StateSpace realization = Realize(plant.tf);
+  ContinuousClosedLoop<double> loop;
+  if (!BuildContinuousClosedLoop<double>(realization, gains, Disturbance(DisturbanceOptions{}), &loop,
+                                         nullptr))
+    return kInf;
+  std::unique_ptr<DiscretePlant> discrete;
+  if (options.loop == LoopKind::kSampled) {
+    discrete = std::make_unique<DiscretePlant>(plant.tf, options.dt_s);
+    PidOptions pid = options.pid;
+    pid.dt_s = options.dt_s;
+    if (!SampledStability(*discrete, gains, pid, options.stability_margin).stable) return kInf;
+  } else if (!ContinuousStability(loop, options.stability_margin).stable) {
+    return kInf;
+  }
+  return LoadIaeOfStableLoop(realization, discrete.get(), gains, options, Disturbance(UnitLoadStep()));
+}
 
 bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
                              const DisturbanceOptions& disturbance, std::vector<double>* y_all,
@@ -568,22 +637,38 @@ bool Evaluate(const Plant& plant, const PidGains& typed_gains, const LoopOptions
     ev->itae = ObjectiveFromSamples(ObjectiveKind::kItae, ev->y, ts, a);
     ev->iae_per_unit = ev->iae / std::abs(a);
     if (!has_disturbance) ev->iae_undisturbed = ev->iae;
+    const std::unique_ptr<DiscretePlant> discrete =
+        options.loop == LoopKind::kSampled ? std::make_unique<DiscretePlant>(plant.tf, options.dt_s)
+                                           : nullptr;
+    // The load response of a linear plant; a nonlinear plant's is not computed (NaN).
+    ev->load_iae = plant.nonlinear
+                       ? std::numeric_limits<double>::quiet_NaN()
+                       : LoadIaeOfStableLoop(ss, discrete.get(), gains, options, Disturbance(UnitLoadStep()));
   } else {
-    ev->iae = ev->ise = ev->itae = ev->iae_continuous = ev->iae_undisturbed = ev->iae_per_unit = kInf;
+    ev->iae = ev->ise = ev->itae = ev->iae_continuous = ev->iae_undisturbed = ev->iae_per_unit =
+        ev->load_iae = kInf;
     ev->step.note = "unstable loop: no step metrics";
   }
   return true;
 }
 
 ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
-                                       SampledRunner runner)
+                                       SampledRunner runner, double load_weight)
     : plant_(plant),
       options_(options),
       kind_(kind),
+      load_weight_(load_weight),
       disturbance_(options.disturbance),
       runner_(std::move(runner)) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
+  if (!(load_weight >= 0.0) || !std::isfinite(load_weight))
+    throw std::invalid_argument("load weight " + std::to_string(load_weight) + " must be finite and >= 0");
+  const bool load = kind == ObjectiveKind::kLoadIae || kind == ObjectiveKind::kSetpointLoad;
+  if (load && runner_)
+    throw std::invalid_argument(ToString(kind) + " runs the loop in process, not over another runner");
+  if (load && plant.nonlinear)
+    throw std::invalid_argument(ToString(kind) + " needs a linear plant, not " + plant.name);
   if (!plant.tf.IsValid(&error)) throw std::invalid_argument(error);
   realization_ = Realize(plant.tf);
   if (plant.nonlinear && options.loop != LoopKind::kSampled)
@@ -611,12 +696,41 @@ double GeneralContinuousObjective(const StateSpace& realization, const Disturban
   return ObjectiveFromSamples(kind, y, options.sample_time_s, options.reference);
 }
 
+double ObjectiveEvaluator::LoadIae(const PidGains& gains) const {
+  return LoadIaeOfStableLoop(realization_, discrete_.get(), gains, options_, load_step_);
+}
+
 double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {
   ++evaluations_;
   thread_local std::vector<double> y;  // reused: no allocation per evaluation
   const PidGains gains = LoopGains(typed_gains, options_);
   if (!GainsAreValid(gains, nullptr)) return kInf;
   const double ts = options_.sample_time_s;
+  if (kind_ == ObjectiveKind::kLoadIae || kind_ == ObjectiveKind::kSetpointLoad) {
+    // The poles do not depend on r or n: one stability test for both responses.
+    bool stable = false;
+    if (options_.loop == LoopKind::kContinuous) {
+      ContinuousClosedLoop<double> loop;
+      stable = BuildContinuousClosedLoop<double>(realization_, gains, disturbance_, &loop, nullptr,
+                                                 options_.reference) &&
+               ContinuousStability(loop, options_.stability_margin).stable;
+      if (stable && kind_ == ObjectiveKind::kSetpointLoad)
+        SampleContinuousLoop<double>(loop, disturbance_, ts, options_.NumSamples(), &y);
+    } else {
+      stable = SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable;
+      if (stable && kind_ == ObjectiveKind::kSetpointLoad &&
+          RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(),
+                                 options_.StepsPerSample(), &y, nullptr,
+                                 options_.reference) == PidStatus::kInvalidInput)
+        return kInf;
+    }
+    if (!stable) return kInf;
+    const double load = LoadIae(gains);
+    if (kind_ == ObjectiveKind::kLoadIae) return load;
+    const double setpoint = ObjectiveFromSamples(ObjectiveKind::kIae, y, ts, options_.reference);
+    const double sum = load_weight_ == 0.0 ? setpoint : setpoint + load_weight_ * load;
+    return std::isfinite(sum) ? sum : kInf;
+  }
   if (fast_ && gains.tf == 0.0) return (*fast_)(gains);
   if (options_.loop == LoopKind::kContinuous)
     return GeneralContinuousObjective(realization_, disturbance_, options_, kind_, gains);

@@ -97,6 +97,8 @@ bool TuneOptions::IsValid(std::string* error) const {
   else if (method == TuneMethod::kMultiStart && EvaluationBudget() < 2)
     os << "multi-start needs at least 2 evaluations (a design point and a polish), not "
        << EvaluationBudget();
+  else if (!(load_weight >= 0.0) || !std::isfinite(load_weight))
+    os << "load weight " << load_weight << " must be finite and >= 0";
   else if (refine_starts < 1)
     os << "refine starts " << refine_starts << " must be >= 1";
   else if (std::isnan(max_overshoot_pct) || max_overshoot_pct < 0.0)
@@ -307,8 +309,14 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   // runner (the LCM trio) is handed to it.
   const bool custom_runner = options.loop.loop == LoopKind::kSampled && runner &&
                              runner.target<decltype(&RunSampledLoopInProcess)>() == nullptr;
+  const bool load =
+      options.objective == ObjectiveKind::kLoadIae || options.objective == ObjectiveKind::kSetpointLoad;
+  if (load && custom_runner) {
+    if (error) *error = ToString(options.objective) + " is evaluated in process: use --backend local";
+    return false;
+  }
   const ObjectiveEvaluator evaluator(plant, options.loop, options.objective,
-                                     custom_runner ? runner : SampledRunner(nullptr));
+                                     custom_runner ? runner : SampledRunner(nullptr), options.load_weight);
   const ObjectiveFunction f = ConstrainedObjective(plant, options, evaluator);
   if (!Search(plant, options, f, evaluator, progress, summary, error)) return false;
   const OptimizerSummary& opt = summary->optimizer;

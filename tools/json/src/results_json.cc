@@ -46,6 +46,7 @@ nlohmann::json ToJson(const Evaluation& ev) {
   j["iae"] = JsonNumber(ev.iae);
   j["iae_per_unit"] = JsonNumber(ev.iae_per_unit);
   j["iae_undisturbed"] = JsonNumber(ev.iae_undisturbed);
+  j["load_iae"] = JsonNumber(ev.load_iae);
   j["ise"] = JsonNumber(ev.ise);
   j["itae"] = JsonNumber(ev.itae);
   j["iae_continuous"] = JsonNumber(ev.iae_continuous);
@@ -67,6 +68,8 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
   j["plant"] = p.name;
   j["method"] = ToString(o.method);
   j["objective_kind"] = ToString(o.objective);
+  if (o.objective == ObjectiveKind::kSetpointLoad) j["load_weight"] = o.load_weight;
+  j["load_iae"] = s.stable ? JsonNumber(ev.load_iae) : nlohmann::json(nullptr);
   j["backend"] = backend;
   j["loop"] = ToString(o.loop.loop);
   j["gains"] = ToJson(s.gains);

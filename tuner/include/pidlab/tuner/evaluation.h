@@ -20,7 +20,11 @@ namespace pidlab {
 ///   iae_continuous = \int_0^n |e(t)| dt (continuous time, on a grid fine
 ///                    enough for the fastest pole; trapezoidal at dt for the
 ///                    sampled loop)
-enum class ObjectiveKind { kIae, kIse, kItae, kIaeContinuous };
+/// and over the load response y_L: r = 0, a unit step n = 1 at the plant
+/// input from t = 0, no other disturbance, so e = -y_L (LoadIntegralAbsError):
+///   load_iae      = sum |y_L(m ts)|  (the same 501 samples as eq. 4)
+///   setpoint_load = iae + W load_iae  (W = the load weight, default 1)
+enum class ObjectiveKind { kIae, kIse, kItae, kIaeContinuous, kLoadIae, kSetpointLoad };
 bool ParseObjectiveKind(const std::string& s, ObjectiveKind* kind);
 std::string ToString(ObjectiveKind kind);
 
@@ -49,6 +53,9 @@ struct Evaluation {
   double iae_per_unit = 0;
   /// IAE of the undisturbed response y1 (equals iae without a disturbance).
   double iae_undisturbed = 0;
+  /// IAE of the load response (LoadIntegralAbsError; unit input step, r = 0).
+  /// +inf if unstable.
+  double load_iae = 0;
   StepInfo step;
   /// stepper_nonlinear only: what the motor did, and whether it lost steps
   /// (at the horizon the rotor is lambda/2 or more from A: it settled at
@@ -62,7 +69,8 @@ struct Evaluation {
   /// Every step of the sampled loop (sampled loop with record_trajectory).
   std::vector<SampledStep> trajectory;
 
-  double Objective(ObjectiveKind kind) const;
+  /// The objective `kind`; setpoint-load weighs load_iae by load_weight.
+  double Objective(ObjectiveKind kind, double load_weight = 1.0) const;
 };
 
 struct EvaluateOptions {
@@ -106,14 +114,19 @@ double GeneralContinuousObjective(const StateSpace& realization, const Disturban
 
 class FastContinuousObjective;
 
+/// The unit step at the plant input from t = 0 of the load response.
+DisturbanceOptions UnitLoadStep();
+
 /// The tuner's inner loop: the objective of one gain vector, +inf for any loop
 /// that is not strictly stable. Realisation and discretisation are done once.
 class ObjectiveEvaluator {
  public:
   /// Throws std::invalid_argument if the options are invalid. A sampled loop
-  /// is run in-process unless another `runner` (e.g. the LCM trio) is given.
+  /// is run in-process unless another `runner` (e.g. the LCM trio) is given;
+  /// the load objectives run in-process only (invalid with a runner).
+  /// `load_weight` (finite, >= 0): W of setpoint-load.
   ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
-                     SampledRunner runner = nullptr);
+                     SampledRunner runner = nullptr, double load_weight = 1.0);
   double operator()(const PidGains& gains) const;
   /// Evaluations so far. operator() may be called from several threads at
   /// once (parallel starts over several trios).
@@ -126,9 +139,14 @@ class ObjectiveEvaluator {
   bool fast_path() const { return fast_ != nullptr; }
 
  private:
+  // The objective of a strictly stable loop (checked by operator()).
+  double LoadIae(const PidGains& gains) const;
+
   Plant plant_;
   LoopOptions options_;
   ObjectiveKind kind_;
+  double load_weight_ = 1.0;
+  Disturbance load_step_{UnitLoadStep()};
   StateSpace realization_;
   Disturbance disturbance_;
   std::unique_ptr<DiscretePlant> discrete_;
@@ -137,10 +155,18 @@ class ObjectiveEvaluator {
   mutable std::atomic<long> evaluations_{0};
 };
 
-/// Objective from output samples y_m at t_m = m ts (not kIaeContinuous), with
-/// e_m = reference - y_m.
+/// Objective from output samples y_m at t_m = m ts (iae, ise, itae only;
+/// throws std::logic_error for the others), with e_m = reference - y_m.
 double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, double ts,
                             double reference = 1.0);
+
+/// The load response's IAE: the loop of `options` (continuous or sampled,
+/// with its stability margin) with r = 0 and, instead of options.disturbance,
+/// a unit step n = 1 at the plant input from t = 0; e = -y, summed over the
+/// samples t_m = m ts of eq. (4): sum_m |y(t_m)|. Exact on the continuous loop
+/// (the step is a state of the exosystem; no derivative kick since r does not
+/// move). +inf if the loop is not strictly stable.
+double LoadIntegralAbsError(const Plant& plant, const PidGains& gains, const LoopOptions& options);
 
 /// MATLAB stepinfo on the exact continuous step response (no disturbance),
 /// on a grid whose step follows the fastest pole still alive, with crossings

@@ -53,6 +53,8 @@ inline constexpr double kGainWarp = 9.210340371976184;
 struct TuneOptions {
   TuneMethod method = TuneMethod::kMultiStart;
   ObjectiveKind objective = ObjectiveKind::kIae;
+  /// W of setpoint-load (iae + W load_iae); finite, >= 0.
+  double load_weight = 1.0;
   /// The loop the objective is evaluated on (default: the paper's continuous
   /// loop, ts = 0.05 s, n = 25 s, no disturbance). Its stability_margin is the
   /// acceptance margin of candidates; DefaultTuneLoop() raises it to 0.01, because
@@ -132,7 +134,8 @@ std::string ToString(RefineTermination termination);
 /// exact objective f (f_search: the search result's objective).
 enum class RefineVerdict {
   /// "not run": --refine none, ziegler-nichols (never refined), the
-  /// iae-continuous objective (no sample least-squares form), or no stable
+  /// iae-continuous, load-iae and setpoint-load objectives (no least-squares
+  /// form in pidlab), or no stable
   /// loop to start from; RefineSummary::message says which of the last two.
   kNotRun,
   /// "agree": |f - f_search| <= agree_tolerance * f_search; Ceres's gains are
