@@ -421,10 +421,20 @@ void JudgeMotor(const NonlinearStepperPlant& motor, const std::vector<double>& y
   ev->motor = motor.peaks();
   ev->final_error = reference - y_all.back();
   const double lambda = motor.options().motor.tooth_pitch_rad;
-  ev->lost_steps = !(std::abs(ev->final_error) < lambda / 2.0);
+  // Over the last tenth of the horizon (at least the last step): a rotor
+  // still swinging half a step away there has not settled, even if it
+  // happens to pass the reference at the end.
+  const std::size_t n = y_all.size();
+  double worst = 0.0;
+  for (std::size_t i = n - std::max<std::size_t>(1, n / 10); i < n; ++i) {
+    const double e = std::abs(reference - y_all[i]);
+    worst = std::isfinite(e) ? std::max(worst, e) : HUGE_VAL;
+  }
+  ev->lost_steps = !(worst < lambda / 2.0);
   std::ostringstream os;
   if (ev->lost_steps)
-    os << "LOST STEPS: the rotor ends " << ev->final_error << " rad from the reference (half a step is "
+    os << "LOST STEPS: over the last 10 % of the horizon the rotor is up to " << worst
+       << " rad from the reference and ends " << ev->final_error << " rad from it (half a step is "
        << lambda / 2.0 << " rad): it settled at another detent or never settled";
   ev->motor_note = os.str();
 }

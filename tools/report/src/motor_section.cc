@@ -335,8 +335,9 @@ void RenderMotorSection(std::ostream& os, const MotorSection& s) {
      << Num(s.holding_voltage_v, 3)
      << " V, so 24 V leaves about five times that for moving. Without a limit the drive is ideal: it "
         "applies whatever voltage the PID asks for, which no real driver does. \"Steps lost\" means the "
-        "rotor ends half a tooth pitch or more from the reference at the horizon (it settled at another "
-        "detent or never settled); such a run is marked, not scored as a good one.\n\n"
+        "rotor is half a tooth pitch or more from the reference somewhere in the last tenth of the horizon "
+        "(it settled at another detent or never settled); such a run is marked, not scored as a good "
+        "one.\n\n"
      << s.robust_note << "\n\n";
   for (const MotorGainSet& set : s.sets) RenderSet(os, s, set);
 
