@@ -217,6 +217,14 @@ std::vector<double> ParseList(const std::string& text, const std::string& what, 
   return out;
 }
 
+double ParseSpread(const std::string& text, const std::string& flag) {
+  const bool percent = !text.empty() && text.back() == '%';
+  const double v = ParseDouble(percent ? text.substr(0, text.size() - 1) : text, flag);
+  const double spread = percent ? v / 100.0 : v;
+  if (!(spread >= 0.0) || !(spread < 1.0)) throw BadInput(flag + " " + Quote(text) + " must be in [0, 1)");
+  return spread;
+}
+
 PidGains ParseGains(const std::string& text) {
   const auto v = ParseList(text, "--gains");
   if (v.size() != 3) throw BadInput("--gains " + Quote(text) + " must be three numbers KP,KI,KD");

@@ -87,6 +87,8 @@ double ParseDouble(const std::string& text, const std::string& what, bool allow_
 /// "a,b,c" -> {a, b, c}; throws BadInput naming `what`.
 std::vector<double> ParseList(const std::string& text, const std::string& what, bool allow_infinite = false);
 PidGains ParseGains(const std::string& text);
+/// A relative spread "10%" or "0.1" of `flag`, in [0, 1); throws BadInput.
+double ParseSpread(const std::string& text, const std::string& flag);
 
 /// --plant / --num / --den / --stepper NAME=VALUE.
 struct PlantFlags {

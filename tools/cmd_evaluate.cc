@@ -148,9 +148,7 @@ struct EvaluateCommand {
     MonteCarloOptions mc;
     if (monte_carlo < 0) throw BadInput("--monte-carlo " + std::to_string(monte_carlo) + " must be >= 0");
     mc.samples = std::max(monte_carlo, 1);
-    const bool percent = !spread.empty() && spread.back() == '%';
-    const double v = ParseDouble(percent ? spread.substr(0, spread.size() - 1) : spread, "--spread");
-    mc.spread = percent ? v / 100.0 : v;
+    mc.spread = ParseSpread(spread, "--spread");
     mc.seed = loop.seed;
     std::string error;
     if (!mc.IsValid(&error)) throw BadInput("--spread " + Quote(spread) + " / --monte-carlo: " + error);

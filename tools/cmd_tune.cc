@@ -27,10 +27,14 @@ struct TuneCommand {
       refine_starts = 2;
   double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3,
          load_weight = 1.0;
-  bool json = false, adaptive = false;
+  bool json = false, adaptive = false, robust = false;
+  int robust_samples = 0;
+  double robust_quantile = 1.0;
+  std::string robust_spread = "10%";
   BoundsFlags loop_bounds;
   LcmFlags lcm;
   std::unique_ptr<EpisodePool> pool;
+  CLI::App* app_ = nullptr;
 
   // The tuner's acceptance margin: with the evaluation's 1e-9 the search games
   // the sampled objective by parking poles a hair left of the imaginary axis
@@ -84,11 +88,28 @@ struct TuneCommand {
     app->add_option("--max-settling", max_settling_time_s, "reject candidates settling later (s)")
         ->check(NumberOrInfinity());
     loop_bounds.Register(app, "reject candidates");
+    app->add_flag("--robust", robust,
+                  "the robust preset (docs/robustness.md): --objective setpoint-load --load-weight 1 "
+                  "--derivative-filter-ratio 10 --max-ms 1.6 --max-time-constant <horizon/10>; a flag given "
+                  "explicitly overrides its part");
+    app->add_option("--robust-samples", robust_samples,
+                    "optimise over the nominal plant and N plants drawn as evaluate --monte-carlo draws them "
+                    "(seeded by --seed): the --robust-quantile of the objective over the set")
+        ->check(WholeNumber())
+        ->capture_default_str();
+    app->add_option("--robust-quantile", robust_quantile,
+                    "quantile of the robust set's objective to minimise, (0, 1]; 1 = the worst case")
+        ->check(FiniteNumber())
+        ->capture_default_str();
+    app->add_option("--robust-spread", robust_spread,
+                    "relative spread of the robust set's draws, 10% or 0.1, in [0, 1)")
+        ->capture_default_str();
     app->add_option("--zn-rule", zn_rule, "classic | pessen | some-overshoot | no-overshoot")
         ->capture_default_str();
     app->add_option("--trace", trace, "write the best-so-far trajectory of the search to this CSV file");
     app->add_flag("--json", json, "print one JSON object");
     lcm.Register(app);
+    app_ = app;
     return [this] { return Run(); };
   }
 
@@ -159,6 +180,24 @@ struct TuneCommand {
     o.max_settling_time_s = max_settling_time_s;
     o.bounds = loop_bounds.Build();
     o.agree_tolerance = agree_tolerance;
+    if (robust) {
+      RobustPresetKeep keep;
+      keep.objective = app_->count("--objective") > 0;
+      keep.load_weight = app_->count("--load-weight") > 0;
+      keep.derivative_filter =
+          app_->count("--derivative-filter") > 0 || app_->count("--derivative-filter-ratio") > 0;
+      keep.max_ms = app_->count("--max-ms") > 0;
+      keep.max_time_constant = app_->count("--max-time-constant") > 0;
+      ApplyRobustPreset(&o, keep);
+    }
+    if (robust_samples < 0 || robust_samples > 10000)
+      throw BadInput("--robust-samples " + std::to_string(robust_samples) + " must be in [0, 10000]");
+    o.robust_samples = robust_samples;
+    o.robust_spread = ParseSpread(robust_spread, "--robust-spread");
+    if (!(robust_quantile > 0.0) || !(robust_quantile <= 1.0))
+      throw BadInput("--robust-quantile " + std::to_string(robust_quantile) + " must be in (0, 1]");
+    o.robust_quantile = robust_quantile;
+    o.stepper = plant.StepperParameters();
     std::string error;
     if (!o.IsValid(&error)) throw BadInput(error);
     return o;
@@ -208,6 +247,14 @@ struct TuneCommand {
                 << ToString(s.refine.termination) << ", " << s.refine.iterations << " iterations)\n";
     std::cout << "verdict          " << ToString(s.refine.verdict, s.method)
               << (s.refine.message.empty() ? "" : ": ") << s.refine.message << "\n";
+    if (o.robust_samples > 0)
+      std::cout << "robust set       " << s.robust_set_size << " plants (nominal + " << o.robust_samples
+                << " draws at " << 100.0 * o.robust_spread << " % spread"
+                << (s.robust_invalid_draws > 0
+                        ? ", " + std::to_string(s.robust_invalid_draws) + " invalid left out"
+                        : std::string())
+                << "): objective = quantile " << o.robust_quantile << "; nominal plant's "
+                << s.nominal_objective << "\n";
     std::cout << "wall time        " << s.wall_time_s << " s\n\n";
     std::cout << FormatEvaluation(ev);
   }

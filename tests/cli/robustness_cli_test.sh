@@ -160,6 +160,45 @@ if "$pidlab" evaluate --plant stepper --gains 20.8836,26.607,12.4866 --monte-car
   pass "--monte-carlo on the stepper perturbs Table I parameters"
 else fail "stepper Monte Carlo table"; fi
 
+# ---- tune --robust: every bound of the preset met, finite noise gain ----
+for plant in double_integrator oscillator stepper_motor; do
+  "$pidlab" tune --plant "$plant" --robust --json >robust.json
+  if /usr/bin/python3 - robust.json <<'PY'
+import json, math, sys
+j = json.load(open(sys.argv[1]))
+r, c = j["robustness"], j["constraints"]
+assert j["objective_kind"] == "setpoint-load" and j["load_weight"] == 1, j
+assert c["max_ms"] == 1.6 and c["max_time_constant_s"] == 2.5 and c["derivative_filter_ratio"] == 10, c
+g = j["gains"]
+assert g["tf"] > 0 and abs(g["tf"] - g["kd"] / (10 * g["kp"])) <= 1e-9 * g["tf"], g
+assert r["ms"] <= 1.6 * (1 + 1e-6) and r["slowest_time_constant_s"] <= 2.5, r
+assert r["noise_gain"] is not None and math.isfinite(r["noise_gain"]), r
+assert r["violations"] == [], r
+assert abs(j["objective"] - (j["iae"] + j["load_iae"])) <= 1e-9 * j["objective"], j
+PY
+  then pass "tune --robust on $plant meets Ms <= 1.6 and tau <= 2.5 s with a finite noise gain"
+  else fail "tune --robust on $plant"; fi
+done
+"$pidlab" tune --plant double_integrator --robust --max-ms 1.4 --objective load-iae --json >robust14.json
+if /usr/bin/python3 -c '
+import json, sys
+j = json.load(open("robust14.json"))
+assert j["constraints"]["max_ms"] == 1.4 and j["objective_kind"] == "load-iae", j
+assert j["robustness"]["ms"] <= 1.4 * (1 + 1e-6), j["robustness"]'; then
+  pass "flags given next to --robust override its parts"
+else fail "--robust overrides"; fi
+"$pidlab" tune --plant double_integrator --robust --robust-samples 6 --robust-spread 20% --max-evals 2000 \
+  --json >rset.json
+if /usr/bin/python3 -c '
+import json
+j = json.load(open("rset.json"))
+s = j["robust_set"]
+assert s["samples"] == 6 and s["size"] == 7 and s["spread"] == 0.2 and s["quantile"] == 1, s
+assert j["objective"] >= s["nominal_objective"], j
+assert j["refine"]["ran"] is False and "robust set" in j["refine"]["message"], j["refine"]'; then
+  pass "--robust-samples: the worst case over nominal + 6 draws, never below the nominal objective"
+else fail "--robust-samples"; fi
+
 # ---- Bad input: exit 2, one line naming the value ----
 for args in "--monte-carlo 10 --spread 150%" "--monte-carlo 10 --spread abc" "--monte-carlo -1" \
   "--max-ms 0.5" "--min-gain-margin 0.5" "--derivative-filter -1" \
@@ -169,6 +208,15 @@ for args in "--monte-carlo 10 --spread 150%" "--monte-carlo 10 --spread abc" "--
   "$pidlab" evaluate --plant linear --gains 1,1,1 $args >bad.out 2>bad.err || status=$?
   if [[ $status -eq 2 && $(wc -l <bad.err) -eq 1 ]]; then pass "bad input $args: exit 2, $(cat bad.err)"; else
     fail "bad input $args: exit $status, $(cat bad.err)"; fi
+done
+
+for args in "--robust-quantile 0" "--robust-quantile 1.5" "--robust-spread 100%" "--robust-samples -2" \
+  "--robust-spread x"; do
+  status=0
+  # shellcheck disable=SC2086
+  "$pidlab" tune --plant linear $args >bad.out 2>bad.err || status=$?
+  if [[ $status -eq 2 && $(wc -l <bad.err) -eq 1 ]]; then pass "bad input tune $args: exit 2, $(cat bad.err)"; else
+    fail "bad input tune $args: exit $status, $(cat bad.err)"; fi
 done
 
 echo "$passed passed, $failed failed"

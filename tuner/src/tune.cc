@@ -82,6 +82,18 @@ std::string ToString(RefineVerdict verdict, TuneMethod method) {
   return "not run";
 }
 
+void ApplyRobustPreset(TuneOptions* o, const RobustPresetKeep& keep) {
+  if (!keep.objective) o->objective = ObjectiveKind::kSetpointLoad;
+  if (!keep.load_weight) o->load_weight = RobustPreset::kLoadWeight;
+  if (!keep.derivative_filter) {
+    o->loop.pid.derivative_filter_s = 0.0;
+    o->loop.derivative_filter_ratio = RobustPreset::kFilterRatio;
+  }
+  if (!keep.max_ms) o->bounds.max_ms = RobustPreset::kMaxMs;
+  if (!keep.max_time_constant)
+    o->bounds.max_time_constant_s = RobustPreset::kTimeConstantFraction * o->loop.horizon_s;
+}
+
 bool TuneOptions::IsValid(std::string* error) const {
   std::ostringstream os;
   if (!std::isfinite(lower) || !std::isfinite(upper) || lower < 0.0 || !(lower < upper) || upper > kMaxGain)
@@ -107,6 +119,12 @@ bool TuneOptions::IsValid(std::string* error) const {
     os << "max settling time " << max_settling_time_s << " s must be positive";
   else if (!bounds.IsValid(error))
     return false;
+  else if (robust_samples < 0 || robust_samples > 10000)
+    os << "robust samples " << robust_samples << " must be in [0, 10000]";
+  else if (!(robust_spread >= 0.0) || !(robust_spread < 1.0))
+    os << "robust spread " << robust_spread << " must be in [0, 1)";
+  else if (!(robust_quantile > 0.0) || !(robust_quantile <= 1.0))
+    os << "robust quantile " << robust_quantile << " must be in (0, 1]";
   else if (!(agree_tolerance > 0.0) || !(agree_tolerance < 1.0))
     os << "agree tolerance " << agree_tolerance << " must be in (0, 1)";
   else if (!loop.IsValid(error))
@@ -209,6 +227,50 @@ ObjectiveFunction ConstrainedObjective(const Plant& plant, const TuneOptions& op
     if (ev.step.overshoot_pct > options.max_overshoot_pct) return HUGE_VAL;
     if (ev.step.settling_time_s > options.max_settling_time_s) return HUGE_VAL;
     return value;
+  };
+}
+
+// The plants of the robust set and their evaluators (one per valid draw).
+struct RobustSet {
+  std::vector<std::unique_ptr<const ObjectiveEvaluator>> draws;
+  int invalid = 0;
+};
+
+RobustSet MakeRobustSet(const Plant& plant, const TuneOptions& options, const SampledRunner& runner) {
+  RobustSet set;
+  if (options.robust_samples == 0) return set;
+  MonteCarloOptions mc;
+  mc.samples = options.robust_samples;
+  mc.spread = options.robust_spread;
+  mc.seed = options.seed;
+  for (const Plant& p : DrawPlants(plant, plant.name == "stepper_motor" ? &options.stepper : nullptr, mc)) {
+    if (p.tf.num.empty() || p.tf.den.empty()) {
+      ++set.invalid;
+      continue;
+    }
+    set.draws.push_back(std::make_unique<const ObjectiveEvaluator>(p, options.loop, options.objective, runner,
+                                                                   options.load_weight));
+  }
+  return set;
+}
+
+// The nearest-rank `quantile` of the objective over the nominal plant (with
+// the constraints of f) and the draws of `set`: +inf when the nominal loop is
+// rejected, and a draw that is not strictly stable counts as +inf.
+ObjectiveFunction RobustSetObjective(const ObjectiveFunction& nominal, const RobustSet& set,
+                                     double quantile) {
+  if (set.draws.empty()) return nominal;
+  return [nominal, &set, quantile](const Eigen::VectorXd& x) {
+    const double f0 = nominal(x);
+    if (!std::isfinite(f0)) return f0;
+    std::vector<double> values{f0};
+    values.reserve(set.draws.size() + 1);
+    const PidGains g{x(0), x(1), x(2)};
+    for (const auto& e : set.draws) values.push_back((*e)(g));
+    const std::size_t rank = static_cast<std::size_t>(
+        std::max(1.0, std::ceil(quantile * static_cast<double>(values.size()) - 1e-9)));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank - 1), values.end());
+    return values[rank - 1];
   };
 }
 
@@ -317,7 +379,15 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   }
   const ObjectiveEvaluator evaluator(plant, options.loop, options.objective,
                                      custom_runner ? runner : SampledRunner(nullptr), options.load_weight);
-  const ObjectiveFunction f = ConstrainedObjective(plant, options, evaluator);
+  if (options.robust_samples > 0 && plant.nonlinear) {
+    if (error) *error = "a robust set draws linear plants: it does not take plant " + plant.name;
+    return false;
+  }
+  const RobustSet robust_set = MakeRobustSet(plant, options, custom_runner ? runner : SampledRunner(nullptr));
+  summary->robust_set_size = options.robust_samples > 0 ? static_cast<int>(robust_set.draws.size()) + 1 : 0;
+  summary->robust_invalid_draws = robust_set.invalid;
+  const ObjectiveFunction f = RobustSetObjective(ConstrainedObjective(plant, options, evaluator), robust_set,
+                                                 options.robust_quantile);
   if (!Search(plant, options, f, evaluator, progress, summary, error)) return false;
   const OptimizerSummary& opt = summary->optimizer;
   summary->evaluations = opt.evaluations;
@@ -339,8 +409,10 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   summary->stable = true;
   summary->message = opt.message;
   // Ceres differentiates the linear loops only; a nonlinear plant keeps the
-  // search's result (refine "not run").
-  if (options.refine && options.method == TuneMethod::kMultiStart && !plant.nonlinear) {
+  // search's result (refine "not run"), and so does a robust set.
+  if (options.refine && options.robust_samples > 0) {
+    summary->refine.message = "not run: the robust set's quantile has no least-squares form";
+  } else if (options.refine && options.method == TuneMethod::kMultiStart && !plant.nonlinear) {
     std::vector<PidGains> starts{summary->search_gains};
     std::vector<double> objectives{summary->search_objective};
     AddDistinctMinima(options, summary->local_minima, &starts, &objectives);
@@ -362,6 +434,7 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
       summary->objective = summary->refine.objective;
     }
   }
+  if (options.robust_samples > 0) summary->nominal_objective = evaluator(summary->gains);
   // The loop's derivative filter of the gains found (tf = 0 for the ideal PID).
   summary->gains = LoopGains(summary->gains, options.loop);
   summary->search_gains = LoopGains(summary->search_gains, options.loop);

@@ -107,6 +107,24 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
     j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},
                             {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
                             {"rule", ToString(o.zn_rule)}};
+  const LoopBounds& b = o.bounds;
+  j["constraints"] = {{"max_ms", JsonNumber(b.max_ms)},
+                      {"max_mt", JsonNumber(b.max_mt)},
+                      {"max_noise_gain", JsonNumber(b.max_noise_gain)},
+                      {"min_phase_margin_deg", b.min_phase_margin_deg},
+                      {"min_gain_margin", b.min_gain_margin},
+                      {"max_time_constant_s", JsonNumber(b.max_time_constant_s)},
+                      {"max_overshoot_pct", JsonNumber(o.max_overshoot_pct)},
+                      {"max_settling_time_s", JsonNumber(o.max_settling_time_s)},
+                      {"derivative_filter_s", o.loop.pid.derivative_filter_s},
+                      {"derivative_filter_ratio", o.loop.derivative_filter_ratio}};
+  if (o.robust_samples > 0)
+    j["robust_set"] = {{"samples", o.robust_samples},
+                       {"spread", o.robust_spread},
+                       {"quantile", o.robust_quantile},
+                       {"size", s.robust_set_size},
+                       {"invalid_draws", s.robust_invalid_draws},
+                       {"nominal_objective", JsonNumber(s.nominal_objective)}};
   if (s.stable) AddMotor(ev, &j);
   return j;
 }

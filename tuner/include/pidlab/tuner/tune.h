@@ -11,8 +11,9 @@
 #include <vector>
 
 #include "pidlab/tuner/evaluation.h"
-#include "pidlab/tuner/multi_start.h"
 #include "pidlab/tuner/loop_analysis.h"
+#include "pidlab/tuner/monte_carlo.h"
+#include "pidlab/tuner/multi_start.h"
 #include "pidlab/tuner/optimizer.h"
 #include "pidlab/tuner/ziegler_nichols.h"
 
@@ -95,7 +96,21 @@ struct TuneOptions {
   /// check ContinuousLoopMeetsBounds (continuous loop) or AnalyzeLoop
   /// (sampled loop, 20 points a decade); the Ceres point only if it meets them.
   LoopBounds bounds;
-  /// Run the Ceres cross-check after the search.
+  /// The robust set (`--robust-samples N`, docs/robustness.md): when N > 0
+  /// the search minimises the `robust_quantile` quantile (nearest rank; 1 =
+  /// the worst case) of the objective over the nominal plant and N plants
+  /// drawn around it as `evaluate --monte-carlo` draws them (DrawPlants with
+  /// `robust_spread` and `seed`). A draw whose loop is not strictly stable
+  /// counts as +inf, so the worst case accepts only gains that stabilise
+  /// every draw. The bounds and step constraints apply to the nominal loop.
+  int robust_samples = 0;
+  double robust_spread = 0.1;
+  double robust_quantile = 1.0;
+  /// Table I of the stepper motor, for the draws when the plant is
+  /// "stepper_motor" (its --stepper overrides); unused otherwise.
+  StepperMotorParameters stepper;
+  /// Run the Ceres cross-check after the search (not with a robust set,
+  /// whose quantile has no least-squares form).
   bool refine = true;
   /// RefineVerdict::kAgree when |f_ceres - f_search| <= agree_tolerance * f_search.
   double agree_tolerance = 1e-3;
@@ -117,6 +132,35 @@ struct TuneOptions {
   /// starts, or the method's default when 0.
   int StartCount() const;
 };
+
+/// The `--robust` preset (docs/robustness.md, "The robust preset"): gains an
+/// engineer would deploy rather than the paper's optimum.
+struct RobustPreset {
+  /// ||S||inf <= 1.6 (about 45 deg of phase margin and a gain margin >= 2.7).
+  static constexpr double kMaxMs = 1.6;
+  /// Derivative filter Tf = kd / (N kp) with N = 10: a finite noise gain
+  /// ||C S||inf, at most about kp (1 + N) at high frequency.
+  static constexpr double kFilterRatio = 10.0;
+  /// Objective setpoint-load with W = 1: the IAE of the reference step plus
+  /// the IAE of a unit step at the plant input.
+  static constexpr double kLoadWeight = 1.0;
+  /// No closed-loop time constant beyond a tenth of the horizon (2.5 s of
+  /// the paper's 25 s): no slow pole left behind by a near cancellation.
+  static constexpr double kTimeConstantFraction = 0.1;
+};
+/// What ApplyRobustPreset leaves as the caller set it (the CLI: the flags
+/// given explicitly next to --robust).
+struct RobustPresetKeep {
+  bool objective = false;
+  bool load_weight = false;
+  bool derivative_filter = false;
+  bool max_ms = false;
+  bool max_time_constant = false;
+};
+/// Sets *o to the robust preset: objective setpoint-load (W = 1), derivative
+/// filter ratio N = 10, Ms <= 1.6 and slowest time constant <= 0.1 x the
+/// loop's horizon, except the fields `keep` names.
+void ApplyRobustPreset(TuneOptions* o, const RobustPresetKeep& keep = RobustPresetKeep{});
 
 /// How Ceres's solver ended (its ceres::TerminationType), or kNotRun.
 enum class RefineTermination {
@@ -200,6 +244,13 @@ struct TuneSummary {
   std::vector<LocalMinimum> local_minima;
   ZieglerNicholsResult ziegler_nichols;  // ziegler-nichols only
   RefineSummary refine;
+  /// With a robust set (TuneOptions::robust_samples > 0): its size (nominal
+  /// plus the valid draws), the draws whose parameters gave no valid plant
+  /// (left out), and the nominal plant's objective at the gains found
+  /// (`objective` is then the quantile).
+  int robust_set_size = 0;
+  int robust_invalid_draws = 0;
+  double nominal_objective = std::numeric_limits<double>::infinity();
   /// The search's one-line summary, or why no strictly stable loop was found.
   std::string message;
   /// One line: method, gains, objective, evaluations and the refine verdict.
