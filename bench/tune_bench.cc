@@ -1,6 +1,7 @@
 // CPU time of one whole default `pidlab tune` per plant (the multi-start:
 // 1024 Sobol' points, 16 Nelder-Mead polishes, Ceres from the best 2
-// minima), unconstrained and with a step-response constraint, against the
+// minima), unconstrained, under the --robust preset and every robustness
+// bound, and with a step-response constraint, against the
 // issue's budget of 0.2 s per plant. Seeds 1-5 in turn, so the figure is no
 // one seed's luck.
 //
@@ -53,6 +54,31 @@ BENCHMARK(BM_TuneMaxOvershoot5)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->Iterations(1);
+
+// The --robust preset (setpoint-load, filtered derivative, Ms <= 1.6, time
+// constant <= 2.5 s): every stable candidate also costs the tuner's cheap
+// bound check (ContinuousLoopMeetsBounds) and the load response.
+void BM_TuneRobust(benchmark::State& state) {
+  pidlab::TuneOptions options;
+  pidlab::ApplyRobustPreset(&options);
+  RunTunes(state, options);
+}
+BENCHMARK(BM_TuneRobust)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+
+// Every constraint flag at once on the paper's objective: Ms, Mt, noise
+// gain, phase and gain margins, time constant, with the filtered derivative.
+void BM_TuneAllBounds(benchmark::State& state) {
+  pidlab::TuneOptions options;
+  options.loop.derivative_filter_ratio = 10.0;
+  options.bounds.max_ms = 1.6;
+  options.bounds.max_mt = 1.3;
+  options.bounds.max_noise_gain = 1000.0;
+  options.bounds.min_phase_margin_deg = 45.0;
+  options.bounds.min_gain_margin = 2.0;
+  options.bounds.max_time_constant_s = 2.5;
+  RunTunes(state, options);
+}
+BENCHMARK(BM_TuneAllBounds)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 }  // namespace
 
