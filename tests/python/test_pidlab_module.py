@@ -111,6 +111,16 @@ class Tune(unittest.TestCase):
         self.assertSameTune(got, want)
         self.assertEqual(got["ziegler_nichols"]["rule"], "pessen")
 
+    def test_the_robust_preset_and_a_robust_set_equal_the_cli_json(self):
+        got = pidlab.tune("double_integrator", robust=True, robust_samples=4, robust_spread=0.2, max_evals=600)
+        want = cli("tune", "--plant", "double_integrator", "--robust", "--robust-samples", "4",
+                   "--robust-spread", "20%", "--max-evals", "600")
+        self.assertSameTune(got, want)
+        self.assertEqual(got["objective_kind"], "setpoint-load")
+        self.assertEqual(got["constraints"]["max_ms"], 1.6)
+        self.assertEqual(got["robust_set"]["size"], 5)
+        self.assertEqual(got["robustness"]["violations"], [])
+
     def test_bad_options_raise_value_error(self):
         with self.assertRaisesRegex(ValueError, "simplex"):
             pidlab.tune("oscillator", method="simplex")

@@ -151,6 +151,10 @@ struct TuneArgs {
   std::optional<double> max_overshoot, max_settling;
   int design_points = pidlab::TuneOptions{}.design_points,
       refine_starts = pidlab::TuneOptions{}.refine_starts;
+  double load_weight = 1.0;
+  bool robust = false;
+  int robust_samples = 0;
+  double robust_quantile = 1.0, robust_spread = 0.1;
 };
 
 py::object TunePy(const py::object& plant, const LoopArgs& loop, const TuneArgs& args,
@@ -162,7 +166,8 @@ py::object TunePy(const py::object& plant, const LoopArgs& loop, const TuneArgs&
   if (!ParseTuneMethod(args.method, &o.method))
     Bad("method '" + args.method + "' must be nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
   if (!ParseObjectiveKind(args.objective, &o.objective))
-    Bad("objective '" + args.objective + "' must be iae, ise, itae or iae-continuous");
+    Bad("objective '" + args.objective +
+        "' must be iae, ise, itae, iae-continuous, load-iae or setpoint-load");
   if (!ParseZieglerNicholsRule(args.zn_rule, &o.zn_rule))
     Bad("zn_rule '" + args.zn_rule + "' must be classic, pessen, some-overshoot or no-overshoot");
   o.lower = args.bounds.first;
@@ -179,6 +184,11 @@ py::object TunePy(const py::object& plant, const LoopArgs& loop, const TuneArgs&
   const double inf = std::numeric_limits<double>::infinity();
   o.max_overshoot_pct = args.max_overshoot.value_or(inf);
   o.max_settling_time_s = args.max_settling.value_or(inf);
+  o.load_weight = args.load_weight;
+  if (args.robust) ApplyRobustPreset(&o);
+  o.robust_samples = args.robust_samples;
+  o.robust_quantile = args.robust_quantile;
+  o.robust_spread = args.robust_spread;
   std::string error;
   if (!o.IsValid(&error)) Bad(error);
   TuneSummary s;
@@ -262,7 +272,8 @@ PYBIND11_MODULE(_pidlab, m) {
          double disturbance_amplitude, double disturbance_period, double disturbance_phase,
          double disturbance_step_time, double noise_hold, std::uint64_t seed, double derivative_filter,
          OptPair output_limits, const std::string& anti_windup, const std::string& derivative_on,
-         const std::string& integral, double reference, const OptVec& num, const OptVec& den) {
+         const std::string& integral, double reference, const OptVec& num, const OptVec& den,
+         double load_weight, bool robust, int robust_samples, double robust_quantile, double robust_spread) {
         const LoopArgs l{loop,
                          dt,
                          sample_time,
@@ -281,13 +292,17 @@ PYBIND11_MODULE(_pidlab, m) {
                          derivative_on,
                          integral,
                          reference};
-        const TuneArgs t{method,        objective,    zn_rule,       bounds,       max_iter,
-                         max_evals,     starts,       adaptive,      refine,       agree_tolerance,
-                         max_overshoot, max_settling, design_points, refine_starts};
+        const TuneArgs t{method,        objective,      zn_rule,         bounds,        max_iter,
+                         max_evals,     starts,         adaptive,        refine,        agree_tolerance,
+                         max_overshoot, max_settling,   design_points,   refine_starts, load_weight,
+                         robust,        robust_samples, robust_quantile, robust_spread};
         return TunePy(plant, l, t, num, den);
       },
       "Tunes PID gains for a plant (as for evaluate) and returns the dict of `pidlab tune --json`. The "
-      "defaults are the command's (the multi-start search, the paper's loop, the Ceres cross-check).",
+      "defaults are the command's (the multi-start search, the paper's loop, the Ceres cross-check). "
+      "robust=True applies `pidlab tune --robust` (objective setpoint-load, load_weight 1, derivative filter "
+      "ratio 10, Ms <= 1.6, time constant <= horizon/10) over those arguments; robust_samples, "
+      "robust_quantile and robust_spread are --robust-samples, --robust-quantile and --robust-spread.",
       py::arg("plant"), py::kw_only(), py::arg("method") = "multi-start", py::arg("objective") = "iae",
       py::arg("bounds") = std::make_pair(0.0, 30.0), py::arg("max_iter") = 0, py::arg("max_evals") = 0,
       py::arg("starts") = pidlab::TuneOptions{}.starts, py::arg("adaptive") = false, py::arg("refine") = true,
@@ -302,5 +317,7 @@ PYBIND11_MODULE(_pidlab, m) {
       py::arg("noise_hold") = 0.01, py::arg("seed") = 1, py::arg("derivative_filter") = 0.0,
       py::arg("output_limits") = py::none(), py::arg("anti_windup") = "clamping",
       py::arg("derivative_on") = "error", py::arg("integral") = "backward-euler", py::arg("reference") = 1.0,
-      py::arg("num") = py::none(), py::arg("den") = py::none());
+      py::arg("num") = py::none(), py::arg("den") = py::none(), py::arg("load_weight") = 1.0,
+      py::arg("robust") = false, py::arg("robust_samples") = 0, py::arg("robust_quantile") = 1.0,
+      py::arg("robust_spread") = 0.1);
 }
