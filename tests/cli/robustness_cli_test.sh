@@ -219,5 +219,11 @@ for args in "--robust-quantile 0" "--robust-quantile 1.5" "--robust-spread 100%"
     fail "bad input tune $args: exit $status, $(cat bad.err)"; fi
 done
 
+status=0
+"$pidlab" tune --plant stepper_nonlinear --robust --loop sampled --dt 1e-4 >bad.out 2>bad.err || status=$?
+if [[ $status -eq 2 && $(wc -l <bad.err) -eq 1 ]] && grep -q "needs a linear plant" bad.err; then
+  pass "tune --robust on the nonlinear motor: exit 2, $(cat bad.err)"
+else fail "tune --robust on the nonlinear motor: exit $status, $(cat bad.err)"; fi
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -377,6 +377,12 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
     if (error) *error = ToString(options.objective) + " is evaluated in process: use --backend local";
     return false;
   }
+  if (load && plant.nonlinear) {
+    if (error)
+      *error = ToString(options.objective) + " needs a linear plant (the load response of " + plant.name +
+               " is not computed): tune the linearisation (--plant stepper) or use --objective iae";
+    return false;
+  }
   const ObjectiveEvaluator evaluator(plant, options.loop, options.objective,
                                      custom_runner ? runner : SampledRunner(nullptr), options.load_weight);
   if (options.robust_samples > 0 && plant.nonlinear) {
