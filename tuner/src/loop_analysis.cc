@@ -11,6 +11,8 @@
 #include <memory>
 #include <sstream>
 
+#include "golden_section.h"
+
 namespace pidlab {
 namespace {
 
@@ -185,30 +187,14 @@ std::vector<double> Grid(double lo, double hi, double per_decade, const std::vec
 
 // Golden-section search for the maximum of f on [log a, log b].
 double GoldenMax(const std::function<double(double)>& f, double a, double b, double* w_best) {
-  double la = std::log(a), lb = std::log(b);
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
   auto F = [&](double lw) {
     const double v = f(std::exp(lw));
     return std::isfinite(v) ? v : -kInf;
   };
-  double c = lb - g * (lb - la), d = la + g * (lb - la), fc = F(c), fd = F(d);
-  for (int it = 0; it < 80 && lb - la > 1e-13; ++it) {
-    if (fc > fd) {
-      lb = d;
-      d = c;
-      fd = fc;
-      c = lb - g * (lb - la);
-      fc = F(c);
-    } else {
-      la = c;
-      c = d;
-      fc = fd;
-      d = la + g * (lb - la);
-      fd = F(d);
-    }
-  }
-  *w_best = std::exp(0.5 * (la + lb));
-  return F(0.5 * (la + lb));
+  const double lw = internal::GoldenSectionArgMax(F, std::log(a), std::log(b), 80,
+                                                  [](double la, double lb) { return !(lb - la > 1e-13); });
+  *w_best = std::exp(lw);
+  return F(lw);
 }
 
 // The grid's largest value, refined at every local maximum when `refine`

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "golden_section.h"
 #include "pidlab/tuner/evaluation.h"
 #include "pidlab/tuner/fast_objective.h"
 
@@ -165,26 +166,11 @@ void FindPeak(const GridResponse& r, double* peak, double* peak_t) {
   *peak = std::abs(r.ys[ip]);
   *peak_t = r.ts[ip];
   if (ip == 0 || ip + 1 >= r.ys.size()) return;
-  double a = r.ts[ip - 1], b = r.ts[ip + 1];
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  auto f = [&](double t) { return -std::abs(r.At(ip - 1, t)); };
-  double c = b - g * (b - a), d = a + g * (b - a), fc = f(c), fd = f(d);
-  for (int it = 0; it < 100 && b - a > 1e-15 * std::max(1.0, b); ++it) {
-    if (fc < fd) {
-      b = d;
-      d = c;
-      fd = fc;
-      c = b - g * (b - a);
-      fc = f(c);
-    } else {
-      a = c;
-      c = d;
-      fc = fd;
-      d = a + g * (b - a);
-      fd = f(d);
-    }
-  }
-  const double tp = 0.5 * (a + b), yp = -f(tp);
+  auto f = [&](double t) { return std::abs(r.At(ip - 1, t)); };
+  const double tp = internal::GoldenSectionArgMax(f, r.ts[ip - 1], r.ts[ip + 1], 100, [](double a, double b) {
+    return !(b - a > 1e-15 * std::max(1.0, b));
+  });
+  const double yp = f(tp);
   if (yp > *peak) {
     *peak = yp;
     *peak_t = tp;
