@@ -214,3 +214,70 @@ TEST(LoopBounds, NamesTheFirstBoundBroken) {
 
 }  // namespace
 }  // namespace pidlab
+
+namespace pidlab {
+namespace {
+
+// 1/s under P control: L = kp/(jw), S = jw/(jw + kp), T = kp/(jw + kp).
+TEST(LoopFrequencyResponse, IntegratorUnderPControlMatchesTheClosedForm) {
+  const double kp = 2.5;
+  const std::vector<double> w = {1e-3, 0.1, 1.0, 2.5, 10.0, 1e3};
+  std::vector<LoopFrequencyPoint> r;
+  std::string error;
+  ASSERT_TRUE(LoopFrequencyResponse(Plant{"custom", TransferFunction{{1.0}, {1.0, 0.0}}},
+                                    PidGains{kp, 0.0, 0.0}, LoopOptions{}, w, &r, &error))
+      << error;
+  ASSERT_EQ(r.size(), w.size());
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const std::complex<double> jw(0.0, w[i]);
+    EXPECT_EQ(r[i].w_rad_s, w[i]);
+    EXPECT_LT(std::abs(r[i].l - kp / jw), 1e-12 * std::abs(kp / jw)) << w[i];
+    EXPECT_LT(std::abs(r[i].s - jw / (jw + kp)), 1e-12) << w[i];
+    EXPECT_LT(std::abs(r[i].t - kp / (jw + kp)), 1e-12) << w[i];
+  }
+  // |S| = 1/sqrt(2) at the bandwidth w = kp.
+  EXPECT_NEAR(std::abs(r[3].s), 1.0 / std::sqrt(2.0), 1e-12);
+}
+
+// The filtered PID of the loop's derivative filter ratio on 1/(s^2+1),
+// against C(jw) G(jw) written out directly; S + T = 1 everywhere.
+TEST(LoopFrequencyResponse, FilteredPidOnTheOscillatorMatchesTheDirectProduct) {
+  LoopOptions o;
+  o.derivative_filter_ratio = 10.0;
+  const PidGains g{3.0, 2.0, 1.5};
+  const double tf = g.kd / (10.0 * g.kp);
+  std::vector<LoopFrequencyPoint> r;
+  std::string error;
+  const std::vector<double> w = {0.01, 0.5, 0.999, 1.001, 7.0, 300.0};
+  ASSERT_TRUE(
+      LoopFrequencyResponse(Plant{"custom", TransferFunction{{1.0}, {1.0, 0.0, 1.0}}}, g, o, w, &r, &error))
+      << error;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const std::complex<double> s(0.0, w[i]);
+    const std::complex<double> l = (g.kp + g.ki / s + g.kd * s / (tf * s + 1.0)) / (s * s + 1.0);
+    EXPECT_LT(std::abs(r[i].l - l), 1e-10 * std::abs(l)) << w[i];
+    EXPECT_LT(std::abs(r[i].s - 1.0 / (1.0 + l)), 1e-10) << w[i];
+    EXPECT_LT(std::abs(r[i].s + r[i].t - 1.0), 1e-12) << w[i];
+  }
+  // On the plant's pole (w = 1) L is infinite: S = 0, T = 1, no NaN.
+  ASSERT_TRUE(LoopFrequencyResponse(Plant{"custom", TransferFunction{{1.0}, {1.0, 0.0, 1.0}}}, g, o, {1.0},
+                                    &r, &error));
+  EXPECT_TRUE(std::isinf(std::abs(r[0].l)));
+  EXPECT_EQ(std::abs(r[0].s), 0.0);
+  EXPECT_EQ(r[0].t, std::complex<double>(1.0, 0.0));
+}
+
+TEST(LoopFrequencyResponse, RejectsTheSampledLoopAndNonPositiveFrequencies) {
+  std::vector<LoopFrequencyPoint> r;
+  std::string error;
+  const Plant p{"custom", TransferFunction{{1.0}, {1.0, 0.0}}};
+  LoopOptions sampled;
+  sampled.loop = LoopKind::kSampled;
+  EXPECT_FALSE(LoopFrequencyResponse(p, PidGains{1.0, 0.0, 0.0}, sampled, {1.0}, &r, &error));
+  EXPECT_NE(error.find("continuous"), std::string::npos) << error;
+  EXPECT_FALSE(LoopFrequencyResponse(p, PidGains{1.0, 0.0, 0.0}, LoopOptions{}, {0.0}, &r, &error));
+  EXPECT_NE(error.find("frequency"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace pidlab

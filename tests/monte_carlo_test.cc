@@ -69,6 +69,20 @@ TEST(MonteCarlo, SpreadAcrossTheRouthBoundaryGivesTheExpectedStableFraction) {
   EXPECT_LE(s.iae.p95, s.iae.max);
 }
 
+TEST(MonteCarlo, WithoutOvershootTheSameDrawsGiveTheSameStableFractionIaeAndMs) {
+  MonteCarloOptions mc;
+  mc.samples = 100;
+  mc.spread = 0.2;
+  const MonteCarloSummary with = RunOrFail(kDoubleIntegrator, {1.0, 0.95, 1.0}, mc);
+  mc.overshoot = false;
+  const MonteCarloSummary without = RunOrFail(kDoubleIntegrator, {1.0, 0.95, 1.0}, mc);
+  EXPECT_EQ(without.stable, with.stable);
+  EXPECT_EQ(without.iae.median, with.iae.median);
+  EXPECT_EQ(without.ms.max, with.ms.max);
+  EXPECT_GT(with.overshoot_pct.count, 0);
+  EXPECT_EQ(without.overshoot_pct.count, 0);
+}
+
 TEST(MonteCarlo, StepperDrawsPerturbTableOneParameters) {
   Plant stepper;
   std::string error;

@@ -6,9 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 namespace pidlab::report {
 namespace {
@@ -138,6 +140,67 @@ TEST(Report, TheMotorItselfRunsEveryMoveWithAndWithoutTheVoltageLimitNextToEquat
                            "| 0.001 | none | ", "| 0.001 | 24 V | ", "(one tooth pitch) | 24 V | ",
                            "| 1 | 24 V | ", "**LOST**", "--robust", "Tuned on the motor itself"})
     EXPECT_NE(md.find(text), std::string::npos) << text;
+}
+
+// "Robust tuning": the three gain sets of each plant, the preset meeting its
+// bounds with a finite noise gain, the ideal derivative's unbounded one, and
+// frequency responses consistent with S + T = 1 and the loop analysis's Ms.
+TEST(Report, RobustTuningComparesThePaperTheOptimumAndThePresetOnEveryPlant) {
+  std::vector<PaperRow> paper;
+  std::string error;
+  ASSERT_TRUE(ReadPaperTables(kPaperTables, &paper, &error)) << error;
+  std::vector<RobustInput> inputs;
+  for (const PaperRow& r : paper)
+    if (r.method == "nelder_mead" && (r.table == "II" || r.table == "III" || r.table == "IV"))
+      inputs.push_back({r.plant, r.gains});
+  ASSERT_EQ(inputs.size(), 3u);
+  RobustSection s;
+  ASSERT_TRUE(ComputeRobustSection(inputs, true, 1, &s, &error)) << error;
+  ASSERT_EQ(s.plants.size(), 3u);
+  for (const RobustPlant& p : s.plants) {
+    ASSERT_EQ(p.sets.size(), 3u) << p.plant;
+    const RobustGainSet& paper_set = p.sets[0];
+    const RobustGainSet& optimum = p.sets[1];
+    const RobustGainSet& robust = p.sets[2];
+    EXPECT_EQ(paper_set.name, "paper Nelder-Mead");
+    EXPECT_EQ(robust.name, "pidlab --robust");
+    // The optimum of the paper's objective beats the paper's gains on it.
+    EXPECT_LT(optimum.setpoint_iae, paper_set.setpoint_iae) << p.plant;
+    EXPECT_NEAR(optimum.setpoint_iae, p.paper_objective_optimum, 1e-9 * p.paper_objective_optimum) << p.plant;
+    for (const RobustGainSet& set : p.sets) {
+      const std::string what = p.plant + " " + set.name;
+      ASSERT_TRUE(set.stable) << what;
+      EXPECT_GT(set.load_iae, 0.0) << what;
+      EXPECT_EQ(set.monte_carlo.samples, 50) << what;
+      EXPECT_GE(set.monte_carlo.stable_fraction, 0.0) << what;
+      EXPECT_LE(set.monte_carlo.stable_fraction, 1.0) << what;
+      ASSERT_EQ(set.response.size(), s.frequencies_rad_s.size()) << what;
+      double peak_s = 0.0;
+      for (const LoopFrequencyPoint& f : set.response) {
+        EXPECT_LT(std::abs(f.s + f.t - 1.0), 1e-9) << what << " w " << f.w_rad_s;
+        peak_s = std::max(peak_s, std::abs(f.s));
+      }
+      // The grid cannot exceed the analysis's true peak (which is refined).
+      EXPECT_LE(peak_s, set.analysis.ms * (1.0 + 1e-9)) << what;
+      if (set.gains.tf == 0.0) {
+        EXPECT_TRUE(std::isinf(set.analysis.noise_gain)) << what;  // the ideal derivative
+      }
+    }
+    // The preset: filtered derivative, every bound met, finite noise gain,
+    // and a smaller load IAE than the paper objective's optimum.
+    EXPECT_GT(robust.gains.tf, 0.0) << p.plant;
+    EXPECT_TRUE(std::isfinite(robust.analysis.noise_gain)) << p.plant;
+    EXPECT_LE(robust.analysis.ms, s.max_ms * (1.0 + 1e-3)) << p.plant;
+    EXPECT_LE(robust.analysis.slowest_time_constant_s, 2.5) << p.plant;
+    EXPECT_LT(robust.load_iae, optimum.load_iae) << p.plant;
+  }
+  std::ostringstream md;
+  RenderRobustSection(md, s);
+  const std::string text = md.str();
+  for (const char* want : {"## Robust tuning", "### 1/s^2", "### 1/(s^2+1)", "### stepper motor, eq. (3)",
+                           "| paper Nelder-Mead | ", "| pidlab, paper objective | ", "| pidlab --robust | ",
+                           "unbounded", "50 plants drawn", "seed 1", "the optimum of the paper's objective"})
+    EXPECT_NE(text.find(want), std::string::npos) << want;
 }
 
 TEST(Report, DeterministicForASeed) {

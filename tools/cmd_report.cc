@@ -80,7 +80,8 @@ struct ReportCommand {
     std::cout << "wrote " << (std::filesystem::path(out_dir) / "report.md").string() << " and "
               << data.figures.size() << " figures (" << data.rows.size() << " published rows, "
               << data.tunings.size() << " tunings; computation " << data.compute_time_s
-              << " s, of it the motor section " << data.motor.compute_time_s << " s beside the rest; figures "
+              << " s, of it the motor section " << data.motor.compute_time_s
+              << " s beside the rest and the robust section " << data.robust.compute_time_s << " s; figures "
               << data.figure_time_s << " s)\n";
     return 0;
   }

@@ -22,7 +22,7 @@ grep -q "bit for bit" "$md" || fail "trio result differs from the in-process sam
 
 figures=$(grep -o '](fig[^)]*\.png)' "$md" | sed 's/^](//; s/)$//')
 count=$(echo "$figures" | grep -c png)
-(( count == 8 )) || fail "expected 8 figures linked, found $count"
+(( count == 11 )) || fail "expected 11 figures linked, found $count"
 # "The motor itself": its tables hold numbers (IAE/A of the motor and of eq. (3), peaks) for every move.
 grep -q "^## The motor itself" "$md" || fail "section The motor itself missing"
 for row in "| 0.001 | none |" "| 0.01 | none |" "(one tooth pitch) | none |" "| 1 | none |" \
@@ -31,6 +31,20 @@ for row in "| 0.001 | none |" "| 0.01 | none |" "(one tooth pitch) | none |" "| 
   (( n == 3 )) || fail "motor row '$row': $n of 3 gain sets with numbers"
 done
 grep -q "fig_motor_itself.png" "$md" || fail "the motor figure is not linked"
+# "Robust tuning": per plant, the three gain sets with numbers in every column, and one figure.
+grep -q "^## Robust tuning" "$md" || fail "section Robust tuning missing"
+robust=$(sed -n '/^## Robust tuning/,/^## Figures/p' "$md")
+num='[0-9.e+-]+'
+for set in "paper Nelder-Mead" "pidlab, paper objective" "pidlab --robust"; do
+  n=$(echo "$robust" | grep -F "| $set | " |
+      grep -cE "\| $num \| $num \| $num \| $num \| ($num|inf) \| ($num deg|inf) \| ($num|unbounded) \| $num % \|$")
+  (( n == 3 )) || fail "robust rows '$set': $n of 3 plants with numbers"
+done
+(( $(echo "$robust" | grep -F "| pidlab --robust | " | grep -c unbounded) == 0 )) \
+  || fail "the --robust preset has an unbounded noise gain"
+for p in double_integrator oscillator stepper_motor; do
+  grep -q "](fig_robust_$p.png)" "$md" || fail "robust figure of $p not linked"
+done
 for f in $figures; do
   [[ -s "$out/r/$f" ]] || fail "figure $f listed but missing"
   sig=$(head -c 8 "$out/r/$f" | od -An -tx1 | tr -d ' \n')

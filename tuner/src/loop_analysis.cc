@@ -581,6 +581,37 @@ bool AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const LoopOpti
   return true;
 }
 
+bool LoopFrequencyResponse(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
+                           const std::vector<double>& w_rad_s, std::vector<LoopFrequencyPoint>* response,
+                           std::string* error) {
+  if (!GainsAreValid(typed_gains, error) || !options.IsValid(error) || !plant.tf.IsValid(error)) return false;
+  if (options.loop != LoopKind::kContinuous) {
+    if (error) *error = "LoopFrequencyResponse: the loop must be continuous";
+    return false;
+  }
+  const PidGains g = LoopGains(typed_gains, options);
+  if (!GainsAreValid(g, error)) return false;
+  Polynomial c_num, c_den;
+  ContinuousPidPolynomials(g, &c_num, &c_den);
+  const Polynomial a = Mul(c_num, plant.tf.num), b = Mul(c_den, plant.tf.den);
+  response->clear();
+  response->reserve(w_rad_s.size());
+  for (const double w : w_rad_s) {
+    if (!(std::isfinite(w) && w > 0.0)) {
+      if (error) *error = "LoopFrequencyResponse: frequency " + std::to_string(w) + " is not finite and > 0";
+      return false;
+    }
+    const cd av = Eval(a, cd(0.0, w)), bv = Eval(b, cd(0.0, w)), sum = av + bv;
+    LoopFrequencyPoint p;
+    p.w_rad_s = w;
+    p.l = bv == 0.0 ? cd(kInf, 0.0) : av / bv;
+    p.s = bv / sum;
+    p.t = av / sum;
+    response->push_back(p);
+  }
+  return true;
+}
+
 bool LoopBounds::Any() const {
   return std::isfinite(max_ms) || std::isfinite(max_mt) || std::isfinite(max_noise_gain) ||
          min_phase_margin_deg > 0.0 || min_gain_margin > 0.0 || std::isfinite(max_time_constant_s);

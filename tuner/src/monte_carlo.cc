@@ -90,6 +90,7 @@ bool RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, 
   Evaluation nominal_ev;
   EvaluateOptions what;
   what.compute_iae_continuous = false;
+  what.compute_step_info = mc.overshoot;
   if (!Evaluate(nominal, gains, options, what, &nominal_ev, error)) return false;
   *summary = MonteCarloSummary();
   summary->samples = mc.samples;

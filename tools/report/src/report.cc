@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pidlab/plot/plot.h"
@@ -466,9 +467,17 @@ bool DrawMotorSectionFigure(ReportData* data, std::string* error) {
   return true;
 }
 
+bool DrawRobustSectionFigures(ReportData* data, std::string* error) {
+  std::vector<std::pair<std::string, std::string>> drawn;
+  if (!DrawRobustFigures(data->robust, data->options.out_dir, &drawn, error)) return false;
+  for (auto& [file, caption] : drawn) data->figures.push_back({file, caption});
+  return true;
+}
+
 bool DrawFigures(ReportData* data, std::string* error) {
   return DrawStepFigures(data, error) && DrawDisturbanceFigures(data, error) &&
-         DrawVeryHighDisturbanceFigure(data, error) && DrawMotorSectionFigure(data, error);
+         DrawVeryHighDisturbanceFigure(data, error) && DrawMotorSectionFigure(data, error) &&
+         DrawRobustSectionFigures(data, error);
 }
 
 // ---------------------------------------------------------------- markdown
@@ -931,6 +940,32 @@ bool EvaluateSampledLoops(SampledSection* s, std::string* error) {
   return true;
 }
 
+// "Robust tuning" (robust_section.h) with the paper's Nelder-Mead gains of
+// Tables II-IV.
+bool ComputeRobust(const ReportOptions& options, const std::vector<PaperRow>& paper, ReportData* data,
+                   std::string* error) {
+  std::vector<RobustInput> inputs;
+  const std::pair<const char*, const char*> plants[] = {
+      {"double_integrator", "II"}, {"oscillator", "III"}, {"stepper_motor", "IV"}};
+  for (const auto& [plant, table] : plants) {
+    RobustInput in;
+    in.plant = plant;
+    bool found = false;
+    for (const PaperRow& row : paper) {
+      if (row.table == table && row.plant == plant && row.method == "nelder_mead" && !found) {
+        in.paper = row.gains;
+        found = true;
+      }
+    }
+    if (found) inputs.push_back(in);
+  }
+  if (!ComputeRobustSection(inputs, options.quick, options.seed, &data->robust, error)) {
+    *error = "robust section: " + *error;
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void FillFromEvaluation(const Evaluation& ev, Metrics* m) {
@@ -1023,6 +1058,7 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
     if (!EvaluatePaperRows(paper, data, error)) return false;
     if (!RunTunings(options, data, error)) return false;
     if (!EvaluateSampledLoops(&s, error)) return false;
+    if (!ComputeRobust(options, paper, data, error)) return false;
     trio.Collect(options.trio_absent_note, &s);
     if (const std::string e = motor.get(); !e.empty()) throw std::runtime_error(e);
   } catch (const std::exception& e) {
@@ -1046,6 +1082,7 @@ std::string RenderMarkdown(const ReportData& data) {
   RenderDisturbanceTunings(os, data);
   RenderSampledSection(os, data.sampled);
   RenderMotorSection(os, data.motor);
+  RenderRobustSection(os, data.robust);
   RenderFigureList(os, data.figures);
   return os.str();
 }

@@ -86,6 +86,22 @@ struct LoopAnalysis {
 bool AnalyzeLoop(const Plant& plant, const PidGains& gains, const LoopOptions& options,
                  const LoopAnalysisOptions& analysis_options, LoopAnalysis* analysis, std::string* error);
 
+/// The continuous loop at one frequency: L(jw) = C(jw) G(jw), S = 1/(1+L),
+/// T = L/(1+L) (the report's Bode and Nyquist figures).
+struct LoopFrequencyPoint {
+  double w_rad_s = 0.0;
+  std::complex<double> l, s, t;
+};
+
+/// L, S and T of the continuous loop of `plant` with `gains` (LoopGains of
+/// `options`, so with its derivative filter) at every w of `w_rad_s` (finite,
+/// > 0), in that order. S and T are computed as b/(a+b) and a/(a+b) from
+/// L = a/b, so they stay finite where L has a pole on the axis (L infinite,
+/// S = 0, T = 1). False with *error for invalid input or options.loop sampled.
+bool LoopFrequencyResponse(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                           const std::vector<double>& w_rad_s, std::vector<LoopFrequencyPoint>* response,
+                           std::string* error);
+
 /// Bounds on a loop (+inf / 0 = none), checked by LoopBoundsViolation.
 struct LoopBounds {
   double max_ms = std::numeric_limits<double>::infinity();

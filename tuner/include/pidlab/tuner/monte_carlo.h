@@ -28,6 +28,9 @@ struct MonteCarloOptions {
   /// Relative half-width of the uniform perturbation, [0, 1) (0.1 = 10 %).
   double spread = 0.1;
   std::uint64_t seed = 1;
+  /// Compute the overshoot distribution (step metrics of every draw; a nearly
+  /// marginal draw can cost seconds). False: overshoot_pct stays empty.
+  bool overshoot = true;
 
   bool IsValid(std::string* error) const;
 };

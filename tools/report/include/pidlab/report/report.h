@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "pidlab/report/motor_section.h"
+#include "pidlab/report/robust_section.h"
 #include "pidlab/tuner/tune.h"
 
 namespace pidlab::report {
@@ -138,6 +139,7 @@ struct ReportData {
   SampledSection sampled;
   std::vector<Figure> figures;
   MotorSection motor;  // "The motor itself" (motor_section.h)
+  RobustSection robust;  // "Robust tuning" (robust_section.h)
   /// Wall time of the computation, s (printed by the command, not in report.md).
   double compute_time_s = 0, figure_time_s = 0;
 };
