@@ -104,8 +104,14 @@ TEST(Report, TheMotorItselfRunsEveryMoveWithAndWithoutTheVoltageLimitNextToEquat
   ASSERT_EQ(m.moves.size(), 4u);
   EXPECT_EQ(m.moves[2], StepperMotorParameters{}.tooth_pitch_rad);
   EXPECT_EQ(m.voltage_limit_v, 24.0);
-  ASSERT_EQ(m.sets.size(), 3u);  // paper's NM, pidlab's default tune, tuned on the motor
+  ASSERT_EQ(m.sets.size(), 4u);  // paper's NM, pidlab's default tune, its robust preset, tuned on the motor
   EXPECT_EQ(m.sets[0].gains.kp, 20.8836);
+  // The robust preset: its filtered derivative is carried into the sampled loop.
+  EXPECT_TRUE(m.robust_available);
+  EXPECT_EQ(m.sets[2].name, "pidlab's robust preset");
+  EXPECT_GT(m.sets[2].gains.tf, 0.0);
+  EXPECT_NEAR(m.sets[2].gains.tf, m.sets[2].gains.kd / (10.0 * m.sets[2].gains.kp), 1e-12);
+  EXPECT_EQ(m.sets[3].name, "Tuned on the motor itself");
   for (const MotorGainSet& set : m.sets) {
     EXPECT_TRUE(set.eq3_stable) << set.name;
     EXPECT_GT(set.eq3_iae_per_unit, 0.0) << set.name;
@@ -136,10 +142,12 @@ TEST(Report, TheMotorItselfRunsEveryMoveWithAndWithoutTheVoltageLimitNextToEquat
   EXPECT_GT(m.motor_tune.evaluations, 0);
   EXPECT_FALSE(m.curves.empty());
   const std::string md = RenderMarkdown(data);
-  for (const char* text : {"## The motor itself", "### Where the linear design fails", "**In short:**",
-                           "| 0.001 | none | ", "| 0.001 | 24 V | ", "(one tooth pitch) | 24 V | ",
-                           "| 1 | 24 V | ", "**LOST**", "--robust", "Tuned on the motor itself"})
+  for (const char* text :
+       {"## The motor itself", "### Where the linear design fails", "**In short:**", "| 0.001 | none | ",
+        "| 0.001 | 24 V | ", "(one tooth pitch) | 24 V | ", "| 1 | 24 V | ", "**LOST**", "--robust",
+        "Tuned on the motor itself", "### pidlab's robust preset: kp, ki, kd = "})
     EXPECT_NE(md.find(text), std::string::npos) << text;
+  EXPECT_EQ(md.find("is not in this build"), std::string::npos);
 }
 
 // "Robust tuning": the three gain sets of each plant, the preset meeting its

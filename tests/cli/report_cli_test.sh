@@ -28,9 +28,10 @@ grep -q "^## The motor itself" "$md" || fail "section The motor itself missing"
 for row in "| 0.001 | none |" "| 0.01 | none |" "(one tooth pitch) | none |" "| 1 | none |" \
            "| 0.001 | 24 V |" "| 0.01 | 24 V |" "(one tooth pitch) | 24 V |" "| 1 | 24 V |"; do
   n=$(grep -F "$row" "$md" | grep -cE '\| [0-9.e+-]+ \| [0-9.e+-]+ \| [0-9.e+-]+ \|')
-  (( n == 3 )) || fail "motor row '$row': $n of 3 gain sets with numbers"
+  (( n == 4 )) || fail "motor row '$row': $n of 4 gain sets with numbers"
 done
 grep -q "fig_motor_itself.png" "$md" || fail "the motor figure is not linked"
+grep -q "^### pidlab's robust preset: kp, ki, kd = .*, Tf " "$md" || fail "the motor section lacks the --robust set"
 # "Robust tuning": per plant, the three gain sets with numbers in every column, and one figure.
 grep -q "^## Robust tuning" "$md" || fail "section Robust tuning missing"
 robust=$(sed -n '/^## Robust tuning/,/^## Figures/p' "$md")

@@ -35,7 +35,10 @@ std::string Num(double v, int digits = 4) {
   return os.str();
 }
 
-std::string Gains(const PidGains& g) { return Num(g.kp, 6) + ", " + Num(g.ki, 6) + ", " + Num(g.kd, 6); }
+std::string Gains(const PidGains& g) {
+  return Num(g.kp, 6) + ", " + Num(g.ki, 6) + ", " + Num(g.kd, 6) +
+         (g.tf > 0.0 ? ", Tf " + Num(g.tf, 4) : "");
+}
 
 Plant Motor(bool limited, double limit_v) {
   NonlinearStepperOptions o;
@@ -212,12 +215,9 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
   s.holding_voltage_v = table_one.motor.resistance_ohm * table_one.motor.stationary_current_a;
   s.horizon_s = quick ? 1.0 : 3.0;
   s.moves = {0.001, 0.01, s.tooth_pitch_rad, 1.0};
-  s.robust_available = false;
-  s.robust_note =
-      "`pidlab tune --robust` (the robust preset of issue 11) is not in this build of pidlab: its row is "
-      "missing here and will be added when the preset lands.";
 
-  // The gain sets: the paper's, pidlab's default tune of eq. (3), one tuned on the motor.
+  // The gain sets: the paper's, pidlab's default tune of eq. (3), its robust
+  // preset, one tuned on the motor.
   MotorGainSet paper;
   paper.name = "The paper's Nelder-Mead gains (Table IV)";
   paper.origin = "Tuned by the paper on eq. (3) (continuous loop, unit step).";
@@ -239,6 +239,28 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
       " on eq. (3), the paper's continuous loop and objective; IAE " + Num(ds.objective, 6) + ").";
   s.sets.push_back(pidlab_default);
 
+  // `pidlab tune --robust` on eq. (3): designed on the continuous loop like
+  // the two sets above, run with its derivative filter (tf) on this section's
+  // sampled loop.
+  TuneOptions r = d;
+  ApplyRobustPreset(&r);
+  TuneSummary rs;
+  if (!Tune(eq3, r, &rs, error)) return false;
+  MotorGainSet robust;
+  robust.name = "pidlab's robust preset";
+  robust.gains = LoopGains(rs.gains, r.loop);
+  robust.origin =
+      "`pidlab tune --plant stepper_motor --seed " + std::to_string(seed) +
+      " --robust` (setpoint-load objective, derivative filter Tf = kd/(10 kp), Ms <= 1.6, slowest "
+      "time constant <= 2.5 s, on eq. (3) and the paper's continuous loop; objective " +
+      Num(rs.objective, 6) + "); the discrete PID here filters its derivative with that Tf.";
+  s.robust_available = rs.stable;
+  s.robust_note =
+      "`pidlab tune --robust` (the robust preset, docs/robustness.md) is the third gain set: it filters its "
+      "derivative (Tf = kd/(10 kp)), so its first-sample kick is bounded, unlike the ideal derivative of the "
+      "other sets designed on eq. (3).";
+  s.sets.push_back(robust);
+
   // Every move with and without the limit, next to eq. (3); the curves of
   // the paper's gains (and of the motor-tuned gains at the tuned move).
   auto run_set = [&](std::size_t k) {
@@ -253,7 +275,7 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
       for (const double move : s.moves) {
         MotorRow row;
         const bool paper_curve = k == 0;
-        const bool tuned_curve = k == 2 && limited && move == s.tune_move_rad;
+        const bool tuned_curve = k == 3 && limited && move == s.tune_move_rad;
         std::vector<SampledStep> steps;
         if (!RunRow(s, set, move, limited, &row, paper_curve || tuned_curve ? &steps : nullptr, error))
           return false;
@@ -290,7 +312,7 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
     std::string e;
     return Tune(limited_motor, t, &s.motor_tune, &e) ? std::string() : e;
   });
-  const bool others = run_set(0) && run_set(1);
+  const bool others = run_set(0) && run_set(1) && run_set(2);
   const std::string tune_error = tune.get();
   if (!others) return false;
   if (!tune_error.empty()) {
@@ -311,7 +333,7 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
          << "; no Ceres refinement: it differentiates linear loops only).";
   on_motor.origin = origin.str();
   s.sets.push_back(on_motor);
-  if (!run_set(2)) return false;
+  if (!run_set(3)) return false;
   s.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return true;
 }

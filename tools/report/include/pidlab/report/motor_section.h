@@ -61,7 +61,8 @@ struct MotorSection {
   double holding_voltage_v = 0;  // r I_o: what the holding point alone needs
   std::vector<double> moves;     // 0.001, 0.01, lambda, 1
   std::vector<MotorGainSet> sets;
-  /// The robust preset (`pidlab tune --robust`): absent from this build.
+  /// The robust preset (`pidlab tune --robust` on eq. (3)), the third set:
+  /// its tune found a stable loop.
   bool robust_available = false;
   std::string robust_note;
   /// The tune done on the motor itself (its gains are the last set).
