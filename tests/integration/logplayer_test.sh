@@ -49,22 +49,42 @@ echo "PASS launch --log wrote a complete log"
 url=udpm://239.255.76.67:7667
 lane1=udpm://239.255.76.67:7668   # PLANT_OUTPUT
 lane2=udpm://239.255.76.67:7669   # CONTROL
-lcm-logger -q -f "--lcm-url=$lane2?recv_buf_size=4194304" control.lcmlog & pids+=($!)
-pidlab-controller --lcm-url "$url?recv_buf_size=4194304" 2>controller.err & ctl=$!; pids+=($ctl)
-sleep 0.5
-kill -0 "$ctl" 2>/dev/null || { echo "FAIL pidlab-controller did not start: $(tail -2 controller.err)"; exit 1; }
-# Both players pace from the log's first event: started together, the
-# configuration reaches the controller before the first y, as it did live.
-lcm-logplayer -s 0.5 -e '^PIDLAB_EPISODE_CONFIG$' -l "$url" run.lcmlog 2>>players.err & a=$!
-lcm-logplayer -s 0.5 -e '^PIDLAB_PLANT_OUTPUT$' -l "$lane1" run.lcmlog 2>>players.err & b=$!
-wait "$a" "$b"
-sleep 0.5
-kill -INT "${pids[0]}"; wait "${pids[0]}" 2>/dev/null
+# Both players pace from their own start. The controller answers a y only
+# after the episode's configuration, and it has no deadline of its own, so
+# the configuration's player gets a 0.5 s head start: started together, a
+# player delayed by the machine's load once let 1807 of 2000 y pass before
+# the configuration arrived.
+playback() {  # playback OUT.lcmlog: one playback into a fresh controller
+  local out=$1 logger ctl a b
+  lcm-logger -q -f "--lcm-url=$lane2?recv_buf_size=4194304" "$out" & logger=$!; pids+=($logger)
+  pidlab-controller --lcm-url "$url?recv_buf_size=4194304" 2>controller.err & ctl=$!; pids+=($ctl)
+  sleep 0.5
+  kill -0 "$ctl" 2>/dev/null || { echo "FAIL pidlab-controller did not start: $(tail -2 controller.err)"; exit 1; }
+  lcm-logplayer -s 0.5 -e '^PIDLAB_EPISODE_CONFIG$' -l "$url" run.lcmlog 2>>players.err & a=$!
+  sleep 0.5
+  lcm-logplayer -s 0.5 -e '^PIDLAB_PLANT_OUTPUT$' -l "$lane1" run.lcmlog 2>>players.err & b=$!
+  wait "$a" "$b"
+  sleep 0.5
+  kill -INT "$logger"; wait "$logger" 2>/dev/null
+  kill "$ctl" 2>/dev/null; wait "$ctl" 2>/dev/null
+}
 
-if out=$(logplayer_check run.lcmlog control.lcmlog); then
-  echo "PASS the played-back log drove pidlab-controller to the same commands: $out"
-else
-  echo "FAIL the controller's commands differ from the log's: $out"
-  tail -5 controller.err
-  exit 1
-fi
+# lcm-logplayer has no lockstep and no resends: on a loaded machine a step
+# can go unanswered (seen with 4 CPU hogs on 2 cores: 79-739 of 2000 missing,
+# never a different u). A playback with steps missing but none different is
+# played again, up to 3 times, and said so; any different u fails at once.
+for attempt in 1 2 3; do
+  playback "control.$attempt.lcmlog"
+  if out=$(logplayer_check run.lcmlog "control.$attempt.lcmlog"); then
+    echo "PASS the played-back log drove pidlab-controller to the same commands (playback $attempt): $out"
+    exit 0
+  fi
+  if [[ $out != *"0 disagreeing); missing"*"different u 0, not in the original 0"* ]]; then
+    echo "FAIL the controller's commands differ from the log's: $out"
+    tail -5 controller.err
+    exit 1
+  fi
+  echo "NOTE playback $attempt left steps unanswered, no u different: $out"
+done
+echo "FAIL three playbacks left steps unanswered: $out"
+exit 1
