@@ -9,6 +9,12 @@
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
 #include <random>
+#include <set>
+#include <thread>
+#include <chrono>
+#include <cerrno>
+#include <cstdlib>
+#include <sched.h>
 
 #include "pidlab/controller/controller_role.h"
 #include "pidlab/plant_sim/disturbance_role.h"
@@ -286,6 +292,61 @@ TEST(Transport, DropsTheConfiguredFractionReproducibly) {
   EXPECT_EQ(a, b);
   EXPECT_NE(a, c);
   EXPECT_NEAR(static_cast<double>(a.size()) / 2000.0, 0.8, 0.03);
+}
+
+/// Moves this test process into a network namespace of its own (root) with
+/// multicast over its loopback, so that udpm:// traffic stays inside it.
+bool EnterPrivateNetwork(std::string* error) {
+  if (unshare(CLONE_NEWNET) != 0) {
+    *error = std::string("unshare(CLONE_NEWNET): ") + std::strerror(errno) + " (run as root)";
+    return false;
+  }
+  if (std::system("ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo") != 0) {
+    *error = "cannot set up multicast on the private namespace's loopback";
+    return false;
+  }
+  return true;
+}
+
+/// Publishes `burst` outputs on the PLANT_OUTPUT lane of a udpm:// trio URL
+/// while the receiving transport does not handle, lets LCM's receive thread
+/// take them all, then handles: the steps that reached the subscription.
+long OutputsSurvivingABurst(int queue_capacity, int burst) {
+  const std::string url = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
+  lcm::LCM base_in(url), base_out(url);
+  TransportOptions in_options, out_options;
+  in_options.step_lane_base_url = out_options.step_lane_base_url = url;
+  in_options.queue_capacity = queue_capacity;
+  Transport in(&base_in, in_options), out(&base_out, out_options);
+  std::set<int64_t> steps;
+  in.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel,
+                                          [&](const pidlab::lcmt_plant_output& m) { steps.insert(m.step); });
+  for (int k = 0; k < burst; ++k) {
+    pidlab::lcmt_plant_output m{};
+    m.step = k;
+    out.Publish(kPlantOutputChannel, &m);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // LCM's receive thread queues them
+  while (in.WaitAndHandle(0.05) > 0) {
+  }
+  return static_cast<long>(steps.size());
+}
+
+TEST(Transport, KeepsEveryMessageOfABurstThatArrivesWhileItIsNotHandling) {
+  std::string error;
+  ASSERT_TRUE(EnterPrivateNetwork(&error)) << error;
+  EXPECT_EQ(OutputsSurvivingABurst(TransportOptions::kDefaultQueueCapacity, 1000), 1000);
+  // LCM's own default of 30 loses most of it, silently: what stalled a lone
+  // controller fed by lcm-logplayer on a loaded machine.
+  EXPECT_LT(OutputsSurvivingABurst(30, 1000), 100);
+}
+
+TEST(Transport, RejectsAQueueCapacityBelowOne) {
+  TransportOptions o;
+  std::string error;
+  o.queue_capacity = 0;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("queue capacity 0"), std::string::npos);
 }
 
 TEST(Transport, RejectsADropRateOutsideUnitInterval) {

@@ -1,12 +1,16 @@
-// logplayer_check ORIGINAL PLAYBACK [PREFIX]: compares the CONTROL commands
-// of two lcm-logger files: ORIGINAL is the log of a live run (`pidlab launch
-// --log`), PLAYBACK what a lone pidlab-controller answered when lcm-logplayer
-// played ORIGINAL to it. The commands of ORIGINAL are every u of every
-// complete episode as `pidlab replay` reads them (pidlab_logreader: CONTROL
-// events and the plant's trajectory chunks); PLAYBACK's are its CONTROL
-// events (event reader). Every step must be in PLAYBACK, and every copy of it
-// there (re-answered duplicates) must carry the same u, bit for bit. Prints
-// the counts; exit 0 if all agree, 1 if not, 2 if a file cannot be read.
+// logplayer_check [--prefix P] ORIGINAL PLAYBACK...: compares the CONTROL
+// commands of lcm-logger files: ORIGINAL is the log of a live run (`pidlab
+// launch --log`), each PLAYBACK what a lone pidlab-controller answered when
+// lcm-logplayer played ORIGINAL to it. The commands of ORIGINAL are every u of
+// every complete episode as `pidlab replay` reads them (pidlab_logreader:
+// CONTROL events and the plant's trajectory chunks); a PLAYBACK's are its
+// CONTROL events (event reader). Several PLAYBACK files (playbacks of the same
+// log into fresh controllers) are taken together: a recording lcm-logger can
+// miss a few answers on a loaded machine, and a controller answers in step
+// order, so a step answered in any of them was reached. Every step must be
+// in some PLAYBACK, and every copy of it (re-answered duplicates, other
+// playbacks) must carry the same u, bit for bit. Prints the counts; exit 0 if
+// all agree, 1 if not, 2 if a file cannot be read or the usage is wrong.
 
 #include <cstdio>
 #include <cstring>
@@ -50,18 +54,24 @@ bool Read(const char* path, const std::string& channel, Commands* out) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr, "usage: logplayer_check ORIGINAL PLAYBACK [PREFIX]\n");
+  std::string prefix = "PIDLAB_";
+  int first = 1;
+  if (argc > 2 && std::strcmp(argv[1], "--prefix") == 0) {
+    prefix = argv[2];
+    first = 3;
+  }
+  if (argc - first < 2) {
+    std::fprintf(stderr, "usage: logplayer_check [--prefix P] ORIGINAL PLAYBACK...\n");
     return 2;
   }
-  const std::string channel = std::string(argc > 3 ? argv[3] : "PIDLAB_") + "CONTROL";
+  const std::string channel = prefix + "CONTROL";
   Commands original, playback;
   pidlab::replay::ReadOptions options;
-  options.channel_prefix = argc > 3 ? argv[3] : "PIDLAB_";
+  options.channel_prefix = prefix;
   pidlab::replay::LogContents log;
   std::string error;
-  if (!pidlab::replay::ReadLog(argv[1], options, &log, &error)) {
-    std::fprintf(stderr, "cannot read %s: %s\n", argv[1], error.c_str());
+  if (!pidlab::replay::ReadLog(argv[first], options, &log, &error)) {
+    std::fprintf(stderr, "cannot read %s: %s\n", argv[first], error.c_str());
     return 2;
   }
   long incomplete = 0;
@@ -76,7 +86,8 @@ int main(int argc, char** argv) {
       original.u.emplace(std::make_pair(e.episode_id, k), bits);
     }
   }
-  if (!Read(argv[2], channel, &playback)) return 2;
+  for (int i = first + 1; i < argc; ++i)
+    if (!Read(argv[i], channel, &playback)) return 2;
   long missing = 0, different = 0, extra = 0;
   for (const auto& [key, bits] : original.u) {
     const auto it = playback.u.find(key);
@@ -87,10 +98,11 @@ int main(int argc, char** argv) {
   }
   for (const auto& entry : playback.u) extra += original.u.count(entry.first) ? 0 : 1;
   std::printf(
-      "original: %zu steps commanded in %zu episodes (%ld incomplete); playback: %zu steps "
+      "original: %zu steps commanded in %zu episodes (%ld incomplete); playback (%d recording%s): %zu steps "
       "(%ld CONTROL events, %ld repeats, %ld disagreeing); missing %ld, different u %ld, not in the original "
       "%ld\n",
-      original.u.size(), log.episodes.size(), incomplete, playback.u.size(), playback.events, playback.copies,
+      original.u.size(), log.episodes.size(), incomplete, argc - first - 1, argc - first - 1 == 1 ? "" : "s",
+      playback.u.size(), playback.events, playback.copies,
       playback.disagreeing, missing, different, extra);
   const bool ok = !original.u.empty() && missing == 0 && different == 0 && extra == 0 && incomplete == 0 &&
                   playback.disagreeing == 0;

@@ -26,6 +26,8 @@ bool TransportOptions::IsValid(std::string* error) const {
   std::ostringstream os;
   if (!(drop_rate >= 0.0 && drop_rate < 1.0)) {
     os << "drop rate " << drop_rate << " must be in [0, 1)";
+  } else if (queue_capacity < 1) {
+    os << "queue capacity " << queue_capacity << " must be at least 1";
   } else if (channel_prefix.find_first_of(" \t\n") != std::string::npos) {
     os << "channel prefix '" << channel_prefix.substr(0, 80) << "' must not contain white space";
   } else if (!step_lane_base_url.empty() && step_lane_base_url.rfind("udpm://", 0) == 0 &&

@@ -43,6 +43,16 @@ struct TransportOptions {
   /// every process of the trio. Empty, or not udpm://: every channel on the
   /// LCM instance given to the transport (memq:// tests).
   std::string step_lane_base_url;
+  /// Messages LCM may hold for each subscription between its receive thread
+  /// and WaitAndHandle. LCM 1.3.1's default is 30 and it drops the rest
+  /// silently (no kernel counter moves): a burst, e.g. lcm-logplayer catching
+  /// up after the machine stalled it, then loses a y_k, and a controller that
+  /// answers y_k only after y_(k-1) waits for ever. The bound keeps a flood
+  /// from growing LCM's ring buffer without limit (at most this many
+  /// datagrams per subscription, each at most LCM's 64 kB packet).
+  int queue_capacity = kDefaultQueueCapacity;
+
+  static constexpr int kDefaultQueueCapacity = 4096;
 
   bool IsValid(std::string* error) const;
 };
@@ -124,7 +134,9 @@ class Transport {
     // channel name for every message received.
     sub->channel = Channel(name);
     const int lane = LaneOf(name.c_str());
-    lcm_subscribe(LcmFor(lane)->getUnderlyingLCM(), sub->channel.c_str(), &Subscription::HandleC, sub.get());
+    lcm_subscription_t* handle =
+        lcm_subscribe(LcmFor(lane)->getUnderlyingLCM(), sub->channel.c_str(), &Subscription::HandleC, sub.get());
+    if (handle) lcm_subscription_set_queue_capacity(handle, options_.queue_capacity);
     listening_[static_cast<std::size_t>(lane)] = true;
     subscriptions_.push_back(std::move(sub));
   }
