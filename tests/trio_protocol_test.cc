@@ -2,8 +2,12 @@
 // one memq:// LCM instance, single-threaded (no network).
 
 #include <gtest/gtest.h>
+#include <sched.h>
 
+#include <cerrno>
+#include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <pidlab/lcmt_control_command.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
@@ -11,10 +15,6 @@
 #include <random>
 #include <set>
 #include <thread>
-#include <chrono>
-#include <cerrno>
-#include <cstdlib>
-#include <sched.h>
 
 #include "pidlab/controller/controller_role.h"
 #include "pidlab/plant_sim/disturbance_role.h"
@@ -301,7 +301,8 @@ bool EnterPrivateNetwork(std::string* error) {
     *error = std::string("unshare(CLONE_NEWNET): ") + std::strerror(errno) + " (run as root)";
     return false;
   }
-  if (std::system("ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo") != 0) {
+  if (std::system("ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo") !=
+      0) {
     *error = "cannot set up multicast on the private namespace's loopback";
     return false;
   }
