@@ -42,6 +42,14 @@ class Evaluate(unittest.TestCase):
         self.assertSameResult(got, want)
         self.assertEqual(got["plant"], "custom")
 
+    def test_bounds_are_reported_as_violations_as_by_the_cli(self):
+        got = pidlab.evaluate("double_integrator", PAPER_NM_GAINS, max_ms=1.2, derivative_filter_ratio=10)
+        want = cli("evaluate", "--plant", "double_integrator", "--gains", "29.6558,0.4977,28.3216", "--max-ms",
+                   "1.2", "--derivative-filter-ratio", "10")
+        self.assertSameResult(got, want)
+        self.assertEqual(len(got["robustness"]["violations"]), 1)
+        self.assertIn("1.2", got["robustness"]["violations"][0])
+
     def test_custom_with_num_and_den_keywords_is_the_same_plant(self):
         a = pidlab.evaluate("custom", (2, 1, 1.5), num=[1], den=[1, 0, 1])
         b = pidlab.evaluate(([1], [1, 0, 1]), (2, 1, 1.5))
@@ -120,6 +128,27 @@ class Tune(unittest.TestCase):
         self.assertEqual(got["constraints"]["max_ms"], 1.6)
         self.assertEqual(got["robust_set"]["size"], 5)
         self.assertEqual(got["robustness"]["violations"], [])
+
+    def test_bound_keywords_and_a_filter_ratio_equal_the_cli_json(self):
+        got = pidlab.tune("stepper", max_ms=1.4, min_phase_margin=45, derivative_filter_ratio=10, max_evals=400)
+        want = cli("tune", "--plant", "stepper", "--max-ms", "1.4", "--min-phase-margin", "45",
+                   "--derivative-filter-ratio", "10", "--max-evals", "400")
+        self.assertSameTune(got, want)
+        self.assertEqual(got["constraints"]["max_ms"], 1.4)
+        self.assertEqual(got["constraints"]["derivative_filter_ratio"], 10)
+        self.assertLessEqual(got["robustness"]["ms"], 1.4)
+        self.assertGreaterEqual(got["robustness"]["phase_margin_deg"], 45)
+        self.assertEqual(got["robustness"]["violations"], [])
+
+    def test_an_argument_next_to_robust_overrides_its_part_as_the_flag_does(self):
+        got = pidlab.tune("stepper", robust=True, max_ms=1.3, load_weight=2, max_evals=600)
+        want = cli("tune", "--plant", "stepper", "--robust", "--max-ms", "1.3", "--load-weight", "2",
+                   "--max-evals", "600")
+        self.assertSameTune(got, want)
+        self.assertEqual(got["objective_kind"], "setpoint-load")
+        self.assertEqual(got["load_weight"], 2)
+        self.assertEqual(got["constraints"]["max_ms"], 1.3)
+        self.assertEqual(got["constraints"]["derivative_filter_ratio"], 10)
 
     def test_bad_options_raise_value_error(self):
         with self.assertRaisesRegex(ValueError, "simplex"):
