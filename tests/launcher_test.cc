@@ -11,6 +11,7 @@
 #include "pidlab/launcher/launcher.h"
 
 #include <gtest/gtest.h>
+#include <lcm/eventlog.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/time.h>
@@ -27,10 +28,12 @@
 #include <iostream>
 #include <iterator>
 #include <map>
+#include <pidlab/lcmt_plant_output.hpp>
 #include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -317,6 +320,155 @@ TEST(MissingSteps, RangesTextStopsAfterMaxRangesWithACount) {
   EXPECT_EQ(RangesText(ranges, 2), "1,3-5,... (4 ranges)");
   EXPECT_EQ(RangesText(ranges, 4), "1,3-5,9,11-20");
   EXPECT_EQ(CountSteps(ranges), 1 + 3 + 1 + 10);
+}
+
+// ---- RebuildLaneOutputs and MergeEventLogs (files only, no processes)
+
+/// A complete episode of `steps` steps, dt 1 ms, y_k = 0.5 + k.
+replay::LogContents OneCompleteEpisode(int64_t id, long steps) {
+  replay::LogContents log;
+  replay::Episode e;
+  e.episode_id = id;
+  e.has_config = true;
+  e.total_steps = steps;
+  e.spec.dt_s = 1e-3;
+  for (long k = 0; k <= steps; ++k) e.y.push_back(0.5 + static_cast<double>(k));
+  log.episodes.push_back(e);
+  return log;
+}
+
+/// Writes (timestamp, channel, payload) events as lcm-logger would.
+void WriteLog(const std::string& path,
+              const std::vector<std::tuple<int64_t, std::string, std::vector<uint8_t>>>& events) {
+  lcm_eventlog_t* l = lcm_eventlog_create(path.c_str(), "w");
+  ASSERT_NE(l, nullptr);
+  for (const auto& [ts, channel, data] : events) {
+    lcm_eventlog_event_t ev{};
+    ev.timestamp = ts;
+    std::string c = channel;
+    std::vector<uint8_t> d = data;
+    ev.channellen = static_cast<int32_t>(c.size());
+    ev.channel = c.data();
+    ev.datalen = static_cast<int32_t>(d.size());
+    ev.data = d.data();
+    ASSERT_EQ(lcm_eventlog_write_event(l, &ev), 0);
+  }
+  lcm_eventlog_destroy(l);
+}
+
+std::vector<uint8_t> Output(int64_t id, int64_t step, double y) {
+  pidlab::lcmt_plant_output m{};
+  m.episode_id = id;
+  m.step = step;
+  m.y = y;
+  std::vector<uint8_t> data(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(data.data(), 0, static_cast<int>(data.size()));
+  return data;
+}
+
+pidlab::lcmt_plant_output Decoded(const std::vector<uint8_t>& data) {
+  pidlab::lcmt_plant_output m{};
+  EXPECT_EQ(m.decode(data.data(), 0, static_cast<int>(data.size())), static_cast<int>(data.size()));
+  return m;
+}
+
+/// (timestamp, channel, step or -1) of every event of a log file.
+std::vector<std::tuple<int64_t, std::string, int64_t>> ReadEvents(const std::string& path) {
+  std::vector<std::tuple<int64_t, std::string, int64_t>> out;
+  lcm_eventlog_t* l = lcm_eventlog_create(path.c_str(), "r");
+  if (!l) return out;
+  while (lcm_eventlog_event_t* ev = lcm_eventlog_read_next_event(l)) {
+    pidlab::lcmt_plant_output m{};
+    const bool output = m.decode(ev->data, 0, static_cast<int>(ev->datalen)) == ev->datalen;
+    out.emplace_back(ev->timestamp, ev->channel, output ? m.step : -1);
+    lcm_eventlog_free_event(ev);
+  }
+  lcm_eventlog_destroy(l);
+  return out;
+}
+
+TEST(RebuildLaneOutputs, FillsAGapBetweenItsLoggedNeighboursWithTheEpisodesY) {
+  TempDir dir;
+  const std::string lane = dir.File("run.lcmlog.lane1");
+  // Steps 0-2 and 5-10 logged 100 us apart; 3 and 4 lost.
+  std::vector<std::tuple<int64_t, std::string, std::vector<uint8_t>>> events;
+  for (int64_t k : {0, 1, 2, 5, 6, 7, 8, 9, 10})
+    events.emplace_back(1000 + 100 * k, "PIDLAB_PLANT_OUTPUT", Output(7, k, 0.5 + k));
+  WriteLog(lane, events);
+  const auto rebuilt = ln::RebuildLaneOutputs(OneCompleteEpisode(7, 10), lane, "PIDLAB_");
+  ASSERT_EQ(rebuilt.size(), 2u);
+  EXPECT_EQ(rebuilt[0].first, 1300);  // evenly between step 2 (1200) and step 5 (1500)
+  EXPECT_EQ(rebuilt[1].first, 1400);
+  const auto m3 = Decoded(rebuilt[0].second), m4 = Decoded(rebuilt[1].second);
+  EXPECT_EQ(m3.episode_id, 7);
+  EXPECT_EQ(m3.step, 3);
+  EXPECT_EQ(m3.y, 3.5);
+  EXPECT_EQ(m3.t_s, 3e-3);
+  EXPECT_EQ(m3.utime, 1300);
+  EXPECT_EQ(m4.step, 4);
+  EXPECT_EQ(m4.y, 4.5);
+}
+
+TEST(RebuildLaneOutputs, PacesALostTailAndHeadOneDtApartAndNeverOutOfOrder) {
+  TempDir dir;
+  const std::string lane = dir.File("lane");
+  // Only steps 2 and 3 logged, 1 us apart: 0-1 (head) and 4-5 (tail) lost;
+  // y_6 = y_N, which no controller answers, is not rebuilt.
+  WriteLog(lane, {{50000, "PIDLAB_PLANT_OUTPUT", Output(9, 2, 2.5)},
+                  {50001, "PIDLAB_PLANT_OUTPUT", Output(9, 3, 3.5)}});
+  const auto rebuilt = ln::RebuildLaneOutputs(OneCompleteEpisode(9, 6), lane, "PIDLAB_");
+  ASSERT_EQ(rebuilt.size(), 4u);
+  std::vector<int64_t> steps, times;
+  for (const auto& r : rebuilt) {
+    steps.push_back(Decoded(r.second).step);
+    times.push_back(r.first);
+  }
+  EXPECT_EQ(steps, (std::vector<int64_t>{0, 1, 4, 5}));
+  EXPECT_EQ(times, (std::vector<int64_t>{48000, 49000, 51001, 52001}));  // dt = 1 ms
+}
+
+TEST(RebuildLaneOutputs, LeavesAnEpisodeTheLaneNeverHeardAndAnIncompleteOneAlone) {
+  TempDir dir;
+  const std::string lane = dir.File("lane");
+  WriteLog(lane,
+           {{10, "PIDLAB_PLANT_OUTPUT", Output(1, 0, 0.5)}, {20, "OTHER_PLANT_OUTPUT", Output(2, 0, 0.5)}});
+  replay::LogContents log = OneCompleteEpisode(2, 3);  // its outputs are on another prefix: unheard
+  EXPECT_TRUE(ln::RebuildLaneOutputs(log, lane, "PIDLAB_").empty());
+  log = OneCompleteEpisode(1, 3);
+  log.episodes[0].commands.missing = {{1, 1}};  // not complete: its y cannot be trusted to be all there
+  EXPECT_TRUE(ln::RebuildLaneOutputs(log, lane, "PIDLAB_").empty());
+  EXPECT_TRUE(ln::RebuildLaneOutputs(OneCompleteEpisode(1, 3), dir.File("absent"), "PIDLAB_").empty());
+}
+
+TEST(MergeEventLogs, InterleavesTheInputsAndTheRebuiltEventsByTimestamp) {
+  TempDir dir;
+  WriteLog(
+      dir.File("base"),
+      {{10, "PIDLAB_EPISODE_CONFIG", {1, 2}}, {40, "PIDLAB_TRAJECTORY", {3}}, {70, "PIDLAB_SUMMARY", {4}}});
+  WriteLog(dir.File("lane1"),
+           {{20, "PIDLAB_PLANT_OUTPUT", Output(1, 0, 0.5)}, {40, "PIDLAB_PLANT_OUTPUT", Output(1, 2, 2.5)}});
+  WriteLog(dir.File("lane2"), {{25, "PIDLAB_CONTROL", {5}}, {45, "PIDLAB_CONTROL", {6}}});
+  const std::vector<ln::TimedPayload> rebuilt = {{30, Output(1, 1, 1.5)}, {60, Output(1, 3, 3.5)}};
+  std::string error;
+  ASSERT_TRUE(ln::MergeEventLogs({dir.File("base"), dir.File("lane1"), dir.File("absent"), dir.File("lane2")},
+                                 rebuilt, "PIDLAB_PLANT_OUTPUT", dir.File("merged"), &error))
+      << error;
+  using E = std::tuple<int64_t, std::string, int64_t>;
+  const auto events = ReadEvents(dir.File("merged"));
+  const std::vector<E> want = {
+      {10, "PIDLAB_EPISODE_CONFIG", -1}, {20, "PIDLAB_PLANT_OUTPUT", 0}, {25, "PIDLAB_CONTROL", -1},
+      {30, "PIDLAB_PLANT_OUTPUT", 1},    {40, "PIDLAB_TRAJECTORY", -1},  {40, "PIDLAB_PLANT_OUTPUT", 2},
+      {45, "PIDLAB_CONTROL", -1},        {60, "PIDLAB_PLANT_OUTPUT", 3}, {70, "PIDLAB_SUMMARY", -1}};
+  EXPECT_EQ(events, want);  // on a tie (40) the base log's event first
+}
+
+TEST(MergeEventLogs, FailsNamingAnUnreadableBaseLogAndWritesNothing) {
+  TempDir dir;
+  std::string error;
+  EXPECT_FALSE(
+      ln::MergeEventLogs({dir.File("absent")}, {}, "PIDLAB_PLANT_OUTPUT", dir.File("merged"), &error));
+  EXPECT_NE(error.find(dir.File("absent")), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.File("merged")));
 }
 
 // ---- LaunchOptions::roles (no network: validation only)

@@ -106,38 +106,23 @@ void LogCapture::StartLaneLoggers(const std::string& lcm_url) {
   }
 }
 
-std::vector<std::pair<int64_t, std::vector<uint8_t>>> LogCapture::MissingLaneOutputs(
-    const std::string& lane_file) const {
-  // The outputs the PLANT_OUTPUT lane's logger lost, rebuilt from the base
-  // log (its trajectory chunks, complete after Repair()): a controller driven
-  // from the log by lcm-logplayer waits for y_k forever if y_k is missing.
-  // Authenticated runs are left as they are (the rebuilt messages would carry
-  // no tag).
-  std::vector<std::pair<int64_t, std::vector<uint8_t>>> out;
-  if (options_.auth_key) return out;
-  replay::ReadOptions read_options;
-  read_options.channel_prefix = options_.channel_prefix;
-  replay::LogContents log;
-  std::string error;
-  if (!replay::ReadLog(options_.log_file, read_options, &log, &error)) return out;
-  std::map<std::pair<int64_t, int64_t>, int64_t> seen;  // (episode, step) -> timestamp
-  const std::string channel = options_.channel_prefix + transport::kPlantOutputChannel;
-  if (lcm_eventlog_t* l = lcm_eventlog_create(lane_file.c_str(), "r")) {
-    while (lcm_eventlog_event_t* ev = lcm_eventlog_read_next_event(l)) {
-      pidlab::lcmt_plant_output m;
-      if (channel == ev->channel && m.decode(ev->data, 0, static_cast<int>(ev->datalen)) >= 0)
-        seen.emplace(std::make_pair(m.episode_id, m.step), ev->timestamp);
-      lcm_eventlog_free_event(ev);
-    }
-    lcm_eventlog_destroy(l);
+std::vector<TimedPayload> RebuildLaneOutputs(const replay::LogContents& log, const std::string& lane_file,
+                                             const std::string& channel_prefix) {
+  std::vector<TimedPayload> out;
+  std::map<std::pair<int64_t, int64_t>, int64_t> seen;  // (episode, step) -> first timestamp
+  const std::string channel = channel_prefix + transport::kPlantOutputChannel;
+  lcm_eventlog_t* l = lcm_eventlog_create(lane_file.c_str(), "r");
+  if (!l) return out;
+  while (lcm_eventlog_event_t* ev = lcm_eventlog_read_next_event(l)) {
+    pidlab::lcmt_plant_output m;
+    if (channel == ev->channel && m.decode(ev->data, 0, static_cast<int>(ev->datalen)) >= 0)
+      seen.emplace(std::make_pair(m.episode_id, m.step), ev->timestamp);
+    lcm_eventlog_free_event(ev);
   }
+  lcm_eventlog_destroy(l);
   for (const replay::Episode& e : log.episodes) {
     if (!e.Complete()) continue;
-    // A lost output takes a timestamp between its logged neighbours', spread
-    // evenly, so the player paces it as the plant did (no burst).
-    // Never before the step before it (logged or rebuilt): the controller
-    // answers y_k only after y_(k-1).
-    int64_t previous = -1;
+    int64_t previous = -1;  // the timestamp of step k - 1, logged or rebuilt
     for (long k = 0; k < e.total_steps; ++k) {
       if (const auto it = seen.find({e.episode_id, k}); it != seen.end()) {
         previous = it->second;
@@ -174,6 +159,81 @@ std::vector<std::pair<int64_t, std::vector<uint8_t>>> LogCapture::MissingLaneOut
   return out;
 }
 
+bool MergeEventLogs(const std::vector<std::string>& inputs, const std::vector<TimedPayload>& extra,
+                    const std::string& extra_channel, const std::string& out_file, std::string* error) {
+  std::vector<lcm_eventlog_t*> logs;
+  bool ok = true;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    lcm_eventlog_t* l = lcm_eventlog_create(inputs[i].c_str(), "r");
+    if (!l) {
+      if (i == 0) {
+        ok = false;
+        if (error) *error = "cannot open " + inputs[i] + " to merge into it";
+      }
+      continue;  // e.g. a lane logger that wrote nothing: nothing to merge
+    }
+    logs.push_back(l);
+  }
+  lcm_eventlog_t* out = ok ? lcm_eventlog_create(out_file.c_str(), "w") : nullptr;
+  if (ok && !out) {
+    ok = false;
+    if (error) *error = "cannot write " + out_file;
+  }
+  if (ok) {
+    // A k-way merge by timestamp; each input is in time order already.
+    std::vector<lcm_eventlog_event_t*> head(logs.size(), nullptr);
+    for (std::size_t i = 0; i < logs.size(); ++i) head[i] = lcm_eventlog_read_next_event(logs[i]);
+    std::string channel = extra_channel;
+    std::size_t next_extra = 0;
+    auto write = [&](lcm_eventlog_event_t* ev) {
+      if (ok && lcm_eventlog_write_event(out, ev) != 0) {
+        ok = false;
+        if (error) *error = "cannot write " + out_file;
+      }
+    };
+    for (;;) {
+      std::size_t best = logs.size();
+      for (std::size_t i = 0; i < logs.size(); ++i)
+        if (head[i] && (best == logs.size() || head[i]->timestamp < head[best]->timestamp)) best = i;
+      if (next_extra < extra.size() &&
+          (best == logs.size() || extra[next_extra].first < head[best]->timestamp)) {
+        const TimedPayload& r = extra[next_extra++];
+        lcm_eventlog_event_t ev{};
+        ev.timestamp = r.first;
+        ev.channellen = static_cast<int32_t>(channel.size());
+        ev.datalen = static_cast<int32_t>(r.second.size());
+        ev.channel = channel.data();
+        ev.data = const_cast<uint8_t*>(r.second.data());
+        write(&ev);
+        continue;
+      }
+      if (best == logs.size()) break;
+      write(head[best]);
+      lcm_eventlog_free_event(head[best]);
+      head[best] = lcm_eventlog_read_next_event(logs[best]);
+    }
+    for (lcm_eventlog_event_t* h : head)
+      if (h) lcm_eventlog_free_event(h);
+    lcm_eventlog_destroy(out);
+  }
+  for (lcm_eventlog_t* l : logs) lcm_eventlog_destroy(l);
+  if (!ok) std::remove(out_file.c_str());
+  return ok;
+}
+
+std::vector<TimedPayload> LogCapture::MissingLaneOutputs(const std::string& lane_file) const {
+  // A controller driven from the log by lcm-logplayer waits for y_k forever
+  // if y_k is missing. Authenticated runs are left as they are (the rebuilt
+  // messages would carry no tag).
+  if (options_.auth_key) return {};
+  replay::ReadOptions read_options;
+  read_options.channel_prefix = options_.channel_prefix;
+  replay::LogContents log;
+  std::string error;
+  if (!replay::ReadLog(options_.log_file, read_options, &log, &error)) return {};
+  return RebuildLaneOutputs(log, lane_file, options_.channel_prefix);
+}
+
 bool LogCapture::MergeLanes(std::string* error) {
   rebuilt_outputs_ = 0;
   if (lane_loggers_.empty()) return true;
@@ -181,75 +241,21 @@ bool LogCapture::MergeLanes(std::string* error) {
     if (pid > 0 && !supervisor_->StopChild(pid, SIGINT, 3.0)) supervisor_->StopChild(pid, SIGKILL, 1.0);
   std::vector<std::string> inputs{options_.log_file};
   for (const auto& lane : lane_loggers_) inputs.push_back(lane.second);
-  std::vector<std::pair<int64_t, std::vector<uint8_t>>> rebuilt;
+  std::vector<TimedPayload> rebuilt;
   for (const auto& lane : lane_loggers_)
     if (lane.second == options_.log_file + ".lane" + std::to_string(transport::kPlantOutputLane))
       rebuilt = MissingLaneOutputs(lane.second);
   std::stable_sort(rebuilt.begin(), rebuilt.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   rebuilt_outputs_ = static_cast<long>(rebuilt.size());
-  std::string rebuilt_channel = options_.channel_prefix + transport::kPlantOutputChannel;
-  std::size_t next_rebuilt = 0;
   const std::string merged = options_.log_file + ".merging";
-  std::vector<lcm_eventlog_t*> logs;
-  bool ok = true;
-  for (const std::string& f : inputs) {
-    lcm_eventlog_t* l = lcm_eventlog_create(f.c_str(), "r");
-    if (!l) {
-      if (f == options_.log_file) {
-        ok = false;
-        if (error) *error = "cannot open " + f + " to merge the step lanes into it";
-      }
-      continue;  // a lane logger that wrote nothing: nothing to merge
-    }
-    logs.push_back(l);
-  }
-  lcm_eventlog_t* out = ok ? lcm_eventlog_create(merged.c_str(), "w") : nullptr;
-  if (ok && !out) {
-    ok = false;
-    if (error) *error = "cannot write " + merged;
-  }
-  if (ok) {
-    // A k-way merge by timestamp; each input is in time order already. A
-    // truncated tail (a logger killed mid-write) ends that input.
-    std::vector<lcm_eventlog_event_t*> head(logs.size(), nullptr);
-    for (std::size_t i = 0; i < logs.size(); ++i) head[i] = lcm_eventlog_read_next_event(logs[i]);
-    for (;;) {
-      std::size_t best = logs.size();
-      for (std::size_t i = 0; i < logs.size(); ++i)
-        if (head[i] && (best == logs.size() || head[i]->timestamp < head[best]->timestamp)) best = i;
-      // A rebuilt output goes before any logged event of a later timestamp.
-      if (next_rebuilt < rebuilt.size() &&
-          (best == logs.size() || rebuilt[next_rebuilt].first < head[best]->timestamp)) {
-        auto& r = rebuilt[next_rebuilt++];
-        lcm_eventlog_event_t ev{};
-        ev.timestamp = r.first;
-        ev.channellen = static_cast<int32_t>(rebuilt_channel.size());
-        ev.datalen = static_cast<int32_t>(r.second.size());
-        ev.channel = rebuilt_channel.data();
-        ev.data = r.second.data();
-        if (ok && lcm_eventlog_write_event(out, &ev) != 0) {
-          ok = false;
-          if (error) *error = "cannot write " + merged;
-        }
-        continue;
-      }
-      if (best == logs.size()) break;
-      if (ok && lcm_eventlog_write_event(out, head[best]) != 0) {
-        ok = false;
-        if (error) *error = "cannot write " + merged;
-      }
-      lcm_eventlog_free_event(head[best]);
-      head[best] = lcm_eventlog_read_next_event(logs[best]);
-    }
-    lcm_eventlog_destroy(out);
-  }
-  for (lcm_eventlog_t* l : logs) lcm_eventlog_destroy(l);
+  bool ok = MergeEventLogs(inputs, rebuilt, options_.channel_prefix + transport::kPlantOutputChannel, merged,
+                           error);
   if (ok && std::rename(merged.c_str(), options_.log_file.c_str()) != 0) {
     ok = false;
     if (error) *error = "cannot rename " + merged + " to " + options_.log_file;
+    std::remove(merged.c_str());
   }
-  if (!ok) std::remove(merged.c_str());
   for (const auto& lane : lane_loggers_) std::remove(lane.second.c_str());
   lane_loggers_.clear();
   return ok;

@@ -26,6 +26,30 @@ std::vector<std::pair<long, long>> MissingSteps(const replay::Episode& episode);
 std::string RangesText(const std::vector<std::pair<long, long>>& ranges, std::size_t max_ranges = 8);
 long CountSteps(const std::vector<std::pair<long, long>>& ranges);
 
+/// One event to write into a log: (timestamp in us, payload).
+using TimedPayload = std::pair<int64_t, std::vector<uint8_t>>;
+
+/// The PLANT_OUTPUT events (<prefix>PLANT_OUTPUT, lcmt_plant_output) a step
+/// lane's lcm-logger lost, rebuilt from `log`: one for every step k <
+/// total_steps (those a controller answers) of every complete episode of
+/// `log` that `lane_file` does not hold, with the y of the episode. Its timestamp lies between those of its
+/// logged neighbours, spread evenly (a lost tail or head: dt apart), and always after the step before it
+/// (logged or rebuilt), so a player paces it as the plant did and a controller, which answers y_k only after
+/// y_(k-1), sees it in order. Nothing for an episode the lane logger heard nothing of, or if `lane_file`
+/// cannot be read. In step order.
+std::vector<TimedPayload> RebuildLaneOutputs(const replay::LogContents& log, const std::string& lane_file,
+                                             const std::string& channel_prefix);
+
+/// Writes `out_file`: every event of the files `inputs` (each in time order,
+/// as lcm-logger writes them) and of `extra` (sorted by timestamp, on
+/// `extra_channel`), merged by timestamp; on a tie an earlier input comes
+/// first, and an extra event goes before any logged event with a later
+/// timestamp. A truncated tail (a logger killed mid-write) ends that input;
+/// an input other than inputs[0] that does not exist is skipped. False with
+/// *error if inputs[0] cannot be read or out_file cannot be written.
+bool MergeEventLogs(const std::vector<std::string>& inputs, const std::vector<TimedPayload>& extra,
+                    const std::string& extra_channel, const std::string& out_file, std::string* error);
+
 enum class RepairStatus {
   kComplete,    // nothing was missing
   kRepaired,    // steps were missing and the plant's chunks filled them
@@ -104,8 +128,7 @@ class LogCapture {
   void AskForGaps(const std::vector<Gap>& gaps, RepairSummary* summary);
   /// (timestamp, encoded lcmt_plant_output) for every step of a complete
   /// episode whose PLANT_OUTPUT is not in `lane_file`.
-  std::vector<std::pair<int64_t, std::vector<uint8_t>>> MissingLaneOutputs(
-      const std::string& lane_file) const;
+  std::vector<TimedPayload> MissingLaneOutputs(const std::string& lane_file) const;
   void DescribeUnrepaired(const std::vector<Gap>& gaps, RepairSummary* summary) const;
 
   LogCaptureOptions options_;
