@@ -21,6 +21,7 @@
 #include <complex>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pidlab/controller/pid.h"
@@ -167,6 +168,22 @@ void SetExosystem(const Disturbance& disturbance, int exo, int ie, MatrixX<T>* m
   }
 }
 
+/// The end both builders share: the exosystem (at the column after the loop
+/// states), then *out from the loop matrix and initial state.
+template <typename T>
+void FinishClosedLoop(const StateSpace& plant, const Disturbance& disturbance, double reference,
+                      int filter_order, int exo, MatrixX<T> m, VectorX<T> w0, ContinuousClosedLoop<T>* out) {
+  const int n = plant.order();
+  SetExosystem<T>(disturbance, exo, n + 2 + filter_order, &m, &w0);
+  out->m = std::move(m);
+  out->w0 = std::move(w0);
+  out->reference = reference;
+  out->plant_order = n;
+  out->filter_order = filter_order;
+  out->exo_size = exo;
+  out->c = plant.c;
+}
+
 /// The filtered PID's loop (see BuildContinuousClosedLoop); g.tf > 0.
 template <typename T>
 bool BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, const Disturbance& disturbance,
@@ -203,14 +220,8 @@ bool BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, con
   m(iv, ir) = inv_tf;
   VectorX<T> w0 = VectorX<T>::Zero(size);
   w0(ir) = T(reference);
-  SetExosystem<T>(disturbance, exo, ie, &m, &w0);
-  out->m = m;
-  out->w0 = w0;
-  out->reference = reference;
-  out->plant_order = n;
-  out->filter_order = 1;
-  out->exo_size = exo;
-  out->c = plant.c;
+  FinishClosedLoop<T>(plant, disturbance, reference, /*filter_order=*/1, exo, std::move(m), std::move(w0),
+                      out);
   return true;
 }
 
@@ -257,14 +268,8 @@ bool BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
   VectorX<T> w0 = VectorX<T>::Zero(size);
   for (int i = 0; i < n; ++i) w0(i) = alpha * g.kd * (reference * plant.b(i));
   w0(ir) = T(reference);
-  SetExosystem<T>(disturbance, exo, ie, &m, &w0);
-  out->m = m;
-  out->reference = reference;
-  out->w0 = w0;
-  out->plant_order = n;
-  out->filter_order = 0;
-  out->exo_size = exo;
-  out->c = plant.c;
+  FinishClosedLoop<T>(plant, disturbance, reference, /*filter_order=*/0, exo, std::move(m), std::move(w0),
+                      out);
   return true;
 }
 
