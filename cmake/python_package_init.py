@@ -4,6 +4,6 @@
 # pidlab.tune, from the C++ module _pidlab (tools/python/, docs/python.md)
 # when it is built (-DPIDLAB_BUILD_PYTHON=ON, the default).
 try:
-    from ._pidlab import evaluate, tune, __version__  # noqa: F401
+    from ._pidlab import evaluate, tune, read_spec, spec_fields, __version__  # noqa: F401
 except ModuleNotFoundError:
     pass

@@ -18,12 +18,12 @@ dot, src = sys.argv[1], sys.argv[2]
 # Levels of the house, bottom (0) to top. A library may link only lower levels.
 level = {
     'pidlab_lcmtypes': 0,
-    'pidlab_plant_sim': 1, 'pidlab_controller': 1, 'pidlab_optim': 1, 'pidlab_plot': 1,
+    'pidlab_spec': 1, 'pidlab_plant_sim': 1, 'pidlab_controller': 1, 'pidlab_optim': 1, 'pidlab_plot': 1,
     'pidlab_transport': 2,
     'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_tuner': 3,
     'pidlab_episode_client': 4, 'pidlab_log_reader': 4, 'pidlab_json': 4,
     'pidlab_replay': 5, 'pidlab_launcher': 5,
-    'pidlab_report': 6,
+    'pidlab_report': 6, 'pidlab_cli': 6,
     'pidlab': 7, 'pidlab_python': 7,
 }
 labels, edges = {}, []
@@ -62,9 +62,9 @@ for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
     if bad: fail(f'{exe} links {", ".join(bad)}')
     else: print(f'ok   {exe} links only ' + ', '.join(sorted(d for d in closure(exe) if d.startswith("pidlab"))))
 # Sources: a folder includes only headers of its own level or below.
-header_level = {'plant_sim': 1, 'controller': 1, 'transport': 2, 'tuner': 3, 'replay': 4, 'launcher': 5,
+header_level = {'spec': 1, 'plant_sim': 1, 'controller': 1, 'transport': 2, 'tuner': 3, 'replay': 4, 'launcher': 5,
                 'plot': 1, 'report': 6, 'json': 4}
-lib_dirs = {'transport': 2, 'tuner': 3, 'replay': 5, 'launcher': 5}
+lib_dirs = {'spec': 1, 'transport': 2, 'tuner': 3, 'replay': 5, 'launcher': 5}
 for d, lv in lib_dirs.items():
     for root, _, files in os.walk(os.path.join(src, d)):
         for f in files:

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "pidlab/json/results_json.h"
+#include "pidlab/spec/field.h"
 #include "pidlab/tuner/episode_client.h"
 #include "pidlab/tuner/episode_pool.h"
 #include "pidlab/tuner/evaluation.h"
@@ -29,18 +30,14 @@ struct BadInput : std::runtime_error {
 
 /// Every number typed on the command line is finite and at most this in
 /// magnitude (README.md, "Exit status and limits").
-inline constexpr double kMaxInputMagnitude = 1e12;
+using spec::kMaxInputMagnitude;
 /// The most points `plot` draws over all its curves, and the most rows of
 /// `evaluate --trajectory-csv` (every step is kept in memory first).
 inline constexpr long kMaxRecordedPoints = 10000000;
-/// The most characters of a user's value an error message echoes.
-inline constexpr std::size_t kMaxEchoedChars = 120;
-
-/// `text` made printable on one line (control characters escaped as \n,
-/// \xHH) and cut to at most `max_chars`, the cut marked "...(N chars)".
-std::string Truncate(const std::string& text, std::size_t max_chars = kMaxEchoedChars);
-/// 'Truncate(text)': how every error message quotes a user's value.
-std::string Quote(const std::string& text);
+// How every error message echoes a user's value (pidlab/spec/field.h).
+using spec::kMaxEchoedChars;
+using spec::Quote;
+using spec::Truncate;
 
 /// CLI11 check of a floating-point flag: a finite number of magnitude at most
 /// kMaxInputMagnitude.
@@ -90,50 +87,12 @@ PidGains ParseGains(const std::string& text);
 /// A relative spread "10%" or "0.1" of `flag`, in [0, 1); throws BadInput.
 double ParseSpread(const std::string& text, const std::string& flag);
 
-/// --plant / --num / --den / --stepper NAME=VALUE.
-struct PlantFlags {
-  std::string plant;
-  std::string num, den;
-  std::vector<std::string> stepper_overrides;
-  // stepper_nonlinear options (docs/stepper.md).
-  double detent_torque_nm = 0.0, load_torque_nm = 0.0, load_step_nm = 0.0, load_step_time_s = 0.0;
-  double voltage_limit_v = HUGE_VAL, input_scale = 0.0;
-  std::string drive = "linear";
-  void Register(CLI::App* app, bool required = true);
-  /// The Table I parameters with the --stepper overrides; throws BadInput.
-  StepperMotorParameters StepperParameters() const;
-  /// The stepper_nonlinear options of the flags; throws BadInput.
-  NonlinearStepperOptions NonlinearOptions() const;
-  Plant Build() const;  // throws BadInput
-};
-
-/// --loop, --dt, --sample-time, --horizon, disturbance and discrete PID flags.
-struct LoopFlags {
-  std::string loop = "continuous";
-  double dt_s = 1e-3, sample_time_s = 0.05, horizon_s = 25.0, stability_margin = 1e-9;
-  double reference = 1.0;   // --reference A: size of the reference step
-  std::string disturbance;  // empty: square if an amplitude is given
-  double disturbance_amplitude = 0.0, disturbance_period_s = 2.0, disturbance_phase_s = 0.0;
-  double disturbance_step_time_s = 0.0, noise_hold_s = 0.01;
-  std::uint64_t seed = 1;
-  double derivative_filter_s = 0.0, derivative_filter_ratio = 0.0;
-  std::string output_limits, anti_windup = "clamping", derivative_on = "error", integral = "backward-euler";
-  void Register(CLI::App* app);
-  LoopOptions Build() const;  // throws BadInput
-};
-
-/// --max-ms, --max-mt, --max-noise-gain, --min-phase-margin,
-/// --min-gain-margin, --max-time-constant (docs/robustness.md).
-struct BoundsFlags {
-  double max_ms = HUGE_VAL, max_mt = HUGE_VAL, max_noise_gain = HUGE_VAL;
-  double min_phase_margin_deg = 0.0, min_gain_margin = 0.0, max_time_constant_s = HUGE_VAL;
-  /// `what`: "reject candidates" (tune) or "report loops" (evaluate).
-  void Register(CLI::App* app, const std::string& what);
-  LoopBounds Build() const;  // throws BadInput
-};
-
 /// The analysis as table rows (evaluate, tune).
 std::string FormatRobustness(const LoopAnalysis& a, const LoopBounds& bounds);
+/// Throws BadInput(error) unless `ok`: a spec that does not build.
+inline void Require(bool ok, const std::string& error) {
+  if (!ok) throw BadInput(error);
+}
 /// AnalyzeLoop with the default options; throws BadInput on its error.
 LoopAnalysis AnalyzeOrThrow(const Plant& plant, const PidGains& gains, const LoopOptions& options);
 

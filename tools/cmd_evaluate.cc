@@ -7,47 +7,35 @@
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <set>
 
 #include "cli_common.h"
+#include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/tuner/episode_client.h"
 #include "pidlab/tuner/monte_carlo.h"
+#include "pidlab/tuner/spec_build.h"
 
 namespace pidlab::cli {
 namespace {
 
 struct EvaluateCommand {
-  PlantFlags plant;
-  LoopFlags loop;
-  std::string gains;
-  BoundsFlags bounds;
-  int monte_carlo = 0;
-  std::string spread = "10%";
+  SpecFlags flags;
   bool json = false;
   std::string samples_csv;
   std::string trajectory_csv;
   // --backend lcm: run the sampled loop over a running process trio.
   std::string backend = "local";
   LcmFlags lcm;
-  CLI::App* app_ = nullptr;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
         "Evaluate one PID gain set on a plant: the paper's IAE (eq. 4) and other error sums, closed-loop "
         "poles and strict stability, MATLAB-stepinfo rise/overshoot/settling of the unit-step response, "
         "margins, Ms, Mt, noise gain and the slowest time constant (docs/robustness.md).");
-    plant.Register(app);
-    loop.Register(app);
-    app->add_option("--gains", gains, "KP,KI,KD (each finite and >= 0)")->required();
-    bounds.Register(app, "report loops");
-    app->add_option(
-           "--monte-carlo", monte_carlo,
-           "also evaluate the gains on N plants drawn around this one (seeded by --seed; stepper: each "
-           "Table I parameter, other plants: each coefficient, uniformly within --spread)")
-        ->capture_default_str();
-    app->add_option("--spread", spread, "--monte-carlo: relative spread, as 10% or 0.1, in [0, 1)")
-        ->capture_default_str();
-    app->add_flag("--json", json, "print one JSON object instead of the table");
+    flags.Register(app, spec::EvaluateSpec{});
+    app->add_flag("--json", json,
+                  "print one JSON object instead of the table (with the spec it ran, \"spec\")");
     app->add_option("--samples-csv", samples_csv, "write t,r,y,e,n at the sample times to this CSV file");
     app->add_option("--trajectory-csv", trajectory_csv,
                     "write k,t,r,y,u,n of every step of the sampled loop to this CSV file (%.17g)");
@@ -58,35 +46,51 @@ struct EvaluateCommand {
         ->check(CLI::IsMember({"local", "lcm"}))
         ->capture_default_str();
     lcm.Register(app);
-    app_ = app;
     return [this] { return Run(); };
   }
 
   int Run() {
-    const Plant p = plant.Build();
-    const StepperMotorParameters stepper = plant.StepperParameters();
-    const MonteCarloOptions mc = BuildMonteCarlo();
-    const PidGains g = ParseGains(gains);
-    LoopOptions options = loop.Build();
-    const LoopBounds loop_bounds = bounds.Build();
+    spec::EvaluateSpec s;
+    std::set<std::string> given;
+    flags.Apply(&s, &given);
+    s.plant.Normalize();
+    std::string error;
+    Plant p;
+    Require(BuildPlant(s.plant, NameStyle::kFlag, &p, &error), error);
+    StepperMotorParameters stepper;
+    Require(BuildStepperParameters(s.plant, NameStyle::kFlag, &stepper, &error), error);
+    MonteCarloOptions mc;
+    Require(BuildMonteCarlo(s, NameStyle::kFlag, &mc, &error), error);
+    if (s.gains.empty()) throw BadInput("--gains is required (or --spec FILE)");
+    PidGains g;
+    Require(BuildGains(s.gains, NameStyle::kFlag, &g, &error), error);
+    if (backend == "lcm") {
+      if (given.count("loop") > 0 && s.loop.loop != "sampled")
+        throw BadInput("--backend lcm runs the sampled loop, not --loop " + Quote(s.loop.loop));
+      s.loop.loop = "sampled";
+    }
+    LoopOptions options;
+    Require(BuildLoopOptions(s.loop, NameStyle::kFlag, &options, &error), error);
+    LoopBounds loop_bounds;
+    Require(BuildBounds(s.bounds, NameStyle::kFlag, &loop_bounds, &error), error);
     EvaluateOptions what;
     what.record_trajectory = !trajectory_csv.empty();
-    if (what.record_trajectory && options.loop != LoopKind::kSampled && backend == "local")
+    if (what.record_trajectory && options.loop != LoopKind::kSampled)
       throw BadInput("--trajectory-csv needs --loop sampled");
     if (what.record_trajectory && options.TotalSteps() + 1 > kMaxRecordedPoints)
       throw BadInput(
           "--trajectory-csv would have horizon / dt + 1 = " + std::to_string(options.TotalSteps() + 1) +
           " rows, more than 1e7: use a coarser --dt or a shorter --horizon");
+    if (s.monte_carlo > 0 && backend == "lcm")
+      throw BadInput("--monte-carlo runs in process: use --backend local");
+    if (s.monte_carlo > 0 && p.nonlinear)
+      throw BadInput("--monte-carlo draws linear plants: it does not take --plant " + Quote(p.name));
     // Unwritable output is bad input, found before any work.
     CheckOutputFile(samples_csv, "--samples-csv");
     CheckOutputFile(trajectory_csv, "--trajectory-csv");
     Evaluation ev;
-    std::string error;
     std::unique_ptr<EpisodeClient> client;
     if (backend == "lcm") {
-      if (app_->count("--loop") > 0 && options.loop != LoopKind::kSampled)
-        throw BadInput("--backend lcm runs the sampled loop, not --loop " + Quote(loop.loop));
-      options.loop = LoopKind::kSampled;
       client = lcm.MakeClient();
       std::string runner_error;
       const bool ok = Evaluate(
@@ -99,25 +103,22 @@ struct EvaluateCommand {
           });
       // A failed episode is a runtime failure (exit 1), not bad input.
       if (!ok && !runner_error.empty()) throw std::runtime_error(runner_error);
-      if (!ok) throw BadInput(error);
-    } else if (!Evaluate(p, g, options, what, &ev, &error)) {
-      throw BadInput(error);
+      Require(ok, error);
+    } else {
+      Require(Evaluate(p, g, options, what, &ev, &error), error);
     }
     // Margins, peaks, noise gain and time constants of the loop evaluated.
     const LoopAnalysis analysis = AnalyzeOrThrow(p, g, options);
     MonteCarloSummary mc_summary;
-    if (monte_carlo > 0) {
-      if (backend == "lcm") throw BadInput("--monte-carlo runs in process: use --backend local");
-      if (p.nonlinear)
-        throw BadInput("--monte-carlo draws linear plants: it does not take --plant " + Quote(p.name));
+    if (s.monte_carlo > 0) {
       const bool tty = isatty(STDERR_FILENO) != 0;
       const auto progress = [tty](int done, int total) {
         if (tty && (done % 10 == 0 || done == total))
           std::fprintf(stderr, "\r  Monte Carlo %d / %d   ", done, total);
       };
-      if (!RunMonteCarlo(p, p.name == "stepper_motor" ? &stepper : nullptr, g, options, mc, &mc_summary,
-                         &error, progress))
-        throw BadInput(error);
+      Require(RunMonteCarlo(p, p.name == "stepper_motor" ? &stepper : nullptr, g, options, mc, &mc_summary,
+                            &error, progress),
+              error);
       if (tty) std::fprintf(stderr, "\r%40s\r", "");
     }
     if (!samples_csv.empty()) WriteSamplesCsv(ev, samples_csv);
@@ -126,13 +127,14 @@ struct EvaluateCommand {
       nlohmann::json j = ToJson(ev);
       j["backend"] = backend;
       j["robustness"] = RobustnessJson(analysis, loop_bounds);
-      if (monte_carlo > 0) j["monte_carlo"] = MonteCarloJson(mc, mc_summary);
+      if (s.monte_carlo > 0) j["monte_carlo"] = json::MonteCarloJson(mc, mc_summary);
       if (client) j["steps_per_second"] = JsonNumber(client->stats().StepsPerSecond());
       if (client && client->stats().realtime.paced()) j["realtime"] = RealtimeJson(client->stats().realtime);
+      j["spec"] = spec::ToJson(s);
       std::cout << j.dump() << "\n";
     } else {
       std::cout << FormatEvaluation(ev) << FormatRobustness(analysis, loop_bounds);
-      if (monte_carlo > 0) std::cout << FormatMonteCarlo(mc, mc_summary);
+      if (s.monte_carlo > 0) std::cout << FormatMonteCarlo(mc, mc_summary);
       if (client) {
         std::printf("backend: lcm, %ld steps in %ld episode(s), %.0f steps/s\n", client->stats().steps,
                     client->stats().episodes, client->stats().StepsPerSecond());
@@ -141,39 +143,6 @@ struct EvaluateCommand {
       }
     }
     return 0;
-  }
-
-  // --monte-carlo, --spread (10% or 0.1) and --seed; throws BadInput.
-  MonteCarloOptions BuildMonteCarlo() const {
-    MonteCarloOptions mc;
-    if (monte_carlo < 0) throw BadInput("--monte-carlo " + std::to_string(monte_carlo) + " must be >= 0");
-    mc.samples = std::max(monte_carlo, 1);
-    mc.spread = ParseSpread(spread, "--spread");
-    mc.seed = loop.seed;
-    std::string error;
-    if (!mc.IsValid(&error)) throw BadInput("--spread " + Quote(spread) + " / --monte-carlo: " + error);
-    return mc;
-  }
-
-  static nlohmann::json DistributionJson(const Distribution& d) {
-    return {{"count", d.count},
-            {"min", JsonNumber(d.min)},
-            {"median", JsonNumber(d.median)},
-            {"p95", JsonNumber(d.p95)},
-            {"max", JsonNumber(d.max)}};
-  }
-
-  static nlohmann::json MonteCarloJson(const MonteCarloOptions& mc, const MonteCarloSummary& s) {
-    return {{"samples", s.samples},
-            {"spread", mc.spread},
-            {"seed", mc.seed},
-            {"perturbed", s.perturbed},
-            {"stable", s.stable},
-            {"invalid", s.invalid},
-            {"stable_fraction", s.stable_fraction},
-            {"iae", DistributionJson(s.iae)},
-            {"overshoot_pct", DistributionJson(s.overshoot_pct)},
-            {"ms", DistributionJson(s.ms)}};
   }
 
   static std::string FormatMonteCarlo(const MonteCarloOptions& mc, const MonteCarloSummary& s) {

@@ -6,14 +6,16 @@
 #include <limits>
 
 #include "cli_common.h"
+#include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
+#include "pidlab/tuner/spec_build.h"
 
 namespace pidlab::cli {
 namespace {
 
 struct LinearizeCommand {
-  PlantFlags plant;
+  SpecFlags flags;
   bool json = false;
 
   std::function<int()> Register(CLI::App* app) {
@@ -22,18 +24,21 @@ struct LinearizeCommand {
         "lambda/2, at rest, no load) by automatic differentiation of the model, and print u -> y as "
         "{\"num\": [...], \"den\": [...]} in descending powers of s with a monic denominator. With Table I "
         "and the default --input-scale this is eq. (3) (docs/stepper.md).");
-    plant.Register(app);
+    flags.Register(app, spec::PlantSpec{}, /*spec_file=*/false);
     app->add_flag("--json", json, "print one JSON object {num, den, plant, eq3} instead of text");
     return [this] { return Run(); };
   }
 
   int Run() {
+    spec::PlantSpec plant;
+    flags.Apply(&plant, nullptr);
     if (plant.plant != "stepper_nonlinear")
       throw BadInput("--plant " + Quote(plant.plant) +
                      " is not a nonlinear plant (expected stepper_nonlinear)");
-    const NonlinearStepperOptions o = plant.NonlinearOptions();
-    StepperLinearization lin;
     std::string error;
+    NonlinearStepperOptions o;
+    Require(BuildNonlinearOptions(plant, NameStyle::kFlag, &o, &error), error);
+    StepperLinearization lin;
     if (!LinearizeStepper(o, &lin, &error)) throw BadInput(error);
     const TransferFunction eq3 = StepperMotorTransferFunction(o.motor);
     if (json) {

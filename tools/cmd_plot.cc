@@ -7,16 +7,28 @@
 #include <sstream>
 
 #include "cli_common.h"
+#include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/plot/loop_figure.h"
+#include "pidlab/tuner/spec_build.h"
 #include "plot_sources.h"
 
 namespace pidlab::cli {
 namespace {
 
+// The plant and loop flags of evaluate; --gains is repeatable here.
+struct PlotSpec {
+  spec::PlantSpec plant;
+  spec::LoopSpec loop;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    plant.Serialize(a);
+    loop.Serialize(a);
+  }
+};
+
 struct PlotCommand {
-  PlantFlags plant;
-  LoopFlags loop;
+  SpecFlags flags;
   std::vector<std::string> gains;
   std::string log_path;
   std::vector<long> episodes;
@@ -30,8 +42,7 @@ struct PlotCommand {
         "u(t) and disturbance n(t), with units and legends. Either from an evaluation (--plant, --gains, "
         "loop flags as for 'pidlab evaluate'; repeat --gains to overlay gain sets) or from an LCM log "
         "(--log FILE [--episode ID]). Writes DIR/NAME.png and the data behind it in DIR/NAME_data/.");
-    plant.Register(app);
-    loop.Register(app);
+    flags.Register(app, PlotSpec{}, /*spec_file=*/false);
     app->add_option("--gains", gains, "KP,KI,KD; repeat to overlay several gain sets")->take_all();
     app->add_option("--log", log_path, "plot the episodes of this LCM log instead of an evaluation");
     app->add_option("--episode", episodes, "with --log: only these episode ids (repeatable; default all)")
@@ -48,8 +59,10 @@ struct PlotCommand {
     figure.width_px = width_px;
     figure.height_px = height_px;
     std::string error;
+    PlotSpec ps;
+    flags.Apply(&ps, nullptr);
     if (!log_path.empty()) {
-      if (!gains.empty() || !plant.plant.empty() || !plant.num.empty())
+      if (!gains.empty() || flags.Given("plant") || flags.Given("num"))
         throw BadInput("--log cannot be combined with --plant/--gains (the log carries its own)");
       PrepareOutputDir(out_dir, "--out");  // bad input before any work
       std::string report;
@@ -59,8 +72,10 @@ struct PlotCommand {
     } else {
       if (!episodes.empty()) throw BadInput("--episode needs --log");
       if (gains.empty()) throw BadInput("--gains is required (or --log FILE)");
-      const Plant p = plant.Build();
-      const LoopOptions options = loop.Build();
+      Plant p;
+      Require(BuildPlant(ps.plant, NameStyle::kFlag, &p, &error), error);
+      LoopOptions options;
+      Require(BuildLoopOptions(ps.loop, NameStyle::kFlag, &options, &error), error);
       std::vector<PidGains> sets;
       for (const auto& g : gains) sets.push_back(ParseGains(g));
       const long points = options.loop == LoopKind::kSampled ? options.TotalSteps() : options.NumSamples();

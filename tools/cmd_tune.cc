@@ -9,113 +9,51 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <set>
 
 #include "cli_common.h"
+#include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/tuner/episode_client.h"
+#include "pidlab/tuner/spec_build.h"
 #include "pidlab/tuner/tune.h"
 
 namespace pidlab::cli {
 namespace {
 
 struct TuneCommand {
-  PlantFlags plant;
-  LoopFlags loop;
-  std::string method = "multi-start", objective = "iae", backend = "local", bounds = "0,30";
-  std::string refine = "ceres", trace, zn_rule = "classic";
-  int max_iterations = 0, max_evaluations = 0, starts = 0, design_points = kMultiStartDesignPoints,
-      refine_starts = 2;
-  double max_overshoot_pct = HUGE_VAL, max_settling_time_s = HUGE_VAL, agree_tolerance = 1e-3,
-         load_weight = 1.0;
-  bool json = false, adaptive = false, robust = false;
-  int robust_samples = 0;
-  double robust_quantile = 1.0;
-  std::string robust_spread = "10%";
-  BoundsFlags loop_bounds;
+  SpecFlags flags;
+  std::string backend = "local", trace;
+  bool json = false;
   LcmFlags lcm;
   std::unique_ptr<EpisodePool> pool;
-  CLI::App* app_ = nullptr;
-
-  // The tuner's acceptance margin: with the evaluation's 1e-9 the search games
-  // the sampled objective by parking poles a hair left of the imaginary axis
-  // (e.g. -1e-9 +/- 1j on 1/(s^2+1), nearly cancelled by the PID zeros). 0.01
-  // asks every pole for Re p <= -0.01 max(1, |p|): damping ratio >= 0.01, or a
-  // decay rate >= 0.01 1/s for poles slower than 1 rad/s. See docs/tuning.md.
-  TuneCommand() { loop.stability_margin = 0.01; }
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
         "Tune PID gains on the paper's objective (IAE of the unit-step response, eq. 4) by a multi-start "
         "from a space-filling design (default), Nelder-Mead or a baseline, rejecting every loop that is not "
         "strictly stable, then cross-check with Ceres.");
-    plant.Register(app);
-    loop.Register(app);
-    app->add_option("--method", method,
-                    "multi-start (Sobol' design + Nelder-Mead polish) | nelder-mead | paper-nm | "
-                    "ziegler-nichols | ga | pso-gsa")
-        ->capture_default_str();
-    app->add_option("--objective", objective,
-                    "iae | ise | itae | iae-continuous | load-iae (IAE of a unit step at the plant input, "
-                    "r = 0) | setpoint-load (iae + W load-iae)")
-        ->capture_default_str();
-    app->add_option("--load-weight", load_weight, "W of --objective setpoint-load (>= 0)")
-        ->check(FiniteNumber())
-        ->capture_default_str();
+    // The tuner's acceptance margin is 0.01 (spec::LoopSpec::ForTuning, docs/tuning.md).
+    flags.Register(app, spec::TuningSpec{});
     app->add_option("--backend", backend, "local (in-process) or lcm (episodes over a running trio)")
         ->capture_default_str();
-    app->add_option("--bounds", bounds, "gain box LO,HI for each of kp, ki, kd")->capture_default_str();
-    app->add_option("--max-iter", max_iterations, "iteration budget (0 = method default; paper-nm: 100)")
-        ->capture_default_str();
-    app->add_option("--max-evals", max_evaluations, "evaluation budget over all starts (0 = method default)")
-        ->capture_default_str();
-    app->add_option("--starts", starts,
-                    "seeded starts (nelder-mead, paper-nm; 0 = 4) or polished starts (multi-start; 0 = 16)")
-        ->capture_default_str();
-    app->add_option("--design-points", design_points,
-                    "multi-start: Sobol' points of the design (at most half of --max-evals when given)")
-        ->capture_default_str();
-    app->add_option("--refine-starts", refine_starts,
-                    "multi-start: Ceres from this many distinct polished minima, best first")
-        ->capture_default_str();
-    app->add_flag("--adaptive", adaptive, "nelder-mead, multi-start: Gao & Han's adaptive coefficients");
-    app->add_option("--refine", refine, "ceres | none: the least-squares cross-check")->capture_default_str();
-    app->add_option("--agree-tolerance", agree_tolerance,
-                    "relative objective difference for the 'agree' verdict")
-        ->check(FiniteNumber())
-        ->capture_default_str();
-    app->add_option("--max-overshoot", max_overshoot_pct, "reject candidates overshooting more (%)")
-        ->check(NumberOrInfinity());
-    app->add_option("--max-settling", max_settling_time_s, "reject candidates settling later (s)")
-        ->check(NumberOrInfinity());
-    loop_bounds.Register(app, "reject candidates");
-    app->add_flag("--robust", robust,
-                  "the robust preset (docs/robustness.md): --objective setpoint-load --load-weight 1 "
-                  "--derivative-filter-ratio 10 --max-ms 1.6 --max-time-constant <horizon/10>; a flag given "
-                  "explicitly overrides its part");
-    app->add_option("--robust-samples", robust_samples,
-                    "optimise over the nominal plant and N plants drawn as evaluate --monte-carlo draws them "
-                    "(seeded by --seed): the --robust-quantile of the objective over the set")
-        ->check(WholeNumber())
-        ->capture_default_str();
-    app->add_option("--robust-quantile", robust_quantile,
-                    "quantile of the robust set's objective to minimise, (0, 1]; 1 = the worst case")
-        ->check(FiniteNumber())
-        ->capture_default_str();
-    app->add_option("--robust-spread", robust_spread,
-                    "relative spread of the robust set's draws, 10% or 0.1, in [0, 1)")
-        ->capture_default_str();
-    app->add_option("--zn-rule", zn_rule, "classic | pessen | some-overshoot | no-overshoot")
-        ->capture_default_str();
     app->add_option("--trace", trace, "write the best-so-far trajectory of the search to this CSV file");
-    app->add_flag("--json", json, "print one JSON object");
+    app->add_flag("--json", json, "print one JSON object (with the spec it ran, \"spec\")");
     lcm.Register(app);
-    app_ = app;
     return [this] { return Run(); };
   }
 
   int Run() {
-    const Plant p = plant.Build();
-    TuneOptions o = BuildOptions();
+    spec::TuningSpec ts;
+    std::set<std::string> given;
+    flags.Apply(&ts, &given);
+    ts.plant.Normalize();
+    ResolveRobustPreset(&ts, given);
+    std::string error;
+    Plant p;
+    Require(BuildPlant(ts.plant, NameStyle::kFlag, &p, &error), error);
+    TuneOptions o;
+    Require(BuildTuneOptions(ts, NameStyle::kFlag, &o, &error), error);
     if (p.nonlinear && o.loop.loop != LoopKind::kSampled)
       throw BadInput("--plant " + p.name +
                      " is nonlinear: tune it on the sampled loop (--loop sampled --dt 1e-4)");
@@ -124,8 +62,7 @@ struct TuneCommand {
     if (pool) o.parallel_for = pool->AsParallelFor();  // the starts on idle trios
     const bool tty = isatty(STDERR_FILENO) != 0;
     TuneSummary s;
-    std::string error;
-    if (!Tune(p, o, &s, &error, MakeProgress(tty), runner)) throw BadInput(error);
+    Require(Tune(p, o, &s, &error, MakeProgress(tty), runner), error);
     if (tty) std::fprintf(stderr, "\r%70s\r", "");
     if (!trace.empty()) WriteTrace(s);
     Evaluation ev;
@@ -138,69 +75,13 @@ struct TuneCommand {
     if (json) {
       nlohmann::json j = json::TuneJson(p, o, s, ev, backend);
       j["robustness"] = s.stable ? RobustnessJson(analysis, o.bounds) : nlohmann::json(nullptr);
+      j["spec"] = spec::ToJson(ts);
       std::cout << j.dump() << "\n";
     } else {
       PrintText(o, s, ev);
       if (s.stable) std::cout << FormatRobustness(analysis, o.bounds);
     }
     return s.stable ? 0 : 1;
-  }
-
-  // The tuning options of the flags; throws BadInput.
-  TuneOptions BuildOptions() const {
-    TuneOptions o;
-    o.loop = loop.Build();
-    if (!ParseTuneMethod(method, &o.method))
-      throw BadInput("--method " + Quote(method) +
-                     " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
-    if (!ParseObjectiveKind(objective, &o.objective))
-      throw BadInput("--objective " + Quote(objective) +
-                     " must be iae, ise, itae, iae-continuous, load-iae or setpoint-load");
-    if (!(load_weight >= 0.0))
-      throw BadInput("--load-weight " + std::to_string(load_weight) + " must be >= 0");
-    o.load_weight = load_weight;
-    if (!ParseZieglerNicholsRule(zn_rule, &o.zn_rule))
-      throw BadInput("--zn-rule " + Quote(zn_rule) +
-                     " must be classic, pessen, some-overshoot or no-overshoot");
-    const auto b = ParseList(bounds, "--bounds");
-    if (b.size() != 2) throw BadInput("--bounds " + Quote(bounds) + " must be LO,HI");
-    o.lower = b[0];
-    o.upper = b[1];
-    if (refine != "ceres" && refine != "none")
-      throw BadInput("--refine " + Quote(refine) + " must be ceres or none");
-    o.refine = refine == "ceres";
-    o.max_iterations = max_iterations;
-    o.max_evaluations = max_evaluations;
-    o.starts = starts;
-    o.design_points = design_points;
-    o.refine_starts = refine_starts;
-    o.adaptive = adaptive;
-    o.seed = loop.seed;
-    o.max_overshoot_pct = max_overshoot_pct;
-    o.max_settling_time_s = max_settling_time_s;
-    o.bounds = loop_bounds.Build();
-    o.agree_tolerance = agree_tolerance;
-    if (robust) {
-      RobustPresetKeep keep;
-      keep.objective = app_->count("--objective") > 0;
-      keep.load_weight = app_->count("--load-weight") > 0;
-      keep.derivative_filter =
-          app_->count("--derivative-filter") > 0 || app_->count("--derivative-filter-ratio") > 0;
-      keep.max_ms = app_->count("--max-ms") > 0;
-      keep.max_time_constant = app_->count("--max-time-constant") > 0;
-      ApplyRobustPreset(&o, keep);
-    }
-    if (robust_samples < 0 || robust_samples > 10000)
-      throw BadInput("--robust-samples " + std::to_string(robust_samples) + " must be in [0, 10000]");
-    o.robust_samples = robust_samples;
-    o.robust_spread = ParseSpread(robust_spread, "--robust-spread");
-    if (!(robust_quantile > 0.0) || !(robust_quantile <= 1.0))
-      throw BadInput("--robust-quantile " + std::to_string(robust_quantile) + " must be in (0, 1]");
-    o.robust_quantile = robust_quantile;
-    o.stepper = plant.StepperParameters();
-    std::string error;
-    if (!o.IsValid(&error)) throw BadInput(error);
-    return o;
   }
 
   // The sampled-loop runner of --backend; throws BadInput.

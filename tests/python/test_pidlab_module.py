@@ -157,6 +157,49 @@ class Tune(unittest.TestCase):
             pidlab.tune("oscillator", bounds=(5, 1))
 
 
+class Spec(unittest.TestCase):
+    """The keywords are the spec's fields: every one reaches the spec, and a
+    result's spec runs again to the same result."""
+
+    def test_every_field_is_a_keyword_that_reaches_the_spec(self):
+        for which in ("evaluate", "tune"):
+            fields = pidlab.spec_fields(which)
+            self.assertGreater(len(fields), 30)
+            for f in fields:
+                with self.subTest(which=which, key=f["key"]):
+                    self.assertEqual(f["flag"], "--" + f["key"].replace("_", "-"))
+                    spec = pidlab.read_spec(which, **{f["key"]: f["example"]})
+                    if which == "tune" and f["key"] == "robust":
+                        continue  # the preset changes other fields too
+                    self.assertEqual(spec[f["key"]], f["example"])
+                    self.assertNotEqual(f["default"], f["example"])
+
+    def test_the_defaults_are_the_commands(self):
+        self.assertEqual(pidlab.read_spec("evaluate")["stability_margin"], 1e-9)
+        self.assertEqual(pidlab.read_spec("tune")["stability_margin"], 0.01)
+        self.assertEqual(pidlab.read_spec("tune", robust=True)["max_time_constant"], 2.5)
+
+    def test_a_results_spec_runs_again_to_the_same_result(self):
+        first = pidlab.evaluate("stepper", (20.8836, 26.607, 12.4866), loop="sampled", dt=1e-4, horizon=2,
+                                output_limits=(-5, float("inf")))
+        again = pidlab.evaluate(**first["spec"])
+        self.assertEqual(first, again)
+        self.assertEqual(first["spec"]["output_limits"], [-5, "inf"])
+
+    def test_the_spec_equals_the_command_lines(self):
+        got = pidlab.evaluate(([1.0], [1.0, 0.5, 0.1]), (1.12, 0.23, 1.3), derivative_filter=0.122)
+        want = cli("evaluate", "--num", "1", "--den", "1,0.5,0.1", "--gains", "1.12,0.23,1.3",
+                   "--derivative-filter", "0.122")
+        self.assertEqual(got["spec"], want["spec"])
+        self.assertEqual(got["spec"]["plant"], "custom")
+
+    def test_an_unknown_keyword_is_a_type_error_naming_it(self):
+        with self.assertRaisesRegex(TypeError, "horizn"):
+            pidlab.evaluate("oscillator", (1, 2, 3), horizn=3)
+        with self.assertRaisesRegex(ValueError, "horizon"):
+            pidlab.evaluate("oscillator", (1, 2, 3), horizon="long")
+
+
 class Messages(unittest.TestCase):
     def test_the_package_also_holds_the_lcm_messages(self):
         m = pidlab.lcmt_control_command()

@@ -166,4 +166,25 @@ nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds) {
   return j;
 }
 
+nlohmann::json DistributionJson(const Distribution& d) {
+  return {{"count", d.count},
+          {"min", JsonNumber(d.min)},
+          {"median", JsonNumber(d.median)},
+          {"p95", JsonNumber(d.p95)},
+          {"max", JsonNumber(d.max)}};
+}
+
+nlohmann::json MonteCarloJson(const MonteCarloOptions& mc, const MonteCarloSummary& s) {
+  return {{"samples", s.samples},
+          {"spread", mc.spread},
+          {"seed", mc.seed},
+          {"perturbed", s.perturbed},
+          {"stable", s.stable},
+          {"invalid", s.invalid},
+          {"stable_fraction", s.stable_fraction},
+          {"iae", DistributionJson(s.iae)},
+          {"overshoot_pct", DistributionJson(s.overshoot_pct)},
+          {"ms", DistributionJson(s.ms)}};
+}
+
 }  // namespace pidlab::json

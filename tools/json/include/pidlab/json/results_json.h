@@ -8,6 +8,7 @@
 
 #include "pidlab/tuner/evaluation.h"
 #include "pidlab/tuner/loop_analysis.h"
+#include "pidlab/tuner/monte_carlo.h"
 #include "pidlab/tuner/tune.h"
 
 namespace pidlab::json {
@@ -29,5 +30,10 @@ nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds);
 /// `backend` is "local" or "lcm".
 nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary& s, const Evaluation& ev,
                         const std::string& backend);
+
+/// {count, min, median, p95, max} of one Monte Carlo distribution.
+nlohmann::json DistributionJson(const Distribution& d);
+/// The `monte_carlo` object of `pidlab evaluate --monte-carlo N --json`.
+nlohmann::json MonteCarloJson(const MonteCarloOptions& mc, const MonteCarloSummary& s);
 
 }  // namespace pidlab::json

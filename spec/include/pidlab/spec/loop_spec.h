@@ -1,0 +1,327 @@
+#pragma once
+// The one description of an evaluation and of a tuning (docs/spec.md).
+//
+// A spec is plain data, the values a user types, with its fields listed once
+// in Serialize(Archive*). Every front end reads and writes it through that
+// list: the flags of `pidlab evaluate`, `tune` and `plot` (tools/cli_spec.h),
+// the keywords of pidlab.evaluate and pidlab.tune (tools/python/), the JSON
+// form (`--spec FILE`, and the "spec" every --json result echoes; json.h),
+// and the field-table test. What the values mean, and their validation, is
+// one library function per spec (tuner/spec_build.h), which names a bad field
+// as the front end does (NameStyle).
+//
+// Archive: any type with
+//   template <typename T> void Visit(const Field& field, T* value);
+// for T in double, std::uint64_t, int, bool, std::string,
+// std::vector<double>, std::pair<double, double> (LO, HI) and
+// std::map<std::string, double> (NAME=VALUE).
+
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pidlab/spec/field.h"
+
+namespace pidlab::spec {
+
+/// The version of the JSON form; a spec file names it as "version".
+inline constexpr int kSpecVersion = 1;
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+/// The multi-start's default design (kMultiStartDesignPoints, checked in tuner).
+inline constexpr int kDefaultDesignPoints = 1024;
+
+/// The plant G(s): a built-in by name, a custom num/den, or the nonlinear
+/// stepper with its options.
+struct PlantSpec {
+  std::string plant;
+  std::vector<double> num, den;
+  std::map<std::string, double> stepper;  // Table I overrides, NAME -> value
+  double detent_torque_nm = 0.0, load_torque_nm = 0.0, load_step_nm = 0.0, load_step_time_s = 0.0;
+  double voltage_limit_v = kInf, input_scale = 0.0;
+  std::string drive = "linear";
+
+  /// A custom plant (num/den given) is named "custom", however it was typed,
+  /// so that a spec echoes one form.
+  void Normalize() {
+    if (plant.empty() && (!num.empty() || !den.empty())) plant = "custom";
+  }
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(
+        {"plant",
+         "double_integrator (alias linear) = 1/s^2, oscillator (alias nonlinear) = 1/(s^2+1), stepper_motor "
+         "(alias stepper) = eq. (3), stepper_nonlinear = the nonlinear PM stepper (sampled loop; "
+         "docs/stepper.md), or custom with --num/--den",
+         "", kEpisode, R"("oscillator")"},
+        &plant);
+    a->Visit({"num", "custom plant numerator, descending powers of s, e.g. 1", "", kEpisode, "[2]"}, &num);
+    a->Visit(
+        {"den", "custom plant denominator, descending powers of s, e.g. 1,0,0", "", kEpisode, "[1, 3, 1]"},
+        &den);
+    a->Visit(
+        {"stepper",
+         "override a Table I parameter, NAME=VALUE (resistance_ohm, self_inductance_h, mutual_inductance_h, "
+         "inertia_kg_m2, rotor_teeth, viscous_friction, tooth_pitch_rad, stationary_current_a, "
+         "flux_linkage); repeatable",
+         "", kEpisode, R"({"resistance_ohm": 5.5})"},
+        &stepper);
+    a->Visit({"detent_torque", "stepper_nonlinear: detent torque amplitude T_d (T_d sin(4 N_r theta))", "N m",
+              kEpisode, "0.01"},
+             &detent_torque_nm);
+    a->Visit({"load_torque", "stepper_nonlinear: constant load torque", "N m", kEpisode, "0.02"},
+             &load_torque_nm);
+    a->Visit({"load_step", "stepper_nonlinear: a further load torque step at --load-step-time", "N m",
+              kEpisode, "0.03"},
+             &load_step_nm);
+    a->Visit({"load_step_time", "stepper_nonlinear: time of the load step", "s", kEpisode, "0.01"},
+             &load_step_time_s);
+    a->Visit({"voltage_limit", "stepper_nonlinear: phase-voltage limit of the drive (default: none)", "V",
+              kEpisode | kInfinite, "24"},
+             &voltage_limit_v);
+    a->Visit(
+        {"input_scale",
+         "stepper_nonlinear: g in phi = theta0 + g u; 0 (default) = (L-M)/L, which makes the linearisation "
+         "eq. (3); 1 = the physical angle command",
+         "", kEpisode, "1"},
+        &input_scale);
+    a->Visit(
+        {"drive",
+         "stepper_nonlinear: linear (phase voltages proportional to u, default) or microstep (sine table at "
+         "phi = theta0 + g u, wraps every electrical period)",
+         "", kEpisode, R"("microstep")"},
+        &drive);
+  }
+};
+
+/// The loop: kind, timing, reference, disturbance and the discrete PID's
+/// options.
+struct LoopSpec {
+  std::string loop = "continuous";
+  double dt_s = 1e-3, sample_time_s = 0.05, horizon_s = 25.0, reference = 1.0;
+  /// Strict stability: 1e-9 to evaluate; the tuner accepts candidates only
+  /// with 0.01 (ForTuning).
+  double stability_margin = 1e-9;
+  std::string disturbance;  // "": square if an amplitude is given, else none
+  double disturbance_amplitude = 0.0, disturbance_period_s = 2.0, disturbance_phase_s = 0.0;
+  double disturbance_step_time_s = 0.0, noise_hold_s = 0.01;
+  std::uint64_t seed = 1;
+  double derivative_filter_s = 0.0, derivative_filter_ratio = 0.0;
+  std::pair<double, double> output_limits{-kInf, kInf};
+  std::string anti_windup = "clamping", derivative_on = "error", integral = "backward-euler";
+
+  /// The loop a tuning starts from: stability margin 0.01, because with a
+  /// margin near zero the search parks poles a hair left of the imaginary
+  /// axis, where the sampled objective cannot see them (docs/tuning.md).
+  static LoopSpec ForTuning() {
+    LoopSpec s;
+    s.stability_margin = 0.01;
+    return s;
+  }
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit({"loop", "continuous (exact, ideal PID) or sampled (discrete PID at --dt, ZOH plant)", "", kNone,
+              R"("sampled")"},
+             &loop);
+    a->Visit({"dt", "sampled-loop period; --sample-time must be a multiple", "s", kEpisode, "0.0005"}, &dt_s);
+    a->Visit({"sample_time", "ts of eq. (4): spacing of the error samples", "s", kEpisode, "0.1"},
+             &sample_time_s);
+    a->Visit({"horizon", "n of eq. (4): last sample time", "s", kEpisode, "10"}, &horizon_s);
+    a->Visit(
+        {"reference",
+         "size A of the reference step r(t) = A (1 = the paper's unit step); e = A - y in every objective, "
+         "step metrics relative to the final value",
+         "", kEpisode, "2"},
+        &reference);
+    a->Visit({"stability_margin",
+              "strict stability: Re p < -margin*max(1,|p|), p = s-plane pole (sampled: p = log(z)/dt)", "",
+              kNone, "0.001"},
+             &stability_margin);
+    a->Visit({"disturbance",
+              "none|square|step|sine|noise at the plant input (default: square if an amplitude is given)", "",
+              kEpisode, R"("sine")"},
+             &disturbance);
+    a->Visit({"disturbance_amplitude", "square +/-A, step height, sine peak or noise std deviation", "",
+              kEpisode, "0.5"},
+             &disturbance_amplitude);
+    a->Visit({"disturbance_period", "square/sine period", "s", kEpisode, "3"}, &disturbance_period_s);
+    a->Visit({"disturbance_phase", "time shift of the disturbance", "s", kEpisode, "0.25"},
+             &disturbance_phase_s);
+    a->Visit({"disturbance_step_time", "step disturbance time", "s", kEpisode, "1.5"},
+             &disturbance_step_time_s);
+    a->Visit({"noise_hold", "noise is held constant over this interval", "s", kEpisode, "0.05"},
+             &noise_hold_s);
+    a->Visit({"seed", "seed of the noise disturbance (and of the search, for tune)", "", kEpisode, "7"},
+             &seed);
+    a->Visit({"derivative_filter",
+              "derivative filter time constant Tf, both loops: C(s) = kp + ki/s + kd s/(Tf s + 1); 0 = the "
+              "paper's ideal PID",
+              "s", kEpisode, "0.01"},
+             &derivative_filter_s);
+    a->Visit({"derivative_filter_ratio",
+              "derivative filter by a ratio N: Tf = kd / (N kp) (Td / N), both loops; 0 = not used; excludes "
+              "--derivative-filter",
+              "", kEpisode, "10"},
+             &derivative_filter_ratio);
+    a->Visit({"output_limits", "sampled PID: output limits LO,HI", "", kEpisode | kInfinite, "[-5, 5]"},
+             &output_limits);
+    a->Visit({"anti_windup", "sampled PID: none|clamping|back-calculation", "", kEpisode, R"("none")"},
+             &anti_windup);
+    a->Visit({"derivative_on", "sampled PID: error|measurement", "", kEpisode, R"("measurement")"},
+             &derivative_on);
+    a->Visit({"integral", "sampled PID: backward-euler|forward-euler|trapezoidal", "", kEpisode,
+              R"("trapezoidal")"},
+             &integral);
+  }
+};
+
+/// Robustness bounds (docs/robustness.md): tune rejects a candidate that
+/// breaks one; evaluate reports it in robustness.violations. +inf / 0: none.
+struct BoundsSpec {
+  double max_ms = kInf, max_mt = kInf, max_noise_gain = kInf;
+  double min_phase_margin_deg = 0.0, min_gain_margin = 0.0, max_time_constant_s = kInf;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit({"max_ms", "bound on Ms = ||S||inf (e.g. 1.6)", "", kInfinite, "1.6"}, &max_ms);
+    a->Visit({"max_mt", "bound on Mt = ||T||inf (e.g. 1.3)", "", kInfinite, "1.3"}, &max_mt);
+    a->Visit({"max_noise_gain", "bound on the noise gain ||C S||inf (the ideal derivative's is unbounded)",
+              "", kInfinite, "500"},
+             &max_noise_gain);
+    a->Visit({"min_phase_margin", "least phase margin", "deg", kNone, "30"}, &min_phase_margin_deg);
+    a->Visit({"min_gain_margin", "least gain margin, a factor > 1 (e.g. 2 = 6 dB; 0 = none)", "", kNone, "2"},
+             &min_gain_margin);
+    a->Visit({"max_time_constant", "bound on the slowest closed-loop time constant 1/min|Re p|", "s",
+              kInfinite, "2.5"},
+             &max_time_constant_s);
+  }
+};
+
+/// How to search: method, objective, box, budgets, constraints, the robust
+/// preset and the robust set.
+struct TuneSpec {
+  std::string method = "multi-start", objective = "iae";
+  double load_weight = 1.0;
+  std::pair<double, double> bounds{0.0, 30.0};
+  int max_iter = 0, max_evals = 0, starts = 0, design_points = kDefaultDesignPoints, refine_starts = 2;
+  bool adaptive = false;
+  std::string refine = "ceres";
+  double agree_tolerance = 1e-3;
+  double max_overshoot_pct = kInf, max_settling_s = kInf;
+  std::string zn_rule = "classic";
+  bool robust = false;
+  int robust_samples = 0;
+  double robust_quantile = 1.0, robust_spread = 0.1;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(
+        {"method",
+         "multi-start (Sobol' design + Nelder-Mead polish) | nelder-mead | paper-nm | ziegler-nichols | ga | "
+         "pso-gsa",
+         "", kNone, R"("nelder-mead")"},
+        &method);
+    a->Visit({"objective",
+              "iae | ise | itae | iae-continuous | load-iae (IAE of a unit step at the plant input, r = 0) | "
+              "setpoint-load (iae + W load-iae)",
+              "", kNone, R"("ise")"},
+             &objective);
+    a->Visit({"load_weight", "W of --objective setpoint-load (>= 0)", "", kNone, "2"}, &load_weight);
+    a->Visit({"bounds", "gain box LO,HI for each of kp, ki, kd", "", kNone, "[0, 20]"}, &bounds);
+    a->Visit({"max_iter", "iteration budget (0 = method default; paper-nm: 100)", "", kNone, "50"},
+             &max_iter);
+    a->Visit({"max_evals", "evaluation budget over all starts (0 = method default)", "", kNone, "300"},
+             &max_evals);
+    a->Visit(
+        {"starts", "seeded starts (nelder-mead, paper-nm; 0 = 4) or polished starts (multi-start; 0 = 16)",
+         "", kNone, "3"},
+        &starts);
+    a->Visit(
+        {"design_points", "multi-start: Sobol' points of the design (at most half of --max-evals when given)",
+         "", kNone, "64"},
+        &design_points);
+    a->Visit({"refine_starts", "multi-start: Ceres from this many distinct polished minima, best first", "",
+              kNone, "1"},
+             &refine_starts);
+    a->Visit({"adaptive", "nelder-mead, multi-start: Gao & Han's adaptive coefficients", "", kNone, "true"},
+             &adaptive);
+    a->Visit({"refine", "ceres | none: the least-squares cross-check", "", kNone, R"("none")"}, &refine);
+    a->Visit({"agree_tolerance", "relative objective difference for the 'agree' verdict", "", kNone, "0.01"},
+             &agree_tolerance);
+    a->Visit({"max_overshoot", "reject candidates overshooting more", "%", kInfinite, "20"},
+             &max_overshoot_pct);
+    a->Visit({"max_settling", "reject candidates settling later", "s", kInfinite, "10"}, &max_settling_s);
+    a->Visit({"zn_rule", "classic | pessen | some-overshoot | no-overshoot", "", kNone, R"("pessen")"},
+             &zn_rule);
+    a->Visit({"robust",
+              "the robust preset (docs/robustness.md): --objective setpoint-load --load-weight 1 "
+              "--derivative-filter-ratio 10 --max-ms 1.6 --max-time-constant <horizon/10>; a field given "
+              "explicitly overrides its part",
+              "", kNone, "true"},
+             &robust);
+    a->Visit(
+        {"robust_samples",
+         "optimise over the nominal plant and N plants drawn as evaluate --monte-carlo draws them (seeded by "
+         "--seed): the --robust-quantile of the objective over the set",
+         "", kNone, "5"},
+        &robust_samples);
+    a->Visit(
+        {"robust_quantile", "quantile of the robust set's objective to minimise, (0, 1]; 1 = the worst case",
+         "", kNone, "0.9"},
+        &robust_quantile);
+    a->Visit({"robust_spread", "relative spread of the robust set's draws, 10% or 0.1, in [0, 1)", "",
+              kPercent, "0.2"},
+             &robust_spread);
+  }
+};
+
+/// `pidlab evaluate` / pidlab.evaluate: a plant, gains, a loop, bounds to
+/// report, and an optional Monte Carlo over plants around this one.
+struct EvaluateSpec {
+  PlantSpec plant;
+  std::vector<double> gains;  // kp, ki, kd
+  LoopSpec loop;
+  BoundsSpec bounds;
+  int monte_carlo = 0;
+  double spread = 0.1;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    plant.Serialize(a);
+    a->Visit({"gains", "KP,KI,KD (each finite and >= 0)", "", kEpisode, "[2, 1, 1.5]"}, &gains);
+    loop.Serialize(a);
+    bounds.Serialize(a);
+    a->Visit(
+        {"monte_carlo",
+         "also evaluate the gains on N plants drawn around this one (seeded by --seed; stepper: each Table I "
+         "parameter, other plants: each coefficient, uniformly within --spread)",
+         "", kNone, "5"},
+        &monte_carlo);
+    a->Visit({"spread", "--monte-carlo: relative spread, as 10% or 0.1, in [0, 1)", "", kPercent, "0.2"},
+             &spread);
+  }
+};
+
+/// `pidlab tune` / pidlab.tune: a plant, a loop (stability margin 0.01),
+/// bounds that reject candidates, and how to search.
+struct TuningSpec {
+  PlantSpec plant;
+  LoopSpec loop = LoopSpec::ForTuning();
+  BoundsSpec bounds;
+  TuneSpec tune;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    plant.Serialize(a);
+    loop.Serialize(a);
+    bounds.Serialize(a);
+    tune.Serialize(a);
+  }
+};
+
+}  // namespace pidlab::spec

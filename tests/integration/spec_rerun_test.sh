@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# The LCM case of the spec's promise: an evaluation and a tuning over the
+# process trio echo their spec, and that spec run again, in process or over
+# the trio, gives the same numbers bit for bit (docs/spec.md).
+# Runs in the private network namespace ctest gives it (unshare -n).
+# usage: spec_rerun_test.sh BIN_DIR
+set -uo pipefail
+bin=$1
+ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || { echo "FAIL namespace"; exit 1; }
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" || exit 1
+passed=0 failed=0
+pass() { echo "PASS $1"; passed=$((passed + 1)); }
+fail() { echo "FAIL $1"; failed=$((failed + 1)); }
+same() {  # same A.json B.json [KEY...]
+  local a=$1 b=$2; shift 2
+  /usr/bin/python3 - "$a" "$b" "$@" <<'PY'
+import json, sys
+a, b = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+for k in sys.argv[3:]:
+    a.pop(k, None); b.pop(k, None)
+if a != b:
+    print("differ in", [k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]); sys.exit(1)
+PY
+}
+run() { "$bin/pidlab" launch --isolated -- "$bin/pidlab" "$@"; }
+
+run evaluate --backend lcm --plant oscillator --gains 2,1,1.5 --horizon 5 --disturbance-amplitude 0.1 \
+  --json >lcm.json 2>err || fail "evaluate over the trio: $(tail -1 err)"
+"$bin/pidlab" evaluate --spec lcm.json --json >local.json 2>err || fail "evaluate --spec: $(tail -1 err)"
+if same lcm.json local.json backend steps_per_second realtime; then
+  pass "an evaluation over the trio, run again in process from its spec: the same numbers"
+else fail "evaluation over the trio and its spec in process differ"; fi
+run evaluate --backend lcm --spec lcm.json --json >lcm2.json 2>err || fail "--spec over the trio: $(tail -1 err)"
+if same lcm.json lcm2.json steps_per_second realtime; then pass "its spec run again over the trio: the same numbers"
+else fail "its spec over the trio differs"; fi
+
+run tune --backend lcm --loop sampled --plant linear --horizon 5 --max-evals 40 --design-points 16 --refine none \
+  --json >tune_lcm.json 2>err || fail "tune over the trio: $(tail -1 err)"
+"$bin/pidlab" tune --spec tune_lcm.json --json >tune_local.json 2>err || fail "tune --spec: $(tail -1 err)"
+if same tune_lcm.json tune_local.json backend wall_time_s; then
+  pass "a tuning over the trio, run again in process from its spec: the same tuning"
+else fail "tuning over the trio and its spec in process differ"; fi
+
+echo "$passed passed, $failed failed"
+[[ $failed -eq 0 ]]
