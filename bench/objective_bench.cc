@@ -67,7 +67,7 @@ void BM_PaperObjectiveSampled(benchmark::State& state) {
   pidlab::LoopOptions options;
   options.loop = pidlab::LoopKind::kSampled;
   options.dt_s = plant.name == "stepper_motor" ? 1e-4 : 1e-3;
-  options.pid.dt_s = options.dt_s;
+  options.pid = PidOptionsAt(options.pid, options.dt_s);
   const pidlab::ObjectiveEvaluator dut(plant, options, pidlab::ObjectiveKind::kIae);
   for (auto _ : state) {
     const double iae = dut(c.gains);

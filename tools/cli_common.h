@@ -14,6 +14,7 @@
 
 #include "pidlab/json/results_json.h"
 #include "pidlab/spec/field.h"
+#include "pidlab/spec/status.h"
 #include "pidlab/tuner/episode_client.h"
 #include "pidlab/tuner/episode_pool.h"
 #include "pidlab/tuner/evaluation.h"
@@ -92,6 +93,14 @@ std::string FormatRobustness(const LoopAnalysis& a, const LoopBounds& bounds);
 /// Throws BadInput(error) unless `ok`: a spec that does not build.
 inline void Require(bool ok, const std::string& error) {
   if (!ok) throw BadInput(error);
+}
+/// The exit convention in one place: a library's Status as the command
+/// line's failure. kInvalidInput is bad input (exit 2); a failed runner or
+/// anything else is a runtime failure (exit 1).
+inline void Require(const Status& status) {
+  if (status.ok()) return;
+  if (status.code() == StatusCode::kInvalidInput) throw BadInput(status.message());
+  throw std::runtime_error(status.message());
 }
 /// AnalyzeLoop with the default options; throws BadInput on its error.
 LoopAnalysis AnalyzeOrThrow(const Plant& plant, const PidGains& gains, const LoopOptions& options);

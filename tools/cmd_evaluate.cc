@@ -90,23 +90,15 @@ struct EvaluateCommand {
     CheckOutputFile(trajectory_csv, "--trajectory-csv");
     Evaluation ev;
     std::unique_ptr<EpisodeClient> client;
+    SampledRunner runner;  // null: in process
     if (backend == "lcm") {
       client = lcm.MakeClient();
-      std::string runner_error;
-      const bool ok = Evaluate(
-          p, g, options, what, &ev, &error,
-          [&](const Plant& pl, const PidGains& ga, const LoopOptions& lo, const DisturbanceOptions& d,
-              std::vector<double>* y, std::vector<SampledStep>* tr, std::string* err) {
-            const bool run_ok = client->Run(pl, ga, lo, d, y, tr, err);
-            if (!run_ok && err) runner_error = *err;
-            return run_ok;
-          });
-      // A failed episode is a runtime failure (exit 1), not bad input.
-      if (!ok && !runner_error.empty()) throw std::runtime_error(runner_error);
-      Require(ok, error);
-    } else {
-      Require(Evaluate(p, g, options, what, &ev, &error), error);
+      runner = [&client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
+                         const DisturbanceOptions& d, std::vector<double>* y, std::vector<SampledStep>* tr,
+                         std::string* err) { return client->Run(pl, ga, lo, d, y, tr, err); };
     }
+    // A failed episode is a runtime failure (exit 1), bad input exit 2.
+    Require(EvaluateLoop(p, g, options, what, &ev, runner));
     // Margins, peaks, noise gain and time constants of the loop evaluated.
     const LoopAnalysis analysis = AnalyzeOrThrow(p, g, options);
     MonteCarloSummary mc_summary;

@@ -86,7 +86,7 @@ struct TuneCommand {
 
   // The sampled-loop runner of --backend; throws BadInput.
   SampledRunner MakeRunner(const TuneOptions& o) {
-    if (backend == "local") return RunSampledLoopInProcess;
+    if (backend == "local") return nullptr;  // in process
     if (backend != "lcm") throw BadInput("--backend " + Quote(backend) + " must be local or lcm");
     if (o.loop.loop != LoopKind::kSampled)
       throw BadInput("--backend lcm runs the sampled loop: add --loop sampled");

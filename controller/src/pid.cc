@@ -60,4 +60,9 @@ std::string ToString(AntiWindup v) {
   return "clamping";
 }
 
+PidOptions PidOptionsAt(PidOptions options, double loop_dt_s) {
+  options.dt_s = loop_dt_s;
+  return options;
+}
+
 }  // namespace pidlab

@@ -22,12 +22,6 @@ std::string Full(double v) {
   return os.str();
 }
 
-bool SameDisturbance(const DisturbanceOptions& a, const DisturbanceOptions& b) {
-  return a.kind == b.kind && SameBits(a.amplitude, b.amplitude) && SameBits(a.period_s, b.period_s) &&
-         SameBits(a.phase_s, b.phase_s) && SameBits(a.step_time_s, b.step_time_s) &&
-         SameBits(a.noise_hold_s, b.noise_hold_s) && a.seed == b.seed;
-}
-
 }  // namespace
 
 bool EpisodeTrajectory(const Episode& e, std::vector<SampledStep>* trajectory) {
@@ -49,20 +43,21 @@ bool EvaluateEpisode(const Episode& e, Evaluation* evaluation, std::string* erro
     if (error) *error = "incomplete: " + e.CompletenessNote();
     return false;
   }
-  const DisturbanceOptions logged = e.spec.disturbance;
-  const SampledRunner from_log = [&e, &logged](
-                                     const Plant& plant, const PidGains& gains, const LoopOptions& options,
-                                     const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                                     std::vector<SampledStep>* trajectory, std::string* err) {
-    if (!SameDisturbance(disturbance, logged))
-      return RunSampledLoopInProcess(plant, gains, options, disturbance, y_all, trajectory, err);
-    *y_all = e.y;
-    if (trajectory) EpisodeTrajectory(e, trajectory);
-    return true;
-  };
+  // The run as the log recorded it; the undisturbed response, which no
+  // episode of the log holds, is the loop run in process without the
+  // disturbance.
+  const LoopOptions options = SampledLoopOptions(e.spec);
+  SampledRun run;
+  run.y = e.y;
+  EpisodeTrajectory(e, &run.trajectory);
+  if (options.disturbance.kind != DisturbanceKind::kNone)
+    RunSampledLoopInProcess(e.spec.plant, LoopGains(e.spec.gains, options), options, DisturbanceOptions{},
+                            &run.y_undisturbed, nullptr, error);
   EvaluateOptions what;
   what.record_trajectory = true;
-  return Evaluate(e.spec.plant, e.spec.gains, SampledLoopOptions(e.spec), what, evaluation, error, from_log);
+  const Status s = EvaluateSampledRun(e.spec.plant, e.spec.gains, options, what, run, evaluation);
+  if (!s.ok() && error) *error = s.message();
+  return s.ok();
 }
 
 RedriveResult Redrive(const Episode& e) {
@@ -72,7 +67,7 @@ RedriveResult Redrive(const Episode& e) {
     return r;
   }
   PidOptions pid = e.spec.pid;
-  pid.dt_s = e.spec.dt_s;
+  pid = PidOptionsAt(pid, e.spec.dt_s);
   DiscretePid<double> dut(e.spec.gains, pid);
   for (long k = 0; k < e.total_steps; ++k) {
     if (!e.has_y[k] || !e.has_u[k]) {

@@ -68,6 +68,13 @@ PY
 if same override.json direct.json; then pass "a flag given with --spec overrides the file"
 else fail "a flag given with --spec does not override the file"; fi
 
+# docs/spec.md's example, as written there.
+"$pidlab" evaluate --plant oscillator --gains 2,1,1.5 --loop sampled --json > result.json &&
+  "$pidlab" evaluate --spec result.json --json > again.json &&
+  "$pidlab" evaluate --spec result.json --gains 3,1,1.5 > text.out &&
+  cmp -s result.json again.json && grep -q "kp = 3" text.out && grep -q "sampled" text.out &&
+  pass "docs/spec.md's example runs as written" || fail "docs/spec.md's example"
+
 # Bad spec files: exit 2, one line naming the file and the key.
 bad() {  # bad NAME NEEDLE JSON
   printf '%s' "$3" >bad.json

@@ -195,7 +195,7 @@ bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec,
   s.horizon_s = m.horizon_s;
   s.total_steps = static_cast<long>(std::clamp<int64_t>(m.total_steps, -1, kMaxEpisodeSteps + 1));
   PidOptions& pid = s.pid;
-  pid.dt_s = m.dt_s;
+  pid = PidOptionsAt(pid, m.dt_s);
   pid.derivative_filter_s = m.derivative_filter_s;
   pid.output_min = m.output_min;
   pid.output_max = m.output_max;

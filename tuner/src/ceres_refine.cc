@@ -54,8 +54,7 @@ struct ErrorResiduals {
       if (!ContinuousStability(cld, loop->stability_margin).stable) return false;
       SampleContinuousLoop<T>(cl, disturbance, ts, loop->NumSamples(), &y);
     } else {
-      PidOptions pid = loop->pid;
-      pid.dt_s = loop->dt_s;
+      PidOptions pid = loop->Pid();
       if (!SampledStability(*discrete, gd, pid, loop->stability_margin).stable) return false;
       if (RunSampledLoop<T>(*discrete, g, pid, disturbance, loop->TotalSteps(), loop->StepsPerSample(), &y,
                             nullptr, loop->reference) == PidStatus::kInvalidInput)

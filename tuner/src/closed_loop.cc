@@ -63,8 +63,7 @@ bool LoopOptions::IsValid(std::string* error) const {
        << " times within the horizon of the continuous loop, more than 1e6: use a longer period or noise "
           "hold";
   else if (loop == LoopKind::kSampled) {
-    PidOptions p = pid;
-    p.dt_s = dt_s;
+    const PidOptions p = Pid();
     if (horizon_s / dt_s > kMaxLoopSteps + 0.5)
       os << "horizon " << horizon_s << " s / dt " << dt_s << " s = " << horizon_s / dt_s
          << " steps is more than 5e7";

@@ -26,7 +26,7 @@ transport::EpisodeSpec MakeEpisodeSpec(int64_t episode_id, const Plant& plant, c
   // The loop's gains, whose tf travels as the wire's derivative_filter_s.
   spec.gains = LoopGains(gains, options);
   spec.pid = options.pid;
-  spec.pid.dt_s = options.dt_s;
+  spec.pid = PidOptionsAt(spec.pid, options.dt_s);
   spec.pid.derivative_filter_s = spec.gains.tf;
   spec.disturbance = disturbance;
   spec.dt_s = options.dt_s;

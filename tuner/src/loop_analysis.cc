@@ -490,8 +490,7 @@ bool AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const LoopOpti
                           "of every local maximum";
   std::vector<cd> s_poles, s_zeros;
   std::unique_ptr<Response> response;
-  PidOptions pid = options.pid;
-  pid.dt_s = options.dt_s;
+  PidOptions pid = options.Pid();
   std::vector<double> special;
   if (continuous) {
     ContinuousClosedLoop<double> loop;

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "evaluation_internal.h"
 #include "golden_section.h"
 #include "pidlab/tuner/evaluation.h"
 #include "pidlab/tuner/fast_objective.h"
@@ -397,43 +398,6 @@ double Evaluation::Objective(ObjectiveKind kind, double load_weight) const {
   return iae;
 }
 
-namespace {
-
-// Lost steps: at the horizon the rotor is half a step angle or more away
-// from the reference (another detent, or still moving), or not finite.
-void JudgeMotor(const NonlinearStepperPlant& motor, const std::vector<double>& y_all, double reference,
-                Evaluation* ev) {
-  ev->has_motor = true;
-  ev->motor = motor.peaks();
-  ev->final_error = reference - y_all.back();
-  const double lambda = motor.options().motor.tooth_pitch_rad;
-  // Over the last tenth of the horizon (at least the last step): a rotor
-  // still swinging half a step away there has not settled, even if it
-  // happens to pass the reference at the end.
-  const std::size_t n = y_all.size();
-  double worst = 0.0;
-  for (std::size_t i = n - std::max<std::size_t>(1, n / 10); i < n; ++i) {
-    const double e = std::abs(reference - y_all[i]);
-    worst = std::isfinite(e) ? std::max(worst, e) : HUGE_VAL;
-  }
-  ev->lost_steps = !(worst < lambda / 2.0);
-  std::ostringstream os;
-  if (ev->lost_steps)
-    os << "LOST STEPS: over the last 10 % of the horizon the rotor is up to " << worst
-       << " rad from the reference and ends " << ev->final_error << " rad from it (half a step is "
-       << lambda / 2.0 << " rad): it settled at another detent or never settled";
-  ev->motor_note = os.str();
-}
-
-bool IsInProcess(const SampledRunner& runner) {
-  using Fn = bool (*)(const Plant&, const PidGains&, const LoopOptions&, const DisturbanceOptions&,
-                      std::vector<double>*, std::vector<SampledStep>*, std::string*);
-  const Fn* fn = runner.target<Fn>();
-  return fn != nullptr && *fn == &RunSampledLoopInProcess;
-}
-
-}  // namespace
-
 DisturbanceOptions UnitLoadStep() {
   DisturbanceOptions d;
   d.kind = DisturbanceKind::kStep;
@@ -442,11 +406,8 @@ DisturbanceOptions UnitLoadStep() {
   return d;
 }
 
-namespace {
+namespace internal {
 
-// sum_m |y_L(m ts)| of the load response of a strictly stable loop: the
-// continuous loop built with r = 0 (no reference state, no derivative kick)
-// and the step as its exosystem state, or the sampled loop run with r_k = 0.
 double LoadIaeOfStableLoop(const StateSpace& realization, const DiscretePlant* discrete,
                            const PidGains& gains, const LoopOptions& options, const Disturbance& step) {
   thread_local std::vector<double> y;
@@ -455,8 +416,7 @@ double LoadIaeOfStableLoop(const StateSpace& realization, const DiscretePlant* d
     if (!BuildContinuousClosedLoop<double>(realization, gains, step, &loop, nullptr, 0.0)) return kInf;
     SampleContinuousLoop<double>(loop, step, options.sample_time_s, options.NumSamples(), &y);
   } else {
-    PidOptions pid = options.pid;
-    pid.dt_s = options.dt_s;
+    PidOptions pid = options.Pid();
     if (RunSampledLoop<double>(*discrete, gains, pid, step, options.TotalSteps(), options.StepsPerSample(),
                                &y, nullptr, 0.0) == PidStatus::kInvalidInput)
       return kInf;
@@ -466,7 +426,7 @@ double LoadIaeOfStableLoop(const StateSpace& realization, const DiscretePlant* d
   return std::isfinite(sum) ? sum : kInf;
 }
 
-}  // namespace
+}  // namespace internal
 
 double LoadIntegralAbsError(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options) {
   const PidGains gains = LoopGains(typed_gains, options);
@@ -478,174 +438,13 @@ double LoadIntegralAbsError(const Plant& plant, const PidGains& typed_gains, con
   std::unique_ptr<DiscretePlant> discrete;
   if (options.loop == LoopKind::kSampled) {
     discrete = std::make_unique<DiscretePlant>(plant.tf, options.dt_s);
-    PidOptions pid = options.pid;
-    pid.dt_s = options.dt_s;
+    PidOptions pid = options.Pid();
     if (!SampledStability(*discrete, gains, pid, options.stability_margin).stable) return kInf;
   } else if (!ContinuousStability(loop, options.stability_margin).stable) {
     return kInf;
   }
-  return LoadIaeOfStableLoop(realization, discrete.get(), gains, options, Disturbance(UnitLoadStep()));
-}
-
-bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
-                             const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                             std::vector<SampledStep>* trajectory, std::string* /*error*/) {
-  PidOptions pid = options.pid;
-  pid.dt_s = options.dt_s;
-  if (plant.nonlinear) {
-    NonlinearStepperPlant motor(*plant.nonlinear, options.dt_s);
-    RunNonlinearSampledLoop(&motor, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
-                            trajectory, options.reference);
-    return true;
-  }
-  const DiscretePlant discrete(plant.tf, options.dt_s);
-  // A diverged loop (PidStatus::kInvalidInput) is not an error here: its
-  // non-finite samples make every objective +inf, as for an unstable loop.
-  RunSampledLoop<double>(discrete, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
-                         trajectory, options.reference);
-  return true;
-}
-
-bool Evaluate(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
-              const EvaluateOptions& what, Evaluation* ev, std::string* error, const SampledRunner& runner) {
-  if (!GainsAreValid(typed_gains, error)) return false;
-  if (!options.IsValid(error)) return false;
-  const PidGains gains = LoopGains(typed_gains, options);
-  if (!std::isfinite(gains.tf)) {
-    if (error) *error = "a derivative filter ratio needs kp > 0 when kd > 0 (tf = kd / (N kp))";
-    return false;
-  }
-  if (!GainsAreValid(gains, error)) return false;
-  if (!plant.tf.IsValid(error)) return false;
-  if (plant.tf.RelativeDegree() < 1) {
-    if (error) *error = "plant " + plant.tf.ToString() + " must be strictly proper";
-    return false;
-  }
-  if (plant.nonlinear && options.loop != LoopKind::kSampled) {
-    if (error)
-      *error = "plant " + plant.name +
-               " is nonlinear: the exact continuous loop applies to linear plants only, use --loop sampled "
-               "(with --dt 1e-4 or less)";
-    return false;
-  }
-  *ev = Evaluation();
-  ev->plant = plant;
-  ev->gains = gains;
-  ev->options = options;
-  const Disturbance disturbance(options.disturbance);
-  const Disturbance none(DisturbanceOptions{});
-  const int num = options.NumSamples();
-  const double ts = options.sample_time_s;
-  for (int m = 0; m < num; ++m) {
-    ev->t.push_back(m * ts);
-    ev->n.push_back(disturbance.Value(m * ts));
-  }
-  const StateSpace ss = Realize(plant.tf);
-  ContinuousClosedLoop<double> loop;
-  const double a = options.reference;
-  if (!BuildContinuousClosedLoop<double>(ss, gains, disturbance, &loop, error, a)) return false;
-  const Stability continuous_stability = ContinuousStability(loop, options.stability_margin);
-  const bool has_disturbance = options.disturbance.kind != DisturbanceKind::kNone;
-
-  if (options.loop == LoopKind::kContinuous) {
-    ev->stability = continuous_stability;
-    if (ev->stability.stable) {
-      SampleContinuousLoop<double>(loop, disturbance, ts, num, &ev->y);
-      if (has_disturbance) {
-        ContinuousClosedLoop<double> clean;
-        BuildContinuousClosedLoop<double>(ss, gains, none, &clean, error, a);
-        std::vector<double> y1;
-        SampleContinuousLoop<double>(clean, none, ts, num, &y1);
-        ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1, ts, a);
-      }
-      if (what.compute_iae_continuous)
-        ev->iae_continuous = ContinuousIntegralAbsError(loop, disturbance, ev->stability, options.horizon_s);
-      if (what.compute_step_info) ev->step = ContinuousStepInfo(loop, ev->stability);
-    }
-  } else {
-    PidOptions pid = options.pid;
-    pid.dt_s = options.dt_s;
-    const DiscretePlant discrete(plant.tf, options.dt_s);
-    ev->stability = SampledStability(discrete, gains, pid, options.stability_margin);
-    if (ev->stability.stable) {
-      std::vector<double> y_all;
-      if (plant.nonlinear && IsInProcess(runner)) {
-        // In process: the motor's peaks and whether it lost steps come with the run.
-        NonlinearStepperPlant motor(*plant.nonlinear, options.dt_s);
-        RunNonlinearSampledLoop(&motor, gains, pid, disturbance, options.TotalSteps(), 1, &y_all,
-                                what.record_trajectory ? &ev->trajectory : nullptr, a);
-        JudgeMotor(motor, y_all, a, ev);
-      } else if (plant.nonlinear) {
-        // Over the trio (or from a log): y comes from the run; the motor's
-        // peaks from the model re-driven by the run's u_k + n_k, which must
-        // give the run's y bit for bit (the plant process integrates the same
-        // model with the same inputs).
-        std::vector<SampledStep> steps;
-        if (!runner(plant, gains, options, options.disturbance, &y_all, &steps, error)) return false;
-        NonlinearStepperPlant motor(*plant.nonlinear, options.dt_s);
-        std::size_t differ = 0;
-        for (const SampledStep& st : steps) {
-          motor.Step(st.u + st.n);
-          const auto next = static_cast<std::size_t>(st.k) + 1;
-          if (next < y_all.size() && !(motor.Output() == y_all[next])) ++differ;
-        }
-        JudgeMotor(motor, y_all, a, ev);
-        if (differ > 0) {
-          std::ostringstream os;
-          os << (ev->motor_note.empty() ? "" : "; ")
-             << "the motor model re-driven by the run's u + n differs "
-             << "from the run's y at " << differ << " steps (peaks are the model's)";
-          ev->motor_note += os.str();
-        }
-        if (what.record_trajectory) ev->trajectory = std::move(steps);
-      } else if (!runner(plant, gains, options, options.disturbance, &y_all,
-                         what.record_trajectory ? &ev->trajectory : nullptr, error)) {
-        return false;
-      }
-      const int per = options.StepsPerSample();
-      for (int m = 0; m < num; ++m) ev->y.push_back(y_all[static_cast<std::size_t>(m) * per]);
-      double integral = 0.0;
-      for (std::size_t k = 1; k < y_all.size(); ++k)
-        integral += 0.5 * options.dt_s * (std::abs(a - y_all[k]) + std::abs(a - y_all[k - 1]));
-      ev->iae_continuous = integral;
-      std::vector<double> y1 = y_all;
-      if (has_disturbance) {
-        if (plant.nonlinear && IsInProcess(runner)) {
-          RunSampledLoopInProcess(plant, gains, options, none.options(), &y1, nullptr, error);
-        } else if (!runner(plant, gains, options, none.options(), &y1, nullptr, error)) {
-          return false;
-        }
-        std::vector<double> y1s;
-        for (int m = 0; m < num; ++m) y1s.push_back(y1[static_cast<std::size_t>(m) * per]);
-        ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1s, ts, a);
-      }
-      if (what.compute_step_info) {
-        std::vector<double> t_all(y1.size());
-        for (std::size_t k = 0; k < t_all.size(); ++k) t_all[k] = static_cast<double>(k) * options.dt_s;
-        const double yf = continuous_stability.stable ? ContinuousFinalValue(loop) : a;
-        ev->step = SampledStepInfo(t_all, y1, yf);
-      }
-    }
-  }
-  if (ev->stability.stable) {
-    ev->iae = ObjectiveFromSamples(ObjectiveKind::kIae, ev->y, ts, a);
-    ev->ise = ObjectiveFromSamples(ObjectiveKind::kIse, ev->y, ts, a);
-    ev->itae = ObjectiveFromSamples(ObjectiveKind::kItae, ev->y, ts, a);
-    ev->iae_per_unit = ev->iae / std::abs(a);
-    if (!has_disturbance) ev->iae_undisturbed = ev->iae;
-    const std::unique_ptr<DiscretePlant> discrete =
-        options.loop == LoopKind::kSampled ? std::make_unique<DiscretePlant>(plant.tf, options.dt_s)
-                                           : nullptr;
-    // The load response of a linear plant; a nonlinear plant's is not computed (NaN).
-    ev->load_iae = plant.nonlinear
-                       ? std::numeric_limits<double>::quiet_NaN()
-                       : LoadIaeOfStableLoop(ss, discrete.get(), gains, options, Disturbance(UnitLoadStep()));
-  } else {
-    ev->iae = ev->ise = ev->itae = ev->iae_continuous = ev->iae_undisturbed = ev->iae_per_unit =
-        ev->load_iae = kInf;
-    ev->step.note = "unstable loop: no step metrics";
-  }
-  return true;
+  return internal::LoadIaeOfStableLoop(realization, discrete.get(), gains, options,
+                                       Disturbance(UnitLoadStep()));
 }
 
 ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
@@ -671,7 +470,7 @@ ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& op
     throw std::invalid_argument("plant " + plant.name +
                                 " is nonlinear: tune it on the sampled loop (--loop sampled)");
   if (options.loop == LoopKind::kSampled) {
-    options_.pid.dt_s = options.dt_s;
+    options_.pid = PidOptionsAt(options_.pid, options.dt_s);
     discrete_ = std::make_unique<DiscretePlant>(plant.tf, options.dt_s);
   }
   if (FastContinuousObjective::CoversPlant(plant, options_, kind_))
@@ -693,7 +492,7 @@ double GeneralContinuousObjective(const StateSpace& realization, const Disturban
 }
 
 double ObjectiveEvaluator::LoadIae(const PidGains& gains) const {
-  return LoadIaeOfStableLoop(realization_, discrete_.get(), gains, options_, load_step_);
+  return internal::LoadIaeOfStableLoop(realization_, discrete_.get(), gains, options_, load_step_);
 }
 
 double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {

@@ -367,10 +367,9 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   const auto start_time = std::chrono::steady_clock::now();
   *summary = TuneSummary();
   summary->method = options.method;
-  // The in-process sampled loop is run by the evaluator itself; only another
-  // runner (the LCM trio) is handed to it.
-  const bool custom_runner = options.loop.loop == LoopKind::kSampled && runner &&
-                             runner.target<decltype(&RunSampledLoopInProcess)>() == nullptr;
+  // No runner: the evaluator runs the sampled loop itself; another runner
+  // (the LCM trio) is handed to it.
+  const bool custom_runner = options.loop.loop == LoopKind::kSampled && runner != nullptr;
   const bool load =
       options.objective == ObjectiveKind::kLoadIae || options.objective == ObjectiveKind::kSetpointLoad;
   if (load && custom_runner) {

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "format.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
 #include "pidlab/plot/plot.h"
 #include "pidlab/tuner/evaluation.h"
@@ -26,14 +27,6 @@ constexpr double kFastWindowS = 0.02;
 constexpr double kSlowStepS = 1e-3;
 // Eq. (3) "holds" on the motor where the IAE/A agree within this.
 constexpr double kHolds = 0.01;
-
-std::string Num(double v, int digits = 4) {
-  if (std::isnan(v)) return "n/a";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  std::ostringstream os;
-  os << std::setprecision(digits) << v;
-  return os.str();
-}
 
 std::string Gains(const PidGains& g) {
   return Num(g.kp, 6) + ", " + Num(g.ki, 6) + ", " + Num(g.kd, 6) +
@@ -53,7 +46,7 @@ LoopOptions SampledLoop(const MotorSection& s, double reference) {
   LoopOptions o;
   o.loop = LoopKind::kSampled;
   o.dt_s = s.dt_s;
-  o.pid.dt_s = s.dt_s;
+  o.pid = PidOptionsAt(o.pid, s.dt_s);
   o.sample_time_s = s.sample_time_s;
   o.horizon_s = s.horizon_s;
   o.reference = reference;
@@ -176,9 +169,9 @@ void RenderSet(std::ostream& os, const MotorSection& s, const MotorGainSet& set)
   os << "### " << set.name << ": kp, ki, kd = " << Gains(set.gains) << "\n\n" << set.origin << "\n\n";
   os << "Eq. (3) on the same loop: ";
   if (set.eq3_stable)
-    os << "IAE/A " << Num(set.eq3_iae_per_unit, 6) << ", rise " << Num(1e3 * set.eq3_rise_time_s)
-       << " ms, overshoot " << Num(set.eq3_overshoot_pct) << " %, settling " << Num(set.eq3_settling_time_s)
-       << " s (the same for every A).\n\n";
+    os << "IAE/A " << Num(set.eq3_iae_per_unit, 6) << ", rise " << Num(1e3 * set.eq3_rise_time_s, 4)
+       << " ms, overshoot " << Num(set.eq3_overshoot_pct, 4) << " %, settling "
+       << Num(set.eq3_settling_time_s, 4) << " s (the same for every A).\n\n";
   else
     os << "unstable.\n\n";
   os << "| move A [rad] | voltage limit | IAE/A motor | IAE/A eq. (3) | motor / eq. (3) | rise [ms] | "
@@ -194,7 +187,8 @@ void RenderSet(std::ostream& os, const MotorSection& s, const MotorGainSet& set)
     os << Num(r.iae_per_unit, 6) << " | " << Num(set.eq3_iae_per_unit, 6) << " | " << Num(r.ratio, 4)
        << " | ";
     if (r.step_valid)
-      os << Num(1e3 * r.rise_time_s) << " | " << Num(r.overshoot_pct) << " | " << Num(r.settling_time_s);
+      os << Num(1e3 * r.rise_time_s, 4) << " | " << Num(r.overshoot_pct, 4) << " | "
+         << Num(r.settling_time_s, 4);
     else
       os << "- | - | -";
     os << " | " << Num(r.peak_phase_voltage_v, 4) << " | " << Num(r.peak_phase_current_a, 3) << " | "
@@ -303,7 +297,7 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
   s.tune_sample_time_s = 0.005;
   t.loop.loop = LoopKind::kSampled;
   t.loop.dt_s = s.dt_s;
-  t.loop.pid.dt_s = s.dt_s;
+  t.loop.pid = PidOptionsAt(t.loop.pid, s.dt_s);
   t.loop.sample_time_s = s.tune_sample_time_s;
   t.loop.horizon_s = s.tune_horizon_s;
   t.loop.reference = s.tune_move_rad;
@@ -324,8 +318,8 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
   on_motor.gains = s.motor_tune.gains;
   std::ostringstream origin;
   origin << "`pidlab tune --plant stepper_nonlinear --voltage-limit " << Num(s.voltage_limit_v, 3)
-         << " --loop sampled --dt " << Num(s.dt_s) << " --reference " << Num(s.tune_move_rad, 17)
-         << " --horizon " << Num(s.tune_horizon_s) << " --sample-time " << Num(s.tune_sample_time_s)
+         << " --loop sampled --dt " << Num(s.dt_s, 4) << " --reference " << Num(s.tune_move_rad, 17)
+         << " --horizon " << Num(s.tune_horizon_s, 4) << " --sample-time " << Num(s.tune_sample_time_s, 4)
          << " --method nelder-mead --starts 1 --max-evals " << t.max_evaluations << " --seed " << seed
          << "`: the IAE of e = A - y for a tooth-pitch move through the limited drive ("
          << s.motor_tune.evaluations << " evaluations of the nonlinear motor, objective "
@@ -346,8 +340,8 @@ void RenderMotorSection(std::ostream& os, const MotorSection& s) {
         "linearisation is eq. (3)). u is the commanded rotor angle, turned into the two phase voltages by a "
         "voltage-mode drive (the microstep table linearised at the holding point). Loop: the sampled loop "
         "(discrete PID, dt = "
-     << Num(s.dt_s) << " s), IAE of eq. (4) with e = A - y sampled every " << Num(s.sample_time_s)
-     << " s over " << Num(s.horizon_s)
+     << Num(s.dt_s, 4) << " s), IAE of eq. (4) with e = A - y sampled every " << Num(s.sample_time_s, 4)
+     << " s over " << Num(s.horizon_s, 4)
      << " s, and the same loop on eq. (3) beside it (on a linear loop IAE/A does not depend on A). Moves: "
         "0.001 and 0.01 rad (small, where eq. (3) should hold), one tooth pitch lambda = "
      << Num(s.tooth_pitch_rad, 6) << " rad, and the paper's 1 rad step (almost four tooth pitches).\n\n"

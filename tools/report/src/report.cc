@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "format.h"
 #include "pidlab/plot/plot.h"
 
 namespace pidlab::report {
@@ -109,16 +110,7 @@ PaperRow ParseRow(const std::vector<std::string>& cells, const Columns& col, con
   return r;
 }
 
-// Significant digits, plain or scientific as the value needs.
-std::string Num(double v, int digits = 5) {
-  if (std::isnan(v)) return "n/a";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  std::ostringstream os;
-  os << std::setprecision(digits) << v;
-  return os.str();
-}
-
-std::string Gains(const PidGains& g) { return Num(g.kp) + ", " + Num(g.ki) + ", " + Num(g.kd); }
+std::string Gains(const PidGains& g) { return Num(g.kp, 5) + ", " + Num(g.ki, 5) + ", " + Num(g.kd, 5); }
 
 std::string PlantTitle(const std::string& plant) {
   if (plant == "double_integrator") return "1/s^2 (the paper's \"linear system\")";
@@ -161,12 +153,12 @@ std::vector<std::string> ExplainDifferences(const PaperRow& row, const Metrics& 
   std::vector<std::string> out;
   if (!RelClose(row.paper_iae, m.iae, 1e-3)) {
     out.push_back(
-        "IAE: paper " + Num(row.paper_iae) + " vs " + Num(m.iae) +
+        "IAE: paper " + Num(row.paper_iae, 5) + " vs " + Num(m.iae, 5) +
         " (eq. 4: sum of |1 - y1| at t = 0, 0.05, ..., 25 s); the published gains do not give the "
         "published IAE on the loop the paper describes, which gives every other row's IAE to 4 digits");
   }
   if (!RelClose(row.paper_rise_time_s, m.rise_time_s, 0.03)) {
-    out.push_back("rise time: paper " + Num(row.paper_rise_time_s) + " s vs " + Num(m.rise_time_s) +
+    out.push_back("rise time: paper " + Num(row.paper_rise_time_s, 5) + " s vs " + Num(m.rise_time_s, 5) +
                   " s for 10 % -> 90 % of the final value (ratio " +
                   Num(row.paper_rise_time_s / m.rise_time_s, 3) +
                   "); the paper does not state its definition and 10-90 % does not give its figure");
@@ -174,7 +166,7 @@ std::vector<std::string> ExplainDifferences(const PaperRow& row, const Metrics& 
   if (std::abs(row.paper_overshoot_pct - m.overshoot_pct) > 0.1 &&
       !RelClose(row.paper_overshoot_pct, m.overshoot_pct, 0.03)) {
     out.push_back(
-        "overshoot: paper " + Num(row.paper_overshoot_pct) + " % vs " + Num(m.overshoot_pct) +
+        "overshoot: paper " + Num(row.paper_overshoot_pct, 5) + " % vs " + Num(m.overshoot_pct, 5) +
         " % (peak of the exact continuous response over its final value); the published value is not "
         "reproduced by the standard definition, most likely a coarser simulation grid missed the peak");
   }
@@ -188,8 +180,8 @@ std::vector<std::string> ExplainDifferences(const PaperRow& row, const Metrics& 
     } else {
       why = "the paper does not state its band; the 2 % band gives pidlab's figure";
     }
-    out.push_back("settling time: paper " + Num(row.paper_settling_time_s) + " s vs " +
-                  Num(m.settling_time_s) + " s (2 % band): " + why);
+    out.push_back("settling time: paper " + Num(row.paper_settling_time_s, 5) + " s vs " +
+                  Num(m.settling_time_s, 5) + " s (2 % band): " + why);
   }
   if (row.method == "ziegler_nichols" && row.plant != "stepper_motor") {
     out.push_back(
@@ -484,8 +476,8 @@ bool DrawFigures(ReportData* data, std::string* error) {
 
 std::string MetricsCells(const Metrics& m) {
   if (!m.stable) return "unstable | | | ";
-  return Num(m.rise_time_s) + " | " + Num(m.overshoot_pct) + " | " + Num(m.settling_time_s) + " | " +
-         Num(m.iae);
+  return Num(m.rise_time_s, 5) + " | " + Num(m.overshoot_pct, 5) + " | " + Num(m.settling_time_s, 5) + " | " +
+         Num(m.iae, 5);
 }
 
 std::string Mark(double paper, double ours, double rel) { return RelClose(paper, ours, rel) ? "" : " **≠**"; }
@@ -531,7 +523,7 @@ void RenderTableLines(std::ostream& os, const std::vector<const RowResult*>& row
     os << "| " << name << " | ";
     for (const RowResult* r : rows) {
       const double p = paper_of(*r), o = ours_of(*r);
-      os << Num(p) << " | " << Num(o) << (mark ? Mark(p, o, rel) : "") << " | ";
+      os << Num(p, 5) << " | " << Num(o, 5) << (mark ? Mark(p, o, rel) : "") << " | ";
     }
     os << "\n";
   };
@@ -560,7 +552,7 @@ void RenderTableLines(std::ostream& os, const std::vector<const RowResult*>& row
   for (const RowResult* r : rows) any_disturbed |= r->paper.disturbance_amplitude > 0;
   if (any_disturbed) {
     os << "| IAE of y = y1 + y2 (pidlab only) | ";
-    for (const RowResult* r : rows) os << " | " << Num(r->pidlab.iae_disturbed) << " | ";
+    for (const RowResult* r : rows) os << " | " << Num(r->pidlab.iae_disturbed, 5) << " | ";
     os << "\n";
   }
   os << "\n";
@@ -622,7 +614,8 @@ std::string Verdict(const Tuning& t) {
   const RefineSummary& r = t.summary.refine;
   const std::string verdict = ToString(r.verdict, t.method);
   if (!r.ran) return verdict;
-  std::string v = verdict + " (Ceres IAE " + Num(r.objective) + ", " + std::to_string(r.iterations) + " it";
+  std::string v =
+      verdict + " (Ceres IAE " + Num(r.objective, 5) + ", " + std::to_string(r.iterations) + " it";
   if (r.relative_improvement > 0) v += ", " + Num(100 * r.relative_improvement, 3) + " % better";
   return v + ")";
 }
@@ -637,12 +630,12 @@ void RenderTunings(std::ostream& os, const ReportData& data, const std::string& 
       os << "| " << ToString(t.method) << " | not applicable: " << t.message << " | | | | | | | |\n";
       continue;
     }
-    os << "| " << ToString(t.method) << " | " << Gains(t.summary.gains) << " | " << Num(t.metrics.rise_time_s)
-       << " | " << Num(t.metrics.overshoot_pct) << " | " << Num(t.metrics.settling_time_s) << " | "
-       << Num(t.metrics.iae);
+    os << "| " << ToString(t.method) << " | " << Gains(t.summary.gains) << " | "
+       << Num(t.metrics.rise_time_s, 5) << " | " << Num(t.metrics.overshoot_pct, 5) << " | "
+       << Num(t.metrics.settling_time_s, 5) << " | " << Num(t.metrics.iae, 5);
     if (paper_nm && amplitude == 0.0)
       os << (t.metrics.iae < paper_nm->paper_iae ? " (< paper)" : " (>= paper)");
-    os << " | " << Num(t.metrics.iae_disturbed) << " | " << t.summary.evaluations << " | " << Verdict(t)
+    os << " | " << Num(t.metrics.iae_disturbed, 5) << " | " << t.summary.evaluations << " | " << Verdict(t)
        << " |\n";
   }
   os << "\n";
@@ -661,7 +654,7 @@ void RenderIntroduction(std::ostream& os, const ReportData& data) {
         "response to the reference alone (eq. 17). Metrics use MATLAB-stepinfo definitions on the exact "
         "response: rise time 10 % -> 90 % of the final value, overshoot in % of the final value, settling "
         "time into a 2 % band for good. Disturbances are square waves of period "
-     << Num(kSquarePeriodS) << " s (pidlab's choice; the paper does not state the period).\n\n"
+     << Num(kSquarePeriodS, 5) << " s (pidlab's choice; the paper does not state the period).\n\n"
      << "In the tables, *paper* is the published figure and *pidlab* is pidlab's re-evaluation of the "
         "published gains; **≠** marks a published figure pidlab does not reproduce (IAE within 0.1 %, "
         "others within 3 %), explained in one line below the table.\n\n";
@@ -702,10 +695,10 @@ void RenderDisturbanceTunings(std::ostream& os, const ReportData& data) {
       os << "failed: " << t.message << " | | | | | | | |\n";
       continue;
     }
-    os << Gains(t.summary.gains) << " | " << Num(t.metrics.rise_time_s) << " | "
-       << Num(t.metrics.overshoot_pct) << " | " << Num(t.metrics.settling_time_s) << " | "
-       << Num(t.metrics.iae) << " | " << Num(t.metrics.iae_disturbed) << " | "
-       << (row ? Num(row->paper_iae) : std::string("not in the paper")) << " | " << Verdict(t) << " |\n";
+    os << Gains(t.summary.gains) << " | " << Num(t.metrics.rise_time_s, 5) << " | "
+       << Num(t.metrics.overshoot_pct, 5) << " | " << Num(t.metrics.settling_time_s, 5) << " | "
+       << Num(t.metrics.iae, 5) << " | " << Num(t.metrics.iae_disturbed, 5) << " | "
+       << (row ? Num(row->paper_iae, 5) : std::string("not in the paper")) << " | " << Verdict(t) << " |\n";
   }
   os << "\n";
 }
@@ -720,10 +713,10 @@ void RenderSampledTable(std::ostream& os, const SampledSection& s) {
   os << "| loop | stable | rise [s] | overshoot [%] | settling [s] | IAE of y1 "
         "|\n|---|---|---:|---:|---:|---:|\n";
   RenderSampledRow(os, "continuous (exact)", s.continuous);
-  RenderSampledRow(os, "sampled, in-process, dt = " + Num(s.dt_s) + " s", s.sampled_in_process);
-  RenderSampledRow(os, "sampled, in-process, dt = " + Num(s.fine_dt_s) + " s", s.sampled_fine);
+  RenderSampledRow(os, "sampled, in-process, dt = " + Num(s.dt_s, 5) + " s", s.sampled_in_process);
+  RenderSampledRow(os, "sampled, in-process, dt = " + Num(s.fine_dt_s, 5) + " s", s.sampled_fine);
   if (s.trio_ran) {
-    const std::string at = "dt = " + Num(s.dt_s) + " s, horizon " + Num(s.trio_horizon_s) + " s";
+    const std::string at = "dt = " + Num(s.dt_s, 5) + " s, horizon " + Num(s.trio_horizon_s, 5) + " s";
     RenderSampledRow(os, "sampled, in-process, " + at, s.sampled_trio_horizon);
     RenderSampledRow(os, "sampled, LCM trio, " + at, s.trio);
   }
@@ -739,11 +732,11 @@ void RenderTrioNote(std::ostream& os, const SampledSection& s) {
     const bool identical = a.stable == b.stable && a.iae == b.iae && a.rise_time_s == b.rise_time_s &&
                            a.overshoot_pct == b.overshoot_pct && a.settling_time_s == b.settling_time_s;
     if (s.trio_horizon_s < s.horizon_s) {
-      os << " The episode covers " << Num(s.trio_horizon_s) << " s instead of the paper's "
-         << Num(s.horizon_s) << " s; the slow tail after it adds "
+      os << " The episode covers " << Num(s.trio_horizon_s, 5) << " s instead of the paper's "
+         << Num(s.horizon_s, 5) << " s; the slow tail after it adds "
          << Num(std::abs(s.sampled_in_process.iae - s.sampled_trio_horizon.iae), 3) << " to the IAE.";
     } else {
-      os << " The episode covers the paper's full " << Num(s.trio_horizon_s) << " s horizon.";
+      os << " The episode covers the paper's full " << Num(s.trio_horizon_s, 5) << " s horizon.";
     }
     os << (identical
                ? std::string(" Its IAE and step metrics equal the in-process sampled loop's on the same "
@@ -758,7 +751,7 @@ void RenderTrioNote(std::ostream& os, const SampledSection& s) {
 // at the finer dt.
 void RenderSampledDiscussion(std::ostream& os, const SampledSection& s) {
   auto rel = [](double a, double b) { return 100.0 * std::abs(a - b) / std::abs(b); };
-  os << "At dt = " << Num(s.dt_s) << " s the sampled IAE is within "
+  os << "At dt = " << Num(s.dt_s, 5) << " s the sampled IAE is within "
      << Num(rel(s.sampled_in_process.iae, s.continuous.iae), 3)
      << " % of the continuous one and the overshoot is " << Num(s.sampled_in_process.overshoot_pct, 4)
      << " % against " << Num(s.continuous.overshoot_pct, 4) << " %: the plant's fastest pole is at "
@@ -766,7 +759,7 @@ void RenderSampledDiscussion(std::ostream& os, const SampledSection& s) {
      << " ms) and the continuous rise time is " << Num(1e3 * s.continuous.rise_time_s, 3)
      << " ms, so one sample of the discrete PID (backward-Euler integral, backward-difference derivative) "
         "spans a large part of the transient. At dt = "
-     << Num(s.fine_dt_s) << " s the overshoot is " << Num(s.sampled_fine.overshoot_pct, 4)
+     << Num(s.fine_dt_s, 5) << " s the overshoot is " << Num(s.sampled_fine.overshoot_pct, 4)
      << " %: the sampled loop converges to the continuous one as dt shrinks. The 2 % settling time, set by "
         "the slow pole pair, is "
      << Num(s.sampled_in_process.settling_time_s, 4) << " s and " << Num(s.sampled_fine.settling_time_s, 4)
@@ -777,8 +770,8 @@ void RenderSampledDiscussion(std::ostream& os, const SampledSection& s) {
 void RenderSampledSection(std::ostream& os, const SampledSection& s) {
   os << "## Stepper motor on the sampled loop (the LCM trio's loop)\n\n"
      << "The paper's Table IV Nelder-Mead gains (" << Gains(s.gains)
-     << ") on the lockstep sampled loop the process trio runs (discrete PID, ZOH plant, dt = " << Num(s.dt_s)
-     << " s) against the continuous loop. Sampled metrics use every step of the loop.\n\n";
+     << ") on the lockstep sampled loop the process trio runs (discrete PID, ZOH plant, dt = "
+     << Num(s.dt_s, 5) << " s) against the continuous loop. Sampled metrics use every step of the loop.\n\n";
   RenderSampledTable(os, s);
   RenderTrioNote(os, s);
   RenderSampledDiscussion(os, s);

@@ -8,19 +8,12 @@
 #include <iomanip>
 #include <sstream>
 
+#include "format.h"
 #include "pidlab/plot/plot.h"
 #include "pidlab/tuner/evaluation.h"
 
 namespace pidlab::report {
 namespace {
-
-std::string Num(double v, int digits = 4) {
-  if (std::isnan(v)) return "n/a";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  std::ostringstream os;
-  os << std::setprecision(digits) << v;
-  return os.str();
-}
 
 std::string Title(const std::string& plant) {
   if (plant == "double_integrator") return "1/s^2";
@@ -56,7 +49,9 @@ bool EvaluateSet(const Plant& plant, const StepperMotorParameters* stepper, cons
   return LoopFrequencyResponse(plant, set->gains, loop, s.frequencies_rad_s, &set->response, error);
 }
 
-std::string MarginCell(double v, const std::string& unit) { return std::isfinite(v) ? Num(v) + unit : "inf"; }
+std::string MarginCell(double v, const std::string& unit) {
+  return std::isfinite(v) ? Num(v, 4) + unit : "inf";
+}
 
 // What the optimum of the paper's objective gets wrong, from the numbers.
 std::string Verdict(const RobustPlant& p, const RobustSection& s) {
@@ -69,20 +64,20 @@ std::string Verdict(const RobustPlant& p, const RobustSection& s) {
   if (!opt || !robust) return "";
   std::ostringstream os;
   os << "On " << Title(p.plant) << " the optimum of the paper's objective has a load IAE of "
-     << Num(opt->load_iae) << " against " << Num(robust->load_iae) << " for the preset, Ms "
-     << Num(opt->analysis.ms) << " against " << Num(robust->analysis.ms) << ", and "
+     << Num(opt->load_iae, 4) << " against " << Num(robust->load_iae, 4) << " for the preset, Ms "
+     << Num(opt->analysis.ms, 4) << " against " << Num(robust->analysis.ms, 4) << ", and "
      << (std::isfinite(opt->analysis.noise_gain)
-             ? "a noise gain of " + Num(opt->analysis.noise_gain)
+             ? "a noise gain of " + Num(opt->analysis.noise_gain, 4)
              : std::string("an unbounded noise gain (its ideal derivative passes measurement noise to u "
                            "without limit)"))
-     << "; its slowest closed-loop time constant is " << Num(opt->analysis.slowest_time_constant_s)
-     << " s (preset: " << Num(robust->analysis.slowest_time_constant_s) << " s)";
+     << "; its slowest closed-loop time constant is " << Num(opt->analysis.slowest_time_constant_s, 4)
+     << " s (preset: " << Num(robust->analysis.slowest_time_constant_s, 4) << " s)";
   if (opt->gains.ki == 0.0) os << " and with ki = 0 it has no integral action against a constant load";
   os << "; " << Num(100.0 * opt->monte_carlo.stable_fraction, 3) << " % of its perturbed plants stay stable ("
      << Num(100.0 * robust->monte_carlo.stable_fraction, 3) << " % for the preset). The preset pays with a "
-     << "setpoint IAE of " << Num(robust->setpoint_iae) << " against " << Num(opt->setpoint_iae) << ".";
+     << "setpoint IAE of " << Num(robust->setpoint_iae, 4) << " against " << Num(opt->setpoint_iae, 4) << ".";
   if (robust->analysis.ms > s.max_ms * (1.0 + 1e-3))
-    os << " **The preset's Ms exceeds " << Num(s.max_ms) << " here.**";
+    os << " **The preset's Ms exceeds " << Num(s.max_ms, 4) << " here.**";
   return os.str();
 }
 
@@ -145,7 +140,7 @@ void RenderRobustSection(std::ostream& os, const RobustSection& s) {
      << "`, the default multi-start, which finds a lower IAE than the single-method tunings above) and "
         "`pidlab tune --robust` (setpoint-load objective with W = 1, derivative filter Tf = kd/(10 kp), Ms "
         "<= "
-     << Num(s.max_ms)
+     << Num(s.max_ms, 4)
      << ", slowest time constant <= 2.5 s; docs/robustness.md). Setpoint IAE is eq. (4) of the unit step; "
         "load IAE is eq. (4) of the output after a unit step at the plant input with r = 0. Ms, Mt, the "
         "margins and the noise gain ||C S||inf come from the loop analysis (`pidlab evaluate` prints the "
@@ -167,9 +162,10 @@ void RenderRobustSection(std::ostream& os, const RobustSection& s) {
         os << "unstable | | | | | | | " << Num(100.0 * set.monte_carlo.stable_fraction, 3) << " % |\n";
         continue;
       }
-      os << Num(set.setpoint_iae) << " | " << Num(set.load_iae) << " | " << Num(a.ms) << " | " << Num(a.mt)
-         << " | " << MarginCell(a.gain_margin, "") << " | " << MarginCell(a.phase_margin_deg, " deg") << " | "
-         << (std::isfinite(a.noise_gain) ? Num(a.noise_gain) : std::string("unbounded")) << " | "
+      os << Num(set.setpoint_iae, 4) << " | " << Num(set.load_iae, 4) << " | " << Num(a.ms, 4) << " | "
+         << Num(a.mt, 4) << " | " << MarginCell(a.gain_margin, "") << " | "
+         << MarginCell(a.phase_margin_deg, " deg") << " | "
+         << (std::isfinite(a.noise_gain) ? Num(a.noise_gain, 4) : std::string("unbounded")) << " | "
          << Num(100.0 * set.monte_carlo.stable_fraction, 3) << " % |\n";
     }
     os << "\n" << Verdict(p, s) << "\n\n";
@@ -198,7 +194,7 @@ bool DrawRobustFigures(const RobustSection& s, const std::string& out_dir,
     bs.y_max = bt.y_max = 15.0;
     std::vector<double> lw;
     for (double w : s.frequencies_rad_s) lw.push_back(std::log10(w));
-    bs.series.push_back({"Ms = " + Num(s.max_ms) + " (" + Num(ms_db, 3) + " dB)",
+    bs.series.push_back({"Ms = " + Num(s.max_ms, 4) + " (" + Num(ms_db, 3) + " dB)",
                          {lw.front(), lw.back()},
                          {ms_db, ms_db},
                          plot::Style::kDashed,
@@ -209,7 +205,7 @@ bool DrawRobustFigures(const RobustSection& s, const std::string& out_dir,
       cx.push_back(-1.0 + radius * std::cos(phi));
       cy.push_back(radius * std::sin(phi));
     }
-    ny.series.push_back({"|1 + L| = 1/" + Num(s.max_ms), cx, cy, plot::Style::kDashed, "black"});
+    ny.series.push_back({"|1 + L| = 1/" + Num(s.max_ms, 4), cx, cy, plot::Style::kDashed, "black"});
     ny.series.push_back({"-1", {-1.0}, {0.0}, plot::Style::kPoints, "black"});
     std::size_t k = 0;
     for (const RobustGainSet& set : p.sets) {
@@ -239,11 +235,11 @@ bool DrawRobustFigures(const RobustSection& s, const std::string& out_dir,
          "Robust tuning on " + Title(p.plant) +
              ": |S| and |T| (dB) of the paper's Nelder-Mead gains, pidlab's optimum of "
              "the paper's objective and the --robust preset, with the Ms = " +
-             Num(s.max_ms) +
+             Num(s.max_ms, 4) +
              " line; the Nyquist plot of L(jw) for w > 0 (the window -3..1.5 around -1, axes not to the same "
              "scale) with the "
              "circle of radius 1/" +
-             Num(s.max_ms) + " around -1 that Ms <= " + Num(s.max_ms) + " keeps the curve out of."});
+             Num(s.max_ms, 4) + " around -1 that Ms <= " + Num(s.max_ms, 4) + " keeps the curve out of."});
   }
   return true;
 }

@@ -113,10 +113,7 @@ struct PidOptions {
 /// The PID's options for a loop of period `loop_dt_s`: `options` with its
 /// sample time set to the loop's. The one place the PID's dt is derived from
 /// a loop (the loop, the episode, replay and the Ceres cross-check call it).
-inline PidOptions PidOptionsAt(PidOptions options, double loop_dt_s) {
-  options.dt_s = loop_dt_s;
-  return options;
-}
+PidOptions PidOptionsAt(PidOptions options, double loop_dt_s);
 
 /// The derivative filter time constant a PID runs with: gains.tf where it is
 /// set (> 0), else options.derivative_filter_s.

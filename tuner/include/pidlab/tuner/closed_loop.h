@@ -76,6 +76,9 @@ struct LoopOptions {
   /// value. Finite, nonzero, |A| <= kMaxCoefficientMagnitude.
   double reference = 1.0;
 
+  /// The discrete PID's options at this loop's period (PidOptionsAt).
+  PidOptions Pid() const { return PidOptionsAt(pid, dt_s); }
+
   /// Positive finite times, a finite nonzero reference, horizon a multiple of ts (and ts of dt for the
   /// sampled loop), a valid disturbance and PID, at most one derivative filter rule, and the work limits
   /// above.

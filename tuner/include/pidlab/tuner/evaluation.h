@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/spec/status.h"
 #include "pidlab/tuner/closed_loop.h"
 
 namespace pidlab {
@@ -80,28 +81,63 @@ struct EvaluateOptions {
 };
 
 /// Runs the sampled loop of `options` with the disturbance `disturbance`
-/// (which may differ from options.disturbance: Evaluate also runs the
-/// undisturbed loop) and returns y at every step k = 0..TotalSteps() in
-/// *y_all; records every step in *trajectory when it is not null. The
-/// in-process runner is RunSampledLoop; the LCM backend runs an episode over
-/// the process trio instead, with bit-identical results.
+/// (which may differ from options.disturbance: the undisturbed response is
+/// run too) and returns y at every step k = 0..TotalSteps() in *y_all;
+/// records every step in *trajectory when it is not null. A backend other
+/// than the process itself: the LCM trio (EpisodeClient::Run), with results
+/// bit-identical to the in-process loop. False with *error if the run failed.
 using SampledRunner =
     std::function<bool(const Plant& plant, const PidGains& gains, const LoopOptions& options,
                        const DisturbanceOptions& disturbance, std::vector<double>* y_all,
                        std::vector<SampledStep>* trajectory, std::string* error)>;
 
-/// The in-process SampledRunner.
+/// The sampled loop run in process (linear or nonlinear plant), as a SampledRunner.
 bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
                              const DisturbanceOptions& disturbance, std::vector<double>* y_all,
                              std::vector<SampledStep>* trajectory, std::string* error);
 
-/// Evaluates `gains` on `plant`. Returns false with a one-line *error for
-/// invalid input (the caller reports it as bad input). An unstable loop is
-/// not an error: evaluation->stability.stable is false and the objectives are
-/// +inf.
+/// What one run of the sampled loop leaves, whichever backend ran it (in
+/// process, the trio, a log). Evaluation is: simulate (RunSampled, or read a
+/// log), then score this record (EvaluateSampledRun), a pure function of it.
+struct SampledRun {
+  /// y_k at every step k = 0..TotalSteps(), with the loop's disturbance.
+  std::vector<double> y;
+  /// The same loop without the disturbance; empty when it has none.
+  std::vector<double> y_undisturbed;
+  /// Every step (k, t, r, y, u, n) of the disturbed run, when recorded; a
+  /// nonlinear plant run by a backend always has it (the motor's peaks are
+  /// the model re-driven by its u + n).
+  std::vector<SampledStep> trajectory;
+  /// The nonlinear motor as the run left it, when it ran in process.
+  std::shared_ptr<const NonlinearStepperPlant> motor;
+};
+
+/// Runs the sampled loop (and, with a disturbance, the undisturbed one) with
+/// `gains` (LoopGains already applied) on `runner`, or in process when
+/// `runner` is null. kRunnerFailed with the runner's message if it failed.
+Status RunSampled(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                  bool record_trajectory, const SampledRunner& runner, SampledRun* run);
+
+/// Evaluates the sampled loop `options` describes from a run record (a
+/// log's episode, a run made elsewhere): the same checks and the same
+/// numbers as Evaluate with the backend that made the record.
+Status EvaluateSampledRun(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                          const EvaluateOptions& what, const SampledRun& run, Evaluation* evaluation);
+
+/// Evaluates `gains` on `plant`: the continuous loop exactly, or the sampled
+/// loop run on `runner` (in process when null) and scored. kInvalidInput for
+/// invalid input, kRunnerFailed when the runner failed. An unstable loop is
+/// not an error: evaluation->stability.stable is false and the objectives
+/// are +inf.
+Status EvaluateLoop(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                    const EvaluateOptions& what, Evaluation* evaluation,
+                    const SampledRunner& runner = nullptr);
+
+/// EvaluateLoop with the message in *error: false for invalid input or a
+/// failed run.
 bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options,
               const EvaluateOptions& what, Evaluation* evaluation, std::string* error,
-              const SampledRunner& runner = RunSampledLoopInProcess);
+              const SampledRunner& runner = nullptr);
 
 /// The continuous-loop objective of `gains` by the general path:
 /// BuildContinuousClosedLoop, ContinuousStability (eigenvalues), then

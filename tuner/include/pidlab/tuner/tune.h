@@ -260,9 +260,9 @@ struct TuneSummary {
 /// Tunes the PID for `plant`. Returns false with *error for invalid input or
 /// when the method does not apply (e.g. Ziegler-Nichols on 1/s^2); true
 /// otherwise, with summary->stable false if no strictly stable loop was found.
-/// `runner` evaluates the sampled loop (in-process, or episodes over the LCM trio).
+/// `runner` evaluates the sampled loop (episodes over the LCM trio); null: in process.
 bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
-          const ProgressCallback& progress = nullptr, const SampledRunner& runner = RunSampledLoopInProcess);
+          const ProgressCallback& progress = nullptr, const SampledRunner& runner = nullptr);
 
 /// The Ceres cross-check alone, from `start` (used by Tune).
 RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, const PidGains& start,
