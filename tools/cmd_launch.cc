@@ -137,6 +137,10 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
               << Started(opt.roles) << " ready on " << where << " prefix " << opt.channel_prefix
               << (opt.log_file.empty() ? "" : ", logging to " + opt.log_file) << "\n";
     int result = trio.Run(flags->command, &g_signal);
+    if (!trio.failure().empty()) {  // a logger died: the run was stopped
+      trio.Stop();
+      throw std::runtime_error(trio.failure());
+    }
     if (!trio.FinishLog(g_signal != 0) && result == 0) result = 1;
     trio.Stop();
     return result;

@@ -37,10 +37,12 @@ class Supervisor {
 
   /// Starts `args` (looked up on PATH) with `env` added to ours. nice != 0:
   /// the child sets its nice value before exec (every thread it creates
-  /// inherits it); a failure (not root) leaves it at ours. Returns the pid;
-  /// throws std::runtime_error if fork fails.
+  /// inherits it); a failure (not root) leaves it at ours. stderr_path: this
+  /// child's stderr goes to that file (truncated) instead of the one set by
+  /// RedirectStderr. Returns the pid; throws std::runtime_error if fork fails.
   pid_t Start(const std::string& name, const std::vector<std::string>& args,
-              const std::map<std::string, std::string>& env = {}, int nice = 0);
+              const std::map<std::string, std::string>& env = {}, int nice = 0,
+              const std::string& stderr_path = "");
 
   /// Children started from now on append their stderr to this file
   /// (empty: they share ours).
