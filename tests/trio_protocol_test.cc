@@ -322,12 +322,21 @@ long OutputsSurvivingABurst(int queue_capacity, int burst) {
   std::set<int64_t> steps;
   in.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel,
                                           [&](const pidlab::lcmt_plant_output& m) { steps.insert(m.step); });
+  lcm::LCM probe(StepLaneUrl(url, kPlantOutputLane));
+  long heard = 0;
+  lcm::Subscription* heard_all = probe.subscribeFunction(
+      ".*", +[](const lcm::ReceiveBuffer*, const std::string&, long* n) { ++*n; }, &heard);
+  heard_all->setQueueCapacity(burst);
   for (int k = 0; k < burst; ++k) {
     pidlab::lcmt_plant_output m{};
     m.step = k;
     out.Publish(kPlantOutputChannel, &m);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // LCM's receive thread queues them
+  // Readiness: a second receiver on the same lane has heard the whole burst
+  // (every receiver's socket gets each datagram as it is sent), so `in`'s
+  // receive thread has had it to queue.
+  const double deadline = NowSeconds() + 5.0;
+  while (heard < burst && NowSeconds() < deadline) probe.handleTimeout(50);
   while (in.WaitAndHandle(0.05) > 0) {
   }
   return static_cast<long>(steps.size());
