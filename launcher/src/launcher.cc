@@ -309,7 +309,8 @@ bool Launcher::FinishLog(bool interrupted) {
   if (!log_) return true;
   if (logger_died_) return false;  // failure() says why
   if (!log_->WaitForMarker("end")) {
-    Note("error: could not confirm that " + options_.log_file + " is complete");
+    failure_ = "could not confirm that " + options_.log_file +
+               " is complete: lcm-logger did not record the end marker (check it with pidlab replay)";
     return false;
   }
   if (interrupted) {
@@ -320,8 +321,17 @@ bool Launcher::FinishLog(bool interrupted) {
   const RepairSummary summary = log_->Repair();
   const bool ok = summary.status == RepairStatus::kComplete || summary.status == RepairStatus::kRepaired;
   for (const std::string& line : summary.notes) Note("note: " + line);
-  for (const std::string& line : summary.lines) Note(ok ? line : "error: " + line);
-  return ok;
+  if (ok) {
+    for (const std::string& line : summary.lines) Note(line);
+    return true;
+  }
+  // One line says why; the other problems are counted (and noted with -v).
+  failure_ = summary.lines.empty() ? options_.log_file + " could not be checked" : summary.lines.front();
+  if (summary.lines.size() > 1)
+    failure_ += " (and " + std::to_string(summary.lines.size() - 1) + " more, -v)";
+  if (options_.verbose)
+    for (std::size_t i = 1; i < summary.lines.size(); ++i) Note(summary.lines[i]);
+  return false;
 }
 
 void Launcher::Stop() {
@@ -330,9 +340,9 @@ void Launcher::Stop() {
   std::string error;
   if (logger_died_) {
     // The lane files were kept as they are (failure() names them).
-  } else if (log_ && !log_->MergeLanes(&error))
-    Note("error: " + error + " (" + options_.log_file + " holds the base port's events only)");
-  else if (log_ && log_->rebuilt_outputs() > 0)
+  } else if (log_ && !log_->MergeLanes(&error)) {
+    if (failure_.empty()) failure_ = error + " (" + options_.log_file + " holds the base port's events only)";
+  } else if (log_ && log_->rebuilt_outputs() > 0)
     Note("note: lcm-logger lost " + std::to_string(log_->rebuilt_outputs()) +
          " PLANT_OUTPUT datagrams on the step lane; written into " + options_.log_file +
          " from the trajectory chunks");

@@ -418,10 +418,12 @@ void LogCapture::DescribeUnrepaired(const std::vector<Gap>& gaps, RepairSummary*
       for (long first = r.first; first <= r.second; first += transport::kMaxTrajectoryChunk)
         answered = answered && answers_.count({g.id, first});
     std::ostringstream os;
+    // The cause before the ranges: a long list is what a 300-character line cuts.
     os << options_.log_file << " is incomplete: episode " << g.id << " misses " << CountSteps(g.ranges)
-       << " steps (" << RangesText(g.ranges) << ") after " << options_.repair_rounds << " repair rounds: "
+       << " steps after " << options_.repair_rounds << " repair rounds, "
        << (answered ? "lcm-logger lost the plant's trajectory chunks every time"
-                    : "pidlab-plant did not resend them (no longer in its history, or it died)");
+                    : "pidlab-plant did not resend them (gone from its history, or dead)")
+       << ": " << RangesText(g.ranges, 4);
     summary->lines.push_back(os.str());
   }
 }

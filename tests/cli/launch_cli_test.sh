@@ -133,5 +133,28 @@ else
   pass "disk full: launch says at the start that the disk is nearly full"
 fi
 
+# --quiet: the same failure is the only line on stderr.
+umount small && mount -t tmpfs -o size=64k tmpfs small || { echo "FAIL: cannot mount a tmpfs"; exit 1; }
+status=0
+timeout 60 "$pidlab" launch --quiet --log small/run.lcmlog -- pidlab evaluate --backend lcm --plant oscillator \
+  --gains 2,1,1.5 --loop sampled --horizon 25 --json >full.out 2>full.err || status=$?
+if ((status != 1)); then
+  fail "disk full, --quiet: exit $status (wanted 1): $(tr '\n' '|' <full.err)"
+elif ! why=$(only_line_ok full.err "No space left on device"); then
+  fail "disk full, --quiet: $why"
+else
+  pass "disk full, --quiet: the failure is the only line"
+fi
+
+status=0
+"$pidlab" launch --quiet --verbose -- true >qv.out 2>qv.err || status=$?
+if ((status != 2)); then
+  fail "--quiet --verbose exits $status (wanted 2)"
+elif ! why=$(only_line_ok qv.err "--quiet and --verbose"); then
+  fail "--quiet --verbose: $why"
+else
+  pass "--quiet --verbose is bad input, one line"
+fi
+
 echo "$passed passed, $failed failed"
 ((failed == 0))

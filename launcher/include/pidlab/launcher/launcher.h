@@ -113,16 +113,19 @@ class Launcher {
           const std::map<std::string, std::string>& environment);
 
   /// After Run, with a log: confirms that the log is complete (end marker)
-  /// and repairs it. Returns false if it is not known complete; the reasons
-  /// went to the note function. After a logger died: false at once.
+  /// and repairs it. Returns false if it is not known complete; failure()
+  /// says why (the first problem, the others counted; noted with verbose).
+  /// After a logger died: false at once.
   bool FinishLog(bool interrupted);
 
   /// Stops the logger (SIGINT, so it closes the file) and every process.
-  /// After a logger died the lane files are not merged but kept.
+  /// After a logger died the lane files are not merged but kept; a merge
+  /// that fails sets failure() if nothing did before.
   void Stop();
 
-  /// Why Run stopped the run (a logger died: which file, how, the cause it
-  /// gave, the files kept), one line; empty if it did not.
+  /// Why the run failed, one line: a logger died (which file, how, the cause
+  /// it gave, the files kept), the log is not known complete (FinishLog), or
+  /// the lanes could not be merged (Stop). Empty if none of these.
   const std::string& failure() const { return failure_; }
 
   const std::string& lcm_url() const { return url_; }
