@@ -294,6 +294,29 @@ TEST(Supervisor, StartWithAStderrFileGivesThatChildItsOwnFile) {
   EXPECT_EQ(ReadFile(dir.File("shared.err")), "shared\n");
 }
 
+TEST(Supervisor, ReportsAStoppedChildOnceAndKeepsItAlive) {
+  Supervisor s;
+  const pid_t pid = s.Start("sleeper", {"sleep", "30"});
+  ASSERT_EQ(kill(pid, SIGSTOP), 0);
+  std::vector<Child> stopped;
+  ASSERT_TRUE(Eventually(
+      [&] {
+        EXPECT_TRUE(s.Reap().empty());
+        stopped = s.TakeStopped();
+        return !stopped.empty();
+      },
+      5.0));
+  ASSERT_EQ(stopped.size(), 1u);
+  EXPECT_EQ(stopped[0].pid, pid);
+  EXPECT_EQ(DescribeStatus(stopped[0].status), std::string("stopped by signal ") + strsignal(SIGSTOP));
+  EXPECT_TRUE(s.Find(pid)->alive);
+  EXPECT_TRUE(s.TakeStopped().empty());  // said once
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  const std::vector<Child> ended = ReapSome(&s);
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ExitCodeOf(ended[0].status), 128 + SIGKILL);
+}
+
 TEST(LastWords, IsTheCauseAfterTheLastColonOfTheLastNonEmptyLine) {
   TempDir dir;
   const std::string file = dir.File("logger.err");

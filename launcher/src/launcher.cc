@@ -273,6 +273,9 @@ bool Launcher::Watch(pid_t command, bool serving, bool* command_ended, int* comm
       must_stop = must_stop || serving;  // serving: a dead process ends the trio
     }
   }
+  // A stopped process answers nothing until continued: said once, as it happens.
+  for (const Child& c : supervisor_->TakeStopped())
+    if (c.pid != command) Note(c.name + " (pid " + std::to_string(c.pid) + ") " + DescribeStatus(c.status));
   return must_stop;
 }
 

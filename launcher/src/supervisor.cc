@@ -29,6 +29,7 @@ std::vector<char*> Argv(std::vector<std::string>* args) {
 std::string DescribeStatus(int status) {
   if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
   if (WIFSIGNALED(status)) return std::string("killed by signal ") + strsignal(WTERMSIG(status));
+  if (WIFSTOPPED(status)) return std::string("stopped by signal ") + strsignal(WSTOPSIG(status));
   return "stopped";
 }
 
@@ -105,13 +106,24 @@ std::vector<Child> Supervisor::Reap() {
   for (Child& c : children_) {
     if (!c.alive) continue;
     int status = 0;
-    if (waitpid(c.pid, &status, WNOHANG) == c.pid) {
-      c.alive = false;
-      c.status = status;
-      ended.push_back(c);
+    if (waitpid(c.pid, &status, WNOHANG | WUNTRACED) != c.pid) continue;
+    if (WIFSTOPPED(status)) {
+      Child stopped = c;
+      stopped.status = status;
+      stopped_.push_back(stopped);
+      continue;
     }
+    c.alive = false;
+    c.status = status;
+    ended.push_back(c);
   }
   return ended;
+}
+
+std::vector<Child> Supervisor::TakeStopped() {
+  std::vector<Child> stopped;
+  stopped.swap(stopped_);
+  return stopped;
 }
 
 Child* Supervisor::FindMutable(pid_t pid) {

@@ -102,6 +102,26 @@ kill_in_trio 2 2
 kill_in_trio 1 2
 kill_in_trio 3 3
 
+# A stopped process is noted as it happens, with its trio's number. COMMAND
+# waits until its process state shows the stop (T), then continues it.
+status=0
+timeout 30 "$pidlab" launch --trios 2 -- bash -c '
+  pid=$PIDLAB_TRIO2_CONTROLLER_PID
+  kill -STOP "$pid"
+  deadline=$(($(date +%s%N) + 1000000000))
+  until [[ $(ps -o stat= -p "$pid") == T* ]]; do
+    (($(date +%s%N) < deadline)) || exit 1
+    sleep 0.01
+  done
+  kill -CONT "$pid"' >stop.out 2>stop.err || status=$?
+if ((status != 0)); then
+  fail "a stop in trio 2: exit $status: $(tr '\n' '|' <stop.err)"
+elif ! grep -q "^pidlab launch: trio 2: pidlab-controller (pid [0-9]*) stopped by signal" stop.err; then
+  fail "a stop in trio 2 is not noted: $(tr '\n' '|' <stop.err)"
+else
+  pass "a stop in trio 2 of 2 is noted with its trio's number"
+fi
+
 # A full disk: a 64 KiB tmpfs fills within the first second of a 25 s
 # evaluation. Launch must stop COMMAND within 1 s of the loggers' death
 # (measured from the last write into the log files) and end with one line

@@ -188,7 +188,8 @@ class TrioSet {
   std::map<std::string, std::string> CommandEnvironment() const;
   /// Runs COMMAND (or serves) as Launcher::Run does, watching every trio: a
   /// process of any trio that ends is reaped at once and noted with its
-  /// trio's number ("trio 2: pidlab-plant (pid N) killed by signal Killed");
+  /// trio's number ("trio 2: pidlab-plant (pid N) killed by signal Killed"),
+  /// one that is stopped is noted too ("... stopped by signal Stopped (signal)");
   /// COMMAND goes on (a tune moves its episodes to the trios still alive). A
   /// logger of any trio that ends stops the run.
   int Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop);

@@ -18,7 +18,8 @@ struct Child {
   int status = 0;  // waitpid status once it ended
 };
 
-/// "exited with status N", "killed by signal NAME" or "stopped".
+/// "exited with status N", "killed by signal NAME" or "stopped by signal
+/// NAME".
 std::string DescribeStatus(int status);
 /// The shell's convention: the exit status, or 128 + signal.
 int ExitCodeOf(int status);
@@ -49,7 +50,12 @@ class Supervisor {
   void RedirectStderr(const std::string& path) { stderr_path_ = path; }
 
   /// Reaps exited children; returns the ones that ended since the last call.
+  /// A child that was stopped (SIGSTOP, SIGTSTP) since is not ended: it is
+  /// kept for TakeStopped.
   std::vector<Child> Reap();
+  /// The children Reap saw stopped since the last call (still alive; status
+  /// is the stop status).
+  std::vector<Child> TakeStopped();
   /// The child with this pid, or null.
   const Child* Find(pid_t pid) const;
   /// Sends sig to one child and waits up to timeout_s for it to end. True if
@@ -63,6 +69,7 @@ class Supervisor {
   pid_t pgid_ = -1;
   std::string stderr_path_;
   std::vector<Child> children_;
+  std::vector<Child> stopped_;
 };
 
 }  // namespace pidlab::launcher
