@@ -198,9 +198,11 @@ TEST(Supervisor, StopChildEndsASleepWithTheSignalItSent) {
 }
 
 TEST(Supervisor, StopChildGivesUpOnAChildThatIgnoresTheSignal) {
+  TempDir dir;
+  const std::string trapped = dir.File("trapped");
   Supervisor s;
-  const pid_t pid = s.Start("stubborn", {"sh", "-c", "trap '' TERM; sleep 30"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the trap is set
+  const pid_t pid = s.Start("stubborn", {"sh", "-c", "trap '' TERM; touch " + trapped + "; sleep 30"});
+  ASSERT_TRUE(Eventually([&] { return FileSize(trapped) >= 0; }, 5.0));  // the trap is set
   EXPECT_FALSE(s.StopChild(pid, SIGTERM, 0.3));
   EXPECT_TRUE(Alive(pid));
   EXPECT_TRUE(s.Find(pid)->alive);
@@ -215,13 +217,14 @@ TEST(Supervisor, KillAllLeavesNoChildOrGrandchildAlive) {
   // A child that starts a grandchild (same process group) and waits for it,
   // one that ignores SIGTERM (so KillAll must escalate) and a plain one.
   const pid_t parent = s.Start("parent", {"sh", "-c", "sleep 30 & echo $! > " + grandchild_file + "; wait"});
-  const pid_t stubborn = s.Start("stubborn", {"sh", "-c", "trap '' TERM; sleep 30"});
+  const std::string trapped = dir.File("trapped");
+  const pid_t stubborn = s.Start("stubborn", {"sh", "-c", "trap '' TERM; touch " + trapped + "; sleep 30"});
   const pid_t plain = s.Start("plain", {"sleep", "30"});
   ASSERT_TRUE(Eventually([&] { return Contains(ReadFile(grandchild_file), "\n"); }, 5.0));
   const pid_t grandchild = std::atoi(ReadFile(grandchild_file).c_str());
   ASSERT_GT(grandchild, 0);
   ASSERT_TRUE(Alive(grandchild));
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the trap is set
+  ASSERT_TRUE(Eventually([&] { return FileSize(trapped) >= 0; }, 5.0));  // the trap is set
   // One process group, led by the first child, not ours.
   EXPECT_EQ(getpgid(parent), parent);
   EXPECT_EQ(getpgid(stubborn), parent);
@@ -277,6 +280,60 @@ TEST(Supervisor, RedirectStderrAppendsTheChildsStderrToAFile) {
   s.Start("talker", {"sh", "-c", "echo two to stderr >&2"});
   ASSERT_EQ(ReapSome(&s).size(), 1u);
   EXPECT_EQ(ReadFile(path), "before\none to stderr\ntwo to stderr\n");
+}
+
+TEST(Supervisor, StartWithAStderrFileGivesThatChildItsOwnFile) {
+  TempDir dir;
+  Supervisor s;
+  s.RedirectStderr(dir.File("shared.err"));
+  s.Start("own", {"sh", "-c", "echo own >&2"}, {}, 0, dir.File("own.err"));
+  s.Start("shared", {"sh", "-c", "echo shared >&2"});
+  std::size_t ended = 0;
+  ASSERT_TRUE(Eventually([&] { return (ended += s.Reap().size()) == 2; }, 5.0));
+  EXPECT_EQ(ReadFile(dir.File("own.err")), "own\n");
+  EXPECT_EQ(ReadFile(dir.File("shared.err")), "shared\n");
+}
+
+TEST(Supervisor, ReportsAStoppedChildOnceAndKeepsItAlive) {
+  Supervisor s;
+  const pid_t pid = s.Start("sleeper", {"sleep", "30"});
+  ASSERT_EQ(kill(pid, SIGSTOP), 0);
+  std::vector<Child> stopped;
+  ASSERT_TRUE(Eventually(
+      [&] {
+        EXPECT_TRUE(s.Reap().empty());
+        stopped = s.TakeStopped();
+        return !stopped.empty();
+      },
+      5.0));
+  ASSERT_EQ(stopped.size(), 1u);
+  EXPECT_EQ(stopped[0].pid, pid);
+  EXPECT_EQ(DescribeStatus(stopped[0].status), std::string("stopped by signal ") + strsignal(SIGSTOP));
+  EXPECT_TRUE(s.Find(pid)->alive);
+  EXPECT_TRUE(s.TakeStopped().empty());  // said once
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  const std::vector<Child> ended = ReapSome(&s);
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ExitCodeOf(ended[0].status), 128 + SIGKILL);
+}
+
+TEST(LastWords, IsTheCauseAfterTheLastColonOfTheLastNonEmptyLine) {
+  TempDir dir;
+  const std::string file = dir.File("logger.err");
+  std::ofstream(file) << "lcm_eventlog_write_event: No space left on device\n"
+                      << "lcm_eventlog_write_event: Input/output error\n\n";
+  EXPECT_EQ(ln::LastWords(file), "Input/output error");
+  std::ofstream(file) << "killed\n";
+  EXPECT_EQ(ln::LastWords(file), "killed");
+  std::ofstream(file) << "";
+  EXPECT_EQ(ln::LastWords(file), "");
+  EXPECT_EQ(ln::LastWords(dir.File("missing")), "");
+}
+
+TEST(FreeBytesBeside, IsKnownForAWritableDirectoryAndUnknownForAMissingOne) {
+  TempDir dir;
+  EXPECT_GT(ln::FreeBytesBeside(dir.File("run.lcmlog")), 0);
+  EXPECT_EQ(ln::FreeBytesBeside(dir.File("no/such/dir/run.lcmlog")), -1);
 }
 
 TEST(RunAndWait, SucceedsOnExitZeroAndQuotesTheCommandOtherwise) {
@@ -760,6 +817,50 @@ TEST_F(Launcher, ServingReturnsOneWhenARoleIsKilled) {
   EXPECT_EQ(l.Run({}, &g_stop), 1);
   StopAfter(0.0);  // disarm
   EXPECT_TRUE(NoteContains("pidlab-controller (pid " + std::to_string(controller) + ") killed by signal"));
+}
+
+TEST_F(Launcher, ATrioSetReapsAndNotesADeathInItsSecondTrioAtOnce) {
+  LaunchOptions o = Options();
+  ln::TrioSet trios(o, 2, Notes());
+  std::string error;
+  ASSERT_EQ(trios.Start(nullptr, &error), LaunchStatus::kReady) << error;
+  const std::map<std::string, std::string> env = trios.CommandEnvironment();
+  const pid_t plant = std::atoi(env.at("PIDLAB_TRIO2_PLANT_PID").c_str());
+  ASSERT_GT(plant, 0);
+  // COMMAND kills trio 2's plant, then waits (1 s at most) until the launcher
+  // reaped it: a zombie keeps its /proc entry.
+  const std::string command =
+      "kill -9 $PIDLAB_TRIO2_PLANT_PID; i=0; while [ -e /proc/$PIDLAB_TRIO2_PLANT_PID ]; do "
+      "i=$((i + 1)); [ $i -gt 100 ] && exit 3; sleep 0.01; done; exit 0";
+  StopAfter(10.0);  // a bound, in case the death went unnoticed
+  EXPECT_EQ(trios.Run({"sh", "-c", command}, &g_stop), 0);
+  StopAfter(0.0);  // disarm
+  EXPECT_TRUE(NoteContains("trio 2: pidlab-plant (pid " + std::to_string(plant) + ") killed by signal"));
+  EXPECT_TRUE(trios.failure().empty()) << trios.failure();
+  trios.Stop();
+}
+
+TEST_F(LogCapture, ALoggerThatDiesStopsTheRunNamingItsFileAndKeepsTheLaneFiles) {
+  LaunchOptions o = Options();
+  o.log_file = dir_.File("run.lcmlog");
+  ln::Launcher l(o, Notes());
+  std::string error;
+  ASSERT_EQ(l.Start(nullptr, &error), LaunchStatus::kReady) << error;
+  const std::string logger = l.CommandEnvironment().at("PIDLAB_LOGGER_PID");
+  const auto t0 = std::chrono::steady_clock::now();
+  StopAfter(10.0);  // a bound, in case the death went unnoticed
+  // COMMAND kills the logger and would then run for 30 s.
+  EXPECT_EQ(l.Run({"sh", "-c", "kill -9 $PIDLAB_LOGGER_PID; exec sleep 30"}, &g_stop), 1);
+  StopAfter(0.0);  // disarm
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+  EXPECT_TRUE(Contains(l.failure(), "lcm-logger writing " + o.log_file + " (pid " + logger +
+                                        ") killed by signal Killed; run stopped; kept " + o.log_file + ", " +
+                                        o.log_file + ".lane1, " + o.log_file + ".lane2"))
+      << l.failure();
+  EXPECT_FALSE(l.FinishLog(false));
+  l.Stop();
+  EXPECT_GE(FileSize(o.log_file + ".lane1"), 0);
+  EXPECT_GE(FileSize(o.log_file + ".lane2"), 0);
 }
 
 TEST_F(Launcher, ServingReturnsZeroWhenStopIsSet) {

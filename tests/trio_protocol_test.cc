@@ -322,12 +322,21 @@ long OutputsSurvivingABurst(int queue_capacity, int burst) {
   std::set<int64_t> steps;
   in.Subscribe<pidlab::lcmt_plant_output>(kPlantOutputChannel,
                                           [&](const pidlab::lcmt_plant_output& m) { steps.insert(m.step); });
+  lcm::LCM probe(StepLaneUrl(url, kPlantOutputLane));
+  long heard = 0;
+  lcm::Subscription* heard_all = probe.subscribeFunction(
+      ".*", +[](const lcm::ReceiveBuffer*, const std::string&, long* n) { ++*n; }, &heard);
+  heard_all->setQueueCapacity(burst);
   for (int k = 0; k < burst; ++k) {
     pidlab::lcmt_plant_output m{};
     m.step = k;
     out.Publish(kPlantOutputChannel, &m);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // LCM's receive thread queues them
+  // Readiness: a second receiver on the same lane has heard the whole burst
+  // (every receiver's socket gets each datagram as it is sent), so `in`'s
+  // receive thread has had it to queue.
+  const double deadline = NowSeconds() + 5.0;
+  while (heard < burst && NowSeconds() < deadline) probe.handleTimeout(50);
   while (in.WaitAndHandle(0.05) > 0) {
   }
   return static_cast<long>(steps.size());
@@ -412,6 +421,75 @@ TEST(Trio, RecoversFromTwentyPercentDropsInEveryProcessWithIdenticalResults) {
   EXPECT_GT(controller.duplicates, 0);  // the plant resent y_k, the controller re-answered with its u_k
   const std::vector<double> expected = Reference(e);
   for (std::size_t k = 0; k < expected.size(); ++k) ASSERT_EQ(rec.y[k], expected[k]) << "step " << k;
+}
+
+/// The number after `key` ("resent ", "re-answered ") in a role's
+/// "episode <id>: done" line, or -1.
+long CountIn(const std::string& line, const std::string& key) {
+  const std::size_t at = line.find(key);
+  return at == std::string::npos ? -1 : std::stol(line.substr(at + key.size()));
+}
+
+TEST(Trio, EachEpisodeReportsItsOwnResendsNotTheProcessTotal) {
+  const Episode e = DoubleIntegrator(0.5);
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  TransportOptions lossy;
+  lossy.drop_rate = 0.1;
+  lossy.drop_seed = 2;
+  Transport plant_t(&lcm, {}), controller_t(&lcm, lossy), disturbance_t(&lcm, {}), client_t(&lcm, {});
+  std::vector<std::string> plant_lines, controller_lines;
+  PlantRole plant(&plant_t, [&](const std::string& line) { plant_lines.push_back(line); });
+  ControllerRole controller(&controller_t,
+                            [&](const std::string& line) { controller_lines.push_back(line); });
+  DisturbanceRole disturbance(&disturbance_t);
+  int64_t id = 0;
+  bool summary = false;
+  client_t.Subscribe<pidlab::lcmt_episode_summary>(
+      kSummaryChannel, [&](const pidlab::lcmt_episode_summary& m) {
+        summary = summary || (m.episode_id == id && m.status == pidlab::lcmt_episode_summary::OK);
+      });
+  RecoveryOptions recovery;
+  recovery.retransmit_interval_s = 0.001;
+  recovery.silence_deadline_s = 0.5;
+  for (id = 1; id <= 3; ++id) {
+    summary = false;
+    auto config = transport::MakeEpisodeConfig(
+        pidlab::MakeEpisodeSpec(id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
+    client_t.Publish(kEpisodeConfigChannel, &config);
+    const double start = NowSeconds();
+    while (!summary && NowSeconds() - start < 20.0) {
+      client_t.WaitAndHandle(0.001);
+      const double now = NowSeconds();
+      plant.Tick(now);
+      controller.Tick(now);
+      disturbance.Tick(now);
+    }
+    ASSERT_TRUE(summary) << "episode " << id;
+  }
+  // One "done" line per episode from each role, each counting that episode
+  // only: together at most the processes' lifetime totals (which also count
+  // what came after a "done" line). Lifetime totals in every line would add
+  // up to more: c1 + (c1 + c2) + (c1 + c2 + c3).
+  long resent = 0, reanswered = 0;
+  std::vector<long> per_episode;
+  for (const std::string& line : plant_lines)
+    if (line.find(": done") != std::string::npos) per_episode.push_back(CountIn(line, "(resent "));
+  ASSERT_EQ(per_episode.size(), 3u);
+  for (long n : per_episode) {
+    EXPECT_GT(n, 0);  // the controller drops: every episode has resends of its own
+    resent += n;
+  }
+  EXPECT_LE(resent, plant.counters().retransmits);
+  per_episode.clear();
+  for (const std::string& line : controller_lines)
+    if (line.find(": done") != std::string::npos) per_episode.push_back(CountIn(line, "(re-answered "));
+  ASSERT_EQ(per_episode.size(), 3u);
+  for (long n : per_episode) {
+    EXPECT_GT(n, 0);
+    reanswered += n;
+  }
+  EXPECT_LE(reanswered, controller.counters().duplicates);
 }
 
 TEST(RttEstimator, UsesTheInitialTimeoutUntilTheFirstSample) {

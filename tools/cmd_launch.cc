@@ -17,7 +17,10 @@ namespace {
 volatile std::sig_atomic_t g_signal = 0;
 void OnSignal(int sig) { g_signal = sig; }
 
-void Note(const std::string& line) { std::cerr << "pidlab launch: " << line << "\n"; }
+bool g_quiet = false;  // --quiet: no notes, only a failure's one line
+void Note(const std::string& line) {
+  if (!g_quiet) std::cerr << "pidlab launch: " << line << "\n";
+}
 
 /// "a,b,c" -> {"a", "b", "c"}; "" -> {} (no role: invalid); empty names are
 /// kept (an invalid role '').
@@ -104,12 +107,17 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
       "run the plant, controller and disturbance SCHED_FIFO at this priority (1-99) with their memory "
       "locked, if the system allows it (each says so if not)");
   app->add_flag("--verbose,-v", o.verbose, "verbose processes and launcher");
+  app->add_flag("--quiet,-q", g_quiet,
+                "no notes from launch and no stderr from the processes: stderr holds only a failure's one "
+                "line (and COMMAND's own stderr)");
   app->add_option("command", flags->command, "COMMAND [ARGS...] after --");
   return [flags, roles, realtime] {
     std::string error;
     if (realtime->count() > 0 && !transport::RealtimeFactorIsValid(flags->options.realtime_factor, &error))
       throw BadInput(error);
     if (roles->count() > 0) flags->options.roles = SplitRoles(flags->roles);
+    if (g_quiet && flags->options.verbose) throw BadInput("--quiet and --verbose contradict each other");
+    if (g_quiet) flags->options.stderr_path = "/dev/null";
     if (!flags->options.IsValid(&error)) throw BadInput(error);
     // An unwritable --log is bad input (exit 2), found before anything starts.
     CheckOutputFile(flags->options.log_file, "--log");
@@ -133,12 +141,16 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
     const launcher::LaunchOptions& opt = flags->options;
     std::string where;
     for (const std::string& url : trio.urls()) where += (where.empty() ? "" : ", ") + url;
-    std::cerr << "pidlab launch: " << (trio.size() > 1 ? std::to_string(trio.size()) + " x " : "")
-              << Started(opt.roles) << " ready on " << where << " prefix " << opt.channel_prefix
-              << (opt.log_file.empty() ? "" : ", logging to " + opt.log_file) << "\n";
-    int result = trio.Run(flags->command, &g_signal);
-    if (!trio.FinishLog(g_signal != 0) && result == 0) result = 1;
+    Note((trio.size() > 1 ? std::to_string(trio.size()) + " x " : "") + Started(opt.roles) + " ready on " +
+         where + " prefix " + opt.channel_prefix +
+         (opt.log_file.empty() ? "" : ", logging to " + opt.log_file));
+    const int result = trio.Run(flags->command, &g_signal);
+    const bool logger_died = !trio.failure().empty();  // Run stopped COMMAND
+    if (!logger_died) trio.FinishLog(g_signal != 0);
     trio.Stop();
+    // Launch's own failure is one line (exit 1). When COMMAND failed by
+    // itself, its line is the last one and says why: launch returns its status.
+    if (!trio.failure().empty() && (logger_died || result == 0)) throw std::runtime_error(trio.failure());
     return result;
   };
 }

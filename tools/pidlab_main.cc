@@ -34,6 +34,38 @@ const Command kCommands[] = {
 // (after "pidlab <command>: error: "), whatever the exception carried.
 std::string OneLine(const std::string& message) { return pidlab::cli::Truncate(message, 270); }
 
+/// The subcommand's name if args[1] names none ("pidlab frobnicate"): CLI11
+/// would only say that a subcommand is required.
+std::string UnknownSubcommand(const std::vector<std::string>& args) {
+  if (args.size() < 2 || args[1].empty() || args[1][0] == '-') return "";
+  for (const Command& command : kCommands)
+    if (args[1] == command.name) return "";
+  return args[1];
+}
+
+/// CLI11 2.1 loses the "--" that follows an option with an optional value
+/// ("launch --realtime -- CMD", "launch --realtime 2 -- CMD"), so CMD's own
+/// flags become the subcommand's. Before the first "--", such an option is
+/// given its value with '=': "--realtime=2", or "--realtime=<its default>"
+/// when "--" or another option follows.
+void JoinOptionalValues(CLI::App* sub, std::vector<std::string>* args) {
+  for (std::size_t i = 2; i < args->size() && (*args)[i] != "--"; ++i) {
+    std::string& token = (*args)[i];
+    if (token.size() < 3 || token.compare(0, 2, "--") != 0 || token.find('=') != std::string::npos) continue;
+    const CLI::Option* option = nullptr;
+    for (const CLI::Option* o : sub->get_options())
+      if (o->check_name(token)) option = o;
+    if (!option || option->get_expected_min() != 0 || option->get_expected_max() != 1) continue;
+    const bool next_is_value = i + 1 < args->size() && !(*args)[i + 1].empty() && (*args)[i + 1][0] != '-';
+    if (next_is_value) {
+      token += "=" + (*args)[i + 1];
+      args->erase(args->begin() + static_cast<std::ptrdiff_t>(i) + 1);
+    } else if (i + 1 < args->size() && (*args)[i + 1] == "--") {
+      token += "=" + option->get_default_str();
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -44,8 +76,21 @@ int main(int argc, char** argv) {
     CLI::App* sub = app.add_subcommand(command.name, command.description);
     actions.emplace_back(sub, command.register_flags(sub));
   }
+  std::vector<std::string> args(argv, argv + argc);
+  const std::string unknown = UnknownSubcommand(args);
+  if (!unknown.empty()) {
+    std::string names;
+    for (const Command& command : kCommands) names += std::string(names.empty() ? "" : ", ") + command.name;
+    std::cerr << "pidlab: error: '" << OneLine(unknown).substr(0, 80) << "' is not a subcommand (" << names
+              << "; pidlab --help)\n";
+    return 2;
+  }
+  for (auto& [sub, action] : actions)
+    if (args.size() > 1 && args[1] == sub->get_name()) JoinOptionalValues(sub, &args);
   try {
-    app.parse(argc, argv);
+    // CLI11 takes the arguments in reverse order when given a vector.
+    app.name(args[0]);
+    app.parse(std::vector<std::string>(args.rbegin(), args.rend() - 1));
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

@@ -26,6 +26,10 @@ struct ControllerRole::Episode {
   long expected = 0;
   pidlab::lcmt_control_command last;
   bool have_last = false;
+  // The process's lifetime counters when this episode started: the episode's
+  // own counts are the differences.
+  long duplicates_at_start = 0;
+  long dropped_at_start = 0;
 };
 
 ControllerRole::ControllerRole(Transport* transport, LogFn log, bool verbose)
@@ -41,6 +45,8 @@ void ControllerRole::StartEpisode(const EpisodeSpec& spec) {
   PidOptions options = spec.pid;
   options.dt_s = spec.dt_s;
   ep->pid = std::make_unique<DiscretePid<double>>(spec.gains, options);
+  ep->duplicates_at_start = counters_.duplicates;
+  ep->dropped_at_start = transport_->counters().dropped;
   ep_ = std::move(ep);
 }
 
@@ -66,8 +72,8 @@ void ControllerRole::OnOutput(const pidlab::lcmt_plant_output& m) {
     transport_->Publish(kControlChannel, &c);
     if (m.step + 1 == e.spec.total_steps) {
       Log("episode " + std::to_string(e.spec.episode_id) + ": done, " + std::to_string(e.expected) +
-          " commands (re-answered " + std::to_string(counters_.duplicates) + ", dropped " +
-          std::to_string(transport_->counters().dropped) + ")");
+          " commands (re-answered " + std::to_string(counters_.duplicates - e.duplicates_at_start) +
+          ", dropped " + std::to_string(transport_->counters().dropped - e.dropped_at_start) + ")");
     }
   } else if (e.have_last && m.step == e.last.step) {
     if (std::memcmp(&m.y, &e.last.y, sizeof m.y) != 0) {

@@ -20,6 +20,9 @@
 namespace pidlab::launcher {
 namespace {
 constexpr const char* kRecvBufSuffix = "&recv_buf_size=4194304";
+// Below this much free space beside the log, launch says so before it starts,
+// rather than only when a logger fails.
+constexpr long long kLowSpaceBytes = 64LL << 20;
 
 bool Started(const std::vector<std::string>& roles, const std::string& role) {
   return std::find(roles.begin(), roles.end(), role) != roles.end();
@@ -202,6 +205,10 @@ LaunchStatus Launcher::WaitReady(const volatile std::sig_atomic_t* stop, std::st
 
 LaunchStatus Launcher::Start(const volatile std::sig_atomic_t* stop, std::string* error) {
   if (log_) {
+    const long long free_bytes = FreeBytesBeside(options_.log_file);
+    if (free_bytes >= 0 && free_bytes < kLowSpaceBytes)
+      Note("only " + std::to_string(free_bytes / 1024) + " KiB free beside " + options_.log_file +
+           ": the log stops, and the run with it, when the disk is full");
     logger_ = log_->StartLogger(url_);
     log_->StartLaneLoggers(url_);
     if (options_.verbose) Note("started lcm-logger (pid " + std::to_string(logger_) + ")");
@@ -242,28 +249,71 @@ int Launcher::Run(const std::vector<std::string>& command, const volatile std::s
 
 int Launcher::Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop,
                   const std::map<std::string, std::string>& environment) {
-  const pid_t cmd = command.empty() ? -1 : supervisor_->Start("COMMAND", command, environment);
-  for (;;) {
-    for (const Child& c : supervisor_->Reap()) {
-      if (c.pid == cmd) return ExitCodeOf(c.status);
+  return RunWatching({this}, command, stop, environment);
+}
+
+bool Launcher::Watch(pid_t command, bool serving, bool* command_ended, int* command_status) {
+  bool must_stop = false;
+  for (const Child& c : supervisor_->Reap()) {
+    if (c.pid == command) {
+      *command_ended = true;
+      *command_status = c.status;
+    } else if (log_ && log_->IsLogger(c.pid)) {
+      // Without its logger the run records nothing more: stop it now, not
+      // after COMMAND ran to its end for nothing.
+      if (!logger_died_) {
+        logger_died_ = true;
+        std::string kept;
+        for (const std::string& file : log_->AbandonLanes()) kept += (kept.empty() ? "" : ", ") + file;
+        failure_ = log_->DescribeLoggerEnd(c) + "; run stopped" + (kept.empty() ? "" : "; kept " + kept);
+      }
+      must_stop = true;
+    } else {
       Note(c.name + " (pid " + std::to_string(c.pid) + ") " + DescribeStatus(c.status));
-      if (cmd < 0) return 1;  // serving: a dead process ends the trio
+      must_stop = must_stop || serving;  // serving: a dead process ends the trio
+    }
+  }
+  // A stopped process answers nothing until continued: said once, as it happens.
+  for (const Child& c : supervisor_->TakeStopped())
+    if (c.pid != command) Note(c.name + " (pid " + std::to_string(c.pid) + ") " + DescribeStatus(c.status));
+  return must_stop;
+}
+
+int Launcher::RunWatching(const std::vector<Launcher*>& trios, const std::vector<std::string>& command,
+                          const volatile std::sig_atomic_t* stop,
+                          const std::map<std::string, std::string>& environment) {
+  Launcher& first = *trios.front();
+  Supervisor& supervisor = *first.supervisor_;
+  const pid_t cmd = command.empty() ? -1 : supervisor.Start("COMMAND", command, environment);
+  for (;;) {
+    bool command_ended = false, must_stop = false;
+    int command_status = 0;
+    for (Launcher* trio : trios)
+      must_stop =
+          trio->Watch(trio == &first ? cmd : -1, cmd < 0, &command_ended, &command_status) || must_stop;
+    if (command_ended) return ExitCodeOf(command_status);
+    if (must_stop) {
+      // COMMAND is told with SIGTERM and has 1 s to finish.
+      if (cmd > 0 && !supervisor.StopChild(cmd, SIGTERM, 1.0)) supervisor.StopChild(cmd, SIGKILL, 1.0);
+      return 1;
     }
     if (stop && *stop) {
       if (cmd < 0) return 0;  // Ctrl-C is how a serving launch ends
       // Ctrl-C reaches COMMAND as SIGINT; it gets 2 s to finish.
-      if (!supervisor_->StopChild(cmd, SIGINT, 2.0)) supervisor_->StopChild(cmd, SIGKILL, 1.0);
-      const Child* c = supervisor_->Find(cmd);
+      if (!supervisor.StopChild(cmd, SIGINT, 2.0)) supervisor.StopChild(cmd, SIGKILL, 1.0);
+      const Child* c = supervisor.Find(cmd);
       return c && !c->alive ? ExitCodeOf(c->status) : 128 + static_cast<int>(*stop);
     }
-    transport_->WaitAndHandle(0.02);
+    first.transport_->WaitAndHandle(0.02);
   }
 }
 
 bool Launcher::FinishLog(bool interrupted) {
   if (!log_) return true;
+  if (logger_died_) return false;  // failure() says why
   if (!log_->WaitForMarker("end")) {
-    Note("error: could not confirm that " + options_.log_file + " is complete");
+    failure_ = "could not confirm that " + options_.log_file +
+               " is complete: lcm-logger did not record the end marker (check it with pidlab replay)";
     return false;
   }
   if (interrupted) {
@@ -274,17 +324,28 @@ bool Launcher::FinishLog(bool interrupted) {
   const RepairSummary summary = log_->Repair();
   const bool ok = summary.status == RepairStatus::kComplete || summary.status == RepairStatus::kRepaired;
   for (const std::string& line : summary.notes) Note("note: " + line);
-  for (const std::string& line : summary.lines) Note(ok ? line : "error: " + line);
-  return ok;
+  if (ok) {
+    for (const std::string& line : summary.lines) Note(line);
+    return true;
+  }
+  // One line says why; the other problems are counted (and noted with -v).
+  failure_ = summary.lines.empty() ? options_.log_file + " could not be checked" : summary.lines.front();
+  if (summary.lines.size() > 1)
+    failure_ += " (and " + std::to_string(summary.lines.size() - 1) + " more, -v)";
+  if (options_.verbose)
+    for (std::size_t i = 1; i < summary.lines.size(); ++i) Note(summary.lines[i]);
+  return false;
 }
 
 void Launcher::Stop() {
   if (!supervisor_) return;
   if (logger_ > 0) supervisor_->StopChild(logger_, SIGINT, 3.0);
   std::string error;
-  if (log_ && !log_->MergeLanes(&error))
-    Note("error: " + error + " (" + options_.log_file + " holds the base port's events only)");
-  else if (log_ && log_->rebuilt_outputs() > 0)
+  if (logger_died_) {
+    // The lane files were kept as they are (failure() names them).
+  } else if (log_ && !log_->MergeLanes(&error)) {
+    if (failure_.empty()) failure_ = error + " (" + options_.log_file + " holds the base port's events only)";
+  } else if (log_ && log_->rebuilt_outputs() > 0)
     Note("note: lcm-logger lost " + std::to_string(log_->rebuilt_outputs()) +
          " PLANT_OUTPUT datagrams on the step lane; written into " + options_.log_file +
          " from the trajectory chunks");
@@ -354,7 +415,16 @@ std::map<std::string, std::string> TrioSet::CommandEnvironment() const {
 }
 
 int TrioSet::Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop) {
-  return trios_.front()->Run(command, stop, CommandEnvironment());
+  std::vector<Launcher*> trios;
+  for (const auto& trio : trios_) trios.push_back(trio.get());
+  return Launcher::RunWatching(trios, command, stop, CommandEnvironment());
+}
+
+std::string TrioSet::failure() const {
+  for (std::size_t i = 0; i < trios_.size(); ++i)
+    if (!trios_[i]->failure().empty())
+      return (trios_.size() > 1 ? "trio " + std::to_string(i + 1) + ": " : "") + trios_[i]->failure();
+  return "";
 }
 
 bool TrioSet::FinishLog(bool interrupted) {

@@ -2,6 +2,7 @@
 
 #include <lcm/eventlog.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -82,14 +83,66 @@ LogCapture::LogCapture(const LogCaptureOptions& options, transport::Transport* t
                        Supervisor* supervisor)
     : options_(options), transport_(transport), supervisor_(supervisor) {}
 
+LogCapture::~LogCapture() {
+  for (const auto& [pid, files] : loggers_) std::remove(files.stderr_file.c_str());
+}
+
+long long FreeBytesBeside(const std::string& file) {
+  const std::size_t slash = file.rfind('/');
+  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : file.substr(0, slash);
+  struct statvfs fs {};
+  if (statvfs(dir.c_str(), &fs) != 0) return -1;
+  return static_cast<long long>(fs.f_bavail) * static_cast<long long>(fs.f_frsize);
+}
+
+std::string LastWords(const std::string& stderr_file) {
+  std::ifstream in(stderr_file);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  const std::size_t colon = last.rfind(": ");
+  return colon == std::string::npos ? last : last.substr(colon + 2);
+}
+
+pid_t LogCapture::StartOneLogger(const std::string& url, const std::string& file) {
+  char stderr_file[] = "/tmp/pidlab-lcm-logger-XXXXXX";
+  const int fd = mkstemp(stderr_file);
+  if (fd >= 0) close(fd);
+  const pid_t pid = supervisor_->Start(
+      "lcm-logger", {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + url, file}, {},
+      options_.logger_nice, fd >= 0 ? stderr_file : "");
+  loggers_[pid] = {file, fd >= 0 ? stderr_file : ""};
+  return pid;
+}
+
+bool LogCapture::IsLogger(pid_t pid) const { return loggers_.count(pid) > 0; }
+
+std::string LogCapture::DescribeLoggerEnd(const Child& logger) const {
+  const auto it = loggers_.find(logger.pid);
+  if (it == loggers_.end())
+    return logger.name + " (pid " + std::to_string(logger.pid) + ") " + DescribeStatus(logger.status);
+  const std::string cause = it->second.stderr_file.empty() ? "" : LastWords(it->second.stderr_file);
+  return "lcm-logger writing " + it->second.log + " (pid " + std::to_string(logger.pid) + ") " +
+         DescribeStatus(logger.status) + (cause.empty() ? "" : ": " + cause.substr(0, 80));
+}
+
+std::vector<std::string> LogCapture::AbandonLanes() {
+  for (const auto& [pid, file] : lane_loggers_)
+    if (pid > 0 && !supervisor_->StopChild(pid, SIGINT, 1.0)) supervisor_->StopChild(pid, SIGKILL, 1.0);
+  std::vector<std::string> kept;
+  struct stat st {};
+  if (stat(options_.log_file.c_str(), &st) == 0) kept.push_back(options_.log_file);
+  for (const auto& lane : lane_loggers_)
+    if (stat(lane.second.c_str(), &st) == 0) kept.push_back(lane.second);
+  lane_loggers_.clear();
+  return kept;
+}
+
 pid_t LogCapture::StartLogger(const std::string& lcm_url) {
   std::string logger_url = lcm_url;
   if (logger_url.find("recv_buf_size=") == std::string::npos)
     logger_url += std::string(logger_url.find('?') == std::string::npos ? "?" : "&") + kRecvBuf;
-  return supervisor_->Start(
-      "lcm-logger",
-      {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + logger_url, options_.log_file}, {},
-      options_.logger_nice);
+  return StartOneLogger(logger_url, options_.log_file);
 }
 
 void LogCapture::StartLaneLoggers(const std::string& lcm_url) {
@@ -99,10 +152,7 @@ void LogCapture::StartLaneLoggers(const std::string& lcm_url) {
     if (url.find("recv_buf_size=") == std::string::npos)
       url += std::string(url.find('?') == std::string::npos ? "?" : "&") + kRecvBuf;
     const std::string file = options_.log_file + ".lane" + std::to_string(lane);
-    const pid_t pid = supervisor_->Start(
-        "lcm-logger", {"lcm-logger", "-q", "-f", "--flush-interval=20", "--lcm-url=" + url, file}, {},
-        options_.logger_nice);
-    lane_loggers_.emplace_back(pid, file);
+    lane_loggers_.emplace_back(StartOneLogger(url, file), file);
   }
 }
 
@@ -256,7 +306,14 @@ bool LogCapture::MergeLanes(std::string* error) {
     if (error) *error = "cannot rename " + merged + " to " + options_.log_file;
     std::remove(merged.c_str());
   }
-  for (const auto& lane : lane_loggers_) std::remove(lane.second.c_str());
+  if (ok) {
+    for (const auto& lane : lane_loggers_) std::remove(lane.second.c_str());
+  } else if (error) {
+    // What the lanes hold exists nowhere else: keep it and say where.
+    std::string kept;
+    for (const auto& lane : lane_loggers_) kept += (kept.empty() ? "" : ", ") + lane.second;
+    *error += "; kept " + kept;
+  }
   lane_loggers_.clear();
   return ok;
 }
@@ -361,10 +418,12 @@ void LogCapture::DescribeUnrepaired(const std::vector<Gap>& gaps, RepairSummary*
       for (long first = r.first; first <= r.second; first += transport::kMaxTrajectoryChunk)
         answered = answered && answers_.count({g.id, first});
     std::ostringstream os;
+    // The cause before the ranges: a long list is what a 300-character line cuts.
     os << options_.log_file << " is incomplete: episode " << g.id << " misses " << CountSteps(g.ranges)
-       << " steps (" << RangesText(g.ranges) << ") after " << options_.repair_rounds << " repair rounds: "
+       << " steps after " << options_.repair_rounds << " repair rounds, "
        << (answered ? "lcm-logger lost the plant's trajectory chunks every time"
-                    : "pidlab-plant did not resend them (no longer in its history, or it died)");
+                    : "pidlab-plant did not resend them (gone from its history, or dead)")
+       << ": " << RangesText(g.ranges, 4);
     summary->lines.push_back(os.str());
   }
 }

@@ -29,6 +29,7 @@ std::vector<char*> Argv(std::vector<std::string>* args) {
 std::string DescribeStatus(int status) {
   if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
   if (WIFSIGNALED(status)) return std::string("killed by signal ") + strsignal(WTERMSIG(status));
+  if (WIFSTOPPED(status)) return std::string("stopped by signal ") + strsignal(WSTOPSIG(status));
   return "stopped";
 }
 
@@ -62,7 +63,8 @@ bool RunAndWait(const std::vector<std::string>& args, std::string* error) {
 Supervisor::~Supervisor() { KillAll(); }
 
 pid_t Supervisor::Start(const std::string& name, const std::vector<std::string>& args,
-                        const std::map<std::string, std::string>& env, int nice) {
+                        const std::map<std::string, std::string>& env, int nice,
+                        const std::string& stderr_path) {
   std::vector<std::string> copy = args;
   // A group whose every process has ended cannot be joined (setpgid fails and
   // the child would stay in ours, out of KillAll's reach): start a new one.
@@ -76,7 +78,10 @@ pid_t Supervisor::Start(const std::string& name, const std::vector<std::string>&
     if (getppid() != parent) _exit(1);  // the supervisor died before prctl
     for (const auto& [k, v] : env) setenv(k.c_str(), v.c_str(), 1);
     if (nice != 0) setpriority(PRIO_PROCESS, 0, nice);
-    if (!stderr_path_.empty()) {
+    if (!stderr_path.empty()) {
+      const int fd = open(stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+      if (fd >= 0) dup2(fd, STDERR_FILENO);
+    } else if (!stderr_path_.empty()) {
       const int fd = open(stderr_path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
       if (fd >= 0) dup2(fd, STDERR_FILENO);
     }
@@ -101,13 +106,24 @@ std::vector<Child> Supervisor::Reap() {
   for (Child& c : children_) {
     if (!c.alive) continue;
     int status = 0;
-    if (waitpid(c.pid, &status, WNOHANG) == c.pid) {
-      c.alive = false;
-      c.status = status;
-      ended.push_back(c);
+    if (waitpid(c.pid, &status, WNOHANG | WUNTRACED) != c.pid) continue;
+    if (WIFSTOPPED(status)) {
+      Child stopped = c;
+      stopped.status = status;
+      stopped_.push_back(stopped);
+      continue;
     }
+    c.alive = false;
+    c.status = status;
+    ended.push_back(c);
   }
   return ended;
+}
+
+std::vector<Child> Supervisor::TakeStopped() {
+  std::vector<Child> stopped;
+  stopped.swap(stopped_);
+  return stopped;
 }
 
 Child* Supervisor::FindMutable(pid_t pid) {

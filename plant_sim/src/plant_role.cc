@@ -57,6 +57,10 @@ struct PlantRole::Episode {
   pidlab::lcmt_episode_summary summary;
   int summary_sent = 0;
   double summary_last_s = 0;
+  // The process's lifetime counters when this episode started: the episode's
+  // own counts are the differences.
+  long retransmits_at_start = 0;
+  long dropped_at_start = 0;
 };
 
 PlantRole::PlantRole(Transport* transport, LogFn log, bool verbose, double realtime_factor)
@@ -99,6 +103,8 @@ void PlantRole::StartEpisode(const EpisodeSpec& spec) {
   ep->have_n.assign(n + 1, 0);
   ep->y_hist[0] = ep->Output();
   ep->start_s = ep->step_start_s = ep->stream_last_s = NowSeconds();
+  ep->retransmits_at_start = counters_.retransmits;
+  ep->dropped_at_start = transport_->counters().dropped;
   ep_ = std::move(ep);
   running_ = true;
   if (!rtt_.has_sample()) {
@@ -313,9 +319,10 @@ void PlantRole::Finish(bool ok, const std::string& silent_role, const std::strin
      << ", " << e.k << "/" << e.spec.total_steps << " steps in " << wall << " s";
   if (ok) os << ", y_final " << s.final_y;
   if (!ok) os << ": " << message;
-  os << " (resent " << counters_.retransmits << ", dropped " << transport_->counters().dropped
-     << ", round trip " << std::lround(rtt_.srtt_s() * 1e6) << " us, resend timeout "
-     << std::lround(rtt_.BaseTimeout() * 1e6) << " us)";
+  os << " (resent " << counters_.retransmits - e.retransmits_at_start << ", dropped "
+     << transport_->counters().dropped - e.dropped_at_start << ", round trip "
+     << std::lround(rtt_.srtt_s() * 1e6) << " us, resend timeout " << std::lround(rtt_.BaseTimeout() * 1e6)
+     << " us)";
   if (realtime.paced()) os << "; " << DescribeRealtime(realtime);
   Log(os.str());
 }

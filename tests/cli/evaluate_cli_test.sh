@@ -4,6 +4,7 @@
 # naming the value, no core dump).
 # Usage: evaluate_cli_test.sh PIDLAB_BINARY PAPER_TABLES_CSV
 set -euo pipefail
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 
 if [[ $# -ne 2 ]]; then
   echo "usage: $0 PIDLAB_BINARY PAPER_TABLES_CSV" >&2
@@ -131,6 +132,8 @@ bad() {
     fail "$what: exit $status, expected 2 (stderr: $(head -c 200 bad.err))"
   elif [[ $lines -ne 1 ]]; then
     fail "$what: $lines stderr lines, expected 1"
+  elif ! why=$(only_line_ok bad.err "$needle"); then
+    fail "$what: $why"
   elif ! grep -qF -- "$needle" bad.err; then
     fail "$what: stderr does not name '$needle': $(cat bad.err)"
   elif [[ -s bad.out ]]; then

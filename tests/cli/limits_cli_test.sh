@@ -9,6 +9,7 @@
 # regression fails instead of hanging).
 # Usage: limits_cli_test.sh PIDLAB_BINARY
 set -uo pipefail
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 
 if [[ $# -ne 1 ]]; then
   echo "usage: $0 PIDLAB_BINARY" >&2
@@ -46,6 +47,8 @@ bad() {
     fail "$what: $lines stderr lines, expected 1: $(head -c 300 bad.err)"
   elif [[ $chars -ge 300 ]]; then
     fail "$what: a stderr line of $chars characters: $(head -c 300 bad.err)"
+  elif ! why=$(only_line_ok bad.err "$needle"); then
+    fail "$what: $why"
   elif ! grep -qF -- "$needle" bad.err; then
     fail "$what: stderr does not contain '$needle': $(cat bad.err)"
   elif [[ -s bad.out ]]; then

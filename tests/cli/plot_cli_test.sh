@@ -4,6 +4,7 @@
 # continuous loop is drawn at the sample times; bad input exits 2.
 # Usage: plot_cli_test.sh PIDLAB_BINARY
 set -uo pipefail
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 pidlab=$(realpath -- "${1:?usage: plot_cli_test.sh PIDLAB_BINARY}")
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -53,7 +54,7 @@ for args in "--plant nope --gains 1,1,1 --out x" "--plant oscillator --gains 1,1
   status=0
   # shellcheck disable=SC2086
   "$pidlab" plot $args >bad.out 2>bad.err || status=$?
-  if [[ $status -eq 2 ]] && [[ $(wc -l <bad.err) -eq 1 ]]; then pass "bad input '$args' exits 2 with one line"
+  if [[ $status -eq 2 ]] && only_line_ok bad.err "error:"; then pass "bad input '$args' exits 2 with one line"
   else fail "bad input '$args': status $status, $(cat bad.err)"; fi
 done
 exit $failed

@@ -4,6 +4,7 @@
 # is measured by bench/report_bench.sh, not asserted here.
 # usage: report_cli_test.sh PIDLAB PAPER_TABLES
 set -u
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 pidlab=$1
 tables=$2
 out=$(mktemp -d)
@@ -56,4 +57,5 @@ done
 status=$?
 (( status == 2 )) || fail "missing tables: exit $status, expected 2"
 grep -q "/nonexistent/paper_tables.csv" "$out/err" || fail "error does not name the path: $(cat "$out/err")"
+why=$(only_line_ok "$out/err" "error:") || fail "missing tables: $why"
 echo PASS

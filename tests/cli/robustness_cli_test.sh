@@ -10,6 +10,7 @@
 # margin and of the ideal derivative, --monte-carlo, and bad input.
 # Usage: robustness_cli_test.sh PIDLAB_BINARY PAPER_TABLES_CSV
 set -euo pipefail
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 if [[ $# -ne 2 ]]; then
   echo "usage: $0 PIDLAB_BINARY PAPER_TABLES_CSV" >&2
   exit 2
@@ -206,7 +207,7 @@ for args in "--monte-carlo 10 --spread 150%" "--monte-carlo 10 --spread abc" "--
   status=0
   # shellcheck disable=SC2086
   "$pidlab" evaluate --plant linear --gains 1,1,1 $args >bad.out 2>bad.err || status=$?
-  if [[ $status -eq 2 && $(wc -l <bad.err) -eq 1 ]]; then pass "bad input $args: exit 2, $(cat bad.err)"; else
+  if [[ $status -eq 2 ]] && only_line_ok bad.err "error:"; then pass "bad input $args: exit 2, $(cat bad.err)"; else
     fail "bad input $args: exit $status, $(cat bad.err)"; fi
 done
 
@@ -215,13 +216,13 @@ for args in "--robust-quantile 0" "--robust-quantile 1.5" "--robust-spread 100%"
   status=0
   # shellcheck disable=SC2086
   "$pidlab" tune --plant linear $args >bad.out 2>bad.err || status=$?
-  if [[ $status -eq 2 && $(wc -l <bad.err) -eq 1 ]]; then pass "bad input tune $args: exit 2, $(cat bad.err)"; else
+  if [[ $status -eq 2 ]] && only_line_ok bad.err "error:"; then pass "bad input tune $args: exit 2, $(cat bad.err)"; else
     fail "bad input tune $args: exit $status, $(cat bad.err)"; fi
 done
 
 status=0
 "$pidlab" tune --plant stepper_nonlinear --robust --loop sampled --dt 1e-4 >bad.out 2>bad.err || status=$?
-if [[ $status -eq 2 && $(wc -l <bad.err) -eq 1 ]] && grep -q "needs a linear plant" bad.err; then
+if [[ $status -eq 2 ]] && only_line_ok bad.err "error:" && grep -q "needs a linear plant" bad.err; then
   pass "tune --robust on the nonlinear motor: exit 2, $(cat bad.err)"
 else fail "tune --robust on the nonlinear motor: exit $status, $(cat bad.err)"; fi
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # pidlab tune from the command line: JSON keys, --trace, bad input.
 set -uo pipefail
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 pidlab="$1"
 pass=0; fail=0
 check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
@@ -33,6 +34,7 @@ bad() {
   local name="$1"; shift
   "$pidlab" tune "$@" >/dev/null 2>"$tmp/bad"; local rc=$?
   check "$name exits 2 with one line" "[ $rc -eq 2 ] && [ \$(wc -l < $tmp/bad) -eq 1 ]"
+  check "$name: one line under 300 characters" "only_line_ok $tmp/bad error:"
 }
 bad "unknown method" --plant linear --method simplex
 bad "bad bounds" --plant linear --bounds 5,1

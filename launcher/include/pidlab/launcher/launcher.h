@@ -104,26 +104,46 @@ class Launcher {
   /// Runs `command` with CommandEnvironment() until it ends and returns its
   /// exit code (128 + signal if killed). *stop forwards SIGINT to it (2 s to
   /// finish). With an empty command, serves until *stop (returns 0) or until
-  /// a process dies (returns 1).
+  /// a process dies (returns 1). A process of the trio that ends is reaped at
+  /// once and noted. An lcm-logger that ends stops the run: COMMAND gets
+  /// SIGTERM (1 s, then SIGKILL), Run returns 1 and failure() says why.
   int Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop);
   /// The same with this environment for COMMAND instead of CommandEnvironment().
   int Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop,
           const std::map<std::string, std::string>& environment);
 
   /// After Run, with a log: confirms that the log is complete (end marker)
-  /// and repairs it. Returns false if it is not known complete; the reasons
-  /// went to the note function.
+  /// and repairs it. Returns false if it is not known complete; failure()
+  /// says why (the first problem, the others counted; noted with verbose).
+  /// After a logger died: false at once.
   bool FinishLog(bool interrupted);
 
   /// Stops the logger (SIGINT, so it closes the file) and every process.
+  /// After a logger died the lane files are not merged but kept; a merge
+  /// that fails sets failure() if nothing did before.
   void Stop();
+
+  /// Why the run failed, one line: a logger died (which file, how, the cause
+  /// it gave, the files kept), the log is not known complete (FinishLog), or
+  /// the lanes could not be merged (Stop). Empty if none of these.
+  const std::string& failure() const { return failure_; }
 
   const std::string& lcm_url() const { return url_; }
   /// The pid of a role started here; -1 for a role not started here.
   pid_t pid_of(const std::string& role) const;
 
  private:
+  friend class TrioSet;
   void Note(const std::string& line) const;
+  /// Runs COMMAND (started by trios[0]) while watching every trio's
+  /// processes; see Run.
+  static int RunWatching(const std::vector<Launcher*>& trios, const std::vector<std::string>& command,
+                         const volatile std::sig_atomic_t* stop,
+                         const std::map<std::string, std::string>& environment);
+  /// Reaps this trio's processes that ended and notes each (COMMAND `command`
+  /// excepted: *command_ended, *command_status). True if the run must stop:
+  /// a logger ended (failure_ set), or, when `serving`, any process.
+  bool Watch(pid_t command, bool serving, bool* command_ended, int* command_status);
   LaunchStatus WaitReady(const volatile std::sig_atomic_t* stop, std::string* error);
   void StartRoles();
 
@@ -137,6 +157,8 @@ class Launcher {
   std::map<std::string, pid_t> roles_;  // "plant" -> pid
   std::map<std::string, int32_t> alive_;
   pid_t logger_ = -1;
+  std::string failure_;
+  bool logger_died_ = false;
 };
 
 /// The LCM URL of trio `index` (0-based) of `pidlab launch --trios K`: the
@@ -164,13 +186,18 @@ class TrioSet {
   /// URLs, separated by spaces) and PIDLAB_TRIO<i>_{PLANT,CONTROLLER,
   /// DISTURBANCE}_PID for i = 1..K.
   std::map<std::string, std::string> CommandEnvironment() const;
-  /// Runs COMMAND (or serves) as Launcher::Run does, under trio 1's
-  /// supervision; a process of another trio that dies is reported when the
-  /// trios stop (a tune moves its episodes to the trios still alive).
+  /// Runs COMMAND (or serves) as Launcher::Run does, watching every trio: a
+  /// process of any trio that ends is reaped at once and noted with its
+  /// trio's number ("trio 2: pidlab-plant (pid N) killed by signal Killed"),
+  /// one that is stopped is noted too ("... stopped by signal Stopped (signal)");
+  /// COMMAND goes on (a tune moves its episodes to the trios still alive). A
+  /// logger of any trio that ends stops the run.
   int Run(const std::vector<std::string>& command, const volatile std::sig_atomic_t* stop);
   /// FinishLog of every trio; false if any log is not known complete.
   bool FinishLog(bool interrupted);
   void Stop();
+  /// The first trio's failure() ("trio i: " before it with K > 1); empty if none.
+  std::string failure() const;
 
   int size() const { return static_cast<int>(trios_.size()); }
   std::vector<std::string> urls() const;

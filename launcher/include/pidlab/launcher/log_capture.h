@@ -50,6 +50,15 @@ std::vector<TimedPayload> RebuildLaneOutputs(const replay::LogContents& log, con
 bool MergeEventLogs(const std::vector<std::string>& inputs, const std::vector<TimedPayload>& extra,
                     const std::string& extra_channel, const std::string& out_file, std::string* error);
 
+/// Bytes free for an unprivileged writer on the file system that holds
+/// `file` (its directory), or -1 if that cannot be told.
+long long FreeBytesBeside(const std::string& file);
+
+/// The cause a program wrote as its last words into `stderr_file`: the text
+/// after the last ": " of its last non-empty line ("lcm_eventlog_write_event:
+/// No space left on device" -> "No space left on device"); empty if none.
+std::string LastWords(const std::string& stderr_file);
+
 enum class RepairStatus {
   kComplete,    // nothing was missing
   kRepaired,    // steps were missing and the plant's chunks filled them
@@ -86,6 +95,10 @@ class LogCapture {
  public:
   /// `transport` and `supervisor` must outlive this object.
   LogCapture(const LogCaptureOptions& options, transport::Transport* transport, Supervisor* supervisor);
+  /// Removes the files that held the loggers' stderr.
+  ~LogCapture();
+  LogCapture(const LogCapture&) = delete;
+  LogCapture& operator=(const LogCapture&) = delete;
 
   /// Starts lcm-logger on `lcm_url` (a large receive buffer is added unless
   /// the URL sets one). Returns its pid.
@@ -96,11 +109,23 @@ class LogCapture {
   /// file of its own beside the log (FILE.lane1, FILE.lane2).
   void StartLaneLoggers(const std::string& lcm_url);
 
+  /// True if `pid` is one of the lcm-loggers started here.
+  bool IsLogger(pid_t pid) const;
+  /// One line on a logger that ended: the file it wrote, its pid, how it
+  /// ended and the cause it gave ("lcm-logger writing run.lcmlog.lane1
+  /// (pid 12) exited with status 1: No space left on device").
+  std::string DescribeLoggerEnd(const Child& logger) const;
+  /// After a logger died: stops the lane loggers without merging, so
+  /// whatever the files hold stays as written. Returns the log files that
+  /// exist (the log first, then the lane files).
+  std::vector<std::string> AbandonLanes();
+
   /// Stops the lane loggers and merges their events into the log by
   /// timestamp (the base port's events first on a tie), so the log holds the
   /// per-step datagrams too and lcm-logplayer can drive a controller from it.
   /// Call after the base logger stopped. False with *error if it failed (the
-  /// log is then left as the base logger wrote it).
+  /// log is then left as the base logger wrote it, and the lane files are
+  /// kept and named in *error).
   /// Outputs the PLANT_OUTPUT lane's logger lost are rebuilt from the
   /// trajectory chunks (not for authenticated runs); rebuilt_outputs() counts them.
   bool MergeLanes(std::string* error);
@@ -140,6 +165,13 @@ class LogCapture {
   std::map<std::pair<int64_t, int64_t>, int> answers_;
   std::vector<std::pair<int64_t, int64_t>> asked_;
   std::vector<std::pair<pid_t, std::string>> lane_loggers_;  // pid, file
+  struct LoggerFiles {
+    std::string log;          // what it writes
+    std::string stderr_file;  // where its complaints go (a temporary file)
+  };
+  std::map<pid_t, LoggerFiles> loggers_;
+  /// Starts one lcm-logger into `file` with its stderr captured.
+  pid_t StartOneLogger(const std::string& url, const std::string& file);
   long rebuilt_outputs_ = 0;
 };
 

@@ -18,7 +18,8 @@ struct Child {
   int status = 0;  // waitpid status once it ended
 };
 
-/// "exited with status N", "killed by signal NAME" or "stopped".
+/// "exited with status N", "killed by signal NAME" or "stopped by signal
+/// NAME".
 std::string DescribeStatus(int status);
 /// The shell's convention: the exit status, or 128 + signal.
 int ExitCodeOf(int status);
@@ -37,17 +38,24 @@ class Supervisor {
 
   /// Starts `args` (looked up on PATH) with `env` added to ours. nice != 0:
   /// the child sets its nice value before exec (every thread it creates
-  /// inherits it); a failure (not root) leaves it at ours. Returns the pid;
-  /// throws std::runtime_error if fork fails.
+  /// inherits it); a failure (not root) leaves it at ours. stderr_path: this
+  /// child's stderr goes to that file (truncated) instead of the one set by
+  /// RedirectStderr. Returns the pid; throws std::runtime_error if fork fails.
   pid_t Start(const std::string& name, const std::vector<std::string>& args,
-              const std::map<std::string, std::string>& env = {}, int nice = 0);
+              const std::map<std::string, std::string>& env = {}, int nice = 0,
+              const std::string& stderr_path = "");
 
   /// Children started from now on append their stderr to this file
   /// (empty: they share ours).
   void RedirectStderr(const std::string& path) { stderr_path_ = path; }
 
   /// Reaps exited children; returns the ones that ended since the last call.
+  /// A child that was stopped (SIGSTOP, SIGTSTP) since is not ended: it is
+  /// kept for TakeStopped.
   std::vector<Child> Reap();
+  /// The children Reap saw stopped since the last call (still alive; status
+  /// is the stop status).
+  std::vector<Child> TakeStopped();
   /// The child with this pid, or null.
   const Child* Find(pid_t pid) const;
   /// Sends sig to one child and waits up to timeout_s for it to end. True if
@@ -61,6 +69,7 @@ class Supervisor {
   pid_t pgid_ = -1;
   std::string stderr_path_;
   std::vector<Child> children_;
+  std::vector<Child> stopped_;
 };
 
 }  // namespace pidlab::launcher
