@@ -42,9 +42,7 @@ ControllerRole::~ControllerRole() = default;
 void ControllerRole::StartEpisode(const EpisodeSpec& spec) {
   auto ep = std::make_unique<Episode>();
   ep->spec = spec;
-  PidOptions options = spec.pid;
-  options.dt_s = spec.dt_s;
-  ep->pid = std::make_unique<DiscretePid<double>>(spec.gains, options);
+  ep->pid = std::make_unique<DiscretePid<double>>(spec.gains, PidOptionsAt(spec.pid, spec.dt_s));
   ep->duplicates_at_start = counters_.duplicates;
   ep->dropped_at_start = transport_->counters().dropped;
   ep_ = std::move(ep);

@@ -1,7 +1,7 @@
 #pragma once
 // Golden-section search (internal to the tuner library): the peak time of a
 // step response (metrics.cc) and the frequency of a sensitivity peak
-// (loop_analysis.cc).
+// (loop_response.cc).
 
 #include <cmath>
 

@@ -359,6 +359,38 @@ void AddDistinctMinima(const TuneOptions& options, const std::vector<LocalMinimu
   }
 }
 
+// Ceres from the search's result into summary->refine, its gains and
+// objective kept when better (and, for one start, feasible for f).
+void RefineSearchResult(const Plant& plant, const TuneOptions& options, const ObjectiveFunction& f,
+                        TuneSummary* summary) {
+  // Ceres differentiates the linear loops only; a nonlinear plant keeps the
+  // search's result (refine "not run"), and so does a robust set.
+  if (options.refine && options.robust_samples > 0) {
+    summary->refine.message = "not run: the robust set's quantile has no least-squares form";
+  } else if (options.refine && options.method == TuneMethod::kMultiStart && !plant.nonlinear) {
+    std::vector<PidGains> starts{summary->search_gains};
+    std::vector<double> objectives{summary->search_objective};
+    AddDistinctMinima(options, summary->local_minima, &starts, &objectives);
+    summary->refine = RefineWithCeres(plant, options, starts, objectives);
+    if (summary->refine.objective < summary->objective) {
+      summary->gains = summary->refine.gains;
+      summary->objective = summary->refine.objective;
+    }
+  } else if (options.refine && options.method != TuneMethod::kZieglerNichols && !plant.nonlinear) {
+    summary->refine = RefineWithCeres(plant, options, summary->search_gains, summary->search_objective);
+    const PidGains& r = summary->refine.gains;
+    // Ceres knows no constraint: its point is kept only if it meets them all.
+    const bool better = summary->refine.objective < summary->objective;
+    const bool feasible = better && std::isfinite(f(Eigen::Vector3d(r.kp, r.ki, r.kd)));
+    if (better && !feasible)
+      summary->refine.message += "; its gains break a constraint of the tuning, the search result stands";
+    if (feasible) {
+      summary->gains = summary->refine.gains;
+      summary->objective = summary->refine.objective;
+    }
+  }
+}
+
 }  // namespace
 
 bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
@@ -413,32 +445,7 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   summary->objective = summary->search_objective;
   summary->stable = true;
   summary->message = opt.message;
-  // Ceres differentiates the linear loops only; a nonlinear plant keeps the
-  // search's result (refine "not run"), and so does a robust set.
-  if (options.refine && options.robust_samples > 0) {
-    summary->refine.message = "not run: the robust set's quantile has no least-squares form";
-  } else if (options.refine && options.method == TuneMethod::kMultiStart && !plant.nonlinear) {
-    std::vector<PidGains> starts{summary->search_gains};
-    std::vector<double> objectives{summary->search_objective};
-    AddDistinctMinima(options, summary->local_minima, &starts, &objectives);
-    summary->refine = RefineWithCeres(plant, options, starts, objectives);
-    if (summary->refine.objective < summary->objective) {
-      summary->gains = summary->refine.gains;
-      summary->objective = summary->refine.objective;
-    }
-  } else if (options.refine && options.method != TuneMethod::kZieglerNichols && !plant.nonlinear) {
-    summary->refine = RefineWithCeres(plant, options, summary->search_gains, summary->search_objective);
-    const PidGains& r = summary->refine.gains;
-    // Ceres knows no constraint: its point is kept only if it meets them all.
-    const bool better = summary->refine.objective < summary->objective;
-    const bool feasible = better && std::isfinite(f(Eigen::Vector3d(r.kp, r.ki, r.kd)));
-    if (better && !feasible)
-      summary->refine.message += "; its gains break a constraint of the tuning, the search result stands";
-    if (feasible) {
-      summary->gains = summary->refine.gains;
-      summary->objective = summary->refine.objective;
-    }
-  }
+  RefineSearchResult(plant, options, f, summary);
   if (options.robust_samples > 0) summary->nominal_objective = evaluator(summary->gains);
   // The loop's derivative filter of the gains found (tf = 0 for the ideal PID).
   summary->gains = LoopGains(summary->gains, options.loop);

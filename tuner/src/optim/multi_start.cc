@@ -67,75 +67,44 @@ struct Polish {
   std::exception_ptr error;
 };
 
-}  // namespace
+// The Sobol design in the unit cube (u), in the box (x) and its values (f).
+struct Design {
+  std::vector<Eigen::VectorXd> u, x;
+  std::vector<double> f;
+};
 
-bool MultiStartOptions::IsValid(std::string* error) const {
-  const char* kOwner = "MultiStartOptions";
-  if (design_points < 1 || design_points > kMaxDesignPoints)
-    return FieldError(kOwner, "design_points", design_points, "in [1, 2^20]", error);
-  if (!(warp >= 0.0 && warp <= kMaxWarp)) return FieldError(kOwner, "warp", warp, "in [0, 40]", error);
-  if (starts < 1) return FieldError(kOwner, "starts", starts, ">= 1", error);
-  if (!(min_separation >= 0.0 && min_separation < 1.0))
-    return FieldError(kOwner, "min_separation", min_separation, "in [0, 1)", error);
-  if (max_evaluations <= design_points)
-    return FieldError(kOwner, "max_evaluations", max_evaluations, "> design_points", error);
-  std::string polish_error;
-  if (!polish.IsValid(&polish_error)) {
-    if (error) *error = "MultiStartOptions.polish: " + polish_error;
-    return false;
-  }
-  return true;
-}
-
-void MultiStart(const ObjectiveFunction& f, const Bounds& bounds, const MultiStartOptions& options,
-                OptimizerSummary* summary, const ProgressCallback& progress,
-                std::vector<LocalMinimum>* minima) {
-  if (minima) minima->clear();
-  if (summary == nullptr) return;
-  if (!optim_internal::StartRun(f, bounds, options, summary)) return;
+// Evaluates the design all at once (one iteration of the trace).
+Design EvaluateDesign(const ObjectiveFunction& f, const Bounds& bounds, const MultiStartOptions& options,
+                      const Warp& warp, OptimizerSummary* summary) {
   const int n = static_cast<int>(bounds.lower.size());
-  if (n > SobolSequence::kMaxDimensions) {
-    std::ostringstream os;
-    os << "MultiStart works in at most " << SobolSequence::kMaxDimensions << " dimensions, not " << n;
-    optim_internal::FailInvalid(os.str(), summary);
-    return;
-  }
-  const Warp warp(bounds, options.warp);
-
-  // 1. The design, evaluated all at once.
   const SobolSequence sobol = options.scramble ? SobolSequence(n, options.seed) : SobolSequence(n);
-  std::vector<Eigen::VectorXd> u(static_cast<std::size_t>(options.design_points)), x(u.size());
+  Design d;
+  std::vector<Eigen::VectorXd>& u = d.u;
+  std::vector<Eigen::VectorXd>& x = d.x;
+  u.resize(static_cast<std::size_t>(options.design_points));
+  x.resize(u.size());
   for (std::size_t i = 0; i < u.size(); ++i) {
     u[i] = sobol.Point(static_cast<std::uint32_t>(i));
     x[i] = warp.ToBox(u[i]);
   }
-  std::vector<double> fu(u.size());
-  {
-    const ProgressCallback no_progress;
-    Evaluator design(f, bounds, options.design_points, no_progress, summary);
-    design.Prefetch(x, options.parallel_for);
-    for (std::size_t i = 0; i < u.size(); ++i) {
-      Eigen::VectorXd xi = x[i];
-      fu[i] = design.Evaluate(&xi);
-    }
-    design.EndIteration();
+  d.f.resize(u.size());
+  const ProgressCallback no_progress;
+  Evaluator design(f, bounds, options.design_points, no_progress, summary);
+  design.Prefetch(x, options.parallel_for);
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    Eigen::VectorXd xi = x[i];
+    d.f[i] = design.Evaluate(&xi);
   }
-  if (progress) progress(summary->trace.back());
+  design.EndIteration();
+  return d;
+}
 
-  // 2. The starts.
-  const int rest = options.max_evaluations - options.design_points;
-  std::vector<int> kept = SelectStarts(u, fu, options);
-  if (static_cast<int>(kept.size()) > rest) kept.resize(static_cast<std::size_t>(rest));  // a share each
+// Nelder-Mead from each kept design point, in the unit cube, with an equal
+// share of the `rest` of the budget; rethrows the first start's exception.
+std::vector<Polish> RunPolishes(const ObjectiveFunction& f, int n, const Warp& warp,
+                                const MultiStartOptions& options, const std::vector<Eigen::VectorXd>& u,
+                                const std::vector<int>& kept, int rest) {
   const int starts = static_cast<int>(kept.size());
-  summary->starts = starts;
-  if (starts == 0) {
-    std::ostringstream os;
-    os << "none of the " << options.design_points << " design points is feasible";
-    optim_internal::Finish(TerminationType::kNoFeasiblePoint, os.str(), summary);
-    return;
-  }
-
-  // 3. The polishes, in the unit cube.
   const Bounds cube{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Ones(n)};
   const ObjectiveFunction g = [&f, &warp](const Eigen::VectorXd& v) { return f(warp.ToBox(v)); };
   std::vector<Polish> polishes(static_cast<std::size_t>(starts));
@@ -156,8 +125,16 @@ void MultiStart(const ObjectiveFunction& f, const Bounds& bounds, const MultiSta
   });
   for (const Polish& p : polishes)
     if (p.error) std::rethrow_exception(p.error);
+  return polishes;
+}
 
-  // Merge in start order.
+// Appends the polishes' traces and counts to *summary in start order, keeps
+// the best usable point, fills *minima (best first). Returns the best start
+// (1-based; 0: the design).
+int MergePolishes(const std::vector<Polish>& polishes, const std::vector<Eigen::VectorXd>& x,
+                  const std::vector<int>& kept, const Warp& warp, const ProgressCallback& progress,
+                  OptimizerSummary* summary, std::vector<LocalMinimum>* minima) {
+  const int starts = static_cast<int>(polishes.size());
   int best_start = 0;  // 0: the design
   for (int s = 0; s < starts; ++s) {
     const OptimizerSummary& part = polishes[static_cast<std::size_t>(s)].part;
@@ -195,7 +172,13 @@ void MultiStart(const ObjectiveFunction& f, const Bounds& bounds, const MultiSta
   if (minima)
     std::stable_sort(minima->begin(), minima->end(),
                      [](const LocalMinimum& a, const LocalMinimum& b) { return a.f < b.f; });
+  return best_start;
+}
 
+// Ends the run with the message and termination of the best start.
+void FinishMultiStart(const MultiStartOptions& options, const std::vector<Polish>& polishes, int best_start,
+                      OptimizerSummary* summary) {
+  const int starts = static_cast<int>(polishes.size());
   std::ostringstream os;
   os << "best of " << options.design_points << " design points and " << starts
      << (starts == 1 ? " polished start" : " polished starts") << ", from ";
@@ -207,6 +190,64 @@ void MultiStart(const ObjectiveFunction& f, const Bounds& bounds, const MultiSta
   const OptimizerSummary& best = polishes[static_cast<std::size_t>(best_start - 1)].part;
   os << "start " << best_start << ": " << best.message;
   optim_internal::Finish(best.termination, os.str(), summary);
+}
+
+}  // namespace
+
+bool MultiStartOptions::IsValid(std::string* error) const {
+  const char* kOwner = "MultiStartOptions";
+  if (design_points < 1 || design_points > kMaxDesignPoints)
+    return FieldError(kOwner, "design_points", design_points, "in [1, 2^20]", error);
+  if (!(warp >= 0.0 && warp <= kMaxWarp)) return FieldError(kOwner, "warp", warp, "in [0, 40]", error);
+  if (starts < 1) return FieldError(kOwner, "starts", starts, ">= 1", error);
+  if (!(min_separation >= 0.0 && min_separation < 1.0))
+    return FieldError(kOwner, "min_separation", min_separation, "in [0, 1)", error);
+  if (max_evaluations <= design_points)
+    return FieldError(kOwner, "max_evaluations", max_evaluations, "> design_points", error);
+  std::string polish_error;
+  if (!polish.IsValid(&polish_error)) {
+    if (error) *error = "MultiStartOptions.polish: " + polish_error;
+    return false;
+  }
+  return true;
+}
+
+void MultiStart(const ObjectiveFunction& f, const Bounds& bounds, const MultiStartOptions& options,
+                OptimizerSummary* summary, const ProgressCallback& progress,
+                std::vector<LocalMinimum>* minima) {
+  if (minima) minima->clear();
+  if (summary == nullptr) return;
+  if (!optim_internal::StartRun(f, bounds, options, summary)) return;
+  const int n = static_cast<int>(bounds.lower.size());
+  if (n > SobolSequence::kMaxDimensions) {
+    std::ostringstream os;
+    os << "MultiStart works in at most " << SobolSequence::kMaxDimensions << " dimensions, not " << n;
+    optim_internal::FailInvalid(os.str(), summary);
+    return;
+  }
+  const Warp warp(bounds, options.warp);
+
+  // 1. The design, evaluated all at once.
+  const Design design = EvaluateDesign(f, bounds, options, warp, summary);
+  if (progress) progress(summary->trace.back());
+
+  // 2. The starts.
+  const int rest = options.max_evaluations - options.design_points;
+  std::vector<int> kept = SelectStarts(design.u, design.f, options);
+  if (static_cast<int>(kept.size()) > rest) kept.resize(static_cast<std::size_t>(rest));  // a share each
+  const int starts = static_cast<int>(kept.size());
+  summary->starts = starts;
+  if (starts == 0) {
+    std::ostringstream os;
+    os << "none of the " << options.design_points << " design points is feasible";
+    optim_internal::Finish(TerminationType::kNoFeasiblePoint, os.str(), summary);
+    return;
+  }
+
+  // 3. The polishes, in the unit cube, merged in start order.
+  const std::vector<Polish> polishes = RunPolishes(f, n, warp, options, design.u, kept, rest);
+  const int best_start = MergePolishes(polishes, design.x, kept, warp, progress, summary, minima);
+  FinishMultiStart(options, polishes, best_start, summary);
 }
 
 }  // namespace pidlab
