@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # K trios on this machine: for K = 1, 2, 4, 8 (or the Ks given), one
-# `pidlab launch --isolated --trios K` runs the tune of issue 10's done-when
+# `pidlab launch --isolated --trios K` runs the tune of docs/trio.md's scaling table
 #   pidlab tune --backend lcm --loop sampled --plant double_integrator
 #     --horizon 5 --max-evals 80 --seed 3 --refine none --json   (TUNE_ARGS overrides)
 # and measures its wall time, episodes/s, the CPU-seconds of every process

@@ -23,8 +23,8 @@ level = {
     'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_tuner': 3,
     'pidlab_episode_client': 4, 'pidlab_log_reader': 4, 'pidlab_json': 4,
     'pidlab_replay': 5, 'pidlab_launcher': 5,
-    'pidlab_report': 6, 'pidlab_cli': 6,
-    'pidlab': 7, 'pidlab_python': 7,
+    'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_figures': 6, 'pidlab_cli': 7,
+    'pidlab': 8, 'pidlab_python': 8,
 }
 labels, edges = {}, []
 for line in open(dot):

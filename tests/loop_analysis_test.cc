@@ -129,7 +129,7 @@ TEST(LoopAnalysis, IdealDerivativeHasAnUnboundedNoiseGainAndTheFilterBoundsIt) {
 }
 
 TEST(LoopAnalysis, ReportsTheNearCancellationOfTheSlowPole) {
-  // Issue 11: kp 0.2999, ki 0, kd 30 on 1/s^2 leaves a pole near -0.01 on the PID zero -kp/kd.
+  // The default tune of 1/s^2: kp 0.2999, ki 0, kd 30 on 1/s^2 leaves a pole near -0.01 on the PID zero -kp/kd.
   const LoopAnalysis dut = AnalyzeOrFail({{1.0}, {1.0, 0.0, 0.0}}, {0.2999, 0.0, 30.0});
   ASSERT_TRUE(dut.stable);
   ASSERT_EQ(dut.cancellations.size(), 1u);

@@ -48,7 +48,7 @@ TEST(RobustPreset, LeavesWhatTheCallerKeepsAsTheCallerSetIt) {
 
 class RobustPresetOnPlant : public ::testing::TestWithParam<const char*> {};
 
-// The done-when of issue 11: every bound of the preset met (by the full
+// What the robust preset promises: every bound of the preset met (by the full
 // analysis, not the tuner's cheap check) and a finite noise gain.
 TEST_P(RobustPresetOnPlant, ReturnsALoopThatMeetsEveryBoundWithAFiniteNoiseGain) {
   const Plant plant = MakeBuiltin(GetParam());

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <mutex>
 #include <sstream>
 
 #include "pidlab/transport/wire.h"
@@ -107,7 +108,62 @@ std::string FromEnv(const std::string& flag, const char* env, const char* fallba
   return v && *v ? v : fallback;
 }
 
+namespace {
+
+struct NoteBoard {
+  std::mutex mutex;
+  bool quiet = false, verbose = false;
+  long rerun = 0, left_out = 0, other = 0;
+};
+NoteBoard& Board() {
+  static NoteBoard board;
+  return board;
+}
+
+std::string Count(long n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+}  // namespace
+
+void SetRunNoteMode(bool quiet, bool verbose) {
+  std::lock_guard<std::mutex> lock(Board().mutex);
+  Board().quiet = quiet;
+  Board().verbose = verbose;
+}
+
+void AddRunNote(const std::string& note) {
+  NoteBoard& b = Board();
+  std::lock_guard<std::mutex> lock(b.mutex);
+  if (note.find("runs on another trio") != std::string::npos)
+    ++b.left_out;
+  else if (note.find("failed") != std::string::npos)
+    ++b.rerun;
+  else
+    ++b.other;
+  if (b.verbose && !b.quiet) std::cerr << "pidlab: note: " << Truncate(note, 280) << "\n";
+}
+
+void FlushRunNotes() {
+  NoteBoard& b = Board();
+  std::lock_guard<std::mutex> lock(b.mutex);
+  std::vector<std::string> parts;
+  if (b.rerun) parts.push_back(Count(b.rerun, "episode run again", "episodes run again"));
+  if (b.left_out) parts.push_back(Count(b.left_out, "trio left out", "trios left out"));
+  if (b.other) parts.push_back(Count(b.other, "other note", "other notes"));
+  if (!parts.empty() && !b.quiet && !b.verbose) {
+    std::string line = "pidlab: note: ";
+    for (std::size_t i = 0; i < parts.size(); ++i) line += (i ? ", " : "") + parts[i];
+    std::cerr << line << " (-v shows each)\n";
+  }
+  b.rerun = b.left_out = b.other = 0;
+}
+
 void LcmFlags::Register(CLI::App* app) {
+  app->add_flag("--quiet,-q", quiet, "--backend lcm: say nothing of episodes run again or trios left out");
+  app->add_flag("--verbose,-v", verbose,
+                "--backend lcm: say each episode run again and each trio left out as it happens (default: "
+                "their count, once)");
   app->add_option("--lcm-url", lcm_url,
                   "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's); tune: one or "
                   "several trios, comma-separated (default: every trio of 'pidlab launch --trios K', "
@@ -165,7 +221,9 @@ EpisodeClientOptions LcmFlags::ClientOptions(const std::string& url) const {
   co.episode_timeout_s = episode_timeout_s;
   co.recovery.silence_deadline_s = silence_deadline_s;
   co.max_attempts = max_attempts;
-  co.on_note = [](const std::string& note) { std::cerr << "pidlab: note: " << note << "\n"; };
+  if (quiet && verbose) throw BadInput("--quiet and --verbose exclude each other");
+  SetRunNoteMode(quiet, verbose);
+  co.on_note = [](const std::string& note) { AddRunNote(note); };
   std::string error;
   const std::string key_file = FromEnv(auth_key_file, transport::kAuthKeyFileEnv, "");
   if (!key_file.empty()) {
@@ -330,14 +388,6 @@ void WriteSamplesCsv(const Evaluation& ev, const std::string& path) {
       << "," << ev.n[m] << "\n";
   f.close();
   if (!f) throw std::runtime_error("writing " + path + " failed");
-}
-
-nlohmann::json RealtimeJson(const transport::RealtimeStats& s) {
-  return {{"missed_deadlines", s.missed_deadlines},
-          {"lateness_p50_s", JsonNumber(s.lateness_p50_s)},
-          {"lateness_p99_s", JsonNumber(s.lateness_p99_s)},
-          {"lateness_max_s", JsonNumber(s.lateness_max_s)},
-          {"rate_hz", JsonNumber(s.rate_hz)}};
 }
 
 }  // namespace pidlab::cli

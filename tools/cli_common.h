@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/json/replay_json.h"
 #include "pidlab/json/results_json.h"
 #include "pidlab/spec/field.h"
 #include "pidlab/spec/status.h"
@@ -59,6 +60,15 @@ void PrepareOutputDir(const std::string& dir, const std::string& flag);
 /// exports to its COMMAND), else the fallback.
 std::string FromEnv(const std::string& flag, const char* env, const char* fallback);
 
+/// The notes of a run over the trio (an episode run again, a trio left
+/// out). Counted and said in one short line by FlushRunNotes (before the
+/// command's last line); each in full as it comes with `verbose`; none with
+/// `quiet`. Thread-safe: the starts of a tuning note from several threads.
+void SetRunNoteMode(bool quiet, bool verbose);
+void AddRunNote(const std::string& note);
+/// "pidlab: note: 3 episodes run again, 1 trio left out (-v shows each)", once.
+void FlushRunNotes();
+
 /// --lcm-url, --channel-prefix, --episode-timeout, --silence-deadline,
 /// --max-attempts and --auth-key of the LCM backend.
 struct LcmFlags {
@@ -66,6 +76,7 @@ struct LcmFlags {
   double episode_timeout_s = 600.0;
   double silence_deadline_s = transport::RecoveryOptions{}.silence_deadline_s;
   int max_attempts = EpisodeClientOptions{}.max_attempts;
+  bool quiet = false, verbose = false;  // --quiet, -v: the notes of the run (SetRunNoteMode)
   void Register(CLI::App* app);
   /// An episode client on the trio these flags (or $PIDLAB_LCM_URL,
   /// $PIDLAB_CHANNEL_PREFIX and $PIDLAB_AUTH_KEY_FILE) name. Throws BadInput for bad flags,
@@ -108,11 +119,9 @@ LoopAnalysis AnalyzeOrThrow(const Plant& plant, const PidGains& gains, const Loo
 // JsonNumber (null for NaN/inf), ToJson(Evaluation), ToJson(PidGains): the
 // JSON objects live in a library the Python module shares (tools/json/).
 using json::JsonNumber;
+using json::RealtimeJson;
 using json::RobustnessJson;
 using json::ToJson;
-/// The `realtime` object of a paced episode: exactly missed_deadlines,
-/// lateness_p50_s, lateness_p99_s, lateness_max_s, rate_hz.
-nlohmann::json RealtimeJson(const transport::RealtimeStats& stats);
 std::string FormatPoles(const std::vector<std::complex<double>>& poles);
 /// Human-readable report of one evaluation.
 std::string FormatEvaluation(const Evaluation& ev);

@@ -115,6 +115,14 @@ struct EvaluateCommand {
     }
     if (!samples_csv.empty()) WriteSamplesCsv(ev, samples_csv);
     if (!trajectory_csv.empty()) WriteTrajectoryCsv(ev, trajectory_csv);
+    Print(s, ev, analysis, loop_bounds, mc, mc_summary, client.get());
+    return 0;
+  }
+
+  // The result: one JSON object (with the spec it ran) or the table.
+  void Print(const spec::EvaluateSpec& s, const Evaluation& ev, const LoopAnalysis& analysis,
+             const LoopBounds& loop_bounds, const MonteCarloOptions& mc, const MonteCarloSummary& mc_summary,
+             const EpisodeClient* client) const {
     if (json) {
       nlohmann::json j = ToJson(ev);
       j["backend"] = backend;
@@ -124,17 +132,16 @@ struct EvaluateCommand {
       if (client && client->stats().realtime.paced()) j["realtime"] = RealtimeJson(client->stats().realtime);
       j["spec"] = spec::ToJson(s);
       std::cout << j.dump() << "\n";
-    } else {
-      std::cout << FormatEvaluation(ev) << FormatRobustness(analysis, loop_bounds);
-      if (s.monte_carlo > 0) std::cout << FormatMonteCarlo(mc, mc_summary);
-      if (client) {
-        std::printf("backend: lcm, %ld steps in %ld episode(s), %.0f steps/s\n", client->stats().steps,
-                    client->stats().episodes, client->stats().StepsPerSecond());
-        if (client->stats().realtime.paced())
-          std::printf("realtime: %s\n", transport::DescribeRealtime(client->stats().realtime).c_str());
-      }
+      return;
     }
-    return 0;
+    std::cout << FormatEvaluation(ev) << FormatRobustness(analysis, loop_bounds);
+    if (s.monte_carlo > 0) std::cout << FormatMonteCarlo(mc, mc_summary);
+    if (client) {
+      std::printf("backend: lcm, %ld steps in %ld episode(s), %.0f steps/s\n", client->stats().steps,
+                  client->stats().episodes, client->stats().StepsPerSecond());
+      if (client->stats().realtime.paced())
+        std::printf("realtime: %s\n", transport::DescribeRealtime(client->stats().realtime).c_str());
+    }
   }
 
   static std::string FormatMonteCarlo(const MonteCarloOptions& mc, const MonteCarloSummary& s) {

@@ -48,15 +48,65 @@ std::string Started(const std::vector<std::string>& roles) {
 
 }  // namespace
 
+namespace {
+
+// The flags of `pidlab launch`.
+struct LaunchFlags {
+  launcher::LaunchOptions options;
+  bool isolated = false;
+  std::string roles;
+  int trios = 1;
+  std::vector<std::string> command;
+};
+
+// Starts the trios, runs COMMAND against them and stops everything.
+int RunLaunch(LaunchFlags* flags, const CLI::Option* roles, const CLI::Option* realtime) {
+  std::string error;
+  if (realtime->count() > 0 && !transport::RealtimeFactorIsValid(flags->options.realtime_factor, &error))
+    throw BadInput(error);
+  if (roles->count() > 0) flags->options.roles = SplitRoles(flags->roles);
+  if (g_quiet && flags->options.verbose) throw BadInput("--quiet and --verbose contradict each other");
+  if (g_quiet) flags->options.stderr_path = "/dev/null";
+  if (!flags->options.IsValid(&error)) throw BadInput(error);
+  // An unwritable --log is bad input (exit 2), found before anything starts.
+  CheckOutputFile(flags->options.log_file, "--log");
+  if (flags->isolated && !launcher::EnterIsolatedNetwork(&error)) throw std::runtime_error(error);
+  struct sigaction sa {};
+  sa.sa_handler = OnSignal;
+  sigemptyset(&sa.sa_mask);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+
+  std::unique_ptr<launcher::TrioSet> launched;
+  try {
+    launched = std::make_unique<launcher::TrioSet>(flags->options, flags->trios, Note);
+  } catch (const std::invalid_argument& bad) {
+    throw BadInput(bad.what());
+  }
+  launcher::TrioSet& trio = *launched;
+  if (trio.Start(&g_signal, &error) != launcher::LaunchStatus::kReady) {
+    if (g_signal) return 128 + static_cast<int>(g_signal);
+    throw std::runtime_error(error);
+  }
+  const launcher::LaunchOptions& opt = flags->options;
+  std::string where;
+  for (const std::string& url : trio.urls()) where += (where.empty() ? "" : ", ") + url;
+  Note((trio.size() > 1 ? std::to_string(trio.size()) + " x " : "") + Started(opt.roles) + " ready on " +
+       where + " prefix " + opt.channel_prefix +
+       (opt.log_file.empty() ? "" : ", logging to " + opt.log_file));
+  const int result = trio.Run(flags->command, &g_signal);
+  const bool logger_died = !trio.failure().empty();  // Run stopped COMMAND
+  if (!logger_died) trio.FinishLog(g_signal != 0);
+  trio.Stop();
+  // Launch's own failure is one line (exit 1). When COMMAND failed by
+  // itself, its line is the last one and says why: launch returns its status.
+  if (!trio.failure().empty() && (logger_died || result == 0)) throw std::runtime_error(trio.failure());
+  return result;
+}
+
+}  // namespace
+
 std::function<int()> RegisterLaunch(CLI::App* app) {
-  struct Flags {
-    launcher::LaunchOptions options;
-    bool isolated = false;
-    std::string roles;
-    int trios = 1;
-    std::vector<std::string> command;
-  };
-  auto flags = std::make_shared<Flags>();
+  auto flags = std::make_shared<LaunchFlags>();
   launcher::LaunchOptions& o = flags->options;
   app->description(
       "Start pidlab-plant, pidlab-controller and pidlab-disturbance, or only the --roles named (and "
@@ -111,48 +161,7 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
                 "no notes from launch and no stderr from the processes: stderr holds only a failure's one "
                 "line (and COMMAND's own stderr)");
   app->add_option("command", flags->command, "COMMAND [ARGS...] after --");
-  return [flags, roles, realtime] {
-    std::string error;
-    if (realtime->count() > 0 && !transport::RealtimeFactorIsValid(flags->options.realtime_factor, &error))
-      throw BadInput(error);
-    if (roles->count() > 0) flags->options.roles = SplitRoles(flags->roles);
-    if (g_quiet && flags->options.verbose) throw BadInput("--quiet and --verbose contradict each other");
-    if (g_quiet) flags->options.stderr_path = "/dev/null";
-    if (!flags->options.IsValid(&error)) throw BadInput(error);
-    // An unwritable --log is bad input (exit 2), found before anything starts.
-    CheckOutputFile(flags->options.log_file, "--log");
-    if (flags->isolated && !launcher::EnterIsolatedNetwork(&error)) throw std::runtime_error(error);
-    struct sigaction sa {};
-    sa.sa_handler = OnSignal;
-    sigemptyset(&sa.sa_mask);
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
-
-    std::unique_ptr<launcher::TrioSet> launched;
-    try {
-      launched = std::make_unique<launcher::TrioSet>(flags->options, flags->trios, Note);
-    } catch (const std::invalid_argument& bad) {
-      throw BadInput(bad.what());
-    }
-    launcher::TrioSet& trio = *launched;
-    if (trio.Start(&g_signal, &error) != launcher::LaunchStatus::kReady) {
-      if (g_signal) return 128 + static_cast<int>(g_signal);
-      throw std::runtime_error(error);
-    }
-    const launcher::LaunchOptions& opt = flags->options;
-    std::string where;
-    for (const std::string& url : trio.urls()) where += (where.empty() ? "" : ", ") + url;
-    Note((trio.size() > 1 ? std::to_string(trio.size()) + " x " : "") + Started(opt.roles) + " ready on " +
-         where + " prefix " + opt.channel_prefix +
-         (opt.log_file.empty() ? "" : ", logging to " + opt.log_file));
-    const int result = trio.Run(flags->command, &g_signal);
-    const bool logger_died = !trio.failure().empty();  // Run stopped COMMAND
-    if (!logger_died) trio.FinishLog(g_signal != 0);
-    trio.Stop();
-    // Launch's own failure is one line (exit 1). When COMMAND failed by
-    // itself, its line is the last one and says why: launch returns its status.
-    if (!trio.failure().empty() && (logger_died || result == 0)) throw std::runtime_error(trio.failure());
-    return result;
-  };
+  return [flags, roles, realtime] { return RunLaunch(flags.get(), roles, realtime); };
 }
 
 }  // namespace pidlab::cli

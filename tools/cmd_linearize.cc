@@ -42,12 +42,7 @@ struct LinearizeCommand {
     if (!LinearizeStepper(o, &lin, &error)) throw BadInput(error);
     const TransferFunction eq3 = StepperMotorTransferFunction(o.motor);
     if (json) {
-      nlohmann::json j;
-      j["plant"] = "stepper_nonlinear";
-      j["num"] = lin.tf.num;
-      j["den"] = lin.tf.den;
-      j["eq3"] = {{"num", eq3.num}, {"den", eq3.den}};
-      j["input_scale"] = o.InputScale();
+      const nlohmann::json j = json::LinearizeJson(lin.tf, eq3, o.InputScale());
       std::cout << std::setprecision(std::numeric_limits<double>::max_digits10) << j.dump() << "\n";
     } else {
       std::cout << std::setprecision(10) << "linearisation  G(s) = " << lin.tf.ToString() << "\n"

@@ -9,9 +9,9 @@
 #include "cli_common.h"
 #include "cli_spec.h"
 #include "commands.h"
+#include "pidlab/figures/figures.h"
 #include "pidlab/plot/loop_figure.h"
 #include "pidlab/tuner/spec_build.h"
-#include "plot_sources.h"
 
 namespace pidlab::cli {
 namespace {
@@ -66,7 +66,7 @@ struct PlotCommand {
         throw BadInput("--log cannot be combined with --plant/--gains (the log carries its own)");
       PrepareOutputDir(out_dir, "--out");  // bad input before any work
       std::string report;
-      if (!LogFigure(log_path, episodes, &figure, &report, &error)) throw BadInput(error);
+      if (!figures::LogFigure(log_path, episodes, &figure, &report, &error)) throw BadInput(error);
       if (!report.empty()) std::cerr << report;
       if (name.empty()) name = std::filesystem::path(log_path).stem().string();
     } else {
@@ -85,7 +85,7 @@ struct PlotCommand {
             " points each are more than 1e7 points: use a coarser --dt or --sample-time, a shorter "
             "--horizon or fewer --gains");
       PrepareOutputDir(out_dir, "--out");  // bad input before any work
-      if (!EvaluationFigure(p, sets, options, &figure, &error)) throw BadInput(error);
+      if (!figures::EvaluationFigure(p, sets, options, &figure, &error)) throw BadInput(error);
       if (name.empty()) name = "evaluation";
     }
     if (name.empty() || name.find('/') != std::string::npos)

@@ -15,6 +15,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "pidlab/json/replay_json.h"
 #include "pidlab/replay/log_reader.h"
 #include "pidlab/replay/replay.h"
 #include "pidlab/transport/episode_spec.h"
@@ -22,19 +23,6 @@
 
 namespace pidlab::cli {
 namespace {
-
-nlohmann::json ToJson(const replay::StreamStats& s) {
-  nlohmann::json missing = nlohmann::json::array();
-  for (const auto& [a, b] : s.missing) missing.push_back({a, b});
-  return {{"expected", s.expected},
-          {"received", s.received},
-          {"duplicates", s.duplicates},
-          {"conflicts", s.conflicts},
-          {"out_of_order", s.out_of_order},
-          {"beyond_end", s.beyond_end},
-          {"filled_from_chunks", s.filled_from_chunks},
-          {"missing", missing}};
-}
 
 std::string Full(double v) {
   std::ostringstream os;
@@ -111,7 +99,7 @@ struct ReplayCommand {
     const std::vector<const replay::Episode*> selected = SelectEpisodes(log);
     std::ofstream csv_file;
     if (!csv.empty()) OpenCsv(&csv_file);
-    nlohmann::json out = LogJson(log);
+    nlohmann::json out = json::LogJson(log, log_path);
     std::ostringstream table;
     TableHeader(log, &table);
     int status = 0;
@@ -166,68 +154,6 @@ struct ReplayCommand {
     return selected;
   }
 
-  // ---- JSON output
-
-  nlohmann::json LogJson(const replay::LogContents& log) const {
-    nlohmann::json out;
-    out["log"] = log_path;
-    out["events"] = log.events;
-    out["pidlab_messages"] = log.pidlab_messages;
-    out["self_test_events"] = log.self_test;
-    out["foreign_events"] = log.foreign;
-    out["unknown_type_events"] = log.unknown_type;
-    out["decode_failures"] = log.decode_failures;
-    out["unauthenticated_events"] = log.unauthenticated;
-    out["unverified_events"] = log.unverified;
-    out["other_prefix_events"] = log.other_prefix;
-    out["eventnum_gaps"] = log.eventnum_gaps;
-    out["clean_end"] = log.clean_end;
-    out["bytes_read"] = log.bytes_read;
-    out["file_bytes"] = log.file_bytes;
-    out["notes"] = log.notes;
-    out["episodes"] = nlohmann::json::array();
-    return out;
-  }
-
-  // The episode without its evaluation and redrive.
-  static nlohmann::json EpisodeJson(const replay::Episode& e) {
-    nlohmann::json j;
-    j["prefix"] = e.prefix;
-    j["episode_id"] = e.episode_id;
-    j["complete"] = e.Complete();
-    j["completeness"] = e.Complete() ? "complete" : e.CompletenessNote();
-    j["total_steps"] = e.total_steps;
-    j["plant_outputs"] = ToJson(e.outputs);
-    j["commands"] = ToJson(e.commands);
-    j["disturbance_samples"] = ToJson(e.disturbances);
-    if (e.has_summary)
-      j["summary"] = {{"status", e.summary_status == 0 ? "ok" : "failed"},
-                      {"step", e.summary_step},
-                      {"message", e.summary_message}};
-    if (e.realtime.paced()) j["realtime"] = cli::RealtimeJson(e.realtime);
-    if (e.has_config) {
-      j["plant"] = e.spec.plant.name;
-      j["gains"] = cli::ToJson(e.spec.gains);
-      j["dt_s"] = e.spec.dt_s;
-      j["disturbance"] = ToString(e.spec.disturbance.kind);
-    } else {
-      j["config_error"] = e.config_error;
-    }
-    return j;
-  }
-
-  static nlohmann::json RedriveJson(const replay::RedriveResult& r) {
-    nlohmann::json j = {{"ok", r.ok},
-                        {"steps_checked", r.steps_checked},
-                        {"first_mismatch_step", r.first_mismatch},
-                        {"message", r.message}};
-    if (r.first_mismatch >= 0) {
-      j["logged_u"] = r.logged_u;
-      j["recomputed_u"] = r.recomputed_u;
-    }
-    return j;
-  }
-
   // ---- Table output
 
   void TableHeader(const replay::LogContents& log, std::ostream* table) const {
@@ -271,7 +197,7 @@ struct ReplayCommand {
   // Appends the episode's JSON to *episodes_json and its lines to *table;
   // false if --redrive found a mismatch.
   bool ReportEpisode(const replay::Episode& e, nlohmann::json* episodes_json, std::ostream* table) const {
-    nlohmann::json j = EpisodeJson(e);
+    nlohmann::json j = json::EpisodeJson(e);
     Evaluation ev;
     std::string why;
     const bool evaluated = replay::EvaluateEpisode(e, &ev, &why);
@@ -300,7 +226,7 @@ struct ReplayCommand {
   // on a mismatch.
   bool RedriveEpisode(const replay::Episode& e, nlohmann::json* j, std::ostream* table) const {
     const replay::RedriveResult r = backend == "lcm" ? RedriveLive(e) : replay::Redrive(e);
-    (*j)["redrive"] = RedriveJson(r);
+    (*j)["redrive"] = json::RedriveJson(r);
     *table << "    redrive: " << (r.ok ? "OK, " : "FAILED, ") << FromLog(r.message) << "\n";
     return r.ok;
   }

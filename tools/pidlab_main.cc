@@ -103,12 +103,17 @@ int main(int argc, char** argv) {
   }
   for (auto& [sub, action] : actions) {
     if (!sub->parsed()) continue;
+    // The counted notes of a run come before its result's end or its last line.
     try {
-      return action();
+      const int status = action();
+      pidlab::cli::FlushRunNotes();
+      return status;
     } catch (const pidlab::cli::BadInput& e) {
+      pidlab::cli::FlushRunNotes();
       std::cerr << "pidlab " << sub->get_name() << ": error: " << OneLine(e.what()) << "\n";
       return 2;
     } catch (const std::exception& e) {
+      pidlab::cli::FlushRunNotes();
       std::cerr << "pidlab " << sub->get_name() << ": failed: " << OneLine(e.what()) << "\n";
       return 1;
     }

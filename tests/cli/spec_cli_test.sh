@@ -6,6 +6,7 @@
 # overrides the file; a bad spec file is bad input naming the key.
 # usage: spec_cli_test.sh PIDLAB
 set -uo pipefail
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 pidlab=$1
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 cd "$tmp" || exit 1
@@ -77,11 +78,12 @@ else fail "a flag given with --spec does not override the file"; fi
 
 # Bad spec files: exit 2, one line naming the file and the key.
 bad() {  # bad NAME NEEDLE JSON
+  local why=""
   printf '%s' "$3" >bad.json
   "$pidlab" evaluate --spec bad.json >/dev/null 2>bad.err
   local status=$?
-  if [[ $status -eq 2 && $(wc -l <bad.err) -eq 1 ]] && grep -qF -- "$2" bad.err; then pass "bad spec $1: $(cat bad.err)"
-  else fail "bad spec $1: exit $status, $(cat bad.err)"; fi
+  if [[ $status -eq 2 ]] && why=$(only_line_ok bad.err "$2"); then pass "bad spec $1: $(cat bad.err)"
+  else fail "bad spec $1: exit $status, ${why:-}"; fi
 }
 bad "unknown key" "'horizn' is unknown" '{"plant": "oscillator", "gains": [1, 2, 3], "horizn": 3}'
 bad "wrong type" "'horizon' must be a number" '{"plant": "oscillator", "gains": [1, 2, 3], "horizon": "long"}'
@@ -90,8 +92,8 @@ bad "another version" "version 7" '{"version": 7}'
 bad "bad value" "horizon" '{"plant": "oscillator", "gains": [1, 2, 3], "horizon": 1e300}'
 bad "no gains" "--gains is required" '{"plant": "oscillator"}'
 "$pidlab" evaluate --spec missing.json >/dev/null 2>bad.err
-if [[ $? -eq 2 ]] && grep -qF "missing.json" bad.err; then pass "a missing spec file is bad input naming it"
-else fail "missing spec file: $(cat bad.err)"; fi
+if [[ $? -eq 2 ]] && why=$(only_line_ok bad.err "missing.json"); then pass "a missing spec file is bad input naming it"
+else fail "missing spec file: ${why:-}"; fi
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -166,6 +166,17 @@ nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds) {
   return j;
 }
 
+nlohmann::json LinearizeJson(const TransferFunction& linearisation, const TransferFunction& eq3,
+                             double input_scale) {
+  nlohmann::json j;
+  j["plant"] = "stepper_nonlinear";
+  j["num"] = linearisation.num;
+  j["den"] = linearisation.den;
+  j["eq3"] = {{"num", eq3.num}, {"den", eq3.den}};
+  j["input_scale"] = input_scale;
+  return j;
+}
+
 nlohmann::json DistributionJson(const Distribution& d) {
   return {{"count", d.count},
           {"min", JsonNumber(d.min)},

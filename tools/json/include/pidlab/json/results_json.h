@@ -31,6 +31,10 @@ nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds);
 nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary& s, const Evaluation& ev,
                         const std::string& backend);
 
+/// The object of `pidlab linearize --json`: plant, num, den (the
+/// linearisation), eq3 {num, den} and input_scale.
+nlohmann::json LinearizeJson(const TransferFunction& linearisation, const TransferFunction& eq3,
+                             double input_scale);
 /// {count, min, median, p95, max} of one Monte Carlo distribution.
 nlohmann::json DistributionJson(const Distribution& d);
 /// The `monte_carlo` object of `pidlab evaluate --monte-carlo N --json`.

@@ -1,5 +1,5 @@
 #pragma once
-// The report's section "The motor itself" (issue 12): gain sets designed on
+// The report's section "The motor itself": gain sets designed on
 // eq. (3) run on the nonlinear two-phase PM stepper (stepper_nonlinear,
 // docs/stepper.md) for moves of 0.001 rad, 0.01 rad, one tooth pitch and the
 // paper's 1 rad, each with and without a driver's phase-voltage limit, next

@@ -1,5 +1,5 @@
 #pragma once
-// The report's section "Robust tuning" (issue 11): on each plant, the
+// The report's section "Robust tuning": on each plant, the
 // paper's Nelder-Mead gains (Tables II-IV), pidlab's optimum of the paper's
 // objective (`pidlab tune`'s default multi-start, the report's other tunings
 // being single-method runs that stop short of it) and the `pidlab tune --robust`

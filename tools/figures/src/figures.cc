@@ -1,14 +1,14 @@
-#include "plot_sources.h"
+#include "pidlab/figures/figures.h"
 
 #include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
 
-#include "pidlab/replay/replay.h"
 #include "pidlab/plot/loop_figure.h"
+#include "pidlab/replay/replay.h"
 
-namespace pidlab::cli {
+namespace pidlab::figures {
 
 namespace {
 std::string GainsLabel(const PidGains& g) {
@@ -133,4 +133,4 @@ bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, p
                               error);
 }
 
-}  // namespace pidlab::cli
+}  // namespace pidlab::figures

@@ -1,14 +1,14 @@
 #pragma once
-// Figures of `pidlab plot`: the loop figure of an evaluation and of the
+// The figures of `pidlab plot` as a library: the loop figure of an evaluation and of the
 // episodes of an LCM log.
 
 #include <string>
 #include <vector>
 
-#include "pidlab/tuner/evaluation.h"
 #include "pidlab/plot/plot.h"
+#include "pidlab/tuner/evaluation.h"
 
-namespace pidlab::cli {
+namespace pidlab::figures {
 
 /// One trace per gain set. The sampled loop records every step (y, e, u, n at
 /// t = k dt); the continuous loop has no sampled command, so y, e, n are drawn
@@ -23,4 +23,4 @@ bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, co
 bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, plot::Figure* figure,
                std::string* report, std::string* error);
 
-}  // namespace pidlab::cli
+}  // namespace pidlab::figures

@@ -1,0 +1,28 @@
+#pragma once
+// The JSON objects of `pidlab replay --json` and of a paced run's `realtime`
+// (evaluate, replay), built in one place for every front end.
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "pidlab/replay/log_reader.h"
+#include "pidlab/replay/replay.h"
+#include "pidlab/transport/pacing.h"
+
+namespace pidlab::json {
+
+/// The `realtime` object of a paced episode: exactly missed_deadlines,
+/// lateness_p50_s, lateness_p99_s, lateness_max_s, rate_hz.
+nlohmann::json RealtimeJson(const transport::RealtimeStats& stats);
+/// One stream of an episode (plant outputs, commands, disturbance samples):
+/// expected, received, duplicates, conflicts, out_of_order, beyond_end,
+/// filled_from_chunks, missing [[from, to], ...].
+nlohmann::json StreamJson(const replay::StreamStats& s);
+/// The log's counts and notes, with an empty "episodes" array; `path` as given.
+nlohmann::json LogJson(const replay::LogContents& log, const std::string& path);
+/// One episode without its evaluation and redrive.
+nlohmann::json EpisodeJson(const replay::Episode& e);
+/// The `redrive` object of an episode.
+nlohmann::json RedriveJson(const replay::RedriveResult& r);
+
+}  // namespace pidlab::json

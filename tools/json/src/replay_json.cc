@@ -1,0 +1,87 @@
+#include "pidlab/json/replay_json.h"
+
+#include "pidlab/json/results_json.h"
+
+namespace pidlab::json {
+
+nlohmann::json RealtimeJson(const transport::RealtimeStats& s) {
+  return {{"missed_deadlines", s.missed_deadlines},
+          {"lateness_p50_s", JsonNumber(s.lateness_p50_s)},
+          {"lateness_p99_s", JsonNumber(s.lateness_p99_s)},
+          {"lateness_max_s", JsonNumber(s.lateness_max_s)},
+          {"rate_hz", JsonNumber(s.rate_hz)}};
+}
+
+nlohmann::json StreamJson(const replay::StreamStats& s) {
+  nlohmann::json missing = nlohmann::json::array();
+  for (const auto& [a, b] : s.missing) missing.push_back({a, b});
+  return {{"expected", s.expected},
+          {"received", s.received},
+          {"duplicates", s.duplicates},
+          {"conflicts", s.conflicts},
+          {"out_of_order", s.out_of_order},
+          {"beyond_end", s.beyond_end},
+          {"filled_from_chunks", s.filled_from_chunks},
+          {"missing", missing}};
+}
+
+nlohmann::json LogJson(const replay::LogContents& log, const std::string& path) {
+  nlohmann::json out;
+  out["log"] = path;
+  out["events"] = log.events;
+  out["pidlab_messages"] = log.pidlab_messages;
+  out["self_test_events"] = log.self_test;
+  out["foreign_events"] = log.foreign;
+  out["unknown_type_events"] = log.unknown_type;
+  out["decode_failures"] = log.decode_failures;
+  out["unauthenticated_events"] = log.unauthenticated;
+  out["unverified_events"] = log.unverified;
+  out["other_prefix_events"] = log.other_prefix;
+  out["eventnum_gaps"] = log.eventnum_gaps;
+  out["clean_end"] = log.clean_end;
+  out["bytes_read"] = log.bytes_read;
+  out["file_bytes"] = log.file_bytes;
+  out["notes"] = log.notes;
+  out["episodes"] = nlohmann::json::array();
+  return out;
+}
+
+nlohmann::json EpisodeJson(const replay::Episode& e) {
+  nlohmann::json j;
+  j["prefix"] = e.prefix;
+  j["episode_id"] = e.episode_id;
+  j["complete"] = e.Complete();
+  j["completeness"] = e.Complete() ? "complete" : e.CompletenessNote();
+  j["total_steps"] = e.total_steps;
+  j["plant_outputs"] = StreamJson(e.outputs);
+  j["commands"] = StreamJson(e.commands);
+  j["disturbance_samples"] = StreamJson(e.disturbances);
+  if (e.has_summary)
+    j["summary"] = {{"status", e.summary_status == 0 ? "ok" : "failed"},
+                    {"step", e.summary_step},
+                    {"message", e.summary_message}};
+  if (e.realtime.paced()) j["realtime"] = RealtimeJson(e.realtime);
+  if (e.has_config) {
+    j["plant"] = e.spec.plant.name;
+    j["gains"] = ToJson(e.spec.gains);
+    j["dt_s"] = e.spec.dt_s;
+    j["disturbance"] = ToString(e.spec.disturbance.kind);
+  } else {
+    j["config_error"] = e.config_error;
+  }
+  return j;
+}
+
+nlohmann::json RedriveJson(const replay::RedriveResult& r) {
+  nlohmann::json j = {{"ok", r.ok},
+                      {"steps_checked", r.steps_checked},
+                      {"first_mismatch_step", r.first_mismatch},
+                      {"message", r.message}};
+  if (r.first_mismatch >= 0) {
+    j["logged_u"] = r.logged_u;
+    j["recomputed_u"] = r.recomputed_u;
+  }
+  return j;
+}
+
+}  // namespace pidlab::json
