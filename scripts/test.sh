@@ -33,4 +33,6 @@ cmake --build build-asan -j"$(nproc)" --target pidlab pidlab-plant pidlab-contro
   hostile_stranger hostile_protocol_test
 bash scripts/build.sh -DPIDLAB_SANITIZED_BIN_DIR="$PWD/build-asan/bin"
 cd build
-ctest --output-on-failure --timeout 600
+# In parallel: the tests that start processes in a network namespace are
+# RUN_SERIAL and run alone.
+ctest -j"$(nproc)" --output-on-failure --timeout 600
