@@ -1,16 +1,38 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs every test (unit, CLI and the
-# LCM integration tests, each in its own private network namespace).
-# A second, sanitised tree (build-asan/, -fsanitize=address,undefined) holds
-# the processes, the decoders and the hostile-traffic tools: the hostile
-# tests run against it too.
+# Installs what is missing, builds, and runs the tests.
+#   scripts/test.sh          every test (unit, cli, integration, install,
+#                            hostile): what .ci/run runs
+#   scripts/test.sh --fast   the fast lane: build/ only, then the `unit` and
+#                            `cli` labels (ctest -L 'unit|cli'), in parallel
+# Every test's label is the first word of its name (tests/CMakeLists.txt).
+# The LCM integration tests run each in its own private network namespace.
+# For the full run a second, sanitised tree (build-asan/,
+# -fsanitize=address,undefined) holds the processes, the decoders and the
+# hostile-traffic tools: the hostile tests run against it too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+fast=0
+case "${1:-}" in
+  --fast) fast=1 ;;
+  "") ;;
+  *) echo "usage: scripts/test.sh [--fast]" >&2; exit 2 ;;
+esac
 bash scripts/install-deps.sh
+if [ "$fast" = 1 ]; then
+  bash scripts/build.sh
+  cd build
+  start=$(date +%s)
+  status=0
+  ctest -L 'unit|cli' -j"$(nproc)" --output-on-failure --timeout 600 || status=$?
+  echo "fast lane (ctest -L 'unit|cli'): $(( $(date +%s) - start )) s"
+  exit "$status"
+fi
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPIDLAB_SANITIZE=ON -DPIDLAB_WERROR=ON \
   -DPIDLAB_BUILD_BENCH=OFF >/dev/null
 cmake --build build-asan -j"$(nproc)" --target pidlab pidlab-plant pidlab-controller pidlab-disturbance \
   hostile_stranger hostile_protocol_test
 bash scripts/build.sh -DPIDLAB_SANITIZED_BIN_DIR="$PWD/build-asan/bin"
 cd build
-ctest --output-on-failure --timeout 600
+# In parallel: the tests that start processes in a network namespace are
+# RUN_SERIAL and run alone.
+ctest -j"$(nproc)" --output-on-failure --timeout 600

@@ -75,7 +75,8 @@ TEST_P(RobustPresetOnPlant, ReturnsALoopThatMeetsEveryBoundWithAFiniteNoiseGain)
 }
 
 INSTANTIATE_TEST_SUITE_P(ThePapersPlants, RobustPresetOnPlant,
-                         ::testing::Values("double_integrator", "oscillator", "stepper_motor"));
+                         ::testing::Values("double_integrator", "oscillator", "stepper_motor"),
+                         [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
 
 TEST(RobustSet, WorstCaseObjectiveIsAtLeastTheNominalOneAndEveryDrawIsStable) {
   const Plant plant = MakeBuiltin("double_integrator");

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <functional>
@@ -53,7 +54,10 @@ TEST_P(TuneBeatsPaper, DefaultTuneBeatsThePapersIaeWithAStrictlyStableLoop) {
 INSTANTIATE_TEST_SUITE_P(Plants, TuneBeatsPaper,
                          ::testing::Values(PaperCase{"double_integrator", 1.9151},
                                            PaperCase{"oscillator", 2.2304},
-                                           PaperCase{"stepper_motor", 1.9751}));
+                                           PaperCase{"stepper_motor", 1.9751}),
+                         [](const ::testing::TestParamInfo<PaperCase>& p) {
+                           return std::string(p.param.plant);
+                         });
 
 TEST(Tune, IsDeterministicForASeed) {
   const Plant plant = MakeBuiltin("oscillator");
@@ -111,7 +115,12 @@ TEST_P(TuneInParallel, GivesTheSameBitsAsOneEvaluationAfterTheOther) {
 
 INSTANTIATE_TEST_SUITE_P(Methods, TuneInParallel,
                          ::testing::Values(TuneMethod::kMultiStart, TuneMethod::kNelderMead,
-                                           TuneMethod::kGeneticAlgorithm, TuneMethod::kPsoGsa));
+                                           TuneMethod::kGeneticAlgorithm, TuneMethod::kPsoGsa),
+                         [](const ::testing::TestParamInfo<TuneMethod>& p) {
+                           std::string name = ToString(p.param);  // "multi-start": gtest names take no '-'
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
 
 // The done-when: for seeds 1-20 the default tune of each plant
 // reaches the same objective to 0.1 %, and that objective is no worse (to
@@ -157,7 +166,8 @@ TEST_P(DefaultTuneOverSeeds, ReachesTheSameObjectiveForEverySeedAndNoWorseThanAn
 }
 
 INSTANTIATE_TEST_SUITE_P(Plants, DefaultTuneOverSeeds,
-                         ::testing::Values("double_integrator", "oscillator", "stepper_motor"));
+                         ::testing::Values("double_integrator", "oscillator", "stepper_motor"),
+                         [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
 
 TEST(MultiStart, RefinesFromSeveralDistinctPolishedMinimaAndKeepsTheBest) {
   const Plant plant = MakeBuiltin("stepper_motor");

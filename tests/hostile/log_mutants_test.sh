@@ -15,13 +15,9 @@ BIN=$(realpath -- "${1:?usage: log_mutants_test.sh BIN_DIR COUNT [MAX_RSS_MB [TO
 COUNT=${2:?usage: log_mutants_test.sh BIN_DIR COUNT [MAX_RSS_MB [TOOL_BIN_DIR]]}
 MAX_RSS_MB=${3:-200}
 TOOLS=$(realpath -- "${4:-$BIN}")
-# Only inside a private network namespace: not pid 1's, and nothing but a
-# loopback (pid 1's namespace may be unreadable: the interfaces decide then).
-if [ "$(readlink /proc/self/ns/net)" = "$(readlink /proc/1/ns/net 2>/dev/null)" ] ||
-   [ "$(ip -o link show | wc -l)" -ne 1 ]; then
-  echo "refusing to run outside a private network namespace (use unshare -n)" >&2; exit 1
-fi
-ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || exit 1
+# Only in the private network namespace ctest made (unshare -n), multicast on its loopback.
+. "$(dirname "${BASH_SOURCE[0]}")/../integration/lib.sh"
+private_network_up
 TMP=$(mktemp -d); trap 'rm -rf "$TMP"' EXIT
 # A sanitizer report is a crash (abort), never a quiet exit 1.
 export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
@@ -40,7 +36,9 @@ for lane in 1 2; do
   lcm-logger -q -f --lcm-url="udpm://239.255.76.67:$((7667 + lane))?ttl=0&recv_buf_size=4194304" \
     "$TMP/lane$lane.lcm" >/dev/null 2>&1 & loggers+=($!)
 done
-sleep 0.5
+for lane in 1 2; do
+  wait_until 10 test -e "$TMP/lane$lane.lcm" || fail "lcm-logger of lane $lane did not start"
+done
 export TOOLS
 "$TOOLS/pidlab" launch --lcm-url "$URL" --log "$TMP/seed.lcm" -- bash -c '
   "$TOOLS/pidlab" evaluate --backend lcm --plant double_integrator --gains 2,1,1.5 --loop sampled --horizon 1 \

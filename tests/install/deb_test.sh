@@ -7,6 +7,9 @@
 # trio (`pidlab launch` starts the processes next to itself).
 # Run as: unshare -n bash deb_test.sh BUILD_DIR   (ctest does this)
 set -uo pipefail
+# Only in the private network namespace ctest made (unshare -n), multicast on its loopback.
+. "$(dirname "${BASH_SOURCE[0]}")/../integration/lib.sh"
+private_network_up
 build=$(realpath -- "${1:?usage: deb_test.sh BUILD_DIR}")
 pass=0; fail=0
 check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
@@ -73,21 +76,16 @@ check "the unpacked Python module evaluates like pidlab" "[ $? -eq 0 ]" || cat "
 
 # Its own trio: pidlab launch starts pidlab-plant, -controller and
 # -disturbance from the unpacked usr/bin, in this private namespace.
-if [[ $(ip -o link show | wc -l) -eq 1 ]] && ip link set lo up && ip link set lo multicast on &&
-   ip route add 224.0.0.0/4 dev lo; then
-  lcm_args=(--plant oscillator --gains 2,1,1.5 --loop sampled --horizon 2 --json)
-  (cd "$tmp" && "$tmp/root/usr/bin/pidlab" launch -- pidlab evaluate --backend lcm "${lcm_args[@]}" \
-     >"$tmp/lcm.json" 2>"$tmp/launch.err")
-  check "unpacked pidlab launch runs an episode over the unpacked trio" "[ $? -eq 0 ]" || tail -3 "$tmp/launch.err"
-  "$build/bin/pidlab" evaluate "${lcm_args[@]}" >"$tmp/local.json"
-  check "its IAE equals the in-process loop's bit for bit" "python3 - '$tmp/lcm.json' '$tmp/local.json' <<'PY'
+lcm_args=(--plant oscillator --gains 2,1,1.5 --loop sampled --horizon 2 --json)
+(cd "$tmp" && "$tmp/root/usr/bin/pidlab" launch -- pidlab evaluate --backend lcm "${lcm_args[@]}" \
+   >"$tmp/lcm.json" 2>"$tmp/launch.err")
+check "unpacked pidlab launch runs an episode over the unpacked trio" "[ $? -eq 0 ]" || tail -3 "$tmp/launch.err"
+"$build/bin/pidlab" evaluate "${lcm_args[@]}" >"$tmp/local.json"
+check "its IAE equals the in-process loop's bit for bit" "python3 - '$tmp/lcm.json' '$tmp/local.json' <<'PY'
 import json, sys
 a, b = (json.load(open(p)) for p in sys.argv[1:])
 assert a['backend'] == 'lcm' and a['iae'] == b['iae'], (a['iae'], b['iae'])
 PY"
-else
-  check "in a private network namespace holding only lo (run under unshare -n)" false
-fi
 
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -28,6 +28,7 @@
 # base port (trio B's is 10 above A's): nothing is firewalled.
 # usage: lan_test.sh BIN_DIR     (prints PASS .../FAIL ... lines)
 set -u
+. "$(dirname "${BASH_SOURCE[0]}")/lib.sh"  # wait_until, log_has
 if [ $# -ne 1 ]; then
   echo "usage: $0 BIN_DIR" >&2
   exit 2
@@ -95,12 +96,9 @@ for h in $HOSTS; do
     ip -n "$h" route add 224.0.0.0/4 dev eth0 || die "cannot set up host $h"
 done
 # Every eth0 is up (both ends of its veth are; no carrier delay on veth).
+eth0_up() { ip -n "$1" link show eth0 | grep -q "state UP"; }
 for h in $HOSTS; do
-  for _ in $(seq 50); do
-    ip -n "$h" link show eth0 | grep -q "state UP" && break
-    sleep 0.1
-  done
-  ip -n "$h" link show eth0 | grep -q "state UP" || die "eth0 of $h is not up: $(ip -n "$h" link show eth0)"
+  wait_until 5 eth0_up "$h" || die "eth0 of $h is not up: $(ip -n "$h" link show eth0)"
 done
 echo "ok   lan: 4 hosts 10.77.0.1-4 on br0 (mcast_snooping 0), 224.0.0.0/4 via eth0 on each, in $(elapsed) ms"
 
@@ -116,30 +114,25 @@ launch() {
 }
 
 # wait_ready NAME...: each launcher said "ROLE ready on URL" within 15 s.
+ready_or_gone() { log_has "$1" " ready on udpm://" || ! kill -0 "$2" 2>/dev/null; }
 wait_ready() {
   local name pid
   for name in "$@"; do
     pid=${PID[$name]}
-    for _ in $(seq 150); do
-      grep -q " ready on udpm://" "$TMP/$name.err" && break
-      kill -0 "$pid" 2>/dev/null || break
-      sleep 0.1
-    done
+    wait_until 15 ready_or_gone "$TMP/$name.err" "$pid"
     grep -q " ready on udpm://" "$TMP/$name.err" ||
       die "$name did not get ready: $(head -c 300 "$TMP/$name.err")"
   done
 }
 
 # stop NAME...: SIGINT to each launcher, which must exit 0 within 10 s.
+gone() { ! kill -0 "$1" 2>/dev/null; }
 stop() {
   local name pid rc
   for name in "$@"; do kill -INT "${PID[$name]}"; done
   for name in "$@"; do
     pid=${PID[$name]}
-    for _ in $(seq 100); do
-      kill -0 "$pid" 2>/dev/null || break
-      sleep 0.1
-    done
+    wait_until 10 gone "$pid"
     if kill -0 "$pid" 2>/dev/null; then
       echo "FAIL $name: still running 10 s after SIGINT"; fail=1; kill -KILL "$pid"
     fi

@@ -11,16 +11,9 @@ set -uo pipefail
 bin=$(realpath -- "${1:?usage: logplayer_test.sh BIN_DIR}")
 export PATH=$bin:$PATH
 
-# Never let LCM traffic leave this machine: we must be in a private network
-# namespace holding nothing but a loopback.
-if [[ $(ip -o link show | wc -l) -ne 1 ]]; then
-  echo "FAIL not in a private network namespace (run under unshare -n)"
-  exit 1
-fi
-ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || {
-  echo "FAIL cannot set up multicast on the namespace's loopback"
-  exit 1
-}
+# Only in the private network namespace ctest made (unshare -n), multicast on its loopback.
+. "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+private_network_up
 
 work=$(mktemp -d)
 pids=()
@@ -54,20 +47,24 @@ lane1=udpm://239.255.76.67:7668   # PLANT_OUTPUT
 lane2=udpm://239.255.76.67:7669   # CONTROL
 # Both players pace from their own start. The controller answers a y only
 # after the episode's configuration, and it has no deadline of its own, so
-# the configuration's player gets a 0.5 s head start: started together, a
-# player delayed by the machine's load once let 1807 of 2000 y pass before
-# the configuration arrived.
+# the outputs' player starts only once the controller has taken the
+# configuration (started together, a player delayed by the machine's load
+# once let 1807 of 2000 y pass before the configuration arrived). A playback
+# ends when the recording holds every step (logplayer_check), or after a
+# deadline with steps missing (see below).
 playback() {  # playback OUT.lcmlog: one playback into a fresh controller
   local out=$1 logger ctl a b
   lcm-logger -q -f "--lcm-url=$lane2?recv_buf_size=4194304" "$out" & logger=$!; pids+=($logger)
   pidlab-controller -v --lcm-url "$url?recv_buf_size=4194304" 2>controller.err & ctl=$!; pids+=($ctl)
-  sleep 0.5
-  kill -0 "$ctl" 2>/dev/null || { echo "FAIL pidlab-controller did not start: $(tail -2 controller.err)"; exit 1; }
+  wait_until 10 log_has controller.err "serving on" ||
+    { echo "FAIL pidlab-controller did not start: $(tail -2 controller.err)"; exit 1; }
+  wait_until 10 test -e "$out" || { echo "FAIL lcm-logger did not open $out"; exit 1; }
   lcm-logplayer -s 0.5 -e '^PIDLAB_EPISODE_CONFIG$' -l "$url" run.lcmlog 2>>players.err & a=$!
-  sleep 0.5
+  wait_until 10 log_has controller.err "episode [0-9]+: started" ||
+    { echo "FAIL pidlab-controller never took the played-back configuration: $(tail -2 controller.err)"; exit 1; }
   lcm-logplayer -s 0.5 -e '^PIDLAB_PLANT_OUTPUT$' -l "$lane1" run.lcmlog 2>>players.err & b=$!
   wait "$a" "$b"
-  sleep 0.5
+  wait_until 5 logplayer_check run.lcmlog "${recordings[@]}" "$out" >/dev/null
   kill -INT "$logger"; wait "$logger" 2>/dev/null
   kill "$ctl" 2>/dev/null; wait "$ctl" 2>/dev/null
 }

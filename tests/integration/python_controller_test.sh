@@ -16,14 +16,9 @@ controller=$(realpath -- "$3/examples/python_controller.py")
 pidlab=$bin/pidlab
 python=/usr/bin/python3
 
-if [[ $(ip -o link show | wc -l) -ne 1 ]]; then
-  echo "FAIL not in a private network namespace (run under unshare -n)"
-  exit 1
-fi
-ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || {
-  echo "FAIL cannot set up multicast on the namespace's loopback"
-  exit 1
-}
+# Only in the private network namespace ctest made (unshare -n), multicast on its loopback.
+. "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+private_network_up
 work=$(mktemp -d)
 pc=
 cleanup() { [[ -n $pc ]] && kill "$pc" 2>/dev/null; rm -rf "$work"; }

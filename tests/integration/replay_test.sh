@@ -12,16 +12,9 @@ pidlab=$bin/pidlab
 tamper=$bin/replay_log_tamper
 export PATH=$bin:$PATH
 
-# Never let LCM traffic leave this machine: we must be in a private network
-# namespace holding nothing but a loopback.
-if [[ $(ip -o link show | wc -l) -ne 1 ]]; then
-  echo "FAIL not in a private network namespace (run under unshare -n)"
-  exit 1
-fi
-ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || {
-  echo "FAIL cannot set up multicast on the namespace's loopback"
-  exit 1
-}
+# Only in the private network namespace ctest made (unshare -n), multicast on its loopback.
+. "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+private_network_up
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -187,9 +180,9 @@ else
 fi
 
 # ---- redrive against a live controller (started alone in this namespace) ----
-"$bin/pidlab-controller" >controller.log 2>&1 &
+"$bin/pidlab-controller" -v >controller.log 2>&1 &
 controller=$!
-sleep 0.5
+wait_until 10 log_has controller.log "serving on" || fail "pidlab-controller did not start: $(tail -2 controller.log)"
 status=0
 "$pidlab" replay run.lcmlog --episode "$id" --redrive --backend lcm >live_redrive.txt 2>&1 || status=$?
 if [[ $status -eq 0 ]] && grep -q "redrive: OK, all .* by the live controller" live_redrive.txt; then

@@ -7,13 +7,11 @@
 set -u
 BIN=$1
 CASE=$2
-# A private namespace made by unshare -n holds nothing but lo (and /proc/1 may
-# be unreadable, which alone would make the first test pass anywhere).
-if [ "$(readlink /proc/self/ns/net)" = "$(readlink /proc/1/ns/net 2>/dev/null)" ] || [ "$(ip -o link show | wc -l)" -ne 1 ]; then
-  echo "refusing to run outside a private network namespace (use unshare -n)" >&2
-  exit 1
-fi
-ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || exit 1
+# Only in the private network namespace ctest made (unshare -n), multicast on its loopback.
+. "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+private_network_up
+# The shell commands that run under `pidlab launch` wait with these too.
+export -f wait_until log_has file_bigger_than wakeups woke_since
 URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"
 export PIDLAB_LCM_URL=$URL
 TMP=$(mktemp -d)
@@ -118,10 +116,11 @@ case $CASE in
     # whole lockstep loop takes --rt-priority) serves on.
     for role in plant controller disturbance; do
       setpriv --inh-caps=-sys_nice --bounding-set=-sys_nice prlimit --rtprio=0 \
-        "$BIN/pidlab-$role" --lcm-url "$URL" --rt-priority 10 2>"$TMP/refused.err" &
+        "$BIN/pidlab-$role" -v --lcm-url "$URL" --rt-priority 10 2>"$TMP/refused.err" &
       pid=$!
-      sleep 0.5
-      if ! kill -0 $pid 2>/dev/null; then
+      # -v: "serving on URL" once its subscriptions are made, after the refusal.
+      wait_until 10 log_has "$TMP/refused.err" "serving on"
+      if ! kill -0 $pid 2>/dev/null || ! log_has "$TMP/refused.err" "serving on"; then
         echo "FAIL realtime: pidlab-$role stopped when SCHED_FIFO was refused: $(cat "$TMP/refused.err")"; fail=1
       else
         kill -INT $pid; wait $pid
@@ -148,11 +147,13 @@ case $CASE in
     # Kill the controller mid-episode: with a 1 s silence deadline and no
     # re-run, the episode must end with an error naming it within 2 s, and
     # launch must return (no hang, no orphans).
+    # Mid-episode: once the controller has answered a thousand or so steps.
     "$PIDLAB" launch --lcm-url "$URL" -- bash -c '
+      base=$(wakeups $PIDLAB_CONTROLLER_PID)
       pidlab evaluate --backend lcm --silence-deadline 1 --max-attempts 1 --plant double_integrator --gains 2,1,1.5 \
         --horizon 200 >/dev/null 2>'"$TMP"'/err &
       e=$!
-      sleep 1.5
+      wait_until 30 woke_since $PIDLAB_CONTROLLER_PID $base 1000 || { echo "FAIL kill: the episode never got under way"; exit 1; }
       kill -9 $PIDLAB_CONTROLLER_PID
       t0=$(date +%s.%N)
       wait $e; rc=$?
@@ -162,14 +163,17 @@ case $CASE in
       fail=1
     ;;
   sigstop)
-    # A controller stopped for 3 s mid-tune: the tune must go on (default
-    # silence deadline) and give exactly the local sampled tune's result.
+    # A controller stopped for 3 s mid-tune (once it has answered a thousand or
+    # so steps; the 3 s are the fault, not a wait): the tune must go on
+    # (default silence deadline) and give exactly the local sampled tune's result.
     TUNE="--method nelder-mead --plant double_integrator --loop sampled --horizon 2 --max-evals 30 --starts 1 --seed 3 --refine none --json"
     "$PIDLAB" tune $TUNE | sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' > "$TMP/tune.local.json" || fail=1
     export TUNE
     "$PIDLAB" launch --lcm-url "$URL" -- bash -c '
+      base=$(wakeups $PIDLAB_CONTROLLER_PID)
       pidlab tune --backend lcm $TUNE > '"$TMP"'/tune.lcm.raw 2>'"$TMP"'/tune.err & t=$!
-      sleep 2; kill -STOP $PIDLAB_CONTROLLER_PID; sleep 3; kill -CONT $PIDLAB_CONTROLLER_PID
+      wait_until 30 woke_since $PIDLAB_CONTROLLER_PID $base 1000 || { echo "FAIL sigstop: the tune never got under way"; exit 1; }
+      kill -STOP $PIDLAB_CONTROLLER_PID; sleep 3; kill -CONT $PIDLAB_CONTROLLER_PID
       wait $t' || { echo "FAIL tune over the trio with a stopped controller: $(grep -v "^pidlab-" "$TMP/tune.err" | head -3)"; fail=1; }
     sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' "$TMP/tune.lcm.raw" > "$TMP/tune.lcm.json"
     if cmp -s "$TMP/tune.local.json" "$TMP/tune.lcm.json"; then
@@ -197,14 +201,17 @@ case $CASE in
     done
     ;;
   trio_killed)
-    # Trio 2 of 2 loses its plant (SIGKILL) mid-tune: the tune names it, runs
-    # its episode on trio 1 and ends with the local tune's result.
+    # Trio 2 of 2 loses its plant (SIGKILL) mid-tune (once it has served a
+    # thousand or so messages): the tune names it, runs its episode on trio 1
+    # and ends with the local tune's result.
     TUNE="--method nelder-mead --plant double_integrator --loop sampled --horizon 4 --max-evals 24 --starts 4 --seed 3 --refine none --json --silence-deadline 1 --max-attempts 2"
     "$PIDLAB" tune $TUNE | sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' > "$TMP/tune.local.json" || fail=1
     export TUNE
     "$PIDLAB" launch --lcm-url "$URL" --trios 2 -- bash -c '
+      base=$(wakeups $PIDLAB_TRIO2_PLANT_PID)
       pidlab tune --backend lcm $TUNE > '"$TMP"'/tune.lcm.raw 2>'"$TMP"'/tune.err & t=$!
-      sleep 1; kill -KILL $PIDLAB_TRIO2_PLANT_PID
+      wait_until 30 woke_since $PIDLAB_TRIO2_PLANT_PID $base 1000 || { echo "FAIL trio_killed: trio 2 never got an episode"; exit 1; }
+      kill -KILL $PIDLAB_TRIO2_PLANT_PID
       wait $t' 2> "$TMP/launch.err" || { echo "FAIL tune with trio 2 killed: $(grep -v "^pidlab-" "$TMP/tune.err" | head -3)"; fail=1; }
     sed 's/"wall_time_s":[^,}]*//; s/"backend":"[a-z]*"//' "$TMP/tune.lcm.raw" > "$TMP/tune.lcm.json"
     # The tune counts what it noted in one short line; launch names the trio.
@@ -228,11 +235,14 @@ case $CASE in
     "$BIN/trio_log_check" "$TMP/run.lcmlog" || fail=1
     ;;
   log_repair)
-    # Force lcm-logger to lose messages: SIGSTOP it for 1 s mid-episode (its
-    # socket buffer overflows). launch must repair the log from the plant's
+    # Force lcm-logger to lose messages: SIGSTOP it for 1 s mid-episode (once
+    # it has logged 300 kB, the first thousand or so steps; the 1 s is the fault, not a wait:
+    # its socket buffer overflows). launch must repair the log from the plant's
     # trajectory chunks, say so, and hand over a log holding every step.
     # The episode must outlast the 1 s stop (at about 10k steps/s: 30000 steps), or the companion
     # episode of evaluate starts while the logger's socket is full and its configuration is lost.
+    REPAIR_LOG=$TMP/run.lcmlog
+    export REPAIR_LOG
     EVAL="pidlab evaluate --backend lcm --plant oscillator --gains 3,1,1 --horizon 30 --disturbance square --disturbance-amplitude 0.2"
     export EVAL
     rm -f "$TMP/run.lcmlog"
@@ -240,7 +250,8 @@ case $CASE in
       ni=$(awk "{print \$19}" /proc/$PIDLAB_LOGGER_PID/stat)
       [ "$ni" = -10 ] || { echo "FAIL lcm-logger runs at nice $ni, not -10"; exit 1; }
       $EVAL >/dev/null & e=$!
-      sleep 0.3; kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
+      wait_until 30 file_bigger_than "$REPAIR_LOG" 300000 || { echo "FAIL log_repair: nothing logged"; exit 1; }
+      kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
       wait $e' 2>"$TMP/launch.err" || { echo "FAIL launch: $(grep -v "^pidlab-" "$TMP/launch.err")"; fail=1; }
     if grep -q "repaired .* from the plant's trajectory chunks" "$TMP/launch.err"; then
       echo "ok   $(grep -o "lcm-logger lost messages.*" "$TMP/launch.err")"
@@ -259,10 +270,12 @@ case $CASE in
     # 20000 steps: the 1 s stop must end inside the first episode, or the
     # companion episode's configuration is lost too (then nothing names steps).
     rm -f "$TMP/run2.lcmlog"
+    REPAIR_LOG=$TMP/run2.lcmlog
     rc=0
     "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/run2.lcmlog" -- bash -c '
       ${EVAL/--horizon 30/--horizon 20} >/dev/null & e=$!
-      sleep 0.3; kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
+      wait_until 30 file_bigger_than "$REPAIR_LOG" 300000 || { echo "FAIL log_repair: nothing logged"; exit 1; }
+      kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
       wait $e; s=$?; kill -9 $PIDLAB_PLANT_PID; exit $s' 2>"$TMP/launch2.err" || rc=$?
     line=$(grep "is incomplete: episode [0-9]* misses [0-9]* steps" "$TMP/launch2.err")
     if [ $rc -ne 0 ] && [ -n "$line" ] && grep -q "did not resend" <<<"$line"; then

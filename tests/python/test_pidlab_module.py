@@ -2,7 +2,7 @@
 and pidlab.tune must return the same keys and the same numbers, bit for bit,
 as `pidlab evaluate --json` and `pidlab tune --json` of the same case.
 
-Run by ctest (python.module) as
+Run by ctest (cli.python_module) as
     PYTHONPATH=<build>/python PIDLAB=<build>/bin/pidlab /usr/bin/python3 -m unittest test_pidlab_module
 """
 

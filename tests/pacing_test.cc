@@ -1,0 +1,128 @@
+// Real-time pacing (transport/pacing.h): the statistics' arithmetic, their
+// round trip through a SUMMARY, and a Pacer on the machine's own clock (only
+// bounds the schedule guarantees are asserted: a step never starts early,
+// and a step started late is counted).
+
+#include "pidlab/transport/pacing.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <thread>
+
+namespace pidlab::transport {
+namespace {
+
+RealtimeStats Paced(double factor, long missed, double p50, double p99, double max, double rate) {
+  RealtimeStats s;
+  s.factor = factor;
+  s.steps = 100;
+  s.missed_deadlines = missed;
+  s.lateness_p50_s = p50;
+  s.lateness_p99_s = p99;
+  s.lateness_max_s = max;
+  s.rate_hz = rate;
+  return s;
+}
+
+TEST(RealtimeFactor, PositiveFiniteFactorsAreValidOthersNamed) {
+  std::string error;
+  EXPECT_TRUE(RealtimeFactorIsValid(1.0, &error));
+  EXPECT_TRUE(RealtimeFactorIsValid(0.25, &error));
+  for (double bad : {0.0, -1.0, std::numeric_limits<double>::infinity(), std::nan("")}) {
+    error.clear();
+    EXPECT_FALSE(RealtimeFactorIsValid(bad, &error)) << bad;
+    EXPECT_NE(error.find("--realtime"), std::string::npos) << error;
+  }
+  EXPECT_FALSE(RealtimeFactorIsValid(-2.0, nullptr));
+}
+
+TEST(DescribeRealtime, IsEmptyWhenNotPacedAndNamesEveryFigureWhenPaced) {
+  EXPECT_EQ(DescribeRealtime(RealtimeStats{}), "");
+  EXPECT_EQ(DescribeRealtime(Paced(1.0, 2, 12e-6, 40e-6, 85e-6, 1000.0)),
+            "paced 1x: 2 missed deadlines, lateness p50 12 us, p99 40 us, max 85 us, 1000.0 steps/s");
+  EXPECT_NE(DescribeRealtime(Paced(2.0, 1, 0, 0, 0, 5.0)).find("1 missed deadline,"), std::string::npos);
+}
+
+TEST(CombineRealtime, SumsMissesTakesTheWorstLatenessAndTheLowestRate) {
+  const RealtimeStats a = Paced(1.0, 2, 10e-6, 50e-6, 90e-6, 1000.0);
+  const RealtimeStats b = Paced(1.0, 3, 20e-6, 30e-6, 200e-6, 900.0);
+  const RealtimeStats dut = CombineRealtime(a, b);
+  EXPECT_EQ(dut.steps, 200);
+  EXPECT_EQ(dut.missed_deadlines, 5);
+  EXPECT_EQ(dut.lateness_p50_s, 20e-6);
+  EXPECT_EQ(dut.lateness_p99_s, 50e-6);
+  EXPECT_EQ(dut.lateness_max_s, 200e-6);
+  EXPECT_EQ(dut.rate_hz, 900.0);
+}
+
+TEST(CombineRealtime, SkipsAnUnpacedSide) {
+  const RealtimeStats a = Paced(1.0, 2, 10e-6, 50e-6, 90e-6, 1000.0);
+  EXPECT_EQ(CombineRealtime(a, RealtimeStats{}).missed_deadlines, 2);
+  EXPECT_EQ(CombineRealtime(RealtimeStats{}, a).rate_hz, 1000.0);
+  EXPECT_FALSE(CombineRealtime(RealtimeStats{}, RealtimeStats{}).paced());
+}
+
+TEST(RealtimeSummary, RoundTripsThroughASummaryAndAnUnpacedOneStaysUnpaced) {
+  pidlab::lcmt_episode_summary m{};
+  const RealtimeStats s = Paced(0.5, 7, 1e-5, 2e-4, 3e-3, 480.5);
+  SetRealtime(s, &m);
+  m.step = 100;
+  const RealtimeStats back = RealtimeFromSummary(m);
+  EXPECT_EQ(back.factor, 0.5);
+  EXPECT_EQ(back.steps, 100);
+  EXPECT_EQ(back.missed_deadlines, 7);
+  EXPECT_EQ(back.lateness_p50_s, 1e-5);
+  EXPECT_EQ(back.lateness_p99_s, 2e-4);
+  EXPECT_EQ(back.lateness_max_s, 3e-3);
+  EXPECT_EQ(back.rate_hz, 480.5);
+  m.realtime_factor = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(RealtimeFromSummary(m).paced());
+  m.realtime_factor = 0.0;
+  EXPECT_FALSE(RealtimeFromSummary(m).paced());
+}
+
+TEST(Pacer, NeverStartsAStepBeforeItIsDue) {
+  Pacer dut(/*factor=*/10.0, /*dt_s=*/0.01, /*total_steps=*/20);  // a 1 ms period
+  EXPECT_DOUBLE_EQ(dut.period_s(), 1e-3);
+  const auto t0 = std::chrono::steady_clock::now();
+  dut.Start();
+  for (long k = 1; k <= 20; ++k) dut.WaitForStep(k);
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_GE(elapsed, 20e-3);
+  const RealtimeStats s = dut.Stats();
+  EXPECT_EQ(s.factor, 10.0);
+  EXPECT_EQ(s.steps, 20);
+  EXPECT_GE(s.lateness_p50_s, 0.0);
+  EXPECT_LE(s.lateness_p50_s, s.lateness_p99_s);
+  EXPECT_LE(s.lateness_p99_s, s.lateness_max_s);
+  EXPECT_GT(s.rate_hz, 0.0);
+  EXPECT_LE(s.rate_hz, 1000.0 * (1 + 1e-9));  // 20 steps in no less than 20 periods
+}
+
+TEST(Pacer, CountsAStepThatStartedMoreThanAPeriodLateAsMissed) {
+  Pacer dut(/*factor=*/1.0, /*dt_s=*/1e-3, /*total_steps=*/2);
+  dut.Start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));  // step 1 was due after 1 ms
+  dut.WaitForStep(1);
+  const RealtimeStats s = dut.Stats();
+  EXPECT_EQ(s.steps, 1);
+  EXPECT_EQ(s.missed_deadlines, 1);
+  EXPECT_GE(s.lateness_max_s, 4e-3);
+}
+
+TEST(Pacer, StatsBeforeAnyStepArePacedAndEmpty) {
+  Pacer dut(2.0, 1e-3, 10);
+  dut.Start();
+  const RealtimeStats s = dut.Stats();
+  EXPECT_TRUE(s.paced());
+  EXPECT_EQ(s.steps, 0);
+  EXPECT_EQ(s.missed_deadlines, 0);
+  EXPECT_EQ(s.rate_hz, 0.0);
+}
+
+}  // namespace
+}  // namespace pidlab::transport
