@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Roles spread over hosts (issue 10): a four-host LAN built out of network
+# Roles spread over hosts: a four-host LAN built out of network
 # namespaces, inside a private network and mount namespace of this test's own
 # (it re-executes itself under `unshare -n -m --propagation private`; root is
 # needed), so nothing it sends can leave the machine and `ip netns add` stays

@@ -6,7 +6,8 @@
 # usage: spec_rerun_test.sh BIN_DIR
 set -uo pipefail
 bin=$1
-ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || { echo "FAIL namespace"; exit 1; }
+. "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+private_network_up
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 cd "$tmp" || exit 1
 passed=0 failed=0
