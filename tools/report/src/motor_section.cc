@@ -197,122 +197,123 @@ void RenderSet(std::ostream& os, const MotorSection& s, const MotorGainSet& set)
   os << "\n";
 }
 
-}  // namespace
-
-bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t seed, MotorSection* section,
-                         std::string* error) {
-  const auto start = std::chrono::steady_clock::now();
-  MotorSection& s = *section;
-  s = MotorSection{};
+// The section's constants from Table I (tooth pitch, holding voltage), its
+// horizon and its moves.
+void StartSection(bool quick, MotorSection* s) {
   const NonlinearStepperOptions table_one;
-  s.tooth_pitch_rad = table_one.motor.tooth_pitch_rad;
-  s.holding_voltage_v = table_one.motor.resistance_ohm * table_one.motor.stationary_current_a;
-  s.horizon_s = quick ? 1.0 : 3.0;
-  s.moves = {0.001, 0.01, s.tooth_pitch_rad, 1.0};
+  s->tooth_pitch_rad = table_one.motor.tooth_pitch_rad;
+  s->holding_voltage_v = table_one.motor.resistance_ohm * table_one.motor.stationary_current_a;
+  s->horizon_s = quick ? 1.0 : 3.0;
+  s->moves = {0.001, 0.01, s->tooth_pitch_rad, 1.0};
+}
 
-  // The gain sets: the paper's, pidlab's default tune of eq. (3), its robust
-  // preset, one tuned on the motor.
+MotorGainSet PaperSet(const PidGains& paper_nm) {
   MotorGainSet paper;
   paper.name = "The paper's Nelder-Mead gains (Table IV)";
   paper.origin = "Tuned by the paper on eq. (3) (continuous loop, unit step).";
   paper.gains = paper_nm;
-  s.sets.push_back(paper);
+  return paper;
+}
 
+// `pidlab tune --plant stepper_motor --seed <seed>`'s options.
+TuneOptions Eq3TuneOptions(bool quick, std::uint64_t seed) {
   TuneOptions d;
   d.seed = seed;
   if (quick) d.starts = 1;
-  Plant eq3;
-  if (!MakePlant("stepper_motor", StepperMotorParameters{}, &eq3, error)) return false;
-  MotorGainSet pidlab_default;
-  pidlab_default.name = "pidlab's default tuning";
+  return d;
+}
+
+// pidlab's default tune of eq. (3).
+bool DefaultSet(const Plant& eq3, const TuneOptions& d, std::uint64_t seed, MotorGainSet* set,
+                std::string* error) {
+  set->name = "pidlab's default tuning";
   TuneSummary ds;
   if (!Tune(eq3, d, &ds, error)) return false;
-  pidlab_default.gains = ds.gains;
-  pidlab_default.origin =
-      "`pidlab tune --plant stepper_motor --seed " + std::to_string(seed) + "` (" + ToString(d.method) +
-      " on eq. (3), the paper's continuous loop and objective; IAE " + Num(ds.objective, 6) + ").";
-  s.sets.push_back(pidlab_default);
+  set->gains = ds.gains;
+  set->origin = "`pidlab tune --plant stepper_motor --seed " + std::to_string(seed) + "` (" +
+                ToString(d.method) + " on eq. (3), the paper's continuous loop and objective; IAE " +
+                Num(ds.objective, 6) + ").";
+  return true;
+}
 
-  // `pidlab tune --robust` on eq. (3): designed on the continuous loop like
-  // the two sets above, run with its derivative filter (tf) on this section's
-  // sampled loop.
+// `pidlab tune --robust` on eq. (3): designed on the continuous loop like
+// the two sets before it, run with its derivative filter (tf) on this
+// section's sampled loop. Also sets the section's robust_available and
+// robust_note.
+bool RobustSet(const Plant& eq3, const TuneOptions& d, std::uint64_t seed, MotorSection* s, MotorGainSet* set,
+               std::string* error) {
   TuneOptions r = d;
   ApplyRobustPreset(&r);
   TuneSummary rs;
   if (!Tune(eq3, r, &rs, error)) return false;
-  MotorGainSet robust;
-  robust.name = "pidlab's robust preset";
-  robust.gains = LoopGains(rs.gains, r.loop);
-  robust.origin =
-      "`pidlab tune --plant stepper_motor --seed " + std::to_string(seed) +
-      " --robust` (setpoint-load objective, derivative filter Tf = kd/(10 kp), Ms <= 1.6, slowest "
-      "time constant <= 2.5 s, on eq. (3) and the paper's continuous loop; objective " +
-      Num(rs.objective, 6) + "); the discrete PID here filters its derivative with that Tf.";
-  s.robust_available = rs.stable;
-  s.robust_note =
+  set->name = "pidlab's robust preset";
+  set->gains = LoopGains(rs.gains, r.loop);
+  set->origin = "`pidlab tune --plant stepper_motor --seed " + std::to_string(seed) +
+                " --robust` (setpoint-load objective, derivative filter Tf = kd/(10 kp), Ms <= 1.6, slowest "
+                "time constant <= 2.5 s, on eq. (3) and the paper's continuous loop; objective " +
+                Num(rs.objective, 6) + "); the discrete PID here filters its derivative with that Tf.";
+  s->robust_available = rs.stable;
+  s->robust_note =
       "`pidlab tune --robust` (the robust preset, docs/robustness.md) is the third gain set: it filters its "
       "derivative (Tf = kd/(10 kp)), so its first-sample kick is bounded, unlike the ideal derivative of the "
       "other sets designed on eq. (3).";
-  s.sets.push_back(robust);
+  return true;
+}
 
-  // Every move with and without the limit, next to eq. (3); the curves of
-  // the paper's gains (and of the motor-tuned gains at the tuned move).
-  auto run_set = [&](std::size_t k) {
-    MotorGainSet& set = s.sets[k];
-    std::vector<SampledStep> eq3_steps;
-    if (!RunEq3(s, &set, k == 0 ? &eq3_steps : nullptr, error)) return false;
-    if (k == 0) {
-      s.curves.push_back(CurveOf("eq. (3), any A", false, eq3_steps, s.dt_s, 1.0));
-      s.curves.push_back(CurveOf("eq. (3), any A", true, eq3_steps, s.dt_s, 1.0));
-    }
-    for (const bool limited : {false, true}) {
-      for (const double move : s.moves) {
-        MotorRow row;
-        const bool paper_curve = k == 0;
-        const bool tuned_curve = k == 3 && limited && move == s.tune_move_rad;
-        std::vector<SampledStep> steps;
-        if (!RunRow(s, set, move, limited, &row, paper_curve || tuned_curve ? &steps : nullptr, error))
-          return false;
-        if (paper_curve || tuned_curve) {
-          std::string name = (paper_curve ? "paper's gains, A = " : "motor-tuned gains, A = ") + Num(move, 4);
-          if (row.lost_steps) name += " (lost steps)";
-          s.curves.push_back(CurveOf(name, limited, steps, s.dt_s, move));
-        }
-        set.rows.push_back(row);
+// Gain set k over every move with and without the limit, next to eq. (3);
+// the curves of the paper's gains (k = 0) and of the motor-tuned gains
+// (k = 3) at the tuned move.
+bool RunGainSet(std::size_t k, MotorSection* section, std::string* error) {
+  MotorSection& s = *section;
+  MotorGainSet& set = s.sets[k];
+  std::vector<SampledStep> eq3_steps;
+  if (!RunEq3(s, &set, k == 0 ? &eq3_steps : nullptr, error)) return false;
+  if (k == 0) {
+    s.curves.push_back(CurveOf("eq. (3), any A", false, eq3_steps, s.dt_s, 1.0));
+    s.curves.push_back(CurveOf("eq. (3), any A", true, eq3_steps, s.dt_s, 1.0));
+  }
+  for (const bool limited : {false, true}) {
+    for (const double move : s.moves) {
+      MotorRow row;
+      const bool paper_curve = k == 0;
+      const bool tuned_curve = k == 3 && limited && move == s.tune_move_rad;
+      std::vector<SampledStep> steps;
+      if (!RunRow(s, set, move, limited, &row, paper_curve || tuned_curve ? &steps : nullptr, error))
+        return false;
+      if (paper_curve || tuned_curve) {
+        std::string name = (paper_curve ? "paper's gains, A = " : "motor-tuned gains, A = ") + Num(move, 4);
+        if (row.lost_steps) name += " (lost steps)";
+        s.curves.push_back(CurveOf(name, limited, steps, s.dt_s, move));
       }
+      set.rows.push_back(row);
     }
-    return true;
-  };
+  }
+  return true;
+}
 
-  // The tune on the motor, on its own thread while the other two sets run:
-  // one tooth pitch under the voltage limit, the objective sampled every 5 ms
-  // over the first 0.5 s.
+// The tune on the motor: one tooth pitch under the voltage limit, the
+// objective sampled every 5 ms over the first 0.5 s. Sets the section's
+// tune_* fields.
+TuneOptions MotorTuneOptions(bool quick, std::uint64_t seed, MotorSection* s) {
   TuneOptions t;
   t.method = TuneMethod::kNelderMead;
   t.starts = 1;
   t.max_evaluations = quick ? 30 : 80;
   t.seed = seed;
-  s.tune_move_rad = s.tooth_pitch_rad;
-  s.tune_horizon_s = 0.5;
-  s.tune_sample_time_s = 0.005;
+  s->tune_move_rad = s->tooth_pitch_rad;
+  s->tune_horizon_s = 0.5;
+  s->tune_sample_time_s = 0.005;
   t.loop.loop = LoopKind::kSampled;
-  t.loop.dt_s = s.dt_s;
-  t.loop.pid = PidOptionsAt(t.loop.pid, s.dt_s);
-  t.loop.sample_time_s = s.tune_sample_time_s;
-  t.loop.horizon_s = s.tune_horizon_s;
-  t.loop.reference = s.tune_move_rad;
-  const Plant limited_motor = Motor(true, s.voltage_limit_v);
-  auto tune = std::async(std::launch::async, [&limited_motor, t, &s] {
-    std::string e;
-    return Tune(limited_motor, t, &s.motor_tune, &e) ? std::string() : e;
-  });
-  const bool others = run_set(0) && run_set(1) && run_set(2);
-  const std::string tune_error = tune.get();
-  if (!others) return false;
-  if (!tune_error.empty()) {
-    *error = "tune on the motor: " + tune_error;
-    return false;
-  }
+  t.loop.dt_s = s->dt_s;
+  t.loop.pid = PidOptionsAt(t.loop.pid, s->dt_s);
+  t.loop.sample_time_s = s->tune_sample_time_s;
+  t.loop.horizon_s = s->tune_horizon_s;
+  t.loop.reference = s->tune_move_rad;
+  return t;
+}
+
+// The gain set of the tune on the motor (s.motor_tune, run with options t).
+MotorGainSet OnMotorSet(const MotorSection& s, const TuneOptions& t, std::uint64_t seed) {
   MotorGainSet on_motor;
   on_motor.name = "Tuned on the motor itself";
   on_motor.gains = s.motor_tune.gains;
@@ -326,13 +327,12 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
          << Num(s.motor_tune.objective, 6) << (s.motor_tune.stable ? "" : ", **no stable loop found**")
          << "; no Ceres refinement: it differentiates linear loops only).";
   on_motor.origin = origin.str();
-  s.sets.push_back(on_motor);
-  if (!run_set(3)) return false;
-  s.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return true;
+  return on_motor;
 }
 
-void RenderMotorSection(std::ostream& os, const MotorSection& s) {
+// What the section covers: the motor, the drive, the loop, the moves, the
+// voltage limit and what "steps lost" means.
+void RenderIntroduction(std::ostream& os, const MotorSection& s) {
   os << "## The motor itself\n\n"
      << "Everything above judges gains on eq. (3), the small-signal linearisation of the stepper about its "
         "holding point. Here the same gains drive the nonlinear two-phase PM stepper (`--plant "
@@ -355,76 +355,127 @@ void RenderMotorSection(std::ostream& os, const MotorSection& s) {
         "(it settled at another detent or never settled); such a run is marked, not scored as a good "
         "one.\n\n"
      << s.robust_note << "\n\n";
-  for (const MotorGainSet& set : s.sets) RenderSet(os, s, set);
+}
 
-  os << "### Where the linear design fails\n\n";
-  if (!s.sets.empty()) {
-    // The headline, from the rows: the paper's gains, and the paper's 1 rad step for every set.
-    const MotorGainSet& paper = s.sets.front();
-    const MotorRow* hold = nullptr;
-    const MotorRow* small_limited = nullptr;
-    for (const MotorRow& r : paper.rows) {
-      if (!r.limited && Holds(r)) hold = &r;
-      if (r.limited && (!small_limited || r.move_rad < small_limited->move_rad)) small_limited = &r;
-    }
-    int lost_unit = 0, sets_unit = 0;
-    for (const MotorGainSet& set : s.sets)
-      for (const MotorRow& r : set.rows)
-        if (r.limited && r.move_rad == 1.0) {
-          ++sets_unit;
-          lost_unit += r.lost_steps ? 1 : 0;
-        }
-    os << "**In short:** ";
-    if (hold)
-      os << "eq. (3) describes the motor under the paper's gains only for moves up to "
-         << Num(hold->move_rad, 3) << " rad, and only through a drive that can apply "
-         << Num(hold->peak_phase_voltage_v, 4) << " V. ";
-    else
-      os << "eq. (3) does not describe the motor under the paper's gains for any move here. ";
-    if (small_limited)
-      os << "Through a " << Num(s.voltage_limit_v, 3) << " V driver their IAE/A is "
-         << Num(small_limited->ratio, 3) << " times what eq. (3) predicts already at "
-         << Num(small_limited->move_rad, 3) << " rad. ";
-    if (sets_unit > 0)
-      os << "On the paper's 1 rad step (" << Num(1.0 / s.tooth_pitch_rad, 3) << " tooth pitches) "
-         << (lost_unit == sets_unit
-                 ? std::string("every gain set here loses steps")
-                 : std::to_string(lost_unit) + " of " + std::to_string(sets_unit) + " gain sets lose steps")
-         << " with the limited drive.";
-    os << "\n\n";
+// "In short": the paper's gains, and the paper's 1 rad step for every set.
+void RenderHeadline(std::ostream& os, const MotorSection& s) {
+  const MotorGainSet& paper = s.sets.front();
+  const MotorRow* hold = nullptr;
+  const MotorRow* small_limited = nullptr;
+  for (const MotorRow& r : paper.rows) {
+    if (!r.limited && Holds(r)) hold = &r;
+    if (r.limited && (!small_limited || r.move_rad < small_limited->move_rad)) small_limited = &r;
   }
+  int lost_unit = 0, sets_unit = 0;
+  for (const MotorGainSet& set : s.sets)
+    for (const MotorRow& r : set.rows)
+      if (r.limited && r.move_rad == 1.0) {
+        ++sets_unit;
+        lost_unit += r.lost_steps ? 1 : 0;
+      }
+  os << "**In short:** ";
+  if (hold)
+    os << "eq. (3) describes the motor under the paper's gains only for moves up to "
+       << Num(hold->move_rad, 3) << " rad, and only through a drive that can apply "
+       << Num(hold->peak_phase_voltage_v, 4) << " V. ";
+  else
+    os << "eq. (3) does not describe the motor under the paper's gains for any move here. ";
+  if (small_limited)
+    os << "Through a " << Num(s.voltage_limit_v, 3) << " V driver their IAE/A is "
+       << Num(small_limited->ratio, 3) << " times what eq. (3) predicts already at "
+       << Num(small_limited->move_rad, 3) << " rad. ";
+  if (sets_unit > 0)
+    os << "On the paper's 1 rad step (" << Num(1.0 / s.tooth_pitch_rad, 3) << " tooth pitches) "
+       << (lost_unit == sets_unit
+               ? std::string("every gain set here loses steps")
+               : std::to_string(lost_unit) + " of " + std::to_string(sets_unit) + " gain sets lose steps")
+       << " with the limited drive.";
+  os << "\n\n";
+}
+
+// The paper's gains on the motor against eq. (3) without a limit, and why
+// the drive's peak voltage grows with the move.
+void RenderLinearisationNotes(std::ostream& os, const MotorSection& s) {
+  const MotorGainSet& paper = s.sets.front();
+  os << "The paper's gains, motor against eq. (3) without a limit:";
+  for (const MotorRow& r : paper.rows) {
+    if (r.limited) continue;
+    os << " " << Num(r.move_rad, 4) << " rad: IAE/A " << Num(r.iae_per_unit, 6) << " vs "
+       << Num(paper.eq3_iae_per_unit, 6) << " (" << Num(100 * (r.ratio - 1.0), 3) << " %"
+       << (r.lost_steps ? ", steps lost" : "") << ");";
+  }
+  os << " a difference within 1 % means eq. (3) describes the motor for that move.\n\n";
+  const MotorRow* small = nullptr;
+  for (const MotorRow& r : paper.rows)
+    if (!r.limited && (!small || r.move_rad < small->move_rad)) small = &r;
+  if (small) {
+    os << "Eq. (3) has no voltage limit and no notion of a tooth pitch: it scales every move linearly. On "
+          "the motor the drive's peak voltage grows with the move: the unfiltered derivative of the "
+          "discrete "
+          "PID puts kd A / dt = "
+       << Num(paper.gains.kd * small->move_rad / s.dt_s, 4)
+       << " rad of commanded angle on the first sample of a " << Num(small->move_rad, 3)
+       << " rad step, hence " << Num(small->peak_phase_voltage_v, 4) << " V there";
+    if (small->peak_phase_voltage_v > s.voltage_limit_v)
+      os << ", beyond a " << Num(s.voltage_limit_v, 3)
+         << " V driver already for the smallest move: the limited rows are what a real motor with these "
+            "gains "
+            "does";
+    os << ".\n\n";
+  }
+}
+
+}  // namespace
+
+bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t seed, MotorSection* section,
+                         std::string* error) {
+  const auto start = std::chrono::steady_clock::now();
+  MotorSection& s = *section;
+  s = MotorSection{};
+  StartSection(quick, &s);
+
+  // The gain sets: the paper's, pidlab's default tune of eq. (3), its robust
+  // preset, one tuned on the motor.
+  s.sets.push_back(PaperSet(paper_nm));
+  const TuneOptions d = Eq3TuneOptions(quick, seed);
+  Plant eq3;
+  if (!MakePlant("stepper_motor", StepperMotorParameters{}, &eq3, error)) return false;
+  MotorGainSet pidlab_default;
+  if (!DefaultSet(eq3, d, seed, &pidlab_default, error)) return false;
+  s.sets.push_back(pidlab_default);
+  MotorGainSet robust;
+  if (!RobustSet(eq3, d, seed, &s, &robust, error)) return false;
+  s.sets.push_back(robust);
+
+  // The tune on the motor, on its own thread while the other three sets run.
+  const TuneOptions t = MotorTuneOptions(quick, seed, &s);
+  const Plant limited_motor = Motor(true, s.voltage_limit_v);
+  auto tune = std::async(std::launch::async, [&limited_motor, t, &s] {
+    std::string e;
+    return Tune(limited_motor, t, &s.motor_tune, &e) ? std::string() : e;
+  });
+  const bool others = RunGainSet(0, &s, error) && RunGainSet(1, &s, error) && RunGainSet(2, &s, error);
+  const std::string tune_error = tune.get();
+  if (!others) return false;
+  if (!tune_error.empty()) {
+    *error = "tune on the motor: " + tune_error;
+    return false;
+  }
+  s.sets.push_back(OnMotorSet(s, t, seed));
+  if (!RunGainSet(3, &s, error)) return false;
+  s.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return true;
+}
+
+void RenderMotorSection(std::ostream& os, const MotorSection& s) {
+  RenderIntroduction(os, s);
+  for (const MotorGainSet& set : s.sets) RenderSet(os, s, set);
+  os << "### Where the linear design fails\n\n";
+  if (!s.sets.empty()) RenderHeadline(os, s);
   for (const MotorGainSet& set : s.sets)
     os << "* **" << set.name << "**: " << Verdict(s, set, false) << " " << Verdict(s, set, true) << "\n";
   os << "\n";
-  if (!s.sets.empty()) {
-    const MotorGainSet& paper = s.sets.front();
-    os << "The paper's gains, motor against eq. (3) without a limit:";
-    for (const MotorRow& r : paper.rows) {
-      if (r.limited) continue;
-      os << " " << Num(r.move_rad, 4) << " rad: IAE/A " << Num(r.iae_per_unit, 6) << " vs "
-         << Num(paper.eq3_iae_per_unit, 6) << " (" << Num(100 * (r.ratio - 1.0), 3) << " %"
-         << (r.lost_steps ? ", steps lost" : "") << ");";
-    }
-    os << " a difference within 1 % means eq. (3) describes the motor for that move.\n\n";
-    const MotorRow* small = nullptr;
-    for (const MotorRow& r : paper.rows)
-      if (!r.limited && (!small || r.move_rad < small->move_rad)) small = &r;
-    if (small) {
-      os << "Eq. (3) has no voltage limit and no notion of a tooth pitch: it scales every move linearly. On "
-            "the motor the drive's peak voltage grows with the move: the unfiltered derivative of the "
-            "discrete "
-            "PID puts kd A / dt = "
-         << Num(paper.gains.kd * small->move_rad / s.dt_s, 4)
-         << " rad of commanded angle on the first sample of a " << Num(small->move_rad, 3)
-         << " rad step, hence " << Num(small->peak_phase_voltage_v, 4) << " V there";
-      if (small->peak_phase_voltage_v > s.voltage_limit_v)
-        os << ", beyond a " << Num(s.voltage_limit_v, 3)
-           << " V driver already for the smallest move: the limited rows are what a real motor with these "
-              "gains "
-              "does";
-      os << ".\n\n";
-    }
-  }
+  if (!s.sets.empty()) RenderLinearisationNotes(os, s);
 }
 
 bool DrawMotorFigure(const MotorSection& s, const std::string& out_dir, const std::string& file,
