@@ -236,7 +236,7 @@ case $CASE in
     ;;
   log_repair)
     # Force lcm-logger to lose messages: SIGSTOP it for 1 s mid-episode (once
-    # it has logged 300 kB, the first thousand or so steps; the 1 s is the fault, not a wait:
+    # it has logged 30 kB, the first few hundred steps; the 1 s is the fault, not a wait:
     # its socket buffer overflows). launch must repair the log from the plant's
     # trajectory chunks, say so, and hand over a log holding every step.
     # The episode must outlast the 1 s stop (at about 10k steps/s: 30000 steps), or the companion
@@ -250,7 +250,7 @@ case $CASE in
       ni=$(awk "{print \$19}" /proc/$PIDLAB_LOGGER_PID/stat)
       [ "$ni" = -10 ] || { echo "FAIL lcm-logger runs at nice $ni, not -10"; exit 1; }
       $EVAL >/dev/null & e=$!
-      wait_until 30 file_bigger_than "$REPAIR_LOG" 300000 || { echo "FAIL log_repair: nothing logged"; exit 1; }
+      wait_until 30 file_bigger_than "$REPAIR_LOG" 30000 || { echo "FAIL log_repair: nothing logged"; exit 1; }
       kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
       wait $e' 2>"$TMP/launch.err" || { echo "FAIL launch: $(grep -v "^pidlab-" "$TMP/launch.err")"; fail=1; }
     if grep -q "repaired .* from the plant's trajectory chunks" "$TMP/launch.err"; then
@@ -269,20 +269,32 @@ case $CASE in
     # the log, and launch must fail with one line naming episode and steps.
     # 20000 steps: the 1 s stop must end inside the first episode, or the
     # companion episode's configuration is lost too (then nothing names steps).
-    rm -f "$TMP/run2.lcmlog"
+    # Whether the stop loses what only the plant holds depends on the machine's
+    # pace: a stop whose losses the step lane's rebuild covers leaves nothing
+    # to fail on (launch exit 0, no "is incomplete" line). That case is run
+    # again, up to 3 times in all, each said in a NOTE line; any other outcome
+    # decides at once.
     REPAIR_LOG=$TMP/run2.lcmlog
-    rc=0
-    "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/run2.lcmlog" -- bash -c '
-      ${EVAL/--horizon 30/--horizon 20} >/dev/null & e=$!
-      wait_until 30 file_bigger_than "$REPAIR_LOG" 300000 || { echo "FAIL log_repair: nothing logged"; exit 1; }
-      kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
-      wait $e; s=$?; kill -9 $PIDLAB_PLANT_PID; exit $s' 2>"$TMP/launch2.err" || rc=$?
-    line=$(grep "is incomplete: episode [0-9]* misses [0-9]* steps" "$TMP/launch2.err")
-    if [ $rc -ne 0 ] && [ -n "$line" ] && grep -q "did not resend" <<<"$line"; then
-      echo "ok   unrepairable log: launch exit $rc: ${line:0:200}"
-    else
-      echo "FAIL unrepairable log: launch exit $rc, stderr: $(grep -v "^pidlab-" "$TMP/launch2.err" | head -5)"; fail=1
-    fi
+    for attempt in 1 2 3; do
+      rm -f "$TMP/run2.lcmlog"
+      rc=0
+      "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/run2.lcmlog" -- bash -c '
+        ${EVAL/--horizon 30/--horizon 20} >/dev/null & e=$!
+        wait_until 30 file_bigger_than "$REPAIR_LOG" 30000 || { echo "FAIL log_repair: nothing logged"; exit 1; }
+        kill -STOP $PIDLAB_LOGGER_PID; sleep 1; kill -CONT $PIDLAB_LOGGER_PID
+        wait $e; s=$?; kill -9 $PIDLAB_PLANT_PID; exit $s' 2>"$TMP/launch2.err" || rc=$?
+      line=$(grep "is incomplete: episode [0-9]* misses [0-9]* steps" "$TMP/launch2.err")
+      if [ $rc -eq 0 ] && [ -z "$line" ] && [ $attempt -lt 3 ]; then
+        echo "NOTE attempt $attempt: the stop lost nothing the plant alone held; again"
+        continue
+      fi
+      if [ $rc -ne 0 ] && [ -n "$line" ] && grep -q "did not resend" <<<"$line"; then
+        echo "ok   unrepairable log: launch exit $rc: ${line:0:200}"
+      else
+        echo "FAIL unrepairable log: launch exit $rc, stderr: $(grep -v "^pidlab-" "$TMP/launch2.err" | head -5)"; fail=1
+      fi
+      break
+    done
     ;;
   motor)
     # The nonlinear stepper (stepper_nonlinear, docs/stepper.md) on the trio:
