@@ -14,7 +14,7 @@
 #include <cstdio>
 #include <string>
 
-#include "pidlab/tuner/tune.h"
+#include "pidlab/tune/tune.h"
 
 namespace {
 
@@ -30,7 +30,8 @@ void BM_PaperObjectiveContinuous(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
   pidlab::Plant plant;
   pidlab::MakePlant(c.plant, {}, &plant, nullptr);
-  const pidlab::ObjectiveEvaluator dut(plant, pidlab::LoopOptions{}, pidlab::ObjectiveKind::kIae);
+  const pidlab::evaluation::ObjectiveEvaluator dut(plant, pidlab::evaluation::LoopOptions{},
+                                                   pidlab::evaluation::ObjectiveKind::kIae);
   double iae = 0.0;
   for (auto _ : state) {
     iae = dut(c.gains);
@@ -49,10 +50,10 @@ void BM_GeneralPathContinuous(benchmark::State& state) {
   pidlab::MakePlant(c.plant, {}, &plant, nullptr);
   const pidlab::StateSpace realization = pidlab::Realize(plant.tf);
   const pidlab::Disturbance none(pidlab::DisturbanceOptions{});
-  const pidlab::LoopOptions options;
+  const pidlab::evaluation::LoopOptions options;
   for (auto _ : state) {
-    const double iae =
-        pidlab::GeneralContinuousObjective(realization, none, options, pidlab::ObjectiveKind::kIae, c.gains);
+    const double iae = pidlab::evaluation::GeneralContinuousObjective(
+        realization, none, options, pidlab::evaluation::ObjectiveKind::kIae, c.gains);
     benchmark::DoNotOptimize(&iae);
   }
   state.SetItemsProcessed(state.iterations());
@@ -64,11 +65,11 @@ void BM_PaperObjectiveSampled(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
   pidlab::Plant plant;
   pidlab::MakePlant(c.plant, {}, &plant, nullptr);
-  pidlab::LoopOptions options;
-  options.loop = pidlab::LoopKind::kSampled;
+  pidlab::evaluation::LoopOptions options;
+  options.loop = pidlab::evaluation::LoopKind::kSampled;
   options.dt_s = plant.name == "stepper_motor" ? 1e-4 : 1e-3;
   options.pid = PidOptionsAt(options.pid, options.dt_s);
-  const pidlab::ObjectiveEvaluator dut(plant, options, pidlab::ObjectiveKind::kIae);
+  const pidlab::evaluation::ObjectiveEvaluator dut(plant, options, pidlab::evaluation::ObjectiveKind::kIae);
   for (auto _ : state) {
     const double iae = dut(c.gains);
     benchmark::DoNotOptimize(&iae);
@@ -84,13 +85,13 @@ void BM_TuneDefault(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
   pidlab::Plant plant;
   pidlab::MakePlant(c.plant, {}, &plant, nullptr);
-  const pidlab::TuneOptions options;
+  const pidlab::tune::TuneOptions options;
   int evaluations = 0;
   double iae = 0.0;
   for (auto _ : state) {
-    pidlab::TuneSummary summary;
+    pidlab::tune::TuneSummary summary;
     std::string error;
-    if (!pidlab::Tune(plant, options, &summary, &error)) state.SkipWithError(error.c_str());
+    if (!pidlab::tune::Tune(plant, options, &summary, &error)) state.SkipWithError(error.c_str());
     // Tune() cannot be optimised away (it allocates and runs Ceres); no
     // DoNotOptimize on a double here: GCC 12 with benchmark 1.7's "+m,r"
     // constraint garbles the value read back.

@@ -21,8 +21,8 @@
 #include <utility>
 #include <vector>
 
+#include "pidlab/episode_client/episode_client.h"
 #include "pidlab/transport/transport.h"
-#include "pidlab/tuner/episode_client.h"
 
 namespace {
 
@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
   const double horizon = argc > 2 ? std::atof(argv[2]) : 20.0;
   const char* env_url = std::getenv("PIDLAB_LCM_URL");
   const std::string url = env_url ? env_url : pidlab::transport::kDefaultLcmUrl;
-  pidlab::EpisodeClientOptions co;
+  pidlab::episode_client::EpisodeClientOptions co;
   co.lcm_url = url;
   if (const char* p = std::getenv("PIDLAB_CHANNEL_PREFIX")) co.transport.channel_prefix = p;
   std::string error;
@@ -153,10 +153,10 @@ int main(int argc, char** argv) {
 
   pidlab::Plant plant;
   pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant, &error);
-  pidlab::LoopOptions options;
-  options.loop = pidlab::LoopKind::kSampled;
+  pidlab::evaluation::LoopOptions options;
+  options.loop = pidlab::evaluation::LoopKind::kSampled;
   options.horizon_s = horizon;
-  pidlab::EpisodeClient client(co);
+  pidlab::episode_client::EpisodeClient client(co);
   std::vector<double> y;
   for (int episode = 0; episode < 3; ++episode) {
     if (!client.Run(plant, pidlab::PidGains{2.0, 1.0, 1.5}, options, options.disturbance, &y, nullptr,

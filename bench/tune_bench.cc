@@ -12,25 +12,25 @@
 #include <cmath>
 #include <string>
 
-#include "pidlab/tuner/tune.h"
+#include "pidlab/tune/tune.h"
 
 namespace {
 
 const char* const kPlants[] = {"double_integrator", "oscillator", "stepper_motor"};
 
-void RunTunes(benchmark::State& state, const pidlab::TuneOptions& base) {
+void RunTunes(benchmark::State& state, const pidlab::tune::TuneOptions& base) {
   pidlab::Plant plant;
   pidlab::MakePlant(kPlants[state.range(0)], {}, &plant, nullptr);
   double iae_sum = 0.0;
   long evaluations = 0, tunes = 0;
   std::uint64_t seed = 1;
   for (auto _ : state) {
-    pidlab::TuneOptions options = base;
+    pidlab::tune::TuneOptions options = base;
     options.seed = seed;
     seed = seed % 5 + 1;
-    pidlab::TuneSummary summary;
+    pidlab::tune::TuneSummary summary;
     std::string error;
-    if (!pidlab::Tune(plant, options, &summary, &error)) state.SkipWithError(error.c_str());
+    if (!pidlab::tune::Tune(plant, options, &summary, &error)) state.SkipWithError(error.c_str());
     iae_sum += summary.objective;
     evaluations += summary.evaluations;
     ++tunes;
@@ -39,13 +39,13 @@ void RunTunes(benchmark::State& state, const pidlab::TuneOptions& base) {
                  " evaluations=" + std::to_string(evaluations / tunes));
 }
 
-void BM_TuneDefault(benchmark::State& state) { RunTunes(state, pidlab::TuneOptions{}); }
+void BM_TuneDefault(benchmark::State& state) { RunTunes(state, pidlab::tune::TuneOptions{}); }
 BENCHMARK(BM_TuneDefault)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 // The same search with the overshoot constraint: every stable candidate also
 // costs the exact stepinfo of its step response.
 void BM_TuneMaxOvershoot5(benchmark::State& state) {
-  pidlab::TuneOptions options;
+  pidlab::tune::TuneOptions options;
   options.max_overshoot_pct = 5.0;
   RunTunes(state, options);
 }
@@ -59,8 +59,8 @@ BENCHMARK(BM_TuneMaxOvershoot5)
 // constant <= 2.5 s): every stable candidate also costs the tuner's cheap
 // bound check (ContinuousLoopMeetsBounds) and the load response.
 void BM_TuneRobust(benchmark::State& state) {
-  pidlab::TuneOptions options;
-  pidlab::ApplyRobustPreset(&options);
+  pidlab::tune::TuneOptions options;
+  pidlab::tune::ApplyRobustPreset(&options);
   RunTunes(state, options);
 }
 BENCHMARK(BM_TuneRobust)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
@@ -68,7 +68,7 @@ BENCHMARK(BM_TuneRobust)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->Measu
 // Every constraint flag at once on the paper's objective: Ms, Mt, noise
 // gain, phase and gain margins, time constant, with the filtered derivative.
 void BM_TuneAllBounds(benchmark::State& state) {
-  pidlab::TuneOptions options;
+  pidlab::tune::TuneOptions options;
   options.loop.derivative_filter_ratio = 10.0;
   options.bounds.max_ms = 1.6;
   options.bounds.max_mt = 1.3;

@@ -8,6 +8,6 @@ int main(int argc, char** argv) {
   return RoleMain(argc, argv, "pidlab-controller",
                   "pidlab-controller: answers each plant output y_k with u_k = PID(r, y_k) (DiscretePid)",
                   [](Transport* t, LogFn log, bool verbose) {
-                    return std::make_unique<ControllerRole>(t, log, verbose);
+                    return std::make_unique<pidlab::controller::ControllerRole>(t, log, verbose);
                   });
 }

@@ -9,6 +9,6 @@ int main(int argc, char** argv) {
   return RoleMain(argc, argv, "pidlab-disturbance",
                   "pidlab-disturbance: answers the plant's DISTURBANCE_REQUESTs with blocks of n_k = n(k dt)",
                   [](Transport* t, LogFn log, bool verbose) {
-                    return std::make_unique<DisturbanceRole>(t, log, verbose);
+                    return std::make_unique<pidlab::plant_sim::DisturbanceRole>(t, log, verbose);
                   });
 }

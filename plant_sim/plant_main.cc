@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
       argc, argv, "pidlab-plant",
       "pidlab-plant: publishes y_k, waits for u_k and n_k, steps x_{k+1} = Phi x_k + Gamma (u_k + n_k)",
       [&realtime](Transport* t, LogFn log, bool verbose) {
-        return std::make_unique<PlantRole>(t, log, verbose, realtime.factor);
+        return std::make_unique<pidlab::plant_sim::PlantRole>(t, log, verbose, realtime.factor);
       },
       &realtime);
 }

@@ -3,8 +3,12 @@
 # graph (cmake --graphviz) and on the sources:
 #  - every pidlab library links only libraries on a lower level;
 #  - pidlab-plant, pidlab-controller and pidlab-disturbance link none of Ceres,
-#    the optimisers, the tuner, the report, the plotting code or the launcher;
+#    the optimisers, the evaluation, the analysis, the tuning, the report,
+#    the plotting code or the launcher;
 #  - no header of a higher folder is included from a lower one;
+#  - the tuner's optim, evaluation, analysis and tune include no LCM,
+#    transport or episode client header, and only pidlab/<x>/ headers of
+#    their own level or below;
 #  - nothing in the repository reads the folder beside it (the repository
 #    stands alone).
 # usage: architecture_test.sh SOURCE_DIR BUILD_DIR
@@ -19,10 +23,10 @@ dot, src = sys.argv[1], sys.argv[2]
 level = {
     'pidlab_lcmtypes': 0,
     'pidlab_spec': 1, 'pidlab_plant_sim': 1, 'pidlab_controller': 1, 'pidlab_optim': 1, 'pidlab_plot': 1,
-    'pidlab_transport': 2,
-    'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_tuner': 3,
-    'pidlab_episode_client': 4, 'pidlab_log_reader': 4, 'pidlab_json': 4,
-    'pidlab_replay': 5, 'pidlab_launcher': 5,
+    'pidlab_transport': 2, 'pidlab_evaluation': 2,
+    'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_analysis': 3,
+    'pidlab_tune': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
+    'pidlab_tuner': 5, 'pidlab_json': 5, 'pidlab_replay': 5, 'pidlab_launcher': 5,
     'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_figures': 6, 'pidlab_cli': 7,
     'pidlab': 8, 'pidlab_python': 8,
 }
@@ -54,7 +58,8 @@ def closure(t):
         for d in deps.get(todo.pop(), ()):
             if d not in seen: seen.add(d); todo.append(d)
     return seen
-forbidden = {'Ceres::ceres', 'pidlab_optim', 'pidlab_tuner', 'pidlab_report', 'pidlab_plot', 'pidlab_launcher',
+forbidden = {'Ceres::ceres', 'pidlab_optim', 'pidlab_evaluation', 'pidlab_analysis', 'pidlab_tune', 'pidlab_tuner',
+             'pidlab_report', 'pidlab_plot', 'pidlab_launcher',
              'pidlab_replay', 'pidlab_log_reader', 'pidlab_episode_client'}
 for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
     if exe not in deps: fail(f'{exe} not in the graph'); continue
@@ -62,22 +67,44 @@ for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
     if bad: fail(f'{exe} links {", ".join(bad)}')
     else: print(f'ok   {exe} links only ' + ', '.join(sorted(d for d in closure(exe) if d.startswith("pidlab"))))
 # Sources: a folder includes only headers of its own level or below.
-header_level = {'spec': 1, 'plant_sim': 1, 'controller': 1, 'transport': 2, 'tuner': 3, 'replay': 4, 'launcher': 5,
-                'plot': 1, 'report': 6, 'json': 4}
-lib_dirs = {'spec': 1, 'transport': 2, 'tuner': 3, 'replay': 5, 'launcher': 5}
+header_level = {'spec': 1, 'plant_sim': 1, 'controller': 1, 'optim': 1, 'plot': 1, 'transport': 2, 'evaluation': 2,
+                'analysis': 3, 'tune': 4, 'episode_client': 4, 'replay': 4, 'json': 5, 'launcher': 5, 'report': 6,
+                'figures': 6}
+lib_dirs = {'spec': 1, 'transport': 2, 'tuner/optim': 1, 'tuner/evaluation': 2, 'tuner/analysis': 3,
+            'tuner/tune': 4, 'tuner/episode_client': 4, 'replay': 5, 'launcher': 5}
 for d, lv in lib_dirs.items():
     for root, _, files in os.walk(os.path.join(src, d)):
         for f in files:
             for inc in re.findall(r'#include "pidlab/(\w+)/', open(os.path.join(root, f)).read()):
                 if header_level.get(inc, 0) > lv:
                     fail(f'{os.path.relpath(os.path.join(root, f), src)} includes a pidlab/{inc}/ header from above')
+# The tuner's libraries other than the episode client: no LCM (<lcm/...>, a
+# message's lcmt_*.hpp), no transport, no episode client; every pidlab/<x>/
+# header they include is of their own level or below (and has a level).
+for d in ('optim', 'evaluation', 'analysis', 'tune'):
+    lv = header_level[d]
+    for root, _, files in os.walk(os.path.join(src, 'tuner', d)):
+        for f in files:
+            path = os.path.join(root, f)
+            rel = os.path.relpath(path, src)
+            for inc in re.findall(r'#include\s*[<"]([^>"]+)[>"]', open(path).read()):
+                if inc.startswith('lcm/') or re.search(r'(^|/)lcmt_\w*\.hpp$', inc):
+                    fail(f'{rel} includes the LCM header {inc}')
+                m = re.match(r'pidlab/(\w+)/', inc)
+                if not m: continue
+                if m.group(1) in ('transport', 'episode_client'):
+                    fail(f'{rel} includes {inc}: only the episode client may use the transport')
+                elif m.group(1) not in header_level:
+                    fail(f'{rel} includes {inc}, whose folder has no level in this test')
+                elif header_level[m.group(1)] > lv:
+                    fail(f'{rel} (level {lv}) includes {inc} (level {header_level[m.group(1)]}) from above')
 # plant_sim and controller models (not their roles) include no transport header.
 for d in ('plant_sim', 'controller'):
     for root, _, files in os.walk(os.path.join(src, d)):
         for f in files:
             if 'role' in f or f.endswith('_main.cc'): continue
             text = open(os.path.join(root, f)).read()
-            if re.search(r'#include "pidlab/(transport|tuner|replay|launcher)/', text) or 'lcm' in re.findall(r'#include <(\w+)', text):
+            if re.search(r'#include "pidlab/(transport|optim|evaluation|analysis|tune|episode_client|replay|launcher)/', text) or 'lcm' in re.findall(r'#include <(\w+)', text):
                 fail(f'{os.path.relpath(os.path.join(root, f), src)} is a model but includes LCM or a higher layer')
 # Nothing in the repository names the folder beside it.
 beside = '..' + '/' + 'shared'

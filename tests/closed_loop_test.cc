@@ -1,7 +1,7 @@
 // Closed-loop responses against closed forms and an independent RK4
 // integration; stability; convergence of the sampled loop; LoopOptions.
 
-#include "pidlab/tuner/closed_loop.h"
+#include "pidlab/evaluation/closed_loop.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,25 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/tuner/evaluation.h"
+#include "pidlab/evaluation/evaluation.h"
+
+using pidlab::evaluation::BuildContinuousClosedLoop;
+using pidlab::evaluation::ContinuousClosedLoop;
+using pidlab::evaluation::ContinuousStability;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::kMaxLoopSteps;
+using pidlab::evaluation::kStepsPerBreakpoint;
+using pidlab::evaluation::LoopGains;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::ObjectiveEvaluator;
+using pidlab::evaluation::ObjectiveKind;
+using pidlab::evaluation::RunSampledLoop;
+using pidlab::evaluation::SampleContinuousLoop;
+using pidlab::evaluation::SampledStability;
+using pidlab::evaluation::SampledStep;
 
 namespace pidlab {
 namespace {

@@ -4,7 +4,7 @@
 // client's LCM instance (every memq:// instance is a queue of its own), so the
 // client's waits handle their messages: one thread, as in trio_protocol_test.
 
-#include "pidlab/tuner/episode_client.h"
+#include "pidlab/episode_client/episode_client.h"
 
 #include <gtest/gtest.h>
 
@@ -16,11 +16,24 @@
 #include <vector>
 
 #include "pidlab/controller/controller_role.h"
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/plant_sim/disturbance_role.h"
 #include "pidlab/plant_sim/plant_role.h"
 #include "pidlab/transport/episode_spec.h"
 #include "pidlab/transport/transport.h"
-#include "pidlab/tuner/evaluation.h"
+
+using pidlab::episode_client::EpisodeClient;
+using pidlab::episode_client::EpisodeClientOptions;
+using pidlab::episode_client::EpisodeClientStats;
+using pidlab::episode_client::MakeEpisodeSpec;
+using pidlab::episode_client::SampledLoopOptions;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::RunSampledLoopInProcess;
+using pidlab::evaluation::SampledStep;
 
 namespace pidlab {
 namespace {
@@ -46,7 +59,7 @@ Loop DoubleIntegrator(double horizon_s = 2.0) {
 struct InProcessTrio {
   explicit InProcessTrio(bool with_controller = true, EpisodeClientOptions options = Defaults()) {
     EXPECT_TRUE(lcm.good());
-    if (with_controller) controller = std::make_unique<transport::ControllerRole>(&controller_t);
+    if (with_controller) controller = std::make_unique<controller::ControllerRole>(&controller_t);
     client = std::make_unique<EpisodeClient>(options, &lcm);
   }
   static EpisodeClientOptions Defaults() {
@@ -58,9 +71,9 @@ struct InProcessTrio {
 
   lcm::LCM lcm{"memq://"};
   transport::Transport plant_t{&lcm, {}}, controller_t{&lcm, {}}, disturbance_t{&lcm, {}};
-  transport::PlantRole plant{&plant_t};
-  transport::DisturbanceRole disturbance{&disturbance_t};
-  std::unique_ptr<transport::ControllerRole> controller;
+  plant_sim::PlantRole plant{&plant_t};
+  plant_sim::DisturbanceRole disturbance{&disturbance_t};
+  std::unique_ptr<controller::ControllerRole> controller;
   std::unique_ptr<EpisodeClient> client;
 };
 

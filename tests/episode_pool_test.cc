@@ -5,7 +5,7 @@
 // live trios is tested end to end by integration.trio.trios and
 // integration.trio.trio_killed (tests/integration/trio_test.sh).
 
-#include "pidlab/tuner/episode_pool.h"
+#include "pidlab/episode_client/episode_pool.h"
 
 #include <gtest/gtest.h>
 
@@ -16,6 +16,14 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+using pidlab::episode_client::EpisodeClientOptions;
+using pidlab::episode_client::EpisodePool;
+using pidlab::episode_client::SplitUrlList;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::SampledRunner;
+using pidlab::optim::ParallelFor;
 
 namespace pidlab {
 namespace {

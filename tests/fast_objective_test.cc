@@ -2,7 +2,7 @@
 // path: Routh-Hurwitz against the eigenvalues, and the objective over many
 // random gains, stable and unstable, on the paper's plants and custom ones.
 
-#include "pidlab/tuner/fast_objective.h"
+#include "pidlab/evaluation/fast_objective.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,26 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/tuner/evaluation.h"
+#include "pidlab/evaluation/evaluation.h"
+
+using pidlab::evaluation::BuildContinuousClosedLoop;
+using pidlab::evaluation::ContinuousClosedLoop;
+using pidlab::evaluation::ContinuousStability;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::FastContinuousObjective;
+using pidlab::evaluation::GeneralContinuousObjective;
+using pidlab::evaluation::IsHurwitz;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::ObjectiveEvaluator;
+using pidlab::evaluation::ObjectiveKind;
+using pidlab::evaluation::PolynomialStability;
+using pidlab::evaluation::PolynomialStabilityTest;
+using pidlab::evaluation::RootRadiusBound;
+using pidlab::evaluation::ShiftPolynomial;
+using pidlab::evaluation::Stability;
 
 namespace pidlab {
 namespace {

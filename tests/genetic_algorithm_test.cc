@@ -1,4 +1,4 @@
-#include "pidlab/tuner/genetic_algorithm.h"
+#include "pidlab/optim/genetic_algorithm.h"
 
 #include <gtest/gtest.h>
 
@@ -6,6 +6,14 @@
 #include <limits>
 #include <string>
 #include <vector>
+
+using pidlab::optim::Bounds;
+using pidlab::optim::GaCrossover;
+using pidlab::optim::GeneticAlgorithm;
+using pidlab::optim::GeneticAlgorithmOptions;
+using pidlab::optim::OptimizerSummary;
+using pidlab::optim::TerminationType;
+using pidlab::optim::TracePoint;
 
 namespace pidlab {
 namespace {

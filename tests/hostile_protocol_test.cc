@@ -20,11 +20,18 @@
 #include <vector>
 
 #include "pidlab/controller/controller_role.h"
+#include "pidlab/episode_client/episode_client.h"
 #include "pidlab/plant_sim/disturbance_role.h"
 #include "pidlab/plant_sim/plant_role.h"
 #include "pidlab/transport/transport.h"
 #include "pidlab/transport/wire.h"
-#include "pidlab/tuner/episode_client.h"
+
+using pidlab::controller::ControllerRole;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::RunSampledLoopInProcess;
+using pidlab::plant_sim::DisturbanceRole;
+using pidlab::plant_sim::PlantRole;
 
 namespace pidlab::transport {
 namespace {
@@ -102,8 +109,8 @@ struct Arena {
     RecoveryOptions recovery;
     recovery.retransmit_interval_s = 0.001;
     recovery.silence_deadline_s = 0.3;
-    auto config = MakeEpisodeConfig(
-        pidlab::MakeEpisodeSpec(kId, model, PidGains{2.0, 1.0, 1.5}, options, options.disturbance, recovery));
+    auto config = MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+        kId, model, PidGains{2.0, 1.0, 1.5}, options, options.disturbance, recovery));
     client_t.Publish(kEpisodeConfigChannel, &config);
     const double start = NowSeconds();
     while (!summary && NowSeconds() - start < 20.0) {

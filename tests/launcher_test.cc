@@ -37,10 +37,15 @@
 #include <utility>
 #include <vector>
 
+#include "pidlab/episode_client/episode_client.h"
 #include "pidlab/launcher/log_capture.h"
 #include "pidlab/launcher/supervisor.h"
 #include "pidlab/replay/log_reader.h"
-#include "pidlab/tuner/episode_client.h"
+
+using pidlab::episode_client::EpisodeClient;
+using pidlab::episode_client::EpisodeClientOptions;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
 
 // Not in pidlab::launcher: the fixtures are called Launcher and LogCapture
 // (test names read Launcher.StartReaches...), the library's classes are

@@ -7,8 +7,21 @@
 #include <limits>
 #include <string>
 
-#include "pidlab/tuner/evaluation.h"
-#include "pidlab/tuner/tune.h"
+#include "pidlab/evaluation/evaluation.h"
+#include "pidlab/tune/tune.h"
+
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoadIntegralAbsError;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::ObjectiveEvaluator;
+using pidlab::evaluation::ObjectiveKind;
+using pidlab::tune::RefineVerdict;
+using pidlab::tune::Tune;
+using pidlab::tune::TuneOptions;
+using pidlab::tune::TuneSummary;
 
 namespace pidlab {
 namespace {

@@ -21,8 +21,17 @@
 #include <pidlab/lcmt_plant_output.hpp>
 #include <random>
 
+#include "pidlab/episode_client/episode_client.h"
 #include "pidlab/transport/episode_spec.h"
-#include "pidlab/tuner/episode_client.h"
+
+using pidlab::episode_client::MakeEpisodeSpec;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::RunSampledLoopInProcess;
+using pidlab::evaluation::SampledStep;
 
 namespace pidlab::replay {
 namespace {
@@ -127,7 +136,7 @@ struct EpisodeWriter {
 
   void Write(lcm::LogFile* log, int64_t* num) const {
     if (with_config) {
-      const auto config = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(episode_id, ref.plant, ref.gains, ref.options,
+      const auto config = transport::MakeEpisodeConfig(MakeEpisodeSpec(episode_id, ref.plant, ref.gains, ref.options,
                                                       ref.options.disturbance, transport::RecoveryOptions{}));
       WriteMsg(log, prefix + "EPISODE_CONFIG", config, num);
       WriteMsg(log, prefix + "EPISODE_CONFIG", config, num);  // republished until acknowledged
@@ -293,7 +302,7 @@ TEST_F(LogReaderTest, GarbageForeignAndSelfTestEventsAreCountedAndSkipped) {
     short_output.resize(20);
     WriteRaw(&log, "PIDLAB_PLANT_OUTPUT", short_output, &num);
     // A configuration whose num_size claims two billion doubles.
-    auto config = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(99, ref.plant, ref.gains, ref.options, ref.options.disturbance,
+    auto config = transport::MakeEpisodeConfig(MakeEpisodeSpec(99, ref.plant, ref.gains, ref.options, ref.options.disturbance,
                                               transport::RecoveryOptions{}));
     std::vector<uint8_t> hostile(static_cast<std::size_t>(config.getEncodedSize()));
     config.encode(hostile.data(), 0, static_cast<int>(hostile.size()));

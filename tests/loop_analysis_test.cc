@@ -2,13 +2,29 @@
 // order lag's margins, a resonance with damping 1e-3 whose peak is 0.002 rad/s
 // wide, the ideal derivative's unbounded noise gain, a near cancellation.
 
-#include "pidlab/tuner/loop_analysis.h"
+#include "pidlab/analysis/loop_analysis.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 #include <string>
+
+using pidlab::analysis::AnalyzeLoop;
+using pidlab::analysis::ContinuousLoopMeetsBounds;
+using pidlab::analysis::HinfNormBruinsmaSteinbuch;
+using pidlab::analysis::LoopAnalysis;
+using pidlab::analysis::LoopAnalysisOptions;
+using pidlab::analysis::LoopBounds;
+using pidlab::analysis::LoopBoundsViolation;
+using pidlab::analysis::LoopFrequencyPoint;
+using pidlab::analysis::LoopFrequencyResponse;
+using pidlab::analysis::Polynomial;
+using pidlab::evaluation::BuildContinuousClosedLoop;
+using pidlab::evaluation::ContinuousClosedLoop;
+using pidlab::evaluation::ContinuousStability;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
 
 namespace pidlab {
 namespace {

@@ -7,7 +7,17 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/tuner/evaluation.h"
+#include "pidlab/evaluation/evaluation.h"
+
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::ObjectiveFromSamples;
+using pidlab::evaluation::ObjectiveKind;
+using pidlab::evaluation::ParseObjectiveKind;
+using pidlab::evaluation::SampledStepInfo;
+using pidlab::evaluation::StepInfo;
 
 namespace pidlab {
 namespace {

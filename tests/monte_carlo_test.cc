@@ -1,12 +1,26 @@
 // Monte Carlo over plant parameters: seeded draws, a tiny spread, a spread
 // that crosses a known stability boundary, order statistics.
 
-#include "pidlab/tuner/monte_carlo.h"
+#include "pidlab/analysis/monte_carlo.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
+
+using pidlab::analysis::AnalyzeLoop;
+using pidlab::analysis::Distribution;
+using pidlab::analysis::DrawPlants;
+using pidlab::analysis::LoopAnalysis;
+using pidlab::analysis::LoopAnalysisOptions;
+using pidlab::analysis::MonteCarloOptions;
+using pidlab::analysis::MonteCarloSummary;
+using pidlab::analysis::RunMonteCarlo;
+using pidlab::analysis::Summarize;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopOptions;
 
 namespace pidlab {
 namespace {

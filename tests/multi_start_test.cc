@@ -1,4 +1,4 @@
-#include "pidlab/tuner/multi_start.h"
+#include "pidlab/optim/multi_start.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,16 @@
 #include <thread>
 #include <vector>
 
-#include "pidlab/tuner/sobol.h"
+#include "pidlab/optim/sobol.h"
+
+using pidlab::optim::Bounds;
+using pidlab::optim::LocalMinimum;
+using pidlab::optim::MultiStart;
+using pidlab::optim::MultiStartOptions;
+using pidlab::optim::ObjectiveFunction;
+using pidlab::optim::OptimizerSummary;
+using pidlab::optim::SobolSequence;
+using pidlab::optim::TerminationType;
 
 namespace pidlab {
 namespace {

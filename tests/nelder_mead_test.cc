@@ -1,4 +1,4 @@
-#include "pidlab/tuner/nelder_mead.h"
+#include "pidlab/optim/nelder_mead.h"
 
 #include <gtest/gtest.h>
 
@@ -7,6 +7,14 @@
 #include <random>
 #include <string>
 #include <vector>
+
+using pidlab::optim::Bounds;
+using pidlab::optim::NelderMead;
+using pidlab::optim::NelderMeadOptions;
+using pidlab::optim::ObjectiveFunction;
+using pidlab::optim::OptimizerSummary;
+using pidlab::optim::TerminationType;
+using pidlab::optim::TracePoint;
 
 namespace pidlab {
 namespace {

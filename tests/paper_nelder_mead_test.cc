@@ -1,4 +1,4 @@
-#include "pidlab/tuner/paper_nelder_mead.h"
+#include "pidlab/optim/paper_nelder_mead.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,17 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/tuner/nelder_mead.h"
+#include "pidlab/optim/nelder_mead.h"
+
+using pidlab::optim::Bounds;
+using pidlab::optim::NelderMead;
+using pidlab::optim::NelderMeadOptions;
+using pidlab::optim::ObjectiveFunction;
+using pidlab::optim::OptimizerSummary;
+using pidlab::optim::PaperNelderMead;
+using pidlab::optim::PaperNelderMeadOptions;
+using pidlab::optim::TerminationType;
+using pidlab::optim::TracePoint;
 
 namespace pidlab {
 namespace {

@@ -10,7 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/tuner/evaluation.h"
+#include "pidlab/evaluation/evaluation.h"
+
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopOptions;
 
 #ifndef PIDLAB_PAPER_TABLES
 #error "PIDLAB_PAPER_TABLES (path of paper_tables.csv) must be defined by the build"

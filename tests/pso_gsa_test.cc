@@ -1,4 +1,4 @@
-#include "pidlab/tuner/pso_gsa.h"
+#include "pidlab/optim/pso_gsa.h"
 
 #include <gtest/gtest.h>
 
@@ -6,6 +6,14 @@
 #include <limits>
 #include <string>
 #include <vector>
+
+using pidlab::optim::Bounds;
+using pidlab::optim::OptimizerSummary;
+using pidlab::optim::PsoGsa;
+using pidlab::optim::PsoGsaInertia;
+using pidlab::optim::PsoGsaOptions;
+using pidlab::optim::TerminationType;
+using pidlab::optim::TracePoint;
 
 namespace pidlab {
 namespace {

@@ -6,8 +6,17 @@
 #include <cmath>
 #include <string>
 
-#include "pidlab/tuner/closed_loop.h"
-#include "pidlab/tuner/evaluation.h"
+#include "pidlab/evaluation/closed_loop.h"
+#include "pidlab/evaluation/evaluation.h"
+
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::ObjectiveEvaluator;
+using pidlab::evaluation::ObjectiveKind;
+using pidlab::evaluation::SampledStep;
 
 namespace pidlab {
 namespace {

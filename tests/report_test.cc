@@ -12,6 +12,10 @@
 #include <fstream>
 #include <sstream>
 
+using pidlab::analysis::LoopFrequencyPoint;
+using pidlab::tune::RefineVerdict;
+using pidlab::tune::TuneMethod;
+
 namespace pidlab::report {
 namespace {
 

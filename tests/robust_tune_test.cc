@@ -4,8 +4,26 @@
 #include <cmath>
 #include <string>
 
-#include "pidlab/tuner/loop_analysis.h"
-#include "pidlab/tuner/tune.h"
+#include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/tune/tune.h"
+
+using pidlab::analysis::AnalyzeLoop;
+using pidlab::analysis::DrawPlants;
+using pidlab::analysis::LoopAnalysis;
+using pidlab::analysis::LoopAnalysisOptions;
+using pidlab::analysis::LoopBoundsViolations;
+using pidlab::analysis::MonteCarloOptions;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::ObjectiveEvaluator;
+using pidlab::evaluation::ObjectiveKind;
+using pidlab::tune::ApplyRobustPreset;
+using pidlab::tune::RobustPreset;
+using pidlab::tune::RobustPresetKeep;
+using pidlab::tune::Tune;
+using pidlab::tune::TuneOptions;
+using pidlab::tune::TuneSummary;
 
 namespace pidlab {
 namespace {

@@ -13,11 +13,20 @@
 
 #include "cli_common.h"
 #include "cli_spec.h"
+#include "pidlab/episode_client/episode_client.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/transport/episode_spec.h"
-#include "pidlab/tuner/episode_client.h"
-#include "pidlab/tuner/spec_build.h"
+#include "pidlab/tune/spec_build.h"
+
+using pidlab::episode_client::MakeEpisodeSpec;
+using pidlab::evaluation::LoopOptions;
+using pidlab::spec::NameStyle;
+using pidlab::tune::BuildGains;
+using pidlab::tune::BuildLoopOptions;
+using pidlab::tune::BuildPlant;
+using pidlab::tune::ResolveRobustPreset;
+using pidlab::tune::TuneOptions;
 
 namespace pidlab {
 namespace {

@@ -14,8 +14,17 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/tuner/evaluation.h"
-#include "pidlab/tuner/fast_objective.h"
+#include "pidlab/evaluation/evaluation.h"
+#include "pidlab/evaluation/fast_objective.h"
+
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::FastContinuousObjective;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::ObjectiveEvaluator;
+using pidlab::evaluation::ObjectiveKind;
 
 namespace pidlab {
 namespace {

@@ -17,6 +17,8 @@
 #include <thread>
 
 #include "pidlab/controller/controller_role.h"
+#include "pidlab/episode_client/episode_client.h"
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/plant_sim/disturbance_role.h"
 #include "pidlab/plant_sim/plant_role.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
@@ -24,8 +26,13 @@
 #include "pidlab/transport/pacing.h"
 #include "pidlab/transport/rtt.h"
 #include "pidlab/transport/transport.h"
-#include "pidlab/tuner/episode_client.h"
-#include "pidlab/tuner/evaluation.h"
+
+using pidlab::controller::ControllerRole;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::RunSampledLoopInProcess;
+using pidlab::plant_sim::DisturbanceRole;
+using pidlab::plant_sim::PlantRole;
 
 namespace pidlab::transport {
 namespace {
@@ -89,8 +96,8 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
   RecoveryOptions recovery;
   recovery.retransmit_interval_s = 0.001;
   recovery.silence_deadline_s = 0.2;
-  auto config = transport::MakeEpisodeConfig(
-      pidlab::MakeEpisodeSpec(id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
+  auto config = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
   client_t.Publish(kEpisodeConfigChannel, &config);
   const double start = NowSeconds();
   double config_sent = start;
@@ -125,8 +132,8 @@ TEST(EpisodeConfig, RoundTripsEveryField) {
   e.options.pid.anti_windup = AntiWindup::kBackCalculation;
   e.options.pid.integral = IntegralMethod::kTrapezoidal;
   e.options.disturbance.seed = 99;
-  const auto msg = transport::MakeEpisodeConfig(
-      pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  const auto msg = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   EpisodeSpec dut;
   std::string error;
   ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
@@ -143,8 +150,8 @@ TEST(EpisodeConfig, RoundTripsEveryField) {
 
 TEST(EpisodeConfig, RejectsMalformedFieldsByName) {
   Episode e = DoubleIntegrator();
-  auto msg = transport::MakeEpisodeConfig(
-      pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  auto msg = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   EpisodeSpec dut;
   std::string error;
   auto bad = msg;
@@ -183,8 +190,8 @@ Episode Motor(double reference, double voltage_limit_v = HUGE_VAL, bool microste
 
 TEST(EpisodeConfig, CarriesTheNonlinearMotorWithItsOptions) {
   const Episode e = Motor(0.2, 24.0);
-  const auto msg = transport::MakeEpisodeConfig(
-      pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  const auto msg = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   EXPECT_EQ(msg.plant_name, "stepper_nonlinear");
   EXPECT_EQ(msg.motor_drive, "microstep");
   EpisodeSpec dut;
@@ -198,7 +205,7 @@ TEST(EpisodeConfig, CarriesTheNonlinearMotorWithItsOptions) {
   EXPECT_EQ(dut.plant.nonlinear->motor.resistance_ohm, 33.0);
   // A linear plant's message carries no motor.
   const Episode linear = DoubleIntegrator();
-  const auto plain = transport::MakeEpisodeConfig(pidlab::MakeEpisodeSpec(
+  const auto plain = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
       8, linear.plant, linear.gains, linear.options, linear.options.disturbance, RecoveryOptions{}));
   EXPECT_EQ(plain.motor_drive, "");
   EXPECT_EQ(plain.motor_resistance_ohm, 0.0);
@@ -208,8 +215,8 @@ TEST(EpisodeConfig, CarriesTheNonlinearMotorWithItsOptions) {
 
 TEST(EpisodeConfig, RejectsABadMotorByName) {
   const Episode e = Motor(0.2);
-  const auto msg = transport::MakeEpisodeConfig(
-      pidlab::MakeEpisodeSpec(7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  const auto msg = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   EpisodeSpec dut;
   std::string error;
   auto bad = msg;
@@ -454,8 +461,8 @@ TEST(Trio, EachEpisodeReportsItsOwnResendsNotTheProcessTotal) {
   recovery.silence_deadline_s = 0.5;
   for (id = 1; id <= 3; ++id) {
     summary = false;
-    auto config = transport::MakeEpisodeConfig(
-        pidlab::MakeEpisodeSpec(id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
+    auto config = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+        id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
     client_t.Publish(kEpisodeConfigChannel, &config);
     const double start = NowSeconds();
     while (!summary && NowSeconds() - start < 20.0) {
@@ -572,8 +579,8 @@ TEST(Trio, PlantLearnsTheRoundTripWithoutSamplesFromResentExchanges) {
   bool done = false;
   client_t.Subscribe<pidlab::lcmt_episode_summary>(kSummaryChannel,
                                                    [&](const pidlab::lcmt_episode_summary&) { done = true; });
-  auto config = transport::MakeEpisodeConfig(
-      pidlab::MakeEpisodeSpec(5, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  auto config = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      5, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   client_t.Publish(kEpisodeConfigChannel, &config);
   const double start = NowSeconds();
   while (!done && NowSeconds() - start < 20.0) {
@@ -609,8 +616,8 @@ TEST(Trio, PacedEpisodeIsBitIdenticalAndReportsBoundedStatistics) {
                                                      done = true;
                                                      summary = m;
                                                    });
-  auto config = transport::MakeEpisodeConfig(
-      pidlab::MakeEpisodeSpec(6, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  auto config = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      6, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   client_t.Publish(kEpisodeConfigChannel, &config);
   const double start = NowSeconds();
   while (!done && NowSeconds() - start < 20.0) {

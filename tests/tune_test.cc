@@ -1,4 +1,4 @@
-#include "pidlab/tuner/tune.h"
+#include "pidlab/tune/tune.h"
 
 #include <gtest/gtest.h>
 
@@ -9,6 +9,24 @@
 #include <limits>
 #include <thread>
 #include <vector>
+
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::ObjectiveEvaluator;
+using pidlab::evaluation::ObjectiveKind;
+using pidlab::optim::MultiStart;
+using pidlab::tune::kMultiStartStarts;
+using pidlab::tune::RefineSummary;
+using pidlab::tune::RefineTermination;
+using pidlab::tune::RefineVerdict;
+using pidlab::tune::RefineWithCeres;
+using pidlab::tune::Tune;
+using pidlab::tune::TuneMethod;
+using pidlab::tune::TuneOptions;
+using pidlab::tune::TuneSummary;
 
 namespace pidlab {
 namespace {

@@ -1,7 +1,7 @@
 // Ziegler-Nichols ultimate gain: textbook plants, the paper's plants, and the
 // cases where the method does not apply.
 
-#include "pidlab/tuner/ziegler_nichols.h"
+#include "pidlab/tune/ziegler_nichols.h"
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,11 @@
 #include <iostream>
 
 #include "pidlab/plant_sim/plants.h"
+
+using pidlab::tune::ParseZieglerNicholsRule;
+using pidlab::tune::ZieglerNicholsResult;
+using pidlab::tune::ZieglerNicholsRule;
+using pidlab::tune::ZieglerNicholsTune;
 
 namespace pidlab {
 namespace {

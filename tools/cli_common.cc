@@ -17,6 +17,21 @@
 
 #include "pidlab/transport/wire.h"
 
+using pidlab::analysis::AnalyzeLoop;
+using pidlab::analysis::Cancellation;
+using pidlab::analysis::LoopAnalysis;
+using pidlab::analysis::LoopAnalysisOptions;
+using pidlab::analysis::LoopBounds;
+using pidlab::analysis::LoopBoundsViolations;
+using pidlab::episode_client::EpisodeClient;
+using pidlab::episode_client::EpisodeClientOptions;
+using pidlab::episode_client::EpisodePool;
+using pidlab::episode_client::SplitUrlList;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::kMaxLoopSteps;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+
 namespace pidlab::cli {
 
 // The CLI's limits agree with the wire format's (the libraries below cannot

@@ -12,14 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/episode_client/episode_client.h"
+#include "pidlab/episode_client/episode_pool.h"
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/json/replay_json.h"
 #include "pidlab/json/results_json.h"
 #include "pidlab/spec/field.h"
 #include "pidlab/spec/status.h"
-#include "pidlab/tuner/episode_client.h"
-#include "pidlab/tuner/episode_pool.h"
-#include "pidlab/tuner/evaluation.h"
-#include "pidlab/tuner/loop_analysis.h"
 
 namespace pidlab::cli {
 
@@ -75,19 +75,19 @@ struct LcmFlags {
   std::string lcm_url, channel_prefix, auth_key_file;
   double episode_timeout_s = 600.0;
   double silence_deadline_s = transport::RecoveryOptions{}.silence_deadline_s;
-  int max_attempts = EpisodeClientOptions{}.max_attempts;
+  int max_attempts = episode_client::EpisodeClientOptions{}.max_attempts;
   bool quiet = false, verbose = false;  // --quiet, -v: the notes of the run (SetRunNoteMode)
   void Register(CLI::App* app);
   /// An episode client on the trio these flags (or $PIDLAB_LCM_URL,
   /// $PIDLAB_CHANNEL_PREFIX and $PIDLAB_AUTH_KEY_FILE) name. Throws BadInput for bad flags,
   /// std::runtime_error if LCM cannot start.
-  std::unique_ptr<EpisodeClient> MakeClient() const;
+  std::unique_ptr<episode_client::EpisodeClient> MakeClient() const;
   /// The trios of tune: --lcm-url (comma-separated URLs), else
   /// $PIDLAB_LCM_URLS (pidlab launch --trios K), else $PIDLAB_LCM_URL.
-  std::unique_ptr<EpisodePool> MakePool() const;
+  std::unique_ptr<episode_client::EpisodePool> MakePool() const;
   /// The first URL of --lcm-url, else $PIDLAB_LCM_URL, else LCM's.
   std::string Url() const;
-  EpisodeClientOptions ClientOptions(const std::string& url) const;
+  episode_client::EpisodeClientOptions ClientOptions(const std::string& url) const;
 };
 
 /// Strict number parsing: the whole string must be a number, finite and at
@@ -100,7 +100,7 @@ PidGains ParseGains(const std::string& text);
 double ParseSpread(const std::string& text, const std::string& flag);
 
 /// The analysis as table rows (evaluate, tune).
-std::string FormatRobustness(const LoopAnalysis& a, const LoopBounds& bounds);
+std::string FormatRobustness(const analysis::LoopAnalysis& a, const analysis::LoopBounds& bounds);
 /// Throws BadInput(error) unless `ok`: a spec that does not build.
 inline void Require(bool ok, const std::string& error) {
   if (!ok) throw BadInput(error);
@@ -114,7 +114,8 @@ inline void Require(const Status& status) {
   throw std::runtime_error(status.message());
 }
 /// AnalyzeLoop with the default options; throws BadInput on its error.
-LoopAnalysis AnalyzeOrThrow(const Plant& plant, const PidGains& gains, const LoopOptions& options);
+analysis::LoopAnalysis AnalyzeOrThrow(const Plant& plant, const PidGains& gains,
+                                      const evaluation::LoopOptions& options);
 
 // JsonNumber (null for NaN/inf), ToJson(Evaluation), ToJson(PidGains): the
 // JSON objects live in a library the Python module shares (tools/json/).
@@ -124,8 +125,8 @@ using json::RobustnessJson;
 using json::ToJson;
 std::string FormatPoles(const std::vector<std::complex<double>>& poles);
 /// Human-readable report of one evaluation.
-std::string FormatEvaluation(const Evaluation& ev);
+std::string FormatEvaluation(const evaluation::Evaluation& ev);
 /// CSV of the sample times: t,r,y,e,n. BadInput if `path` cannot be opened.
-void WriteSamplesCsv(const Evaluation& ev, const std::string& path);
+void WriteSamplesCsv(const evaluation::Evaluation& ev, const std::string& path);
 
 }  // namespace pidlab::cli

@@ -12,9 +12,31 @@
 #include "cli_common.h"
 #include "cli_spec.h"
 #include "commands.h"
-#include "pidlab/tuner/episode_client.h"
-#include "pidlab/tuner/monte_carlo.h"
-#include "pidlab/tuner/spec_build.h"
+#include "pidlab/analysis/monte_carlo.h"
+#include "pidlab/episode_client/episode_client.h"
+#include "pidlab/tune/spec_build.h"
+
+using pidlab::analysis::Distribution;
+using pidlab::analysis::LoopAnalysis;
+using pidlab::analysis::LoopBounds;
+using pidlab::analysis::MonteCarloOptions;
+using pidlab::analysis::MonteCarloSummary;
+using pidlab::analysis::RunMonteCarlo;
+using pidlab::episode_client::EpisodeClient;
+using pidlab::evaluation::EvaluateLoop;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::SampledRunner;
+using pidlab::evaluation::SampledStep;
+using pidlab::spec::NameStyle;
+using pidlab::tune::BuildBounds;
+using pidlab::tune::BuildGains;
+using pidlab::tune::BuildLoopOptions;
+using pidlab::tune::BuildMonteCarlo;
+using pidlab::tune::BuildPlant;
+using pidlab::tune::BuildStepperParameters;
 
 namespace pidlab::cli {
 namespace {

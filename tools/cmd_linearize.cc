@@ -9,7 +9,10 @@
 #include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
-#include "pidlab/tuner/spec_build.h"
+#include "pidlab/tune/spec_build.h"
+
+using pidlab::spec::NameStyle;
+using pidlab::tune::BuildNonlinearOptions;
 
 namespace pidlab::cli {
 namespace {

@@ -11,7 +11,13 @@
 #include "commands.h"
 #include "pidlab/figures/figures.h"
 #include "pidlab/plot/loop_figure.h"
-#include "pidlab/tuner/spec_build.h"
+#include "pidlab/tune/spec_build.h"
+
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::spec::NameStyle;
+using pidlab::tune::BuildLoopOptions;
+using pidlab::tune::BuildPlant;
 
 namespace pidlab::cli {
 namespace {

@@ -21,6 +21,8 @@
 #include "pidlab/transport/episode_spec.h"
 #include "pidlab/transport/transport.h"
 
+using pidlab::evaluation::Evaluation;
+
 namespace pidlab::cli {
 namespace {
 

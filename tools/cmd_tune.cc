@@ -14,9 +14,26 @@
 #include "cli_common.h"
 #include "cli_spec.h"
 #include "commands.h"
-#include "pidlab/tuner/episode_client.h"
-#include "pidlab/tuner/spec_build.h"
-#include "pidlab/tuner/tune.h"
+#include "pidlab/episode_client/episode_client.h"
+#include "pidlab/tune/spec_build.h"
+#include "pidlab/tune/tune.h"
+
+using pidlab::analysis::LoopAnalysis;
+using pidlab::episode_client::EpisodePool;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::SampledRunner;
+using pidlab::optim::ProgressCallback;
+using pidlab::optim::TracePoint;
+using pidlab::spec::NameStyle;
+using pidlab::tune::BuildPlant;
+using pidlab::tune::BuildTuneOptions;
+using pidlab::tune::ResolveRobustPreset;
+using pidlab::tune::Tune;
+using pidlab::tune::TuneOptions;
+using pidlab::tune::TuneSummary;
 
 namespace pidlab::cli {
 namespace {

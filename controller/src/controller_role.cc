@@ -5,7 +5,14 @@
 
 #include "pidlab/controller/pid.h"
 
-namespace pidlab::transport {
+namespace pidlab::controller {
+using transport::EpisodeSpec;
+using transport::kControlChannel;
+using transport::kPlantOutputChannel;
+using transport::LogFn;
+using transport::Role;
+using transport::Transport;
+
 namespace {
 int8_t ToCommandStatus(PidStatus status) {
   switch (status) {
@@ -91,4 +98,4 @@ void ControllerRole::OnOutput(const pidlab::lcmt_plant_output& m) {
   }
 }
 
-}  // namespace pidlab::transport
+}  // namespace pidlab::controller

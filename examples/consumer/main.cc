@@ -7,9 +7,9 @@
 #include <cstdio>
 #include <string>
 
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/transport/protocol.h"
-#include "pidlab/tuner/evaluation.h"
-#include "pidlab/tuner/tune.h"
+#include "pidlab/tune/tune.h"
 
 int main() {
   std::string error;
@@ -22,9 +22,9 @@ int main() {
     return 2;
   }
   const pidlab::PidGains paper_nm{29.6558, 0.4977, 28.3216};
-  pidlab::Evaluation evaluation;
-  if (!pidlab::Evaluate(plant, paper_nm, pidlab::LoopOptions{}, pidlab::EvaluateOptions{}, &evaluation,
-                        &error)) {
+  pidlab::evaluation::Evaluation evaluation;
+  if (!pidlab::evaluation::Evaluate(plant, paper_nm, pidlab::evaluation::LoopOptions{},
+                                    pidlab::evaluation::EvaluateOptions{}, &evaluation, &error)) {
     std::fprintf(stderr, "consumer: %s\n", error.c_str());
     return 2;
   }
@@ -39,17 +39,17 @@ int main() {
     std::fprintf(stderr, "consumer: %s\n", error.c_str());
     return 2;
   }
-  pidlab::TuneOptions options;
+  pidlab::tune::TuneOptions options;
   options.max_evaluations = 400;
-  pidlab::TuneSummary summary;
-  if (!pidlab::Tune(oscillator, options, &summary, &error)) {
+  pidlab::tune::TuneSummary summary;
+  if (!pidlab::tune::Tune(oscillator, options, &summary, &error)) {
     std::fprintf(stderr, "consumer: %s\n", error.c_str());
     return 2;
   }
   std::printf("tune kp=%.17g ki=%.17g kd=%.17g objective=%.17g\n", summary.gains.kp, summary.gains.ki,
               summary.gains.kd, summary.objective);
   std::printf("%s\n", summary.BriefReport().c_str());
-  // Over a trio (pidlab launch), pidlab::EpisodeClient is the SampledRunner
+  // Over a trio (pidlab launch), pidlab::episode_client::EpisodeClient is the SampledRunner
   // to pass to Evaluate and Tune; its default URL:
   std::printf("trio url %s\n", pidlab::transport::kDefaultLcmUrl);
   return summary.stable ? 0 : 1;

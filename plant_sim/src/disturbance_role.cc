@@ -5,7 +5,16 @@
 
 #include "pidlab/plant_sim/disturbance.h"
 
-namespace pidlab::transport {
+namespace pidlab::plant_sim {
+using transport::EpisodeSpec;
+using transport::LogFn;
+using transport::Role;
+using transport::Transport;
+using transport::kDisturbanceBlockChannel;
+using transport::kDisturbanceRequestChannel;
+using transport::kMaxNoiseRequest;
+using transport::kNoiseBlock;
+
 
 struct DisturbanceRole::Episode {
   EpisodeSpec spec;
@@ -66,4 +75,4 @@ void DisturbanceRole::OnRequest(const pidlab::lcmt_disturbance_request& m) {
   }
 }
 
-}  // namespace pidlab::transport
+}  // namespace pidlab::plant_sim

@@ -14,7 +14,30 @@
 #include "pidlab/plant_sim/discrete_plant.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
 
-namespace pidlab::transport {
+namespace pidlab::plant_sim {
+using transport::DescribeRealtime;
+using transport::EpisodeSpec;
+using transport::kControlChannel;
+using transport::kDisturbanceBlockChannel;
+using transport::kDisturbanceRequestChannel;
+using transport::kMaxNoiseRequest;
+using transport::kMaxTrajectoryChunk;
+using transport::kNoiseBlock;
+using transport::kNoiseLookahead;
+using transport::kPlantOutputChannel;
+using transport::kSummaryChannel;
+using transport::kTrajectoryChannel;
+using transport::kTrajectoryRequestChannel;
+using transport::LogFn;
+using transport::NowSeconds;
+using transport::Pacer;
+using transport::RealtimeStats;
+using transport::Role;
+using transport::RttEstimator;
+using transport::RttOptions;
+using transport::SetRealtime;
+using transport::Transport;
+
 namespace {
 constexpr int kStreamChunk = 1000;      // the plant streams its trajectory in chunks of this many steps...
 constexpr double kStreamPeriod = 0.1;   // ...or of whatever is new after this many seconds (liveness)
@@ -411,4 +434,4 @@ void PlantRole::Tick(double now_s) {
   if (now_s - e.stream_last_s >= kStreamPeriod) StreamTrajectory(e.k);  // also the client's liveness signal
 }
 
-}  // namespace pidlab::transport
+}  // namespace pidlab::plant_sim

@@ -8,8 +8,18 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pidlab/episode_client/episode_client.h"
 #include "pidlab/transport/episode_start.h"
-#include "pidlab/tuner/episode_client.h"
+
+using pidlab::episode_client::SampledLoopOptions;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::EvaluateSampledRun;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopGains;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::RunSampledLoopInProcess;
+using pidlab::evaluation::SampledRun;
+using pidlab::evaluation::SampledStep;
 
 namespace pidlab::replay {
 namespace {

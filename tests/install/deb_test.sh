@@ -37,7 +37,7 @@ done
 # (checked on this machine with ldconfig and dpkg -S).
 dpkg-deb --contents "$deb" | awk '{print $6}' >"$tmp/contents"
 for f in ./usr/bin/pidlab ./usr/bin/pidlab-plant ./usr/bin/pidlab-controller ./usr/bin/pidlab-disturbance \
-         ./usr/lib/libpidlab_tuner.a ./usr/include/pidlab/tuner/tune.h ./usr/include/pidlab/lcmt_plant_output.hpp \
+         ./usr/lib/libpidlab_tune.a ./usr/include/pidlab/tune/tune.h ./usr/include/pidlab/lcmt_plant_output.hpp \
          ./usr/share/pidlab/lcmtypes/lcmt_plant_output.lcm ./usr/lib/cmake/pidlab/pidlabConfig.cmake \
          ./usr/lib/cmake/pidlab/pidlabTargets.cmake ./usr/lib/pkgconfig/pidlab.pc \
          ./usr/lib/python3/dist-packages/pidlab/lcmt_plant_output.py ./usr/share/pidlab/examples/python_controller.py; do

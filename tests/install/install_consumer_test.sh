@@ -15,7 +15,7 @@ prefix=$tmp/prefix
 cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" 2>&1
 check "cmake --install into a fresh prefix exits 0" "[ $? -eq 0 ]"
 for f in bin/pidlab bin/pidlab-plant bin/pidlab-controller bin/pidlab-disturbance \
-         lib/libpidlab_tuner.a lib/libpidlab_transport.a include/pidlab/tuner/tune.h \
+         lib/libpidlab_tune.a lib/libpidlab_transport.a include/pidlab/tune/tune.h \
          include/pidlab/transport/protocol.h include/pidlab/lcmt_control_command.hpp \
          share/pidlab/lcmtypes/lcmt_control_command.lcm lib/cmake/pidlab/pidlabConfig.cmake \
          lib/cmake/pidlab/pidlabConfigVersion.cmake lib/cmake/pidlab/pidlabTargets.cmake lib/pkgconfig/pidlab.pc \
@@ -24,7 +24,7 @@ for f in bin/pidlab bin/pidlab-plant bin/pidlab-controller bin/pidlab-disturbanc
   check "installs $f" "[ -e '$prefix/$f' ]"
 done
 check "the exported targets carry the pidlab:: namespace" \
-  "grep -q 'add_library(pidlab::tuner STATIC IMPORTED)' '$prefix/lib/cmake/pidlab/pidlabTargets.cmake'"
+  "grep -q 'add_library(pidlab::tune STATIC IMPORTED)' '$prefix/lib/cmake/pidlab/pidlabTargets.cmake'"
 check "the installed headers name no build or source directory" \
   "! grep -rqF -e '$src' -e '$build' '$prefix/include' '$prefix/lib/cmake' '$prefix/lib/pkgconfig'"
 

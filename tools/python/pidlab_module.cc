@@ -17,12 +17,31 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/json/results_json.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
-#include "pidlab/tuner/evaluation.h"
-#include "pidlab/tuner/spec_build.h"
-#include "pidlab/tuner/tune.h"
+#include "pidlab/tune/spec_build.h"
+#include "pidlab/tune/tune.h"
+
+using pidlab::analysis::AnalyzeLoop;
+using pidlab::analysis::LoopAnalysis;
+using pidlab::analysis::LoopAnalysisOptions;
+using pidlab::analysis::LoopBounds;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopOptions;
+using pidlab::spec::NameStyle;
+using pidlab::tune::BuildBounds;
+using pidlab::tune::BuildGains;
+using pidlab::tune::BuildLoopOptions;
+using pidlab::tune::BuildPlant;
+using pidlab::tune::BuildTuneOptions;
+using pidlab::tune::ResolveRobustPreset;
+using pidlab::tune::Tune;
+using pidlab::tune::TuneOptions;
+using pidlab::tune::TuneSummary;
 
 namespace py = pybind11;
 
@@ -269,7 +288,7 @@ PYBIND11_MODULE(_pidlab, m) {
         if (which != "tune") Bad("read_spec: '" + which + "' must be evaluate or tune");
         pidlab::spec::TuningSpec s;
         ReadKwargs("read_spec", py::dict(kwargs), &s, &given);
-        pidlab::ResolveRobustPreset(&s, given);
+        pidlab::tune::ResolveRobustPreset(&s, given);
         return ToPython(pidlab::spec::ToJson(s));
       },
       "read_spec(which, **spec): the spec evaluate or tune would read from these keywords (defaults filled "

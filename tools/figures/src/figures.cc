@@ -8,6 +8,13 @@
 #include "pidlab/plot/loop_figure.h"
 #include "pidlab/replay/replay.h"
 
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::SampledStep;
+
 namespace pidlab::figures {
 
 namespace {

@@ -2,6 +2,20 @@
 
 #include <cmath>
 
+using pidlab::analysis::Cancellation;
+using pidlab::analysis::Distribution;
+using pidlab::analysis::LoopAnalysis;
+using pidlab::analysis::LoopBounds;
+using pidlab::analysis::LoopBoundsViolations;
+using pidlab::analysis::MonteCarloOptions;
+using pidlab::analysis::MonteCarloSummary;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::ObjectiveKind;
+using pidlab::tune::TuneMethod;
+using pidlab::tune::TuneOptions;
+using pidlab::tune::TuneSummary;
+
 namespace pidlab::json {
 
 nlohmann::json JsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }

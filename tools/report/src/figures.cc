@@ -10,6 +10,12 @@
 #include "pidlab/plot/plot.h"
 #include "report_internal.h"
 
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopOptions;
+using pidlab::tune::TuneMethod;
+
 namespace pidlab::report {
 namespace {
 

@@ -12,9 +12,22 @@
 #include <stdexcept>
 
 #include "format.h"
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
 #include "pidlab/plot/plot.h"
-#include "pidlab/tuner/evaluation.h"
+
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopGains;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+using pidlab::evaluation::SampledStep;
+using pidlab::tune::ApplyRobustPreset;
+using pidlab::tune::Tune;
+using pidlab::tune::TuneMethod;
+using pidlab::tune::TuneOptions;
+using pidlab::tune::TuneSummary;
 
 namespace pidlab::report {
 namespace {

@@ -18,6 +18,10 @@
 #include "format.h"
 #include "report_internal.h"
 
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+
 namespace pidlab::report {
 namespace {
 

@@ -9,6 +9,9 @@
 #include "format.h"
 #include "report_internal.h"
 
+using pidlab::evaluation::LoopOptions;
+using pidlab::tune::TuneMethod;
+
 namespace pidlab::report {
 
 std::string Gains(const PidGains& g) { return Num(g.kp, 5) + ", " + Num(g.ki, 5) + ", " + Num(g.kd, 5); }

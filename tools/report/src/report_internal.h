@@ -26,14 +26,14 @@ bool RelClose(double a, double b, double rel);
 /// A built-in plant by name; throws std::invalid_argument if unknown.
 Plant BuiltinPlant(const std::string& name);
 /// The paper's loop, with a +/-amplitude square wave (0: none).
-LoopOptions PaperLoop(double amplitude);
+evaluation::LoopOptions PaperLoop(double amplitude);
 /// The published row of `table`, `plant` and `method` (and `amplitude` if
 /// >= 0); null if none.
 const PaperRow* FindRow(const std::vector<RowResult>& rows, const std::string& table,
                         const std::string& plant, const std::string& method, double amplitude = -1.0);
 /// pidlab's tuning of `plant` by `method` under `amplitude`; null if none.
-const Tuning* FindTuning(const std::vector<Tuning>& tunings, const std::string& plant, TuneMethod method,
-                         double amplitude);
+const Tuning* FindTuning(const std::vector<Tuning>& tunings, const std::string& plant,
+                         tune::TuneMethod method, double amplitude);
 
 // ------------------------------------------------------------- Tables II-VI (paper_table_section.cc)
 

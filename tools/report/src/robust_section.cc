@@ -9,8 +9,26 @@
 #include <sstream>
 
 #include "format.h"
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/plot/plot.h"
-#include "pidlab/tuner/evaluation.h"
+
+using pidlab::analysis::AnalyzeLoop;
+using pidlab::analysis::LoopAnalysis;
+using pidlab::analysis::LoopAnalysisOptions;
+using pidlab::analysis::LoopFrequencyPoint;
+using pidlab::analysis::LoopFrequencyResponse;
+using pidlab::analysis::MonteCarloOptions;
+using pidlab::analysis::RunMonteCarlo;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopGains;
+using pidlab::evaluation::LoopOptions;
+using pidlab::tune::ApplyRobustPreset;
+using pidlab::tune::RobustPreset;
+using pidlab::tune::Tune;
+using pidlab::tune::TuneOptions;
+using pidlab::tune::TuneSummary;
 
 namespace pidlab::report {
 namespace {

@@ -9,6 +9,12 @@
 #include "format.h"
 #include "report_internal.h"
 
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
+
 namespace pidlab::report {
 namespace {
 

@@ -3,8 +3,16 @@
 #include <fstream>
 #include <sstream>
 
+#include "pidlab/episode_client/episode_client.h"
 #include "pidlab/launcher/launcher.h"
-#include "pidlab/tuner/episode_client.h"
+
+using pidlab::episode_client::EpisodeClient;
+using pidlab::episode_client::EpisodeClientOptions;
+using pidlab::evaluation::Evaluate;
+using pidlab::evaluation::EvaluateOptions;
+using pidlab::evaluation::Evaluation;
+using pidlab::evaluation::LoopKind;
+using pidlab::evaluation::LoopOptions;
 
 namespace pidlab::report {
 

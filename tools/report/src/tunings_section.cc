@@ -8,6 +8,11 @@
 #include "format.h"
 #include "report_internal.h"
 
+using pidlab::tune::RefineSummary;
+using pidlab::tune::Tune;
+using pidlab::tune::TuneMethod;
+using pidlab::tune::TuneOptions;
+
 namespace pidlab::report {
 namespace {
 

@@ -8,15 +8,15 @@
 
 #include "pidlab/transport/role.h"
 
-namespace pidlab::transport {
+namespace pidlab::controller {
 
-class ControllerRole : public Role {
+class ControllerRole : public transport::Role {
  public:
-  ControllerRole(Transport* transport, LogFn log = {}, bool verbose = false);
+  ControllerRole(transport::Transport* transport, transport::LogFn log = {}, bool verbose = false);
   ~ControllerRole() override;
 
  protected:
-  void StartEpisode(const EpisodeSpec& spec) override;
+  void StartEpisode(const transport::EpisodeSpec& spec) override;
 
  private:
   void OnOutput(const pidlab::lcmt_plant_output& msg);
@@ -24,4 +24,4 @@ class ControllerRole : public Role {
   std::unique_ptr<Episode> ep_;
 };
 
-}  // namespace pidlab::transport
+}  // namespace pidlab::controller

@@ -9,15 +9,15 @@
 
 #include "pidlab/transport/role.h"
 
-namespace pidlab::transport {
+namespace pidlab::plant_sim {
 
-class DisturbanceRole : public Role {
+class DisturbanceRole : public transport::Role {
  public:
-  DisturbanceRole(Transport* transport, LogFn log = {}, bool verbose = false);
+  DisturbanceRole(transport::Transport* transport, transport::LogFn log = {}, bool verbose = false);
   ~DisturbanceRole() override;
 
  protected:
-  void StartEpisode(const EpisodeSpec& spec) override;
+  void StartEpisode(const transport::EpisodeSpec& spec) override;
 
  private:
   void OnRequest(const pidlab::lcmt_disturbance_request& msg);
@@ -25,4 +25,4 @@ class DisturbanceRole : public Role {
   std::unique_ptr<Episode> ep_;
 };
 
-}  // namespace pidlab::transport
+}  // namespace pidlab::plant_sim

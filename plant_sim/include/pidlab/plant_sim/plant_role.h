@@ -24,7 +24,7 @@
 #include "pidlab/transport/role.h"
 #include "pidlab/transport/rtt.h"
 
-namespace pidlab::transport {
+namespace pidlab::plant_sim {
 
 /// The plant answers TRAJECTORY_REQUEST for its current episode and for
 /// finished ones it still holds: the trajectories (y, u, n) of the most
@@ -34,20 +34,21 @@ namespace pidlab::transport {
 /// repair its log after COMMAND (docs/trio.md).
 inline constexpr std::size_t kPlantHistoryBytes = std::size_t{64} << 20;
 
-class PlantRole : public Role {
+class PlantRole : public transport::Role {
  public:
   /// realtime_factor > 0 paces every episode: step k starts no earlier than
   /// t0 + k dt / realtime_factor (pacing.h); 0: as fast as the loop goes.
-  PlantRole(Transport* transport, LogFn log = {}, bool verbose = false, double realtime_factor = 0.0);
+  PlantRole(transport::Transport* transport, transport::LogFn log = {}, bool verbose = false,
+            double realtime_factor = 0.0);
   ~PlantRole() override;
   void Tick(double now_s) override;
   double MaxWait() const override;
   bool running() const { return running_; }
   /// The resend timer (measured round trips of y_k -> u_k).
-  const RttEstimator& rtt() const { return rtt_; }
+  const transport::RttEstimator& rtt() const { return rtt_; }
 
  protected:
-  void StartEpisode(const EpisodeSpec& spec) override;
+  void StartEpisode(const transport::EpisodeSpec& spec) override;
 
  private:
   void OnControl(const pidlab::lcmt_control_command& msg);
@@ -70,8 +71,8 @@ class PlantRole : public Role {
   std::deque<std::unique_ptr<Episode>> history_;  // finished or abandoned episodes, oldest first
   std::size_t history_bytes_ = 0;
   bool running_ = false;
-  RttEstimator rtt_;
+  transport::RttEstimator rtt_;
   double realtime_factor_ = 0.0;
 };
 
-}  // namespace pidlab::transport
+}  // namespace pidlab::plant_sim

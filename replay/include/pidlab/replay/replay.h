@@ -6,14 +6,14 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/replay/log_reader.h"
-#include "pidlab/tuner/evaluation.h"
 
 namespace pidlab::replay {
 
 /// The logged trajectory as SampledSteps (k, t = k dt, r, y, u, n) for
 /// k = 0..total_steps-1; false if the episode is not complete.
-bool EpisodeTrajectory(const Episode& episode, std::vector<SampledStep>* trajectory);
+bool EpisodeTrajectory(const Episode& episode, std::vector<evaluation::SampledStep>* trajectory);
 
 /// Recomputes the episode's metrics with pidlab::Evaluate, the code of
 /// `pidlab evaluate`: the logged plant outputs stand in for the sampled loop
@@ -21,7 +21,7 @@ bool EpisodeTrajectory(const Episode& episode, std::vector<SampledStep>* traject
 /// run that Evaluate also needs is simulated in process. Records the logged
 /// trajectory in evaluation->trajectory. False with *error if the episode has
 /// no valid configuration or is not complete.
-bool EvaluateEpisode(const Episode& episode, Evaluation* evaluation, std::string* error);
+bool EvaluateEpisode(const Episode& episode, evaluation::Evaluation* evaluation, std::string* error);
 
 /// Result of re-driving a fresh controller with the logged plant outputs.
 struct RedriveResult {

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/plot/plot.h"
-#include "pidlab/tuner/evaluation.h"
 
 namespace pidlab::figures {
 
@@ -14,8 +14,8 @@ namespace pidlab::figures {
 /// t = k dt); the continuous loop has no sampled command, so y, e, n are drawn
 /// at the sample times t = m ts and the title says so. False with *error for
 /// invalid input.
-bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, const LoopOptions& options,
-                      plot::Figure* figure, std::string* error);
+bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains,
+                      const evaluation::LoopOptions& options, plot::Figure* figure, std::string* error);
 
 /// One trace per episode of the log (all, or those listed in `episodes`).
 /// *report receives the reader's warnings (one line each). False with *error

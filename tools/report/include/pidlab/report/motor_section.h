@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/tuner/tune.h"
+#include "pidlab/tune/tune.h"
 
 namespace pidlab::report {
 
@@ -66,7 +66,7 @@ struct MotorSection {
   bool robust_available = false;
   std::string robust_note;
   /// The tune done on the motor itself (its gains are the last set).
-  TuneSummary motor_tune;
+  tune::TuneSummary motor_tune;
   double tune_move_rad = 0, tune_horizon_s = 0, tune_sample_time_s = 0;
   std::vector<MotorCurve> curves;
   double compute_time_s = 0;  // wall time (printed by nobody in report.md)

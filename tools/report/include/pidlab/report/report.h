@@ -19,7 +19,7 @@
 
 #include "pidlab/report/motor_section.h"
 #include "pidlab/report/robust_section.h"
-#include "pidlab/tuner/tune.h"
+#include "pidlab/tune/tune.h"
 
 namespace pidlab::report {
 
@@ -80,11 +80,11 @@ enum class TuningStatus {
 /// One of pidlab's own tunings.
 struct Tuning {
   std::string plant;
-  TuneMethod method = TuneMethod::kNelderMead;
+  tune::TuneMethod method = tune::TuneMethod::kNelderMead;
   double disturbance_amplitude = 0.0;  // square wave during tuning (0: none)
   TuningStatus status = TuningStatus::kNotApplicable;
   std::string message;  // kTuned: the search's summary; otherwise why not
-  TuneSummary summary;
+  tune::TuneSummary summary;
   Metrics metrics;  // of summary.gains (kTuned only)
   bool Tuned() const { return status == TuningStatus::kTuned; }
 };
@@ -155,7 +155,7 @@ bool WriteReport(ReportData* data, std::string* error);
 std::string RenderMarkdown(const ReportData& data);
 
 /// The report's metrics of an evaluation (step metrics NaN where not valid).
-void FillFromEvaluation(const Evaluation& evaluation, Metrics* metrics);
+void FillFromEvaluation(const evaluation::Evaluation& evaluation, Metrics* metrics);
 
 /// Metrics of `gains` on `plant` under the paper's continuous loop with a
 /// ±amplitude square disturbance (period 2 s; 0: none).

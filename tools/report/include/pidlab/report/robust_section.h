@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "pidlab/tuner/loop_analysis.h"
-#include "pidlab/tuner/monte_carlo.h"
-#include "pidlab/tuner/tune.h"
+#include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/analysis/monte_carlo.h"
+#include "pidlab/tune/tune.h"
 
 namespace pidlab::report {
 
@@ -34,9 +34,9 @@ struct RobustGainSet {
   PidGains gains;  // tf filled in: 0 = the ideal derivative
   bool stable = false;
   double setpoint_iae = 0, load_iae = 0;  // eq. (4) of the step, and of a unit load step at the plant input
-  LoopAnalysis analysis;
-  MonteCarloSummary monte_carlo;
-  std::vector<LoopFrequencyPoint> response;  // on RobustSection::frequencies_rad_s
+  analysis::LoopAnalysis analysis;
+  analysis::MonteCarloSummary monte_carlo;
+  std::vector<analysis::LoopFrequencyPoint> response;  // on RobustSection::frequencies_rad_s
 };
 
 struct RobustPlant {

@@ -1,0 +1,275 @@
+// Loop analysis (loop_analysis.h): the closed-loop poles and the controller's
+// zeros, then the margins (loop_margins.cc) and the peaks of S, T and C S
+// (loop_response.cc) over the loop's frequency response (loop_response.h).
+
+#include "pidlab/analysis/loop_analysis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "loop_response.h"
+
+namespace pidlab::analysis {
+namespace {
+
+using loop_internal::cd;
+using loop_internal::ContinuousResponse;
+using loop_internal::Eval;
+using loop_internal::FindCrossings;
+using loop_internal::Grid;
+using loop_internal::kInf;
+using loop_internal::kNaN;
+using loop_internal::kPi;
+using loop_internal::Mul;
+using loop_internal::Peak;
+using loop_internal::PeakOnGrid;
+using loop_internal::Point;
+using loop_internal::Response;
+using loop_internal::SampledResponse;
+using loop_internal::SetMargins;
+using loop_internal::SlowestTimeConstant;
+using loop_internal::SpecialFrequencies;
+
+// s-plane image of a pole or zero of the loop kind.
+std::vector<cd> ToS(const std::vector<cd>& roots, evaluation::LoopKind kind, double dt) {
+  if (kind == evaluation::LoopKind::kContinuous) return roots;
+  std::vector<cd> out;
+  for (const cd& z : roots)
+    if (std::abs(z) > 1e-300) out.push_back(std::log(z) / dt);
+  return out;
+}
+
+std::vector<Cancellation> FindCancellations(const std::vector<cd>& s_poles, const std::vector<cd>& s_zeros,
+                                            double tolerance) {
+  std::vector<Cancellation> out;
+  for (const cd& q : s_zeros) {
+    if (!(std::abs(q) > 0.0)) continue;
+    for (const cd& p : s_poles) {
+      const double d = std::abs(p - q) / std::abs(q);
+      if (d <= tolerance) out.push_back({p, q, d});
+    }
+  }
+  return out;
+}
+
+// The inputs AnalyzeLoop accepts, and the loop gains *g of typed_gains.
+bool CheckAnalysisInputs(const Plant& plant, const PidGains& typed_gains,
+                         const evaluation::LoopOptions& options, const LoopAnalysisOptions& ao, PidGains* g,
+                         std::string* error) {
+  if (!GainsAreValid(typed_gains, error) || !options.IsValid(error) || !ao.IsValid(error) ||
+      !plant.tf.IsValid(error))
+    return false;
+  if (plant.tf.RelativeDegree() < 1) {
+    if (error) *error = "plant " + plant.tf.ToString() + " must be strictly proper";
+    return false;
+  }
+  *g = evaluation::LoopGains(typed_gains, options);
+  return GainsAreValid(*g, error);
+}
+
+const char* AnalysisMethod(bool continuous) {
+  return continuous ? "log grid + closed-loop/open-loop pole and zero frequencies, golden-section "
+                      "refinement of every local maximum, Bruinsma-Steinbuch Hamiltonian iteration"
+                    : "log grid up to pi/dt + closed-loop pole frequencies, golden-section refinement "
+                      "of every local maximum";
+}
+
+// The closed loop's poles and the controller's zeros (s-plane), the
+// frequencies a narrow feature can sit at, and the loop's response.
+struct LoopModel {
+  bool stable = false;
+  std::vector<cd> s_poles, s_zeros;
+  std::vector<double> special;
+  std::unique_ptr<Response> response;
+};
+
+bool ContinuousModel(const Plant& plant, const PidGains& g, const evaluation::LoopOptions& options,
+                     LoopModel* m, std::string* error) {
+  evaluation::ContinuousClosedLoop<double> loop;
+  if (!evaluation::BuildContinuousClosedLoop<double>(Realize(plant.tf), g, Disturbance(DisturbanceOptions{}),
+                                                     &loop, error))
+    return false;
+  const evaluation::Stability st = evaluation::ContinuousStability(loop, options.stability_margin);
+  m->stable = st.stable;
+  m->s_poles = st.poles;
+  auto r = std::make_unique<ContinuousResponse>(plant.tf, g);
+  m->s_zeros = PolynomialRoots(r->controller_num());
+  m->special = SpecialFrequencies(m->s_poles);
+  for (const auto& v : {PolynomialRoots(r->a()), PolynomialRoots(r->b())})
+    for (double w : SpecialFrequencies(v)) m->special.push_back(w);
+  m->response.reset(r.release());
+  return true;
+}
+
+void SampledModel(const Plant& plant, const PidGains& g, const evaluation::LoopOptions& options,
+                  const PidOptions& pid, LoopModel* m) {
+  const DiscretePlant discrete(plant.tf, options.dt_s);
+  const evaluation::Stability st = evaluation::SampledStability(discrete, g, pid, options.stability_margin);
+  m->stable = st.stable;
+  m->s_poles = ToS(st.poles, evaluation::LoopKind::kSampled, options.dt_s);
+  auto r = std::make_unique<SampledResponse>(discrete, g, pid);
+  m->s_zeros = ToS(PolynomialRoots(r->controller_num()), evaluation::LoopKind::kSampled, options.dt_s);
+  m->special = SpecialFrequencies(m->s_poles);
+  m->response.reset(r.release());
+}
+
+void MarkUnstable(LoopAnalysis* a) {
+  a->gain_margin_note = a->phase_margin_note = a->noise_gain_note = "unstable loop: no margins or peaks";
+  a->gain_margin = a->phase_margin_deg = a->delay_margin_s = kNaN;
+}
+
+// The analysis grid: 1e-3 x the slowest to 1e3 x the fastest special
+// frequency (sampled: up to pi/dt), with the special frequencies.
+std::vector<double> AnalysisGrid(const std::vector<double>& special, const evaluation::LoopOptions& options,
+                                 const LoopAnalysisOptions& ao) {
+  double lo = kInf, hi = 0.0;
+  for (double w : special) {
+    if (!(w > 0.0) || !std::isfinite(w)) continue;
+    lo = std::min(lo, w);
+    hi = std::max(hi, w);
+  }
+  if (!(hi > 0.0)) lo = hi = 1.0;
+  double w_lo = 1e-3 * lo, w_hi = 1e3 * hi;
+  if (options.loop != evaluation::LoopKind::kContinuous) {
+    w_hi = kPi / options.dt_s;
+    w_lo = std::min(w_lo, 1e-3 * w_hi);
+  }
+  return Grid(w_lo, w_hi, ao.points_per_decade, special);
+}
+
+// Raises the grid's peak *value (at *w) of the continuous loop to its limits
+// w -> 0 and w -> inf, then to the Bruinsma-Steinbuch norm when asked.
+void RaiseContinuousPeak(const ContinuousResponse& r, Peak which, const LoopAnalysisOptions& ao,
+                         double* value, double* w) {
+  const Polynomial& x = which == Peak::kS ? r.b() : (which == Peak::kT ? r.a() : r.c());
+  const double at0 = std::abs(Eval(x, 0.0) / Eval(r.p(), 0.0));
+  if (at0 > *value) {
+    *value = at0;
+    *w = 0.0;
+  }
+  const double at_inf = r.AtInfinity(x);
+  if (at_inf > *value) {
+    *value = at_inf;
+    *w = kInf;
+  }
+  if (std::isfinite(*value) && ao.hamiltonian_check) {
+    double wp = *w;
+    const double h = HinfNormBruinsmaSteinbuch(x, r.p(), *value, *w, 1e-7, &wp);
+    if (h > *value * (1.0 + 1e-6)) {
+      *value = h;
+      *w = wp;
+    }
+  }
+}
+
+// Ms, Mt and the noise gain with their frequencies: peaks on the grid, then
+// the limits w -> 0 and w -> inf (continuous).
+void SetPeaks(const Response& response, const std::vector<double>& w, const std::vector<Point>& pts,
+              bool continuous, const LoopAnalysisOptions& ao, LoopAnalysis* a) {
+  struct Target {
+    Peak which;
+    double* value;
+    double* w;
+  };
+  const Target targets[] = {{Peak::kS, &a->ms, &a->ms_rad_s},
+                            {Peak::kT, &a->mt, &a->mt_rad_s},
+                            {Peak::kCs, &a->noise_gain, &a->noise_gain_rad_s}};
+  for (const Target& t : targets) {
+    *t.value = PeakOnGrid(response, w, pts, t.which, ao.refine_peaks, -kInf, t.w);
+    if (continuous)
+      RaiseContinuousPeak(static_cast<const ContinuousResponse&>(response), t.which, ao, t.value, t.w);
+  }
+}
+
+}  // namespace
+
+namespace loop_internal {
+
+double SlowestTimeConstant(const std::vector<cd>& s_poles) {
+  double slowest = kInf;
+  for (const cd& p : s_poles) slowest = std::min(slowest, std::abs(p.real()));
+  return s_poles.empty() ? kNaN : 1.0 / slowest;
+}
+
+}  // namespace loop_internal
+
+bool LoopAnalysisOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  if (!(points_per_decade > 0.0) || !(points_per_decade <= 10000.0))
+    os << "points per decade " << points_per_decade << " must be in (0, 10000]";
+  else if (!(cancellation_tolerance >= 0.0) || !(cancellation_tolerance < 1.0))
+    os << "cancellation tolerance " << cancellation_tolerance << " must be in [0, 1)";
+  else
+    return true;
+  if (error) *error = os.str();
+  return false;
+}
+
+bool AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
+                 const LoopAnalysisOptions& ao, LoopAnalysis* out, std::string* error) {
+  PidGains g;
+  if (!CheckAnalysisInputs(plant, typed_gains, options, ao, &g, error)) return false;
+  *out = LoopAnalysis();
+  LoopAnalysis& a = *out;
+  a.loop = options.loop;
+  const bool continuous = options.loop == evaluation::LoopKind::kContinuous;
+  a.method = AnalysisMethod(continuous);
+  const PidOptions pid = options.Pid();
+  LoopModel m;
+  if (continuous) {
+    if (!ContinuousModel(plant, g, options, &m, error)) return false;
+  } else {
+    SampledModel(plant, g, options, pid, &m);
+  }
+  a.stable = m.stable;
+  a.slowest_time_constant_s = SlowestTimeConstant(m.s_poles);
+  a.cancellations = FindCancellations(m.s_poles, m.s_zeros, ao.cancellation_tolerance);
+  if (!a.stable) {
+    MarkUnstable(&a);
+    return true;
+  }
+  const std::vector<double> w = AnalysisGrid(m.special, options, ao);
+  std::vector<Point> pts(w.size());
+  for (std::size_t i = 0; i < w.size(); ++i) pts[i] = m.response->At(w[i]);
+  SetMargins(*m.response, FindCrossings(*m.response, w, pts), &a);
+  SetPeaks(*m.response, w, pts, continuous, ao, &a);
+  if (std::isinf(a.noise_gain)) {
+    a.noise_gain_note = g.kd > 0.0 && !(g.tf > 0.0) ? "ideal derivative: unbounded" : "unbounded";
+  }
+  return true;
+}
+
+bool LoopFrequencyResponse(const Plant& plant, const PidGains& typed_gains,
+                           const evaluation::LoopOptions& options, const std::vector<double>& w_rad_s,
+                           std::vector<LoopFrequencyPoint>* response, std::string* error) {
+  if (!GainsAreValid(typed_gains, error) || !options.IsValid(error) || !plant.tf.IsValid(error)) return false;
+  if (options.loop != evaluation::LoopKind::kContinuous) {
+    if (error) *error = "LoopFrequencyResponse: the loop must be continuous";
+    return false;
+  }
+  const PidGains g = evaluation::LoopGains(typed_gains, options);
+  if (!GainsAreValid(g, error)) return false;
+  Polynomial c_num, c_den;
+  ContinuousPidPolynomials(g, &c_num, &c_den);
+  const Polynomial a = Mul(c_num, plant.tf.num), b = Mul(c_den, plant.tf.den);
+  response->clear();
+  response->reserve(w_rad_s.size());
+  for (const double w : w_rad_s) {
+    if (!(std::isfinite(w) && w > 0.0)) {
+      if (error) *error = "LoopFrequencyResponse: frequency " + std::to_string(w) + " is not finite and > 0";
+      return false;
+    }
+    const cd av = Eval(a, cd(0.0, w)), bv = Eval(b, cd(0.0, w)), sum = av + bv;
+    LoopFrequencyPoint p;
+    p.w_rad_s = w;
+    p.l = bv == 0.0 ? cd(kInf, 0.0) : av / bv;
+    p.s = bv / sum;
+    p.t = av / sum;
+    response->push_back(p);
+  }
+  return true;
+}
+
+}  // namespace pidlab::analysis

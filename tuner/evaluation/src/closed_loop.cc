@@ -1,0 +1,245 @@
+#include "pidlab/evaluation/closed_loop.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace pidlab::evaluation {
+namespace {
+
+// |x / step - round(x / step)| small: x is a whole multiple of step.
+bool IsMultiple(double x, double step, long* count) {
+  const double ratio = x / step;
+  const double r = std::round(ratio);
+  if (std::abs(ratio - r) > 1e-9 * std::max(1.0, r)) return false;
+  *count = static_cast<long>(r);
+  return true;
+}
+
+}  // namespace
+
+bool ParseLoopKind(const std::string& s, LoopKind* kind) {
+  if (s == "continuous")
+    *kind = LoopKind::kContinuous;
+  else if (s == "sampled")
+    *kind = LoopKind::kSampled;
+  else
+    return false;
+  return true;
+}
+
+std::string ToString(LoopKind kind) { return kind == LoopKind::kContinuous ? "continuous" : "sampled"; }
+
+bool LoopOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  long count = 0;
+  // Ratios are compared with the limits as doubles before any conversion.
+  if (!(sample_time_s > 0.0) || !std::isfinite(sample_time_s))
+    os << "sample time " << sample_time_s << " s must be positive and finite";
+  else if (!(horizon_s > 0.0) || !std::isfinite(horizon_s))
+    os << "horizon " << horizon_s << " s must be positive and finite";
+  else if (horizon_s / sample_time_s > kMaxLoopSamples + 0.5)
+    os << "horizon / sample time = " << horizon_s / sample_time_s << " samples is more than 1e7";
+  else if (!IsMultiple(horizon_s, sample_time_s, &count) || count < 1)
+    os << "horizon " << horizon_s << " s must be a whole multiple of the sample time " << sample_time_s
+       << " s";
+  else if (!std::isfinite(reference) || reference == 0.0 || std::abs(reference) > kMaxCoefficientMagnitude)
+    os << "reference " << reference << " must be finite, nonzero and at most " << kMaxCoefficientMagnitude
+       << " in magnitude";
+  else if (!(stability_margin >= 0.0) || !(stability_margin < 1.0))
+    os << "stability margin " << stability_margin << " must be in [0, 1)";
+  else if (!(dt_s > 0.0) || !std::isfinite(dt_s))  // a bad --dt is an error even if the loop ignores it
+    os << "dt " << dt_s << " s must be positive and finite";
+  else if (!(derivative_filter_ratio >= 0.0) || !std::isfinite(derivative_filter_ratio))
+    os << "derivative filter ratio " << derivative_filter_ratio << " must be >= 0 and finite";
+  else if (derivative_filter_ratio > 0.0 && pid.derivative_filter_s != 0.0)
+    os << "give the derivative filter once: a time constant " << pid.derivative_filter_s << " s or a ratio "
+       << derivative_filter_ratio << ", not both";
+  else if (!(pid.derivative_filter_s >= 0.0) || !std::isfinite(pid.derivative_filter_s))
+    os << "derivative filter " << pid.derivative_filter_s << " s must be >= 0 and finite";
+  else if (!disturbance.IsValid(error))
+    return false;
+  else if (loop == LoopKind::kContinuous && DisturbanceBreakpoints() > kMaxDisturbanceBreakpoints)
+    os << "the " << ToString(disturbance.kind) << " disturbance switches " << DisturbanceBreakpoints()
+       << " times within the horizon of the continuous loop, more than 1e6: use a longer period or noise "
+          "hold";
+  else if (loop == LoopKind::kSampled) {
+    const PidOptions p = Pid();
+    if (horizon_s / dt_s > kMaxLoopSteps + 0.5)
+      os << "horizon " << horizon_s << " s / dt " << dt_s << " s = " << horizon_s / dt_s
+         << " steps is more than 5e7";
+    else if (!IsMultiple(sample_time_s, dt_s, &count) || count < 1)
+      os << "sample time " << sample_time_s << " s must be a whole multiple of dt " << dt_s << " s";
+    else if (!p.IsValid(error))
+      return false;
+    else
+      return true;
+  } else {
+    return true;
+  }
+  if (error) *error = os.str();
+  return false;
+}
+
+int LoopOptions::NumSamples() const { return static_cast<int>(std::lround(horizon_s / sample_time_s)) + 1; }
+int LoopOptions::StepsPerSample() const { return static_cast<int>(std::lround(sample_time_s / dt_s)); }
+long LoopOptions::TotalSteps() const { return std::lround(horizon_s / dt_s); }
+
+double LoopOptions::DisturbanceBreakpoints() const {
+  switch (disturbance.kind) {
+    case DisturbanceKind::kSquare:
+      return std::floor(horizon_s / (disturbance.period_s / 2.0)) + 1.0;
+    case DisturbanceKind::kNoise:
+      return std::floor(horizon_s / disturbance.noise_hold_s) + 1.0;
+    case DisturbanceKind::kStep:
+      return 1.0;
+    case DisturbanceKind::kNone:
+    case DisturbanceKind::kSine:
+      break;
+  }
+  return 0.0;
+}
+
+double LoopOptions::StepsPerEvaluation() const {
+  if (loop == LoopKind::kSampled) return horizon_s / dt_s;
+  return horizon_s / sample_time_s + 1.0 + kStepsPerBreakpoint * DisturbanceBreakpoints();
+}
+
+std::vector<int> LiveLoopStates(const ContinuousClosedLoop<double>& loop) {
+  // With ki = 0 the integrator state z never reaches u (with kd = 0 the
+  // filter state v neither): its pole is a hidden mode of the realisation,
+  // not of the loop.
+  const int order = loop.loop_order();
+  std::vector<int> live;
+  for (int j = 0; j < order; ++j) {
+    bool feeds = j < loop.plant_order;
+    for (int i = 0; i < order && !feeds; ++i)
+      if (i != j && loop.m(i, j) != 0.0) feeds = true;
+    if (feeds) live.push_back(j);
+  }
+  return live;
+}
+
+int EffectiveLoopOrder(const ContinuousClosedLoop<double>& loop) {
+  return static_cast<int>(LiveLoopStates(loop).size());
+}
+
+Eigen::MatrixXd LiveLoopMatrix(const ContinuousClosedLoop<double>& loop) {
+  const std::vector<int> live = LiveLoopStates(loop);
+  const int n = static_cast<int>(live.size());
+  Eigen::MatrixXd m(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) m(i, j) = loop.m(live[i], live[j]);
+  return m;
+}
+
+Stability ContinuousStability(const ContinuousClosedLoop<double>& loop, double margin) {
+  Eigen::MatrixXd m = LiveLoopMatrix(loop);
+  const int n = static_cast<int>(m.rows());
+  BalanceInPlace(&m);
+  Eigen::EigenSolver<Eigen::MatrixXd> es(m, false);
+  Stability s;
+  s.abscissa = -std::numeric_limits<double>::infinity();
+  bool ok = es.info() == Eigen::Success;
+  for (int i = 0; i < n && es.info() == Eigen::Success; ++i) {  // every pole, even past an unstable one
+    const std::complex<double> p = es.eigenvalues()(i);
+    s.poles.push_back(p);
+    s.abscissa = std::max(s.abscissa, p.real());
+    if (!std::isfinite(p.real()) || !(p.real() < -margin * std::max(1.0, std::abs(p)))) ok = false;
+  }
+  s.stable = ok && static_cast<int>(s.poles.size()) == n;
+  std::sort(s.poles.begin(), s.poles.end(), [](const auto& a, const auto& b) {
+    return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag();
+  });
+  return s;
+}
+
+Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const PidOptions& o,
+                           double margin) {
+  // State z_k = [x_k; I_{k-1}; D_{k-1}; e_{k-1}; s_{k-1}] with r = n = 0, so
+  // e_k = s_k = -C x_k for both derivative modes.
+  const int n = plant.order();
+  const int size = n + 4;
+  const int ii = n, id = n + 1, iep = n + 2, isp = n + 3;
+  const double dt = o.dt_s, tf = EffectiveDerivativeFilter(g, o);
+  const double a = tf / (tf + dt), b = g.kd / (tf + dt);
+  Eigen::RowVectorXd e_row = Eigen::RowVectorXd::Zero(size);
+  e_row.head(n) = -plant.c();
+  Eigen::RowVectorXd i_row = Eigen::RowVectorXd::Zero(size);
+  i_row(ii) = 1.0;
+  switch (o.integral) {
+    case IntegralMethod::kBackwardEuler:
+      i_row += g.ki * dt * e_row;
+      break;
+    case IntegralMethod::kForwardEuler:
+      i_row(iep) += g.ki * dt;
+      break;
+    case IntegralMethod::kTrapezoidal:
+      i_row += 0.5 * g.ki * dt * e_row;
+      i_row(iep) += 0.5 * g.ki * dt;
+      break;
+  }
+  Eigen::RowVectorXd d_row = b * e_row;
+  d_row(id) += a;
+  d_row(isp) -= b;
+  const Eigen::RowVectorXd u_row = g.kp * e_row + i_row + d_row;
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(size, size);
+  m.topLeftCorner(n, n) = plant.phi();
+  m.topRows(n) += plant.gamma() * u_row;
+  m.row(ii) = i_row;
+  m.row(id) = d_row;
+  m.row(iep) = e_row;
+  m.row(isp) = e_row;
+  // With ki = 0 the integral stays 0: drop its hidden eigenvalue at z = 1.
+  if (g.ki == 0.0) m.row(ii).setZero();
+  BalanceInPlace(&m);
+  Eigen::EigenSolver<Eigen::MatrixXd> es(m, false);
+  Stability s;
+  s.abscissa = 0.0;
+  bool ok = es.info() == Eigen::Success;
+  // The continuous criterion Re p < -margin max(1, |p|) applied to the
+  // equivalent s-plane poles p = log(z) / dt, so that a margin means the same
+  // in both loops whatever dt; z = 0 is the fastest possible decay.
+  for (int i = 0; i < size && es.info() == Eigen::Success; ++i) {  // every pole, even past an unstable one
+    const std::complex<double> z = es.eigenvalues()(i);
+    s.poles.push_back(z);
+    s.abscissa = std::max(s.abscissa, std::abs(z));
+    if (!std::isfinite(std::abs(z)) || !(std::abs(z) < 1.0)) {
+      ok = false;
+    } else if (std::abs(z) > 0.0) {
+      const std::complex<double> p = std::log(z) / dt;
+      if (!(p.real() < -margin * std::max(1.0, std::abs(p)))) ok = false;
+    }
+  }
+  s.stable = ok && std::isfinite(s.abscissa) && s.abscissa < 1.0;
+  std::sort(s.poles.begin(), s.poles.end(), [](const auto& p, const auto& q) {
+    return std::abs(p) != std::abs(q) ? std::abs(p) > std::abs(q) : p.imag() < q.imag();
+  });
+  return s;
+}
+
+PidStatus RunNonlinearSampledLoop(NonlinearStepperPlant* plant, const PidGains& gains,
+                                  const PidOptions& pid_options, const Disturbance& disturbance,
+                                  long total_steps, int steps_per_sample, std::vector<double>* y_samples,
+                                  std::vector<SampledStep>* trajectory, double reference) {
+  DiscretePid<double> pid(gains, pid_options);
+  plant->Reset();
+  const double dt = pid_options.dt_s;
+  y_samples->clear();
+  y_samples->reserve(static_cast<std::size_t>(total_steps / steps_per_sample + 1));
+  PidStatus status = PidStatus::kOk;
+  for (long k = 0;; ++k) {
+    const double y = plant->Output();
+    if (k % steps_per_sample == 0) y_samples->push_back(y);
+    if (k == total_steps) break;
+    const double t = static_cast<double>(k) * dt;
+    const double n = disturbance.Value(t);
+    double u = 0.0;
+    const PidStatus s = pid.Step(reference, y, &u);
+    if (s != PidStatus::kOk && s != PidStatus::kSaturated) status = s;
+    if (trajectory) trajectory->push_back({k, t, reference, y, u, n});
+    plant->Step(u + n);
+  }
+  return status;
+}
+
+}  // namespace pidlab::evaluation

@@ -1,0 +1,307 @@
+#include "pidlab/tune/spec_build.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace pidlab::tune {
+
+using spec::Quote;
+
+static_assert(spec::kDefaultDesignPoints == kMultiStartDesignPoints,
+              "the tuning spec's default design matches the multi-start's");
+
+namespace {
+
+// Sets *error and returns false: the one exit of every check below.
+bool Bad(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+}  // namespace
+
+namespace internal {
+
+bool CheckNumber(const spec::Field& f, double v, NameStyle style, std::string* error) {
+  const bool infinite_ok = f.Has(spec::kInfinite) && std::isinf(v);
+  if (infinite_ok || (std::isfinite(v) && std::abs(v) <= spec::kMaxInputMagnitude)) return true;
+  std::ostringstream os;
+  os << spec::DisplayName(f.key, style) << " " << v << " is out of range: numbers must be finite and at most "
+     << spec::kMaxInputMagnitude << " in magnitude";
+  return Bad(error, os.str());
+}
+
+}  // namespace internal
+
+bool BuildStepperParameters(const spec::PlantSpec& s, NameStyle style, StepperMotorParameters* out,
+                            std::string* error) {
+  const auto name = [style](const char* key) { return spec::DisplayName(key, style); };
+  StepperMotorParameters sp;
+  const std::pair<const char*, double*> table[] = {{"resistance_ohm", &sp.resistance_ohm},
+                                                   {"self_inductance_h", &sp.self_inductance_h},
+                                                   {"mutual_inductance_h", &sp.mutual_inductance_h},
+                                                   {"inertia_kg_m2", &sp.inertia_kg_m2},
+                                                   {"rotor_teeth", &sp.rotor_teeth},
+                                                   {"viscous_friction", &sp.viscous_friction},
+                                                   {"tooth_pitch_rad", &sp.tooth_pitch_rad},
+                                                   {"stationary_current_a", &sp.stationary_current_a},
+                                                   {"flux_linkage", &sp.flux_linkage}};
+  for (const auto& [parameter, value] : s.stepper) {
+    double* field = nullptr;
+    for (const auto& [known, where] : table)
+      if (parameter == known) field = where;
+    if (!field) return Bad(error, name("stepper") + " parameter " + Quote(parameter) + " is unknown");
+    *field = value;
+  }
+  if (!s.stepper.empty() && s.plant != "stepper_motor" && s.plant != "stepper" &&
+      s.plant != "stepper_nonlinear")
+    return Bad(error, name("stepper") + " overrides apply only to " + name("plant") +
+                          " stepper_motor or stepper_nonlinear, not " + Quote(s.plant));
+  if (!sp.IsValid(error)) return false;
+  *out = sp;
+  return true;
+}
+
+bool BuildNonlinearOptions(const spec::PlantSpec& s, NameStyle style, NonlinearStepperOptions* out,
+                           std::string* error) {
+  NonlinearStepperOptions o;
+  if (!BuildStepperParameters(s, style, &o.motor, error)) return false;
+  o.detent_torque_nm = s.detent_torque_nm;
+  o.load_torque_nm = s.load_torque_nm;
+  o.load_step_nm = s.load_step_nm;
+  o.load_step_time_s = s.load_step_time_s;
+  o.voltage_limit_v = s.voltage_limit_v;
+  o.input_scale = s.input_scale;
+  if (s.drive != "linear" && s.drive != "microstep")
+    return Bad(error,
+               spec::DisplayName("drive", style) + " " + Quote(s.drive) + " must be linear or microstep");
+  o.microstep_table = s.drive == "microstep";
+  if (!o.IsValid(error)) return false;
+  *out = o;
+  return true;
+}
+
+namespace {
+
+// True when a stepper_nonlinear option differs from its default.
+bool HasNonlinearOption(const spec::PlantSpec& s) {
+  const spec::PlantSpec d;
+  return s.detent_torque_nm != d.detent_torque_nm || s.load_torque_nm != d.load_torque_nm ||
+         s.load_step_nm != d.load_step_nm || s.load_step_time_s != d.load_step_time_s ||
+         s.voltage_limit_v != d.voltage_limit_v || s.input_scale != d.input_scale || s.drive != d.drive;
+}
+
+}  // namespace
+
+bool BuildPlant(const spec::PlantSpec& s, NameStyle style, Plant* out, std::string* error) {
+  const auto name = [style](const char* key) { return spec::DisplayName(key, style); };
+  if (!CheckSpecNumbers(s, style, error)) return false;
+  const bool custom = !s.num.empty() || !s.den.empty();
+  if (custom && !s.plant.empty() && s.plant != "custom")
+    return Bad(error, name("plant") + " " + Quote(s.plant) + " cannot be combined with " + name("num") + "/" +
+                          name("den") + " (use " + name("plant") + " custom or omit it)");
+  if (custom) {
+    if (s.num.empty() || s.den.empty())
+      return Bad(error, "a custom plant needs both " + name("num") + " and " + name("den"));
+    return MakeCustomPlant(s.num, s.den, out, error);
+  }
+  if (s.plant.empty())
+    return Bad(error, name("plant") + " is required (or " + name("num") + " and " + name("den") +
+                          " for a custom plant)");
+  if (s.plant == "custom")
+    return Bad(error, name("plant") + " custom needs " + name("num") + " and " + name("den"));
+  if (s.plant == "stepper_nonlinear") {
+    NonlinearStepperOptions o;
+    return BuildNonlinearOptions(s, style, &o, error) && MakeNonlinearStepperPlant(o, out, error);
+  }
+  if (HasNonlinearOption(s))
+    return Bad(error, name("detent_torque") + ", " + name("load_torque") + ", " + name("load_step") + ", " +
+                          name("load_step_time") + ", " + name("voltage_limit") + ", " + name("input_scale") +
+                          " and " + name("drive") + " apply only to " + name("plant") +
+                          " stepper_nonlinear, not " + Quote(s.plant));
+  StepperMotorParameters sp;
+  if (!BuildStepperParameters(s, style, &sp, error)) return false;
+  // A plant name is printable and short, so Truncate leaves every valid one
+  // as it is, and MakePlant's "unknown plant '...'" echoes at most 200 chars.
+  return MakePlant(spec::Truncate(s.plant), sp, out, error);
+}
+
+bool BuildGains(const std::vector<double>& g, NameStyle style, PidGains* out, std::string* error) {
+  if (g.size() != 3) {
+    std::ostringstream os;
+    os << spec::DisplayName("gains", style) << " ";
+    for (std::size_t i = 0; i < g.size() && i < 8; ++i) os << (i ? "," : "") << g[i];
+    if (g.size() > 8) os << ",...(" << g.size() << " numbers)";
+    os << " must be three numbers KP,KI,KD";
+    return Bad(error, os.str());
+  }
+  const PidGains gains{g[0], g[1], g[2]};
+  if (!GainsAreValid(gains, error)) return false;
+  *out = gains;
+  return true;
+}
+
+namespace {
+
+bool BuildDisturbance(const spec::LoopSpec& s, NameStyle style, DisturbanceOptions* d, std::string* error) {
+  if (s.disturbance.empty()) {
+    d->kind = s.disturbance_amplitude != 0.0 ? DisturbanceKind::kSquare : DisturbanceKind::kNone;
+  } else if (!ParseDisturbanceKind(s.disturbance, &d->kind)) {
+    return Bad(error, spec::DisplayName("disturbance", style) + " " + Quote(s.disturbance) +
+                          " must be none, square, step, sine or noise");
+  }
+  d->amplitude = s.disturbance_amplitude;
+  d->period_s = s.disturbance_period_s;
+  d->phase_s = s.disturbance_phase_s;
+  d->step_time_s = s.disturbance_step_time_s;
+  d->noise_hold_s = s.noise_hold_s;
+  d->seed = s.seed;
+  return true;
+}
+
+bool BuildPidOptions(const spec::LoopSpec& s, NameStyle style, PidOptions* pid, std::string* error) {
+  const auto name = [style](const char* key) { return spec::DisplayName(key, style); };
+  pid->derivative_filter_s = s.derivative_filter_s;
+  pid->output_min = s.output_limits.first;
+  pid->output_max = s.output_limits.second;
+  if (!ParseAntiWindup(s.anti_windup, &pid->anti_windup))
+    return Bad(error, name("anti_windup") + " " + Quote(s.anti_windup) +
+                          " must be none, clamping or back-calculation");
+  if (!ParseDerivativeOn(s.derivative_on, &pid->derivative_on))
+    return Bad(error, name("derivative_on") + " " + Quote(s.derivative_on) + " must be error or measurement");
+  if (!ParseIntegralMethod(s.integral, &pid->integral))
+    return Bad(error, name("integral") + " " + Quote(s.integral) +
+                          " must be backward-euler, forward-euler or trapezoidal");
+  return true;
+}
+
+}  // namespace
+
+bool BuildLoopOptions(const spec::LoopSpec& s, NameStyle style, evaluation::LoopOptions* out,
+                      std::string* error) {
+  if (!CheckSpecNumbers(s, style, error)) return false;
+  evaluation::LoopOptions o;
+  if (!evaluation::ParseLoopKind(s.loop, &o.loop))
+    return Bad(error,
+               spec::DisplayName("loop", style) + " " + Quote(s.loop) + " must be continuous or sampled");
+  o.dt_s = s.dt_s;
+  o.sample_time_s = s.sample_time_s;
+  o.horizon_s = s.horizon_s;
+  o.stability_margin = s.stability_margin;
+  o.reference = s.reference;
+  o.derivative_filter_ratio = s.derivative_filter_ratio;
+  if (!BuildDisturbance(s, style, &o.disturbance, error) || !BuildPidOptions(s, style, &o.pid, error))
+    return false;
+  o.pid = PidOptionsAt(o.pid, o.dt_s);
+  if (!o.IsValid(error)) return false;
+  *out = o;
+  return true;
+}
+
+bool BuildBounds(const spec::BoundsSpec& s, NameStyle style, analysis::LoopBounds* out, std::string* error) {
+  if (!CheckSpecNumbers(s, style, error)) return false;
+  analysis::LoopBounds b;
+  b.max_ms = s.max_ms;
+  b.max_mt = s.max_mt;
+  b.max_noise_gain = s.max_noise_gain;
+  b.min_phase_margin_deg = s.min_phase_margin_deg;
+  b.min_gain_margin = s.min_gain_margin;
+  b.max_time_constant_s = s.max_time_constant_s;
+  if (!b.IsValid(error)) return false;
+  *out = b;
+  return true;
+}
+
+bool BuildMonteCarlo(const spec::EvaluateSpec& s, NameStyle style, analysis::MonteCarloOptions* out,
+                     std::string* error) {
+  const auto name = [style](const char* key) { return spec::DisplayName(key, style); };
+  if (s.monte_carlo < 0)
+    return Bad(error, name("monte_carlo") + " " + std::to_string(s.monte_carlo) + " must be >= 0");
+  if (!(s.spread >= 0.0) || !(s.spread < 1.0))
+    return Bad(error, name("spread") + " " + spec::FormatNumber(s.spread) + " must be in [0, 1)");
+  analysis::MonteCarloOptions mc;
+  mc.samples = std::max(s.monte_carlo, 1);
+  mc.spread = s.spread;
+  mc.seed = s.loop.seed;
+  std::string why;
+  if (!mc.IsValid(&why))
+    return Bad(error, name("spread") + " " + spec::FormatNumber(s.spread) + " / " + name("monte_carlo") +
+                          ": " + why);
+  *out = mc;
+  return true;
+}
+
+void ResolveRobustPreset(spec::TuningSpec* s, const std::set<std::string>& given) {
+  if (!s->tune.robust) return;
+  const auto kept = [&given](const char* key) { return given.count(key) > 0; };
+  if (!kept("objective")) s->tune.objective = ToString(evaluation::ObjectiveKind::kSetpointLoad);
+  if (!kept("load_weight")) s->tune.load_weight = RobustPreset::kLoadWeight;
+  if (!kept("derivative_filter") && !kept("derivative_filter_ratio")) {
+    s->loop.derivative_filter_s = 0.0;
+    s->loop.derivative_filter_ratio = RobustPreset::kFilterRatio;
+  }
+  if (!kept("max_ms")) s->bounds.max_ms = RobustPreset::kMaxMs;
+  if (!kept("max_time_constant"))
+    s->bounds.max_time_constant_s = RobustPreset::kTimeConstantFraction * s->loop.horizon_s;
+}
+
+namespace {
+
+bool BuildSearch(const spec::TuneSpec& t, NameStyle style, TuneOptions* o, std::string* error) {
+  const auto name = [style](const char* key) { return spec::DisplayName(key, style); };
+  if (!ParseTuneMethod(t.method, &o->method))
+    return Bad(error, name("method") + " " + Quote(t.method) +
+                          " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
+  if (!evaluation::ParseObjectiveKind(t.objective, &o->objective))
+    return Bad(error, name("objective") + " " + Quote(t.objective) +
+                          " must be iae, ise, itae, iae-continuous, load-iae or setpoint-load");
+  if (!(t.load_weight >= 0.0))
+    return Bad(error, name("load_weight") + " " + spec::FormatNumber(t.load_weight) + " must be >= 0");
+  o->load_weight = t.load_weight;
+  if (!ParseZieglerNicholsRule(t.zn_rule, &o->zn_rule))
+    return Bad(error, name("zn_rule") + " " + Quote(t.zn_rule) +
+                          " must be classic, pessen, some-overshoot or no-overshoot");
+  if (t.refine != "ceres" && t.refine != "none")
+    return Bad(error, name("refine") + " " + Quote(t.refine) + " must be ceres or none");
+  o->refine = t.refine == "ceres";
+  o->lower = t.bounds.first;
+  o->upper = t.bounds.second;
+  o->max_iterations = t.max_iter;
+  o->max_evaluations = t.max_evals;
+  o->starts = t.starts;
+  o->design_points = t.design_points;
+  o->refine_starts = t.refine_starts;
+  o->adaptive = t.adaptive;
+  o->max_overshoot_pct = t.max_overshoot_pct;
+  o->max_settling_time_s = t.max_settling_s;
+  o->agree_tolerance = t.agree_tolerance;
+  if (t.robust_samples < 0 || t.robust_samples > 10000)
+    return Bad(error,
+               name("robust_samples") + " " + std::to_string(t.robust_samples) + " must be in [0, 10000]");
+  if (!(t.robust_spread >= 0.0) || !(t.robust_spread < 1.0))
+    return Bad(error,
+               name("robust_spread") + " " + spec::FormatNumber(t.robust_spread) + " must be in [0, 1)");
+  if (!(t.robust_quantile > 0.0) || !(t.robust_quantile <= 1.0))
+    return Bad(error,
+               name("robust_quantile") + " " + spec::FormatNumber(t.robust_quantile) + " must be in (0, 1]");
+  o->robust_samples = t.robust_samples;
+  o->robust_spread = t.robust_spread;
+  o->robust_quantile = t.robust_quantile;
+  return true;
+}
+
+}  // namespace
+
+bool BuildTuneOptions(const spec::TuningSpec& s, NameStyle style, TuneOptions* out, std::string* error) {
+  TuneOptions o;
+  if (!CheckSpecNumbers(s.tune, style, error) || !BuildLoopOptions(s.loop, style, &o.loop, error) ||
+      !BuildSearch(s.tune, style, &o, error) || !BuildBounds(s.bounds, style, &o.bounds, error) ||
+      !BuildStepperParameters(s.plant, style, &o.stepper, error))
+    return false;
+  o.seed = s.loop.seed;
+  if (!o.IsValid(error)) return false;
+  *out = o;
+  return true;
+}
+
+}  // namespace pidlab::tune

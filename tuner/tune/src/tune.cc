@@ -1,0 +1,466 @@
+#include "pidlab/tune/tune.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "pidlab/optim/genetic_algorithm.h"
+#include "pidlab/optim/multi_start.h"
+#include "pidlab/optim/nelder_mead.h"
+#include "pidlab/optim/paper_nelder_mead.h"
+#include "pidlab/optim/pso_gsa.h"
+
+namespace pidlab::tune {
+
+bool ParseTuneMethod(const std::string& s, TuneMethod* method) {
+  if (s == "multi-start")
+    *method = TuneMethod::kMultiStart;
+  else if (s == "nelder-mead")
+    *method = TuneMethod::kNelderMead;
+  else if (s == "paper-nm")
+    *method = TuneMethod::kPaperNelderMead;
+  else if (s == "ziegler-nichols")
+    *method = TuneMethod::kZieglerNichols;
+  else if (s == "ga")
+    *method = TuneMethod::kGeneticAlgorithm;
+  else if (s == "pso-gsa")
+    *method = TuneMethod::kPsoGsa;
+  else
+    return false;
+  return true;
+}
+
+std::string ToString(TuneMethod method) {
+  switch (method) {
+    case TuneMethod::kMultiStart:
+      return "multi-start";
+    case TuneMethod::kNelderMead:
+      return "nelder-mead";
+    case TuneMethod::kPaperNelderMead:
+      return "paper-nm";
+    case TuneMethod::kZieglerNichols:
+      return "ziegler-nichols";
+    case TuneMethod::kGeneticAlgorithm:
+      return "ga";
+    case TuneMethod::kPsoGsa:
+      return "pso-gsa";
+  }
+  return "multi-start";
+}
+
+std::string ToString(RefineTermination termination) {
+  switch (termination) {
+    case RefineTermination::kNotRun:
+      return "";
+    case RefineTermination::kConvergence:
+      return "CONVERGENCE";
+    case RefineTermination::kNoConvergence:
+      return "NO_CONVERGENCE";
+    case RefineTermination::kFailure:
+      return "FAILURE";
+    case RefineTermination::kUserSuccess:
+      return "USER_SUCCESS";
+    case RefineTermination::kUserFailure:
+      return "USER_FAILURE";
+  }
+  return "";
+}
+
+std::string ToString(RefineVerdict verdict, TuneMethod method) {
+  switch (verdict) {
+    case RefineVerdict::kNotRun:
+      return "not run";
+    case RefineVerdict::kAgree:
+      return "agree";
+    case RefineVerdict::kSearchStoppedShort:
+      return ToString(method) + " stopped short";
+    case RefineVerdict::kSearchBetter:
+      return "search better";
+  }
+  return "not run";
+}
+
+void ApplyRobustPreset(TuneOptions* o, const RobustPresetKeep& keep) {
+  if (!keep.objective) o->objective = evaluation::ObjectiveKind::kSetpointLoad;
+  if (!keep.load_weight) o->load_weight = RobustPreset::kLoadWeight;
+  if (!keep.derivative_filter) {
+    o->loop.pid.derivative_filter_s = 0.0;
+    o->loop.derivative_filter_ratio = RobustPreset::kFilterRatio;
+  }
+  if (!keep.max_ms) o->bounds.max_ms = RobustPreset::kMaxMs;
+  if (!keep.max_time_constant)
+    o->bounds.max_time_constant_s = RobustPreset::kTimeConstantFraction * o->loop.horizon_s;
+}
+
+bool TuneOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  if (!std::isfinite(lower) || !std::isfinite(upper) || lower < 0.0 || !(lower < upper) || upper > kMaxGain)
+    os << "bounds [" << lower << ", " << upper << "] must be finite with 0 <= lower < upper <= " << kMaxGain;
+  else if (max_iterations < 0)
+    os << "max iterations " << max_iterations << " must be >= 0";
+  else if (max_evaluations < 0)
+    os << "max evaluations " << max_evaluations << " must be >= 0";
+  else if (starts < 0)
+    os << "starts " << starts << " must be >= 0 (0: the method's default)";
+  else if (method == TuneMethod::kMultiStart && (design_points < 1 || design_points > (1 << 20)))
+    os << "design points " << design_points << " must be in [1, 1048576]";
+  else if (method == TuneMethod::kMultiStart && EvaluationBudget() < 2)
+    os << "multi-start needs at least 2 evaluations (a design point and a polish), not "
+       << EvaluationBudget();
+  else if (!(load_weight >= 0.0) || !std::isfinite(load_weight))
+    os << "load weight " << load_weight << " must be finite and >= 0";
+  else if (refine_starts < 1)
+    os << "refine starts " << refine_starts << " must be >= 1";
+  else if (std::isnan(max_overshoot_pct) || max_overshoot_pct < 0.0)
+    os << "max overshoot " << max_overshoot_pct << " % must be >= 0";
+  else if (std::isnan(max_settling_time_s) || !(max_settling_time_s > 0.0))
+    os << "max settling time " << max_settling_time_s << " s must be positive";
+  else if (!bounds.IsValid(error))
+    return false;
+  else if (robust_samples < 0 || robust_samples > 10000)
+    os << "robust samples " << robust_samples << " must be in [0, 10000]";
+  else if (!(robust_spread >= 0.0) || !(robust_spread < 1.0))
+    os << "robust spread " << robust_spread << " must be in [0, 1)";
+  else if (!(robust_quantile > 0.0) || !(robust_quantile <= 1.0))
+    os << "robust quantile " << robust_quantile << " must be in (0, 1]";
+  else if (!(agree_tolerance > 0.0) || !(agree_tolerance < 1.0))
+    os << "agree tolerance " << agree_tolerance << " must be in (0, 1)";
+  else if (!loop.IsValid(error))
+    return false;
+  else if (EvaluationBudget() * loop.StepsPerEvaluation() > kMaxTuneSteps)
+    os << EvaluationBudget() << " evaluations x " << loop.StepsPerEvaluation()
+       << " loop steps each = " << EvaluationBudget() * loop.StepsPerEvaluation()
+       << " steps is more than 5e9: use a coarser dt or sample time, a shorter horizon, a slower disturbance "
+          "or fewer evaluations";
+  else
+    return true;
+  if (error) *error = os.str();
+  return false;
+}
+
+int TuneOptions::EvaluationBudget() const {
+  if (method == TuneMethod::kZieglerNichols) return 1;
+  if (max_evaluations > 0) return max_evaluations;
+  switch (method) {
+    case TuneMethod::kMultiStart:
+      return kMultiStartEvaluations;
+    case TuneMethod::kNelderMead:
+      return optim::NelderMeadOptions{}.max_evaluations;
+    case TuneMethod::kPaperNelderMead:
+      return optim::PaperNelderMeadOptions{}.max_evaluations;
+    case TuneMethod::kGeneticAlgorithm:
+      return optim::GeneticAlgorithmOptions{}.max_evaluations;
+    case TuneMethod::kPsoGsa:
+      return optim::PsoGsaOptions{}.max_evaluations;
+    case TuneMethod::kZieglerNichols:
+      break;
+  }
+  return 1;
+}
+
+int TuneOptions::StartCount() const {
+  if (starts > 0) return starts;
+  return method == TuneMethod::kMultiStart ? kMultiStartStarts : 4;
+}
+
+std::string TuneSummary::BriefReport() const {
+  std::ostringstream os;
+  os << ToString(method) << ": kp=" << gains.kp << " ki=" << gains.ki << " kd=" << gains.kd
+     << " objective=" << objective << " evaluations=" << evaluations
+     << " refine=" << ToString(refine.verdict, method);
+  return os.str();
+}
+
+namespace {
+
+// The seed and the budgets of TuneOptions (0 = the method's default) applied
+// to one optimiser's options.
+template <typename Options>
+Options WithBudget(Options o, const TuneOptions& t, int Options::*iterations) {
+  o.seed = t.seed;
+  if (t.max_iterations > 0) o.*iterations = t.max_iterations;
+  if (t.max_evaluations > 0) o.max_evaluations = t.max_evaluations;
+  return o;
+}
+
+// The function the search minimises: the evaluator's objective, or +inf
+// where the undisturbed step response breaks the overshoot or settling
+// constraint of `options`.
+// True if the loop of `g` meets options.bounds (cheap check, see TuneOptions).
+bool MeetsBounds(const Plant& plant, const StateSpace& realization, const TuneOptions& options,
+                 const PidGains& typed) {
+  if (!options.bounds.Any()) return true;
+  const PidGains g = evaluation::LoopGains(typed, options.loop);
+  if (options.loop.loop == evaluation::LoopKind::kContinuous) {
+    evaluation::ContinuousClosedLoop<double> loop;
+    if (!evaluation::BuildContinuousClosedLoop<double>(realization, g, Disturbance(DisturbanceOptions{}),
+                                                       &loop, nullptr))
+      return false;
+    return analysis::ContinuousLoopMeetsBounds(
+        plant.tf, g, evaluation::ContinuousStability(loop, options.loop.stability_margin), options.bounds);
+  }
+  analysis::LoopAnalysisOptions coarse;
+  coarse.points_per_decade = 20.0;
+  analysis::LoopAnalysis a;
+  return analysis::AnalyzeLoop(plant, g, options.loop, coarse, &a, nullptr) &&
+         analysis::LoopBoundsViolation(a, options.bounds).empty();
+}
+
+optim::ObjectiveFunction ConstrainedObjective(const Plant& plant, const TuneOptions& options,
+                                              const evaluation::ObjectiveEvaluator& evaluator) {
+  const bool constrained =
+      std::isfinite(options.max_overshoot_pct) || std::isfinite(options.max_settling_time_s);
+  auto realization = std::make_shared<StateSpace>(Realize(plant.tf));
+  return [&plant, &options, &evaluator, constrained, realization](const Eigen::VectorXd& x) {
+    const PidGains g{x(0), x(1), x(2)};
+    const double value = evaluator(g);
+    if (!std::isfinite(value)) return value;
+    if (!MeetsBounds(plant, *realization, options, g)) return HUGE_VAL;
+    if (!constrained) return value;
+    evaluation::LoopOptions undisturbed = options.loop;
+    undisturbed.disturbance = DisturbanceOptions{};
+    evaluation::Evaluation ev;
+    evaluation::EvaluateOptions what;
+    what.compute_iae_continuous = false;
+    if (!evaluation::Evaluate(plant, g, undisturbed, what, &ev, nullptr) || !ev.step.valid) return HUGE_VAL;
+    if (ev.step.overshoot_pct > options.max_overshoot_pct) return HUGE_VAL;
+    if (ev.step.settling_time_s > options.max_settling_time_s) return HUGE_VAL;
+    return value;
+  };
+}
+
+// The plants of the robust set and their evaluators (one per valid draw).
+struct RobustSet {
+  std::vector<std::unique_ptr<const evaluation::ObjectiveEvaluator>> draws;
+  int invalid = 0;
+};
+
+RobustSet MakeRobustSet(const Plant& plant, const TuneOptions& options,
+                        const evaluation::SampledRunner& runner) {
+  RobustSet set;
+  if (options.robust_samples == 0) return set;
+  analysis::MonteCarloOptions mc;
+  mc.samples = options.robust_samples;
+  mc.spread = options.robust_spread;
+  mc.seed = options.seed;
+  for (const Plant& p :
+       analysis::DrawPlants(plant, plant.name == "stepper_motor" ? &options.stepper : nullptr, mc)) {
+    if (p.tf.num.empty() || p.tf.den.empty()) {
+      ++set.invalid;
+      continue;
+    }
+    set.draws.push_back(std::make_unique<const evaluation::ObjectiveEvaluator>(
+        p, options.loop, options.objective, runner, options.load_weight));
+  }
+  return set;
+}
+
+// The nearest-rank `quantile` of the objective over the nominal plant (with
+// the constraints of f) and the draws of `set`: +inf when the nominal loop is
+// rejected, and a draw that is not strictly stable counts as +inf.
+optim::ObjectiveFunction RobustSetObjective(const optim::ObjectiveFunction& nominal, const RobustSet& set,
+                                            double quantile) {
+  if (set.draws.empty()) return nominal;
+  return [nominal, &set, quantile](const Eigen::VectorXd& x) {
+    const double f0 = nominal(x);
+    if (!std::isfinite(f0)) return f0;
+    std::vector<double> values{f0};
+    values.reserve(set.draws.size() + 1);
+    const PidGains g{x(0), x(1), x(2)};
+    for (const auto& e : set.draws) values.push_back((*e)(g));
+    const std::size_t rank = static_cast<std::size_t>(
+        std::max(1.0, std::ceil(quantile * static_cast<double>(values.size()) - 1e-9)));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank - 1), values.end());
+    return values[rank - 1];
+  };
+}
+
+// Runs options.method on f over the gain box into summary->optimizer
+// (Ziegler-Nichols: its rule's gains, evaluated once). False with *error if
+// Ziegler-Nichols does not apply.
+bool Search(const Plant& plant, const TuneOptions& options, const optim::ObjectiveFunction& f,
+            const evaluation::ObjectiveEvaluator& evaluator, const optim::ProgressCallback& progress,
+            TuneSummary* summary, std::string* error) {
+  optim::Bounds bounds{Eigen::VectorXd::Constant(3, options.lower),
+                       Eigen::VectorXd::Constant(3, options.upper)};
+  optim::OptimizerSummary& opt = summary->optimizer;
+  switch (options.method) {
+    case TuneMethod::kMultiStart: {
+      optim::MultiStartOptions o;
+      o.seed = options.seed;
+      o.max_evaluations = options.EvaluationBudget();
+      o.design_points = options.max_evaluations > 0
+                            ? std::max(1, std::min(options.design_points, o.max_evaluations / 2))
+                            : options.design_points;
+      o.starts = options.StartCount();
+      o.warp = kGainWarp;
+      o.min_separation = kMultiStartSeparation;
+      if (options.max_iterations > 0) o.polish.max_iterations = options.max_iterations;
+      o.polish.adaptive = options.adaptive;
+      o.parallel_for = options.parallel_for;
+      optim::MultiStart(f, bounds, o, &opt, progress, &summary->local_minima);
+      break;
+    }
+    case TuneMethod::kNelderMead: {
+      optim::NelderMeadOptions o =
+          WithBudget(optim::NelderMeadOptions{}, options, &optim::NelderMeadOptions::max_iterations);
+      o.starts = options.StartCount();
+      o.adaptive = options.adaptive;
+      o.parallel_for = options.parallel_for;
+      optim::NelderMead(f, bounds, o, &opt, progress);
+      break;
+    }
+    case TuneMethod::kPaperNelderMead: {
+      optim::PaperNelderMeadOptions o = WithBudget(optim::PaperNelderMeadOptions{}, options,
+                                                   &optim::PaperNelderMeadOptions::max_iterations);
+      o.starts = options.StartCount();
+      optim::PaperNelderMead(f, bounds, o, &opt, progress);
+      break;
+    }
+    case TuneMethod::kGeneticAlgorithm: {
+      optim::GeneticAlgorithmOptions o = WithBudget(optim::GeneticAlgorithmOptions{}, options,
+                                                    &optim::GeneticAlgorithmOptions::max_generations);
+      o.parallel_for = options.parallel_for;
+      optim::GeneticAlgorithm(f, bounds, o, &opt, progress);
+      break;
+    }
+    case TuneMethod::kPsoGsa: {
+      optim::PsoGsaOptions o =
+          WithBudget(optim::PsoGsaOptions{}, options, &optim::PsoGsaOptions::max_iterations);
+      o.parallel_for = options.parallel_for;
+      optim::PsoGsa(f, bounds, o, &opt, progress);
+      break;
+    }
+    case TuneMethod::kZieglerNichols: {
+      if (!ZieglerNicholsTune(plant.tf, options.zn_rule, &summary->ziegler_nichols, error)) return false;
+      const PidGains& g = summary->ziegler_nichols.gains;
+      opt.x = Eigen::Vector3d(g.kp, g.ki, g.kd);
+      opt.f = evaluator(g);
+      opt.evaluations = 1;
+      opt.termination = optim::TerminationType::kConverged;
+      opt.message = summary->ziegler_nichols.message;
+      break;
+    }
+  }
+  return true;
+}
+
+// Adds the polished minima that differ from every start so far (by more than
+// 1e-4 of the box width in some gain), best first, up to refine_starts starts.
+void AddDistinctMinima(const TuneOptions& options, const std::vector<optim::LocalMinimum>& minima,
+                       std::vector<PidGains>* starts, std::vector<double>* objectives) {
+  const double tolerance = 1e-4 * (options.upper - options.lower);
+  for (const optim::LocalMinimum& m : minima) {
+    if (static_cast<int>(starts->size()) >= options.refine_starts) break;
+    if (m.x.size() != 3 || !std::isfinite(m.f)) continue;
+    const PidGains g{m.x(0), m.x(1), m.x(2)};
+    const bool distinct = std::all_of(starts->begin(), starts->end(), [&](const PidGains& s) {
+      return std::max({std::abs(s.kp - g.kp), std::abs(s.ki - g.ki), std::abs(s.kd - g.kd)}) > tolerance;
+    });
+    if (!distinct) continue;
+    starts->push_back(g);
+    objectives->push_back(m.f);
+  }
+}
+
+// Ceres from the search's result into summary->refine, its gains and
+// objective kept when better (and, for one start, feasible for f).
+void RefineSearchResult(const Plant& plant, const TuneOptions& options, const optim::ObjectiveFunction& f,
+                        TuneSummary* summary) {
+  // Ceres differentiates the linear loops only; a nonlinear plant keeps the
+  // search's result (refine "not run"), and so does a robust set.
+  if (options.refine && options.robust_samples > 0) {
+    summary->refine.message = "not run: the robust set's quantile has no least-squares form";
+  } else if (options.refine && options.method == TuneMethod::kMultiStart && !plant.nonlinear) {
+    std::vector<PidGains> starts{summary->search_gains};
+    std::vector<double> objectives{summary->search_objective};
+    AddDistinctMinima(options, summary->local_minima, &starts, &objectives);
+    summary->refine = RefineWithCeres(plant, options, starts, objectives);
+    if (summary->refine.objective < summary->objective) {
+      summary->gains = summary->refine.gains;
+      summary->objective = summary->refine.objective;
+    }
+  } else if (options.refine && options.method != TuneMethod::kZieglerNichols && !plant.nonlinear) {
+    summary->refine = RefineWithCeres(plant, options, summary->search_gains, summary->search_objective);
+    const PidGains& r = summary->refine.gains;
+    // Ceres knows no constraint: its point is kept only if it meets them all.
+    const bool better = summary->refine.objective < summary->objective;
+    const bool feasible = better && std::isfinite(f(Eigen::Vector3d(r.kp, r.ki, r.kd)));
+    if (better && !feasible)
+      summary->refine.message += "; its gains break a constraint of the tuning, the search result stands";
+    if (feasible) {
+      summary->gains = summary->refine.gains;
+      summary->objective = summary->refine.objective;
+    }
+  }
+}
+
+}  // namespace
+
+bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
+          const optim::ProgressCallback& progress, const evaluation::SampledRunner& runner) {
+  if (!options.IsValid(error)) return false;
+  const auto start_time = std::chrono::steady_clock::now();
+  *summary = TuneSummary();
+  summary->method = options.method;
+  // No runner: the evaluator runs the sampled loop itself; another runner
+  // (the LCM trio) is handed to it.
+  const bool custom_runner = options.loop.loop == evaluation::LoopKind::kSampled && runner != nullptr;
+  const bool load = options.objective == evaluation::ObjectiveKind::kLoadIae ||
+                    options.objective == evaluation::ObjectiveKind::kSetpointLoad;
+  if (load && custom_runner) {
+    if (error) *error = ToString(options.objective) + " is evaluated in process: use --backend local";
+    return false;
+  }
+  if (load && plant.nonlinear) {
+    if (error)
+      *error = ToString(options.objective) + " needs a linear plant (the load response of " + plant.name +
+               " is not computed): tune the linearisation (--plant stepper) or use --objective iae";
+    return false;
+  }
+  const evaluation::ObjectiveEvaluator evaluator(plant, options.loop, options.objective,
+                                                 custom_runner ? runner : evaluation::SampledRunner(nullptr),
+                                                 options.load_weight);
+  if (options.robust_samples > 0 && plant.nonlinear) {
+    if (error) *error = "a robust set draws linear plants: it does not take plant " + plant.name;
+    return false;
+  }
+  const RobustSet robust_set =
+      MakeRobustSet(plant, options, custom_runner ? runner : evaluation::SampledRunner(nullptr));
+  summary->robust_set_size = options.robust_samples > 0 ? static_cast<int>(robust_set.draws.size()) + 1 : 0;
+  summary->robust_invalid_draws = robust_set.invalid;
+  const optim::ObjectiveFunction f = RobustSetObjective(ConstrainedObjective(plant, options, evaluator),
+                                                        robust_set, options.robust_quantile);
+  if (!Search(plant, options, f, evaluator, progress, summary, error)) return false;
+  const optim::OptimizerSummary& opt = summary->optimizer;
+  summary->evaluations = opt.evaluations;
+  summary->iterations = opt.iterations;
+  if (opt.termination == optim::TerminationType::kInvalidOptions) {
+    if (error) *error = opt.message;
+    return false;
+  }
+  if (!opt.IsUsable()) {
+    summary->message = "no strictly stable loop found in the box: " + opt.message;
+    summary->wall_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+    return true;
+  }
+  summary->search_gains = {opt.x(0), opt.x(1), opt.x(2)};
+  summary->search_objective = opt.f;
+  summary->gains = summary->search_gains;
+  summary->objective = summary->search_objective;
+  summary->stable = true;
+  summary->message = opt.message;
+  RefineSearchResult(plant, options, f, summary);
+  if (options.robust_samples > 0) summary->nominal_objective = evaluator(summary->gains);
+  // The loop's derivative filter of the gains found (tf = 0 for the ideal PID).
+  summary->gains = evaluation::LoopGains(summary->gains, options.loop);
+  summary->search_gains = evaluation::LoopGains(summary->search_gains, options.loop);
+  summary->refine.gains = evaluation::LoopGains(summary->refine.gains, options.loop);
+  summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  return true;
+}
+
+}  // namespace pidlab::tune
