@@ -43,6 +43,9 @@ struct Plant {
   TransferFunction tf;
   /// Set for stepper_nonlinear: the sampled loop integrates this model.
   std::shared_ptr<const NonlinearStepperOptions> nonlinear = nullptr;
+  /// Dead time L of the plant, G(s) e^(-sL), s: at least 0 and finite
+  /// (docs/deadtime.md). 0 is the plant without delay.
+  double delay_s = 0.0;
 };
 
 /// Canonical names and aliases accepted by MakePlant.
