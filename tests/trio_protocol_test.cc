@@ -433,7 +433,7 @@ long CountIn(const std::string& line, const std::string& key) {
 
 /// The per-episode counts the roles' "episode <id>: done" lines report.
 struct EpisodeCounts {
-  long resent = -1, plant_dropped = -1, reanswered = -1, controller_dropped = -1;
+  long resent = -1, plant_dropped = -1, reanswered = -1, controller_dropped = -1, disturbance_dropped = -1;
 };
 
 TEST(Trio, ThreeIdenticalEpisodesWithASeededDropRateEachReportTheSameResendsAndReAnswers) {
@@ -451,16 +451,21 @@ TEST(Trio, ThreeIdenticalEpisodesWithASeededDropRateEachReportTheSameResendsAndR
   auto lossy = [](uint64_t seed) {
     TransportOptions o;
     o.drop_rate = 0.1;
-    o.drop_seed = seed;  // as pidlab launch gives them: 1, 2, 3
+    o.drop_seed = seed;
     return o;
   };
-  Transport plant_t(&lcm, lossy(1)), controller_t(&lcm, lossy(2)), disturbance_t(&lcm, lossy(3)),
+  // The plant's and the controller's seeds as pidlab launch gives them (1, 2);
+  // the disturbance's 5, not 3: with 3 it loses none of its few requests
+  // (one per 128 steps) and its count could not tell an episode's own from
+  // the lifetime's.
+  Transport plant_t(&lcm, lossy(1)), controller_t(&lcm, lossy(2)), disturbance_t(&lcm, lossy(5)),
       client_t(&lcm, {});
-  std::vector<std::string> plant_lines, controller_lines;
+  std::vector<std::string> plant_lines, controller_lines, disturbance_lines;
   PlantRole plant(&plant_t, [&](const std::string& line) { plant_lines.push_back(line); });
   ControllerRole controller(&controller_t,
                             [&](const std::string& line) { controller_lines.push_back(line); });
-  DisturbanceRole disturbance(&disturbance_t);
+  DisturbanceRole disturbance(&disturbance_t,
+                              [&](const std::string& line) { disturbance_lines.push_back(line); });
   int64_t id = 0;
   bool summary = false;
   client_t.Subscribe<pidlab::lcmt_episode_summary>(
@@ -477,7 +482,8 @@ TEST(Trio, ThreeIdenticalEpisodesWithASeededDropRateEachReportTheSameResendsAndR
   std::vector<EpisodeCounts> counts;
   for (id = 101; id <= 103; ++id) {  // ids of their own: the drops must not depend on them
     summary = false;
-    const std::size_t plant_seen = plant_lines.size(), controller_seen = controller_lines.size();
+    const std::size_t plant_seen = plant_lines.size(), controller_seen = controller_lines.size(),
+                      disturbance_seen = disturbance_lines.size();
     auto config = transport::MakeEpisodeConfig(
         pidlab::MakeEpisodeSpec(id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
     // Three copies at once, as a client resends an unacknowledged one: a role
@@ -502,8 +508,14 @@ TEST(Trio, ThreeIdenticalEpisodesWithASeededDropRateEachReportTheSameResendsAndR
         c.reanswered = CountIn(controller_lines[i], "(re-answered ");
         c.controller_dropped = CountIn(controller_lines[i], ", dropped ");
       }
-    std::printf("episode %lld: plant resent %ld, dropped %ld; controller re-answered %ld, dropped %ld\n",
-                static_cast<long long>(id), c.resent, c.plant_dropped, c.reanswered, c.controller_dropped);
+    for (std::size_t i = disturbance_seen; i < disturbance_lines.size(); ++i)
+      if (disturbance_lines[i].find(": done") != std::string::npos)
+        c.disturbance_dropped = CountIn(disturbance_lines[i], "(dropped ");
+    std::printf(
+        "episode %lld: plant resent %ld, dropped %ld; controller re-answered %ld, dropped %ld; "
+        "disturbance dropped %ld\n",
+        static_cast<long long>(id), c.resent, c.plant_dropped, c.reanswered, c.controller_dropped,
+        c.disturbance_dropped);
     counts.push_back(c);
   }
   ASSERT_EQ(counts.size(), 3u);
@@ -511,6 +523,7 @@ TEST(Trio, ThreeIdenticalEpisodesWithASeededDropRateEachReportTheSameResendsAndR
   EXPECT_GT(counts[0].reanswered, 0);
   EXPECT_GT(counts[0].plant_dropped, 0);
   EXPECT_GT(counts[0].controller_dropped, 0);
+  EXPECT_GT(counts[0].disturbance_dropped, 0);
   for (std::size_t i = 1; i < counts.size(); ++i) {
     // Equal, so each line counts its own episode: lifetime totals would grow
     // (c, 2c, 3c).
@@ -518,6 +531,7 @@ TEST(Trio, ThreeIdenticalEpisodesWithASeededDropRateEachReportTheSameResendsAndR
     EXPECT_EQ(counts[i].plant_dropped, counts[0].plant_dropped) << "episode " << i + 1;
     EXPECT_EQ(counts[i].reanswered, counts[0].reanswered) << "episode " << i + 1;
     EXPECT_EQ(counts[i].controller_dropped, counts[0].controller_dropped) << "episode " << i + 1;
+    EXPECT_EQ(counts[i].disturbance_dropped, counts[0].disturbance_dropped) << "episode " << i + 1;
   }
   // The lifetime totals hold all three (and whatever came after a "done"
   // line, e.g. a re-answer of the last step).
