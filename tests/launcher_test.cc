@@ -859,11 +859,16 @@ TEST_F(LogCapture, ALoggerThatDiesStopsTheRunNamingItsFileAndKeepsTheLaneFiles) 
   StopAfter(0.0);  // disarm
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
   EXPECT_TRUE(Contains(l.failure(), "lcm-logger writing " + o.log_file + " (pid " + logger +
-                                        ") killed by signal Killed; run stopped; kept " + o.log_file + ", " +
-                                        o.log_file + ".lane1, " + o.log_file + ".lane2"))
+                                        ") killed by signal Killed; run stopped; kept " + o.log_file +
+                                        " and its .lane1, .lane2"))
       << l.failure();
   EXPECT_FALSE(l.FinishLog(false));
   l.Stop();
+  // No episode ran: Stop() read the log and says that none misses a step,
+  // between the cause and the files kept.
+  EXPECT_TRUE(Contains(l.failure(), "run stopped; no episode in " + o.log_file + " misses a step; kept " +
+                                        o.log_file + " and its .lane1, .lane2"))
+      << l.failure();
   EXPECT_GE(FileSize(o.log_file + ".lane1"), 0);
   EXPECT_GE(FileSize(o.log_file + ".lane2"), 0);
 }

@@ -252,6 +252,28 @@ int Launcher::Run(const std::vector<std::string>& command, const volatile std::s
   return RunWatching({this}, command, stop, environment);
 }
 
+namespace {
+/// "kept FILE and its .lane1, .lane2" (files beside the log named by their
+/// suffix, to keep the failure line short); empty if none is left.
+std::string KeptFiles(const std::string& log_file, const std::vector<std::string>& files) {
+  std::string text;
+  const bool log_kept = !files.empty() && files.front() == log_file;
+  std::string suffixes;
+  for (std::size_t i = log_kept ? 1 : 0; i < files.size(); ++i) {
+    const std::string& file = files[i];
+    const bool beside =
+        log_kept && file.size() > log_file.size() && file.compare(0, log_file.size(), log_file) == 0;
+    if (beside)
+      suffixes += (suffixes.empty() ? "" : ", ") + file.substr(log_file.size());
+    else
+      text += (text.empty() ? "" : ", ") + file;
+  }
+  if (log_kept)
+    text = log_file + (suffixes.empty() ? "" : " and its " + suffixes) + (text.empty() ? "" : ", " + text);
+  return text.empty() ? "" : "kept " + text;
+}
+}  // namespace
+
 bool Launcher::Watch(pid_t command, bool serving, bool* command_ended, int* command_status) {
   bool must_stop = false;
   for (const Child& c : supervisor_->Reap()) {
@@ -263,9 +285,10 @@ bool Launcher::Watch(pid_t command, bool serving, bool* command_ended, int* comm
       // after COMMAND ran to its end for nothing.
       if (!logger_died_) {
         logger_died_ = true;
-        std::string kept;
-        for (const std::string& file : log_->AbandonLanes()) kept += (kept.empty() ? "" : ", ") + file;
-        failure_ = log_->DescribeLoggerEnd(c) + "; run stopped" + (kept.empty() ? "" : "; kept " + kept);
+        logger_end_ = log_->DescribeLoggerEnd(c) + "; run stopped";
+        kept_ = KeptFiles(options_.log_file, log_->AbandonLanes());
+        // Stop() adds what the log misses, once the base logger has stopped.
+        failure_ = logger_end_ + (kept_.empty() ? "" : "; " + kept_);
       }
       must_stop = true;
     } else {
@@ -342,7 +365,9 @@ void Launcher::Stop() {
   if (logger_ > 0) supervisor_->StopChild(logger_, SIGINT, 3.0);
   std::string error;
   if (logger_died_) {
-    // The lane files were kept as they are (failure() names them).
+    // The lane files were kept as they are (failure() names them). What the
+    // log misses is read now, after COMMAND was stopped, not before.
+    failure_ = logger_end_ + "; " + log_->DescribeMissing() + (kept_.empty() ? "" : "; " + kept_);
   } else if (log_ && !log_->MergeLanes(&error)) {
     if (failure_.empty()) failure_ = error + " (" + options_.log_file + " holds the base port's events only)";
   } else if (log_ && log_->rebuilt_outputs() > 0)

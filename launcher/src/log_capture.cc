@@ -156,6 +156,35 @@ void LogCapture::StartLaneLoggers(const std::string& lcm_url) {
   }
 }
 
+std::string LogCapture::DescribeMissing() const {
+  replay::ReadOptions read_options;
+  read_options.channel_prefix = options_.channel_prefix;
+  read_options.auth_key = options_.auth_key;
+  replay::LogContents log;
+  std::string error;
+  if (!replay::ReadLog(options_.log_file, read_options, &log, &error))
+    return options_.log_file + " cannot be read";
+  const replay::Episode* first = nullptr;
+  long more = 0;
+  for (const replay::Episode& e : log.episodes) {
+    // As the repair: an episode without a configuration cannot be sized, one
+    // that failed live is left as it is.
+    if (!e.has_config || e.Complete()) continue;
+    if (e.has_summary && e.summary_status == pidlab::lcmt_episode_summary::FAILED) continue;
+    if (first)
+      ++more;
+    else
+      first = &e;
+  }
+  if (!first) return "no episode in " + options_.log_file + " misses a step";
+  const std::vector<std::pair<long, long>> ranges = MissingSteps(*first);
+  std::ostringstream os;
+  os << options_.log_file << " misses " << CountSteps(ranges) << " steps of episode " << first->episode_id;
+  if (more > 0) os << " (and of " << more << " more episode" << (more == 1 ? "" : "s") << ")";
+  os << ": " << RangesText(ranges, 2);
+  return os.str();
+}
+
 std::vector<TimedPayload> RebuildLaneOutputs(const replay::LogContents& log, const std::string& lane_file,
                                              const std::string& channel_prefix) {
   std::vector<TimedPayload> out;

@@ -21,6 +21,7 @@ struct DisturbanceRole::Episode {
   std::unique_ptr<Disturbance> disturbance;
   pidlab::lcmt_disturbance_block block;
   bool logged = false;
+  long dropped_at_start = 0;  // the transport's lifetime count when the episode started
 };
 
 DisturbanceRole::DisturbanceRole(Transport* transport, LogFn log, bool verbose)
@@ -34,6 +35,7 @@ void DisturbanceRole::StartEpisode(const EpisodeSpec& spec) {
   auto ep = std::make_unique<Episode>();
   ep->spec = spec;
   ep->disturbance = std::make_unique<Disturbance>(spec.disturbance);
+  ep->dropped_at_start = transport_->counters().dropped;
   ep_ = std::move(ep);
 }
 
@@ -71,7 +73,7 @@ void DisturbanceRole::OnRequest(const pidlab::lcmt_disturbance_request& m) {
   if (end == total && !e.logged) {
     e.logged = true;
     Log("episode " + std::to_string(e.spec.episode_id) + ": done, " + std::to_string(total) +
-        " samples (dropped " + std::to_string(transport_->counters().dropped) + ")");
+        " samples (dropped " + std::to_string(transport_->counters().dropped - e.dropped_at_start) + ")");
   }
 }
 

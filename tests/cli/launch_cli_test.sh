@@ -3,7 +3,8 @@
 # --realtime forms among them), an unknown subcommand is named, a process
 # killed in any trio of --trios K is reported with its trio's number and
 # reaped at once, and a log on a full disk stops the run with one line that
-# names the cause and the file, keeping what the lane files hold.
+# names the cause, the file, the episode and steps the log misses, and the
+# lane files it keeps.
 # The whole test runs in a private network and mount namespace of its own.
 # Usage: launch_cli_test.sh PIDLAB_BINARY
 set -uo pipefail
@@ -140,12 +141,58 @@ elif ! tail -n 1 full.err | grep -q "small/run.lcmlog"; then
   fail "disk full: the line does not name the file: $(tail -n 1 full.err)"
 elif [[ ! -s small/run.lcmlog.lane1 || ! -s small/run.lcmlog.lane2 ]]; then
   fail "disk full: the lane files were not kept: $(ls -l small | tr '\n' '|')"
-elif ! tail -n 1 full.err | grep -q "kept small/run.lcmlog, small/run.lcmlog.lane1, small/run.lcmlog.lane2"; then
+elif ! tail -n 1 full.err | grep -q "kept small/run.lcmlog and its .lane1, .lane2$"; then
   fail "disk full: the kept files are not named: $(tail -n 1 full.err)"
 elif ! awk -v a="$ended" -v b="$last_write" 'BEGIN { exit !(a - b < 1.5) }'; then
   fail "disk full: launch ended $(awk -v a="$ended" -v b="$last_write" 'BEGIN { print a - b }') s after the last write"
 else
   pass "disk full: exit 1 within 1 s of the loggers' death, one line: $(tail -n 1 full.err)"
+fi
+# The line names the episode the log misses steps of and those steps, as
+# pidlab replay reports them: the first episode with its configuration in the
+# log that is incomplete (and did not fail live), the union of its three
+# streams' missing steps (count and at most two ranges), how many more
+# episodes miss steps.
+"$pidlab" replay --json small/run.lcmlog >replay.json 2>replay.err || true
+if ! why=$(/usr/bin/python3 - "$(tail -n 1 full.err)" 2>&1 <<'PY'
+import json, sys
+line = sys.argv[1]
+try:
+    log = json.load(open("replay.json"))
+except ValueError as e:
+    sys.exit("pidlab replay gave no JSON: %s" % e)
+def missing(e):
+    ranges = sorted(tuple(r) for s in ("plant_outputs", "commands", "disturbance_samples")
+                    for r in e[s]["missing"])
+    merged = []
+    for a, b in ranges:
+        if merged and a <= merged[-1][1] + 1:
+            merged[-1][1] = max(merged[-1][1], b)
+        else:
+            merged.append([a, b])
+    return merged
+incomplete = [e for e in log["episodes"] if "plant" in e and not e["complete"]
+              and e.get("summary", {}).get("status") != "failed"]
+if not incomplete:
+    sys.exit("pidlab replay finds no incomplete episode in small/run.lcmlog")
+e = incomplete[0]
+m = missing(e)
+text = ",".join(str(a) if a == b else "%d-%d" % (a, b) for a, b in m[:2])
+if len(m) > 2:
+    text += ",... (%d ranges)" % len(m)
+more = len(incomplete) - 1
+want = "small/run.lcmlog misses %d steps of episode %d" % (sum(b - a + 1 for a, b in m), e["episode_id"])
+if more:
+    want += " (and of %d more episode%s)" % (more, "" if more == 1 else "s")
+want += ": " + text + "; kept"
+if want not in line:
+    sys.exit("wanted '%s' in: %s" % (want, line))
+print(want)
+PY
+); then
+  fail "disk full: the episode and steps the log misses: $why"
+else
+  pass "disk full: the line names what pidlab replay finds missing: $why"
 fi
 if ! grep -q "KiB free beside small/run.lcmlog" full.err; then
   fail "disk full: launch did not say at the start that the disk is nearly full"

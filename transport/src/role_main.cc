@@ -39,7 +39,10 @@ void RegisterRoleFlags(CLI::App* app, RoleFlags* f, RealtimeFlags* realtime) {
   app->add_option("--drop-rate", f->transport.drop_rate,
                   "fault injection: fraction in [0, 1) of received messages to throw away")
       ->capture_default_str();
-  app->add_option("--drop-seed", f->transport.drop_seed, "seed of the fault injection")
+  app->add_option("--drop-seed", f->transport.drop_seed,
+                  "seed of the fault injection: each decision hashes the seed with the channel, the "
+                  "message's step and its copy number, so an episode run again with the same seed loses "
+                  "the same messages")
       ->capture_default_str();
   app->add_option("--auth-key", f->auth_key_file,
                   "authenticate every message with the key in this file (HMAC-SHA256; docs/security.md); "

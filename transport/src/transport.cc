@@ -73,8 +73,56 @@ std::string StepLaneUrl(const std::string& base_url, int lane) {
   return scheme + group + ":" + std::to_string(port + lane) + rest;
 }
 
-Transport::Transport(lcm::LCM* lcm, const TransportOptions& options)
-    : lcm_(lcm), options_(options), drop_rng_(options.drop_seed) {}
+namespace {
+/// SplitMix64's finaliser: every input bit moves about half the output bits.
+uint64_t Mix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+int64_t BigEndianInt64(const uint8_t* p) {
+  uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
+  return static_cast<int64_t>(v);
+}
+}  // namespace
+
+uint64_t ChannelNameHash(const std::string& name) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  for (const char c : name) {
+    h ^= static_cast<uint8_t>(c);
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+bool DropDecision(uint64_t seed, double drop_rate, uint64_t name_hash, int64_t step, uint64_t attempt) {
+  if (drop_rate <= 0.0) return false;
+  const uint64_t h = Mix(Mix(Mix(Mix(seed) ^ name_hash) ^ static_cast<uint64_t>(step)) ^ attempt);
+  // Uniform in [0, 1) from the top 53 bits: the same on every platform.
+  const double r = static_cast<double>(h >> 11) * 0x1.0p-53;
+  return r < drop_rate;
+}
+
+bool PeekEpisodeAndStep(const void* data, std::size_t size, int64_t* episode_id, int64_t* step) {
+  *episode_id = *step = 0;
+  // fingerprint (8), utime (8), episode_id (8), step (8)
+  if (size < 32) return false;
+  const auto* p = static_cast<const uint8_t*>(data);
+  *episode_id = BigEndianInt64(p + 16);
+  *step = BigEndianInt64(p + 24);
+  return true;
+}
+
+std::size_t Transport::DropKeyHash::operator()(const DropKey& k) const {
+  return static_cast<std::size_t>(
+      Mix(Mix(reinterpret_cast<uintptr_t>(k.sub) ^ static_cast<uint64_t>(k.episode_id)) ^
+          static_cast<uint64_t>(k.step)));
+}
+
+Transport::Transport(lcm::LCM* lcm, const TransportOptions& options) : lcm_(lcm), options_(options) {}
 
 lcm::LCM* Transport::LcmFor(int lane) {
   if (lane == 0) return lcm_;
@@ -88,11 +136,17 @@ lcm::LCM* Transport::LcmFor(int lane) {
   return instance.get();
 }
 
-bool Transport::ShouldDrop() {
+bool Transport::ShouldDrop(const Subscription& sub, const lcm_recv_buf_t& rbuf) {
   if (options_.drop_rate <= 0.0) return false;
-  // Uniform in [0, 1) from the top 53 bits: the same on every platform.
-  const double r = static_cast<double>(drop_rng_() >> 11) * 0x1.0p-53;
-  return r < options_.drop_rate;
+  // Keyed on the message, not on the order of arrival: the step and the
+  // number of copies of it seen, never the episode id (a new one each run)
+  // nor utime. Too short for a step (not a pidlab message): all such
+  // messages of the channel share one key and are told apart by the count.
+  int64_t episode_id = 0, step = 0;
+  PeekEpisodeAndStep(rbuf.data, rbuf.data_size, &episode_id, &step);
+  if (drop_attempts_.size() >= kMaxDropKeys) drop_attempts_.clear();
+  const uint64_t attempt = drop_attempts_[DropKey{&sub, episode_id, step}]++;
+  return DropDecision(options_.drop_seed, options_.drop_rate, sub.name_hash, step, attempt);
 }
 
 const Transport::CachedName& Transport::CachedChannel(const char* name) {
@@ -109,7 +163,7 @@ void Transport::Subscription::HandleC(const lcm_recv_buf_t* rbuf, const char* /*
   auto* sub = static_cast<Subscription*>(self);
   TransportCounters& c = sub->owner->counters_;
   ++c.received;
-  if (sub->owner->ShouldDrop()) {
+  if (sub->owner->ShouldDrop(*sub, *rbuf)) {
     ++c.dropped;
     return;
   }

@@ -119,13 +119,16 @@ class Launcher {
   bool FinishLog(bool interrupted);
 
   /// Stops the logger (SIGINT, so it closes the file) and every process.
-  /// After a logger died the lane files are not merged but kept; a merge
-  /// that fails sets failure() if nothing did before.
+  /// After a logger died the lane files are not merged but kept, and the log
+  /// is read to name in failure() the episode it misses steps of
+  /// (LogCapture::DescribeMissing); a merge that fails sets failure() if
+  /// nothing did before.
   void Stop();
 
   /// Why the run failed, one line: a logger died (which file, how, the cause
-  /// it gave, the files kept), the log is not known complete (FinishLog), or
-  /// the lanes could not be merged (Stop). Empty if none of these.
+  /// it gave, after Stop the episode and steps the log misses, the files
+  /// kept), the log is not known complete (FinishLog), or the lanes could not
+  /// be merged (Stop). Empty if none of these.
   const std::string& failure() const { return failure_; }
 
   const std::string& lcm_url() const { return url_; }
@@ -159,6 +162,8 @@ class Launcher {
   pid_t logger_ = -1;
   std::string failure_;
   bool logger_died_ = false;
+  /// After a logger died: how it ended, and the files kept ("kept ...").
+  std::string logger_end_, kept_;
 };
 
 /// The LCM URL of trio `index` (0-based) of `pidlab launch --trios K`: the

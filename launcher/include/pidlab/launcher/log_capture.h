@@ -120,6 +120,15 @@ class LogCapture {
   /// exist (the log first, then the lane files).
   std::vector<std::string> AbandonLanes();
 
+  /// After a logger died and the base logger stopped: what the log misses,
+  /// as `pidlab replay` would report it, in one short clause: "FILE misses
+  /// 24590 steps of episode ID: 411-25000" for the first episode with a
+  /// configuration in FILE that misses steps (and did not fail live), with
+  /// "(and of N more episodes)" before the ranges if others miss steps too;
+  /// "no episode in FILE misses a step" or "FILE cannot be read" otherwise.
+  /// Episodes whose configuration never reached FILE are not known to it.
+  std::string DescribeMissing() const;
+
   /// Stops the lane loggers and merges their events into the log by
   /// timestamp (the base port's events first on a tie), so the log holds the
   /// per-step datagrams too and lcm-logplayer can drive a controller from it.

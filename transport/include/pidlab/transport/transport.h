@@ -1,7 +1,8 @@
 #pragma once
 // The thin layer between LCM and the trio's protocol logic: channel names
 // with a prefix, typed publish, decoding with undecodable messages counted
-// (never a crash), seeded fault injection on receipt, and bounded waits.
+// (never a crash), seeded fault injection on receipt (the same messages of an
+// episode lost on every run), and bounded waits.
 // Works on any LCM URL, including memq:// for single-process tests.
 
 #include <algorithm>
@@ -11,8 +12,8 @@
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
 #include <optional>
-#include <random>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "pidlab/transport/auth.h"
@@ -32,7 +33,13 @@ struct TransportOptions {
   /// Fault injection: fraction in [0, 1) of received messages thrown away
   /// before decoding, as if the network had lost them.
   double drop_rate = 0.0;
-  /// Seed of the drop decisions (std::mt19937_64).
+  /// Seed of the drop decisions. Each decision is a hash of (seed, channel
+  /// name without prefix, the message's step, how many times this
+  /// subscription has received a message of that episode and step on that
+  /// channel before): not a draw from one stream, whose order would follow
+  /// the timing. The same episode run again with the same seed (whatever its
+  /// id, its timing or the episodes before it) loses the same messages: the
+  /// first y_k, its first resend, ... (DropDecision).
   uint64_t drop_seed = 1;
   /// With a key, every message sent carries an HMAC-SHA256 tag and every
   /// message received must carry a valid, fresh one (auth.h).
@@ -77,6 +84,18 @@ struct TransportCounters {
   long unauthenticated = 0;  // with a key: no tag, or a tag that does not verify (forged)
   long replayed = 0;         // with a key: dated outside the replay window, or a repeat
 };
+
+/// The fault injection's decision for one received message (TransportOptions::
+/// drop_seed): true to throw it away. `name_hash` is ChannelNameHash of the
+/// channel name without prefix, `attempt` counts the copies of the same
+/// (episode, step) that reached the subscription before (0 for the first).
+bool DropDecision(uint64_t seed, double drop_rate, uint64_t name_hash, int64_t step, uint64_t attempt);
+/// FNV-1a of a channel name (without prefix).
+uint64_t ChannelNameHash(const std::string& name);
+/// The episode id and step of an encoded pidlab message: every lcmt type
+/// starts with int64 utime, episode_id, step after LCM's 8-byte fingerprint.
+/// False (and 0, 0) if `size` is too short to hold them.
+bool PeekEpisodeAndStep(const void* data, std::size_t size, int64_t* episode_id, int64_t* step);
 
 class Transport {
  public:
@@ -133,6 +152,7 @@ class Transport {
     // The C API directly: lcm-cpp's trampoline builds a std::string of the
     // channel name for every message received.
     sub->channel = Channel(name);
+    sub->name_hash = ChannelNameHash(name);
     const int lane = LaneOf(name.c_str());
     lcm_subscription_t* handle =
         lcm_subscribe(LcmFor(lane)->getUnderlyingLCM(), sub->channel.c_str(), &Subscription::HandleC, sub.get());
@@ -154,7 +174,8 @@ class Transport {
  private:
   struct Subscription {
     Transport* owner = nullptr;
-    std::string channel;  // prefixed
+    std::string channel;     // prefixed
+    uint64_t name_hash = 0;  // ChannelNameHash of the name without prefix
     std::function<bool(const void*, int)> decode_and_call;
     static void HandleC(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
   };
@@ -162,7 +183,7 @@ class Transport {
     std::string name, prefixed;
     int lane = 0;
   };
-  bool ShouldDrop();
+  bool ShouldDrop(const Subscription& sub, const lcm_recv_buf_t& rbuf);
   const CachedName& CachedChannel(const char* name);
   /// The LCM instance of a lane (0: the one given), created on first use: a
   /// lane only published on never opens a receive socket (LCM 1.3.1 sets
@@ -175,7 +196,21 @@ class Transport {
   lcm::LCM* lcm_;
   TransportOptions options_;
   TransportCounters counters_;
-  std::mt19937_64 drop_rng_;
+  /// Copies received so far per (subscription, episode, step), for the drop
+  /// decisions' attempt number; cleared when it holds kMaxDropKeys keys
+  /// (copies of one step arrive close together, long before that).
+  struct DropKey {
+    const Subscription* sub;
+    int64_t episode_id, step;
+    bool operator==(const DropKey& o) const {
+      return sub == o.sub && episode_id == o.episode_id && step == o.step;
+    }
+  };
+  struct DropKeyHash {
+    std::size_t operator()(const DropKey& k) const;
+  };
+  static constexpr std::size_t kMaxDropKeys = 1 << 15;
+  std::unordered_map<DropKey, uint64_t, DropKeyHash> drop_attempts_;
   ReplayGuard replay_guard_;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
   std::unique_ptr<lcm::LCM> lanes_[3];  // [0] unused: lane 0 is lcm_
