@@ -1,6 +1,6 @@
 // pidlab tune: a multi-start from a space-filling design (or Nelder-Mead, the
-// paper's variant, a baseline) on the paper's objective, with a Ceres
-// least-squares cross-check.
+// paper's variant, a baseline, a tuning rule) on the paper's objective, with a
+// Ceres least-squares cross-check.
 
 #include <unistd.h>
 
@@ -131,6 +131,8 @@ struct TuneCommand {
     std::cout << std::setprecision(6);
     std::cout << "method           " << ToString(o.method) << " on " << ToString(o.objective) << ", box ["
               << o.lower << ", " << o.upper << "]^3, seed " << o.seed << "\n";
+    if (o.method == pidlab::tune::TuneMethod::kSimc || o.method == pidlab::tune::TuneMethod::kAmigo)
+      std::cout << "rule             " << s.tuning_rule.message << "\n";
     if (!s.stable) {
       std::cout << "result           " << s.message << "\n";
       return;

@@ -119,6 +119,15 @@ class Tune(unittest.TestCase):
         self.assertSameTune(got, want)
         self.assertEqual(got["ziegler_nichols"]["rule"], "pessen")
 
+    def test_a_tuning_rule_with_its_model_equals_the_cli_json(self):
+        got = pidlab.tune(([1], [0.2, 1.2, 1]), method="amigo", rule="pi")
+        want = cli("tune", "--num", "1", "--den", "0.2,1.2,1", "--method", "amigo", "--rule", "pi")
+        self.assertSameTune(got, want)
+        self.assertEqual(got["model"]["kind"], "fopdt")
+        self.assertTrue(got["model"]["half_rule"])
+        self.assertEqual(got["tuning_rule"]["rule"], "pi")
+        self.assertEqual(got["spec"]["rule"], "pi")
+
     def test_the_robust_preset_and_a_robust_set_equal_the_cli_json(self):
         got = pidlab.tune("double_integrator", robust=True, robust_samples=4, robust_spread=0.2, max_evals=600)
         want = cli("tune", "--plant", "double_integrator", "--robust", "--robust-samples", "4",

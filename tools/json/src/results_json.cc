@@ -12,9 +12,11 @@ using pidlab::analysis::MonteCarloSummary;
 using pidlab::evaluation::Evaluation;
 using pidlab::evaluation::LoopKind;
 using pidlab::evaluation::ObjectiveKind;
+using pidlab::tune::ProcessModel;
 using pidlab::tune::TuneMethod;
 using pidlab::tune::TuneOptions;
 using pidlab::tune::TuneSummary;
+using pidlab::tune::TuningRuleResult;
 
 namespace pidlab::json {
 
@@ -34,6 +36,28 @@ void AddMotor(const Evaluation& ev, nlohmann::json* j) {
                    {"peak_phase_current_a", JsonNumber(ev.motor.phase_current_a)},
                    {"peak_load_angle_rad", JsonNumber(ev.motor.load_angle_rad)}};
   if (!ev.motor_note.empty()) (*j)["motor"]["note"] = ev.motor_note;
+}
+
+// simc, amigo: the model the rule used ("model") and its controller
+// ("tuning_rule"). The gains are scored on the spec's loop with the plant as
+// given; Tune() refuses a plant with a dead time, which the loops do not
+// simulate yet, so "delay_simulated" is false and the model's delay is the
+// half rule's alone.
+void AddTuningRule(const TuneOptions& o, const TuningRuleResult& r, nlohmann::json* j) {
+  const ProcessModel& m = r.model;
+  (*j)["model"] = {{"kind", ToString(m.kind)},
+                   {"gain", m.gain},
+                   {"time_constants", m.time_constants},
+                   {"delay", m.delay_s},
+                   {"half_rule", m.half_rule}};
+  (*j)["tuning_rule"] = {{"rule", ToString(r.form)},
+                         {"kc", r.kc},
+                         {"ti_s", r.ti_s},
+                         {"td_s", r.td_s},
+                         {"controller_form", r.controller_form},
+                         {"evaluated_on", ToString(o.loop.loop)},
+                         {"delay_simulated", false},
+                         {"message", r.message}};
 }
 
 }  // namespace
@@ -121,6 +145,7 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
     j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},
                             {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
                             {"rule", ToString(o.zn_rule)}};
+  if (o.method == TuneMethod::kSimc || o.method == TuneMethod::kAmigo) AddTuningRule(o, s.tuning_rule, &j);
   const LoopBounds& b = o.bounds;
   j["constraints"] = {{"max_ms", JsonNumber(b.max_ms)},
                       {"max_mt", JsonNumber(b.max_mt)},

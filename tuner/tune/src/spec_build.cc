@@ -250,8 +250,10 @@ namespace {
 bool BuildSearch(const spec::TuneSpec& t, NameStyle style, TuneOptions* o, std::string* error) {
   const auto name = [style](const char* key) { return spec::DisplayName(key, style); };
   if (!ParseTuneMethod(t.method, &o->method))
-    return Bad(error, name("method") + " " + Quote(t.method) +
-                          " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga or pso-gsa");
+    return Bad(
+        error,
+        name("method") + " " + Quote(t.method) +
+            " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga, pso-gsa, simc or amigo");
   if (!evaluation::ParseObjectiveKind(t.objective, &o->objective))
     return Bad(error, name("objective") + " " + Quote(t.objective) +
                           " must be iae, ise, itae, iae-continuous, load-iae or setpoint-load");
@@ -261,6 +263,8 @@ bool BuildSearch(const spec::TuneSpec& t, NameStyle style, TuneOptions* o, std::
   if (!ParseZieglerNicholsRule(t.zn_rule, &o->zn_rule))
     return Bad(error, name("zn_rule") + " " + Quote(t.zn_rule) +
                           " must be classic, pessen, some-overshoot or no-overshoot");
+  if (!ParseRuleForm(t.rule, &o->rule))
+    return Bad(error, name("rule") + " " + Quote(t.rule) + " must be pi or pid");
   if (t.refine != "ceres" && t.refine != "none")
     return Bad(error, name("refine") + " " + Quote(t.refine) + " must be ceres or none");
   o->refine = t.refine == "ceres";

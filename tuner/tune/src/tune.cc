@@ -27,6 +27,10 @@ bool ParseTuneMethod(const std::string& s, TuneMethod* method) {
     *method = TuneMethod::kGeneticAlgorithm;
   else if (s == "pso-gsa")
     *method = TuneMethod::kPsoGsa;
+  else if (s == "simc")
+    *method = TuneMethod::kSimc;
+  else if (s == "amigo")
+    *method = TuneMethod::kAmigo;
   else
     return false;
   return true;
@@ -46,8 +50,16 @@ std::string ToString(TuneMethod method) {
       return "ga";
     case TuneMethod::kPsoGsa:
       return "pso-gsa";
+    case TuneMethod::kSimc:
+      return "simc";
+    case TuneMethod::kAmigo:
+      return "amigo";
   }
   return "multi-start";
+}
+
+bool IsTuningRule(TuneMethod method) {
+  return method == TuneMethod::kZieglerNichols || method == TuneMethod::kSimc || method == TuneMethod::kAmigo;
 }
 
 std::string ToString(RefineTermination termination) {
@@ -141,7 +153,7 @@ bool TuneOptions::IsValid(std::string* error) const {
 }
 
 int TuneOptions::EvaluationBudget() const {
-  if (method == TuneMethod::kZieglerNichols) return 1;
+  if (IsTuningRule(method)) return 1;
   if (max_evaluations > 0) return max_evaluations;
   switch (method) {
     case TuneMethod::kMultiStart:
@@ -155,6 +167,8 @@ int TuneOptions::EvaluationBudget() const {
     case TuneMethod::kPsoGsa:
       return optim::PsoGsaOptions{}.max_evaluations;
     case TuneMethod::kZieglerNichols:
+    case TuneMethod::kSimc:
+    case TuneMethod::kAmigo:
       break;
   }
   return 1;
@@ -277,9 +291,40 @@ optim::ObjectiveFunction RobustSetObjective(const optim::ObjectiveFunction& nomi
   };
 }
 
+// A rule's gains as the search's result: one converged evaluation.
+void RuleResult(const PidGains& g, const evaluation::ObjectiveEvaluator& evaluator,
+                const std::string& message, optim::OptimizerSummary* opt) {
+  opt->x = Eigen::Vector3d(g.kp, g.ki, g.kd);
+  opt->f = evaluator(g);
+  opt->evaluations = 1;
+  opt->termination = optim::TerminationType::kConverged;
+  opt->message = message;
+}
+
+// SIMC or AMIGO into summary->tuning_rule and summary->optimizer. False with
+// *error where the rule does not apply, or for a plant with a dead time, which
+// neither loop simulates yet (its gains would be scored on the plant without it).
+bool RuleSearch(const Plant& plant, const TuneOptions& options,
+                const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary, std::string* error) {
+  const TuningRule rule = options.method == TuneMethod::kSimc ? TuningRule::kSimc : TuningRule::kAmigo;
+  const Status status = ApplyTuningRule(plant, rule, options.rule, &summary->tuning_rule);
+  if (!status.ok()) {
+    if (error) *error = status.message();
+    return false;
+  }
+  if (plant.delay_s > 0.0) {
+    if (error)
+      *error = summary->tuning_rule.message +
+               "; but the loop does not simulate the plant's dead time yet: its gains are not evaluated";
+    return false;
+  }
+  RuleResult(summary->tuning_rule.gains, evaluator, summary->tuning_rule.message, &summary->optimizer);
+  return true;
+}
+
 // Runs options.method on f over the gain box into summary->optimizer
-// (Ziegler-Nichols: its rule's gains, evaluated once). False with *error if
-// Ziegler-Nichols does not apply.
+// (Ziegler-Nichols, SIMC, AMIGO: the rule's gains, evaluated once). False
+// with *error if the rule does not apply.
 bool Search(const Plant& plant, const TuneOptions& options, const optim::ObjectiveFunction& f,
             const evaluation::ObjectiveEvaluator& evaluator, const optim::ProgressCallback& progress,
             TuneSummary* summary, std::string* error) {
@@ -335,14 +380,12 @@ bool Search(const Plant& plant, const TuneOptions& options, const optim::Objecti
     }
     case TuneMethod::kZieglerNichols: {
       if (!ZieglerNicholsTune(plant.tf, options.zn_rule, &summary->ziegler_nichols, error)) return false;
-      const PidGains& g = summary->ziegler_nichols.gains;
-      opt.x = Eigen::Vector3d(g.kp, g.ki, g.kd);
-      opt.f = evaluator(g);
-      opt.evaluations = 1;
-      opt.termination = optim::TerminationType::kConverged;
-      opt.message = summary->ziegler_nichols.message;
+      RuleResult(summary->ziegler_nichols.gains, evaluator, summary->ziegler_nichols.message, &opt);
       break;
     }
+    case TuneMethod::kSimc:
+    case TuneMethod::kAmigo:
+      return RuleSearch(plant, options, evaluator, summary, error);
   }
   return true;
 }
@@ -382,7 +425,7 @@ void RefineSearchResult(const Plant& plant, const TuneOptions& options, const op
       summary->gains = summary->refine.gains;
       summary->objective = summary->refine.objective;
     }
-  } else if (options.refine && options.method != TuneMethod::kZieglerNichols && !plant.nonlinear) {
+  } else if (options.refine && !IsTuningRule(options.method) && !plant.nonlinear) {
     summary->refine = RefineWithCeres(plant, options, summary->search_gains, summary->search_objective);
     const PidGains& r = summary->refine.gains;
     // Ceres knows no constraint: its point is kept only if it meets them all.

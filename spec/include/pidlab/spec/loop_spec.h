@@ -214,6 +214,7 @@ struct TuneSpec {
   double agree_tolerance = 1e-3;
   double max_overshoot_pct = kInf, max_settling_s = kInf;
   std::string zn_rule = "classic";
+  std::string rule = "pid";
   bool robust = false;
   int robust_samples = 0;
   double robust_quantile = 1.0, robust_spread = 0.1;
@@ -223,7 +224,7 @@ struct TuneSpec {
     a->Visit(
         {"method",
          "multi-start (Sobol' design + Nelder-Mead polish) | nelder-mead | paper-nm | ziegler-nichols | ga | "
-         "pso-gsa",
+         "pso-gsa | simc | amigo (tuning rules on a reduced model, docs/tuning.md)",
          "", kNone, R"("nelder-mead")"},
         &method);
     a->Visit({"objective",
@@ -258,6 +259,7 @@ struct TuneSpec {
     a->Visit({"max_settling", "reject candidates settling later", "s", kInfinite, "10"}, &max_settling_s);
     a->Visit({"zn_rule", "classic | pessen | some-overshoot | no-overshoot", "", kNone, R"("pessen")"},
              &zn_rule);
+    a->Visit({"rule", "simc, amigo: pi | pid, the controller the rule gives", "", kNone, R"("pi")"}, &rule);
     a->Visit({"robust",
               "the robust preset (docs/robustness.md): --objective setpoint-load --load-weight 1 "
               "--derivative-filter-ratio 10 --max-ms 1.6 --max-time-constant <horizon/10>; a field given "

@@ -15,6 +15,7 @@
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/optim/multi_start.h"
 #include "pidlab/optim/optimizer.h"
+#include "pidlab/tune/tuning_rules.h"
 #include "pidlab/tune/ziegler_nichols.h"
 
 namespace pidlab::tune {
@@ -31,11 +32,16 @@ enum class TuneMethod {
   kPaperNelderMead,
   kZieglerNichols,
   kGeneticAlgorithm,
-  kPsoGsa
+  kPsoGsa,
+  kSimc,   // Skogestad's SIMC rule on a reduced model (tuning_rules.h)
+  kAmigo,  // Astrom and Hagglund's AMIGO rule on a reduced model (tuning_rules.h)
 };
-/// multi-start | nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa
+/// multi-start | nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa | simc | amigo
 bool ParseTuneMethod(const std::string& s, TuneMethod* method);
 std::string ToString(TuneMethod method);
+/// True for the methods that compute their gains by a rule and evaluate them
+/// once (ziegler-nichols, simc, amigo): no search, no Ceres cross-check.
+bool IsTuningRule(TuneMethod method);
 
 /// The multi-start's defaults (docs/optimisers.md, "MultiStart"): the design
 /// of 1024 scrambled Sobol' points warped by ln(10^4), 16 polished starts at
@@ -116,6 +122,8 @@ struct TuneOptions {
   double agree_tolerance = 1e-3;
   /// Ziegler-Nichols rule (ziegler-nichols only).
   ZieglerNicholsRule zn_rule = ZieglerNicholsRule::kClassic;
+  /// PI or PID (simc and amigo only).
+  RuleForm rule = RuleForm::kPid;
   /// Runs independent evaluations at the same time (e.g. one thread per LCM
   /// trio): the starts of multi-start Nelder-Mead, each generation of GA and
   /// PSO-GSA. Empty: one after the other. The result is the same bits either
@@ -126,8 +134,8 @@ struct TuneOptions {
   /// loop steps over EvaluationBudget().
   bool IsValid(std::string* error) const;
   /// The search's evaluation budget: max_evaluations, else the method's
-  /// default (5000; multi-start 20000); 1 for ziegler-nichols, which
-  /// evaluates its rule once.
+  /// default (5000; multi-start 20000); 1 for ziegler-nichols, simc and
+  /// amigo, which evaluate their rule once.
   int EvaluationBudget() const;
   /// starts, or the method's default when 0.
   int StartCount() const;
@@ -177,7 +185,7 @@ std::string ToString(RefineTermination termination);
 /// What the cross-check concluded, after re-evaluating Ceres's point with the
 /// exact objective f (f_search: the search result's objective).
 enum class RefineVerdict {
-  /// "not run": --refine none, ziegler-nichols (never refined), the
+  /// "not run": --refine none, ziegler-nichols, simc, amigo (never refined), the
   /// iae-continuous, load-iae and setpoint-load objectives (no least-squares
   /// form in pidlab), or no stable
   /// loop to start from; RefineSummary::message says which of the last two.
@@ -243,6 +251,7 @@ struct TuneSummary {
   /// multi-start: the polished starts, best first.
   std::vector<optim::LocalMinimum> local_minima;
   ZieglerNicholsResult ziegler_nichols;  // ziegler-nichols only
+  TuningRuleResult tuning_rule;          // simc and amigo only: the model and the rule's controller
   RefineSummary refine;
   /// With a robust set (TuneOptions::robust_samples > 0): its size (nominal
   /// plus the valid draws), the draws whose parameters gave no valid plant
@@ -258,7 +267,9 @@ struct TuneSummary {
 };
 
 /// Tunes the PID for `plant`. Returns false with *error for invalid input or
-/// when the method does not apply (e.g. Ziegler-Nichols on 1/s^2); true
+/// when the method does not apply (e.g. Ziegler-Nichols on 1/s^2, SIMC on
+/// 1/(s^2+1), or simc and amigo on a plant with a dead time, which the loops
+/// do not simulate yet: ApplyTuningRule gives its gains); true
 /// otherwise, with summary->stable false if no strictly stable loop was found.
 /// `runner` evaluates the sampled loop (episodes over the LCM trio); null: in process.
 bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
