@@ -94,7 +94,9 @@ for k in np.nonzero(np.diff(np.sign(im)) != 0)[0]:
     lp = parts([wp])[1][0]
     if lp.real < 0 and abs(lp) < 1e9:  # not the phase jump at a pole on the axis
         gms.append(1.0 / abs(lp))
-ref["phase_margin_deg"] = min(pms) if pms else None
+# The phase margin a user reads: the smallest |arg L + 180| over the crossovers
+# (MATLAB's margin); every crossover's signed margin in phase_margins_deg (allmargin).
+ref["phase_margin_deg"] = min(abs(p) for p in pms) if pms else None
 ref["delay_margin_s"] = min(dms) if dms else None
 ref["gain_margin"] = min(gms, key=lambda x: abs(math.log(x))) if gms else None
 if tf == 0 and kd > 0:
@@ -111,6 +113,9 @@ for key, want in ref.items():
     print(f"  {key:18s} pidlab {got:.6g}  numpy/scipy {want:.6g}  rel diff {err:.1e}")
     if err > 5e-3:
         bad.append(f"{key}: pidlab {got} numpy {want} ({err:.2%})")
+got_pms = rob["phase_margins_deg"]
+if len(got_pms) != len(pms) or any(abs(a - b) > 5e-3 * max(1.0, abs(b)) for a, b in zip(got_pms, pms)):
+    bad.append(f"phase_margins_deg: pidlab {got_pms} numpy {pms}")
 if bad:
     print("\n".join(bad))
     sys.exit(1)
