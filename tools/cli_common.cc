@@ -319,12 +319,24 @@ std::string FormatRobustness(const LoopAnalysis& a, const LoopBounds& bounds) {
          << ", delay margin " << a.delay_margin_s << " s\n";
     else
       os << "  phase margin   inf (" << a.phase_margin_note << ")\n";
+    if (a.phase_margins_deg.size() > 1) {
+      os << "  crossovers     ";
+      for (std::size_t i = 0; i < a.phase_margins_deg.size(); ++i)
+        os << (i ? ", " : "") << a.phase_margins_deg[i] << " deg at " << a.gain_crossovers_rad_s[i]
+           << " rad/s";
+      os << "   (arg L + 180 each; the phase margin is the smallest |.|)\n";
+    }
     if (std::isfinite(a.noise_gain))
       os << "  noise gain     " << a.noise_gain << at(a.noise_gain_rad_s) << "   (||C S||inf)\n";
     else
       os << "  noise gain     unbounded (" << a.noise_gain_note << ")\n";
   }
-  os << "  slowest tau    " << a.slowest_time_constant_s << " s   (1 / min |Re p|)\n";
+  if (a.delay_s > 0.0)
+    os << "  dead time      " << a.delay_s << " s, exact e^(-jwL); " << a.stability_note << "\n";
+  if (a.time_constant_note.empty())
+    os << "  slowest tau    " << a.slowest_time_constant_s << " s   (1 / min |Re p|)\n";
+  else
+    os << "  slowest tau    - (" << a.time_constant_note << ")\n";
   for (const Cancellation& c : a.cancellations)
     os << "  cancellation   pole " << FormatPoles({c.pole}) << " near controller zero "
        << FormatPoles({c.zero}) << " (" << 100.0 * c.relative_distance << " % apart)\n";

@@ -27,11 +27,19 @@ pass() { echo "PASS: $1"; passed=$((passed + 1)); }
 fail() { echo "FAIL: $1"; failed=$((failed + 1)); }
 
 # ---- The paper's NM gains against numpy/scipy ----
+cases=()
 for plant in double_integrator oscillator stepper_motor; do
   gains=$(awk -F, -v p="$plant" '$2 == p && $3 == "nelder_mead" { print $5 "," $6 "," $7; exit }' "$csv")
   filtered=0.01
   [[ $plant == stepper_motor ]] && filtered=1e-5  # its loop is fast: 0.01 s destabilises it
-  for tf in 0 $filtered; do
+  cases+=("$plant $gains 0" "$plant $gains $filtered")
+done
+# A stable stepper loop with three gain crossovers, at +91.2, -91.3 and +19.3 deg (found by
+# tests/loop_delay_test.cc's seeded search): its phase margin is 19.3 deg, the smallest distance.
+cases+=("stepper_motor 0.02312248198680401,0.082003684650619205,7.4018005317821451 0.00054138902437990356")
+for case in "${cases[@]}"; do
+  read -r plant gains tf <<<"$case"
+  {
     name="$plant gains $gains tf $tf"
     if "$pidlab" evaluate --plant "$plant" --gains "$gains" --derivative-filter "$tf" --json >out.json 2>err.txt &&
       /usr/bin/python3 - out.json "$plant" "$gains" "$tf" <<'PY'
@@ -94,7 +102,9 @@ for k in np.nonzero(np.diff(np.sign(im)) != 0)[0]:
     lp = parts([wp])[1][0]
     if lp.real < 0 and abs(lp) < 1e9:  # not the phase jump at a pole on the axis
         gms.append(1.0 / abs(lp))
-ref["phase_margin_deg"] = min(pms) if pms else None
+# The phase margin a user reads: the smallest |arg L + 180| over the crossovers
+# (MATLAB's margin); every crossover's signed margin in phase_margins_deg (allmargin).
+ref["phase_margin_deg"] = min(abs(p) for p in pms) if pms else None
 ref["delay_margin_s"] = min(dms) if dms else None
 ref["gain_margin"] = min(gms, key=lambda x: abs(math.log(x))) if gms else None
 if tf == 0 and kd > 0:
@@ -111,6 +121,9 @@ for key, want in ref.items():
     print(f"  {key:18s} pidlab {got:.6g}  numpy/scipy {want:.6g}  rel diff {err:.1e}")
     if err > 5e-3:
         bad.append(f"{key}: pidlab {got} numpy {want} ({err:.2%})")
+got_pms = rob["phase_margins_deg"]
+if len(got_pms) != len(pms) or any(abs(a - b) > 5e-3 * max(1.0, abs(b)) for a, b in zip(got_pms, pms)):
+    bad.append(f"phase_margins_deg: pidlab {got_pms} numpy {pms}")
 if bad:
     print("\n".join(bad))
     sys.exit(1)
@@ -120,7 +133,7 @@ PY
     else
       fail "$name: $(tail -3 err.txt 2>/dev/null)"
     fi
-  done
+  }
 done
 
 # ---- Keys, notes, bounds reported ----
@@ -138,6 +151,22 @@ assert any(v.startswith("time constant") for v in r["violations"]), r["violation
 assert j["gains"]["tf"] == 0
 PY
 then pass "robustness keys, null with notes, the cancellation and a violated bound"; else fail "robustness keys"; fi
+
+# ---- Several gain crossovers: --min-phase-margin reads the smallest distance to -180 deg ----
+several=(--plant stepper_motor --gains 0.02312248198680401,0.082003684650619205,7.4018005317821451
+  --derivative-filter 0.00054138902437990356 --json)
+"$pidlab" evaluate "${several[@]}" --min-phase-margin 15 >pm15.json
+"$pidlab" evaluate "${several[@]}" --min-phase-margin 25 >pm25.json
+if /usr/bin/python3 - pm15.json pm25.json <<'PY'
+import json, sys
+r15, r25 = (json.load(open(f))["robustness"] for f in sys.argv[1:3])
+assert r15["stable"] and len(r15["phase_margins_deg"]) == 3, r15
+assert min(r15["phase_margins_deg"]) < 0 < r15["phase_margin_deg"], r15
+assert abs(r15["phase_margin_deg"] - min(abs(m) for m in r15["phase_margins_deg"])) < 1e-12, r15
+assert not any(v.startswith("phase margin") for v in r15["violations"]), r15["violations"]
+assert any(v.startswith("phase margin") for v in r25["violations"]), r25["violations"]
+PY
+then pass "three crossovers (one at -91 deg): phase margin 19.3 deg meets 15, breaks 25"; else fail "several crossovers"; fi
 
 "$pidlab" evaluate --plant double_integrator --gains 30,1,30 --derivative-filter-ratio 10 --json >ratio.json
 if /usr/bin/python3 -c "import json,sys; g=json.load(open('ratio.json'))['gains']; assert abs(g['tf']-0.1)<1e-15, g"; then

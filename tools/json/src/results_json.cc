@@ -189,6 +189,10 @@ nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds) {
   j["phase_crossover_rad_s"] = JsonNumber(a.phase_crossover_rad_s);
   j["gain_crossovers_rad_s"] = a.gain_crossovers_rad_s;
   j["phase_crossovers_rad_s"] = a.phase_crossovers_rad_s;
+  // Every crossover's own margin, in the order of the crossovers (allmargin).
+  j["phase_margins_deg"] = a.phase_margins_deg;
+  j["gain_margins"] = a.gain_margins;
+  j["delay_s"] = a.delay_s;
   nlohmann::json cancellations = nlohmann::json::array();
   for (const Cancellation& c : a.cancellations)
     cancellations.push_back({{"pole", complex_json(c.pole)},
@@ -199,6 +203,8 @@ nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds) {
   if (!a.gain_margin_note.empty()) notes["gain_margin"] = a.gain_margin_note;
   if (!a.phase_margin_note.empty()) notes["phase_margin_deg"] = notes["delay_margin_s"] = a.phase_margin_note;
   if (!a.noise_gain_note.empty()) notes["noise_gain"] = a.noise_gain_note;
+  if (!a.time_constant_note.empty()) notes["slowest_time_constant_s"] = a.time_constant_note;
+  if (!a.stability_note.empty()) notes["stable"] = a.stability_note;
   j["notes"] = notes;
   j["violations"] = LoopBoundsViolations(a, bounds);
   j["method"] = a.method;

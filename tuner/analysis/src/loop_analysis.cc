@@ -16,6 +16,9 @@ namespace {
 
 using loop_internal::cd;
 using loop_internal::ContinuousResponse;
+using loop_internal::CountEncirclements;
+using loop_internal::Crossings;
+using loop_internal::DelayGrid;
 using loop_internal::Eval;
 using loop_internal::FindCrossings;
 using loop_internal::Grid;
@@ -54,12 +57,27 @@ std::vector<Cancellation> FindCancellations(const std::vector<cd>& s_poles, cons
   return out;
 }
 
+// A dead time the analysis can use: finite, >= 0, and for the continuous loop
+// only (the sampled loop's analysis with dead time is not supported yet).
+bool DelayIsValid(const Plant& plant, const evaluation::LoopOptions& options, std::string* error) {
+  std::ostringstream os;
+  if (!(plant.delay_s >= 0.0) || !std::isfinite(plant.delay_s))
+    os << "dead time " << plant.delay_s << " s must be finite and >= 0";
+  else if (plant.delay_s > 0.0 && options.loop != evaluation::LoopKind::kContinuous)
+    os << "dead time " << plant.delay_s << " s: the sampled loop's analysis with dead time is not supported "
+       << "yet (analyse the continuous loop)";
+  else
+    return true;
+  if (error) *error = os.str();
+  return false;
+}
+
 // The inputs AnalyzeLoop accepts, and the loop gains *g of typed_gains.
 bool CheckAnalysisInputs(const Plant& plant, const PidGains& typed_gains,
                          const evaluation::LoopOptions& options, const LoopAnalysisOptions& ao, PidGains* g,
                          std::string* error) {
   if (!GainsAreValid(typed_gains, error) || !options.IsValid(error) || !ao.IsValid(error) ||
-      !plant.tf.IsValid(error))
+      !plant.tf.IsValid(error) || !DelayIsValid(plant, options, error))
     return false;
   if (plant.tf.RelativeDegree() < 1) {
     if (error) *error = "plant " + plant.tf.ToString() + " must be strictly proper";
@@ -154,7 +172,7 @@ void RaiseContinuousPeak(const ContinuousResponse& r, Peak which, const LoopAnal
     *value = at_inf;
     *w = kInf;
   }
-  if (std::isfinite(*value) && ao.hamiltonian_check) {
+  if (std::isfinite(*value) && ao.hamiltonian_check && !(r.delay() > 0.0)) {
     double wp = *w;
     const double h = HinfNormBruinsmaSteinbuch(x, r.p(), *value, *w, 1e-7, &wp);
     if (h > *value * (1.0 + 1e-6)) {
@@ -181,6 +199,49 @@ void SetPeaks(const Response& response, const std::vector<double>& w, const std:
     if (continuous)
       RaiseContinuousPeak(static_cast<const ContinuousResponse&>(response), t.which, ao, t.value, t.w);
   }
+}
+
+// The frequencies of the open-loop poles and zeros of r, and 1/L.
+std::vector<double> OpenLoopFrequencies(const ContinuousResponse& r) {
+  std::vector<double> special;
+  if (r.delay() > 0.0) special.push_back(1.0 / r.delay());
+  for (const auto& v : {PolynomialRoots(r.a()), PolynomialRoots(r.b())})
+    for (double w : SpecialFrequencies(v)) special.push_back(w);
+  return special;
+}
+
+// The continuous loop with dead time: the open-loop features and 1/L on the
+// analysis grid, e^{-jwL} resolved below the band's top, stability by the
+// Nyquist count, crossovers within the band, peaks without the Hamiltonian
+// iteration (which needs a rational loop).
+bool AnalyzeDelayedLoop(const Plant& plant, const PidGains& g, const evaluation::LoopOptions& options,
+                        const LoopAnalysisOptions& ao, LoopAnalysis* a, std::string* error) {
+  a->delay_s = plant.delay_s;
+  a->method =
+      "log grid + open-loop pole and zero frequencies, points every pi/16 of e^(-jwL) up to where |L| < "
+      "0.01 for good, golden-section refinement of every local maximum (no Hamiltonian iteration "
+      "with dead time)";
+  a->time_constant_note = "dead time: the closed-loop poles are not computed";
+  const ContinuousResponse r(plant.tf, g, plant.delay_s);
+  std::vector<double> w;
+  std::vector<Point> pts;
+  double w_top = 0.0;
+  if (!DelayGrid(r, AnalysisGrid(OpenLoopFrequencies(r), options, ao), &w, &pts, &w_top, error)) return false;
+  const NyquistCount n = CountEncirclements(r, w, pts);
+  a->stable = n.stable;
+  a->stability_note = n.note;
+  if (!a->stable) {
+    MarkUnstable(a);
+    return true;
+  }
+  Crossings c = FindCrossings(r, w, pts);
+  for (auto* list : {&c.gain, &c.phase})
+    list->erase(std::remove_if(list->begin(), list->end(), [&](double x) { return x > w_top; }), list->end());
+  SetMargins(r, c, a);
+  SetPeaks(r, w, pts, true, ao, a);
+  if (std::isinf(a->noise_gain))
+    a->noise_gain_note = g.kd > 0.0 && !(g.tf > 0.0) ? "ideal derivative: unbounded" : "unbounded";
+  return true;
 }
 
 }  // namespace
@@ -214,6 +275,7 @@ bool AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const evaluati
   *out = LoopAnalysis();
   LoopAnalysis& a = *out;
   a.loop = options.loop;
+  if (plant.delay_s > 0.0) return AnalyzeDelayedLoop(plant, g, options, ao, &a, error);
   const bool continuous = options.loop == evaluation::LoopKind::kContinuous;
   a.method = AnalysisMethod(continuous);
   const PidOptions pid = options.Pid();
@@ -241,10 +303,34 @@ bool AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const evaluati
   return true;
 }
 
+bool CountNyquist(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
+                  NyquistCount* count, std::string* error) {
+  PidGains g;
+  evaluation::LoopOptions continuous = options;
+  continuous.loop = evaluation::LoopKind::kContinuous;
+  const LoopAnalysisOptions ao;
+  if (!CheckAnalysisInputs(plant, typed_gains, continuous, ao, &g, error)) return false;
+  const ContinuousResponse r(plant.tf, g, plant.delay_s);
+  const std::vector<double> base = AnalysisGrid(OpenLoopFrequencies(r), continuous, ao);
+  std::vector<double> w = base;
+  std::vector<Point> pts;
+  if (plant.delay_s > 0.0) {
+    double w_top = 0.0;
+    if (!DelayGrid(r, base, &w, &pts, &w_top, error)) return false;
+  } else {
+    pts.resize(w.size());
+    for (std::size_t i = 0; i < w.size(); ++i) pts[i] = r.At(w[i]);
+  }
+  *count = CountEncirclements(r, w, pts);
+  return true;
+}
+
 bool LoopFrequencyResponse(const Plant& plant, const PidGains& typed_gains,
                            const evaluation::LoopOptions& options, const std::vector<double>& w_rad_s,
                            std::vector<LoopFrequencyPoint>* response, std::string* error) {
-  if (!GainsAreValid(typed_gains, error) || !options.IsValid(error) || !plant.tf.IsValid(error)) return false;
+  if (!GainsAreValid(typed_gains, error) || !options.IsValid(error) || !plant.tf.IsValid(error) ||
+      !DelayIsValid(plant, options, error))
+    return false;
   if (options.loop != evaluation::LoopKind::kContinuous) {
     if (error) *error = "LoopFrequencyResponse: the loop must be continuous";
     return false;
@@ -261,7 +347,9 @@ bool LoopFrequencyResponse(const Plant& plant, const PidGains& typed_gains,
       if (error) *error = "LoopFrequencyResponse: frequency " + std::to_string(w) + " is not finite and > 0";
       return false;
     }
-    const cd av = Eval(a, cd(0.0, w)), bv = Eval(b, cd(0.0, w)), sum = av + bv;
+    cd av = Eval(a, cd(0.0, w));
+    if (plant.delay_s > 0.0) av *= std::polar(1.0, -w * plant.delay_s);
+    const cd bv = Eval(b, cd(0.0, w)), sum = av + bv;
     LoopFrequencyPoint p;
     p.w_rad_s = w;
     p.l = bv == 0.0 ? cd(kInf, 0.0) : av / bv;

@@ -66,10 +66,13 @@ void SetMargins(const Response& r, const Crossings& c, LoopAnalysis* a) {
     const Point p = r.At(w);
     double pm = std::arg(p.a / p.b) + kPi;  // (0, 2 pi]
     if (pm > kPi) pm -= 2.0 * kPi;          // (-pi, pi]
+    // The extra delay that brings this crossover to -180 deg.
     const double lag = pm > 0.0 ? pm : pm + 2.0 * kPi;
     const double pm_deg = pm * 180.0 / kPi;
-    if (pm_deg < a->phase_margin_deg) {
-      a->phase_margin_deg = pm_deg;
+    a->phase_margins_deg.push_back(pm_deg);
+    // The margin a user reads: the distance in phase to -180 deg (MATLAB's margin).
+    if (std::abs(pm_deg) < a->phase_margin_deg) {
+      a->phase_margin_deg = std::abs(pm_deg);
       a->gain_crossover_rad_s = w;
     }
     a->delay_margin_s = std::min(a->delay_margin_s, lag / w);
@@ -78,6 +81,7 @@ void SetMargins(const Response& r, const Crossings& c, LoopAnalysis* a) {
   for (double w : c.phase) {
     const Point p = r.At(w);
     const double gm = std::abs(p.b) / std::abs(p.a);
+    a->gain_margins.push_back(gm);
     if (std::abs(std::log(gm)) < best) {
       best = std::abs(std::log(gm));
       a->gain_margin = gm;
@@ -152,6 +156,8 @@ std::vector<std::string> LoopBoundsViolations(const LoopAnalysis& a, const LoopB
     add("gain margin ", a.gain_margin, " within a factor ", b.min_gain_margin, " of 1");
   if (a.slowest_time_constant_s > b.max_time_constant_s)
     add("time constant ", a.slowest_time_constant_s, " s > ", b.max_time_constant_s);
+  else if (std::isfinite(b.max_time_constant_s) && !a.time_constant_note.empty())
+    add("time constant unknown (", a.time_constant_note, ")");
   return out;
 }
 

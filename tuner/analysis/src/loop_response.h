@@ -9,6 +9,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "pidlab/analysis/loop_analysis.h"
@@ -86,9 +87,11 @@ class Response {
   virtual Point At(double w) const = 0;
 };
 
+// L = C G e^{-s delay}: the dead time multiplies a (its |.| is 1 on the axis).
 class ContinuousResponse : public Response {
  public:
-  ContinuousResponse(const TransferFunction& plant, const PidGains& g) {
+  ContinuousResponse(const TransferFunction& plant, const PidGains& g, double delay_s = 0.0)
+      : delay_(delay_s) {
     ContinuousPidPolynomials(g, &nc_, &dc_);
     ng_ = Trim(plant.num);
     dg_ = Trim(plant.den);
@@ -99,15 +102,25 @@ class ContinuousResponse : public Response {
   }
   Point At(double w) const override {
     const cd s(0.0, w);
+    if (delay_ > 0.0) return {Eval(a_, s) * std::polar(1.0, -w * delay_), Eval(b_, s), Eval(c_, s)};
     return {Eval(a_, s), Eval(b_, s), Eval(c_, s)};
   }
+  double delay() const { return delay_; }
   const Polynomial& a() const { return a_; }
   const Polynomial& b() const { return b_; }
   const Polynomial& c() const { return c_; }
   const Polynomial& p() const { return p_; }
   const Polynomial& controller_num() const { return nc_; }
-  // The limit of |x / p| as w -> inf (x of degree <= deg p, else +inf).
+  // The limit of |x / p| as w -> inf (x of degree <= deg p, else +inf). With
+  // dead time and deg a = deg b, p = a e^{-jwL} + b has no limit: the supremum
+  // of |x / p| at infinity, |x0| / (|b0| - |a0|) (leading coefficients).
   double AtInfinity(const Polynomial& x) const {
+    if (delay_ > 0.0 && Degree(a_) == Degree(b_)) {
+      const int dx = Degree(x), db = Degree(b_);
+      if (dx < db) return 0.0;
+      const double gap = std::abs(Trim(b_)[0]) - std::abs(Trim(a_)[0]);
+      return dx > db || !(gap > 0.0) ? kInf : std::abs(Trim(x)[0]) / gap;
+    }
     const int dx = Degree(x), dp = Degree(p_);
     if (dx < dp) return 0.0;
     if (dx > dp) return kInf;
@@ -116,6 +129,7 @@ class ContinuousResponse : public Response {
 
  private:
   Polynomial nc_, dc_, ng_, dg_, a_, b_, c_, p_;
+  double delay_ = 0.0;
 };
 
 class SampledResponse : public Response {
@@ -193,6 +207,24 @@ Crossings FindCrossings(const Response& r, const std::vector<double>& w, const s
 
 // The margins at the crossings, their frequencies and notes, into *a.
 void SetMargins(const Response& r, const Crossings& c, LoopAnalysis* a);
+
+// loop_nyquist.cc
+
+// Dead time: the analysis grid `base` (the loop's features) with points added
+// below *w_top so that e^{-jwL} turns by at most pi/16 between neighbours;
+// *w_top is where |L| falls below kSmallLoopGain for good on `base`, raised
+// until the band holds a phase crossover. False with *error when that takes
+// more than kMaxDelayGridPoints.
+inline constexpr double kSmallLoopGain = 0.01;
+inline constexpr std::size_t kMaxDelayGridPoints = 2000000;
+bool DelayGrid(const ContinuousResponse& r, const std::vector<double>& base, std::vector<double>* w,
+               std::vector<Point>* pts, double* w_top, std::string* error);
+
+// The Nyquist count of the continuous loop over the grid `w` (increasing,
+// reaching where |L| < 1 for good) with its points: encirclements of -1 by
+// L(jw), w from -inf to inf, the open-loop poles on the axis indented.
+NyquistCount CountEncirclements(const ContinuousResponse& r, const std::vector<double>& w,
+                                const std::vector<Point>& pts);
 
 // loop_analysis.cc
 

@@ -11,6 +11,12 @@
 //    derivative filter D(z) = kd/(tf+dt) (z-1)/(z - tf/(tf+dt))), G(z) the
 //    exact ZOH plant C (zI - Phi)^-1 Gamma of the lockstep loop.
 // S = 1/(1+L), T = L/(1+L), noise gain = |C S| (measurement noise to u).
+// A plant with dead time (Plant::delay_s = L > 0) multiplies the continuous
+// L(s) by e^{-sL} exactly (docs/deadtime.md, "Analysis: exact in frequency"):
+// its stability is the Nyquist count (CountNyquist), its crossovers are
+// bracketed on a grid on which e^{-jwL} turns by at most pi/16 per point, and
+// no closed-loop pole is computed (no time constant, no cancellation). The
+// sampled loop with dead time is refused (not supported yet).
 //
 // Peaks are found by a method that cannot miss a narrow one: a log grid
 // (points_per_decade) merged with every frequency where a narrow feature can
@@ -61,12 +67,20 @@ struct LoopAnalysis {
   /// closest to 1 on a log scale; < 1 is a gain-reduction margin. +inf: none.
   double gain_margin = std::numeric_limits<double>::infinity();
   double phase_crossover_rad_s = std::numeric_limits<double>::quiet_NaN();
-  /// The smallest phase margin over the gain crossovers, degrees. +inf: none.
+  /// The phase margin, degrees, >= 0: min over the gain crossovers of
+  /// |arg L + 180 deg| wrapped to [0, 180] (MATLAB's `margin`: the smallest
+  /// distance in phase to the critical point). +inf: no gain crossover.
   double phase_margin_deg = std::numeric_limits<double>::infinity();
   double gain_crossover_rad_s = std::numeric_limits<double>::quiet_NaN();
   /// min over gain crossovers of PM_i / w_i, s (sampled loop too). +inf: none.
   double delay_margin_s = std::numeric_limits<double>::infinity();
   std::vector<double> gain_crossovers_rad_s, phase_crossovers_rad_s;
+  /// Every crossover's own margin (MATLAB's `allmargin`), in the order of the
+  /// crossovers: arg L + 180 deg wrapped to (-180, 180] at each gain
+  /// crossover, and 1/|L| at each phase crossover.
+  std::vector<double> phase_margins_deg, gain_margins;
+  /// The plant's dead time the analysis used, s (0: rational loop).
+  double delay_s = 0.0;
   /// Peaks and where they are (frequency +inf: approached as w -> inf).
   double ms = std::numeric_limits<double>::quiet_NaN(), ms_rad_s = 0.0;
   double mt = std::numeric_limits<double>::quiet_NaN(), mt_rad_s = 0.0;
@@ -75,9 +89,39 @@ struct LoopAnalysis {
   double slowest_time_constant_s = std::numeric_limits<double>::quiet_NaN();
   std::vector<Cancellation> cancellations;
   std::string gain_margin_note, phase_margin_note, noise_gain_note;
+  /// Set when no closed-loop pole is known (dead time): why
+  /// slowest_time_constant_s is NaN and no cancellation is listed.
+  std::string time_constant_note;
+  /// How stability was decided with dead time (the Nyquist count), else "".
+  std::string stability_note;
   /// How the peaks were found (for the report and JSON).
   std::string method;
 };
+
+/// The Nyquist criterion for the continuous loop (with its dead time): Z = N + P
+/// closed-loop poles in the open right half-plane, N the clockwise
+/// encirclements of -1 by L(jw), w from -inf to inf, P the open-loop poles in
+/// the open right half-plane; open-loop poles on the imaginary axis (the
+/// integrators, the oscillator's +-j) are passed on the right by small
+/// semicircles.
+struct NyquistCount {
+  /// False when 1 + L(jw) comes within 1e-12 of 0 (a pole on the axis) or the
+  /// count is not an integer to 0.1: then stable is false.
+  bool decided = false;
+  bool stable = false;
+  int open_loop_rhp_poles = 0;    // P
+  int open_loop_axis_poles = 0;   // on the imaginary axis, with multiplicity
+  int encirclements = 0;          // N, clockwise
+  int closed_loop_rhp_poles = 0;  // Z = N + P
+  double winding_turns = 0.0;     // -N before rounding
+  std::string note;
+};
+
+/// The Nyquist count of the continuous loop of `plant` (with plant.delay_s)
+/// with `gains` (LoopGains of `options`). False with *error for invalid input,
+/// as AnalyzeLoop.
+bool CountNyquist(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
+                  NyquistCount* count, std::string* error);
 
 /// Analyses the loop of `plant` with `gains` (LoopGains of `options`) for
 /// options.loop. False with *error for invalid input (as Evaluate). An
@@ -94,7 +138,7 @@ struct LoopFrequencyPoint {
 };
 
 /// L, S and T of the continuous loop of `plant` with `gains` (LoopGains of
-/// `options`, so with its derivative filter) at every w of `w_rad_s` (finite,
+/// `options`, so with its derivative filter; L with e^{-jw plant.delay_s}) at every w of `w_rad_s` (finite,
 /// > 0), in that order. S and T are computed as b/(a+b) and a/(a+b) from
 /// L = a/b, so they stay finite where L has a pole on the axis (L infinite,
 /// S = 0, T = 1). False with *error for invalid input or options.loop sampled.
