@@ -27,8 +27,10 @@ if [ "$fast" = 1 ]; then
   echo "fast lane (ctest -L 'unit|cli'): $(( $(date +%s) - start )) s"
   exit "$status"
 fi
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPIDLAB_SANITIZE=ON -DPIDLAB_WERROR=ON \
-  -DPIDLAB_BUILD_BENCH=OFF >/dev/null
+# -O1 -g1: what the sanitisers' own documentation recommends, with line
+# tables enough for a report's stack (and half the compile time of -O2 -g).
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
+  -DPIDLAB_SANITIZE=ON -DPIDLAB_WERROR=ON -DPIDLAB_BUILD_BENCH=OFF >/dev/null
 cmake --build build-asan -j"$(nproc)" --target pidlab pidlab-plant pidlab-controller pidlab-disturbance \
   hostile_stranger hostile_protocol_test
 bash scripts/build.sh -DPIDLAB_SANITIZED_BIN_DIR="$PWD/build-asan/bin"
