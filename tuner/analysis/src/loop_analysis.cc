@@ -59,7 +59,7 @@ bool CheckAnalysisInputs(const Plant& plant, const PidGains& typed_gains,
                          const evaluation::LoopOptions& options, const LoopAnalysisOptions& ao, PidGains* g,
                          std::string* error) {
   if (!GainsAreValid(typed_gains, error) || !options.IsValid(error) || !ao.IsValid(error) ||
-      !plant.tf.IsValid(error))
+      !plant.tf.IsValid(error) || !evaluation::DelayIsValid(plant, options, "delay", error))
     return false;
   if (plant.tf.RelativeDegree() < 1) {
     if (error) *error = "plant " + plant.tf.ToString() + " must be strictly proper";
@@ -105,7 +105,7 @@ bool ContinuousModel(const Plant& plant, const PidGains& g, const evaluation::Lo
 
 void SampledModel(const Plant& plant, const PidGains& g, const evaluation::LoopOptions& options,
                   const PidOptions& pid, LoopModel* m) {
-  const DiscretePlant discrete(plant.tf, options.dt_s);
+  const DiscretePlant discrete = evaluation::SampledPlant(plant, options.dt_s);
   const evaluation::Stability st = evaluation::SampledStability(discrete, g, pid, options.stability_margin);
   m->stable = st.stable;
   m->s_poles = ToS(st.poles, evaluation::LoopKind::kSampled, options.dt_s);
