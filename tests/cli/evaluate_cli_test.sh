@@ -148,7 +148,7 @@ bad() {
 # A plant's dead time (docs/deadtime.md): out of range, or where it is not supported yet.
 F=(--plant custom --num 1 --den 1,1 --gains 1,1,0)
 bad "negative delay" "--delay -1" evaluate --loop sampled "${F[@]}" --delay -1
-bad "NaN delay" "--delay nan" evaluate --loop sampled "${F[@]}" --delay nan
+bad "NaN delay" "--delay 'nan'" evaluate --loop sampled "${F[@]}" --delay nan
 bad "huge delay" "--delay 1e+09" evaluate --loop sampled "${F[@]}" --delay 1e9
 bad "delay of more stored inputs than the analysis takes" "--delay 2 s at dt 0.001 s" evaluate --loop sampled \
   "${F[@]}" --delay 2

@@ -58,8 +58,8 @@ j = json.load(open(sys.argv[1]))
 assert j["spec"]["delay"] == 0.3 and j["spec"]["loop"] == "sampled", j["spec"]
 assert j["stable"] is True and j["iae"] > 0, j
 PY
-rerun delayed_tune tune --loop sampled --plant custom --num 1 --den 1,1 --delay 0.3 --method nelder-mead \
-  --starts 1 --max-evals 60 --horizon 10
+rerun delayed_tune tune --loop sampled --dt 0.01 --plant custom --num 1 --den 1,1 --delay 0.3 --bounds 0,3 \
+  --method nelder-mead --starts 1 --max-evals 60 --horizon 10
 rerun montecarlo evaluate --plant stepper --gains 20.8836,26.607,12.4866 --monte-carlo 20 --spread 10%
 rerun tuned tune --plant oscillator --max-evals 300 --design-points 64
 rerun robust tune --plant stepper --robust --max-evals 300 --design-points 64 --max-ms 1.5
