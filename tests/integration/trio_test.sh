@@ -363,7 +363,7 @@ PY
     export TMP PIDLAB
     rm -f "$TMP/delay.lcmlog"
     "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/delay.lcmlog" -- bash -c 'fail=0
-      compare stepper_delay --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --delay 0.0123
+      compare stepper_delay --plant stepper_motor --gains 0.1,0.5,0.001 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --delay 0.0123
       compare fopdt_delay --plant custom --num 1 --den 1,1 --delay 0.3 --gains 1,1,0 --horizon 10 --disturbance square --disturbance-amplitude 0.2
       exit $fail' || fail=1
     if "$PIDLAB" replay --json "$TMP/delay.lcmlog" >"$TMP/delay.replay.json" 2>"$TMP/delay.replay.err" &&
@@ -379,7 +379,7 @@ for name in ("stepper_delay", "fopdt_delay"):
     live = json.load(open(f"{tmp}/{name}.lcm.json"))
     assert live["spec"]["delay"] in (0.0123, 0.3), live["spec"]
     assert live["iae"] in iaes, (name, live["iae"], iaes)
-print(f"ok   replay: {len(iaes)} delayed episodes, each live IAE reproduced exactly")
+print(f"ok   replay: {len(iaes)} episodes of delayed plants, each live IAE reproduced exactly")
 PY
     then :; else
       echo "FAIL replay of the delay log: $(head -3 "$TMP/delay.replay.err")"; fail=1
