@@ -17,6 +17,7 @@
 #include <limits>
 #include <new>
 #include <pidlab/lcmt_episode_config_v1.hpp>
+#include <pidlab/lcmt_episode_config_v2.hpp>
 
 #include "pidlab/replay/decoder_table.h"
 #include "pidlab/replay/episode_assembler.h"
@@ -341,7 +342,7 @@ std::vector<uint8_t> Encode(const Msg& m) {
 
 TEST(DecoderTable, FindsEveryPidlabTypeByItsFingerprint) {
   const DecoderTable table;
-  ASSERT_EQ(table.types().size(), 11u);  // ten types and the configuration of older logs
+  ASSERT_EQ(table.types().size(), 12u);  // ten types and the two configurations of older logs
   for (const MessageType& t : table.types()) {
     const MessageType* found = table.Find(t.fingerprint);
     ASSERT_NE(found, nullptr) << t.name;
@@ -426,8 +427,49 @@ TEST(DecoderTable, AConfigurationOfAnOlderLogIsReadAsOneOfALinearPlant) {
     const std::vector<uint8_t> cut_bytes(whole.begin(), whole.end() - static_cast<std::ptrdiff_t>(cut));
     EXPECT_FALSE(current->decode(cut_bytes.data(), cut_bytes.size(), &message)) << cut;
   }
-  whole[whole.size() - 11] = 0x7f;  // motor_drive's length ("linear": 4 + 7 bytes): 2^31 - 1 + ...
+  // motor_drive's length ("linear": 4 + 7 bytes, then delay_s's 8): 2^31 - 1 + ...
+  whole[whole.size() - 19] = 0x7f;
   EXPECT_FALSE(current->decode(whole.data(), whole.size(), &message));
+}
+
+TEST(DecoderTable, AConfigurationWrittenBeforeTheDeadTimeIsReadWithoutADelay) {
+  // lcmt_episode_config before delay_s was appended: its own fingerprint,
+  // decoded with its own layout, the motor's fields kept, delay_s 0.
+  pidlab::lcmt_episode_config_v2 old{};
+  old.episode_id = 11;
+  old.plant_name = "stepper_nonlinear";
+  old.num = {1.0};
+  old.num_size = 1;
+  old.den = {1.0, 2.0, 1.0};
+  old.den_size = 3;
+  old.kp = 2.0;
+  old.anti_windup = "clamping";
+  old.derivative_on = "error";
+  old.integral = "backward-euler";
+  old.disturbance_kind = "none";
+  old.motor_resistance_ohm = 33.0;
+  old.motor_flux_linkage = 1.2e-3;
+  old.motor_drive = "microstep";
+  ASSERT_NE(pidlab::lcmt_episode_config_v2::getHash(), pidlab::lcmt_episode_config::getHash());
+  ASSERT_NE(pidlab::lcmt_episode_config_v2::getHash(), pidlab::lcmt_episode_config_v1::getHash());
+  std::vector<uint8_t> bytes = Encode(old);
+  const DecoderTable table;
+  const MessageType* type = table.Find(pidlab::lcmt_episode_config_v2::getHash());
+  ASSERT_NE(type, nullptr);
+  EXPECT_EQ(type->name, "lcmt_episode_config");
+  PidlabMessage message;
+  ASSERT_TRUE(type->decode(bytes.data(), bytes.size(), &message));
+  const auto* config = std::get_if<pidlab::lcmt_episode_config>(&message);
+  ASSERT_NE(config, nullptr);
+  EXPECT_EQ(config->episode_id, 11);
+  EXPECT_EQ(config->den, old.den);
+  EXPECT_EQ(config->motor_resistance_ohm, 33.0);
+  EXPECT_EQ(config->motor_flux_linkage, 1.2e-3);
+  EXPECT_EQ(config->motor_drive, "microstep");
+  EXPECT_EQ(config->delay_s, 0.0);
+  // Cut inside the motor's fields: refused like every other layout.
+  const std::vector<uint8_t> cut(bytes.begin(), bytes.end() - 12);
+  EXPECT_FALSE(type->decode(cut.data(), cut.size(), &message));
 }
 
 TEST(DecoderTable, RefusesAnArrayLongerThanThePayloadBeforeTheDecoderAllocatesIt) {

@@ -233,14 +233,20 @@ TEST(LoopDelay, SteppersLoopWithSeveralCrossoversReportsTheSmallestDistanceToThe
   EXPECT_NE(LoopBoundsViolation(found, bounds), "");
 }
 
-TEST(LoopDelay, SampledLoopWithDelayIsRefusedNamingTheDelay) {
+TEST(LoopDelay, SampledLoopAnalysisTakesTheDelayItsStoredInputsAllowAndRefusesTheRestNamingIt) {
   LoopOptions o;
   o.loop = LoopKind::kSampled;
+  o.dt_s = 0.01;
   LoopAnalysis a;
   std::string error;
-  EXPECT_FALSE(AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, 0.25), P(1.0), o,
-                           LoopAnalysisOptions{}, &a, &error));
-  EXPECT_NE(error.find("dead time 0.25 s"), std::string::npos) << error;
+  EXPECT_TRUE(AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, 0.25), P(1.0), o, LoopAnalysisOptions{}, &a,
+                          &error))
+      << error;
+  EXPECT_TRUE(a.stable);
+  // 100 s at dt 0.01 s: ten thousand stored inputs, more than the analysis takes.
+  EXPECT_FALSE(AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, 100.0), P(1.0), o, LoopAnalysisOptions{},
+                           &a, &error));
+  EXPECT_NE(error.find("delay 100 s"), std::string::npos) << error;
   EXPECT_FALSE(AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, -1.0), P(1.0), LoopOptions{},
                            LoopAnalysisOptions{}, &a, &error));
   EXPECT_NE(error.find("dead time -1 s"), std::string::npos) << error;

@@ -387,6 +387,60 @@ TEST(Trio, MatchesTheInProcessSampledLoopBitForBit) {
   }
 }
 
+// 1/(s+1) e^(-sL) with a split delay (L not a multiple of dt) and a
+// disturbance, which the plant also delays.
+Episode Fopdt(double delay_s) {
+  Episode e;
+  std::string error;
+  EXPECT_TRUE(MakeCustomPlant({1.0}, {1.0, 1.0}, &e.plant, &error)) << error;
+  e.plant.delay_s = delay_s;
+  e.gains = PidGains{1.0, 1.0, 0.0};
+  e.options.loop = LoopKind::kSampled;
+  e.options.horizon_s = 2.0;
+  e.options.disturbance.kind = DisturbanceKind::kSquare;
+  e.options.disturbance.amplitude = 0.3;
+  return e;
+}
+
+TEST(Trio, ThePlantsDeadTimeIsBitIdenticalToTheInProcessLoop) {
+  for (const double delay : {0.3, 0.0123}) {
+    SCOPED_TRACE(delay);
+    const Episode e = Fopdt(delay);
+    Recorder rec;
+    ASSERT_TRUE(RunOnMemq(e, 0.05, &rec)) << rec.last.message;
+    const std::vector<double> expected = Reference(e);
+    ASSERT_EQ(rec.y.size(), expected.size());
+    EXPECT_EQ(expected[1], 0.0) << "the input reaches the plant only after the dead time";
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      ASSERT_TRUE(rec.have[k]) << "step " << k;
+      ASSERT_EQ(rec.y[k], expected[k]) << "step " << k;
+    }
+  }
+}
+
+TEST(EpisodeConfig, CarriesThePlantsDeadTimeAndRejectsABadOneByName) {
+  const Episode e = Fopdt(0.3);
+  const auto msg = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  EXPECT_EQ(msg.delay_s, 0.3);
+  EpisodeSpec dut;
+  std::string error;
+  ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
+  EXPECT_EQ(dut.plant.delay_s, 0.3);
+  for (const double bad_delay : {-1.0, std::nan(""), HUGE_VAL, 1e9, 2e4}) {
+    SCOPED_TRACE(bad_delay);
+    auto bad = msg;
+    bad.delay_s = bad_delay;  // 2e4 s at dt 1e-3 is 2e7 stored inputs, more than 1e7
+    EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+    EXPECT_EQ(error.rfind("delay_s", 0), 0u) << error;
+  }
+  auto motor = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      7, Motor(1.0).plant, e.gains, Motor(1.0).options, DisturbanceOptions{}, RecoveryOptions{}));
+  motor.delay_s = 0.01;
+  EXPECT_FALSE(ParseEpisodeConfig(motor, &dut, &error));
+  EXPECT_NE(error.find("delay_s"), std::string::npos) << error;
+}
+
 TEST(Trio, RecoversFromDroppedMessagesWithIdenticalResults) {
   const Episode e = DoubleIntegrator();
   Recorder rec;

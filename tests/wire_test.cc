@@ -14,6 +14,7 @@
 #include <pidlab/lcmt_disturbance_sample.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
 #include <pidlab/lcmt_episode_config_v1.hpp>
+#include <pidlab/lcmt_episode_config_v2.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
@@ -65,6 +66,7 @@ TEST(WireLayout, EveryMessageAsEncodedPasses) {
   config.plant_name = "double_integrator";
   EXPECT_TRUE(Ok<pidlab::lcmt_episode_config>(Encode(config)));
   EXPECT_TRUE(Ok<pidlab::lcmt_episode_config_v1>(Encode(pidlab::lcmt_episode_config_v1{})));
+  EXPECT_TRUE(Ok<pidlab::lcmt_episode_config_v2>(Encode(pidlab::lcmt_episode_config_v2{})));
   pidlab::lcmt_ready ready{};
   ready.role = "plant";
   ready.detail = "nonce";

@@ -18,6 +18,7 @@ using pidlab::evaluation::LoopOptions;
 using pidlab::spec::NameStyle;
 using pidlab::tune::BuildLoopOptions;
 using pidlab::tune::BuildPlant;
+using pidlab::tune::CheckPlantInLoop;
 
 namespace pidlab::cli {
 namespace {
@@ -82,6 +83,7 @@ struct PlotCommand {
       Require(BuildPlant(ps.plant, NameStyle::kFlag, &p, &error), error);
       LoopOptions options;
       Require(BuildLoopOptions(ps.loop, NameStyle::kFlag, &options, &error), error);
+      Require(CheckPlantInLoop(p, options, NameStyle::kFlag, &error), error);
       std::vector<PidGains> sets;
       for (const auto& g : gains) sets.push_back(ParseGains(g));
       const long points = options.loop == LoopKind::kSampled ? options.TotalSteps() : options.NumSamples();

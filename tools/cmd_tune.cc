@@ -30,6 +30,7 @@ using pidlab::optim::TracePoint;
 using pidlab::spec::NameStyle;
 using pidlab::tune::BuildPlant;
 using pidlab::tune::BuildTuneOptions;
+using pidlab::tune::CheckPlantInLoop;
 using pidlab::tune::ResolveRobustPreset;
 using pidlab::tune::Tune;
 using pidlab::tune::TuneOptions;
@@ -71,6 +72,7 @@ struct TuneCommand {
     Require(BuildPlant(ts.plant, NameStyle::kFlag, &p, &error), error);
     TuneOptions o;
     Require(BuildTuneOptions(ts, NameStyle::kFlag, &o, &error), error);
+    Require(CheckPlantInLoop(p, o.loop, NameStyle::kFlag, &error), error);
     if (p.nonlinear && o.loop.loop != LoopKind::kSampled)
       throw BadInput("--plant " + p.name +
                      " is nonlinear: tune it on the sampled loop (--loop sampled --dt 1e-4)");

@@ -116,7 +116,9 @@ void PlantRole::StartEpisode(const EpisodeSpec& spec) {
     ep->motor = std::make_unique<NonlinearStepperPlant>(*spec.plant.nonlinear, spec.dt_s);
     ep->motor->Reset();
   } else {
-    ep->plant = std::make_unique<DiscretePlant>(spec.plant.tf, spec.dt_s);
+    // With its dead time: the applied input (control plus disturbance) acts
+    // delay_s later, as in the in-process loop (DelayedPlantStep).
+    ep->plant = std::make_unique<DiscretePlant>(spec.plant.tf, spec.dt_s, spec.plant.delay_s);
     ep->plant->Reset();
   }
   const auto n = static_cast<std::size_t>(spec.total_steps);

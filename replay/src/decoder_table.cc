@@ -3,6 +3,7 @@
 #include <climits>
 #include <exception>
 #include <pidlab/lcmt_episode_config_v1.hpp>
+#include <pidlab/lcmt_episode_config_v2.hpp>
 
 #include "pidlab/transport/wire.h"
 
@@ -28,13 +29,11 @@ bool Decode(const uint8_t* data, std::size_t size, PidlabMessage* message) {
   return true;
 }
 
-// A configuration written before the motor's fields were appended: decoded
-// with its own layout, read as an lcmt_episode_config of a linear plant (the
-// motor's fields 0, motor_drive "").
-bool DecodeConfigV1(const uint8_t* data, std::size_t size, PidlabMessage* message) {
-  pidlab::lcmt_episode_config_v1 o{};
-  if (!DecodeAs(data, size, &o)) return false;
-  pidlab::lcmt_episode_config m{};
+// The fields every older configuration has (lcmt_episode_config_v1's) into
+// *m.
+template <typename Old>
+void CopyCommonConfig(const Old& o, pidlab::lcmt_episode_config* out) {
+  pidlab::lcmt_episode_config& m = *out;
   m.utime = o.utime;
   m.episode_id = o.episode_id;
   m.step = o.step;
@@ -67,6 +66,46 @@ bool DecodeConfigV1(const uint8_t* data, std::size_t size, PidlabMessage* messag
   m.seed = o.seed;
   m.retransmit_interval_s = o.retransmit_interval_s;
   m.silence_deadline_s = o.silence_deadline_s;
+}
+
+// A configuration written before the motor's fields were appended: decoded
+// with its own layout, read as an lcmt_episode_config of a linear plant (the
+// motor's fields 0, motor_drive "", no delay).
+bool DecodeConfigV1(const uint8_t* data, std::size_t size, PidlabMessage* message) {
+  pidlab::lcmt_episode_config_v1 o{};
+  if (!DecodeAs(data, size, &o)) return false;
+  pidlab::lcmt_episode_config m{};
+  CopyCommonConfig(o, &m);
+  *message = std::move(m);
+  return true;
+}
+
+// A configuration written before delay_s was appended: read as an
+// lcmt_episode_config without a delay (delay_s 0).
+bool DecodeConfigV2(const uint8_t* data, std::size_t size, PidlabMessage* message) {
+  pidlab::lcmt_episode_config_v2 o{};
+  if (!DecodeAs(data, size, &o)) return false;
+  pidlab::lcmt_episode_config m{};
+  CopyCommonConfig(o, &m);
+  m.motor_resistance_ohm = o.motor_resistance_ohm;
+  m.motor_self_inductance_h = o.motor_self_inductance_h;
+  m.motor_mutual_inductance_h = o.motor_mutual_inductance_h;
+  m.motor_inertia_kg_m2 = o.motor_inertia_kg_m2;
+  m.motor_rotor_teeth = o.motor_rotor_teeth;
+  m.motor_viscous_friction = o.motor_viscous_friction;
+  m.motor_tooth_pitch_rad = o.motor_tooth_pitch_rad;
+  m.motor_stationary_current_a = o.motor_stationary_current_a;
+  m.motor_flux_linkage = o.motor_flux_linkage;
+  m.motor_detent_torque_nm = o.motor_detent_torque_nm;
+  m.motor_load_torque_nm = o.motor_load_torque_nm;
+  m.motor_load_step_nm = o.motor_load_step_nm;
+  m.motor_load_step_time_s = o.motor_load_step_time_s;
+  m.motor_voltage_limit_v = o.motor_voltage_limit_v;
+  m.motor_input_scale = o.motor_input_scale;
+  m.motor_abs_tolerance = o.motor_abs_tolerance;
+  m.motor_rel_tolerance = o.motor_rel_tolerance;
+  m.motor_drive = o.motor_drive;
+  m.delay_s = 0.0;
   *message = std::move(m);
   return true;
 }
@@ -92,6 +131,8 @@ DecoderTable::DecoderTable()
           Type<pidlab::lcmt_episode_config>("lcmt_episode_config", "EPISODE_CONFIG"),
           MessageType{"lcmt_episode_config", "EPISODE_CONFIG", pidlab::lcmt_episode_config_v1::getHash(),
                       &DecodeConfigV1},  // older logs
+          MessageType{"lcmt_episode_config", "EPISODE_CONFIG", pidlab::lcmt_episode_config_v2::getHash(),
+                      &DecodeConfigV2},  // logs written before the plant's dead time
           Type<pidlab::lcmt_ready>("lcmt_ready", "READY"),
           Type<pidlab::lcmt_plant_output>("lcmt_plant_output", "PLANT_OUTPUT"),
           Type<pidlab::lcmt_control_command>("lcmt_control_command", "CONTROL"),

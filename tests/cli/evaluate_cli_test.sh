@@ -145,6 +145,41 @@ bad() {
   fi
 }
 
+# A plant's dead time (docs/deadtime.md): out of range, or where it is not supported yet.
+F=(--plant custom --num 1 --den 1,1 --gains 1,1,0)
+bad "negative delay" "--delay -1" evaluate --loop sampled "${F[@]}" --delay -1
+bad "NaN delay" "--delay 'nan'" evaluate --loop sampled "${F[@]}" --delay nan
+bad "huge delay" "--delay 1e+09" evaluate --loop sampled "${F[@]}" --delay 1e9
+bad "delay of more stored inputs than the analysis takes" "--delay 2 s at dt 0.001 s" evaluate --loop sampled \
+  "${F[@]}" --delay 2
+bad "delay on the continuous loop" "--delay 0.3 s: the continuous loop with dead time is not supported yet" \
+  evaluate --loop continuous "${F[@]}" --delay 0.3
+bad "delay on the nonlinear motor" "--delay 0.01 s: --plant 'stepper_nonlinear' with dead time" \
+  evaluate --loop sampled --plant stepper_nonlinear --dt 1e-4 --gains 1,1,0 --delay 0.01
+bad "delay with Monte Carlo" "--monte-carlo with --delay" evaluate --loop sampled "${F[@]}" --delay 0.3 \
+  --monte-carlo 5
+bad "tune the continuous loop with a delay" "--delay 0.3 s: the continuous loop" tune --plant custom --num 1 \
+  --den 1,1 --delay 0.3
+bad "tune ziegler-nichols with a delay" "ziegler-nichols with a plant dead time" tune --loop sampled \
+  --plant custom --num 1 --den 1,1 --delay 0.3 --method ziegler-nichols
+bad "plot the continuous loop with a delay" "--delay 0.3 s: the continuous loop" plot --plant custom --num 1 \
+  --den 1,1 --delay 0.3 --gains 1,1,0 --out plots
+status=0
+"$pidlab" evaluate --loop sampled "${F[@]}" --delay 0.3 --json --samples-csv delay.csv >delay.json 2>delay.err ||
+  status=$?
+if [[ $status -eq 0 ]] && /usr/bin/python3 - delay.json delay.csv <<'PY'
+import csv, json, sys
+j = json.load(open(sys.argv[1]))
+assert j["spec"]["delay"] == 0.3 and j["stable"] is True, j["spec"]
+y = [float(r["y"]) for r in csv.DictReader(open(sys.argv[2]))]
+assert y[6] == 0.0 and y[7] > 0.0, y[:8]  # y rests until t = L = 0.3 s (ts 0.05 s)
+PY
+then
+  pass "a sampled loop with --delay 0.3 runs, echoes \"delay\": 0.3 and rests for the dead time"
+else
+  fail "a sampled loop with --delay 0.3 (exit $status: $(head -c 200 delay.err))"
+fi
+
 bad "unknown plant" "quadruple_integrator" evaluate --plant quadruple_integrator --gains 1,2,3
 bad "NaN gain" "nan" evaluate --plant linear --gains nan,2,3
 bad "negative gain" "-2" evaluate --plant linear --gains 1,-2,3

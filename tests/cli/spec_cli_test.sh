@@ -51,6 +51,15 @@ rerun disturbed evaluate --plant linear --gains 29.6558,0.4977,28.3216 --disturb
 rerun filtered evaluate --plant stepper --gains 2.71,30,0.1535 --derivative-filter-ratio 10 --max-ms 1.6
 rerun limited evaluate --num 1 --den 1,0.5,0.1 --gains 1.12,0.23,1.3 --loop sampled --output-limits -2,inf \
   --anti-windup back-calculation --derivative-on measurement
+rerun delayed evaluate --loop sampled --plant custom --num 1 --den 1,1 --delay 0.3 --gains 1,1,0
+/usr/bin/python3 - delayed.json <<'PY' && pass "delayed: the spec echoes \"delay\": 0.3" || fail "delayed: echo"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["spec"]["delay"] == 0.3 and j["spec"]["loop"] == "sampled", j["spec"]
+assert j["stable"] is True and j["iae"] > 0, j
+PY
+rerun delayed_tune tune --loop sampled --dt 0.01 --plant custom --num 1 --den 1,1 --delay 0.3 --bounds 0,3 \
+  --method nelder-mead --starts 1 --max-evals 60 --horizon 10
 rerun montecarlo evaluate --plant stepper --gains 20.8836,26.607,12.4866 --monte-carlo 20 --spread 10%
 rerun tuned tune --plant oscillator --max-evals 300 --design-points 64
 rerun robust tune --plant stepper --robust --max-evals 300 --design-points 64 --max-ms 1.5

@@ -36,6 +36,18 @@ run evaluate --backend lcm --spec lcm.json --json >lcm2.json 2>err || fail "--sp
 if same lcm.json lcm2.json steps_per_second realtime; then pass "its spec run again over the trio: the same numbers"
 else fail "its spec over the trio differs"; fi
 
+# A plant with dead time (docs/deadtime.md): the spec echoes "delay", and
+# runs again bit for bit in process and over the trio.
+run evaluate --backend lcm --plant custom --num 1 --den 1,1 --delay 0.3 --gains 1,1,0 --horizon 5 \
+  --json >delay_lcm.json 2>err || fail "a delayed plant over the trio: $(tail -1 err)"
+"$bin/pidlab" evaluate --spec delay_lcm.json --json >delay_local.json 2>err ||
+  fail "evaluate --spec (delay): $(tail -1 err)"
+if same delay_lcm.json delay_local.json backend steps_per_second realtime &&
+  /usr/bin/python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); assert j["spec"]["delay"] == 0.3' \
+    delay_local.json; then
+  pass "a delayed plant over the trio, run again in process from its spec: the same numbers"
+else fail "a delayed plant over the trio and its spec in process differ"; fi
+
 run tune --backend lcm --loop sampled --plant linear --horizon 5 --max-evals 40 --design-points 16 --refine none \
   --json >tune_lcm.json 2>err || fail "tune over the trio: $(tail -1 err)"
 "$bin/pidlab" tune --spec tune_lcm.json --json >tune_local.json 2>err || fail "tune --spec: $(tail -1 err)"

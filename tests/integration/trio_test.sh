@@ -3,7 +3,7 @@
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
 # ever sent outside its loopback. CASE: identity | faults | drop20 | realtime | kill | sigstop | trios | trio_killed | stranger |
-# log | log_repair | motor.
+# log | log_repair | motor | delay.
 set -u
 BIN=$1
 CASE=$2
@@ -349,6 +349,40 @@ print(f"ok   replay: {len(motor)} motor episodes, each live IAE and motor object
 PY
     then :; else
       echo "FAIL replay of the motor log: $(head -3 "$TMP/motor.replay.err")"; fail=1
+    fi
+    ;;
+  delay)
+    # Plants with dead time (docs/deadtime.md, "In every loop") on the trio:
+    # the plant process delays the applied input (control plus disturbance)
+    # by L; the JSON and y, u, n of every step are bit-identical to the
+    # in-process loop, for a split delay on the stepper motor (L = 0.0123 s,
+    # 123 steps of 1e-4 s) and L = 0.3 s on 1/(s+1) with a disturbance. Then
+    # pidlab replay of the log, which rebuilds each loop from its logged
+    # configuration (delay_s included), gives each live IAE exactly.
+    export -f compare
+    export TMP PIDLAB
+    rm -f "$TMP/delay.lcmlog"
+    "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/delay.lcmlog" -- bash -c 'fail=0
+      compare stepper_delay --plant stepper_motor --gains 0.1,0.5,0.001 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --delay 0.0123
+      compare fopdt_delay --plant custom --num 1 --den 1,1 --delay 0.3 --gains 1,1,0 --horizon 10 --disturbance square --disturbance-amplitude 0.2
+      exit $fail' || fail=1
+    if "$PIDLAB" replay --json "$TMP/delay.lcmlog" >"$TMP/delay.replay.json" 2>"$TMP/delay.replay.err" &&
+      python3 - "$TMP" <<'PY'
+import json, sys
+tmp = sys.argv[1]
+rep = json.load(open(tmp + "/delay.replay.json"))
+assert rep["clean_end"], "log not read cleanly to the end"
+for e in rep["episodes"]:
+    assert e["complete"], e["completeness"]
+iaes = [e["evaluation"]["iae"] for e in rep["episodes"]]
+for name in ("stepper_delay", "fopdt_delay"):
+    live = json.load(open(f"{tmp}/{name}.lcm.json"))
+    assert live["spec"]["delay"] in (0.0123, 0.3), live["spec"]
+    assert live["iae"] in iaes, (name, live["iae"], iaes)
+print(f"ok   replay: {len(iaes)} episodes of delayed plants, each live IAE reproduced exactly")
+PY
+    then :; else
+      echo "FAIL replay of the delay log: $(head -3 "$TMP/delay.replay.err")"; fail=1
     fi
     ;;
   *)

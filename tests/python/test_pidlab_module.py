@@ -82,6 +82,21 @@ class Evaluate(unittest.TestCase):
         self.assertFalse(got["motor"]["lost_steps"])
         self.assertGreater(got["motor"]["peak_phase_voltage_v"], 0.0)
 
+    def test_a_plant_with_dead_time_equals_the_cli_json(self):
+        got = pidlab.evaluate("custom", (1, 1, 0), num=[1], den=[1, 1], loop="sampled", delay=0.3)
+        want = cli("evaluate", "--loop", "sampled", "--plant", "custom", "--num", "1", "--den", "1,1",
+                   "--delay", "0.3", "--gains", "1,1,0")
+        self.assertSameResult(got, want)
+        self.assertEqual(got["spec"]["delay"], 0.3)
+        self.assertNotEqual(got["iae"], pidlab.evaluate("custom", (1, 1, 0), num=[1], den=[1, 1],
+                                                        loop="sampled")["iae"])
+
+    def test_a_dead_time_on_the_continuous_loop_is_refused_naming_delay(self):
+        with self.assertRaisesRegex(ValueError, "delay 0.3 s: the continuous loop with dead time"):
+            pidlab.evaluate("custom", (1, 1, 0), num=[1], den=[1, 1], delay=0.3)
+        with self.assertRaisesRegex(ValueError, "delay -1"):
+            pidlab.evaluate("custom", (1, 1, 0), num=[1], den=[1, 1], loop="sampled", delay=-1)
+
     def test_bad_input_raises_value_error_naming_the_value(self):
         with self.assertRaisesRegex(ValueError, "nope"):
             pidlab.evaluate("nope", (1, 2, 3))

@@ -38,6 +38,7 @@ using pidlab::tune::BuildGains;
 using pidlab::tune::BuildLoopOptions;
 using pidlab::tune::BuildPlant;
 using pidlab::tune::BuildTuneOptions;
+using pidlab::tune::CheckPlantInLoop;
 using pidlab::tune::ResolveRobustPreset;
 using pidlab::tune::Tune;
 using pidlab::tune::TuneOptions;
@@ -187,6 +188,7 @@ py::object EvaluatePy(const py::object& plant, const py::object& gains, py::kwar
   Require(BuildPlant(s.plant, NameStyle::kKey, &p, &error) &&
               BuildGains(s.gains, NameStyle::kKey, &g, &error) &&
               BuildLoopOptions(s.loop, NameStyle::kKey, &options, &error) &&
+              CheckPlantInLoop(p, options, NameStyle::kKey, &error) &&
               BuildBounds(s.bounds, NameStyle::kKey, &bounds, &error),
           error);
   Evaluation ev;
@@ -214,9 +216,10 @@ py::object TunePy(const py::object& plant, py::kwargs kwargs) {
   std::string error;
   Plant p;
   TuneOptions o;
-  Require(
-      BuildPlant(s.plant, NameStyle::kKey, &p, &error) && BuildTuneOptions(s, NameStyle::kKey, &o, &error),
-      error);
+  Require(BuildPlant(s.plant, NameStyle::kKey, &p, &error) &&
+              BuildTuneOptions(s, NameStyle::kKey, &o, &error) &&
+              CheckPlantInLoop(p, o.loop, NameStyle::kKey, &error),
+          error);
   TuneSummary summary;
   Evaluation ev;
   LoopAnalysis analysis;

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
+#include "pidlab/plant_sim/discrete_plant.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
 
 namespace pidlab::transport {
@@ -62,6 +64,14 @@ bool EpisodeSpec::IsValid(std::string* error) const {
   else if (pid.dt_s != dt_s)
     os << "PID period " << pid.dt_s << " s differs from dt " << dt_s << " s";
   if (!os.str().empty()) return Fail(os.str(), error);
+  if (plant.delay_s != 0.0) {
+    if (plant.nonlinear) return Fail("delay_s on plant '" + plant.name + "' (a linear plant only)", error);
+    try {
+      SplitDelay(plant.delay_s, dt_s);
+    } catch (const std::invalid_argument& e) {
+      return Fail(std::string("delay_s: ") + e.what(), error);
+    }
+  }
   if (!pid.IsValid(error) || !disturbance.IsValid(error)) return false;
   return recovery.IsValid(error);
 }
@@ -76,6 +86,7 @@ pidlab::lcmt_episode_config MakeEpisodeConfig(const EpisodeSpec& spec) {
   m.num_size = static_cast<int32_t>(m.num.size());
   m.den = spec.plant.tf.den;
   m.den_size = static_cast<int32_t>(m.den.size());
+  m.delay_s = spec.plant.delay_s;
   m.kp = spec.gains.kp;
   m.ki = spec.gains.ki;
   m.kd = spec.gains.kd;
@@ -188,6 +199,7 @@ bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec,
   } else if (!m.motor_drive.empty()) {
     return Fail("motor fields on plant '" + m.plant_name + "' (only stepper_nonlinear has a motor)", error);
   }
+  s.plant.delay_s = m.delay_s;  // after the motor's plant is made; IsValid checks it
   s.gains = PidGains{m.kp, m.ki, m.kd};
   s.reference = m.reference;
   s.dt_s = m.dt_s;

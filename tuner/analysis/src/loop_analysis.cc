@@ -57,15 +57,15 @@ std::vector<Cancellation> FindCancellations(const std::vector<cd>& s_poles, cons
   return out;
 }
 
-// A dead time the analysis can use: finite, >= 0, and for the continuous loop
-// only (the sampled loop's analysis with dead time is not supported yet).
+// A dead time the analysis can use: finite and >= 0; in the continuous loop
+// any (e^(-jwL) exactly, stability by the Nyquist count), in the sampled loop
+// what its stored inputs allow (evaluation::DelayIsValid).
 bool DelayIsValid(const Plant& plant, const evaluation::LoopOptions& options, std::string* error) {
   std::ostringstream os;
   if (!(plant.delay_s >= 0.0) || !std::isfinite(plant.delay_s))
     os << "dead time " << plant.delay_s << " s must be finite and >= 0";
-  else if (plant.delay_s > 0.0 && options.loop != evaluation::LoopKind::kContinuous)
-    os << "dead time " << plant.delay_s << " s: the sampled loop's analysis with dead time is not supported "
-       << "yet (analyse the continuous loop)";
+  else if (options.loop != evaluation::LoopKind::kContinuous)  // the stored inputs' bound, a linear plant
+    return evaluation::DelayIsValid(plant, options, "delay", error);
   else
     return true;
   if (error) *error = os.str();
@@ -123,7 +123,7 @@ bool ContinuousModel(const Plant& plant, const PidGains& g, const evaluation::Lo
 
 void SampledModel(const Plant& plant, const PidGains& g, const evaluation::LoopOptions& options,
                   const PidOptions& pid, LoopModel* m) {
-  const DiscretePlant discrete(plant.tf, options.dt_s);
+  const DiscretePlant discrete = evaluation::SampledPlant(plant, options.dt_s);
   const evaluation::Stability st = evaluation::SampledStability(discrete, g, pid, options.stability_margin);
   m->stable = st.stable;
   m->s_poles = ToS(st.poles, evaluation::LoopKind::kSampled, options.dt_s);

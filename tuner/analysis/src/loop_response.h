@@ -135,7 +135,13 @@ class ContinuousResponse : public Response {
 class SampledResponse : public Response {
  public:
   SampledResponse(const DiscretePlant& plant, const PidGains& g, const PidOptions& o)
-      : phi_(plant.phi()), gamma_(plant.gamma()), c_(plant.c()), dt_(o.dt_s) {
+      : phi_(plant.phi()),
+        gamma1_(plant.gamma1()),
+        gamma0_(plant.gamma0().size() > 0 ? Eigen::VectorXd(plant.gamma0())
+                                          : Eigen::VectorXd::Zero(plant.gamma1().size())),
+        c_(plant.c()),
+        dt_(o.dt_s),
+        delay_steps_(plant.delay_steps()) {
     // C(z) = kp + I(z) + b (z - 1)/(z - a) over the common denominator.
     const double tf = EffectiveDerivativeFilter(g, o), dt = o.dt_s;
     const double a = tf / (tf + dt), b = g.kd / (tf + dt);
@@ -168,8 +174,13 @@ class SampledResponse : public Response {
     const int n = static_cast<int>(phi_.rows());
     Eigen::MatrixXcd m = -phi_.cast<cd>();
     for (int i = 0; i < n; ++i) m(i, i) += z;
-    const Eigen::VectorXcd x = m.partialPivLu().solve(gamma_.cast<cd>());
-    const cd g = (c_.cast<cd>() * x)(0);
+    // The plant with its dead time: z^-d C (zI - Phi)^-1 (Gamma0 z + Gamma1)
+    // (docs/deadtime.md); without one, C (zI - Phi)^-1 Gamma.
+    const Eigen::VectorXcd x =
+        delay_steps_ == 0 ? m.partialPivLu().solve(gamma1_.cast<cd>()).eval()
+                          : m.partialPivLu().solve(gamma1_.cast<cd>() + gamma0_.cast<cd>() * z).eval();
+    cd g = (c_.cast<cd>() * x)(0);
+    if (delay_steps_ > 0) g *= std::polar(1.0, -w * dt_ * static_cast<double>(delay_steps_));
     const cd nc = Eval(nc_, z);
     return {nc * g, Eval(dc_, z), nc};
   }
@@ -177,9 +188,10 @@ class SampledResponse : public Response {
 
  private:
   Eigen::MatrixXd phi_;
-  Eigen::VectorXd gamma_;
+  Eigen::VectorXd gamma1_, gamma0_;
   Eigen::RowVectorXd c_;
   double dt_;
+  long delay_steps_;
   Polynomial nc_, dc_;
 };
 

@@ -153,13 +153,67 @@ Stability ContinuousStability(const ContinuousClosedLoop<double>& loop, double m
   return s;
 }
 
+bool DelayIsValid(const Plant& plant, const LoopOptions& o, const std::string& name, std::string* error) {
+  const double l = plant.delay_s;
+  std::ostringstream os;
+  if (!std::isfinite(l) || !(l >= 0.0) || !(l <= kMaxDelaySeconds))
+    os << name << " " << l << " s must be >= 0, finite and at most " << kMaxDelaySeconds << " s";
+  else if (l == 0.0)
+    return true;
+  else if (o.loop != LoopKind::kSampled)
+    os << name << " " << l << " s: the continuous loop with dead time is not supported yet (use the sampled "
+       << "loop)";
+  else if (plant.nonlinear)
+    os << name << " " << l << " s: plant " << plant.name << " with dead time is not supported yet";
+  else if (!(o.dt_s > 0.0) || !std::isfinite(o.dt_s))
+    os << "dt " << o.dt_s << " s must be positive and finite";
+  else if (l / o.dt_s > 2.0 * static_cast<double>(kMaxAnalysedDelaySteps) ||
+           SplitDelay(l, o.dt_s).steps > kMaxAnalysedDelaySteps)  // d = ceil(L / dt) as the plant counts it
+    os << name << " " << l << " s at dt " << o.dt_s << " s needs ceil(L / dt) = " << std::ceil(l / o.dt_s)
+       << " stored inputs, more than the " << kMaxAnalysedDelaySteps
+       << " the sampled loop's stability analysis takes: use a larger dt";
+  else
+    return true;
+  if (error) *error = os.str();
+  return false;
+}
+
+DiscretePlant SampledPlant(const Plant& plant, double dt_s) {
+  return DiscretePlant(plant.tf, dt_s, plant.delay_s);
+}
+
+namespace {
+
+// The plant's rows of the sampled loop matrix m over the state
+// [x; u_{k-1} .. u_{k-d}; ...] (the delay line at columns n .. n + d - 1):
+// x_{k+1} = Phi x + Gamma1 u_{k-d} + Gamma0 u_{k-d+1} (u_{k-d} = u_k when
+// d = 0, u_{k-d+1} = u_k when d = 1), the line shifted by one with u_k in
+// front. u_row is u_k over the state.
+void SetPlantRows(const DiscretePlant& plant, const Eigen::RowVectorXd& u_row, Eigen::MatrixXd* m) {
+  const int n = plant.order();
+  const int d = static_cast<int>(plant.delay_steps());
+  m->topLeftCorner(n, n) = plant.phi();
+  const auto input = [&](int age) -> Eigen::RowVectorXd {  // u_{k-age} over the state
+    if (age == 0) return u_row;
+    Eigen::RowVectorXd e = Eigen::RowVectorXd::Zero(u_row.size());
+    e(n + age - 1) = 1.0;
+    return e;
+  };
+  m->topRows(n) += plant.gamma1() * input(d);
+  if (plant.gamma0().size() > 0) m->topRows(n) += plant.gamma0() * input(d - 1);
+  for (int j = 0; j < d; ++j) m->row(n + j) = input(j);
+}
+
+}  // namespace
+
 Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const PidOptions& o,
                            double margin) {
-  // State z_k = [x_k; I_{k-1}; D_{k-1}; e_{k-1}; s_{k-1}] with r = n = 0, so
-  // e_k = s_k = -C x_k for both derivative modes.
+  // State z_k = [x_k; u_{k-1} .. u_{k-d}; I_{k-1}; D_{k-1}; e_{k-1}; s_{k-1}]
+  // with r = n = 0, so e_k = s_k = -C x_k for both derivative modes.
   const int n = plant.order();
-  const int size = n + 4;
-  const int ii = n, id = n + 1, iep = n + 2, isp = n + 3;
+  const int d = static_cast<int>(plant.delay_steps());
+  const int size = n + d + 4;
+  const int ii = n + d, id = n + d + 1, iep = n + d + 2, isp = n + d + 3;
   const double dt = o.dt_s, tf = EffectiveDerivativeFilter(g, o);
   const double a = tf / (tf + dt), b = g.kd / (tf + dt);
   Eigen::RowVectorXd e_row = Eigen::RowVectorXd::Zero(size);
@@ -183,8 +237,7 @@ Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const 
   d_row(isp) -= b;
   const Eigen::RowVectorXd u_row = g.kp * e_row + i_row + d_row;
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(size, size);
-  m.topLeftCorner(n, n) = plant.phi();
-  m.topRows(n) += plant.gamma() * u_row;
+  SetPlantRows(plant, u_row, &m);
   m.row(ii) = i_row;
   m.row(id) = d_row;
   m.row(iep) = e_row;

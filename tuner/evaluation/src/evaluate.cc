@@ -84,6 +84,7 @@ Status CheckLoop(const Plant& plant, const PidGains& typed_gains, const LoopOpti
   if (!GainsAreValid(*gains, &error) || !plant.tf.IsValid(&error)) return Status::InvalidInput(error);
   if (plant.tf.RelativeDegree() < 1)
     return Status::InvalidInput("plant " + plant.tf.ToString() + " must be strictly proper");
+  if (!DelayIsValid(plant, options, "delay", &error)) return Status::InvalidInput(error);
   if (plant.nonlinear && options.loop != LoopKind::kSampled)
     return Status::InvalidInput("plant " + plant.name +
                                 " is nonlinear: the exact continuous loop applies to linear plants only, use "
@@ -155,7 +156,13 @@ void ScoreSampled(const Plant& plant, const PidGains& gains, const LoopOptions& 
     const bool built = BuildContinuousClosedLoop<double>(Realize(plant.tf), gains,
                                                          Disturbance(options.disturbance), &loop, nullptr, a);
     const bool continuous_stable = built && ContinuousStability(loop, options.stability_margin).stable;
-    ev->step = SampledStepInfo(t_all, y1, continuous_stable ? ContinuousFinalValue(loop) : a);
+    // With a dead time the sampled loop is stable here and its final value is
+    // the undelayed loop's steady state (e^(-sL) = 1 at s = 0), whatever the
+    // undelayed loop's stability.
+    const double delayed_final = built && plant.delay_s > 0.0 ? ContinuousFinalValue(loop) : a;
+    ev->step = SampledStepInfo(
+        t_all, y1,
+        continuous_stable ? ContinuousFinalValue(loop) : (std::isfinite(delayed_final) ? delayed_final : a));
   }
   if (what.record_trajectory) ev->trajectory = run.trajectory;
 }
@@ -176,7 +183,8 @@ void FinishScores(const Plant& plant, const PidGains& gains, const LoopOptions& 
   ev->iae_per_unit = ev->iae / std::abs(a);
   if (options.disturbance.kind == DisturbanceKind::kNone) ev->iae_undisturbed = ev->iae;
   const std::unique_ptr<DiscretePlant> discrete =
-      options.loop == LoopKind::kSampled ? std::make_unique<DiscretePlant>(plant.tf, options.dt_s) : nullptr;
+      options.loop == LoopKind::kSampled ? std::make_unique<DiscretePlant>(SampledPlant(plant, options.dt_s))
+                                         : nullptr;
   // The load response of a linear plant; a nonlinear plant's is not computed (NaN).
   ev->load_iae = plant.nonlinear ? std::numeric_limits<double>::quiet_NaN()
                                  : internal::LoadIaeOfStableLoop(Realize(plant.tf), discrete.get(), gains,
@@ -190,7 +198,7 @@ Status StartSampled(const Plant& plant, const PidGains& typed_gains, const LoopO
   const Status checked = CheckLoop(plant, typed_gains, options, gains);
   if (!checked.ok()) return checked;
   StartEvaluation(plant, *gains, options, ev);
-  const DiscretePlant discrete(plant.tf, options.dt_s);
+  const DiscretePlant discrete = SampledPlant(plant, options.dt_s);
   ev->stability = SampledStability(discrete, *gains, options.Pid(), options.stability_margin);
   return Status::Ok();
 }
@@ -207,7 +215,7 @@ bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const Lo
                             trajectory, options.reference);
     return true;
   }
-  const DiscretePlant discrete(plant.tf, options.dt_s);
+  const DiscretePlant discrete = SampledPlant(plant, options.dt_s);
   // A diverged loop (PidStatus::kInvalidInput) is not an error here: its
   // non-finite samples make every objective +inf, as for an unstable loop.
   RunSampledLoop<double>(discrete, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,

@@ -429,6 +429,9 @@ double LoadIaeOfStableLoop(const StateSpace& realization, const DiscretePlant* d
 }  // namespace internal
 
 double LoadIntegralAbsError(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options) {
+  // A dead time the loop cannot take (the continuous loop's) has no load
+  // response here: NaN, not a number of the undelayed plant.
+  if (!DelayIsValid(plant, options, "delay", nullptr)) return std::numeric_limits<double>::quiet_NaN();
   const PidGains gains = LoopGains(typed_gains, options);
   const StateSpace realization = Realize(plant.tf);
   ContinuousClosedLoop<double> loop;
@@ -437,7 +440,7 @@ double LoadIntegralAbsError(const Plant& plant, const PidGains& typed_gains, con
     return kInf;
   std::unique_ptr<DiscretePlant> discrete;
   if (options.loop == LoopKind::kSampled) {
-    discrete = std::make_unique<DiscretePlant>(plant.tf, options.dt_s);
+    discrete = std::make_unique<DiscretePlant>(SampledPlant(plant, options.dt_s));
     PidOptions pid = options.Pid();
     if (!SampledStability(*discrete, gains, pid, options.stability_margin).stable) return kInf;
   } else if (!ContinuousStability(loop, options.stability_margin).stable) {
@@ -464,14 +467,15 @@ ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& op
     throw std::invalid_argument(ToString(kind) + " runs the loop in process, not over another runner");
   if (load && plant.nonlinear)
     throw std::invalid_argument(ToString(kind) + " needs a linear plant, not " + plant.name);
-  if (!plant.tf.IsValid(&error)) throw std::invalid_argument(error);
+  if (!plant.tf.IsValid(&error) || !DelayIsValid(plant, options, "delay", &error))
+    throw std::invalid_argument(error);
   realization_ = Realize(plant.tf);
   if (plant.nonlinear && options.loop != LoopKind::kSampled)
     throw std::invalid_argument("plant " + plant.name +
                                 " is nonlinear: tune it on the sampled loop (--loop sampled)");
   if (options.loop == LoopKind::kSampled) {
     options_.pid = PidOptionsAt(options_.pid, options.dt_s);
-    discrete_ = std::make_unique<DiscretePlant>(plant.tf, options.dt_s);
+    discrete_ = std::make_unique<DiscretePlant>(SampledPlant(plant, options.dt_s));
   }
   if (FastContinuousObjective::CoversPlant(plant, options_, kind_))
     fast_ = std::make_shared<const FastContinuousObjective>(plant.tf, realization_, options_, kind_);

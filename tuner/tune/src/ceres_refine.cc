@@ -109,7 +109,7 @@ void SolveLeastSquares(const Plant& plant, const TuneOptions& options, const Pid
   const StateSpace realization = Realize(plant.tf);
   std::unique_ptr<DiscretePlant> discrete;
   if (options.loop.loop == evaluation::LoopKind::kSampled)
-    discrete = std::make_unique<DiscretePlant>(plant.tf, options.loop.dt_s);
+    discrete = std::make_unique<DiscretePlant>(evaluation::SampledPlant(plant, options.loop.dt_s));
   double x[3] = {start.kp, start.ki, start.kd};
   ceres::Problem problem;
   auto* cost = new ceres::AutoDiffCostFunction<ErrorResiduals, ceres::DYNAMIC, 3>(

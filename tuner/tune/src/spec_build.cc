@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace pidlab::tune {
 
@@ -93,9 +94,10 @@ bool HasNonlinearOption(const spec::PlantSpec& s) {
 
 }  // namespace
 
-bool BuildPlant(const spec::PlantSpec& s, NameStyle style, Plant* out, std::string* error) {
+namespace {
+
+bool BuildPlantModel(const spec::PlantSpec& s, NameStyle style, Plant* out, std::string* error) {
   const auto name = [style](const char* key) { return spec::DisplayName(key, style); };
-  if (!CheckSpecNumbers(s, style, error)) return false;
   const bool custom = !s.num.empty() || !s.den.empty();
   if (custom && !s.plant.empty() && s.plant != "custom")
     return Bad(error, name("plant") + " " + Quote(s.plant) + " cannot be combined with " + name("num") + "/" +
@@ -124,6 +126,30 @@ bool BuildPlant(const spec::PlantSpec& s, NameStyle style, Plant* out, std::stri
   // A plant name is printable and short, so Truncate leaves every valid one
   // as it is, and MakePlant's "unknown plant '...'" echoes at most 200 chars.
   return MakePlant(spec::Truncate(s.plant), sp, out, error);
+}
+
+}  // namespace
+
+bool BuildPlant(const spec::PlantSpec& s, NameStyle style, Plant* out, std::string* error) {
+  if (!CheckSpecNumbers(s, style, error)) return false;
+  const std::string delay = spec::DisplayName("delay", style);
+  if (!(s.delay_s >= 0.0) || !(s.delay_s <= kMaxDelaySeconds))
+    return Bad(error, delay + " " + spec::FormatNumber(s.delay_s) + " s must be >= 0, finite and at most " +
+                          spec::FormatNumber(kMaxDelaySeconds) + " s");
+  Plant p;
+  if (!BuildPlantModel(s, style, &p, error)) return false;
+  if (s.delay_s > 0.0 && p.nonlinear)
+    return Bad(error, delay + " " + spec::FormatNumber(s.delay_s) +
+                          " s: " + spec::DisplayName("plant", style) + " " + Quote(p.name) +
+                          " with dead time is not supported yet");
+  p.delay_s = s.delay_s;
+  *out = std::move(p);
+  return true;
+}
+
+bool CheckPlantInLoop(const Plant& plant, const evaluation::LoopOptions& loop, NameStyle style,
+                      std::string* error) {
+  return evaluation::DelayIsValid(plant, loop, spec::DisplayName("delay", style), error);
 }
 
 bool BuildGains(const std::vector<double>& g, NameStyle style, PidGains* out, std::string* error) {

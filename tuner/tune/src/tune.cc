@@ -444,7 +444,18 @@ void RefineSearchResult(const Plant& plant, const TuneOptions& options, const op
 
 bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
           const optim::ProgressCallback& progress, const evaluation::SampledRunner& runner) {
-  if (!options.IsValid(error)) return false;
+  if (!options.IsValid(error) || !evaluation::DelayIsValid(plant, options.loop, "delay", error)) return false;
+  if (plant.delay_s > 0.0 && options.method == TuneMethod::kZieglerNichols) {
+    if (error)
+      *error =
+          "ziegler-nichols with a plant dead time is not supported yet (its rules read the "
+          "undelayed plant): use another method";
+    return false;
+  }
+  if (plant.delay_s > 0.0 && options.robust_samples > 0) {
+    if (error) *error = "a robust set with a plant dead time is not supported yet (its draws are undelayed)";
+    return false;
+  }
   const auto start_time = std::chrono::steady_clock::now();
   *summary = TuneSummary();
   summary->method = options.method;

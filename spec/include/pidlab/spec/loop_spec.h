@@ -43,6 +43,7 @@ struct PlantSpec {
   double detent_torque_nm = 0.0, load_torque_nm = 0.0, load_step_nm = 0.0, load_step_time_s = 0.0;
   double voltage_limit_v = kInf, input_scale = 0.0;
   std::string drive = "linear";
+  double delay_s = 0.0;  // dead time L, s (docs/deadtime.md)
 
   /// A custom plant (num/den given) is named "custom", however it was typed,
   /// so that a spec echoes one form.
@@ -63,6 +64,8 @@ struct PlantSpec {
     a->Visit(
         {"den", "custom plant denominator, descending powers of s, e.g. 1,0,0", "", kEpisode, "[1, 3, 1]"},
         &den);
+    a->Visit({"delay", "dead time L of the plant, G(s) e^(-sL), s (docs/deadtime.md)", "s", kEpisode, "0.3"},
+             &delay_s);
     a->Visit(
         {"stepper",
          "override a Table I parameter, NAME=VALUE (resistance_ohm, self_inductance_h, mutual_inductance_h, "

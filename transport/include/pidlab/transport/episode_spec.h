@@ -33,7 +33,9 @@ struct RecoveryOptions {
 inline constexpr int64_t kMaxEpisodeSteps = 50000000;
 
 /// One episode, decoded: the sampled loop x_{k+1} = Phi x_k + Gamma (u_k + n_k),
-/// u_k = PID(reference, y_k), n_k = n(k dt_s), for k = 0..total_steps-1.
+/// u_k = PID(reference, y_k), n_k = n(k dt_s), for k = 0..total_steps-1; with
+/// a plant dead time (plant.delay_s: finite, >= 0, ceil(delay / dt) at most
+/// kMaxDelaySteps, linear plants only) the delayed step of docs/deadtime.md.
 struct EpisodeSpec {
   int64_t episode_id = 0;
   Plant plant;

@@ -30,7 +30,15 @@ bool BuildStepperParameters(const spec::PlantSpec& s, NameStyle style, StepperMo
 /// The nonlinear stepper's options (plant stepper_nonlinear).
 bool BuildNonlinearOptions(const spec::PlantSpec& s, NameStyle style, NonlinearStepperOptions* out,
                            std::string* error);
+/// The plant, with its dead time (delay: >= 0, finite, at most
+/// kMaxDelaySeconds; not for stepper_nonlinear yet).
 bool BuildPlant(const spec::PlantSpec& s, NameStyle style, Plant* out, std::string* error);
+/// The plant in its loop: a dead time needs the sampled loop (the continuous
+/// loop with dead time is not supported yet) and at most
+/// evaluation::kMaxAnalysedDelaySteps stored inputs at its dt
+/// (evaluation::DelayIsValid, with the field named as `style` names it).
+bool CheckPlantInLoop(const Plant& plant, const evaluation::LoopOptions& loop, NameStyle style,
+                      std::string* error);
 /// Three gains kp, ki, kd, each finite, >= 0 and at most kMaxGain.
 bool BuildGains(const std::vector<double>& g, NameStyle style, PidGains* out, std::string* error);
 bool BuildLoopOptions(const spec::LoopSpec& s, NameStyle style, evaluation::LoopOptions* out,
