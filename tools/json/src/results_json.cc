@@ -40,9 +40,8 @@ void AddMotor(const Evaluation& ev, nlohmann::json* j) {
 
 // simc, amigo: the model the rule used ("model") and its controller
 // ("tuning_rule"). The gains are scored on the spec's loop with the plant as
-// given; Tune() refuses a plant with a dead time, which the loops do not
-// simulate yet, so "delay_simulated" is false and the model's delay is the
-// half rule's alone.
+// given: "delay_simulated" is true when the plant has a dead time (only the
+// sampled loop takes one), false when the model's delay is the half rule's alone.
 void AddTuningRule(const TuneOptions& o, const TuningRuleResult& r, nlohmann::json* j) {
   const ProcessModel& m = r.model;
   (*j)["model"] = {{"kind", ToString(m.kind)},
@@ -56,7 +55,7 @@ void AddTuningRule(const TuneOptions& o, const TuningRuleResult& r, nlohmann::js
                          {"td_s", r.td_s},
                          {"controller_form", r.controller_form},
                          {"evaluated_on", ToString(o.loop.loop)},
-                         {"delay_simulated", false},
+                         {"delay_simulated", r.plant_delay_s > 0.0},
                          {"message", r.message}};
 }
 

@@ -275,8 +275,9 @@ bool AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const evaluati
   *out = LoopAnalysis();
   LoopAnalysis& a = *out;
   a.loop = options.loop;
-  if (plant.delay_s > 0.0) return AnalyzeDelayedLoop(plant, g, options, ao, &a, error);
   const bool continuous = options.loop == evaluation::LoopKind::kContinuous;
+  // The sampled loop's dead time is in its plant (stored inputs, eigenvalues).
+  if (continuous && plant.delay_s > 0.0) return AnalyzeDelayedLoop(plant, g, options, ao, &a, error);
   a.method = AnalysisMethod(continuous);
   const PidOptions pid = options.Pid();
   LoopModel m;

@@ -302,20 +302,14 @@ void RuleResult(const PidGains& g, const evaluation::ObjectiveEvaluator& evaluat
 }
 
 // SIMC or AMIGO into summary->tuning_rule and summary->optimizer. False with
-// *error where the rule does not apply, or for a plant with a dead time, which
-// neither loop simulates yet (its gains would be scored on the plant without it).
+// *error where the rule does not apply. A plant with a dead time reaches this
+// only in the sampled loop (Tune checks DelayIsValid), which simulates it.
 bool RuleSearch(const Plant& plant, const TuneOptions& options,
                 const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary, std::string* error) {
   const TuningRule rule = options.method == TuneMethod::kSimc ? TuningRule::kSimc : TuningRule::kAmigo;
   const Status status = ApplyTuningRule(plant, rule, options.rule, &summary->tuning_rule);
   if (!status.ok()) {
     if (error) *error = status.message();
-    return false;
-  }
-  if (plant.delay_s > 0.0) {
-    if (error)
-      *error = summary->tuning_rule.message +
-               "; but the loop does not simulate the plant's dead time yet: its gains are not evaluated";
     return false;
   }
   RuleResult(summary->tuning_rule.gains, evaluator, summary->tuning_rule.message, &summary->optimizer);

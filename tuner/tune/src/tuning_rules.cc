@@ -262,7 +262,9 @@ Status ApplyTuningRule(const Plant& plant, TuningRule rule, RuleForm form, Tunin
   ProcessModel model;
   const Status reduced = ReduceModel(plant, rule, form, &model);
   if (!reduced.ok()) return reduced;
-  return rule == TuningRule::kSimc ? SimcTune(model, form, result) : AmigoTune(model, form, result);
+  const Status tuned = rule == TuningRule::kSimc ? SimcTune(model, form, result) : AmigoTune(model, form, result);
+  result->plant_delay_s = plant.delay_s;
+  return tuned;
 }
 
 }  // namespace pidlab::tune

@@ -74,6 +74,9 @@ struct TuningRuleResult {
   PidGains gains;
   /// One line: rule, model and gains.
   std::string message;
+  /// The plant's own dead time, s (the model's delay also holds what the
+  /// half rule moved into it). The sampled loop simulates it.
+  double plant_delay_s = 0.0;
 };
 
 /// Series PID Kc (1 + 1/(ti s)) (td s + 1) as the parallel kp + ki/s + kd s,
