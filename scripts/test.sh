@@ -35,6 +35,8 @@ cmake --build build-asan -j"$(nproc)" --target pidlab pidlab-plant pidlab-contro
   hostile_stranger hostile_protocol_test
 bash scripts/build.sh -DPIDLAB_SANITIZED_BIN_DIR="$PWD/build-asan/bin"
 cd build
-# In parallel: the tests that start processes in a network namespace are
-# RUN_SERIAL and run alone.
+# In parallel: every test that starts processes does so in a private network
+# namespace of its own, so two of them can run side by side; the ones that
+# keep two processors busy by themselves (the hostile floods, the log
+# mutants, the report) ask for both (PROCESSORS 2) and run alone.
 ctest -j"$(nproc)" --output-on-failure --timeout 600

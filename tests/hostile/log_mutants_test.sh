@@ -75,7 +75,7 @@ outputs=$(LC_ALL=C grep -ao PIDLAB_PLANT_OUTPUT "$TMP/full.lcm" | wc -l)
 echo "ok   seed logs: launch --log $(stat -c %s "$TMP/seed.lcm") bytes, with the step lanes $(stat -c %s "$TMP/full.lcm") bytes; $(grep -c complete "$TMP/seed.txt") episodes, replayed cleanly"
 
 mkdir "$TMP/mutants"
-jobs=$(( $(nproc) > 1 ? 2 : 1 ))  # two replays at a time (ctest runs this alone: RUN_SERIAL)
+jobs=$(( $(nproc) > 1 ? 2 : 1 ))  # two replays at a time (ctest gives this test two processors: PROCESSORS 2)
 start=$(date +%s%N)
 "$TOOLS/log_mutator" --pidlab "$BIN/pidlab" --seed-log "$TMP/seed.lcm" "$TMP/full.lcm" --count "$COUNT" \
   --seed 13 --work-dir "$TMP/mutants" --max-rss-mb "$MAX_RSS_MB" --timeout 20 --jobs "$jobs" \
