@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <string>
 #include <vector>
@@ -664,6 +665,34 @@ TEST(FilteredPid, DiscretePidUsesTheGainsFilter) {
     b.Step(1.0, 0.01 * k, &ub);
     EXPECT_EQ(ua, ub) << "k = " << k;
   }
+}
+
+// A dead time L = 0.3 s at dt = 1 ms stores 300 inputs, whose poles reach
+// |Im p| = pi / dt with a decay that grows only like log |p| / L: counted at
+// their full modulus, the tuner's margin 0.01 refused this well-damped PI
+// loop. Counted up to pi / L they pass, and the loop's own modes still carry
+// the full criterion (a margin of 0.3 refuses the lightly damped kp = ki = 3).
+TEST(SampledLoop, CountsADeadTimesPolesUpToPiOverLInTheStabilityMargin) {
+  const double dt = 1e-3;
+  const DiscretePlant plant(TransferFunction{{1.0}, {1.0, 1.0}}, dt, 0.3);
+  PidOptions pid;
+  pid.dt_s = dt;
+  const PidGains gains{0.5, 0.8, 0.0};
+  const auto dut = SampledStability(plant, gains, pid, 0.01);
+  EXPECT_TRUE(dut.stable);
+  EXPECT_EQ(dut.poles.size(), 1u + 300u + 4u);
+  // Some stored-input pole fails the uncapped criterion at 0.01.
+  bool uncapped_fails = false;
+  for (const auto& z : dut.poles) {
+    if (std::abs(z) == 0.0) continue;
+    const std::complex<double> p = std::log(z) / dt;
+    if (!(p.real() < -0.01 * std::max(1.0, std::abs(p)))) uncapped_fails = true;
+  }
+  EXPECT_TRUE(uncapped_fails);
+  EXPECT_TRUE(SampledStability(plant, gains, pid, 0.3).stable);
+  EXPECT_FALSE(SampledStability(plant, PidGains{3.0, 3.0, 0.0}, pid, 0.3).stable);
+  EXPECT_DOUBLE_EQ(evaluation::DelayedMarginModulus(0.3), 3.14159265358979323846 / 0.3);
+  EXPECT_TRUE(std::isinf(evaluation::DelayedMarginModulus(0.0)));
 }
 
 }  // namespace

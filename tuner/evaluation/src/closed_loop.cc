@@ -251,7 +251,9 @@ Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const 
   bool ok = es.info() == Eigen::Success;
   // The continuous criterion Re p < -margin max(1, |p|) applied to the
   // equivalent s-plane poles p = log(z) / dt, so that a margin means the same
-  // in both loops whatever dt; z = 0 is the fastest possible decay.
+  // in both loops whatever dt; z = 0 is the fastest possible decay. With a
+  // dead time L, |p| counts up to pi / L only (DelayedMarginModulus).
+  const double cap = DelayedMarginModulus(plant.delay_s());
   for (int i = 0; i < size && es.info() == Eigen::Success; ++i) {  // every pole, even past an unstable one
     const std::complex<double> z = es.eigenvalues()(i);
     s.poles.push_back(z);
@@ -260,7 +262,7 @@ Stability SampledStability(const DiscretePlant& plant, const PidGains& g, const 
       ok = false;
     } else if (std::abs(z) > 0.0) {
       const std::complex<double> p = std::log(z) / dt;
-      if (!(p.real() < -margin * std::max(1.0, std::abs(p)))) ok = false;
+      if (!(p.real() < -margin * std::max(1.0, std::min(std::abs(p), cap)))) ok = false;
     }
   }
   s.stable = ok && std::isfinite(s.abscissa) && s.abscissa < 1.0;

@@ -398,10 +398,22 @@ PidStatus RunNonlinearSampledLoop(NonlinearStepperPlant* plant, const PidGains& 
                                   long total_steps, int steps_per_sample, std::vector<double>* y_samples,
                                   std::vector<SampledStep>* trajectory, double reference);
 
+/// The largest |p| the stability margin counts for a loop with dead time L:
+/// pi / L (+inf without one). A dead time brings a chain of poles up to
+/// |Im p| = pi / dt in the sampled loop (infinitely many in the continuous
+/// one) whose decay grows only like log |p| / L; counted at their full
+/// modulus, Re p < -margin |p| would refuse every loop with many stored
+/// inputs. The loop's own modes lie below pi / L, where the delay's phase
+/// lag reaches 180 degrees, and keep the full criterion.
+inline double DelayedMarginModulus(double delay_s) {
+  return delay_s > 0.0 ? 3.14159265358979323846 / delay_s : std::numeric_limits<double>::infinity();
+}
+
 /// Eigenvalues of the sampled loop's one-step map (plant ZOH states, the d
 /// inputs u_{k-1} .. u_{k-d} a plant with dead time stores, plus the PID's
 /// integral, filtered derivative, previous error and previous signal),
-/// ignoring output limits.
+/// ignoring output limits. Strictly stable: every |z| < 1 and
+/// Re p < -margin max(1, min(|p|, DelayedMarginModulus(L))), p = log(z) / dt.
 Stability SampledStability(const DiscretePlant& plant, const PidGains& gains, const PidOptions& options,
                            double margin);
 
