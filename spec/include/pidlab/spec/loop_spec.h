@@ -142,9 +142,8 @@ struct LoopSpec {
          "", kEpisode, "2"},
         &reference);
     a->Visit({"stability_margin",
-              "strict stability: Re p < -margin*max(1,|p|), p = s-plane pole (sampled: p = log(z)/dt); with "
-              "a dead "
-              "time L, |p| counts up to pi/L",
+              "strict stability: Re p < -margin*max(1,|p|), p = s-plane pole (sampled: p = log(z)/dt); "
+              "with a dead time L, |p| counts up to pi/L",
               "", kNone, "0.001"},
              &stability_margin);
     a->Visit({"disturbance",
