@@ -695,5 +695,27 @@ TEST(SampledLoop, CountsADeadTimesPolesUpToPiOverLInTheStabilityMargin) {
   EXPECT_TRUE(std::isinf(evaluation::DelayedMarginModulus(0.0)));
 }
 
+// A prbs at the plant input is piecewise constant with a switch every clock:
+// the exact continuous loop follows its switches, and the sampled loop at a
+// fine dt (the clock a multiple of dt) converges to it.
+TEST(Evaluate, APrbsDisturbanceGivesTheSameLoopContinuousAndFinelySampled) {
+  LoopOptions o;
+  o.horizon_s = 10.0;
+  o.disturbance.kind = DisturbanceKind::kPrbs;
+  o.disturbance.amplitude = 0.3;
+  o.disturbance.noise_hold_s = 0.2;
+  o.disturbance.seed = 11;
+  const TransferFunction tf{{1.0}, {1.0, 2.0, 1.0}};
+  const PidGains gains{2.0, 1.0, 0.5, 0.05};
+  const Evaluation continuous = EvaluateOrFail(tf, gains, o);
+  o.loop = LoopKind::kSampled;
+  o.dt_s = 1e-4;
+  const Evaluation sampled = EvaluateOrFail(tf, gains, o);
+  ASSERT_TRUE(continuous.stability.stable);
+  EXPECT_GT(continuous.iae, 1.2 * continuous.iae_undisturbed);  // the prbs moves the output
+  EXPECT_NEAR(sampled.iae, continuous.iae, 2e-3 * continuous.iae);
+  EXPECT_NEAR(sampled.iae_undisturbed, continuous.iae_undisturbed, 2e-3 * continuous.iae_undisturbed);
+}
+
 }  // namespace
 }  // namespace pidlab

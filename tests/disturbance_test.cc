@@ -8,6 +8,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <vector>
 
 namespace pidlab {
 namespace {
@@ -221,13 +222,81 @@ TEST(DisturbanceOptions, RejectsAZeroNoiseHold) {
 
 TEST(DisturbanceKind, ParsesEveryKindAndRejectsOthers) {
   for (DisturbanceKind k : {DisturbanceKind::kNone, DisturbanceKind::kSquare, DisturbanceKind::kStep,
-                            DisturbanceKind::kSine, DisturbanceKind::kNoise}) {
+                            DisturbanceKind::kSine, DisturbanceKind::kNoise, DisturbanceKind::kPrbs}) {
     DisturbanceKind dut = DisturbanceKind::kNone;
     EXPECT_TRUE(ParseDisturbanceKind(ToString(k), &dut)) << ToString(k);
     EXPECT_EQ(dut, k);
   }
   DisturbanceKind dut;
   EXPECT_FALSE(ParseDisturbanceKind("triangle", &dut));
+}
+
+DisturbanceOptions Prbs(double amplitude, std::uint64_t seed, double clock_s) {
+  DisturbanceOptions o;
+  o.kind = DisturbanceKind::kPrbs;
+  o.amplitude = amplitude;
+  o.seed = seed;
+  o.noise_hold_s = clock_s;
+  return o;
+}
+
+// A maximal-length sequence of order 15: period 2^15 - 1, 2^14 ones and
+// 2^14 - 1 zeros in a period, and no shorter period (a shorter one would
+// divide 32767 = 7 * 31 * 151).
+TEST(Prbs, IsTheMaximalLengthSequenceOfOrderFifteen) {
+  ASSERT_EQ(kPrbsLength, 32767);
+  long ones = 0;
+  for (std::int64_t i = 0; i < kPrbsLength; ++i) ones += PrbsBit(i) ? 1 : 0;
+  EXPECT_EQ(ones, 16384);
+  for (std::int64_t divisor : {7, 31, 151, 7 * 31, 7 * 151, 31 * 151}) {
+    bool repeats = true;
+    for (std::int64_t i = 0; i + divisor < kPrbsLength && repeats; ++i)
+      repeats = PrbsBit(i) == PrbsBit(i + divisor);
+    EXPECT_FALSE(repeats) << divisor;
+  }
+}
+
+// The circular autocorrelation of the +/-1 sequence is N at lag 0 and -1 at
+// every other lag: the property that makes a PRBS a white excitation.
+TEST(Prbs, HasTheTwoValuedAutocorrelation) {
+  std::vector<int> x(static_cast<std::size_t>(kPrbsLength));
+  for (std::int64_t i = 0; i < kPrbsLength; ++i) x[static_cast<std::size_t>(i)] = PrbsBit(i) ? 1 : -1;
+  for (std::int64_t lag : {0, 1, 2, 15, 100, 4096, 32766}) {
+    long sum = 0;
+    for (std::int64_t i = 0; i < kPrbsLength; ++i)
+      sum += x[static_cast<std::size_t>(i)] * x[static_cast<std::size_t>((i + lag) % kPrbsLength)];
+    EXPECT_EQ(sum, lag == 0 ? kPrbsLength : -1) << lag;
+  }
+}
+
+TEST(Prbs, HoldsEachBitOverOneClockAndSwitchesOnlyAtClockMultiples) {
+  const Disturbance dut(Prbs(0.5, 0, 0.1));
+  for (int k = 0; k < 200; ++k) {
+    const double level = PrbsBit(k) ? 0.5 : -0.5;
+    EXPECT_EQ(dut.Value(k * 0.1), level) << k;
+    EXPECT_EQ(dut.Value(k * 0.1 + 0.05), level) << k;
+    EXPECT_EQ(dut.Value(k * 0.1 + 0.0999), level) << k;
+    EXPECT_NEAR(dut.NextBreakpoint(k * 0.1 + 0.03), (k + 1) * 0.1, 1e-12) << k;
+  }
+  EXPECT_TRUE(dut.IsPiecewiseConstant());
+  EXPECT_EQ(dut.Value(-1.0), 0.0);
+}
+
+TEST(Prbs, StartsAtTheSeedsBitAndWrapsAfterAPeriod) {
+  const Disturbance from0(Prbs(1.0, 0, 1.0)), from5(Prbs(1.0, 5, 1.0)), wrapped(Prbs(1.0, 5 + 32767, 1.0));
+  for (int k = 0; k < 100; ++k) {
+    EXPECT_EQ(from5.Value(k), from0.Value(k + 5)) << k;
+    EXPECT_EQ(wrapped.Value(k), from5.Value(k)) << k;
+  }
+  EXPECT_EQ(from0.Value(32767.0), from0.Value(0.0));
+  EXPECT_EQ(from0.Value(32768.5), from0.Value(1.5));
+}
+
+TEST(DisturbanceOptions, RejectsAPrbsWithoutAPositiveClockNamingIt) {
+  std::string error;
+  EXPECT_FALSE(Prbs(1.0, 1, 0.0).IsValid(&error));
+  EXPECT_NE(error.find("prbs clock (noise hold) 0 s must be positive"), std::string::npos) << error;
+  EXPECT_TRUE(Prbs(1.0, 1, 0.05).IsValid(&error)) << error;
 }
 
 }  // namespace

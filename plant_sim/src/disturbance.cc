@@ -4,6 +4,7 @@
 #include <limits>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 namespace pidlab {
 namespace {
@@ -45,6 +46,8 @@ bool ParseDisturbanceKind(const std::string& s, DisturbanceKind* kind) {
     *kind = DisturbanceKind::kSine;
   else if (s == "noise")
     *kind = DisturbanceKind::kNoise;
+  else if (s == "prbs")
+    *kind = DisturbanceKind::kPrbs;
   else
     return false;
   return true;
@@ -62,6 +65,8 @@ std::string ToString(DisturbanceKind kind) {
       return "sine";
     case DisturbanceKind::kNoise:
       return "noise";
+    case DisturbanceKind::kPrbs:
+      return "prbs";
   }
   return "none";
 }
@@ -91,8 +96,10 @@ bool DisturbanceOptions::IsValid(std::string* error) const {
     os << "disturbance phase " << phase_s << " s must be finite";
   else if (kind == DisturbanceKind::kStep && !(step_time_s >= 0.0 && std::isfinite(step_time_s)))
     os << "disturbance step time " << step_time_s << " s must be >= 0 and finite";
-  else if (kind == DisturbanceKind::kNoise && !(noise_hold_s > 0.0 && std::isfinite(noise_hold_s)))
-    os << "noise hold " << noise_hold_s << " s must be positive";
+  else if ((kind == DisturbanceKind::kNoise || kind == DisturbanceKind::kPrbs) &&
+           !(noise_hold_s > 0.0 && std::isfinite(noise_hold_s)))
+    os << (kind == DisturbanceKind::kPrbs ? "prbs clock (noise hold) " : "noise hold ") << noise_hold_s
+       << " s must be positive";
   else
     return true;
   if (error) *error = os.str();
@@ -119,6 +126,11 @@ double Disturbance::Value(double t) const {
       return o.amplitude * std::sin(kTwoPi * (t + o.phase_s) / o.period_s);
     case DisturbanceKind::kNoise:
       return o.amplitude * StandardNormal(o.seed, static_cast<std::int64_t>(PieceIndex(t, o.noise_hold_s)));
+    case DisturbanceKind::kPrbs: {
+      const double k = std::fmod(PieceIndex(t, o.noise_hold_s), static_cast<double>(kPrbsLength));
+      const auto start = static_cast<std::int64_t>(o.seed % static_cast<std::uint64_t>(kPrbsLength));
+      return PrbsBit((static_cast<std::int64_t>(k) + start) % kPrbsLength) ? o.amplitude : -o.amplitude;
+    }
   }
   return 0.0;
 }
@@ -139,9 +151,26 @@ double Disturbance::NextBreakpoint(double t) const {
       return (PieceIndex(t + o.phase_s, half) + 1.0) * half - o.phase_s;
     }
     case DisturbanceKind::kNoise:
+    case DisturbanceKind::kPrbs:
       return (PieceIndex(t, o.noise_hold_s) + 1.0) * o.noise_hold_s;
   }
   return inf;
+}
+
+bool PrbsBit(std::int64_t i) {
+  // Fibonacci register: the output is bit 0; the feedback bit 0 ^ bit 1
+  // (taps 15 and 14) enters at bit 14.
+  static const std::vector<bool> sequence = [] {
+    std::vector<bool> bits(static_cast<std::size_t>(kPrbsLength));
+    std::uint32_t state = 1;
+    for (auto&& bit : bits) {
+      bit = (state & 1u) != 0;
+      const std::uint32_t feedback = (state ^ (state >> 1)) & 1u;
+      state = (state >> 1) | (feedback << (kPrbsOrder - 1));
+    }
+    return bits;
+  }();
+  return sequence[static_cast<std::size_t>(i)];
 }
 
 }  // namespace pidlab

@@ -123,6 +123,10 @@ bad "square disturbance period 1e-6 (5e7 switches)" "1e6" \
   evaluate --plant stepper --gains 20.8836,26.607,12.4866 --disturbance-amplitude 1 --disturbance-period 1e-6
 bad "noise hold 1e-9" "1e6" \
   evaluate --plant linear --gains 1,1,1 --disturbance noise --disturbance-amplitude 1 --noise-hold 1e-9
+bad "prbs clock 1e-9" "1e6" \
+  evaluate --plant linear --gains 1,1,1 --disturbance prbs --disturbance-amplitude 1 --noise-hold 1e-9
+bad "prbs clock 0" "prbs clock (noise hold) 0 s must be positive" \
+  evaluate --plant linear --gains 1,1,1 --disturbance prbs --disturbance-amplitude 1 --noise-hold 0
 bad "tune sampled --dt 1e-5 (5000 x 2.5e6 steps)" "5e9" tune --plant stepper --loop sampled --dt 1e-5
 bad "tune --max-evals 1e8 (1e8 x 501 samples)" "5e9" tune --plant linear --max-evals 100000000
 bad "tune square period 1e-3 (5000 x 5e4 switches)" "5e9" \

@@ -52,6 +52,8 @@ run_all_plants() {
   compare di_square --plant double_integrator --gains 2,1,1.5 --horizon 10 --disturbance square --disturbance-amplitude 0.3
   compare osc_clean --plant oscillator --gains 3,1,1 --horizon 10
   compare osc_noise --plant oscillator --gains 3,1,1 --horizon 10 --disturbance noise --disturbance-amplitude 0.1 --seed 7
+  compare di_prbs --plant double_integrator --gains 2,1,1.5 --horizon 10 --disturbance prbs --disturbance-amplitude 0.2 --noise-hold 0.05 --seed 9
+  compare open_loop_prbs --plant custom --num 1 --den 1,2,1 --gains 0,0,0 --horizon 10 --disturbance prbs --disturbance-amplitude 0.5 --noise-hold 0.1 --seed 3
   compare stepper_clean --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5
   compare stepper_reference --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --reference 0.0123
   compare stepper_sine --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --disturbance sine --disturbance-amplitude 0.5 --disturbance-period 0.2

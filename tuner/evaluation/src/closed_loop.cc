@@ -89,6 +89,7 @@ double LoopOptions::DisturbanceBreakpoints() const {
     case DisturbanceKind::kSquare:
       return std::floor(horizon_s / (disturbance.period_s / 2.0)) + 1.0;
     case DisturbanceKind::kNoise:
+    case DisturbanceKind::kPrbs:
       return std::floor(horizon_s / disturbance.noise_hold_s) + 1.0;
     case DisturbanceKind::kStep:
       return 1.0;
