@@ -146,22 +146,25 @@ struct LoopSpec {
               "with a dead time L, |p| counts up to pi/L",
               "", kNone, "0.001"},
              &stability_margin);
-    a->Visit({"disturbance",
-              "none|square|step|sine|noise|prbs at the plant input (default: square if an amplitude is given)", "",
-              kEpisode, R"("sine")"},
-             &disturbance);
-    a->Visit({"disturbance_amplitude", "square and prbs +/-A, step height, sine peak or noise std deviation", "",
-              kEpisode, "0.5"},
+    a->Visit(
+        {"disturbance",
+         "none|square|step|sine|noise|prbs at the plant input (default: square if an amplitude is given)", "",
+         kEpisode, R"("sine")"},
+        &disturbance);
+    a->Visit({"disturbance_amplitude", "square and prbs +/-A, step height, sine peak or noise std deviation",
+              "", kEpisode, "0.5"},
              &disturbance_amplitude);
     a->Visit({"disturbance_period", "square/sine period", "s", kEpisode, "3"}, &disturbance_period_s);
     a->Visit({"disturbance_phase", "time shift of the disturbance", "s", kEpisode, "0.25"},
              &disturbance_phase_s);
     a->Visit({"disturbance_step_time", "step disturbance time", "s", kEpisode, "1.5"},
              &disturbance_step_time_s);
-    a->Visit({"noise_hold", "noise is held constant over this interval; the prbs's clock period", "s", kEpisode, "0.05"},
+    a->Visit({"noise_hold", "noise is held constant over this interval; the prbs's clock period", "s",
+              kEpisode, "0.05"},
              &noise_hold_s);
-    a->Visit({"seed", "seed of the noise and prbs disturbances (and of the search, for tune)", "", kEpisode, "7"},
-             &seed);
+    a->Visit(
+        {"seed", "seed of the noise and prbs disturbances (and of the search, for tune)", "", kEpisode, "7"},
+        &seed);
     a->Visit({"derivative_filter",
               "derivative filter time constant Tf, both loops: C(s) = kp + ki/s + kd s/(Tf s + 1); 0 = the "
               "paper's ideal PID",
