@@ -172,6 +172,9 @@ void DrawFigure(const std::vector<BatchResult>& results, const std::string& path
     plot::Series s;
     s.name = "P" + std::to_string(f);
     s.style = plot::Style::kPoints;
+    static const char* const kColors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+                                          "#8c564b", "#e377c2", "#7f7f7f", "#17becf"};
+    s.color = kColors[f - 1];
     for (const BatchResult& r : results)
       if (r.plant.family == s.name && std::isfinite(r.ratio)) {
         s.x.push_back(r.tau);

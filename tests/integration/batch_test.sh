@@ -5,7 +5,8 @@
 set -uo pipefail
 pidlab="$1"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-"$pidlab" batch --set amigo --json > "$tmp/batch.json" || { echo "FAIL: pidlab batch exited $?"; exit 1; }
+"$pidlab" batch --set amigo --json --out "$tmp/batch" > "$tmp/batch.json" || { echo "FAIL: pidlab batch exited $?"; exit 1; }
+for f in batch.json batch.csv batch.png; do [ -s "$tmp/batch/$f" ] || { echo "FAIL: --out wrote no $f"; exit 1; }; done
 python3 - "$tmp/batch.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
