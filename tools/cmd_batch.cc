@@ -93,7 +93,8 @@ Tally Count(const std::vector<BatchResult>& results) {
     t.worst_ratio = std::max(t.worst_ratio, r.ratio);
     t.best_ratio = std::min(t.best_ratio, r.ratio);
   }
-  if (!std::isfinite(t.best_ratio)) t.best_ratio = NAN;
+  if (!std::isfinite(t.best_ratio)) t.best_ratio = t.worst_ratio = NAN;
+  if (t.pidlab_feasible == 0) t.max_ms = NAN;
   return t;
 }
 
@@ -106,7 +107,7 @@ nlohmann::json TallyJson(const Tally& t) {
           {"losses", t.losses},
           {"best_ratio", Number(t.best_ratio)},
           {"worst_ratio", Number(t.worst_ratio)},
-          {"max_ms", t.max_ms}};
+          {"max_ms", Number(t.max_ms)}};
 }
 
 std::string Fixed(double v, int precision = 4) {

@@ -42,6 +42,21 @@ check "--out writes batch.json, batch.csv (a row per plant) and batch.png" \
 check "the table: a row per plant and the summary line" \
   "[ \$(grep -c '^P9 ' $tmp/table) -eq 10 ] && grep -q 'AMIGO feasible' $tmp/table && grep -q 'at_bounds' $tmp/table"
 
+# --loop continuous: the delay-free P4 is scored on the exact continuous loop;
+# a plant with dead time says why it is not (until that loop takes a delay).
+"$pidlab" batch --families P4,P6 --loop continuous --json > "$tmp/cont.json" 2> "$tmp/err"
+check "batch --loop continuous scores P4 and names why P6 is not scored" "python3 - $tmp/cont.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j['loop'] == 'continuous', j['loop']
+for p in j['plants']:
+    if p['family'] == 'P4':
+        assert p['pidlab']['feasible'] and p['pidlab']['ms'] <= 1.4 + 1e-3, p
+        if p['amigo']['feasible']: assert p['pidlab']['load_iae'] <= p['amigo']['load_iae'], p
+    else:
+        assert not p['pidlab']['feasible'] and 'dead time' in p['message'], p
+PY"
+
 # The search box of a custom plant: (s + 1)^3 has AMIGO's FOPDT T = L = 1.5,
 # kp = 0.65, so the box is [0, 6.5]; the spec echoes it and runs again to the
 # same numbers; --bounds overrides it.

@@ -88,9 +88,6 @@ Score ScoreGains(const Plant& plant, const PidGains& g, const LoopOptions& loop)
 
 void AmigoPart(const TuningRuleResult& rule, const Plant& plant, const LoopOptions& loop,
                const BatchOptions& o, BatchResult* r) {
-  r->amigo_k = rule.kc;
-  r->amigo_ti_s = rule.ti_s;
-  r->amigo_td_s = rule.td_s;
   r->amigo_gains = evaluation::LoopGains(rule.gains, loop);
   const Score s = ScoreGains(plant, rule.gains, loop);
   r->amigo_ms = s.ms;
@@ -197,6 +194,9 @@ Status RunBatchPlant(const BatchPlant& bp, const BatchOptions& o, BatchResult* r
     r->message = status.message();
     return Status::Ok();
   }
+  r->amigo_k = rule.kc;
+  r->amigo_ti_s = rule.ti_s;
+  r->amigo_td_s = rule.td_s;
   const bool ipdt = r->model.kind == ProcessModelKind::kIntegrating;
   r->tau = ipdt ? 0.0 : r->model.delay_s / (r->model.delay_s + r->model.time_constants[0]);
   const LoopOptions loop = BatchLoop(o, r->model, rule.ti_s);
