@@ -74,6 +74,8 @@ import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:])
 assert a['gains'] == b['gains'] and a['box'] == b['box'] and a['spec'] == b['spec'], (a['gains'], b['gains'])
 PY"
+"$pidlab" tune --num 1 --den 1,3,3,1 --max-evals 200 > "$tmp/box.txt"
+check "the text says where the box came from" "grep -q '^box  *\[0, 6.5' $tmp/box.txt"
 "$pidlab" tune --num 1 --den 1,3,3,1 --max-evals 200 --bounds 0,2 --json > "$tmp/given.json"
 check "--bounds overrides the plant's box" "python3 -c \"import json; j = json.load(open('$tmp/given.json')); assert j['box']['upper'] == 2, j['box']\""
 "$pidlab" tune --plant linear --json > "$tmp/paper.json"

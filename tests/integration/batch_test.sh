@@ -5,9 +5,12 @@
 set -uo pipefail
 pidlab="$1"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-"$pidlab" batch --set amigo --json --out "$tmp/batch" > "$tmp/batch.json" || { echo "FAIL: pidlab batch exited $?"; exit 1; }
+# The command of docs/deadtime.md, "The AMIGO test batch": the table on
+# stdout, the JSON, CSV and figure in the folder.
+"$pidlab" batch --set amigo --out "$tmp/batch" > "$tmp/table" || { echo "FAIL: pidlab batch exited $?"; exit 1; }
 for f in batch.json batch.csv batch.png; do [ -s "$tmp/batch/$f" ] || { echo "FAIL: --out wrote no $f"; exit 1; }; done
-python3 - "$tmp/batch.json" <<'PY'
+[ "$(grep -c '^P[1-9] ' "$tmp/table")" -eq 133 ] || { echo "FAIL: the table has no row per plant"; exit 1; }
+python3 - "$tmp/batch/batch.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
 bad = []
