@@ -72,7 +72,7 @@ struct BatchOptions {
 struct BatchResult {
   BatchPlant plant;
   ProcessModel model;  // AMIGO's model (half rule)
-  /// tau = L / (L + T) of the FOPDT model (1 for ... 0 for an ipdt model).
+  /// tau = L / (L + T) of the FOPDT model; 0 for an ipdt model (T infinite).
   double tau = 0.0;
   double dt_s = 0.0, horizon_s = 0.0;
   double box_upper = 0.0;  // the search box [0, box_upper]^3
