@@ -15,6 +15,7 @@
 #include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/episode_client/episode_client.h"
+#include "pidlab/tune/search_box.h"
 #include "pidlab/tune/spec_build.h"
 #include "pidlab/tune/tune.h"
 
@@ -32,6 +33,8 @@ using pidlab::tune::BuildPlant;
 using pidlab::tune::BuildTuneOptions;
 using pidlab::tune::CheckPlantInLoop;
 using pidlab::tune::ResolveRobustPreset;
+using pidlab::tune::ResolveSearchBox;
+using pidlab::tune::SearchBox;
 using pidlab::tune::Tune;
 using pidlab::tune::TuneOptions;
 using pidlab::tune::TuneSummary;
@@ -67,6 +70,7 @@ struct TuneCommand {
     flags.Apply(&ts, &given);
     ts.plant.Normalize();
     ResolveRobustPreset(&ts, given);
+    const SearchBox box = ResolveSearchBox(&ts, given);
     std::string error;
     Plant p;
     Require(BuildPlant(ts.plant, NameStyle::kFlag, &p, &error), error);
@@ -97,7 +101,7 @@ struct TuneCommand {
       j["spec"] = spec::ToJson(ts);
       std::cout << j.dump() << "\n";
     } else {
-      PrintText(o, s, ev);
+      PrintText(o, s, ev, box);
       if (s.stable) std::cout << FormatRobustness(analysis, o.bounds);
     }
     return s.stable ? 0 : 1;
@@ -129,7 +133,8 @@ struct TuneCommand {
   }
 
   // The human-readable result; `ev` as for ToJson.
-  static void PrintText(const TuneOptions& o, const TuneSummary& s, const Evaluation& ev) {
+  static void PrintText(const TuneOptions& o, const TuneSummary& s, const Evaluation& ev,
+                        const SearchBox& box) {
     std::cout << std::setprecision(6);
     std::cout << "method           " << ToString(o.method) << " on " << ToString(o.objective) << ", box ["
               << o.lower << ", " << o.upper << "]^3, seed " << o.seed << "\n";
@@ -157,6 +162,12 @@ struct TuneCommand {
                         : std::string())
                 << "): objective = quantile " << o.robust_quantile << "; nominal plant's "
                 << s.nominal_objective << "\n";
+    if (box.source == "plant") std::cout << "box              " << box.message << "\n";
+    if (!s.at_bounds.empty()) {
+      std::cout << "at bounds        ";
+      for (std::size_t i = 0; i < s.at_bounds.size(); ++i) std::cout << (i ? ", " : "") << s.at_bounds[i];
+      std::cout << "  (an optimum on the box's edge: widen it with --bounds)\n";
+    }
     std::cout << "wall time        " << s.wall_time_s << " s\n\n";
     std::cout << FormatEvaluation(ev);
   }

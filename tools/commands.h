@@ -14,5 +14,6 @@ std::function<int()> RegisterReplay(CLI::App* app);
 std::function<int()> RegisterPlot(CLI::App* app);
 std::function<int()> RegisterReport(CLI::App* app);
 std::function<int()> RegisterLinearize(CLI::App* app);
+std::function<int()> RegisterBatch(CLI::App* app);
 
 }  // namespace pidlab::cli

@@ -19,6 +19,8 @@ struct Command {
 };
 
 const Command kCommands[] = {
+    {"batch", "the AMIGO test batch: AMIGO's PID against pidlab's optimum on P1-P9",
+     pidlab::cli::RegisterBatch},
     {"evaluate", "evaluate one gain set (IAE, poles, step metrics)", pidlab::cli::RegisterEvaluate},
     {"linearize", "transfer function of a nonlinear plant's linearisation (stepper_nonlinear)",
      pidlab::cli::RegisterLinearize},

@@ -21,6 +21,7 @@
 #include "pidlab/json/results_json.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
+#include "pidlab/tune/search_box.h"
 #include "pidlab/tune/spec_build.h"
 #include "pidlab/tune/tune.h"
 
@@ -213,6 +214,7 @@ py::object TunePy(const py::object& plant, py::kwargs kwargs) {
   ReadKwargs("tune", WithPositional(plant, nullptr, kwargs), &s, &given);
   s.plant.Normalize();
   ResolveRobustPreset(&s, given);
+  pidlab::tune::ResolveSearchBox(&s, given);
   std::string error;
   Plant p;
   TuneOptions o;
@@ -292,6 +294,7 @@ PYBIND11_MODULE(_pidlab, m) {
         pidlab::spec::TuningSpec s;
         ReadKwargs("read_spec", py::dict(kwargs), &s, &given);
         pidlab::tune::ResolveRobustPreset(&s, given);
+        pidlab::tune::ResolveSearchBox(&s, given);
         return ToPython(pidlab::spec::ToJson(s));
       },
       "read_spec(which, **spec): the spec evaluate or tune would read from these keywords (defaults filled "

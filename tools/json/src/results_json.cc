@@ -124,6 +124,8 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
                  {"termination", ToString(s.optimizer.termination)},
                  {"starts", s.optimizer.starts},
                  {"message", s.optimizer.message}};
+  j["box"] = {{"lower", o.lower}, {"upper", o.upper}};
+  j["at_bounds"] = s.at_bounds;
   j["evaluations"] = s.evaluations;
   j["rejected_evaluations"] = s.optimizer.rejected_evaluations;
   j["iterations"] = s.iterations;

@@ -11,6 +11,7 @@
 #include "pidlab/optim/nelder_mead.h"
 #include "pidlab/optim/paper_nelder_mead.h"
 #include "pidlab/optim/pso_gsa.h"
+#include "pidlab/tune/search_box.h"
 
 namespace pidlab::tune {
 
@@ -110,6 +111,10 @@ bool TuneOptions::IsValid(std::string* error) const {
   std::ostringstream os;
   if (!std::isfinite(lower) || !std::isfinite(upper) || lower < 0.0 || !(lower < upper) || upper > kMaxGain)
     os << "bounds [" << lower << ", " << upper << "] must be finite with 0 <= lower < upper <= " << kMaxGain;
+  else if (!start.empty() && (start.size() != 3 || std::any_of(start.begin(), start.end(), [this](double g) {
+                                return !(g >= lower && g <= upper);
+                              })))
+    os << "start must be three gains inside the box [" << lower << ", " << upper << "]";
   else if (max_iterations < 0)
     os << "max iterations " << max_iterations << " must be >= 0";
   else if (max_evaluations < 0)
@@ -346,6 +351,8 @@ bool Search(const Plant& plant, const TuneOptions& options, const optim::Objecti
       optim::NelderMeadOptions o =
           WithBudget(optim::NelderMeadOptions{}, options, &optim::NelderMeadOptions::max_iterations);
       o.starts = options.StartCount();
+      if (options.start.size() == 3)
+        o.x0 = Eigen::Vector3d(options.start[0], options.start[1], options.start[2]);
       o.adaptive = options.adaptive;
       o.parallel_for = options.parallel_for;
       optim::NelderMead(f, bounds, o, &opt, progress);
@@ -507,6 +514,8 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   summary->gains = evaluation::LoopGains(summary->gains, options.loop);
   summary->search_gains = evaluation::LoopGains(summary->search_gains, options.loop);
   summary->refine.gains = evaluation::LoopGains(summary->refine.gains, options.loop);
+  if (!IsTuningRule(options.method))
+    summary->at_bounds = GainsAtBounds(summary->gains, options.lower, options.upper);
   summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return true;
 }

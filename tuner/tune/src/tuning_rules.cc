@@ -76,14 +76,7 @@ std::vector<double> StripZeros(std::vector<double> p, int* trailing) {
   return p;
 }
 
-// The plant factored as K s^-integrators prod(-T0 s + 1) / prod(tau s + 1)
-// e^(-delay s): its lags (descending) and inverse-response time constants.
-struct Factored {
-  double gain = 0.0;
-  int integrators = 0;
-  std::vector<double> lags;     // tau, descending
-  std::vector<double> inverse;  // T0 of right half-plane zeros
-};
+using Factored = FactoredPlant;
 
 Status Factor(const Plant& plant, Factored* f) {
   const std::string tf = plant.tf.ToString();
@@ -127,7 +120,8 @@ Status Factor(const Plant& plant, Factored* f) {
 // half to the smallest kept one (if any is kept; an integrator is an infinite
 // time constant that takes nothing) and half to the dead time; the rest and
 // every inverse-response time constant go to the dead time.
-ProcessModel HalfRule(const Factored& f, double delay_s, std::size_t keep) {
+ProcessModel HalfRule(const Factored& f, std::size_t keep) {
+  const double delay_s = f.delay_s;
   ProcessModel m;
   m.gain = f.gain;
   m.delay_s = delay_s;
@@ -187,14 +181,28 @@ Status ReduceModel(const Plant& plant, TuningRule rule, RuleForm form, ProcessMo
   Factored f;
   const Status factored = Factor(plant, &f);
   if (!factored.ok()) return factored;
+  f.delay_s = plant.delay_s;
+  if (f.lags.empty() && f.integrators == 0)
+    return Status::InvalidInput("plant " + plant.name + " has no pole: nothing to reduce");
+  return ReduceFactored(f, rule, form, model);
+}
+
+Status ReduceFactored(const FactoredPlant& plant, TuningRule rule, RuleForm form, ProcessModel* model) {
+  FactoredPlant f = plant;
+  if (!std::isfinite(f.delay_s) || f.delay_s < 0.0)
+    return Status::InvalidInput("plant delay " + Num(f.delay_s) + " s must be finite and >= 0");
+  if (!(f.gain > 0.0) || !std::isfinite(f.gain) || f.integrators < 0 || f.integrators > 1)
+    return Status::InvalidInput("a factored plant needs a positive gain and at most one integrator");
+  if (f.lags.empty() && f.integrators == 0)
+    return Status::InvalidInput("a plant with no pole: nothing to reduce");
+  std::sort(f.lags.begin(), f.lags.end(), std::greater<double>());
   const bool sopdt = rule == TuningRule::kSimc && form == RuleForm::kPid;
   if (f.integrators == 1) {
-    *model = HalfRule(f, plant.delay_s, sopdt ? 1 : 0);
+    *model = HalfRule(f, sopdt ? 1 : 0);
     model->kind = ProcessModelKind::kIntegrating;
     return Status::Ok();
   }
-  if (f.lags.empty()) return Status::InvalidInput("plant " + plant.name + " has no pole: nothing to reduce");
-  *model = HalfRule(f, plant.delay_s, sopdt ? 2 : 1);
+  *model = HalfRule(f, sopdt ? 2 : 1);
   // The second-order model is symmetric in T1 and T2; the half rule can make
   // the kept smaller one the larger ((s+1)^3: 1 and 1.5), SIMC wants T1 >= T2.
   std::sort(model->time_constants.begin(), model->time_constants.end(), std::greater<double>());
@@ -262,7 +270,8 @@ Status ApplyTuningRule(const Plant& plant, TuningRule rule, RuleForm form, Tunin
   ProcessModel model;
   const Status reduced = ReduceModel(plant, rule, form, &model);
   if (!reduced.ok()) return reduced;
-  const Status tuned = rule == TuningRule::kSimc ? SimcTune(model, form, result) : AmigoTune(model, form, result);
+  const Status tuned =
+      rule == TuningRule::kSimc ? SimcTune(model, form, result) : AmigoTune(model, form, result);
   result->plant_delay_s = plant.delay_s;
   return tuned;
 }

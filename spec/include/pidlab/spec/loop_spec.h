@@ -240,7 +240,11 @@ struct TuneSpec {
               "", kNone, R"("ise")"},
              &objective);
     a->Visit({"load_weight", "W of --objective setpoint-load (>= 0)", "", kNone, "2"}, &load_weight);
-    a->Visit({"bounds", "gain box LO,HI for each of kp, ki, kd", "", kNone, "[0, 20]"}, &bounds);
+    a->Visit({"bounds",
+              "gain box LO,HI for each of kp, ki, kd (not given: 0 to 10 x the largest AMIGO PID gain on the "
+              "plant's half-rule model, or 0,30 where the rule does not apply; docs/tuning.md)",
+              "", kNone, "[0, 20]"},
+             &bounds);
     a->Visit({"max_iter", "iteration budget (0 = method default; paper-nm: 100)", "", kNone, "50"},
              &max_iter);
     a->Visit({"max_evals", "evaluation budget over all starts (0 = method default)", "", kNone, "300"},

@@ -89,6 +89,10 @@ struct TuneOptions {
   /// multi-start: Ceres runs from this many distinct polished minima, best
   /// first (>= 1); the best exact result is kept.
   int refine_starts = 2;
+  /// nelder-mead: the base point of the first start (kp, ki, kd), e.g. a
+  /// tuning rule's gains to improve on; empty: drawn from the seed. Inside
+  /// the box. Other methods ignore it.
+  std::vector<double> start;
   /// nelder-mead: Gao & Han's dimension-dependent coefficients instead of
   /// (1, 2, 1/2, 1/2).
   bool adaptive = false;
@@ -260,6 +264,11 @@ struct TuneSummary {
   int robust_set_size = 0;
   int robust_invalid_draws = 0;
   double nominal_objective = std::numeric_limits<double>::infinity();
+  /// The bounds of the box the gains found lie on (GainsAtBounds: "kp_lo",
+  /// "kp_hi", "ki_lo", ..., within 1e-6 of the box's width): an optimum on
+  /// an edge the box may have cut short. Empty for a rule (no box) and when
+  /// no stable loop was found.
+  std::vector<std::string> at_bounds;
   /// The search's one-line summary, or why no strictly stable loop was found.
   std::string message;
   /// One line: method, gains, objective, evaluations and the refine verdict.

@@ -88,6 +88,19 @@ PidGains SeriesToParallel(double kc, double ti_s, double td_s);
 /// with a lag). kInvalidInput with one line if the plant does not reduce.
 Status ReduceModel(const Plant& plant, TuningRule rule, RuleForm form, ProcessModel* model);
 
+/// A plant given by its factors: K s^-integrators prod(-T0 s + 1) /
+/// prod(tau s + 1) e^(-delay s), the form the half rule reads.
+struct FactoredPlant {
+  double gain = 0.0;
+  int integrators = 0;          // 0 or 1
+  std::vector<double> lags;     // tau > 0, s (any order)
+  std::vector<double> inverse;  // T0 > 0 of right half-plane zeros, s
+  double delay_s = 0.0;
+};
+/// ReduceModel on a plant given by its factors (no root finding: a repeated
+/// pole such as (s + 1)^8 stays exactly real).
+Status ReduceFactored(const FactoredPlant& plant, TuningRule rule, RuleForm form, ProcessModel* model);
+
 /// SIMC with tight tuning (tau_c = theta) on `model`.
 Status SimcTune(const ProcessModel& model, RuleForm form, TuningRuleResult* result);
 /// AMIGO on `model` (an fopdt or an ipdt without a lag).
