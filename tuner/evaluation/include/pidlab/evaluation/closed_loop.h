@@ -104,11 +104,12 @@ struct LoopOptions {
 };
 
 /// The plant's dead time L = plant.delay_s in the loop `o`: finite, >= 0 and
-/// at most kMaxDelaySeconds; with L > 0 the loop must be sampled (the
-/// continuous loop with dead time is not supported yet), the plant linear,
-/// and d = ceil(L / dt) at most kMaxAnalysedDelaySteps (below plant_sim's
-/// kMaxDelaySteps). False with *error naming `name` (the field as the caller
-/// spells it) and the value. Needs a valid o.dt_s.
+/// at most kMaxDelaySeconds; with L > 0 the plant linear, and in the sampled
+/// loop d = ceil(L / dt) at most kMaxAnalysedDelaySteps (below plant_sim's
+/// kMaxDelaySteps). The continuous loop takes any such L (delayed_loop.h);
+/// its gains are checked apart (DelayedLoopIsRetarded: an ideal derivative on
+/// a plant of relative degree 1 is refused). False with *error naming `name`
+/// (the field as the caller spells it) and the value. Needs a valid o.dt_s.
 bool DelayIsValid(const Plant& plant, const LoopOptions& o, const std::string& name, std::string* error);
 
 /// The plant the sampled loop runs at dt_s: the exact ZOH of plant.tf with its
