@@ -139,7 +139,12 @@ class DelayedIntegrator {
  private:
   double NextNode(double t, double t_end) {
     double tb = std::min(t_end, (std::floor((t + tol_) / h_) + 1.0) * h_);
-    if (piecewise_) tb = std::min(tb, disturbance_.NextBreakpoint(t + tol_));
+    if (piecewise_) {
+      // A breakpoint within rounding of the regular node replaces it: the
+      // node after it would ask for the breakpoint after that one.
+      next_break_ = disturbance_.NextBreakpoint(t);
+      if (next_break_ < tb + tol_) tb = next_break_;
+    }
     const double s = t - loop_.delay_s;
     const double cap = s < -tol_ ? loop_.delay_s : stored_[Source(s)].sb + loop_.delay_s;
     if (cap < tb - tol_) tb = cap;
@@ -171,8 +176,7 @@ class DelayedIntegrator {
   // At node t: a disturbance breakpoint resets its state; the ideal
   // derivative's kick reaches the plant at t = L.
   void Events(double t, Eigen::VectorXd* w) {
-    if (piecewise_ && std::abs(disturbance_.NextBreakpoint(t - 2.0 * tol_) - t) <= tol_)
-      (*w)(loop_.exo_index) = disturbance_.Value(t + tol_);
+    if (piecewise_ && t == next_break_) (*w)(loop_.exo_index) = disturbance_.Value(t);
     if (!kicked_ && std::abs(t - loop_.delay_s) <= tol_) {
       *w += loop_.impulse;
       kicked_ = true;
@@ -184,6 +188,7 @@ class DelayedIntegrator {
   ExpCache cache_;
   double h_, tol_;
   bool piecewise_ = false, kicked_ = false;
+  double next_break_ = kInf;  // the disturbance's next breakpoint after the current node
   std::vector<StoredPiece> stored_;
   std::size_t source_ = 0;
 };
@@ -261,7 +266,7 @@ double DelayedStepSize(const DelayedClosedLoop& loop) {
 
 bool SampleDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturbance, double ts,
                        int num_samples, std::vector<double>* y, DelayedTrace* trace, std::string* error) {
-  const double h = DelayedStepSize(loop);
+  const double h = trace && trace->force_step_s > 0.0 ? trace->force_step_s : DelayedStepSize(loop);
   const double t_end = (num_samples - 1) * ts;
   if (!(h > 0.0) || t_end / h > static_cast<double>(kMaxDelayedPieces)) {
     std::ostringstream os;

@@ -207,7 +207,9 @@ bool MeetsBounds(const Plant& plant, const StateSpace& realization, const TuneOp
                  const PidGains& typed) {
   if (!options.bounds.Any()) return true;
   const PidGains g = evaluation::LoopGains(typed, options.loop);
-  if (options.loop.loop == evaluation::LoopKind::kContinuous) {
+  // With dead time the continuous loop's bounds come from the frequency-domain
+  // analysis (e^(-jwL) exact, the Nyquist count), as the sampled loop's.
+  if (options.loop.loop == evaluation::LoopKind::kContinuous && plant.delay_s == 0.0) {
     evaluation::ContinuousClosedLoop<double> loop;
     if (!evaluation::BuildContinuousClosedLoop<double>(realization, g, Disturbance(DisturbanceOptions{}),
                                                        &loop, nullptr))
@@ -302,8 +304,9 @@ void RuleResult(const PidGains& g, const evaluation::ObjectiveEvaluator& evaluat
 }
 
 // SIMC or AMIGO into summary->tuning_rule and summary->optimizer. False with
-// *error where the rule does not apply. A plant with a dead time reaches this
-// only in the sampled loop (Tune checks DelayIsValid), which simulates it.
+// *error where the rule does not apply. A plant's dead time is simulated in
+// both loops (the sampled loop's stored inputs, the continuous loop's method
+// of steps), so delay_simulated is true on either.
 bool RuleSearch(const Plant& plant, const TuneOptions& options,
                 const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary, std::string* error) {
   const TuningRule rule = options.method == TuneMethod::kSimc ? TuningRule::kSimc : TuningRule::kAmigo;

@@ -66,10 +66,11 @@ double DelayedStepSize(const DelayedClosedLoop& loop);
 
 /// What one run records besides y at the samples.
 struct DelayedTrace {
-  bool record = false;       // fill t and y at every node
-  std::vector<double> t, y;  // the nodes (t = 0 first) and y there
-  long pieces = 0;           // integration pieces taken
-  double step_s = 0.0;       // h
+  bool record = false;        // fill t and y at every node
+  double force_step_s = 0.0;  // > 0: this h instead of DelayedStepSize (tests)
+  std::vector<double> t, y;   // the nodes (t = 0 first) and y there
+  long pieces = 0;            // integration pieces taken
+  double step_s = 0.0;        // h
 };
 
 /// y at t = 0, ts, ..., (num_samples - 1) ts of the delayed loop. False
