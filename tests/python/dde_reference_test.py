@@ -149,11 +149,21 @@ def check_sampled_converges(pidlab):
     return []
 
 
+def check_documented_example(pidlab):
+    # docs/deadtime.md, "In every loop": the continuous loop with dead time.
+    got = run_pidlab(pidlab, ["evaluate", "--plant", "custom", "--num", "1", "--den", "1,1", "--delay", "0.3",
+                              "--gains", "1,1,0", "--json"])
+    if not (got["stable"] and got["spec"]["delay"] == 0.3 and got["iae"] > 0):
+        return ["documented example: %r" % {k: got[k] for k in ("stable", "iae")}]
+    print("documented example: IAE %.12g" % got["iae"])
+    return []
+
+
 def main():
     pidlab = sys.argv[1]
     with tempfile.TemporaryDirectory() as tmp:
         failures = compare_cases(pidlab, tmp)
-    failures += check_neutral(pidlab) + check_continuity(pidlab) + check_sampled_converges(pidlab)
+    failures += check_documented_example(pidlab) + check_neutral(pidlab) + check_continuity(pidlab) + check_sampled_converges(pidlab)
     for f in failures:
         print("FAIL: " + f)
     sys.exit(1 if failures else 0)

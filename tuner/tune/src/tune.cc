@@ -437,6 +437,23 @@ void RefineSearchResult(const Plant& plant, const TuneOptions& options, const op
   }
 }
 
+// A rule's PID with an ideal derivative on a plant of relative degree 1 with
+// a dead time is a neutral continuous loop (delayed_loop.h): refused up front
+// rather than scored +inf.
+bool RuleLoopIsRetarded(const Plant& plant, const TuneOptions& options, std::string* error) {
+  const bool rule = options.method == TuneMethod::kSimc || options.method == TuneMethod::kAmigo;
+  if (!rule || options.rule != RuleForm::kPid || options.loop.loop != evaluation::LoopKind::kContinuous ||
+      !(plant.delay_s > 0.0) || plant.tf.RelativeDegree() != 1 ||
+      options.loop.derivative_filter_ratio > 0.0 || options.loop.pid.derivative_filter_s > 0.0)
+    return true;
+  if (error)
+    *error =
+        "--rule pid's ideal derivative on a plant of relative degree 1 with a dead time makes the "
+        "continuous loop of neutral type: give a derivative filter (--derivative-filter or "
+        "--derivative-filter-ratio)";
+  return false;
+}
+
 }  // namespace
 
 bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
@@ -449,6 +466,7 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
           "undelayed plant): use another method";
     return false;
   }
+  if (!RuleLoopIsRetarded(plant, options, error)) return false;
   if (plant.delay_s > 0.0 && options.robust_samples > 0) {
     if (error) *error = "a robust set with a plant dead time is not supported yet (its draws are undelayed)";
     return false;
