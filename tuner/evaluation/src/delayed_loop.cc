@@ -93,6 +93,13 @@ class ExpCache {
   std::map<double, Eigen::MatrixXd> cache_;
 };
 
+// The stored pieces of one run, reused per thread (cleared by each run).
+std::vector<StoredPiece>& StoredBuffer() {
+  thread_local std::vector<StoredPiece> buffer;
+  buffer.clear();
+  return buffer;
+}
+
 // The method of steps, node to node. Nodes: the regular grid k h, the
 // disturbance's breakpoints, and every stored node + L (so that each piece's
 // delayed interval lies in one stored piece).
@@ -189,7 +196,7 @@ class DelayedIntegrator {
   double h_, tol_;
   bool piecewise_ = false, kicked_ = false;
   double next_break_ = kInf;  // the disturbance's next breakpoint after the current node
-  std::vector<StoredPiece> stored_;
+  std::vector<StoredPiece>& stored_ = StoredBuffer();
   std::size_t source_ = 0;
 };
 

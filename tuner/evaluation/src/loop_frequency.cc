@@ -78,8 +78,11 @@ bool CountContinuousNyquist(const TransferFunction& tf, const PidGains& g, doubl
   }
   if (!(hi > 0.0)) lo = hi = 1.0;
   const std::vector<double> base = frequency::Grid(1e-3 * lo, 1e3 * hi, points_per_decade, special);
-  std::vector<double> w = base;
-  std::vector<Point> pts;
+  // Reused per thread: the tuner counts once per evaluation, and a fresh
+  // grid of large vectors each time costs more in page faults than the count.
+  thread_local std::vector<double> w;
+  thread_local std::vector<Point> pts;
+  w = base;
   if (delay_s > 0.0) {
     double w_top = 0.0;
     if (!frequency::DelayGrid(r, base, &w, &pts, &w_top, error)) return false;
