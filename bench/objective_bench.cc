@@ -79,6 +79,47 @@ void BM_PaperObjectiveSampled(benchmark::State& state) {
 }
 BENCHMARK(BM_PaperObjectiveSampled)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
+// Dead time (docs/deadtime.md): one evaluation of the objective on the same
+// plant, 1/(s+1)^2 under the PI (0.5, 0.3), with and without L = 0.5 s, in
+// the sampled loop (dt = 1e-3, the target: within 2x) and in the
+// continuous loop (the fast path without delay, the method of steps with
+// it). Arg: 0 = no delay, 1 = L = 0.5 s.
+pidlab::Plant Sopdt(double delay_s) {
+  pidlab::Plant p;
+  p.name = "custom";
+  p.tf = pidlab::TransferFunction{{1.0}, {1.0, 2.0, 1.0}};
+  p.delay_s = delay_s;
+  return p;
+}
+
+void BM_DelaySampled(benchmark::State& state) {
+  pidlab::evaluation::LoopOptions options;
+  options.loop = pidlab::evaluation::LoopKind::kSampled;
+  options.pid = PidOptionsAt(options.pid, options.dt_s);
+  const pidlab::evaluation::ObjectiveEvaluator dut(Sopdt(state.range(0) ? 0.5 : 0.0), options,
+                                                   pidlab::evaluation::ObjectiveKind::kIae);
+  for (auto _ : state) {
+    const double iae = dut({0.5, 0.3, 0.0});
+    benchmark::DoNotOptimize(&iae);
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(state.range(0) ? "L=0.5 dt=1e-3" : "L=0 dt=1e-3");
+}
+BENCHMARK(BM_DelaySampled)->DenseRange(0, 1)->Unit(benchmark::kMicrosecond);
+
+void BM_DelayContinuous(benchmark::State& state) {
+  const pidlab::evaluation::ObjectiveEvaluator dut(Sopdt(state.range(0) ? 0.5 : 0.0),
+                                                   pidlab::evaluation::LoopOptions{},
+                                                   pidlab::evaluation::ObjectiveKind::kIae);
+  for (auto _ : state) {
+    const double iae = dut({0.5, 0.3, 0.0});
+    benchmark::DoNotOptimize(&iae);
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(state.range(0) ? "L=0.5 method of steps" : "L=0 fast path");
+}
+BENCHMARK(BM_DelayContinuous)->DenseRange(0, 1)->Unit(benchmark::kMicrosecond);
+
 // A whole default tune (4-start Nelder-Mead on the paper's objective plus the
 // Ceres cross-check): the "well under a second" per plant.
 void BM_TuneDefault(benchmark::State& state) {

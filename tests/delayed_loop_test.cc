@@ -1,6 +1,7 @@
 // The sampled loop with a plant dead time G(s) e^(-sL) (docs/deadtime.md, "In
 // every loop"): the loop runs the plant's exact delayed step, its stability
-// gate sees the stored inputs, and what is not supported yet is refused.
+// gate sees the stored inputs, and what is not supported yet is refused; the
+// continuous loop with dead time is evaluated (tests/delayed_continuous_test.cc).
 
 #include <gtest/gtest.h>
 
@@ -165,18 +166,24 @@ TEST(DelayedSampledLoop, GainMarginOfTheSampledLoopIsItsUltimateGain) {
   EXPECT_NEAR(dut.gain_margin, ku, 1e-4 * ku);
 }
 
-TEST(DelayedLoop, ContinuousLoopWithDeadTimeIsRefusedAsInvalidInput) {
-  LoopOptions o;  // continuous
+TEST(DelayedLoop, ContinuousLoopWithDeadTimeIsEvaluatedAndItsNeutralCaseRefused) {
+  LoopOptions o;  // continuous: the method of steps (delayed_loop.h)
   Evaluation ev;
-  const auto status = EvaluateLoop(Fopdt(0.3), {1.0, 1.0, 0.0}, o, EvaluateOptions{}, &ev);
+  ASSERT_TRUE(EvaluateLoop(Fopdt(0.3), {1.0, 1.0, 0.0}, o, EvaluateOptions{}, &ev).ok());
+  EXPECT_TRUE(ev.stability.stable);
+  EXPECT_TRUE(std::isfinite(ev.iae));
+  const ObjectiveEvaluator objective(Fopdt(0.3), o, ObjectiveKind::kIae);
+  EXPECT_NEAR(objective({1.0, 1.0, 0.0}), ev.iae, 1e-12 * ev.iae);
+  EXPECT_NEAR(LoadIntegralAbsError(Fopdt(0.3), {1.0, 1.0, 0.0}, o), ev.load_iae, 1e-12 * ev.load_iae);
+  // An ideal derivative on a plant of relative degree 1: a neutral loop.
+  const auto status = EvaluateLoop(Fopdt(0.3), {1.0, 1.0, 0.1}, o, EvaluateOptions{}, &ev);
   EXPECT_EQ(status.code(), StatusCode::kInvalidInput);
-  EXPECT_NE(status.message().find("delay 0.3 s: the continuous loop with dead time is not supported yet"),
-            std::string::npos)
-      << status.message();
-  EXPECT_THROW(ObjectiveEvaluator(Fopdt(0.3), o, ObjectiveKind::kIae), std::invalid_argument);
-  EXPECT_TRUE(std::isnan(LoadIntegralAbsError(Fopdt(0.3), {1.0, 1.0, 0.0}, o)));
-  // The continuous loop's analysis is in the frequency domain, exact with the
-  // dead time (tests/loop_delay_test.cc): it is not refused.
+  EXPECT_NE(status.message().find("derivative filter"), std::string::npos) << status.message();
+  EXPECT_TRUE(std::isinf(objective({1.0, 1.0, 0.1})));
+  // Past the ultimate gain the Nyquist count says unstable: +inf, not a number.
+  ASSERT_TRUE(EvaluateLoop(Fopdt(1.0), {2.3, 0.0, 0.0}, o, EvaluateOptions{}, &ev).ok());
+  EXPECT_FALSE(ev.stability.stable);
+  EXPECT_TRUE(std::isinf(ev.iae));
   LoopAnalysis analysis;
   std::string error;
   EXPECT_TRUE(AnalyzeLoop(Fopdt(0.3), {1.0, 1.0, 0.0}, o, LoopAnalysisOptions{}, &analysis, &error)) << error;

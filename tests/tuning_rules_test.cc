@@ -298,13 +298,21 @@ TEST(TuningRules, TuneEvaluatesTheRulesGainsOnceWithoutCeres) {
   EXPECT_NEAR(dut.tuning_rule.model.delay_s, 0.1, 1e-9);
 }
 
-TEST(TuningRules, TuneScoresARuleOnADelayedPlantInTheSampledLoopAndRefusesTheContinuousOne) {
+TEST(TuningRules, TuneScoresARuleOnADelayedPlantInBothLoops) {
   TuneOptions o;
   o.method = TuneMethod::kAmigo;
   TuneSummary dut;
   std::string error;
+  // Continuous: the method of steps; the rule's ideal derivative on this plant
+  // of relative degree 1 would make the loop neutral, so it needs a filter.
   EXPECT_FALSE(Tune(UnitFopdt(), o, &dut, &error));
-  EXPECT_NE(error.find("continuous loop with dead time"), std::string::npos) << error;
+  EXPECT_NE(error.find("derivative filter"), std::string::npos) << error;
+  o.loop.derivative_filter_ratio = 10.0;
+  ASSERT_TRUE(Tune(UnitFopdt(), o, &dut, &error)) << error;
+  EXPECT_NEAR(dut.gains.kp, 0.65, 1e-9);
+  EXPECT_TRUE(std::isfinite(dut.objective));
+  EXPECT_EQ(dut.tuning_rule.plant_delay_s, 1.0);
+  o.loop.derivative_filter_ratio = 0.0;
   o.loop.loop = evaluation::LoopKind::kSampled;
   o.loop.dt_s = 0.01;
   // The stored inputs add closed-loop poles whose s-plane images the tuner's

@@ -380,8 +380,12 @@ std::string FormatEvaluation(const Evaluation& ev) {
        << ev.options.disturbance.amplitude << ", period " << ev.options.disturbance.period_s
        << " s, at the plant input\n";
   os << "stable           " << (ev.stability.stable ? "yes" : "NO (objectives are +inf)") << "\n";
-  os << "closed-loop poles " << (ev.options.loop == LoopKind::kSampled ? "(z) " : "(s) ")
-     << FormatPoles(ev.stability.poles) << "\n";
+  if (ev.options.loop == LoopKind::kContinuous && ev.plant.delay_s > 0.0)
+    os << "closed-loop poles (s) infinitely many (dead time " << ev.plant.delay_s
+       << " s): stability by the Nyquist count, the response by the method of steps\n";
+  else
+    os << "closed-loop poles " << (ev.options.loop == LoopKind::kSampled ? "(z) " : "(s) ")
+       << FormatPoles(ev.stability.poles) << "\n";
   os << "IAE (eq. 4)      " << num(ev.iae) << "\n";
   if (ev.options.reference != 1.0) os << "IAE / A          " << num(ev.iae_per_unit) << "\n";
   if (ev.options.disturbance.kind != DisturbanceKind::kNone)

@@ -27,6 +27,19 @@ assert j['method'] == 'simc' and j['evaluations'] == 1 and j['refine']['verdict'
 assert j['stable'] is True and j['iae'] > 0 and j['spec']['rule'] == 'pi' and j['spec']['method'] == 'simc'
 PY"
 
+# A plant with dead time on the continuous loop (docs/tuning.md "Dead time", the documented command):
+# AMIGO PI for T = L = 1 gives K = 0.25, scored by the method of steps, delay_simulated true.
+"$pidlab" tune --num 1 --den 1,1 --delay 1 --method amigo --rule pi --json > "$tmp/delay.json" 2>"$tmp/err"
+check "tune --delay 1 --method amigo --rule pi on the continuous loop exits 0" "[ $? -eq 0 ]"
+check "amigo pi on e^(-s)/(s+1): K = 0.25, evaluated on the continuous loop with its delay" "python3 - \"$tmp/delay.json\" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+r = j['tuning_rule']
+assert abs(j['gains']['kp'] - 0.25) < 1e-9, j['gains']
+assert r['evaluated_on'] == 'continuous' and r['delay_simulated'] is True, r
+assert j['stable'] is True and j['iae'] > 0 and j['spec']['delay'] == 1, j
+PY"
+
 # (s + 1)^3: FOPDT T = 1 + 1/2 = 1.5, L = 1/2 + 1 = 1.5, so T = L as in
 # Astrom and Hagglund's K = 1, T = L = 1 case: AMIGO PID K = 0.65,
 # Ti = 1.2/1.1 L, Td = 0.5 L / 1.3.

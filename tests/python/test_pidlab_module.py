@@ -91,9 +91,11 @@ class Evaluate(unittest.TestCase):
         self.assertNotEqual(got["iae"], pidlab.evaluate("custom", (1, 1, 0), num=[1], den=[1, 1],
                                                         loop="sampled")["iae"])
 
-    def test_a_dead_time_on_the_continuous_loop_is_refused_naming_delay(self):
-        with self.assertRaisesRegex(ValueError, "delay 0.3 s: the continuous loop with dead time"):
-            pidlab.evaluate("custom", (1, 1, 0), num=[1], den=[1, 1], delay=0.3)
+    def test_a_dead_time_on_the_continuous_loop_is_evaluated_and_a_bad_one_refused(self):
+        got = pidlab.evaluate("custom", (1, 1, 0), num=[1], den=[1, 1], delay=0.3)
+        self.assertTrue(got["stable"])
+        with self.assertRaisesRegex(ValueError, "derivative filter"):
+            pidlab.evaluate("custom", (1, 1, 0.1), num=[1], den=[1, 1], delay=0.3)
         with self.assertRaisesRegex(ValueError, "delay -1"):
             pidlab.evaluate("custom", (1, 1, 0), num=[1], den=[1, 1], loop="sampled", delay=-1)
 

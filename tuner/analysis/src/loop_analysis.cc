@@ -14,6 +14,7 @@
 namespace pidlab::analysis {
 namespace {
 
+using evaluation::frequency::OpenLoopFrequencies;
 using loop_internal::cd;
 using loop_internal::ContinuousResponse;
 using loop_internal::CountEncirclements;
@@ -202,14 +203,6 @@ void SetPeaks(const Response& response, const std::vector<double>& w, const std:
 }
 
 // The frequencies of the open-loop poles and zeros of r, and 1/L.
-std::vector<double> OpenLoopFrequencies(const ContinuousResponse& r) {
-  std::vector<double> special;
-  if (r.delay() > 0.0) special.push_back(1.0 / r.delay());
-  for (const auto& v : {PolynomialRoots(r.a()), PolynomialRoots(r.b())})
-    for (double w : SpecialFrequencies(v)) special.push_back(w);
-  return special;
-}
-
 // The continuous loop with dead time: the open-loop features and 1/L on the
 // analysis grid, e^{-jwL} resolved below the band's top, stability by the
 // Nyquist count, crossovers within the band, peaks without the Hamiltonian
@@ -311,19 +304,7 @@ bool CountNyquist(const Plant& plant, const PidGains& typed_gains, const evaluat
   continuous.loop = evaluation::LoopKind::kContinuous;
   const LoopAnalysisOptions ao;
   if (!CheckAnalysisInputs(plant, typed_gains, continuous, ao, &g, error)) return false;
-  const ContinuousResponse r(plant.tf, g, plant.delay_s);
-  const std::vector<double> base = AnalysisGrid(OpenLoopFrequencies(r), continuous, ao);
-  std::vector<double> w = base;
-  std::vector<Point> pts;
-  if (plant.delay_s > 0.0) {
-    double w_top = 0.0;
-    if (!DelayGrid(r, base, &w, &pts, &w_top, error)) return false;
-  } else {
-    pts.resize(w.size());
-    for (std::size_t i = 0; i < w.size(); ++i) pts[i] = r.At(w[i]);
-  }
-  *count = CountEncirclements(r, w, pts);
-  return true;
+  return evaluation::CountContinuousNyquist(plant.tf, g, plant.delay_s, ao.points_per_decade, count, error);
 }
 
 bool LoopFrequencyResponse(const Plant& plant, const PidGains& typed_gains,

@@ -29,21 +29,6 @@ double GoldenMax(const std::function<double(double)>& f, double a, double b, dou
 
 }  // namespace
 
-// Log grid over [lo, hi] merged with the special frequencies inside it.
-std::vector<double> Grid(double lo, double hi, double per_decade, const std::vector<double>& special) {
-  std::vector<double> w;
-  const double decades = std::log10(hi / lo);
-  const int n = std::max(2, static_cast<int>(std::ceil(decades * per_decade)) + 1);
-  for (int i = 0; i < n; ++i) w.push_back(lo * std::pow(10.0, decades * i / (n - 1)));
-  w.back() = hi;
-  for (double s : special)
-    for (double f : {1.0 - 1e-3, 1.0, 1.0 + 1e-3})
-      if (s * f > lo && s * f < hi) w.push_back(s * f);
-  std::sort(w.begin(), w.end());
-  w.erase(std::unique(w.begin(), w.end()), w.end());
-  return w;
-}
-
 // The grid's largest value, refined at every local maximum when `refine`
 // (only at those above `refine_above`).
 double PeakOnGrid(const Response& r, const std::vector<double>& w, const std::vector<Point>& pts, Peak which,
@@ -88,15 +73,6 @@ double PeakOnGrid(const Response& r, const std::vector<double>& w, const std::ve
 }
 
 // Every frequency a narrow feature can sit at.
-std::vector<double> SpecialFrequencies(const std::vector<cd>& roots) {
-  std::vector<double> w;
-  for (const cd& p : roots) {
-    if (std::abs(p) > 0.0 && std::isfinite(std::abs(p))) w.push_back(std::abs(p));
-    if (std::abs(p.imag()) > 0.0 && std::isfinite(p.imag())) w.push_back(std::abs(p.imag()));
-  }
-  return w;
-}
-
 }  // namespace loop_internal
 
 namespace {
@@ -136,23 +112,6 @@ void RealizeRatio(const Polynomial& num_in, const Polynomial& den_in, Eigen::Mat
 }
 
 }  // namespace
-
-void ContinuousPidPolynomials(const PidGains& g, Polynomial* num, Polynomial* den) {
-  const bool d = g.kd > 0.0, filtered = d && g.tf > 0.0, integral = g.ki > 0.0;
-  if (filtered) {
-    // (kp + kd/tf) - (kd/tf)/(tf s + 1) + ki/s over s (tf s + 1).
-    *num = integral ? Polynomial{g.kp * g.tf + g.kd, g.kp + g.ki * g.tf, g.ki}
-                    : Polynomial{g.kp * g.tf + g.kd, g.kp};
-    *den = integral ? Polynomial{g.tf, 1.0, 0.0} : Polynomial{g.tf, 1.0};
-  } else if (d) {
-    *num = integral ? Polynomial{g.kd, g.kp, g.ki} : Polynomial{g.kd, g.kp};
-    *den = integral ? Polynomial{1.0, 0.0} : Polynomial{1.0};
-  } else {
-    *num = integral ? Polynomial{g.kp, g.ki} : Polynomial{g.kp};
-    *den = integral ? Polynomial{1.0, 0.0} : Polynomial{1.0};
-  }
-  *num = Trim(*num);
-}
 
 double HinfNormBruinsmaSteinbuch(const Polynomial& num, const Polynomial& den, double gamma_lower,
                                  double w_lower, double tol, double* w_peak) {

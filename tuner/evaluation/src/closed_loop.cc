@@ -161,11 +161,10 @@ bool DelayIsValid(const Plant& plant, const LoopOptions& o, const std::string& n
     os << name << " " << l << " s must be >= 0, finite and at most " << kMaxDelaySeconds << " s";
   else if (l == 0.0)
     return true;
-  else if (o.loop != LoopKind::kSampled)
-    os << name << " " << l << " s: the continuous loop with dead time is not supported yet (use the sampled "
-       << "loop)";
   else if (plant.nonlinear)
     os << name << " " << l << " s: plant " << plant.name << " with dead time is not supported yet";
+  else if (o.loop == LoopKind::kContinuous)
+    return true;  // the method of steps (delayed_loop.h); a neutral loop is refused with the gains
   else if (!(o.dt_s > 0.0) || !std::isfinite(o.dt_s))
     os << "dt " << o.dt_s << " s must be positive and finite";
   else if (l / o.dt_s > 2.0 * static_cast<double>(kMaxAnalysedDelaySteps) ||

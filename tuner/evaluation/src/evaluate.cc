@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "evaluation_internal.h"
+#include "pidlab/evaluation/delayed_loop.h"
 #include "pidlab/evaluation/evaluation.h"
 
 namespace pidlab::evaluation {
@@ -85,6 +86,9 @@ Status CheckLoop(const Plant& plant, const PidGains& typed_gains, const LoopOpti
   if (plant.tf.RelativeDegree() < 1)
     return Status::InvalidInput("plant " + plant.tf.ToString() + " must be strictly proper");
   if (!DelayIsValid(plant, options, "delay", &error)) return Status::InvalidInput(error);
+  if (options.loop == LoopKind::kContinuous && plant.delay_s > 0.0 &&
+      !DelayedLoopIsRetarded(plant.tf, *gains, &error))
+    return Status::InvalidInput(error);
   if (plant.nonlinear && options.loop != LoopKind::kSampled)
     return Status::InvalidInput("plant " + plant.name +
                                 " is nonlinear: the exact continuous loop applies to linear plants only, use "
@@ -109,6 +113,7 @@ void StartEvaluation(const Plant& plant, const PidGains& gains, const LoopOption
 // integral of |e| and stepinfo.
 Status EvaluateContinuous(const Plant& plant, const PidGains& gains, const LoopOptions& options,
                           const EvaluateOptions& what, Evaluation* ev) {
+  if (plant.delay_s > 0.0) return internal::EvaluateDelayedContinuous(plant, gains, options, what, ev);
   const Disturbance disturbance(options.disturbance), none(DisturbanceOptions{});
   const StateSpace ss = Realize(plant.tf);
   const double a = options.reference, ts = options.sample_time_s;
@@ -186,6 +191,10 @@ void FinishScores(const Plant& plant, const PidGains& gains, const LoopOptions& 
       options.loop == LoopKind::kSampled ? std::make_unique<DiscretePlant>(SampledPlant(plant, options.dt_s))
                                          : nullptr;
   // The load response of a linear plant; a nonlinear plant's is not computed (NaN).
+  if (options.loop == LoopKind::kContinuous && plant.delay_s > 0.0) {
+    ev->load_iae = internal::DelayedLoadIae(plant, gains, options);
+    return;
+  }
   ev->load_iae = plant.nonlinear ? std::numeric_limits<double>::quiet_NaN()
                                  : internal::LoadIaeOfStableLoop(Realize(plant.tf), discrete.get(), gains,
                                                                  options, Disturbance(UnitLoadStep()));

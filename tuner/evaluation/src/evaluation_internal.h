@@ -13,3 +13,23 @@ double LoadIaeOfStableLoop(const StateSpace& realization, const DiscretePlant* d
                            const PidGains& gains, const LoopOptions& options, const Disturbance& step);
 
 }  // namespace pidlab::evaluation::internal
+
+namespace pidlab::evaluation::internal {
+
+/// The continuous loop with dead time (evaluate_delayed.cc): its stability by
+/// the Nyquist count (no poles, abscissa NaN; kInvalidInput when e^(-jwL)
+/// cannot be resolved),
+Status DelayedStability(const Plant& plant, const PidGains& loop_gains, Stability* s);
+/// y at the samples, the undisturbed IAE, the integral of |e| over the nodes
+/// and stepinfo of the undisturbed response on the nodes, into *ev (a stable
+/// loop; +inf scores are FinishScores' for an unstable one),
+Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& loop_gains, const LoopOptions& options,
+                                 const EvaluateOptions& what, Evaluation* ev);
+/// sum_m |y_L(m ts)| of its load response (r = 0, a unit step at the plant
+/// input, delayed with the control),
+double DelayedLoadIae(const Plant& plant, const PidGains& loop_gains, const LoopOptions& options);
+/// and the tuner's objective: +inf for an unstable or neutral loop.
+double DelayedContinuousObjective(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
+                                  double load_weight, const PidGains& loop_gains);
+
+}  // namespace pidlab::evaluation::internal

@@ -192,7 +192,7 @@ bool FastContinuousObjective::Covers(const TransferFunction& tf, const LoopOptio
 
 bool FastContinuousObjective::CoversPlant(const Plant& plant, const LoopOptions& options,
                                           ObjectiveKind kind) {
-  return !plant.nonlinear && Covers(plant.tf, options, kind);
+  return !plant.nonlinear && plant.delay_s == 0.0 && Covers(plant.tf, options, kind);
 }
 
 FastContinuousObjective::FastContinuousObjective(const TransferFunction& tf, const StateSpace& realization,

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "evaluation_internal.h"
+#include "pidlab/evaluation/delayed_loop.h"
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/evaluation/fast_objective.h"
 #include "pidlab/optim/golden_section.h"
@@ -433,6 +434,12 @@ double LoadIntegralAbsError(const Plant& plant, const PidGains& typed_gains, con
   // response here: NaN, not a number of the undelayed plant.
   if (!DelayIsValid(plant, options, "delay", nullptr)) return std::numeric_limits<double>::quiet_NaN();
   const PidGains gains = LoopGains(typed_gains, options);
+  if (options.loop == LoopKind::kContinuous && plant.delay_s > 0.0) {
+    Stability s;
+    if (!DelayedLoopIsRetarded(plant.tf, gains, nullptr)) return std::numeric_limits<double>::quiet_NaN();
+    if (!internal::DelayedStability(plant, gains, &s).ok() || !s.stable) return kInf;
+    return internal::DelayedLoadIae(plant, gains, options);
+  }
   const StateSpace realization = Realize(plant.tf);
   ContinuousClosedLoop<double> loop;
   if (!BuildContinuousClosedLoop<double>(realization, gains, Disturbance(DisturbanceOptions{}), &loop,
@@ -504,6 +511,8 @@ double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {
   thread_local std::vector<double> y;  // reused: no allocation per evaluation
   const PidGains gains = LoopGains(typed_gains, options_);
   if (!GainsAreValid(gains, nullptr)) return kInf;
+  if (options_.loop == LoopKind::kContinuous && plant_.delay_s > 0.0)  // the exact path, not the fast one
+    return internal::DelayedContinuousObjective(plant_, options_, kind_, load_weight_, gains);
   const double ts = options_.sample_time_s;
   if (kind_ == ObjectiveKind::kLoadIae || kind_ == ObjectiveKind::kSetpointLoad) {
     // The poles do not depend on r or n: one stability test for both responses.

@@ -167,7 +167,10 @@ void Judge(const TuneOptions& options, const PidGains& refined, double f, double
 namespace {
 
 // Why the cross-check cannot run from `start_objective` ("" when it can).
-std::string WhyNotRun(const TuneOptions& options, double start_objective) {
+std::string WhyNotRun(const Plant& plant, const TuneOptions& options, double start_objective) {
+  if (options.loop.loop == evaluation::LoopKind::kContinuous && plant.delay_s > 0.0)
+    return "not run: the continuous loop with dead time has no templated (differentiable) path; the "
+           "search's result stands";
   if (options.objective == evaluation::ObjectiveKind::kIaeContinuous)
     return "not run: iae-continuous has no sample least-squares form";
   if (options.objective == evaluation::ObjectiveKind::kLoadIae ||
@@ -193,7 +196,7 @@ RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, co
   RefineSummary summary;
   summary.gains = start;
   summary.objective = start_objective;
-  summary.message = WhyNotRun(options, start_objective);
+  summary.message = WhyNotRun(plant, options, start_objective);
   if (!summary.message.empty()) return summary;
   PidGains refined;
   const double f = SolveAndEvaluate(plant, options, start, &refined, &summary);
@@ -213,7 +216,7 @@ RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options,
   const double f_search = start_objectives[0];
   summary.gains = starts[0];
   summary.objective = f_search;
-  summary.message = WhyNotRun(options, f_search);
+  summary.message = WhyNotRun(plant, options, f_search);
   if (!summary.message.empty()) return summary;
   // Every run from its start; the lowest finite exact objective wins (ties:
   // the earlier start), its termination and iterations are reported.

@@ -212,7 +212,9 @@ bool MeetsBounds(const Plant& plant, const StateSpace& realization, const TuneOp
                  const PidGains& typed) {
   if (!options.bounds.Any()) return true;
   const PidGains g = evaluation::LoopGains(typed, options.loop);
-  if (options.loop.loop == evaluation::LoopKind::kContinuous) {
+  // With dead time the continuous loop's bounds come from the frequency-domain
+  // analysis (e^(-jwL) exact, the Nyquist count), as the sampled loop's.
+  if (options.loop.loop == evaluation::LoopKind::kContinuous && plant.delay_s == 0.0) {
     evaluation::ContinuousClosedLoop<double> loop;
     if (!evaluation::BuildContinuousClosedLoop<double>(realization, g, Disturbance(DisturbanceOptions{}),
                                                        &loop, nullptr))
@@ -307,8 +309,9 @@ void RuleResult(const PidGains& g, const evaluation::ObjectiveEvaluator& evaluat
 }
 
 // SIMC or AMIGO into summary->tuning_rule and summary->optimizer. False with
-// *error where the rule does not apply. A plant with a dead time reaches this
-// only in the sampled loop (Tune checks DelayIsValid), which simulates it.
+// *error where the rule does not apply. A plant's dead time is simulated in
+// both loops (the sampled loop's stored inputs, the continuous loop's method
+// of steps), so delay_simulated is true on either.
 bool RuleSearch(const Plant& plant, const TuneOptions& options,
                 const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary, std::string* error) {
   const TuningRule rule = options.method == TuneMethod::kSimc ? TuningRule::kSimc : TuningRule::kAmigo;
@@ -441,6 +444,23 @@ void RefineSearchResult(const Plant& plant, const TuneOptions& options, const op
   }
 }
 
+// A rule's PID with an ideal derivative on a plant of relative degree 1 with
+// a dead time is a neutral continuous loop (delayed_loop.h): refused up front
+// rather than scored +inf.
+bool RuleLoopIsRetarded(const Plant& plant, const TuneOptions& options, std::string* error) {
+  const bool rule = options.method == TuneMethod::kSimc || options.method == TuneMethod::kAmigo;
+  if (!rule || options.rule != RuleForm::kPid || options.loop.loop != evaluation::LoopKind::kContinuous ||
+      !(plant.delay_s > 0.0) || plant.tf.RelativeDegree() != 1 ||
+      options.loop.derivative_filter_ratio > 0.0 || options.loop.pid.derivative_filter_s > 0.0)
+    return true;
+  if (error)
+    *error =
+        "--rule pid's ideal derivative on a plant of relative degree 1 with a dead time makes the "
+        "continuous loop of neutral type: give a derivative filter (--derivative-filter or "
+        "--derivative-filter-ratio)";
+  return false;
+}
+
 }  // namespace
 
 bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
@@ -453,6 +473,7 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
           "undelayed plant): use another method";
     return false;
   }
+  if (!RuleLoopIsRetarded(plant, options, error)) return false;
   if (plant.delay_s > 0.0 && options.robust_samples > 0) {
     if (error) *error = "a robust set with a plant dead time is not supported yet (its draws are undelayed)";
     return false;

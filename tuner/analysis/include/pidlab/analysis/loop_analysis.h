@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "pidlab/evaluation/closed_loop.h"
+#include "pidlab/evaluation/loop_frequency.h"
 
 namespace pidlab::analysis {
 
@@ -98,24 +99,9 @@ struct LoopAnalysis {
   std::string method;
 };
 
-/// The Nyquist criterion for the continuous loop (with its dead time): Z = N + P
-/// closed-loop poles in the open right half-plane, N the clockwise
-/// encirclements of -1 by L(jw), w from -inf to inf, P the open-loop poles in
-/// the open right half-plane; open-loop poles on the imaginary axis (the
-/// integrators, the oscillator's +-j) are passed on the right by small
-/// semicircles.
-struct NyquistCount {
-  /// False when 1 + L(jw) comes within 1e-12 of 0 (a pole on the axis) or the
-  /// count is not an integer to 0.1: then stable is false.
-  bool decided = false;
-  bool stable = false;
-  int open_loop_rhp_poles = 0;    // P
-  int open_loop_axis_poles = 0;   // on the imaginary axis, with multiplicity
-  int encirclements = 0;          // N, clockwise
-  int closed_loop_rhp_poles = 0;  // Z = N + P
-  double winding_turns = 0.0;     // -N before rounding
-  std::string note;
-};
+/// The Nyquist count (pidlab/evaluation/loop_frequency.h, where the evaluation
+/// of the delayed loop needs it).
+using evaluation::NyquistCount;
 
 /// The Nyquist count of the continuous loop of `plant` (with plant.delay_s)
 /// with `gains` (LoopGains of `options`). False with *error for invalid input,
@@ -178,9 +164,8 @@ bool ContinuousLoopMeetsBounds(const TransferFunction& plant, const PidGains& lo
 
 /// Polynomials in descending powers.
 using Polynomial = std::vector<double>;
-/// The reduced controller C = num/den of the continuous PID (no factor
-/// common to both: ki = 0 drops the integrator, kd = 0 the filter).
-void ContinuousPidPolynomials(const PidGains& loop_gains, Polynomial* num, Polynomial* den);
+/// The reduced controller C = num/den of the continuous PID (loop_frequency.h).
+using evaluation::ContinuousPidPolynomials;
 /// The H-infinity norm of the stable num/den (deg num <= deg den) by the
 /// Bruinsma-Steinbuch iteration from the lower bound `gamma_lower`; the
 /// frequency of the peak in *w_peak (+inf if at infinity). Relative accuracy `tol`.

@@ -1,4 +1,4 @@
-// The continuous loop with dead time (loop_analysis.h, docs/deadtime.md):
+// The continuous loop with dead time (loop_frequency.h, docs/deadtime.md):
 // the grid on which e^{-jwL} is resolved, and the Nyquist count of
 // encirclements of -1 by L(jw) with the open-loop poles on the imaginary axis
 // indented.
@@ -7,10 +7,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "loop_response.h"
+#include "pidlab/evaluation/loop_frequency.h"
 
-namespace pidlab::analysis {
-namespace loop_internal {
+namespace pidlab::evaluation::frequency {
 namespace {
 
 // The largest turn of e^{-jwL} between neighbours of the delay grid.
@@ -211,5 +210,4 @@ NyquistCount CountEncirclements(const ContinuousResponse& r, const std::vector<d
   return n;
 }
 
-}  // namespace loop_internal
-}  // namespace pidlab::analysis
+}  // namespace pidlab::evaluation::frequency
