@@ -43,7 +43,8 @@ check "the table: a row per plant and the summary line" \
   "[ \$(grep -c '^P9 ' $tmp/table) -eq 10 ] && grep -q 'AMIGO feasible' $tmp/table && grep -q 'at_bounds' $tmp/table"
 
 # --loop continuous: the delay-free P4 is scored on the exact continuous loop;
-# a plant with dead time says why it is not (until that loop takes a delay).
+# a plant with dead time says why it is not (the method of steps is too slow
+# for the batch's searches).
 "$pidlab" batch --families P4,P6 --loop continuous --json > "$tmp/cont.json" 2> "$tmp/err"
 check "batch --loop continuous scores P4 and names why P6 is not scored" "python3 - $tmp/cont.json <<'PY'
 import json, sys
