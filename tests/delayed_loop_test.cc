@@ -6,6 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
+#include <iostream>
+#include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -105,6 +109,75 @@ TEST(DelayedSampledStability, LoopMatrixHoldsTheStoredInputs) {
   // n + d + 4: 1 + 0 + 4 and 1 + 13 + 4.
   EXPECT_EQ(undelayed.poles.size(), 5u);
   EXPECT_EQ(delayed.poles.size(), 18u);
+}
+
+// How far the eigenvalue verdict is from turning: the smallest slack of the
+// criterion Re p < -m max(1, min(|p|, pi / L)) over the poles, relative to
+// max(1, |p|). Loops within rounding of the boundary are not compared.
+double SmallestSlack(const pidlab::evaluation::Stability& s, double dt, double margin, double delay) {
+  const double cap = pidlab::evaluation::DelayedMarginModulus(delay);
+  double slack = std::numeric_limits<double>::infinity();
+  for (const auto& z : s.poles) {
+    if (std::abs(z) == 0.0) continue;
+    const std::complex<double> p = std::log(z) / dt;
+    const double c = p.real() + margin * std::max(1.0, std::min(std::abs(p), cap));
+    slack = std::min(slack, std::abs(c) / std::max(1.0, std::abs(p)));
+  }
+  return slack;
+}
+
+TEST(DelayedSampledStability, CountOnTheMarginsContourAgreesWithTheEigenvaluesOnRandomLoops) {
+  // Plants with lags, an integrator, a right-half-plane zero, a lightly damped
+  // pair, poles on the imaginary axis and a double integrator; random gains,
+  // filters, integral methods, margins, dt and delays of 24 to 400 stored
+  // inputs (the split fraction random too).
+  const std::vector<TransferFunction> plants = {
+      {{1.0}, {1.0, 1.0}},           {{1.0}, {1.0, 2.0, 1.0}},        {{1.0}, {1.0, 1.0, 0.0}},
+      {{1.0}, {1.0, 0.4, 1.0}},      {{-0.5, 1.0}, {2.0, 3.0, 1.0}},  {{1.0}, {1.0, 0.0, 1.0}},
+      {{1.0}, {1.0, 0.0, 0.0}},      {{2.0}, {1.0, 3.0, 3.0, 1.0}}};
+  const double dts[] = {1e-3, 4e-3, 0.01, 0.02};
+  const double margins[] = {1e-9, 0.01, 0.1};
+  const pidlab::IntegralMethod methods[] = {pidlab::IntegralMethod::kBackwardEuler,
+                                            pidlab::IntegralMethod::kForwardEuler,
+                                            pidlab::IntegralMethod::kTrapezoidal};
+  std::mt19937_64 rng(20261124);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto log_uniform = [&](double lo, double hi) { return lo * std::pow(hi / lo, unit(rng)); };
+  int stable = 0, unstable = 0, compared = 0, decided = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    Plant plant;
+    plant.name = "custom";
+    plant.tf = plants[trial % plants.size()];
+    const double dt = dts[rng() % 4];
+    const long d = (trial % 20 == 0) ? 300 + static_cast<long>(rng() % 101) : 24 + static_cast<long>(rng() % 130);
+    plant.delay_s = (static_cast<double>(d) - unit(rng)) * dt;
+    const double margin = margins[rng() % 3];
+    LoopOptions o = Sampled(dt);
+    PidOptions pid = o.Pid();
+    pid.integral = methods[rng() % 3];
+    const double scale = 1.0 / std::max(plant.delay_s, 0.05);
+    PidGains g{log_uniform(0.01, 2.0) * scale, unit(rng) < 0.3 ? 0.0 : log_uniform(0.001, 1.0) * scale,
+               unit(rng) < 0.4 ? 0.0 : log_uniform(0.001, 0.5) * scale};
+    if (g.kd > 0.0 && unit(rng) < 0.7) g.tf = log_uniform(dt, 20.0 * dt);
+    const pidlab::DiscretePlant discrete = SampledPlant(plant, dt);
+    ASSERT_EQ(discrete.delay_steps(), d) << "trial " << trial;
+    const auto eig = SampledStability(discrete, g, pid, margin);
+    const auto counted = pidlab::evaluation::CountedSampledStability(discrete, g, pid, margin);
+    decided += counted ? 1 : 0;
+    EXPECT_EQ(pidlab::evaluation::SampledLoopIsStable(discrete, g, pid, margin), eig.stable) << "trial " << trial;
+    if (!counted || SmallestSlack(eig, dt, margin, plant.delay_s) < 1e-6) continue;
+    ++compared;
+    (eig.stable ? stable : unstable) += 1;
+    EXPECT_EQ(*counted, eig.stable) << "trial " << trial << ": plant " << trial % plants.size() << ", dt " << dt
+                                    << ", d " << d << ", margin " << margin << ", gains " << g.kp << " " << g.ki
+                                    << " " << g.kd << " tf " << g.tf;
+  }
+  std::cout << "count decided " << decided << " of 400 loops; compared " << compared << ": " << stable
+            << " stable, " << unstable << " unstable\n";
+  EXPECT_GE(decided, 390) << "the count decides nearly every loop itself";
+  EXPECT_GE(compared, 380);
+  EXPECT_GE(stable, 60) << "both verdicts are exercised";
+  EXPECT_GE(unstable, 60);
 }
 
 TEST(DelayedSampledLoop, RunsThePlantsOwnDelayedStepBitForBit) {

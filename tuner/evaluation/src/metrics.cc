@@ -449,7 +449,7 @@ double LoadIntegralAbsError(const Plant& plant, const PidGains& typed_gains, con
   if (options.loop == LoopKind::kSampled) {
     discrete = std::make_unique<DiscretePlant>(SampledPlant(plant, options.dt_s));
     PidOptions pid = options.Pid();
-    if (!SampledStability(*discrete, gains, pid, options.stability_margin).stable) return kInf;
+    if (!SampledLoopIsStable(*discrete, gains, pid, options.stability_margin)) return kInf;
   } else if (!ContinuousStability(loop, options.stability_margin).stable) {
     return kInf;
   }
@@ -525,7 +525,7 @@ double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {
       if (stable && kind_ == ObjectiveKind::kSetpointLoad)
         SampleContinuousLoop<double>(loop, disturbance_, ts, options_.NumSamples(), &y);
     } else {
-      stable = SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable;
+      stable = SampledLoopIsStable(*discrete_, gains, options_.pid, options_.stability_margin);
       if (stable && kind_ == ObjectiveKind::kSetpointLoad &&
           RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(),
                                  options_.StepsPerSample(), &y, nullptr,
@@ -542,7 +542,7 @@ double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {
   if (fast_ && gains.tf == 0.0) return (*fast_)(gains);
   if (options_.loop == LoopKind::kContinuous)
     return GeneralContinuousObjective(realization_, disturbance_, options_, kind_, gains);
-  if (!SampledStability(*discrete_, gains, options_.pid, options_.stability_margin).stable) return kInf;
+  if (!SampledLoopIsStable(*discrete_, gains, options_.pid, options_.stability_margin)) return kInf;
   if (runner_ || kind_ == ObjectiveKind::kIaeContinuous || plant_.nonlinear) {
     if (plant_.nonlinear && !runner_) {
       std::string error;

@@ -57,7 +57,7 @@ struct ErrorResiduals {
       evaluation::SampleContinuousLoop<T>(cl, disturbance, ts, loop->NumSamples(), &y);
     } else {
       PidOptions pid = loop->Pid();
-      if (!evaluation::SampledStability(*discrete, gd, pid, loop->stability_margin).stable) return false;
+      if (!evaluation::SampledLoopIsStable(*discrete, gd, pid, loop->stability_margin)) return false;
       if (evaluation::RunSampledLoop<T>(*discrete, g, pid, disturbance, loop->TotalSteps(),
                                         loop->StepsPerSample(), &y, nullptr,
                                         loop->reference) == PidStatus::kInvalidInput)

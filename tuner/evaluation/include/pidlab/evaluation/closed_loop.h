@@ -22,6 +22,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -418,5 +419,27 @@ inline double DelayedMarginModulus(double delay_s) {
 /// Re p < -margin max(1, min(|p|, DelayedMarginModulus(L))), p = log(z) / dt.
 Stability SampledStability(const DiscretePlant& plant, const PidGains& gains, const PidOptions& options,
                            double margin);
+
+/// From this many stored inputs on, SampledLoopIsStable counts instead of
+/// solving the (n + d + 4)-square eigenvalue problem.
+inline constexpr long kCountedStabilityFromSteps = 24;
+
+/// SampledStability's verdict without the poles, for the tuner's gate. With
+/// d >= kCountedStabilityFromSteps stored inputs, by the argument principle:
+/// z^-d det(zI - M) = det(zI - A) - z^-d u adj(zI - A) (Gamma1 + z Gamma0)
+/// for the loop A without its delay line; its winding along the margin's
+/// contour (|z| = e^{sigma_b dt}, where the criterion turns; a grid of three
+/// points a turn of z^-d and 100 a decade of the angle towards z = 1,
+/// bisected where the argument turns by more than 0.4 pi) is n + 4 iff all
+/// n + d + 4 poles lie inside. O(d (n + 4)^3)
+/// instead of O((n + d)^3). Where the count cannot decide (a closed-loop pole
+/// on the contour), the eigenvalues do.
+bool SampledLoopIsStable(const DiscretePlant& plant, const PidGains& gains, const PidOptions& options,
+                         double margin);
+
+/// The count alone: nullopt where it cannot decide (a margin outside
+/// [0, 1), a zero of det(zI - M) on the contour, a bisection too deep).
+std::optional<bool> CountedSampledStability(const DiscretePlant& plant, const PidGains& gains,
+                                            const PidOptions& options, double margin);
 
 }  // namespace pidlab::evaluation
