@@ -132,9 +132,9 @@ TEST(DelayedSampledStability, CountOnTheMarginsContourAgreesWithTheEigenvaluesOn
   // filters, integral methods, margins, dt and delays of 24 to 400 stored
   // inputs (the split fraction random too).
   const std::vector<TransferFunction> plants = {
-      {{1.0}, {1.0, 1.0}},           {{1.0}, {1.0, 2.0, 1.0}},        {{1.0}, {1.0, 1.0, 0.0}},
-      {{1.0}, {1.0, 0.4, 1.0}},      {{-0.5, 1.0}, {2.0, 3.0, 1.0}},  {{1.0}, {1.0, 0.0, 1.0}},
-      {{1.0}, {1.0, 0.0, 0.0}},      {{2.0}, {1.0, 3.0, 3.0, 1.0}}};
+      {{1.0}, {1.0, 1.0}},      {{1.0}, {1.0, 2.0, 1.0}},       {{1.0}, {1.0, 1.0, 0.0}},
+      {{1.0}, {1.0, 0.4, 1.0}}, {{-0.5, 1.0}, {2.0, 3.0, 1.0}}, {{1.0}, {1.0, 0.0, 1.0}},
+      {{1.0}, {1.0, 0.0, 0.0}}, {{2.0}, {1.0, 3.0, 3.0, 1.0}}};
   const double dts[] = {1e-3, 4e-3, 0.01, 0.02};
   const double margins[] = {1e-9, 0.01, 0.1};
   const pidlab::IntegralMethod methods[] = {pidlab::IntegralMethod::kBackwardEuler,
@@ -149,7 +149,8 @@ TEST(DelayedSampledStability, CountOnTheMarginsContourAgreesWithTheEigenvaluesOn
     plant.name = "custom";
     plant.tf = plants[trial % plants.size()];
     const double dt = dts[rng() % 4];
-    const long d = (trial % 20 == 0) ? 300 + static_cast<long>(rng() % 101) : 24 + static_cast<long>(rng() % 130);
+    const long d =
+        (trial % 20 == 0) ? 300 + static_cast<long>(rng() % 101) : 24 + static_cast<long>(rng() % 130);
     plant.delay_s = (static_cast<double>(d) - unit(rng)) * dt;
     const double margin = margins[rng() % 3];
     LoopOptions o = Sampled(dt);
@@ -164,13 +165,14 @@ TEST(DelayedSampledStability, CountOnTheMarginsContourAgreesWithTheEigenvaluesOn
     const auto eig = SampledStability(discrete, g, pid, margin);
     const auto counted = pidlab::evaluation::CountedSampledStability(discrete, g, pid, margin);
     decided += counted ? 1 : 0;
-    EXPECT_EQ(pidlab::evaluation::SampledLoopIsStable(discrete, g, pid, margin), eig.stable) << "trial " << trial;
+    EXPECT_EQ(pidlab::evaluation::SampledLoopIsStable(discrete, g, pid, margin), eig.stable)
+        << "trial " << trial;
     if (!counted || SmallestSlack(eig, dt, margin, plant.delay_s) < 1e-6) continue;
     ++compared;
     (eig.stable ? stable : unstable) += 1;
-    EXPECT_EQ(*counted, eig.stable) << "trial " << trial << ": plant " << trial % plants.size() << ", dt " << dt
-                                    << ", d " << d << ", margin " << margin << ", gains " << g.kp << " " << g.ki
-                                    << " " << g.kd << " tf " << g.tf;
+    EXPECT_EQ(*counted, eig.stable) << "trial " << trial << ": plant " << trial % plants.size() << ", dt "
+                                    << dt << ", d " << d << ", margin " << margin << ", gains " << g.kp << " "
+                                    << g.ki << " " << g.kd << " tf " << g.tf;
   }
   std::cout << "count decided " << decided << " of 400 loops; compared " << compared << ": " << stable
             << " stable, " << unstable << " unstable\n";

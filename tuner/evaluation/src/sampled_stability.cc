@@ -24,8 +24,8 @@ struct ControllerRows {
   Eigen::RowVectorXd e, i, d, u;
 };
 
-ControllerRows MakeControllerRows(const DiscretePlant& plant, const PidGains& g, const PidOptions& o, int size,
-                                  int c0) {
+ControllerRows MakeControllerRows(const DiscretePlant& plant, const PidGains& g, const PidOptions& o,
+                                  int size, int c0) {
   const int n = plant.order();
   const int ii = c0, id = c0 + 1, iep = c0 + 2, isp = c0 + 3;
   const double dt = o.dt_s, tf = EffectiveDerivativeFilter(g, o);
@@ -182,7 +182,8 @@ class LoopFunction {
       ux += u_(i) * x[static_cast<std::size_t>(i)];
     }
     const double turn = static_cast<double>(d_) * theta;  // z^-d = r^-d e^{-j d theta}
-    const cd zbeta = std::exp(-static_cast<double>(d_) * log_r) * cd(std::cos(turn), -std::sin(turn)) * det * ux;
+    const cd zbeta =
+        std::exp(-static_cast<double>(d_) * log_r) * cd(std::cos(turn), -std::sin(turn)) * det * ux;
     *scale2 = std::norm(det) + std::norm(zbeta);
     return det - zbeta;
   }
@@ -234,8 +235,8 @@ const std::vector<double>& ContourGrid(int turns, double dt, double margin) {
 
 }  // namespace
 
-std::optional<bool> CountedSampledStability(const DiscretePlant& plant, const PidGains& g, const PidOptions& o,
-                                            double margin) {
+std::optional<bool> CountedSampledStability(const DiscretePlant& plant, const PidGains& g,
+                                            const PidOptions& o, double margin) {
   if (!(margin >= 0.0) || !(margin < 1.0)) return std::nullopt;
   const int n = plant.order();
   const int d = static_cast<int>(plant.delay_steps());
