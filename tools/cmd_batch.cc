@@ -15,6 +15,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "pidlab/json/batch_json.h"
 #include "pidlab/plot/plot.h"
 #include "pidlab/tune/batch.h"
 
@@ -24,91 +25,6 @@ using pidlab::tune::BatchResult;
 
 namespace pidlab::cli {
 namespace {
-
-nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-nlohmann::json GainsJson(const PidGains& g) {
-  return {{"kp", Number(g.kp)}, {"ki", Number(g.ki)}, {"kd", Number(g.kd)}, {"tf", Number(g.tf)}};
-}
-
-nlohmann::json ResultJson(const BatchResult& r) {
-  const tune::ProcessModel& m = r.model;
-  return {{"family", r.plant.family},
-          {"parameter", r.plant.parameter},
-          {"value", r.plant.value},
-          {"label", r.plant.label},
-          {"plant_tf", r.plant.plant.tf.ToString()},
-          {"delay_s", r.plant.plant.delay_s},
-          {"model",
-           {{"kind", tune::ToString(m.kind)},
-            {"gain", m.gain},
-            {"time_constants", m.time_constants},
-            {"delay_s", m.delay_s}}},
-          {"tau", r.tau},
-          {"dt_s", r.dt_s},
-          {"horizon_s", r.horizon_s},
-          {"box", {{"lower", 0.0}, {"upper", r.box_upper}}},
-          {"amigo",
-           {{"k", r.amigo_k},
-            {"ti_s", r.amigo_ti_s},
-            {"td_s", r.amigo_td_s},
-            {"gains", GainsJson(r.amigo_gains)},
-            {"ms", Number(r.amigo_ms)},
-            {"load_iae", Number(r.amigo_load_iae)},
-            {"feasible", r.amigo_feasible}}},
-          {"pidlab",
-           {{"gains", GainsJson(r.gains)},
-            {"ms", Number(r.ms)},
-            {"load_iae", Number(r.load_iae)},
-            {"feasible", r.feasible},
-            {"source", r.source},
-            {"at_bounds", r.at_bounds}}},
-          {"ratio", Number(r.ratio)},
-          {"wall_time_s", r.wall_time_s},
-          {"message", r.message}};
-}
-
-// Wins: pidlab's load IAE below AMIGO's by more than 1e-9 relative; losses:
-// above it, on a plant where AMIGO is feasible.
-struct Tally {
-  int plants = 0, amigo_feasible = 0, pidlab_feasible = 0, wins = 0, ties = 0, losses = 0;
-  double worst_ratio = 0.0, best_ratio = 0.0, max_ms = 0.0;
-};
-
-Tally Count(const std::vector<BatchResult>& results) {
-  Tally t;
-  t.best_ratio = HUGE_VAL;
-  for (const BatchResult& r : results) {
-    ++t.plants;
-    t.amigo_feasible += r.amigo_feasible;
-    t.pidlab_feasible += r.feasible;
-    if (r.feasible) t.max_ms = std::max(t.max_ms, r.ms);
-    if (!r.amigo_feasible || !r.feasible) continue;
-    if (r.ratio < 1.0 - 1e-9)
-      ++t.wins;
-    else if (r.ratio > 1.0 + 1e-9)
-      ++t.losses;
-    else
-      ++t.ties;
-    t.worst_ratio = std::max(t.worst_ratio, r.ratio);
-    t.best_ratio = std::min(t.best_ratio, r.ratio);
-  }
-  if (!std::isfinite(t.best_ratio)) t.best_ratio = t.worst_ratio = NAN;
-  if (t.pidlab_feasible == 0) t.max_ms = NAN;
-  return t;
-}
-
-nlohmann::json TallyJson(const Tally& t) {
-  return {{"plants", t.plants},
-          {"amigo_feasible", t.amigo_feasible},
-          {"pidlab_feasible", t.pidlab_feasible},
-          {"wins", t.wins},
-          {"ties", t.ties},
-          {"losses", t.losses},
-          {"best_ratio", Number(t.best_ratio)},
-          {"worst_ratio", Number(t.worst_ratio)},
-          {"max_ms", Number(t.max_ms)}};
-}
 
 std::string Fixed(double v, int precision = 4) {
   if (!std::isfinite(v)) return "-";
@@ -257,9 +173,9 @@ struct BatchCommand {
                         {"wall_time_s", wall},
                         {"max_ms", options.max_ms},
                         {"filter_ratio", options.filter_ratio},
-                        {"summary", TallyJson(Count(results))},
+                        {"summary", json::BatchTallyJson(tune::TallyBatch(results))},
                         {"plants", nlohmann::json::array()}};
-    for (const BatchResult& r : results) j["plants"].push_back(ResultJson(r));
+    for (const BatchResult& r : results) j["plants"].push_back(json::BatchResultJson(r));
     if (!out_dir.empty()) {
       WriteFile(out_dir + "/batch.json", j.dump(1) + "\n");
       WriteFile(out_dir + "/batch.csv", Csv(results));
@@ -268,7 +184,7 @@ struct BatchCommand {
     if (json) {
       std::cout << j.dump() << "\n";
     } else {
-      const Tally t = Count(results);
+      const tune::BatchTally t = tune::TallyBatch(results);
       std::cout << Table(results) << "\n"
                 << t.plants << " plants, " << loop << " loop, " << used << " jobs, " << Fixed(wall, 3)
                 << " s; AMIGO feasible (Ms <= " << options.max_ms << ") on " << t.amigo_feasible

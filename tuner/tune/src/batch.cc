@@ -249,4 +249,30 @@ Status RunBatch(const std::vector<BatchPlant>& plants, const BatchOptions& optio
   return Status::Ok();
 }
 
+BatchTally TallyBatch(const std::vector<BatchResult>& results) {
+  BatchTally t;
+  double best = std::numeric_limits<double>::infinity(), worst = 0.0, max_ms = 0.0;
+  for (const BatchResult& r : results) {
+    ++t.plants;
+    t.amigo_feasible += r.amigo_feasible ? 1 : 0;
+    t.pidlab_feasible += r.feasible ? 1 : 0;
+    if (r.feasible) max_ms = std::max(max_ms, r.ms);
+    if (!r.amigo_feasible || !r.feasible) continue;
+    if (r.ratio < 1.0 - 1e-9)
+      ++t.wins;
+    else if (r.ratio > 1.0 + 1e-9)
+      ++t.losses;
+    else
+      ++t.ties;
+    worst = std::max(worst, r.ratio);
+    best = std::min(best, r.ratio);
+  }
+  if (std::isfinite(best)) {
+    t.best_ratio = best;
+    t.worst_ratio = worst;
+  }
+  if (t.pidlab_feasible > 0) t.max_ms = max_ms;
+  return t;
+}
+
 }  // namespace pidlab::tune

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -107,5 +108,18 @@ Status RunBatchPlant(const BatchPlant& plant, const BatchOptions& options, Batch
 Status RunBatch(const std::vector<BatchPlant>& plants, const BatchOptions& options,
                 std::vector<BatchResult>* results,
                 const std::function<void(int done, int total)>& progress = nullptr);
+
+/// The batch in a few numbers. On the plants where both AMIGO and pidlab
+/// meet the Ms bound, a win is pidlab's load IAE below AMIGO's by more than
+/// 1e-9 relative, a loss above it, else a tie; the ratios' range over those
+/// plants and pidlab's largest feasible Ms (NaN where there is none).
+struct BatchTally {
+  int plants = 0, amigo_feasible = 0, pidlab_feasible = 0, wins = 0, ties = 0, losses = 0;
+  double best_ratio = std::numeric_limits<double>::quiet_NaN();
+  double worst_ratio = std::numeric_limits<double>::quiet_NaN();
+  double max_ms = std::numeric_limits<double>::quiet_NaN();
+};
+
+BatchTally TallyBatch(const std::vector<BatchResult>& results);
 
 }  // namespace pidlab::tune
