@@ -343,7 +343,7 @@ std::vector<uint8_t> Encode(const Msg& m) {
 
 TEST(DecoderTable, FindsEveryPidlabTypeByItsFingerprint) {
   const DecoderTable table;
-  ASSERT_EQ(table.types().size(), 12u);  // ten types and the two configurations of older logs
+  ASSERT_EQ(table.types().size(), 13u);  // ten types and the three configurations of older logs
   for (const MessageType& t : table.types()) {
     const MessageType* found = table.Find(t.fingerprint);
     ASSERT_NE(found, nullptr) << t.name;

@@ -468,7 +468,9 @@ TEST(Trio, AChirpWithMeasurementNoiseIsBitIdenticalToTheInProcessLoop) {
       ASSERT_TRUE(RunOnMemq(e, 0.05, &rec)) << rec.last.message;
       const std::vector<double> expected = Reference(e);
       ASSERT_EQ(rec.y.size(), expected.size());
-      if (sigma > 0.0) EXPECT_NE(expected[0], 0.0) << "y_0 is measured with noise";
+      if (sigma > 0.0) {
+        EXPECT_NE(expected[0], 0.0) << "y_0 is measured with noise";
+      }
       for (std::size_t k = 0; k < expected.size(); ++k) {
         ASSERT_TRUE(rec.have[k]) << "step " << k;
         ASSERT_EQ(rec.y[k], expected[k]) << "step " << k;
