@@ -441,6 +441,77 @@ TEST(EpisodeConfig, CarriesThePlantsDeadTimeAndRejectsABadOneByName) {
   EXPECT_NE(error.find("delay_s"), std::string::npos) << error;
 }
 
+// An identification experiment on 1/(s^2 + 2 s + 1): a chirp at the plant
+// input, open loop (gains 0) or closed, with noise on the measured y.
+Episode Experiment(bool closed, double sigma) {
+  Episode e;
+  std::string error;
+  EXPECT_TRUE(MakeCustomPlant({1.0}, {1.0, 2.0, 1.0}, &e.plant, &error)) << error;
+  e.gains = closed ? PidGains{2.0, 1.0, 0.5} : PidGains{0.0, 0.0, 0.0};
+  e.options.loop = LoopKind::kSampled;
+  e.options.horizon_s = 2.0;
+  e.options.disturbance.kind = DisturbanceKind::kChirp;
+  e.options.disturbance.amplitude = 0.5;
+  e.options.disturbance.chirp_f0_hz = 0.2;
+  e.options.disturbance.chirp_f1_hz = 20.0;
+  e.options.disturbance.chirp_duration_s = 1.5;
+  e.options.measurement_noise = MeasurementNoise{sigma, 4};
+  return e;
+}
+
+TEST(Trio, AChirpWithMeasurementNoiseIsBitIdenticalToTheInProcessLoop) {
+  for (const bool closed : {false, true}) {
+    for (const double sigma : {0.0, 0.01}) {
+      SCOPED_TRACE(std::string(closed ? "closed" : "open") + " loop, sigma " + std::to_string(sigma));
+      const Episode e = Experiment(closed, sigma);
+      Recorder rec;
+      ASSERT_TRUE(RunOnMemq(e, 0.05, &rec)) << rec.last.message;
+      const std::vector<double> expected = Reference(e);
+      ASSERT_EQ(rec.y.size(), expected.size());
+      if (sigma > 0.0) {
+        EXPECT_NE(expected[0], 0.0) << "y_0 is measured with noise";
+      }
+      for (std::size_t k = 0; k < expected.size(); ++k) {
+        ASSERT_TRUE(rec.have[k]) << "step " << k;
+        ASSERT_EQ(rec.y[k], expected[k]) << "step " << k;
+      }
+    }
+  }
+}
+
+TEST(EpisodeConfig, CarriesTheChirpAndTheMeasurementNoiseAndRejectsBadOnesByName) {
+  const Episode e = Experiment(true, 0.01);
+  const auto msg = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+      7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
+  EXPECT_EQ(msg.disturbance_kind, "chirp");
+  EXPECT_EQ(msg.chirp_f1_hz, 20.0);
+  EXPECT_EQ(msg.measurement_noise, 0.01);
+  EpisodeSpec dut;
+  std::string error;
+  ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
+  EXPECT_EQ(dut.disturbance.chirp_f0_hz, 0.2);
+  EXPECT_EQ(dut.disturbance.chirp_duration_s, 1.5);
+  EXPECT_EQ(dut.measurement_noise.sigma, 0.01);
+  EXPECT_EQ(dut.measurement_noise.seed, 4u);
+  const auto refuse = [&](pidlab::lcmt_episode_config bad, const std::string& name) {
+    EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error)) << name;
+    EXPECT_NE(error.find(name), std::string::npos) << error;
+  };
+  for (const double sigma : {-1.0, std::nan(""), HUGE_VAL}) {
+    auto bad = msg;
+    bad.measurement_noise = sigma;
+    refuse(bad, "measurement noise");
+  }
+  for (const double f1 : {0.1, std::nan(""), 500.0}) {  // below f0, NaN, at Nyquist (dt 1e-3)
+    auto bad = msg;
+    bad.chirp_f1_hz = f1;
+    refuse(bad, "chirp");
+  }
+  auto bad = msg;
+  bad.chirp_duration_s = 0.0;
+  refuse(bad, "chirp duration");
+}
+
 TEST(Trio, RecoversFromDroppedMessagesWithIdenticalResults) {
   const Episode e = DoubleIntegrator();
   Recorder rec;
@@ -545,8 +616,8 @@ TEST(Trio, ThreeIdenticalEpisodesWithASeededDropRateEachReportTheSameResendsAndR
     summary = false;
     const std::size_t plant_seen = plant_lines.size(), controller_seen = controller_lines.size(),
                       disturbance_seen = disturbance_lines.size();
-    auto config = transport::MakeEpisodeConfig(
-        pidlab::episode_client::MakeEpisodeSpec(id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
+    auto config = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
+        id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
     // Three copies at once, as a client resends an unacknowledged one: a role
     // that drops a copy takes the next, before any y_0 (memq:// is FIFO).
     for (int copy = 0; copy < 3; ++copy) client_t.Publish(kEpisodeConfigChannel, &config);

@@ -15,6 +15,7 @@
 #include <pidlab/lcmt_episode_config.hpp>
 #include <pidlab/lcmt_episode_config_v1.hpp>
 #include <pidlab/lcmt_episode_config_v2.hpp>
+#include <pidlab/lcmt_episode_config_v3.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
@@ -67,6 +68,7 @@ TEST(WireLayout, EveryMessageAsEncodedPasses) {
   EXPECT_TRUE(Ok<pidlab::lcmt_episode_config>(Encode(config)));
   EXPECT_TRUE(Ok<pidlab::lcmt_episode_config_v1>(Encode(pidlab::lcmt_episode_config_v1{})));
   EXPECT_TRUE(Ok<pidlab::lcmt_episode_config_v2>(Encode(pidlab::lcmt_episode_config_v2{})));
+  EXPECT_TRUE(Ok<pidlab::lcmt_episode_config_v3>(Encode(pidlab::lcmt_episode_config_v3{})));
   pidlab::lcmt_ready ready{};
   ready.role = "plant";
   ready.detail = "nonce";

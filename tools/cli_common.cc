@@ -375,10 +375,16 @@ std::string FormatEvaluation(const Evaluation& ev) {
      << ev.options.NumSamples() << " samples\n";
   if (ev.options.reference != 1.0)
     os << "reference        step of A = " << ev.options.reference << " (e = A - y)\n";
-  if (ev.options.disturbance.kind != DisturbanceKind::kNone)
-    os << "disturbance      " << ToString(ev.options.disturbance.kind) << " +/-"
-       << ev.options.disturbance.amplitude << ", period " << ev.options.disturbance.period_s
+  const DisturbanceOptions& d = ev.options.disturbance;
+  if (d.kind == DisturbanceKind::kChirp)
+    os << "disturbance      chirp +/-" << d.amplitude << ", " << d.chirp_f0_hz << " to " << d.chirp_f1_hz
+       << " Hz over " << d.chirp_duration_s << " s, at the plant input\n";
+  else if (d.kind != DisturbanceKind::kNone)
+    os << "disturbance      " << ToString(d.kind) << " +/-" << d.amplitude << ", period " << d.period_s
        << " s, at the plant input\n";
+  if (ev.options.measurement_noise.enabled())
+    os << "measured y       y + noise of std deviation " << ev.options.measurement_noise.sigma << " (seed "
+       << ev.options.measurement_noise.seed << "): every score is of the measured y\n";
   os << "stable           " << (ev.stability.stable ? "yes" : "NO (objectives are +inf)") << "\n";
   if (ev.options.loop == LoopKind::kContinuous && ev.plant.delay_s > 0.0)
     os << "closed-loop poles (s) infinitely many (dead time " << ev.plant.delay_s

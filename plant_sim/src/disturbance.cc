@@ -48,6 +48,8 @@ bool ParseDisturbanceKind(const std::string& s, DisturbanceKind* kind) {
     *kind = DisturbanceKind::kNoise;
   else if (s == "prbs")
     *kind = DisturbanceKind::kPrbs;
+  else if (s == "chirp")
+    *kind = DisturbanceKind::kChirp;
   else
     return false;
   return true;
@@ -67,17 +69,19 @@ std::string ToString(DisturbanceKind kind) {
       return "noise";
     case DisturbanceKind::kPrbs:
       return "prbs";
+    case DisturbanceKind::kChirp:
+      return "chirp";
   }
   return "none";
 }
 
 bool DisturbanceOptions::IsValid(std::string* error) const {
   std::ostringstream os;
-  const std::pair<const char*, double> fields[] = {{"disturbance amplitude ", amplitude},
-                                                   {"disturbance period ", period_s},
-                                                   {"disturbance phase ", phase_s},
-                                                   {"disturbance step time ", step_time_s},
-                                                   {"noise hold ", noise_hold_s}};
+  const std::pair<const char*, double> fields[] = {
+      {"disturbance amplitude ", amplitude}, {"disturbance period ", period_s},
+      {"disturbance phase ", phase_s},       {"disturbance step time ", step_time_s},
+      {"noise hold ", noise_hold_s},         {"chirp band f0 ", chirp_f0_hz},
+      {"chirp band f1 ", chirp_f1_hz},       {"chirp duration ", chirp_duration_s}};
   for (const auto& [name, v] : fields) {
     if (std::isfinite(v) && std::abs(v) > kMaxDisturbanceMagnitude) {
       os << name << v << " must be at most " << kMaxDisturbanceMagnitude << " in magnitude";
@@ -100,6 +104,13 @@ bool DisturbanceOptions::IsValid(std::string* error) const {
            !(noise_hold_s > 0.0 && std::isfinite(noise_hold_s)))
     os << (kind == DisturbanceKind::kPrbs ? "prbs clock (noise hold) " : "noise hold ") << noise_hold_s
        << " s must be positive";
+  else if (!std::isfinite(chirp_f0_hz) || !std::isfinite(chirp_f1_hz) || !std::isfinite(chirp_duration_s))
+    os << "chirp band " << chirp_f0_hz << "," << chirp_f1_hz << " Hz and duration " << chirp_duration_s
+       << " s must be finite";
+  else if (kind == DisturbanceKind::kChirp && !(chirp_f0_hz >= 0.0 && chirp_f0_hz < chirp_f1_hz))
+    os << "chirp band " << chirp_f0_hz << "," << chirp_f1_hz << " Hz must have 0 <= F0 < F1";
+  else if (kind == DisturbanceKind::kChirp && !(chirp_duration_s > 0.0))
+    os << "chirp duration " << chirp_duration_s << " s must be positive";
   else
     return true;
   if (error) *error = os.str();
@@ -131,11 +142,20 @@ double Disturbance::Value(double t) const {
       const auto start = static_cast<std::int64_t>(o.seed % static_cast<std::uint64_t>(kPrbsLength));
       return PrbsBit((static_cast<std::int64_t>(k) + start) % kPrbsLength) ? o.amplitude : -o.amplitude;
     }
+    case DisturbanceKind::kChirp: {
+      if (t < 0.0 || t > o.chirp_duration_s) return 0.0;
+      // The phase in cycles from t alone (never accumulated).
+      const double cycles =
+          o.chirp_f0_hz * t + (o.chirp_f1_hz - o.chirp_f0_hz) * t * t / (2.0 * o.chirp_duration_s);
+      return o.amplitude * std::sin(kTwoPi * cycles);
+    }
   }
   return 0.0;
 }
 
-bool Disturbance::IsPiecewiseConstant() const { return options_.kind != DisturbanceKind::kSine; }
+bool Disturbance::IsPiecewiseConstant() const {
+  return options_.kind != DisturbanceKind::kSine && options_.kind != DisturbanceKind::kChirp;
+}
 
 double Disturbance::NextBreakpoint(double t) const {
   const DisturbanceOptions& o = options_;
@@ -143,6 +163,7 @@ double Disturbance::NextBreakpoint(double t) const {
   switch (o.kind) {
     case DisturbanceKind::kNone:
     case DisturbanceKind::kSine:
+    case DisturbanceKind::kChirp:
       return inf;
     case DisturbanceKind::kStep:
       return (o.step_time_s > t + kBreakTolerance) ? o.step_time_s : inf;
@@ -155,6 +176,19 @@ double Disturbance::NextBreakpoint(double t) const {
       return (PieceIndex(t, o.noise_hold_s) + 1.0) * o.noise_hold_s;
   }
   return inf;
+}
+
+bool MeasurementNoise::IsValid(std::string* error) const {
+  if (sigma >= 0.0 && sigma <= kMaxDisturbanceMagnitude) return true;
+  std::ostringstream os;
+  os << "measurement noise " << sigma << " must be >= 0, finite and at most " << kMaxDisturbanceMagnitude;
+  if (error) *error = os.str();
+  return false;
+}
+
+double MeasurementNoise::Value(std::int64_t k) const {
+  if (sigma == 0.0) return 0.0;
+  return sigma * StandardNormal(SplitMix64(seed ^ kMeasurementNoiseStream), k);
 }
 
 bool PrbsBit(std::int64_t i) {

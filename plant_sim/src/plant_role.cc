@@ -126,7 +126,9 @@ void PlantRole::StartEpisode(const EpisodeSpec& spec) {
   ep->u_hist.assign(n + 1, kNaN);
   ep->n_hist.assign(n + 1, kNaN);
   ep->have_n.assign(n + 1, 0);
-  ep->y_hist[0] = ep->Output();
+  // y as the plant reports it: with measurement noise y_k + v_k, the same
+  // function as the in-process loop (MeasurementNoise::Measured).
+  ep->y_hist[0] = spec.measurement_noise.Measured(ep->Output(), 0);
   ep->start_s = ep->step_start_s = ep->stream_last_s = NowSeconds();
   ep->retransmits_at_start = counters_.retransmits;
   ep->dropped_at_start = transport_->counters().dropped;
@@ -283,7 +285,7 @@ void PlantRole::TryAdvance() {
   e.Step(e.u + e.n_hist[k]);
   ++e.k;
   e.have_u = false;
-  e.y_hist[k + 1] = e.Output();
+  e.y_hist[k + 1] = e.spec.measurement_noise.Measured(e.Output(), static_cast<std::int64_t>(k + 1));
   if (e.pacer) e.pacer->WaitForStep(e.k);  // step k starts no earlier than t0 + k dt / factor
   e.step_start_s = NowSeconds();
   e.y_resent = false;

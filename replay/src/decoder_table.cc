@@ -4,6 +4,7 @@
 #include <exception>
 #include <pidlab/lcmt_episode_config_v1.hpp>
 #include <pidlab/lcmt_episode_config_v2.hpp>
+#include <pidlab/lcmt_episode_config_v3.hpp>
 
 #include "pidlab/transport/wire.h"
 
@@ -80,32 +81,56 @@ bool DecodeConfigV1(const uint8_t* data, std::size_t size, PidlabMessage* messag
   return true;
 }
 
+// The motor's fields of lcmt_episode_config_v2 and later into *m.
+template <typename Old>
+void CopyMotorConfig(const Old& o, pidlab::lcmt_episode_config* m) {
+  m->motor_resistance_ohm = o.motor_resistance_ohm;
+  m->motor_self_inductance_h = o.motor_self_inductance_h;
+  m->motor_mutual_inductance_h = o.motor_mutual_inductance_h;
+  m->motor_inertia_kg_m2 = o.motor_inertia_kg_m2;
+  m->motor_rotor_teeth = o.motor_rotor_teeth;
+  m->motor_viscous_friction = o.motor_viscous_friction;
+  m->motor_tooth_pitch_rad = o.motor_tooth_pitch_rad;
+  m->motor_stationary_current_a = o.motor_stationary_current_a;
+  m->motor_flux_linkage = o.motor_flux_linkage;
+  m->motor_detent_torque_nm = o.motor_detent_torque_nm;
+  m->motor_load_torque_nm = o.motor_load_torque_nm;
+  m->motor_load_step_nm = o.motor_load_step_nm;
+  m->motor_load_step_time_s = o.motor_load_step_time_s;
+  m->motor_voltage_limit_v = o.motor_voltage_limit_v;
+  m->motor_input_scale = o.motor_input_scale;
+  m->motor_abs_tolerance = o.motor_abs_tolerance;
+  m->motor_rel_tolerance = o.motor_rel_tolerance;
+  m->motor_drive = o.motor_drive;
+}
+
 // A configuration written before delay_s was appended: read as an
-// lcmt_episode_config without a delay (delay_s 0).
+// lcmt_episode_config without a delay (delay_s 0), chirp or measurement
+// noise.
 bool DecodeConfigV2(const uint8_t* data, std::size_t size, PidlabMessage* message) {
   pidlab::lcmt_episode_config_v2 o{};
   if (!DecodeAs(data, size, &o)) return false;
   pidlab::lcmt_episode_config m{};
   CopyCommonConfig(o, &m);
-  m.motor_resistance_ohm = o.motor_resistance_ohm;
-  m.motor_self_inductance_h = o.motor_self_inductance_h;
-  m.motor_mutual_inductance_h = o.motor_mutual_inductance_h;
-  m.motor_inertia_kg_m2 = o.motor_inertia_kg_m2;
-  m.motor_rotor_teeth = o.motor_rotor_teeth;
-  m.motor_viscous_friction = o.motor_viscous_friction;
-  m.motor_tooth_pitch_rad = o.motor_tooth_pitch_rad;
-  m.motor_stationary_current_a = o.motor_stationary_current_a;
-  m.motor_flux_linkage = o.motor_flux_linkage;
-  m.motor_detent_torque_nm = o.motor_detent_torque_nm;
-  m.motor_load_torque_nm = o.motor_load_torque_nm;
-  m.motor_load_step_nm = o.motor_load_step_nm;
-  m.motor_load_step_time_s = o.motor_load_step_time_s;
-  m.motor_voltage_limit_v = o.motor_voltage_limit_v;
-  m.motor_input_scale = o.motor_input_scale;
-  m.motor_abs_tolerance = o.motor_abs_tolerance;
-  m.motor_rel_tolerance = o.motor_rel_tolerance;
-  m.motor_drive = o.motor_drive;
+  CopyMotorConfig(o, &m);
   m.delay_s = 0.0;
+  *message = std::move(m);
+  return true;
+}
+
+// A configuration written before the chirp's band and the measurement noise
+// were appended: read as an lcmt_episode_config with those 0 (no chirp, no
+// noise on y).
+bool DecodeConfigV3(const uint8_t* data, std::size_t size, PidlabMessage* message) {
+  pidlab::lcmt_episode_config_v3 o{};
+  if (!DecodeAs(data, size, &o)) return false;
+  pidlab::lcmt_episode_config m{};
+  CopyCommonConfig(o, &m);
+  CopyMotorConfig(o, &m);
+  m.delay_s = o.delay_s;
+  m.chirp_f0_hz = m.chirp_f1_hz = m.chirp_duration_s = 0.0;
+  m.measurement_noise = 0.0;
+  m.measurement_noise_seed = 0;
   *message = std::move(m);
   return true;
 }
@@ -133,6 +158,8 @@ DecoderTable::DecoderTable()
                       &DecodeConfigV1},  // older logs
           MessageType{"lcmt_episode_config", "EPISODE_CONFIG", pidlab::lcmt_episode_config_v2::getHash(),
                       &DecodeConfigV2},  // logs written before the plant's dead time
+          MessageType{"lcmt_episode_config", "EPISODE_CONFIG", pidlab::lcmt_episode_config_v3::getHash(),
+                      &DecodeConfigV3},  // logs written before the chirp and the measurement noise
           Type<pidlab::lcmt_ready>("lcmt_ready", "READY"),
           Type<pidlab::lcmt_plant_output>("lcmt_plant_output", "PLANT_OUTPUT"),
           Type<pidlab::lcmt_control_command>("lcmt_control_command", "CONTROL"),

@@ -127,6 +127,28 @@ bad "prbs clock 1e-9" "1e6" \
   evaluate --plant linear --gains 1,1,1 --disturbance prbs --disturbance-amplitude 1 --noise-hold 1e-9
 bad "prbs clock 0" "prbs clock (noise hold) 0 s must be positive" \
   evaluate --plant linear --gains 1,1,1 --disturbance prbs --disturbance-amplitude 1 --noise-hold 0
+chirp() { echo evaluate --plant linear --gains 1,1,1 --loop sampled --disturbance chirp --disturbance-amplitude 1; }
+bad "chirp band F1 at the Nyquist frequency" "--chirp-band 0,500 Hz: F1 must be below the Nyquist frequency" \
+  $(chirp) --chirp-band 0,500
+bad "chirp band F1 above Nyquist at a coarser dt" "--chirp-band 1,60 Hz" $(chirp) --chirp-band 1,60 --dt 0.01
+bad "chirp band F0 >= F1" "--chirp-band 5,5 Hz must have 0 <= F0 < F1" $(chirp) --chirp-band 5,5
+bad "chirp band negative F0" "--chirp-band -1,5 Hz must have 0 <= F0 < F1" $(chirp) --chirp-band -1,5
+bad "chirp band not given" "--chirp-band 0,0 Hz must have 0 <= F0 < F1" $(chirp)
+bad "chirp band nan" "--chirp-band" $(chirp) --chirp-band nan,5
+bad "chirp band 1e13" "--chirp-band" $(chirp) --chirp-band 0,1e13
+bad "chirp duration negative" "--chirp-duration -1 s must be >= 0" $(chirp) --chirp-band 0,5 --chirp-duration -1
+bad "chirp on the continuous loop" "--disturbance 'chirp': the continuous loop cannot integrate a chirp exactly" \
+  evaluate --plant linear --gains 1,1,1 --disturbance chirp --disturbance-amplitude 1 --chirp-band 0,5
+bad "measurement noise negative" "--measurement-noise -0.1 must be >= 0" \
+  evaluate --plant linear --gains 1,1,1 --loop sampled --measurement-noise -0.1
+bad "measurement noise inf" "--measurement-noise" \
+  evaluate --plant linear --gains 1,1,1 --loop sampled --measurement-noise inf
+bad "measurement noise 1e13" "--measurement-noise" \
+  evaluate --plant linear --gains 1,1,1 --loop sampled --measurement-noise 1e13
+bad "measurement noise on the continuous loop" "--measurement-noise 0.01: noise on the measured y needs --loop sampled" \
+  evaluate --plant linear --gains 1,1,1 --measurement-noise 0.01
+bad "measurement noise in tune" "--measurement-noise 0.01: tune does not take measurement noise" \
+  tune --plant linear --loop sampled --measurement-noise 0.01
 bad "tune sampled --dt 1e-5 (5000 x 2.5e6 steps)" "5e9" tune --plant stepper --loop sampled --dt 1e-5
 bad "tune --max-evals 1e8 (1e8 x 501 samples)" "5e9" tune --plant linear --max-evals 100000000
 bad "tune square period 1e-3 (5000 x 5e4 switches)" "5e9" \

@@ -51,6 +51,15 @@ rerun disturbed evaluate --plant linear --gains 29.6558,0.4977,28.3216 --disturb
 rerun filtered evaluate --plant stepper --gains 2.71,30,0.1535 --derivative-filter-ratio 10 --max-ms 1.6
 rerun limited evaluate --num 1 --den 1,0.5,0.1 --gains 1.12,0.23,1.3 --loop sampled --output-limits -2,inf \
   --anti-windup back-calculation --derivative-on measurement
+rerun noisy_chirp evaluate --loop sampled --plant custom --num 1 --den 1,2,1 --gains 0,0,0 --horizon 5 \
+  --disturbance chirp --disturbance-amplitude 0.5 --chirp-band 0.1,5 --measurement-noise 0.01 --seed 3
+/usr/bin/python3 - noisy_chirp.json <<'PY' && pass "noisy_chirp: the spec echoes the chirp and the measurement noise" || fail "noisy_chirp: echo"
+import json, sys
+j = json.load(open(sys.argv[1]))
+s = j["spec"]
+assert s["measurement_noise"] == 0.01 and s["chirp_band"] == [0.1, 5] and s["chirp_duration"] == 0, s
+assert s["disturbance"] == "chirp" and s["seed"] == 3, s
+PY
 rerun delayed evaluate --loop sampled --plant custom --num 1 --den 1,1 --delay 0.3 --gains 1,1,0
 /usr/bin/python3 - delayed.json <<'PY' && pass "delayed: the spec echoes \"delay\": 0.3" || fail "delayed: echo"
 import json, sys

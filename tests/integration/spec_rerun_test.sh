@@ -48,6 +48,20 @@ if same delay_lcm.json delay_local.json backend steps_per_second realtime &&
   pass "a delayed plant over the trio, run again in process from its spec: the same numbers"
 else fail "a delayed plant over the trio and its spec in process differ"; fi
 
+# A closed-loop PRBS experiment with noise on the measured y
+# (docs/identify.md): the spec echoes "measurement_noise", and runs again bit
+# for bit in process.
+run evaluate --backend lcm --plant double_integrator --gains 2,1,1.5 --horizon 5 --disturbance prbs \
+  --disturbance-amplitude 0.2 --noise-hold 0.05 --seed 9 --measurement-noise 0.01 \
+  --json >noisy_lcm.json 2>err || fail "measurement noise over the trio: $(tail -1 err)"
+"$bin/pidlab" evaluate --spec noisy_lcm.json --json >noisy_local.json 2>err ||
+  fail "evaluate --spec (measurement noise): $(tail -1 err)"
+if same noisy_lcm.json noisy_local.json backend steps_per_second realtime &&
+  /usr/bin/python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); assert j["spec"]["measurement_noise"] == 0.01' \
+    noisy_local.json; then
+  pass "measurement noise over the trio, run again in process from its spec: the same numbers"
+else fail "measurement noise over the trio and its spec in process differ"; fi
+
 run tune --backend lcm --loop sampled --plant linear --horizon 5 --max-evals 40 --design-points 16 --refine none \
   --json >tune_lcm.json 2>err || fail "tune over the trio: $(tail -1 err)"
 "$bin/pidlab" tune --spec tune_lcm.json --json >tune_local.json 2>err || fail "tune --spec: $(tail -1 err)"

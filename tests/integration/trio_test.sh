@@ -3,7 +3,7 @@
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
 # ever sent outside its loopback. CASE: identity | faults | drop20 | realtime | kill | sigstop | trios | trio_killed | stranger |
-# log | log_repair | motor | delay.
+# log | log_repair | motor | delay | excite.
 set -u
 BIN=$1
 CASE=$2
@@ -47,6 +47,17 @@ compare() {
   fi
 }
 
+# Identification experiments (docs/identify.md): an open-loop chirp with
+# gains 0, a closed-loop PRBS with noise on the measured y, and a chirp with
+# measurement noise, and the nonlinear motor under a chirp with measurement
+# noise; the plant process adds the noise before publishing y.
+run_experiments() {
+  compare open_loop_chirp --plant custom --num 1 --den 1,2,1 --gains 0,0,0 --horizon 10 --disturbance chirp --disturbance-amplitude 0.5 --chirp-band 0.05,5
+  compare di_prbs_noisy --plant double_integrator --gains 2,1,1.5 --horizon 10 --disturbance prbs --disturbance-amplitude 0.2 --noise-hold 0.05 --seed 9 --measurement-noise 0.01
+  compare chirp_noisy --plant custom --num 1 --den 1,2,1 --gains 0,0,0 --horizon 10 --disturbance chirp --disturbance-amplitude 0.5 --chirp-band 0.1,20 --chirp-duration 8 --measurement-noise 0.01 --seed 4
+  compare motor_noisy --plant stepper_nonlinear --gains 5,10,0.05 --dt 1e-4 --sample-time 0.01 --horizon 0.2 --reference 0.01 --disturbance chirp --disturbance-amplitude 0.05 --chirp-band 1,200 --measurement-noise 0.0005 --seed 2
+}
+
 run_all_plants() {
   compare di_clean --plant double_integrator --gains 2,1,1.5 --horizon 10
   compare di_square --plant double_integrator --gains 2,1,1.5 --horizon 10 --disturbance square --disturbance-amplitude 0.3
@@ -54,6 +65,7 @@ run_all_plants() {
   compare osc_noise --plant oscillator --gains 3,1,1 --horizon 10 --disturbance noise --disturbance-amplitude 0.1 --seed 7
   compare di_prbs --plant double_integrator --gains 2,1,1.5 --horizon 10 --disturbance prbs --disturbance-amplitude 0.2 --noise-hold 0.05 --seed 9
   compare open_loop_prbs --plant custom --num 1 --den 1,2,1 --gains 0,0,0 --horizon 10 --disturbance prbs --disturbance-amplitude 0.5 --noise-hold 0.1 --seed 3
+  run_experiments
   compare stepper_clean --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5
   compare stepper_reference --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --reference 0.0123
   compare stepper_sine --plant stepper_motor --gains 5,10,0.05 --dt 1e-4 --sample-time 0.05 --horizon 0.5 --disturbance sine --disturbance-amplitude 0.5 --disturbance-period 0.2
@@ -61,12 +73,12 @@ run_all_plants() {
 
 case $CASE in
   identity)
-    export -f compare run_all_plants
+    export -f compare run_all_plants run_experiments
     export TMP PIDLAB
     "$PIDLAB" launch --lcm-url "$URL" -- bash -c 'fail=0; run_all_plants; exit $fail' || fail=1
     ;;
   faults)
-    export -f compare run_all_plants
+    export -f compare run_all_plants run_experiments
     export TMP PIDLAB
     "$PIDLAB" launch --lcm-url "$URL" --drop-rate 0.05 -- bash -c 'fail=0; run_all_plants; exit $fail' || fail=1
     ;;
@@ -385,6 +397,55 @@ print(f"ok   replay: {len(iaes)} episodes of delayed plants, each live IAE repro
 PY
     then :; else
       echo "FAIL replay of the delay log: $(head -3 "$TMP/delay.replay.err")"; fail=1
+    fi
+    ;;
+  excite)
+    # Identification experiments (docs/identify.md) on a logged trio: the
+    # open-loop chirp, the closed-loop PRBS with measurement noise and the
+    # chirp with measurement noise, each bit-identical to in process (JSON
+    # and y, u, n of every step); then pidlab replay of the log, which
+    # rebuilds each loop from its logged configuration (the chirp's band and
+    # the measurement noise included), gives each live IAE exactly.
+    export -f compare run_experiments
+    export TMP PIDLAB
+    rm -f "$TMP/excite.lcmlog"
+    "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/excite.lcmlog" -- bash -c 'fail=0; run_experiments; exit $fail' ||
+      fail=1
+    if "$PIDLAB" replay --json "$TMP/excite.lcmlog" >"$TMP/excite.replay.json" 2>"$TMP/excite.replay.err" &&
+      python3 - "$TMP" <<'PY'
+import json, sys
+tmp = sys.argv[1]
+rep = json.load(open(tmp + "/excite.replay.json"))
+assert rep["clean_end"], "log not read cleanly to the end"
+for e in rep["episodes"]:
+    assert e["complete"], e["completeness"]
+iaes = [e["evaluation"]["iae"] for e in rep["episodes"]]
+notes = [e["evaluation"].get("motor_note", "") for e in rep["episodes"]]
+assert not any("differs" in n for n in notes), notes  # the re-driven motor plus v_k is the logged y
+for name in ("open_loop_chirp", "di_prbs_noisy", "chirp_noisy", "motor_noisy"):
+    live = json.load(open(f"{tmp}/{name}.lcm.json"))
+    assert live["iae"] in iaes, (name, live["iae"], iaes)
+noisy = json.load(open(f"{tmp}/chirp_noisy.lcm.json"))["spec"]
+assert noisy["measurement_noise"] == 0.01 and noisy["chirp_band"] == [0.1, 20], noisy
+print(f"ok   replay: {len(iaes)} experiment episodes, each live IAE reproduced exactly")
+PY
+    then :; else
+      echo "FAIL replay of the experiment log: $(head -3 "$TMP/excite.replay.err")"; fail=1
+    fi
+    # docs/identify.md's commands, as written there (pidlab from BIN).
+    docs=$(dirname "${BASH_SOURCE[0]}")/../../docs/identify.md
+    mkdir -p "$TMP/docs"
+    n_docs=0
+    while IFS= read -r cmd; do
+      n_docs=$((n_docs + 1))
+      if ! (cd "$TMP/docs" && PATH="$BIN:$PATH" bash -c "$cmd") >"$TMP/docs/out" 2>&1; then
+        echo "FAIL docs/identify.md: $cmd: $(tail -1 "$TMP/docs/out")"; fail=1
+      fi
+    done < <(awk '/^```sh/{on=1; next} /^```/{on=0} on && /^pidlab /' "$docs")
+    if [ "$n_docs" -eq 3 ] && [ "$(wc -l <"$TMP/docs/chirp.csv")" -ge 10002 ]; then
+      echo "ok   docs/identify.md: its 3 commands run as written, chirp.csv has $(wc -l <"$TMP/docs/chirp.csv") lines"
+    else
+      echo "FAIL docs/identify.md: $n_docs commands, chirp.csv $(wc -l <"$TMP/docs/chirp.csv" 2>&1)"; fail=1
     fi
     ;;
   *)

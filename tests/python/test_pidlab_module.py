@@ -99,6 +99,23 @@ class Evaluate(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "delay -1"):
             pidlab.evaluate("custom", (1, 1, 0), num=[1], den=[1, 1], loop="sampled", delay=-1)
 
+    def test_a_chirp_experiment_with_measurement_noise_equals_the_cli_json(self):
+        got = pidlab.evaluate("custom", (0, 0, 0), num=[1], den=[1, 2, 1], loop="sampled", horizon=5,
+                              disturbance="chirp", disturbance_amplitude=0.5, chirp_band=(0.1, 5),
+                              measurement_noise=0.01, seed=3)
+        want = cli("evaluate", "--loop", "sampled", "--plant", "custom", "--num", "1", "--den", "1,2,1",
+                   "--gains", "0,0,0", "--horizon", "5", "--disturbance", "chirp", "--disturbance-amplitude",
+                   "0.5", "--chirp-band", "0.1,5", "--measurement-noise", "0.01", "--seed", "3")
+        self.assertSameResult(got, want)
+        self.assertEqual(got["spec"]["measurement_noise"], 0.01)
+        self.assertEqual(got["spec"]["chirp_band"], [0.1, 5])
+
+    def test_measurement_noise_is_refused_on_the_continuous_loop_and_when_negative(self):
+        with self.assertRaisesRegex(ValueError, "measurement_noise 0.01: noise on the measured y needs loop"):
+            pidlab.evaluate("linear", (1, 1, 1), measurement_noise=0.01)
+        with self.assertRaisesRegex(ValueError, "measurement_noise -1 must be >= 0"):
+            pidlab.evaluate("linear", (1, 1, 1), loop="sampled", measurement_noise=-1)
+
     def test_bad_input_raises_value_error_naming_the_value(self):
         with self.assertRaisesRegex(ValueError, "nope"):
             pidlab.evaluate("nope", (1, 2, 3))

@@ -24,6 +24,12 @@ bool Fail(const std::string& what, std::string* error) {
   return false;
 }
 
+std::string FormatDouble(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
 }  // namespace
 
 bool RecoveryOptions::IsValid(std::string* error) const {
@@ -73,6 +79,12 @@ bool EpisodeSpec::IsValid(std::string* error) const {
     }
   }
   if (!pid.IsValid(error) || !disturbance.IsValid(error)) return false;
+  std::string why;
+  if (!measurement_noise.IsValid(&why)) return Fail("measurement_noise: " + why, error);
+  if (disturbance.kind == DisturbanceKind::kChirp && !(disturbance.chirp_f1_hz < 0.5 / dt_s))
+    return Fail("chirp_f1_hz " + FormatDouble(disturbance.chirp_f1_hz) +
+                    " Hz is not below the Nyquist frequency 1/(2 dt_s)",
+                error);
   return recovery.IsValid(error);
 }
 
@@ -111,6 +123,11 @@ pidlab::lcmt_episode_config MakeEpisodeConfig(const EpisodeSpec& spec) {
   m.disturbance_step_time_s = d.step_time_s;
   m.noise_hold_s = d.noise_hold_s;
   m.seed = static_cast<int64_t>(d.seed);
+  m.chirp_f0_hz = d.chirp_f0_hz;
+  m.chirp_f1_hz = d.chirp_f1_hz;
+  m.chirp_duration_s = d.chirp_duration_s;
+  m.measurement_noise = spec.measurement_noise.sigma;
+  m.measurement_noise_seed = static_cast<int64_t>(spec.measurement_noise.seed);
   m.retransmit_interval_s = spec.recovery.retransmit_interval_s;
   m.silence_deadline_s = spec.recovery.silence_deadline_s;
   m.motor_resistance_ohm = m.motor_self_inductance_h = m.motor_mutual_inductance_h = 0.0;
@@ -227,6 +244,11 @@ bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec,
   d.step_time_s = m.disturbance_step_time_s;
   d.noise_hold_s = m.noise_hold_s;
   d.seed = static_cast<uint64_t>(m.seed);
+  d.chirp_f0_hz = m.chirp_f0_hz;
+  d.chirp_f1_hz = m.chirp_f1_hz;
+  d.chirp_duration_s = m.chirp_duration_s;
+  s.measurement_noise.sigma = m.measurement_noise;
+  s.measurement_noise.seed = static_cast<uint64_t>(m.measurement_noise_seed);
   s.recovery.retransmit_interval_s = m.retransmit_interval_s;
   s.recovery.silence_deadline_s = m.silence_deadline_s;
   if (!s.IsValid(error)) return false;

@@ -30,6 +30,7 @@ transport::EpisodeSpec MakeEpisodeSpec(int64_t episode_id, const Plant& plant, c
   spec.pid = PidOptionsAt(spec.pid, options.dt_s);
   spec.pid.derivative_filter_s = spec.gains.tf;
   spec.disturbance = disturbance;
+  spec.measurement_noise = options.measurement_noise;
   spec.dt_s = options.dt_s;
   spec.sample_time_s = options.sample_time_s;
   spec.horizon_s = options.horizon_s;
@@ -49,6 +50,7 @@ evaluation::LoopOptions SampledLoopOptions(const transport::EpisodeSpec& spec) {
   o.horizon_s = spec.horizon_s;
   o.pid = spec.pid;
   o.disturbance = spec.disturbance;
+  o.measurement_noise = spec.measurement_noise;
   o.reference = spec.reference;
   return o;
 }

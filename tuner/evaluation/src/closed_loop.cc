@@ -56,8 +56,18 @@ bool LoopOptions::IsValid(std::string* error) const {
        << derivative_filter_ratio << ", not both";
   else if (!(pid.derivative_filter_s >= 0.0) || !std::isfinite(pid.derivative_filter_s))
     os << "derivative filter " << pid.derivative_filter_s << " s must be >= 0 and finite";
-  else if (!disturbance.IsValid(error))
+  else if (!disturbance.IsValid(error) || !measurement_noise.IsValid(error))
     return false;
+  else if (loop == LoopKind::kContinuous && disturbance.kind == DisturbanceKind::kChirp)
+    os << "disturbance chirp: the continuous loop cannot integrate a chirp exactly (its exosystem holds "
+          "constants and sines), use --loop sampled";
+  else if (loop == LoopKind::kContinuous && measurement_noise.enabled())
+    os << "measurement noise " << measurement_noise.sigma
+       << ": noise on the measured y needs the sampled loop, use --loop sampled";
+  else if (loop == LoopKind::kSampled && disturbance.kind == DisturbanceKind::kChirp &&
+           !(disturbance.chirp_f1_hz < 0.5 / dt_s))
+    os << "chirp band " << disturbance.chirp_f0_hz << "," << disturbance.chirp_f1_hz
+       << " Hz: F1 must be below the Nyquist frequency 1/(2 dt) = " << 0.5 / dt_s << " Hz";
   else if (loop == LoopKind::kContinuous && DisturbanceBreakpoints() > kMaxDisturbanceBreakpoints)
     os << "the " << ToString(disturbance.kind) << " disturbance switches " << DisturbanceBreakpoints()
        << " times within the horizon of the continuous loop, more than 1e6: use a longer period or noise "
@@ -95,6 +105,7 @@ double LoopOptions::DisturbanceBreakpoints() const {
       return 1.0;
     case DisturbanceKind::kNone:
     case DisturbanceKind::kSine:
+    case DisturbanceKind::kChirp:
       break;
   }
   return 0.0;
@@ -185,7 +196,8 @@ DiscretePlant SampledPlant(const Plant& plant, double dt_s) {
 PidStatus RunNonlinearSampledLoop(NonlinearStepperPlant* plant, const PidGains& gains,
                                   const PidOptions& pid_options, const Disturbance& disturbance,
                                   long total_steps, int steps_per_sample, std::vector<double>* y_samples,
-                                  std::vector<SampledStep>* trajectory, double reference) {
+                                  std::vector<SampledStep>* trajectory, double reference,
+                                  const MeasurementNoise& noise) {
   DiscretePid<double> pid(gains, pid_options);
   plant->Reset();
   const double dt = pid_options.dt_s;
@@ -193,7 +205,7 @@ PidStatus RunNonlinearSampledLoop(NonlinearStepperPlant* plant, const PidGains& 
   y_samples->reserve(static_cast<std::size_t>(total_steps / steps_per_sample + 1));
   PidStatus status = PidStatus::kOk;
   for (long k = 0;; ++k) {
-    const double y = plant->Output();
+    const double y = noise.Measured(plant->Output(), k);
     if (k % steps_per_sample == 0) y_samples->push_back(y);
     if (k == total_steps) break;
     const double t = static_cast<double>(k) * dt;

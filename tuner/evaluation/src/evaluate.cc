@@ -55,7 +55,9 @@ void ScoreMotor(const Plant& plant, const LoopOptions& options, const SampledRun
   for (const SampledStep& st : run.trajectory) {
     motor.Step(st.u + st.n);
     const auto next = static_cast<std::size_t>(st.k) + 1;
-    if (next < run.y.size() && !(motor.Output() == run.y[next])) ++differ;
+    const double measured =
+        options.measurement_noise.Measured(motor.Output(), static_cast<std::int64_t>(next));
+    if (next < run.y.size() && !(measured == run.y[next])) ++differ;
   }
   JudgeMotor(motor, run.y, options.reference, ev);
   if (differ > 0) {
@@ -221,14 +223,14 @@ bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const Lo
   if (plant.nonlinear) {
     NonlinearStepperPlant motor(*plant.nonlinear, options.dt_s);
     RunNonlinearSampledLoop(&motor, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
-                            trajectory, options.reference);
+                            trajectory, options.reference, options.measurement_noise);
     return true;
   }
   const DiscretePlant discrete = SampledPlant(plant, options.dt_s);
   // A diverged loop (PidStatus::kInvalidInput) is not an error here: its
   // non-finite samples make every objective +inf, as for an unstable loop.
   RunSampledLoop<double>(discrete, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
-                         trajectory, options.reference);
+                         trajectory, options.reference, options.measurement_noise);
   return true;
 }
 
@@ -242,7 +244,7 @@ Status RunSampled(const Plant& plant, const PidGains& gains, const LoopOptions& 
     auto motor = std::make_shared<NonlinearStepperPlant>(*plant.nonlinear, options.dt_s);
     RunNonlinearSampledLoop(motor.get(), gains, options.Pid(), Disturbance(options.disturbance),
                             options.TotalSteps(), 1, &run->y, record_trajectory ? &run->trajectory : nullptr,
-                            options.reference);
+                            options.reference, options.measurement_noise);
     run->motor = std::move(motor);
   } else {
     const SampledRunner& backend = runner ? runner : SampledRunner(RunSampledLoopInProcess);

@@ -169,12 +169,31 @@ bool BuildGains(const std::vector<double>& g, NameStyle style, PidGains* out, st
 
 namespace {
 
+// A chirp's band and duration, named as the caller spells them.
+bool CheckChirp(const spec::LoopSpec& s, NameStyle style, std::string* error) {
+  const auto [f0, f1] = s.chirp_band;
+  const std::string band =
+      spec::DisplayName("chirp_band", style) + " " + spec::FormatNumber(f0) + "," + spec::FormatNumber(f1);
+  if (s.loop != "sampled")
+    return Bad(error, spec::DisplayName("disturbance", style) +
+                          " 'chirp': the continuous loop cannot integrate a chirp exactly, use " +
+                          spec::DisplayName("loop", style) + " sampled");
+  if (!(f0 >= 0.0 && f0 < f1)) return Bad(error, band + " Hz must have 0 <= F0 < F1");
+  if (!(f1 < 0.5 / s.dt_s))
+    return Bad(error, band + " Hz: F1 must be below the Nyquist frequency 1/(2 dt) = " +
+                          spec::FormatNumber(0.5 / s.dt_s) + " Hz");
+  if (!(s.chirp_duration_s >= 0.0))
+    return Bad(error, spec::DisplayName("chirp_duration", style) + " " +
+                          spec::FormatNumber(s.chirp_duration_s) + " s must be >= 0 (0: the horizon)");
+  return true;
+}
+
 bool BuildDisturbance(const spec::LoopSpec& s, NameStyle style, DisturbanceOptions* d, std::string* error) {
   if (s.disturbance.empty()) {
     d->kind = s.disturbance_amplitude != 0.0 ? DisturbanceKind::kSquare : DisturbanceKind::kNone;
   } else if (!ParseDisturbanceKind(s.disturbance, &d->kind)) {
     return Bad(error, spec::DisplayName("disturbance", style) + " " + Quote(s.disturbance) +
-                          " must be none, square, step, sine or noise");
+                          " must be none, square, step, sine, noise, prbs or chirp");
   }
   d->amplitude = s.disturbance_amplitude;
   d->period_s = s.disturbance_period_s;
@@ -182,6 +201,23 @@ bool BuildDisturbance(const spec::LoopSpec& s, NameStyle style, DisturbanceOptio
   d->step_time_s = s.disturbance_step_time_s;
   d->noise_hold_s = s.noise_hold_s;
   d->seed = s.seed;
+  d->chirp_f0_hz = s.chirp_band.first;
+  d->chirp_f1_hz = s.chirp_band.second;
+  d->chirp_duration_s = s.chirp_duration_s == 0.0 ? s.horizon_s : s.chirp_duration_s;
+  return d->kind != DisturbanceKind::kChirp || CheckChirp(s, style, error);
+}
+
+// The measurement noise: sigma >= 0 on the sampled loop, seeded by --seed.
+bool BuildMeasurementNoise(const spec::LoopSpec& s, NameStyle style, MeasurementNoise* noise,
+                           std::string* error) {
+  const std::string name = spec::DisplayName("measurement_noise", style);
+  const std::string value = name + " " + spec::FormatNumber(s.measurement_noise);
+  if (!(s.measurement_noise >= 0.0)) return Bad(error, value + " must be >= 0");
+  if (s.measurement_noise > 0.0 && s.loop != "sampled")
+    return Bad(error,
+               value + ": noise on the measured y needs " + spec::DisplayName("loop", style) + " sampled");
+  noise->sigma = s.measurement_noise;
+  noise->seed = s.seed;
   return true;
 }
 
@@ -216,7 +252,8 @@ bool BuildLoopOptions(const spec::LoopSpec& s, NameStyle style, evaluation::Loop
   o.stability_margin = s.stability_margin;
   o.reference = s.reference;
   o.derivative_filter_ratio = s.derivative_filter_ratio;
-  if (!BuildDisturbance(s, style, &o.disturbance, error) || !BuildPidOptions(s, style, &o.pid, error))
+  if (!BuildDisturbance(s, style, &o.disturbance, error) || !BuildPidOptions(s, style, &o.pid, error) ||
+      !BuildMeasurementNoise(s, style, &o.measurement_noise, error))
     return false;
   o.pid = PidOptionsAt(o.pid, o.dt_s);
   if (!o.IsValid(error)) return false;
@@ -328,6 +365,13 @@ bool BuildTuneOptions(const spec::TuningSpec& s, NameStyle style, TuneOptions* o
       !BuildSearch(s.tune, style, &o, error) || !BuildBounds(s.bounds, style, &o.bounds, error) ||
       !BuildStepperParameters(s.plant, style, &o.stepper, error))
     return false;
+  // The tuner's objective runs the noise-free loop: a noisy y would make the
+  // IAE a random variable the search cannot minimise (evaluate and the trio
+  // take it; docs/identify.md).
+  if (o.loop.measurement_noise.enabled())
+    return Bad(error, spec::DisplayName("measurement_noise", style) + " " +
+                          spec::FormatNumber(s.loop.measurement_noise) +
+                          ": tune does not take measurement noise (evaluate and launch experiments do)");
   o.seed = s.loop.seed;
   if (!o.IsValid(error)) return false;
   *out = o;

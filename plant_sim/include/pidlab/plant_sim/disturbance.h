@@ -7,9 +7,9 @@
 
 namespace pidlab {
 
-enum class DisturbanceKind { kNone, kSquare, kStep, kSine, kNoise, kPrbs };
+enum class DisturbanceKind { kNone, kSquare, kStep, kSine, kNoise, kPrbs, kChirp };
 
-/// Parses none|square|step|sine|noise|prbs.
+/// Parses none|square|step|sine|noise|prbs|chirp.
 bool ParseDisturbanceKind(const std::string& s, DisturbanceKind* kind);
 std::string ToString(DisturbanceKind kind);
 
@@ -36,9 +36,16 @@ struct DisturbanceOptions {
   /// Seed of the noise and of the prbs; the value at t depends only on
   /// (seed, t).
   std::uint64_t seed = 1;
+  /// Chirp: the linear sweep's start and end frequencies in Hz
+  /// (0 <= f0 < f1) and its duration T in s (> 0; the spec's default is
+  /// the horizon).
+  double chirp_f0_hz = 0.0;
+  double chirp_f1_hz = 0.0;
+  double chirp_duration_s = 0.0;
 
   /// Finite amplitude and phase, a positive finite period (square, sine),
-  /// step time >= 0 (step) or hold (noise, prbs), and no finite value beyond
+  /// step time >= 0 (step) or hold (noise, prbs), a band 0 <= f0 < f1 and a
+  /// positive duration (chirp), and no finite value beyond
   /// kMaxDisturbanceMagnitude. Names the offending value on failure.
   bool IsValid(std::string* error) const;
 };
@@ -51,13 +58,19 @@ struct DisturbanceOptions {
 /// bits), +amplitude for a 1 and -amplitude for a 0, bit k held over
 /// [k hold, (k + 1) hold), starting at bit (seed mod 32767) of the sequence
 /// (PrbsBit): an excitation for identification experiments, flat in
-/// spectrum up to about 0.4 / hold Hz.
+/// spectrum up to about 0.4 / hold Hz. The chirp is the linear sweep
+/// amplitude sin(2 pi (f0 t + (f1 - f0) t^2 / (2 T))) for 0 <= t <= T, its
+/// instantaneous frequency f0 + (f1 - f0) t / T, and 0 after T (the
+/// experiment ends with the sweep); its phase is computed from t alone,
+/// never accumulated, so that sample k at t = k dt is the same bits in every
+/// process.
 class Disturbance {
  public:
   explicit Disturbance(const DisturbanceOptions& options);
 
   double Value(double t) const;
-  /// True for none, square, step, noise and prbs: constant between breakpoints.
+  /// True for none, square, step, noise and prbs: constant between
+  /// breakpoints (not sine and chirp).
   bool IsPiecewiseConstant() const;
   /// The first breakpoint strictly after t (+infinity if none). Only for
   /// piecewise-constant signals. Breakpoints closer than 1e-9 s to t count as t.
@@ -78,5 +91,27 @@ inline constexpr std::int64_t kPrbsLength = (std::int64_t{1} << kPrbsOrder) - 1;
 /// Bit i (0 <= i < kPrbsLength) of the maximal-length sequence of
 /// x^15 + x^14 + 1 from the register state 1, computed once.
 bool PrbsBit(std::int64_t i);
+
+/// Seeded Gaussian noise on the measured output: the plant reports
+/// y_k + v_k, v_k = sigma N(0, 1) drawn from (seed, k) by a counter-based
+/// generator (no state: a step sent again or replayed gets the same v_k).
+/// Its stream differs from the noise disturbance's for the same seed: the
+/// draw is the noise disturbance's with the seed SplitMix64(seed ^
+/// kMeasurementNoiseStream).
+struct MeasurementNoise {
+  /// Standard deviation of v_k, in the output's unit; 0 = none.
+  double sigma = 0.0;
+  std::uint64_t seed = 1;
+
+  /// sigma >= 0, finite, at most kMaxDisturbanceMagnitude.
+  bool IsValid(std::string* error) const;
+  bool enabled() const { return sigma != 0.0; }
+  /// v_k (0 when sigma is 0).
+  double Value(std::int64_t k) const;
+  /// y + v_k, or y itself (the same bits) when sigma is 0.
+  double Measured(double y, std::int64_t k) const { return enabled() ? y + Value(k) : y; }
+};
+
+inline constexpr std::uint64_t kMeasurementNoiseStream = 0x6d65617375726564ULL;  // "measured"
 
 }  // namespace pidlab

@@ -113,6 +113,13 @@ struct LoopSpec {
   double disturbance_amplitude = 0.0, disturbance_period_s = 2.0, disturbance_phase_s = 0.0;
   double disturbance_step_time_s = 0.0, noise_hold_s = 0.01;
   std::uint64_t seed = 1;
+  /// Chirp band F0,F1 in Hz ([0, 0]: not given) and duration T in s (0: the
+  /// horizon).
+  std::pair<double, double> chirp_band{0.0, 0.0};
+  double chirp_duration_s = 0.0;
+  /// Standard deviation of the seeded Gaussian noise on the measured y
+  /// (sampled loop; 0 = none).
+  double measurement_noise = 0.0;
   double derivative_filter_s = 0.0, derivative_filter_ratio = 0.0;
   std::pair<double, double> output_limits{-kInf, kInf};
   std::string anti_windup = "clamping", derivative_on = "error", integral = "backward-euler";
@@ -146,13 +153,14 @@ struct LoopSpec {
               "with a dead time L, |p| counts up to pi/L",
               "", kNone, "0.001"},
              &stability_margin);
-    a->Visit(
-        {"disturbance",
-         "none|square|step|sine|noise|prbs at the plant input (default: square if an amplitude is given)", "",
-         kEpisode, R"("sine")"},
-        &disturbance);
-    a->Visit({"disturbance_amplitude", "square and prbs +/-A, step height, sine peak or noise std deviation",
-              "", kEpisode, "0.5"},
+    a->Visit({"disturbance",
+              "none|square|step|sine|noise|prbs|chirp at the plant input (default: square if an amplitude is "
+              "given)",
+              "", kEpisode, R"("sine")"},
+             &disturbance);
+    a->Visit({"disturbance_amplitude",
+              "square and prbs +/-A, step height, sine and chirp peak or noise std deviation", "", kEpisode,
+              "0.5"},
              &disturbance_amplitude);
     a->Visit({"disturbance_period", "square/sine period", "s", kEpisode, "3"}, &disturbance_period_s);
     a->Visit({"disturbance_phase", "time shift of the disturbance", "s", kEpisode, "0.25"},
@@ -162,9 +170,26 @@ struct LoopSpec {
     a->Visit({"noise_hold", "noise is held constant over this interval; the prbs's clock period", "s",
               kEpisode, "0.05"},
              &noise_hold_s);
+    a->Visit({"seed",
+              "seed of the noise and prbs disturbances and of the measurement noise (another stream), and of "
+              "the search, for tune",
+              "", kEpisode, "7"},
+             &seed);
     a->Visit(
-        {"seed", "seed of the noise and prbs disturbances (and of the search, for tune)", "", kEpisode, "7"},
-        &seed);
+        {"chirp_band",
+         "chirp: the linear sweep's start and end frequencies F0,F1, 0 <= F0 < F1 < 1/(2 dt) (sampled loop "
+         "only)",
+         "Hz", kEpisode, "[0.5, 4]"},
+        &chirp_band);
+    a->Visit({"chirp_duration", "chirp: sweep duration T (default 0: the horizon); n = 0 after T", "s",
+              kEpisode, "4"},
+             &chirp_duration_s);
+    a->Visit(
+        {"measurement_noise",
+         "std deviation of seeded Gaussian noise on the measured y (from --seed, sampled loop only): the "
+         "PID, the trajectory and IAE etc. see y + noise",
+         "", kEpisode, "0.01"},
+        &measurement_noise);
     a->Visit({"derivative_filter",
               "derivative filter time constant Tf, both loops: C(s) = kp + ki/s + kd s/(Tf s + 1); 0 = the "
               "paper's ideal PID",

@@ -43,6 +43,8 @@ struct EpisodeSpec {
   /// Discrete PID options; pid.dt_s equals dt_s.
   PidOptions pid;
   DisturbanceOptions disturbance;
+  /// Noise on the measured y: the plant publishes y_k + v_k (sampled loop).
+  MeasurementNoise measurement_noise;
   double dt_s = 1e-3;           // lockstep period, s
   double sample_time_s = 0.05;  // spacing of the objective's samples, s (a multiple of dt_s)
   double horizon_s = 25.0;      // last sample time, s

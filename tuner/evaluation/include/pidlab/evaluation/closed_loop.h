@@ -42,7 +42,7 @@ namespace pidlab::evaluation {
 inline constexpr long kMaxLoopSteps = 50000000;
 /// sample intervals horizon / sample time,
 inline constexpr long kMaxLoopSamples = 10000000;
-/// and switches of a square or noise disturbance within the horizon of the
+/// and switches of a square, noise or prbs disturbance within the horizon of the
 /// continuous loop (each one costs a matrix exponential).
 inline constexpr long kMaxDisturbanceBreakpoints = 1000000;
 /// What one continuous-loop disturbance breakpoint costs in loop steps, for
@@ -83,6 +83,11 @@ struct LoopOptions {
   /// is 1). Every error is e = A - y; step metrics stay relative to the final
   /// value. Finite, nonzero, |A| <= kMaxCoefficientMagnitude.
   double reference = 1.0;
+  /// Seeded Gaussian noise on the measured y (sampled loop only): the PID,
+  /// the run record and every score see y_k + v_k (docs/spec.md). Its seed
+  /// is the spec's seed, kept here apart from disturbance.seed because a run
+  /// without the disturbance (the undisturbed response) keeps the noise.
+  MeasurementNoise measurement_noise;
 
   /// The discrete PID's options at this loop's period (PidOptionsAt).
   PidOptions Pid() const { return PidOptionsAt(pid, dt_s); }
@@ -362,12 +367,14 @@ struct SampledStep {
 /// pidlab-controller answers, and the step is still taken and recorded.
 /// Returns the last PidStatus that was not kOk/kSaturated (kInvalidInput,
 /// the only such status), or kOk; saturation alone is not reported.
-/// `reference` is r_k = A for every k (LoopOptions::reference).
+/// `reference` is r_k = A for every k (LoopOptions::reference). With
+/// `noise` the plant reports y_k + v_k (MeasurementNoise::Measured): the PID,
+/// y_samples and the trajectory see that measured y, as over the trio.
 template <typename T>
 PidStatus RunSampledLoop(const DiscretePlant& plant, const PidGainsT<T>& gains, const PidOptions& pid_options,
                          const Disturbance& disturbance, long total_steps, int steps_per_sample,
                          std::vector<T>* y_samples, std::vector<SampledStep>* trajectory = nullptr,
-                         double reference = 1.0) {
+                         double reference = 1.0, const MeasurementNoise& noise = MeasurementNoise{}) {
   DiscretePid<T> pid(gains, pid_options);
   std::vector<T> x(static_cast<std::size_t>(plant.order()), T(0.0)), next = x;
   InputDelayLine<T> line(plant.delay_steps());  // the plant's dead time (none: the step is ZohStep's)
@@ -376,7 +383,8 @@ PidStatus RunSampledLoop(const DiscretePlant& plant, const PidGainsT<T>& gains, 
   y_samples->reserve(static_cast<std::size_t>(total_steps / steps_per_sample + 1));
   PidStatus status = PidStatus::kOk;
   for (long k = 0;; ++k) {
-    const T y = OutputOf(plant.c(), x);
+    T y = OutputOf(plant.c(), x);
+    if (noise.enabled()) y += T(noise.Value(k));
     if (k % steps_per_sample == 0) y_samples->push_back(y);
     if (k == total_steps) break;
     const double t = static_cast<double>(k) * dt;
@@ -399,7 +407,8 @@ PidStatus RunSampledLoop(const DiscretePlant& plant, const PidGainsT<T>& gains, 
 PidStatus RunNonlinearSampledLoop(NonlinearStepperPlant* plant, const PidGains& gains,
                                   const PidOptions& pid_options, const Disturbance& disturbance,
                                   long total_steps, int steps_per_sample, std::vector<double>* y_samples,
-                                  std::vector<SampledStep>* trajectory, double reference);
+                                  std::vector<SampledStep>* trajectory, double reference,
+                                  const MeasurementNoise& noise = MeasurementNoise{});
 
 /// The largest |p| the stability margin counts for a loop with dead time L:
 /// pi / L (+inf without one). A dead time brings a chain of poles up to
