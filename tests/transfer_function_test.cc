@@ -16,6 +16,7 @@
 #include "pidlab/plant_sim/discrete_plant.h"
 #include "pidlab/plant_sim/matrix_exp.h"
 #include "pidlab/plant_sim/plants.h"
+#include "pidlab/plant_sim/polynomial.h"
 
 namespace pidlab {
 namespace {
@@ -455,4 +456,12 @@ TEST(DiscretePlant, RejectsAnInvalidTransferFunction) {
 }
 
 }  // namespace
+TEST(Polynomial, ProductOfLagsExpandsTheFactors) {
+  // (2s + 1)(s + 1)(0.5s + 1) = s^3 + 3.5 s^2 + 3.5 s + 1.
+  EXPECT_EQ(LagProduct({2.0, 1.0, 0.5}), (std::vector<double>{1.0, 3.5, 3.5, 1.0}));
+  EXPECT_EQ(LagProduct({}), (std::vector<double>{1.0}));
+  EXPECT_EQ(PolynomialProduct({1.0, -2.0}, {1.0, 2.0}), (std::vector<double>{1.0, 0.0, -4.0}));
+  EXPECT_TRUE(PolynomialProduct({}, {1.0}).empty());
+}
+
 }  // namespace pidlab

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/plant_sim/polynomial.h"
 #include "pidlab/tune/tune.h"
 
 using pidlab::tune::AmigoTune;
@@ -32,20 +33,6 @@ namespace pidlab {
 namespace {
 
 constexpr double kTol = 1e-9;
-
-std::vector<double> Multiply(const std::vector<double>& a, const std::vector<double>& b) {
-  std::vector<double> c(a.size() + b.size() - 1, 0.0);
-  for (std::size_t i = 0; i < a.size(); ++i)
-    for (std::size_t j = 0; j < b.size(); ++j) c[i + j] += a[i] * b[j];
-  return c;
-}
-
-// prod (tau s + 1) over `lags`.
-std::vector<double> Lags(const std::vector<double>& lags) {
-  std::vector<double> p{1.0};
-  for (double tau : lags) p = Multiply(p, {tau, 1.0});
-  return p;
-}
 
 Plant MakePlantOrDie(const std::vector<double>& num, const std::vector<double>& den, double delay_s) {
   Plant p;
@@ -119,7 +106,7 @@ TEST(TuningRules, SimcIntegralTimeIsCappedAtFourTimesTauCPlusTheta) {
 // (-0.3 s + 1) e^(-0.5 s) / ((2 s + 1)(s + 1)(0.4 s + 1)), worked by hand:
 // FOPDT: T = 2 + 1/2 = 2.5, L = 0.5 + 1/2 + 0.4 + 0.3 = 1.7;
 // SOPDT: T1 = 2, T2 = 1 + 0.4/2 = 1.2, L = 0.5 + 0.4/2 + 0.3 = 1.0.
-Plant InverseResponsePlant() { return MakePlantOrDie({-0.3, 1.0}, Lags({2.0, 1.0, 0.4}), 0.5); }
+Plant InverseResponsePlant() { return MakePlantOrDie({-0.3, 1.0}, LagProduct({2.0, 1.0, 0.4}), 0.5); }
 
 TEST(TuningRules, HalfRuleReducesAnInverseResponsePlantToFopdt) {
   ProcessModel dut;
@@ -156,7 +143,7 @@ TEST(TuningRules, HalfRuleReducesAnInverseResponsePlantToSopdtForSimcPid) {
 // FOPDT: T = 1 + 0.1 = 1.1, L = 0.1 + 0.04 + 0.008 = 0.148;
 // SOPDT: T1 = 1, T2 = 0.2 + 0.02 = 0.22, L = 0.02 + 0.008 = 0.028.
 TEST(TuningRules, HalfRuleSplitsOnlyTheLargestNeglectedLag) {
-  const Plant plant = MakePlantOrDie({1.0}, Lags({1.0, 0.2, 0.04, 0.008}), 0.0);
+  const Plant plant = MakePlantOrDie({1.0}, LagProduct({1.0, 0.2, 0.04, 0.008}), 0.0);
   ProcessModel fopdt, sopdt;
   ASSERT_TRUE(ReduceModel(plant, TuningRule::kSimc, RuleForm::kPi, &fopdt).ok());
   ASSERT_TRUE(ReduceModel(plant, TuningRule::kSimc, RuleForm::kPid, &sopdt).ok());
@@ -170,18 +157,18 @@ TEST(TuningRules, HalfRuleSplitsOnlyTheLargestNeglectedLag) {
 TEST(TuningRules, ARepeatedRealPoleIsReal) {
   // (s + 1)^3: FOPDT T = 1.5, L = 1.5.
   ProcessModel dut;
-  ASSERT_TRUE(
-      ReduceModel(MakePlantOrDie({1.0}, Lags({1.0, 1.0, 1.0}), 0.0), TuningRule::kAmigo, RuleForm::kPid, &dut)
-          .ok());
+  ASSERT_TRUE(ReduceModel(MakePlantOrDie({1.0}, LagProduct({1.0, 1.0, 1.0}), 0.0), TuningRule::kAmigo,
+                          RuleForm::kPid, &dut)
+                  .ok());
   EXPECT_NEAR(dut.time_constants.at(0), 1.5, 1e-4);
   EXPECT_NEAR(dut.delay_s, 1.5, 1e-4);
 }
 
 TEST(TuningRules, AnExactSopdtIsUsedAsItIsBySimcPid) {
   ProcessModel dut;
-  ASSERT_TRUE(
-      ReduceModel(MakePlantOrDie({3.0}, Lags({4.0, 0.5}), 0.25), TuningRule::kSimc, RuleForm::kPid, &dut)
-          .ok());
+  ASSERT_TRUE(ReduceModel(MakePlantOrDie({3.0}, LagProduct({4.0, 0.5}), 0.25), TuningRule::kSimc,
+                          RuleForm::kPid, &dut)
+                  .ok());
   EXPECT_EQ(dut.kind, ProcessModelKind::kSopdt);
   EXPECT_FALSE(dut.half_rule);
   EXPECT_NEAR(dut.gain, 3.0, 1e-12);
@@ -221,7 +208,7 @@ TEST(TuningRules, IntegratingPlusDeadTimeUsesTheIntegratingRules) {
 
 TEST(TuningRules, SimcPidOnAnIntegratorWithALagPutsTheLagInTauD) {
   // 1 / (s (s + 1)(0.2 s + 1)), no delay: T2 = 1 + 0.1, theta = 0.1.
-  const Plant plant = MakePlantOrDie({1.0}, Multiply({1.0, 0.0}, Lags({1.0, 0.2})), 0.0);
+  const Plant plant = MakePlantOrDie({1.0}, PolynomialProduct({1.0, 0.0}, LagProduct({1.0, 0.2})), 0.0);
   const TuningRuleResult dut = RuleOrDie(plant, TuningRule::kSimc, RuleForm::kPid);
   EXPECT_EQ(dut.model.kind, ProcessModelKind::kIntegrating);
   EXPECT_NEAR(dut.model.time_constants.at(0), 1.1, 1e-9);
@@ -261,8 +248,8 @@ TEST(TuningRules, TheDoubleIntegratorIsRefused) {
 }
 
 TEST(TuningRules, ALeftHalfPlaneZeroIsRefused) {
-  ExpectRefused(MakePlantOrDie({1.0, 2.0}, Lags({1.0, 0.5, 0.1}), 0.1), TuningRule::kSimc, RuleForm::kPid,
-                "(a lead)");
+  ExpectRefused(MakePlantOrDie({1.0, 2.0}, LagProduct({1.0, 0.5, 0.1}), 0.1), TuningRule::kSimc,
+                RuleForm::kPid, "(a lead)");
 }
 
 TEST(TuningRules, ANegativeGainIsRefused) {
@@ -274,13 +261,13 @@ TEST(TuningRules, AModelWithoutDeadTimeIsRefused) {
                 "needs a dead time");
   ExpectRefused(MakePlantOrDie({1.0}, {1.0, 1.0}, 0.0), TuningRule::kAmigo, RuleForm::kPid,
                 "needs a dead time");
-  ExpectRefused(MakePlantOrDie({1.0}, Lags({1.0, 0.2}), 0.0), TuningRule::kSimc, RuleForm::kPid,
+  ExpectRefused(MakePlantOrDie({1.0}, LagProduct({1.0, 0.2}), 0.0), TuningRule::kSimc, RuleForm::kPid,
                 "needs a dead time");
 }
 
 TEST(TuningRules, TuneEvaluatesTheRulesGainsOnceWithoutCeres) {
   // 1 / ((s + 1)(0.2 s + 1)): SIMC PI on T = 1.1, theta = 0.1: Kc = 5.5, tau_I = 0.8.
-  const Plant plant = MakePlantOrDie({1.0}, Lags({1.0, 0.2}), 0.0);
+  const Plant plant = MakePlantOrDie({1.0}, LagProduct({1.0, 0.2}), 0.0);
   TuneOptions o;
   o.method = TuneMethod::kSimc;
   o.rule = RuleForm::kPi;

@@ -4,25 +4,11 @@
 #include <algorithm>
 #include <sstream>
 
+#include "pidlab/plant_sim/polynomial.h"
 #include "pidlab/tune/batch.h"
 
 namespace pidlab::tune {
 namespace {
-
-// a(s) b(s), coefficients in descending powers of s.
-std::vector<double> Multiply(const std::vector<double>& a, const std::vector<double>& b) {
-  std::vector<double> c(a.size() + b.size() - 1, 0.0);
-  for (std::size_t i = 0; i < a.size(); ++i)
-    for (std::size_t j = 0; j < b.size(); ++j) c[i + j] += a[i] * b[j];
-  return c;
-}
-
-// prod (tau s + 1) over `lags`.
-std::vector<double> Lags(const std::vector<double>& lags) {
-  std::vector<double> p{1.0};
-  for (double tau : lags) p = Multiply(p, {tau, 1.0});
-  return p;
-}
 
 std::string Label(const std::string& parameter, double value) {
   std::ostringstream os;
@@ -39,8 +25,8 @@ BatchPlant Make(const std::string& family, const std::string& parameter, double 
   p.value = value;
   p.label = Label(parameter, value);
   std::vector<double> num{f.gain};
-  for (double t0 : f.inverse) num = Multiply(num, {-t0, 1.0});
-  std::vector<double> den = Multiply(Lags(den_lags), extra_den);
+  for (double t0 : f.inverse) num = PolynomialProduct(num, {-t0, 1.0});
+  std::vector<double> den = PolynomialProduct(LagProduct(den_lags), extra_den);
   if (f.integrators == 1) den.push_back(0.0);
   p.plant.name = family + " " + p.label;
   p.plant.tf.num = num;
