@@ -451,4 +451,19 @@ bool SampledLoopIsStable(const DiscretePlant& plant, const PidGains& gains, cons
 std::optional<bool> CountedSampledStability(const DiscretePlant& plant, const PidGains& gains,
                                             const PidOptions& options, double margin);
 
+// The double loops are compiled once (closed_loop_instances.cc), not in
+// every file that runs them; other scalars (Ceres's Jet) instantiate here.
+extern template bool BuildFilteredClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
+                                                     const Disturbance&, ContinuousClosedLoop<double>*,
+                                                     std::string*, double);
+extern template bool BuildContinuousClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
+                                                       const Disturbance&, ContinuousClosedLoop<double>*,
+                                                       std::string*, double);
+extern template void SampleContinuousLoop<double>(const ContinuousClosedLoop<double>&, const Disturbance&,
+                                                  double, int, std::vector<double>*);
+extern template PidStatus RunSampledLoop<double>(const DiscretePlant&, const PidGainsT<double>&,
+                                                 const PidOptions&, const Disturbance&, long, int,
+                                                 std::vector<double>*, std::vector<SampledStep>*, double,
+                                                 const MeasurementNoise&);
+
 }  // namespace pidlab::evaluation
