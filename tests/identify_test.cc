@@ -1,6 +1,8 @@
 // pidlab::identify: process models fitted to a record (docs/identify.md,
 // "Identifying a model from a CSV").
 
+#include "pidlab/identify/identify.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +12,6 @@
 #include <random>
 
 #include "pidlab/identify/csv_data.h"
-#include "pidlab/identify/identify.h"
 
 namespace pidlab::identify {
 namespace {
@@ -86,8 +87,8 @@ TEST_P(NoiseFree, EveryParameterIsRecoveredWithinOnePartInAMillion) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, NoiseFree,
-                         ::testing::Values(ProcessModelKind::kP1D, ProcessModelKind::kP2D, ProcessModelKind::kP2DU,
-                                           ProcessModelKind::kP1DI),
+                         ::testing::Values(ProcessModelKind::kP1D, ProcessModelKind::kP2D,
+                                           ProcessModelKind::kP2DU, ProcessModelKind::kP1DI),
                          [](const auto& name_info) { return std::string(ToString(name_info.param)); });
 
 TEST(Identify, TheMultiStartReportsHowManyStartsReachedTheOptimum) {
@@ -179,7 +180,8 @@ TEST(Identify, BadOptionsAreRefusedNamingTheField) {
   IdentifyOptions options;
   options.starts = 0;
   IdentifyResult result;
-  const Status status = Identify(RecordOf(Truth(ProcessModelKind::kP1D)), ProcessModelKind::kP1D, options, &result);
+  const Status status =
+      Identify(RecordOf(Truth(ProcessModelKind::kP1D)), ProcessModelKind::kP1D, options, &result);
   EXPECT_EQ(status.code(), StatusCode::kInvalidInput);
   EXPECT_NE(status.message().find("starts = 0"), std::string::npos) << status.message();
 }

@@ -58,11 +58,11 @@ std::string Table(const IdentifyResult& r) {
   const TransferFunction tf = r.model.ToTransferFunction();
   os << "fit " << Num(r.fit_percent, 6) << " %, AIC " << Num(r.aic, 6) << " (N log(2 cost / N) + 2 p), cost "
      << Num(r.cost, 4) << "\n"
-     << r.samples << " samples at dt " << Num(r.dt_s) << " s, offsets u0 " << Num(r.u0) << ", y0 " << Num(r.y0)
-     << "\n"
+     << r.samples << " samples at dt " << Num(r.dt_s) << " s, offsets u0 " << Num(r.u0) << ", y0 "
+     << Num(r.y0) << "\n"
      << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)\n"
-     << "num " << Polynomial(tf.num) << " den " << Polynomial(tf.den) << " delay " << Num(r.model.delay_s(), 10)
-     << " s\n";
+     << "num " << Polynomial(tf.num) << " den " << Polynomial(tf.den) << " delay "
+     << Num(r.model.delay_s(), 10) << " s\n";
   return os.str();
 }
 
@@ -78,7 +78,8 @@ struct IdentifyCommand {
         "exact ZOH response with a continuous delay from several starts (docs/identify.md).");
     app->add_option("--csv", csv, "the CSV file with columns t, u, y")->required();
     app->add_option("--model", model, "the model: " + identify::ProcessModelKindNames())->required();
-    app->add_option("--starts", options.starts, "starting points of the multi-start fit")->capture_default_str();
+    app->add_option("--starts", options.starts, "starting points of the multi-start fit")
+        ->capture_default_str();
     app->add_flag("--json", json, "print one JSON object");
     app->add_option("--out", out, "also write the JSON object to this file");
     return [this] { return Run(); };
@@ -95,7 +96,8 @@ struct IdentifyCommand {
     Require(identify::ReadCsvData(csv, &data));
     IdentifyResult result;
     const Status status = identify::Identify(data, kind, options, &result);
-    if (status.code() == StatusCode::kInvalidInput) throw BadInput("--csv " + Quote(csv) + ": " + status.message());
+    if (status.code() == StatusCode::kInvalidInput)
+      throw BadInput("--csv " + Quote(csv) + ": " + status.message());
     Require(status);
     const nlohmann::json j = json::IdentifyResultJson(result);
     if (!out.empty()) {

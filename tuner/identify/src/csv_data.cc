@@ -38,7 +38,8 @@ Status ReadCsvData(const std::string& path, IdentifyData* data) {
   std::ifstream in(path);
   if (!in) return Status::InvalidInput(file + " cannot be read");
   std::string line;
-  if (!std::getline(in, line)) return Status::InvalidInput(file + " is empty: a header naming t, u and y is needed");
+  if (!std::getline(in, line))
+    return Status::InvalidInput(file + " is empty: a header naming t, u and y is needed");
   const std::vector<std::string> header = SplitCells(line);
   const char* const kNames[] = {"t", "u", "y"};
   std::size_t column[3];
@@ -47,8 +48,8 @@ Status ReadCsvData(const std::string& path, IdentifyData* data) {
     for (std::size_t i = 0; i < header.size(); ++i)
       if (header[i] == kNames[c]) column[c] = i;
     if (column[c] == header.size())
-      return Status::InvalidInput(file + ": the header " + spec::Quote(line) + " names no column " + kNames[c] +
-                                  " (t, u and y are needed)");
+      return Status::InvalidInput(file + ": the header " + spec::Quote(line) + " names no column " +
+                                  kNames[c] + " (t, u and y are needed)");
   }
   *data = IdentifyData{};
   std::vector<double>* const series[] = {&data->t, &data->u, &data->y};

@@ -46,14 +46,16 @@ bool IsLogParameter(ProcessModelKind kind, int i) {
 ProcessModel ModelOf(ProcessModelKind kind, const double* theta) {
   const int p = ParameterCount(kind);
   std::vector<double> values(static_cast<std::size_t>(p));
-  for (int i = 0; i < p; ++i) values[static_cast<std::size_t>(i)] = IsLogParameter(kind, i) ? std::exp(theta[i]) : theta[i];
+  for (int i = 0; i < p; ++i)
+    values[static_cast<std::size_t>(i)] = IsLogParameter(kind, i) ? std::exp(theta[i]) : theta[i];
   // A central difference at the bound Td = 0 looks just below it.
   values.back() = std::max(0.0, values.back());
   return ModelFromValues(kind, values);
 }
 
 // yhat of the model, false if it is not a valid plant or diverges.
-bool TrySimulate(const ProcessModel& model, const std::vector<double>& du, double dt_s, std::vector<double>* yhat) {
+bool TrySimulate(const ProcessModel& model, const std::vector<double>& du, double dt_s,
+                 std::vector<double>* yhat) {
   try {
     *yhat = SimulateModel(model, du, 0.0, dt_s);
   } catch (const std::exception&) {
@@ -76,7 +78,8 @@ struct OutputError {
 
 // The problem over one parameter block `theta`, with its bounds.
 void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) {
-  auto* cost = new ceres::DynamicNumericDiffCostFunction<OutputError, ceres::CENTRAL>(new OutputError{&record});
+  auto* cost =
+      new ceres::DynamicNumericDiffCostFunction<OutputError, ceres::CENTRAL>(new OutputError{&record});
   const int p = ParameterCount(record.kind);
   cost->AddParameterBlock(p);
   cost->SetNumResiduals(static_cast<int>(record.dy.size()));
@@ -195,7 +198,8 @@ std::string Number(double v) {
 
 bool IdentifyOptions::IsValid(std::string* error) const {
   std::string e;
-  if (starts < 1) e = "starts = " + std::to_string(starts) + " must be at least 1";
+  if (starts < 1)
+    e = "starts = " + std::to_string(starts) + " must be at least 1";
   else if (!(max_delay_fraction > 0.0 && max_delay_fraction < 1.0))
     e = "max_delay_fraction = " + Number(max_delay_fraction) + " must be in (0, 1)";
   else if (max_iterations < 1)
@@ -215,10 +219,16 @@ Status CheckData(const IdentifyData& data, double* dt_s) {
     return Status::InvalidInput("too short: " + std::to_string(n) + " samples, at least " +
                                 std::to_string(kMinSamples) + " needed");
   for (std::size_t k = 0; k < n; ++k) {
-    const char* name = !std::isfinite(data.t[k]) ? "t" : !std::isfinite(data.u[k]) ? "u" : !std::isfinite(data.y[k]) ? "y" : nullptr;
+    const char* name = !std::isfinite(data.t[k])   ? "t"
+                       : !std::isfinite(data.u[k]) ? "u"
+                       : !std::isfinite(data.y[k]) ? "y"
+                                                   : nullptr;
     if (name)
-      return Status::InvalidInput(std::string("not finite: ") + name + " at sample " + std::to_string(k) + " is " +
-                                  Number(std::string(name) == "t" ? data.t[k] : std::string(name) == "u" ? data.u[k] : data.y[k]));
+      return Status::InvalidInput(std::string("not finite: ") + name + " at sample " + std::to_string(k) +
+                                  " is " +
+                                  Number(std::string(name) == "t"   ? data.t[k]
+                                         : std::string(name) == "u" ? data.u[k]
+                                                                    : data.y[k]));
   }
   for (std::size_t k = 1; k < n; ++k)
     if (!(data.t[k] > data.t[k - 1]))
@@ -227,8 +237,8 @@ Status CheckData(const IdentifyData& data, double* dt_s) {
   const double dt = (data.t[n - 1] - data.t[0]) / static_cast<double>(n - 1);
   for (std::size_t k = 1; k < n; ++k)
     if (std::abs(data.t[k] - data.t[k - 1] - dt) > kUniformSamplingTolerance * dt)
-      return Status::InvalidInput("non-uniform sampling: the interval before sample " + std::to_string(k) + " is " +
-                                  Number(data.t[k] - data.t[k - 1]) + " s, the mean " + Number(dt) +
+      return Status::InvalidInput("non-uniform sampling: the interval before sample " + std::to_string(k) +
+                                  " is " + Number(data.t[k] - data.t[k - 1]) + " s, the mean " + Number(dt) +
                                   " s (only uniform sampling is supported)");
   if (std::all_of(data.u.begin(), data.u.end(), [&](double v) { return v == data.u[0]; }))
     return Status::InvalidInput("constant input: u is " + Number(data.u[0]) +
@@ -237,7 +247,8 @@ Status CheckData(const IdentifyData& data, double* dt_s) {
   return Status::Ok();
 }
 
-std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<double>& u, double u0, double dt_s) {
+std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<double>& u, double u0,
+                                  double dt_s) {
   DiscretePlant plant(model.ToTransferFunction(), dt_s, model.delay_s());
   std::vector<double> yhat(u.size());
   for (std::size_t k = 0; k < u.size(); ++k) {
@@ -250,7 +261,8 @@ std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<d
 namespace {
 
 // The best of the starts: its theta, and every start's cost.
-std::vector<double> MultiStart(const Record& record, const IdentifyOptions& options, std::vector<double>* costs) {
+std::vector<double> MultiStart(const Record& record, const IdentifyOptions& options,
+                               std::vector<double>* costs) {
   std::vector<double> best;
   double best_cost = std::numeric_limits<double>::infinity();
   for (int s = 0; s < options.starts; ++s) {

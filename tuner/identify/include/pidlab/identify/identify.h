@@ -53,16 +53,16 @@ struct IdentifyResult {
   /// residual variance 2 cost / (N - p); NaN when the covariance failed.
   std::vector<double> standard_errors;
   bool covariance_ok = false;
-  std::string covariance_message;  // why it failed, else empty
-  double cost = 0.0;               // 1/2 sum of squared residuals
-  double fit_percent = 0.0;        // 100 (1 - |y - yhat| / |y - mean y|)
-  double aic = 0.0;                // N log(2 cost / N) + 2 p
-  double u0 = 0.0, y0 = 0.0;       // the operating point used
-  double dt_s = 0.0;               // the sampling interval found
-  int samples = 0;                 // N
-  int starts = 0;                  // starts run
-  int starts_at_best = 0;          // starts whose cost is the best's within 1e-8 relative
-  std::vector<double> start_costs; // final cost of every start, in design order
+  std::string covariance_message;   // why it failed, else empty
+  double cost = 0.0;                // 1/2 sum of squared residuals
+  double fit_percent = 0.0;         // 100 (1 - |y - yhat| / |y - mean y|)
+  double aic = 0.0;                 // N log(2 cost / N) + 2 p
+  double u0 = 0.0, y0 = 0.0;        // the operating point used
+  double dt_s = 0.0;                // the sampling interval found
+  int samples = 0;                  // N
+  int starts = 0;                   // starts run
+  int starts_at_best = 0;           // starts whose cost is the best's within 1e-8 relative
+  std::vector<double> start_costs;  // final cost of every start, in design order
 };
 
 /// Status kInvalidInput with one plain message naming the reason unless the
