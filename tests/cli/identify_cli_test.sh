@@ -6,6 +6,7 @@
 set -uo pipefail
 source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 pidlab="$1"
+docs=$(cd "$(dirname -- "$0")/../../docs" && pwd)/identify.md
 pass=0; fail=0
 check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
@@ -38,7 +39,14 @@ with open('step.csv', 'w') as f:
     for k in range(n): f.write('%.17g,%.17g,0,%.17g\n' % (u[k] + 1, k * dt, y(k * dt) + 3))
 PY
 
-# The commands of docs/identify.md, as printed there.
+# The commands of docs/identify.md's section, as written there (its ```bash block).
+n_docs=0
+while IFS= read -r cmd; do
+  n_docs=$((n_docs + 1))
+  (pidlab() { "$pidlab" "$@"; }; eval "$cmd") > docs.out 2>&1
+  check "docs/identify.md: $cmd" "[ $? -eq 0 ]"
+done < <(awk '/^```bash/{on=1; next} /^```/{on=0} on && /^pidlab identify /' "$docs")
+check "docs/identify.md has 3 identify commands (found $n_docs)" "[ $n_docs -eq 3 ]"
 pidlab() { "$pidlab" "$@"; }
 pidlab identify --csv step.csv --model p1d > table 2> err
 check "identify --csv step.csv --model p1d exits 0 with the table" \
