@@ -91,6 +91,23 @@ INSTANTIATE_TEST_SUITE_P(Models, NoiseFree,
                                            ProcessModelKind::kP2DU, ProcessModelKind::kP1DI),
                          [](const auto& name_info) { return std::string(ToString(name_info.param)); });
 
+class Delay : public ::testing::TestWithParam<double> {};
+
+// The delay on the sample grid (where the delayed step stops splitting), at
+// its bound 0 and within the first sample.
+TEST_P(Delay, P1dIsRecoveredWhateverTheDelay) {
+  ProcessModel truth = Truth(ProcessModelKind::kP1D);
+  truth.td_s = GetParam();
+  IdentifyResult dut;
+  ASSERT_TRUE(Identify(RecordOf(truth), ProcessModelKind::kP1D, IdentifyOptions{}, &dut).ok());
+  const std::vector<double> expected = ParameterValues(truth);
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    EXPECT_NEAR(dut.values[i], expected[i], 1e-6 * std::max(1.0, std::abs(expected[i]))) << dut.names[i];
+  EXPECT_GT(dut.fit_percent, 99.99);
+}
+
+INSTANTIATE_TEST_SUITE_P(OnAndOffTheGrid, Delay, ::testing::Values(0.0, 0.05, 0.4));
+
 TEST(Identify, TheMultiStartReportsHowManyStartsReachedTheOptimum) {
   IdentifyOptions options;
   options.starts = 8;
