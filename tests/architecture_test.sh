@@ -25,7 +25,7 @@ level = {
     'pidlab_spec': 1, 'pidlab_plant_sim': 1, 'pidlab_controller': 1, 'pidlab_optim': 1, 'pidlab_plot': 1,
     'pidlab_transport': 2, 'pidlab_evaluation': 2,
     'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_analysis': 3,
-    'pidlab_tune': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
+    'pidlab_tune': 4, 'pidlab_identify': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
     'pidlab_tuner': 5, 'pidlab_json': 5, 'pidlab_replay': 5, 'pidlab_launcher': 5,
     'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_figures': 6, 'pidlab_cli': 7,
     'pidlab': 8, 'pidlab_python': 8,
@@ -68,20 +68,20 @@ for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
     else: print(f'ok   {exe} links only ' + ', '.join(sorted(d for d in closure(exe) if d.startswith("pidlab"))))
 # Sources: a folder includes only headers of its own level or below.
 header_level = {'spec': 1, 'plant_sim': 1, 'controller': 1, 'optim': 1, 'plot': 1, 'transport': 2, 'evaluation': 2,
-                'analysis': 3, 'tune': 4, 'episode_client': 4, 'replay': 4, 'json': 5, 'launcher': 5, 'report': 6,
+                'analysis': 3, 'tune': 4, 'identify': 4, 'episode_client': 4, 'replay': 4, 'json': 5, 'launcher': 5, 'report': 6,
                 'figures': 6}
 lib_dirs = {'spec': 1, 'transport': 2, 'tuner/optim': 1, 'tuner/evaluation': 2, 'tuner/analysis': 3,
-            'tuner/tune': 4, 'tuner/episode_client': 4, 'replay': 5, 'launcher': 5}
+            'tuner/tune': 4, 'tuner/identify': 4, 'tuner/episode_client': 4, 'replay': 5, 'launcher': 5}
 for d, lv in lib_dirs.items():
     for root, _, files in os.walk(os.path.join(src, d)):
         for f in files:
             for inc in re.findall(r'#include "pidlab/(\w+)/', open(os.path.join(root, f)).read()):
                 if header_level.get(inc, 0) > lv:
                     fail(f'{os.path.relpath(os.path.join(root, f), src)} includes a pidlab/{inc}/ header from above')
-# The tuner's libraries other than the episode client: no LCM (<lcm/...>, a
+# The tuner's libraries other than the episode client (identify included): no LCM (<lcm/...>, a
 # message's lcmt_*.hpp), no transport, no episode client; every pidlab/<x>/
 # header they include is of their own level or below (and has a level).
-for d in ('optim', 'evaluation', 'analysis', 'tune'):
+for d in ('optim', 'evaluation', 'analysis', 'tune', 'identify'):
     lv = header_level[d]
     for root, _, files in os.walk(os.path.join(src, 'tuner', d)):
         for f in files:

@@ -15,5 +15,6 @@ std::function<int()> RegisterPlot(CLI::App* app);
 std::function<int()> RegisterReport(CLI::App* app);
 std::function<int()> RegisterLinearize(CLI::App* app);
 std::function<int()> RegisterBatch(CLI::App* app);
+std::function<int()> RegisterIdentify(CLI::App* app);
 
 }  // namespace pidlab::cli

@@ -22,6 +22,8 @@ const Command kCommands[] = {
     {"batch", "the AMIGO test batch: AMIGO's PID against pidlab's optimum on P1-P9",
      pidlab::cli::RegisterBatch},
     {"evaluate", "evaluate one gain set (IAE, poles, step metrics)", pidlab::cli::RegisterEvaluate},
+    {"identify", "fit a process model (p1d, p2d, p2du, p1di) to t, u, y in a CSV",
+     pidlab::cli::RegisterIdentify},
     {"linearize", "transfer function of a nonlinear plant's linearisation (stepper_nonlinear)",
      pidlab::cli::RegisterLinearize},
     {"launch", "start the LCM process trio (plant, controller, disturbance)", pidlab::cli::RegisterLaunch},

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# pidlab identify: a P1D record written by python3 from the closed-form step
+# response (independent of DiscretePlant), its parameters recovered; the
+# commands of docs/identify.md ("Identifying a model from a CSV") run as
+# printed there; bad input exits 2 with one line.
+set -uo pipefail
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
+pidlab="$1"
+docs=$(cd "$(dirname -- "$0")/../../docs" && pwd)/identify.md
+pass=0; fail=0
+check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" || exit 1
+
+"$pidlab" identify --help > help
+check "identify --help exits 0 and names its flags" \
+  "[ $? -eq 0 ] && grep -q -- '--csv' help && grep -q -- '--model' help && grep -q -- '--json' help"
+
+# P1D Kp = 2, Tp1 = 1.5 s, Td = 0.25 s (not a multiple of dt = 0.1 s), around
+# u0 = 1, y0 = 3; columns out of order, one extra.
+/usr/bin/python3 - <<'PY'
+import math, random
+kp, tp1, td, dt, n = 2.0, 1.5, 0.25, 0.1, 300
+random.seed(3)
+u, k = [0.0] * n, 5
+while k < n:
+    level, hold = random.uniform(-1, 1), random.randint(3, 15)
+    for i in range(k, min(n, k + hold)): u[i] = level
+    k += hold
+def y(t):  # superposition of the delayed steps of u
+    total, prev = 0.0, 0.0
+    for j in range(n):
+        s = t - (j * dt + td)
+        if u[j] != prev and s > 0: total += (u[j] - prev) * kp * (1 - math.exp(-s / tp1))
+        prev = u[j]
+    return total
+with open('step.csv', 'w') as f:
+    f.write('u,t,note,y\n')
+    for k in range(n): f.write('%.17g,%.17g,0,%.17g\n' % (u[k] + 1, k * dt, y(k * dt) + 3))
+PY
+
+# The commands of docs/identify.md's section, as written there (its ```bash block).
+n_docs=0
+while IFS= read -r cmd; do
+  n_docs=$((n_docs + 1))
+  (pidlab() { "$pidlab" "$@"; }; eval "$cmd") > docs.out 2>&1
+  check "docs/identify.md: $cmd" "[ $? -eq 0 ]"
+done < <(awk '/^```bash/{on=1; next} /^```/{on=0} on && /^pidlab identify /' "$docs")
+check "docs/identify.md has 3 identify commands (found $n_docs)" "[ $n_docs -eq 3 ]"
+pidlab() { "$pidlab" "$@"; }
+pidlab identify --csv step.csv --model p1d > table 2> err
+check "identify --csv step.csv --model p1d exits 0 with the table" \
+  "[ $? -eq 0 ] && grep -q '^Kp  *2 ' table && grep -q '^Tp1  *1.5 ' table && grep -q '^Td  *0.25 ' table && grep -q 'starts reached the best cost' table"
+pidlab identify --csv step.csv --model p1d --json > p1d.json 2> err
+check "identify --json exits 0" "[ $? -eq 0 ] && [ ! -s err ]"
+check "the JSON: Kp, Tp1, Td within 1e-6 relative, fit > 99.99 %, every key" "/usr/bin/python3 - p1d.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+for key in ('model', 'parameters', 'transfer_function', 'fit_percent', 'aic', 'aic_form', 'cost', 'samples', 'dt_s',
+            'u0', 'y0', 'starts', 'starts_at_best', 'covariance'): assert key in j, key
+p = j['parameters']
+for name, want in (('Kp', 2.0), ('Tp1', 1.5), ('Td', 0.25)):
+    assert abs(p[name]['value'] - want) <= 1e-6 * want, (name, p[name])
+    assert 'standard_error' in p[name], name
+assert j['model'] == 'p1d' and j['fit_percent'] > 99.99 and j['samples'] == 300, j
+assert j['u0'] == 1 and j['y0'] == 3 and abs(j['dt_s'] - 0.1) < 1e-12, j
+assert 1 <= j['starts_at_best'] <= j['starts'] == 16, j
+tf = j['transfer_function']
+assert abs(tf['num'][0] - 2) < 1e-6 and abs(tf['den'][0] - 1.5) < 1e-6 and tf['den'][1] == 1, tf
+assert abs(tf['delay_s'] - 0.25) < 1e-6, tf
+PY"
+pidlab identify --csv step.csv --model p2d --out model.json > /dev/null 2> err
+check "--out writes the JSON object" \
+  "[ $? -eq 0 ] && /usr/bin/python3 -c 'import json; j = json.load(open(\"model.json\")); assert j[\"model\"] == \"p2d\"'"
+
+# Bad input: exit 2, one line naming the flag, file, column, row or value.
+sed '1s/^u,t,note,y/u,time,note,y/' step.csv > nocolumn.csv
+awk 'NR == 40 { $0 = "0.5,3.8,0,abc" } { print }' step.csv > badcell.csv
+awk 'NR == 40 { $0 = "nan,3.8,0,3" } { print }' step.csv > nan.csv
+head -n 15 step.csv > short.csv
+awk -F, 'NR == 1 { print; next } { print "1," $2 ",0," $4 }' step.csv > constant.csv
+for case in "nocolumn.csv --model p1d|names no column t" "badcell.csv --model p1d|row 40, column y: 'abc'" \
+            "nan.csv --model p1d|not finite: u at sample 38" "short.csv --model p1d|too short: 14 samples" \
+            "constant.csv --model p1d|constant input" "step.csv --model auto|--model 'auto'" \
+            "missing.csv --model p1d|cannot be read"; do
+  args=${case%%|*} needle=${case#*|}
+  "$pidlab" identify --csv $args > out 2> err
+  check "identify --csv $args exits 2 with one line naming '$needle'" \
+    "[ $? -eq 2 ] && only_line_ok err \"$needle\" && [ ! -s out ]"
+done
+"$pidlab" identify --csv step.csv --model p1d --starts 0 > out 2> err
+check "--starts 0 exits 2 with one line" "[ $? -eq 2 ] && only_line_ok err '--starts 0'"
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]

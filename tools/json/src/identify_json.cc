@@ -1,0 +1,32 @@
+#include "pidlab/json/identify_json.h"
+
+#include "pidlab/json/results_json.h"
+
+namespace pidlab::json {
+
+nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
+  nlohmann::json parameters = nlohmann::json::object();
+  for (std::size_t i = 0; i < r.names.size(); ++i)
+    parameters[r.names[i]] = {{"value", JsonNumber(r.values[i])},
+                              {"standard_error", JsonNumber(r.standard_errors.at(i))}};
+  const TransferFunction tf = r.model.ToTransferFunction();
+  nlohmann::json num = nlohmann::json::array(), den = nlohmann::json::array();
+  for (double c : tf.num) num.push_back(JsonNumber(c));
+  for (double c : tf.den) den.push_back(JsonNumber(c));
+  return {{"model", identify::ToString(r.model.kind)},
+          {"parameters", parameters},
+          {"transfer_function", {{"num", num}, {"den", den}, {"delay_s", JsonNumber(r.model.delay_s())}}},
+          {"fit_percent", JsonNumber(r.fit_percent)},
+          {"aic", JsonNumber(r.aic)},
+          {"aic_form", "N log(2 cost / N) + 2 p"},
+          {"cost", JsonNumber(r.cost)},
+          {"samples", r.samples},
+          {"dt_s", JsonNumber(r.dt_s)},
+          {"u0", JsonNumber(r.u0)},
+          {"y0", JsonNumber(r.y0)},
+          {"starts", r.starts},
+          {"starts_at_best", r.starts_at_best},
+          {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}}}};
+}
+
+}  // namespace pidlab::json

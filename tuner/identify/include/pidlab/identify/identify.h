@@ -1,0 +1,83 @@
+#pragma once
+// A process model (process_model.h) fitted to one record of sampled input
+// and output by least squares on the output error: the residuals are
+// y_k - y0 - yhat_k, with yhat the exact zero-order-hold response of the
+// model, its delay included and fractional (DiscretePlant(tf, dt, Td)), to
+// u - u0 from a zero state. Ceres fits from several starts and keeps the
+// best. docs/identify.md, "Identifying a model from a CSV".
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "pidlab/identify/process_model.h"
+#include "pidlab/spec/status.h"
+
+namespace pidlab::identify {
+
+/// One record: sample times t (s, uniform), input u and output y.
+struct IdentifyData {
+  std::vector<double> t;
+  std::vector<double> u;
+  std::vector<double> y;
+};
+
+/// The fewest samples a record may have.
+inline constexpr std::size_t kMinSamples = 20;
+/// How far a sampling interval may be from the mean one, relative (what a CSV
+/// written with ten significant digits keeps).
+inline constexpr double kUniformSamplingTolerance = 1e-6;
+
+struct IdentifyOptions {
+  /// Starts of the multi-start design (Halton points over the time constants,
+  /// Zeta and the delay), >= 1.
+  int starts = 16;
+  /// The delay's upper bound as a fraction of the record's length, in (0, 1).
+  double max_delay_fraction = 0.5;
+  /// Levenberg-Marquardt iterations per start, >= 1.
+  int max_iterations = 200;
+  /// The operating point subtracted from u and y; NaN means the first sample
+  /// (the record starts at rest).
+  double u0 = std::numeric_limits<double>::quiet_NaN();
+  double y0 = std::numeric_limits<double>::quiet_NaN();
+
+  /// Names the field, its value and the rule on failure.
+  bool IsValid(std::string* error) const;
+};
+
+struct IdentifyResult {
+  ProcessModel model;
+  std::vector<std::string> names;  // ParameterNames(model.kind)
+  std::vector<double> values;      // ParameterValues(model)
+  /// Standard errors of `values` from Ceres's covariance scaled by the
+  /// residual variance 2 cost / (N - p); NaN when the covariance failed.
+  std::vector<double> standard_errors;
+  bool covariance_ok = false;
+  std::string covariance_message;   // why it failed, else empty
+  double cost = 0.0;                // 1/2 sum of squared residuals
+  double fit_percent = 0.0;         // 100 (1 - |y - yhat| / |y - mean y|)
+  double aic = 0.0;                 // N log(2 cost / N) + 2 p
+  double u0 = 0.0, y0 = 0.0;        // the operating point used
+  double dt_s = 0.0;                // the sampling interval found
+  int samples = 0;                  // N
+  int starts = 0;                   // starts run
+  int starts_at_best = 0;           // starts whose cost is the best's within 1e-8 relative
+  std::vector<double> start_costs;  // final cost of every start, in design order
+};
+
+/// Status kInvalidInput with one plain message naming the reason unless the
+/// record has at least kMinSamples samples, equal lengths, only finite
+/// values, strictly increasing uniform t and a non-constant u. Sets *dt_s.
+Status CheckData(const IdentifyData& data, double* dt_s);
+
+/// yhat_k (without y0) of `model` for the input u - u0 sampled every dt_s.
+/// Throws std::invalid_argument if the model is not a valid plant.
+std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<double>& u, double u0,
+                                  double dt_s);
+
+/// Fits a model of `kind` to `data`. kInvalidInput for bad data or options
+/// (CheckData, IdentifyOptions::IsValid); kRunnerFailed if no start converged.
+Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
+                IdentifyResult* result);
+
+}  // namespace pidlab::identify

@@ -1,0 +1,336 @@
+// The fit of identify.h. The parameters Ceres sees, theta, are in the order
+// of ParameterNames: Kp free, every time constant (Tp1, Tp2, Tw) as its
+// logarithm (positive, and scaled alike whatever its size), Zeta bounded to
+// (0, 1) and Td bounded to [0, max_delay_fraction of the record]. The delay
+// stays continuous: DiscretePlant splits it over the sample exactly, so the
+// cost is a continuous function of Td and central differences see it.
+
+#include "pidlab/identify/identify.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "pidlab/plant_sim/discrete_plant.h"
+
+namespace pidlab::identify {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Bounds of Zeta inside (0, 1).
+constexpr double kMinZeta = 1e-3;
+constexpr double kMaxZeta = 1.0 - 1e-9;
+// How far the time constants may go from the record's scales: [dt / 1000, 1000 T_record].
+constexpr double kTimeConstantRange = 1e3;
+
+// What every start's problem shares: the record without its operating point.
+struct Record {
+  ProcessModelKind kind;
+  std::vector<double> du, dy;
+  double dt_s = 0.0, length_s = 0.0, max_delay_s = 0.0;
+};
+
+int ParameterCount(ProcessModelKind kind) { return static_cast<int>(ParameterNames(kind).size()); }
+
+// theta[i] is the logarithm of a time constant.
+bool IsLogParameter(ProcessModelKind kind, int i) {
+  const int p = ParameterCount(kind);
+  return i > 0 && i < p - 1 && !(kind == ProcessModelKind::kP2DU && i == 2);
+}
+
+ProcessModel ModelOf(ProcessModelKind kind, const double* theta) {
+  const int p = ParameterCount(kind);
+  std::vector<double> values(static_cast<std::size_t>(p));
+  for (int i = 0; i < p; ++i)
+    values[static_cast<std::size_t>(i)] = IsLogParameter(kind, i) ? std::exp(theta[i]) : theta[i];
+  // A central difference at the bound Td = 0 looks just below it.
+  values.back() = std::max(0.0, values.back());
+  return ModelFromValues(kind, values);
+}
+
+// yhat of the model, false if it is not a valid plant or diverges.
+bool TrySimulate(const ProcessModel& model, const std::vector<double>& du, double dt_s,
+                 std::vector<double>* yhat) {
+  try {
+    *yhat = SimulateModel(model, du, 0.0, dt_s);
+  } catch (const std::exception&) {
+    return false;
+  }
+  for (double v : *yhat)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+struct OutputError {
+  const Record* record;
+  bool operator()(double const* const* parameters, double* residuals) const {
+    std::vector<double> yhat;
+    if (!TrySimulate(ModelOf(record->kind, parameters[0]), record->du, record->dt_s, &yhat)) return false;
+    for (std::size_t k = 0; k < yhat.size(); ++k) residuals[k] = record->dy[k] - yhat[k];
+    return true;
+  }
+};
+
+// The problem over one parameter block `theta`, with its bounds.
+void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) {
+  auto* cost =
+      new ceres::DynamicNumericDiffCostFunction<OutputError, ceres::CENTRAL>(new OutputError{&record});
+  const int p = ParameterCount(record.kind);
+  cost->AddParameterBlock(p);
+  cost->SetNumResiduals(static_cast<int>(record.dy.size()));
+  problem->AddResidualBlock(cost, nullptr, theta);
+  for (int i = 1; i < p - 1; ++i) {
+    if (IsLogParameter(record.kind, i)) {
+      problem->SetParameterLowerBound(theta, i, std::log(record.dt_s / kTimeConstantRange));
+      problem->SetParameterUpperBound(theta, i, std::log(record.length_s * kTimeConstantRange));
+    } else {
+      problem->SetParameterLowerBound(theta, i, kMinZeta);
+      problem->SetParameterUpperBound(theta, i, kMaxZeta);
+    }
+  }
+  problem->SetParameterLowerBound(theta, p - 1, 0.0);
+  problem->SetParameterUpperBound(theta, p - 1, record.max_delay_s);
+}
+
+// The radical inverse of `index` in `base`: the Halton sequence's coordinate.
+double Halton(int index, int base) {
+  double f = 1.0, r = 0.0;
+  for (int i = index; i > 0; i /= base) {
+    f /= base;
+    r += f * (i % base);
+  }
+  return r;
+}
+
+// Start `index` of the design: time constants log-spaced over [dt/2, T/2],
+// Zeta over [0.1, 0.9], Td over [0, min(max delay, T/4)], by Halton points
+// (bases 2, 3, 5); Kp then by linear least squares, the model being linear in it.
+std::vector<double> StartPoint(const Record& record, int index) {
+  const int p = ParameterCount(record.kind);
+  std::vector<double> theta(static_cast<std::size_t>(p), 0.0);
+  const double lo = std::log(0.5 * record.dt_s), hi = std::log(0.5 * record.length_s);
+  static const int kBases[] = {2, 3, 5};
+  for (int i = 1; i < p; ++i) {
+    const double h = Halton(index + 1, kBases[i - 1]);
+    if (i == p - 1)
+      theta.back() = h * std::min(record.max_delay_s, 0.25 * record.length_s);
+    else if (IsLogParameter(record.kind, i))
+      theta[static_cast<std::size_t>(i)] = lo + h * (hi - lo);
+    else
+      theta[static_cast<std::size_t>(i)] = 0.1 + 0.8 * h;
+  }
+  theta[0] = 1.0;
+  std::vector<double> g;
+  if (TrySimulate(ModelOf(record.kind, theta.data()), record.du, record.dt_s, &g)) {
+    double gy = 0.0, gg = 0.0;
+    for (std::size_t k = 0; k < g.size(); ++k) {
+      gy += g[k] * record.dy[k];
+      gg += g[k] * g[k];
+    }
+    if (gg > 0.0 && std::isfinite(gy / gg)) theta[0] = gy / gg;
+  }
+  return theta;
+}
+
+// One start's fit; the final cost, or infinity if Ceres failed.
+double FitFrom(const Record& record, const IdentifyOptions& options, std::vector<double>* theta) {
+  ceres::Problem problem;
+  BuildProblem(record, theta->data(), &problem);
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = 1e-15;
+  solver.gradient_tolerance = 1e-20;
+  solver.parameter_tolerance = 1e-13;
+  solver.logging_type = ceres::SILENT;
+  solver.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost))
+    return std::numeric_limits<double>::infinity();
+  return summary.final_cost;
+}
+
+// Standard errors of the parameters at `theta` (values, not theta), scaled
+// by the residual variance; false with the reason if Ceres cannot invert J'J.
+bool StandardErrors(const Record& record, std::vector<double> theta, double cost, std::vector<double>* errors,
+                    std::string* message) {
+  const int p = ParameterCount(record.kind);
+  const int n = static_cast<int>(record.dy.size());
+  errors->assign(static_cast<std::size_t>(p), kNaN);
+  ceres::Problem problem;
+  BuildProblem(record, theta.data(), &problem);
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.num_threads = 1;
+  ceres::Covariance covariance(covariance_options);
+  std::vector<std::pair<const double*, const double*>> blocks = {{theta.data(), theta.data()}};
+  if (!covariance.Compute(blocks, &problem)) {
+    *message = "Ceres could not compute the covariance (J'J singular or ill-conditioned)";
+    return false;
+  }
+  std::vector<double> c(static_cast<std::size_t>(p * p));
+  covariance.GetCovarianceBlock(theta.data(), theta.data(), c.data());
+  const double variance = 2.0 * cost / std::max(1, n - p);
+  const ProcessModel model = ModelOf(record.kind, theta.data());
+  const std::vector<double> values = ParameterValues(model);
+  for (int i = 0; i < p; ++i) {
+    const double se = std::sqrt(std::max(0.0, c[static_cast<std::size_t>(i * p + i)] * variance));
+    // d value / d theta = value for a logarithm.
+    (*errors)[static_cast<std::size_t>(i)] =
+        IsLogParameter(record.kind, i) ? se * values[static_cast<std::size_t>(i)] : se;
+  }
+  return true;
+}
+
+std::string Number(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+bool IdentifyOptions::IsValid(std::string* error) const {
+  std::string e;
+  if (starts < 1)
+    e = "starts = " + std::to_string(starts) + " must be at least 1";
+  else if (!(max_delay_fraction > 0.0 && max_delay_fraction < 1.0))
+    e = "max_delay_fraction = " + Number(max_delay_fraction) + " must be in (0, 1)";
+  else if (max_iterations < 1)
+    e = "max_iterations = " + std::to_string(max_iterations) + " must be at least 1";
+  else if (std::isinf(u0) || std::isinf(y0))
+    e = "u0 and y0 must be finite, or NaN for the first sample";
+  if (error) *error = e;
+  return e.empty();
+}
+
+Status CheckData(const IdentifyData& data, double* dt_s) {
+  const std::size_t n = data.t.size();
+  if (data.u.size() != n || data.y.size() != n)
+    return Status::InvalidInput("t, u and y have different lengths (" + std::to_string(n) + ", " +
+                                std::to_string(data.u.size()) + ", " + std::to_string(data.y.size()) + ")");
+  if (n < kMinSamples)
+    return Status::InvalidInput("too short: " + std::to_string(n) + " samples, at least " +
+                                std::to_string(kMinSamples) + " needed");
+  for (std::size_t k = 0; k < n; ++k) {
+    const char* name = !std::isfinite(data.t[k])   ? "t"
+                       : !std::isfinite(data.u[k]) ? "u"
+                       : !std::isfinite(data.y[k]) ? "y"
+                                                   : nullptr;
+    if (name)
+      return Status::InvalidInput(std::string("not finite: ") + name + " at sample " + std::to_string(k) +
+                                  " is " +
+                                  Number(std::string(name) == "t"   ? data.t[k]
+                                         : std::string(name) == "u" ? data.u[k]
+                                                                    : data.y[k]));
+  }
+  for (std::size_t k = 1; k < n; ++k)
+    if (!(data.t[k] > data.t[k - 1]))
+      return Status::InvalidInput("t is not strictly increasing: t = " + Number(data.t[k]) + " at sample " +
+                                  std::to_string(k) + " after " + Number(data.t[k - 1]));
+  const double dt = (data.t[n - 1] - data.t[0]) / static_cast<double>(n - 1);
+  for (std::size_t k = 1; k < n; ++k)
+    if (std::abs(data.t[k] - data.t[k - 1] - dt) > kUniformSamplingTolerance * dt)
+      return Status::InvalidInput("non-uniform sampling: the interval before sample " + std::to_string(k) +
+                                  " is " + Number(data.t[k] - data.t[k - 1]) + " s, the mean " + Number(dt) +
+                                  " s (only uniform sampling is supported)");
+  if (std::all_of(data.u.begin(), data.u.end(), [&](double v) { return v == data.u[0]; }))
+    return Status::InvalidInput("constant input: u is " + Number(data.u[0]) +
+                                " throughout, so nothing can be identified");
+  *dt_s = dt;
+  return Status::Ok();
+}
+
+std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<double>& u, double u0,
+                                  double dt_s) {
+  DiscretePlant plant(model.ToTransferFunction(), dt_s, model.delay_s());
+  std::vector<double> yhat(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    yhat[k] = plant.Output();
+    plant.Step(u[k] - u0);
+  }
+  return yhat;
+}
+
+namespace {
+
+// The best of the starts: its theta, and every start's cost.
+std::vector<double> MultiStart(const Record& record, const IdentifyOptions& options,
+                               std::vector<double>* costs) {
+  std::vector<double> best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int s = 0; s < options.starts; ++s) {
+    std::vector<double> theta = StartPoint(record, s);
+    const double cost = FitFrom(record, options, &theta);
+    costs->push_back(cost);
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = theta;
+    }
+  }
+  return best;
+}
+
+// Figures of merit of the fit at `theta` into *result.
+void Summarise(const Record& record, const IdentifyData& data, const std::vector<double>& theta, double cost,
+               IdentifyResult* result) {
+  const int p = ParameterCount(record.kind);
+  const double n = static_cast<double>(data.y.size());
+  result->model = ModelOf(record.kind, theta.data());
+  result->names = ParameterNames(record.kind);
+  result->values = ParameterValues(result->model);
+  result->cost = cost;
+  double mean = 0.0;
+  for (double v : data.y) mean += v / n;
+  double spread = 0.0;
+  for (double v : data.y) spread += (v - mean) * (v - mean);
+  result->fit_percent = 100.0 * (1.0 - std::sqrt(2.0 * cost) / std::sqrt(spread));
+  result->aic = n * std::log(2.0 * cost / n) + 2.0 * p;
+  result->covariance_ok =
+      StandardErrors(record, theta, cost, &result->standard_errors, &result->covariance_message);
+}
+
+}  // namespace
+
+Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
+                IdentifyResult* result) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::InvalidInput(error);
+  Record record;
+  record.kind = kind;
+  const Status status = CheckData(data, &record.dt_s);
+  if (!status.ok()) return status;
+  *result = IdentifyResult{};
+  result->u0 = std::isnan(options.u0) ? data.u[0] : options.u0;
+  result->y0 = std::isnan(options.y0) ? data.y[0] : options.y0;
+  for (std::size_t k = 0; k < data.u.size(); ++k) {
+    record.du.push_back(data.u[k] - result->u0);
+    record.dy.push_back(data.y[k] - result->y0);
+  }
+  record.length_s = data.t.back() - data.t.front();
+  record.max_delay_s = options.max_delay_fraction * record.length_s;
+  std::vector<double> theta = MultiStart(record, options, &result->start_costs);
+  if (theta.empty()) return Status::RunnerFailed("no start of the fit converged");
+  // P2D's time constants are interchangeable: report Tp1 >= Tp2.
+  if (kind == ProcessModelKind::kP2D && theta[2] > theta[1]) std::swap(theta[1], theta[2]);
+  const double best = *std::min_element(result->start_costs.begin(), result->start_costs.end());
+  double scale = 0.0;
+  for (double v : record.dy) scale += 0.5 * v * v;
+  // Within 1e-8 of the best cost, relative; a record fitted exactly (best
+  // cost ~ 0) is measured against 1e-16 of the cost of the zero model.
+  const double tolerance = 1e-8 * std::max(best, 1e-16 * scale);
+  for (double c : result->start_costs) result->starts_at_best += c - best <= tolerance ? 1 : 0;
+  result->starts = options.starts;
+  result->samples = static_cast<int>(data.y.size());
+  result->dt_s = record.dt_s;
+  Summarise(record, data, theta, best, result);
+  return Status::Ok();
+}
+
+}  // namespace pidlab::identify
