@@ -25,7 +25,7 @@ set(CPACK_DEBIAN_PACKAGE_MAINTAINER "pidlab maintainers <pidlab@localhost>")
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE amd64)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.35), libstdc++6 (>= 12), libgcc-s1 (>= 4.0), liblcm1, libsodium23 (>= 0.6.0), libgoogle-glog0v6 (>= 0.6.0), libcholmod3 (>= 1:4.5.2), libcxsparse3 (>= 1:4.5.2), liblapack3 | liblapack.so.3, libatlas3-base")
+    "libc6 (>= 2.35), libstdc++6 (>= 12), libgcc-s1 (>= 4.0), liblcm1, libsodium23 (>= 0.6.0), libgoogle-glog0v6 (>= 0.6.0), libcholmod3 (>= 1:4.5.2), libcxsparse3 (>= 1:4.5.2), libspqr2 (>= 1:4.5.2), liblapack3 | liblapack.so.3, libatlas3-base")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
     "liblcm-bin, gnuplot-nox | gnuplot, liblcm-dev, libeigen3-dev, libceres-dev, libsodium-dev, libcli11-dev, nlohmann-json3-dev, pkg-config, cmake")
 if(PIDLAB_BUILD_PYTHON)

@@ -27,7 +27,7 @@ field() { dpkg-deb --field "$deb" "$1"; }
 names() { field "$1" | tr ',|' '\n\n' | sed 's/ *(.*//; s/^ *//; s/ *$//'; }
 check "Package is pidlab, Version $version, Architecture amd64" \
   "[ \"\$(field Package)\" = pidlab ] && [ \"\$(field Version)\" = '$version' ] && [ \"\$(field Architecture)\" = amd64 ]"
-for dep in libc6 libstdc++6 liblcm1 libsodium23 libgoogle-glog0v6 libcholmod3 libcxsparse3 liblapack3 libatlas3-base; do
+for dep in libc6 libstdc++6 liblcm1 libsodium23 libgoogle-glog0v6 libcholmod3 libcxsparse3 libspqr2 liblapack3 libatlas3-base; do
   check "Depends names $dep" "names Depends | grep -qx '$dep'"
 done
 for rec in liblcm-bin liblcm-dev libeigen3-dev libceres-dev libsodium-dev; do
