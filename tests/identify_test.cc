@@ -154,6 +154,40 @@ TEST(Identify, NoisyDataGivesFiniteStandardErrorsThatCoverTheTruth) {
   EXPECT_TRUE(std::isfinite(dut.aic));
 }
 
+TEST(Identify, TheCovarianceIsSymmetricAndItsDiagonalGivesTheStandardErrors) {
+  IdentifyData data = RecordOf(Truth(ProcessModelKind::kP2D));
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (std::size_t k = 1; k < data.y.size(); ++k) data.y[k] += noise(rng);
+  IdentifyResult dut;
+  ASSERT_TRUE(Identify(data, ProcessModelKind::kP2D, IdentifyOptions{}, &dut).ok());
+  ASSERT_TRUE(dut.covariance_ok) << dut.covariance_message;
+  const std::size_t p = dut.names.size();
+  ASSERT_EQ(dut.covariance.size(), p * p);
+  for (std::size_t i = 0; i < p; ++i) {
+    EXPECT_NEAR(std::sqrt(dut.covariance[i * p + i]), dut.standard_errors[i], 1e-12 * dut.standard_errors[i]);
+    for (std::size_t j = 0; j < p; ++j) {
+      EXPECT_NEAR(dut.covariance[i * p + j], dut.covariance[j * p + i],
+                  1e-12 * std::abs(dut.covariance[i * p + j]) + 1e-300);
+      // A correlation, so within [-1, 1].
+      EXPECT_LE(std::abs(dut.covariance[i * p + j]), dut.standard_errors[i] * dut.standard_errors[j] * (1 + 1e-9));
+    }
+  }
+}
+
+TEST(Identify, AnotherSeedShiftsTheStartsButReachesTheSameOptimum) {
+  const IdentifyData data = RecordOf(Truth(ProcessModelKind::kP2DU));
+  IdentifyOptions options;
+  IdentifyResult unshifted, shifted;
+  ASSERT_TRUE(Identify(data, ProcessModelKind::kP2DU, options, &unshifted).ok());
+  options.seed = 12345;
+  ASSERT_TRUE(Identify(data, ProcessModelKind::kP2DU, options, &shifted).ok());
+  EXPECT_EQ(shifted.seed, 12345u);
+  EXPECT_NE(unshifted.start_costs, shifted.start_costs) << "the seed must move the starts";
+  for (std::size_t i = 0; i < unshifted.values.size(); ++i)
+    EXPECT_NEAR(shifted.values[i], unshifted.values[i], 1e-6 * std::abs(unshifted.values[i])) << unshifted.names[i];
+}
+
 Status Refusal(const IdentifyData& data) {
   IdentifyResult result;
   return Identify(data, ProcessModelKind::kP1D, IdentifyOptions{}, &result);

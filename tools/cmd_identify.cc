@@ -80,6 +80,11 @@ struct IdentifyCommand {
     app->add_option("--model", model, "the model: " + identify::ProcessModelKindNames())->required();
     app->add_option("--starts", options.starts, "starting points of the multi-start fit")
         ->capture_default_str();
+    app->add_option("--seed", options.seed,
+                    "digital shift of the starts' Sobol' design (0: the unshifted sequence)")
+        ->capture_default_str();
+    app->add_option("--u0", options.u0, "the input's operating point (default: the first sample of u)");
+    app->add_option("--y0", options.y0, "the output's operating point (default: the first sample of y)");
     app->add_flag("--json", json, "print one JSON object");
     app->add_option("--out", out, "also write the JSON object to this file");
     return [this] { return Run(); };
@@ -91,6 +96,10 @@ struct IdentifyCommand {
       throw BadInput("--model " + Quote(model) + " must be one of " + identify::ProcessModelKindNames());
     if (options.starts < 1 || options.starts > 1000)
       throw BadInput("--starts " + std::to_string(options.starts) + " must be in [1, 1000]");
+    if (!std::isnan(options.u0) && !std::isfinite(options.u0))
+      throw BadInput("--u0 " + Num(options.u0) + " must be finite");
+    if (!std::isnan(options.y0) && !std::isfinite(options.y0))
+      throw BadInput("--y0 " + Num(options.y0) + " must be finite");
     if (!out.empty()) CheckOutputFile(out, "--out");
     identify::IdentifyData data;
     Require(identify::ReadCsvData(csv, &data));

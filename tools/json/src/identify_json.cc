@@ -13,6 +13,13 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
   nlohmann::json num = nlohmann::json::array(), den = nlohmann::json::array();
   for (double c : tf.num) num.push_back(JsonNumber(c));
   for (double c : tf.den) den.push_back(JsonNumber(c));
+  nlohmann::json matrix = nlohmann::json::array();
+  const std::size_t p = r.names.size();
+  for (std::size_t i = 0; i < p && r.covariance.size() == p * p; ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (std::size_t j = 0; j < p; ++j) row.push_back(JsonNumber(r.covariance[i * p + j]));
+    matrix.push_back(row);
+  }
   return {{"model", identify::ToString(r.model.kind)},
           {"parameters", parameters},
           {"transfer_function", {{"num", num}, {"den", den}, {"delay_s", JsonNumber(r.model.delay_s())}}},
@@ -26,7 +33,8 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
           {"y0", JsonNumber(r.y0)},
           {"starts", r.starts},
           {"starts_at_best", r.starts_at_best},
-          {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}}}};
+          {"seed", r.seed},
+          {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}, {"matrix", matrix}}}};
 }
 
 }  // namespace pidlab::json

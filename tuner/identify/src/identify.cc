@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pidlab/optim/sobol.h"
 #include "pidlab/plant_sim/discrete_plant.h"
 
 namespace pidlab::identify {
@@ -97,32 +98,24 @@ void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) 
   problem->SetParameterUpperBound(theta, p - 1, record.max_delay_s);
 }
 
-// The radical inverse of `index` in `base`: the Halton sequence's coordinate.
-double Halton(int index, int base) {
-  double f = 1.0, r = 0.0;
-  for (int i = index; i > 0; i /= base) {
-    f /= base;
-    r += f * (i % base);
-  }
-  return r;
-}
-
 // Start `index` of the design: time constants log-spaced over [dt/2, T/2],
-// Zeta over [0.1, 0.9], Td over [0, min(max delay, T/4)], by Halton points
-// (bases 2, 3, 5); Kp then by linear least squares, the model being linear in it.
-std::vector<double> StartPoint(const Record& record, int index) {
+// Zeta over [0.1, 0.9], Td over [0, min(max delay, T/4)], by the points of a
+// Sobol' sequence (optim/sobol.h, as the tuner's multi-start), digitally
+// shifted by the seed unless it is 0; Kp then by linear least squares, the
+// model being linear in it.
+std::vector<double> StartPoint(const Record& record, const optim::SobolSequence& sobol, int index) {
   const int p = ParameterCount(record.kind);
   std::vector<double> theta(static_cast<std::size_t>(p), 0.0);
   const double lo = std::log(0.5 * record.dt_s), hi = std::log(0.5 * record.length_s);
-  static const int kBases[] = {2, 3, 5};
+  const Eigen::VectorXd h = sobol.Point(static_cast<std::uint32_t>(index));
   for (int i = 1; i < p; ++i) {
-    const double h = Halton(index + 1, kBases[i - 1]);
+    const double hi_coordinate = h[i - 1];
     if (i == p - 1)
-      theta.back() = h * std::min(record.max_delay_s, 0.25 * record.length_s);
+      theta.back() = hi_coordinate * std::min(record.max_delay_s, 0.25 * record.length_s);
     else if (IsLogParameter(record.kind, i))
-      theta[static_cast<std::size_t>(i)] = lo + h * (hi - lo);
+      theta[static_cast<std::size_t>(i)] = lo + hi_coordinate * (hi - lo);
     else
-      theta[static_cast<std::size_t>(i)] = 0.1 + 0.8 * h;
+      theta[static_cast<std::size_t>(i)] = 0.1 + 0.8 * hi_coordinate;
   }
   theta[0] = 1.0;
   std::vector<double> g;
@@ -156,13 +149,15 @@ double FitFrom(const Record& record, const IdentifyOptions& options, std::vector
   return summary.final_cost;
 }
 
-// Standard errors of the parameters at `theta` (values, not theta), scaled
-// by the residual variance; false with the reason if Ceres cannot invert J'J.
-bool StandardErrors(const Record& record, std::vector<double> theta, double cost, std::vector<double>* errors,
-                    std::string* message) {
+// The covariance of the parameters at `theta` (of the values, not of theta;
+// p x p, row-major) and their standard errors, scaled by the residual
+// variance; false with the reason if Ceres cannot invert J'J.
+bool Covariance(const Record& record, std::vector<double> theta, double cost, std::vector<double>* errors,
+                std::vector<double>* matrix, std::string* message) {
   const int p = ParameterCount(record.kind);
   const int n = static_cast<int>(record.dy.size());
   errors->assign(static_cast<std::size_t>(p), kNaN);
+  matrix->assign(static_cast<std::size_t>(p * p), kNaN);
   ceres::Problem problem;
   BuildProblem(record, theta.data(), &problem);
   ceres::Covariance::Options covariance_options;
@@ -179,12 +174,18 @@ bool StandardErrors(const Record& record, std::vector<double> theta, double cost
   const double variance = 2.0 * cost / std::max(1, n - p);
   const ProcessModel model = ModelOf(record.kind, theta.data());
   const std::vector<double> values = ParameterValues(model);
-  for (int i = 0; i < p; ++i) {
-    const double se = std::sqrt(std::max(0.0, c[static_cast<std::size_t>(i * p + i)] * variance));
-    // d value / d theta = value for a logarithm.
+  // d value / d theta: the value for a logarithm, else 1.
+  std::vector<double> d(static_cast<std::size_t>(p));
+  for (int i = 0; i < p; ++i)
+    d[static_cast<std::size_t>(i)] = IsLogParameter(record.kind, i) ? values[static_cast<std::size_t>(i)] : 1.0;
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j < p; ++j) {
+      const auto ij = static_cast<std::size_t>(i * p + j);
+      (*matrix)[ij] = c[ij] * variance * d[static_cast<std::size_t>(i)] * d[static_cast<std::size_t>(j)];
+    }
+  for (int i = 0; i < p; ++i)
     (*errors)[static_cast<std::size_t>(i)] =
-        IsLogParameter(record.kind, i) ? se * values[static_cast<std::size_t>(i)] : se;
-  }
+        std::sqrt(std::max(0.0, (*matrix)[static_cast<std::size_t>(i * p + i)]));
   return true;
 }
 
@@ -265,8 +266,11 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
                                std::vector<double>* costs) {
   std::vector<double> best;
   double best_cost = std::numeric_limits<double>::infinity();
+  const int dimensions = ParameterCount(record.kind) - 1;
+  const optim::SobolSequence sobol =
+      options.seed == 0 ? optim::SobolSequence(dimensions) : optim::SobolSequence(dimensions, options.seed);
   for (int s = 0; s < options.starts; ++s) {
-    std::vector<double> theta = StartPoint(record, s);
+    std::vector<double> theta = StartPoint(record, sobol, s);
     const double cost = FitFrom(record, options, &theta);
     costs->push_back(cost);
     if (cost < best_cost) {
@@ -292,8 +296,8 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
   for (double v : data.y) spread += (v - mean) * (v - mean);
   result->fit_percent = 100.0 * (1.0 - std::sqrt(2.0 * cost) / std::sqrt(spread));
   result->aic = n * std::log(2.0 * cost / n) + 2.0 * p;
-  result->covariance_ok =
-      StandardErrors(record, theta, cost, &result->standard_errors, &result->covariance_message);
+  result->covariance_ok = Covariance(record, theta, cost, &result->standard_errors, &result->covariance,
+                                     &result->covariance_message);
 }
 
 }  // namespace
@@ -327,6 +331,7 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   const double tolerance = 1e-8 * std::max(best, 1e-16 * scale);
   for (double c : result->start_costs) result->starts_at_best += c - best <= tolerance ? 1 : 0;
   result->starts = options.starts;
+  result->seed = options.seed;
   result->samples = static_cast<int>(data.y.size());
   result->dt_s = record.dt_s;
   Summarise(record, data, theta, best, result);

@@ -6,6 +6,7 @@
 // u - u0 from a zero state. Ceres fits from several starts and keeps the
 // best. docs/identify.md, "Identifying a model from a CSV".
 
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
@@ -29,9 +30,12 @@ inline constexpr std::size_t kMinSamples = 20;
 inline constexpr double kUniformSamplingTolerance = 1e-6;
 
 struct IdentifyOptions {
-  /// Starts of the multi-start design (Halton points over the time constants,
-  /// Zeta and the delay), >= 1.
+  /// Starts of the multi-start design (Sobol' points over the time constants,
+  /// Zeta and the delay, optim/sobol.h), >= 1.
   int starts = 16;
+  /// The design's digital shift (SobolSequence(d, seed)); 0: the unshifted
+  /// sequence, whose first start is the lower corner of every range.
+  std::uint64_t seed = 0;
   /// The delay's upper bound as a fraction of the record's length, in (0, 1).
   double max_delay_fraction = 0.5;
   /// Levenberg-Marquardt iterations per start, >= 1.
@@ -52,6 +56,9 @@ struct IdentifyResult {
   /// Standard errors of `values` from Ceres's covariance scaled by the
   /// residual variance 2 cost / (N - p); NaN when the covariance failed.
   std::vector<double> standard_errors;
+  /// Their covariance, p x p row-major in the order of `names` (the matrix
+  /// whose diagonal gives `standard_errors`); NaN when it failed.
+  std::vector<double> covariance;
   bool covariance_ok = false;
   std::string covariance_message;   // why it failed, else empty
   double cost = 0.0;                // 1/2 sum of squared residuals
@@ -61,6 +68,7 @@ struct IdentifyResult {
   double dt_s = 0.0;                // the sampling interval found
   int samples = 0;                  // N
   int starts = 0;                   // starts run
+  std::uint64_t seed = 0;           // the design's shift (IdentifyOptions::seed)
   int starts_at_best = 0;           // starts whose cost is the best's within 1e-8 relative
   std::vector<double> start_costs;  // final cost of every start, in design order
 };
