@@ -170,7 +170,8 @@ TEST(Identify, TheCovarianceIsSymmetricAndItsDiagonalGivesTheStandardErrors) {
       EXPECT_NEAR(dut.covariance[i * p + j], dut.covariance[j * p + i],
                   1e-12 * std::abs(dut.covariance[i * p + j]) + 1e-300);
       // A correlation, so within [-1, 1].
-      EXPECT_LE(std::abs(dut.covariance[i * p + j]), dut.standard_errors[i] * dut.standard_errors[j] * (1 + 1e-9));
+      EXPECT_LE(std::abs(dut.covariance[i * p + j]),
+                dut.standard_errors[i] * dut.standard_errors[j] * (1 + 1e-9));
     }
   }
 }
@@ -185,8 +186,53 @@ TEST(Identify, AnotherSeedShiftsTheStartsButReachesTheSameOptimum) {
   EXPECT_EQ(shifted.seed, 12345u);
   EXPECT_NE(unshifted.start_costs, shifted.start_costs) << "the seed must move the starts";
   for (std::size_t i = 0; i < unshifted.values.size(); ++i)
-    EXPECT_NEAR(shifted.values[i], unshifted.values[i], 1e-6 * std::abs(unshifted.values[i])) << unshifted.names[i];
+    EXPECT_NEAR(shifted.values[i], unshifted.values[i], 1e-6 * std::abs(unshifted.values[i]))
+        << unshifted.names[i];
 }
+
+TEST(Whiteness, WhiteNoisePassesTheLjungBoxTestAndAnAutoregressionFailsIt) {
+  std::mt19937 rng(17);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<double> white(2000), coloured(2000);
+  double state = 0.0;
+  for (std::size_t k = 0; k < white.size(); ++k) {
+    white[k] = noise(rng);
+    state = 0.5 * state + noise(rng);
+    coloured[k] = state;
+  }
+  const Whiteness w = ResidualWhiteness(white);
+  EXPECT_EQ(w.lags, 25);
+  EXPECT_DOUBLE_EQ(w.band, 1.96 / std::sqrt(2000.0));
+  EXPECT_TRUE(w.white) << "p = " << w.p_value;
+  EXPECT_LE(w.outside_band, 4);
+  const Whiteness c = ResidualWhiteness(coloured);
+  EXPECT_FALSE(c.white) << "p = " << c.p_value;
+  EXPECT_NEAR(c.autocorrelation[0], 0.5, 0.06);
+  EXPECT_LT(c.p_value, 1e-6);
+}
+
+class AutoChoice : public ::testing::TestWithParam<ProcessModelKind> {};
+
+TEST_P(AutoChoice, TheTrueKindHasTheLowestAicOnANoisyRecord) {
+  const ProcessModel truth = Truth(GetParam());
+  IdentifyData data = RecordOf(truth, 600);
+  std::mt19937 rng(23);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  for (std::size_t k = 1; k < data.y.size(); ++k) data.y[k] += noise(rng);
+  AutoResult dut;
+  ASSERT_TRUE(IdentifyAuto(data, IdentifyOptions{}, &dut).ok());
+  ASSERT_EQ(dut.candidates.size(), 4u);
+  ASSERT_GE(dut.chosen, 0);
+  EXPECT_EQ(dut.candidates[static_cast<std::size_t>(dut.chosen)].kind, GetParam()) << dut.reason;
+  EXPECT_NE(dut.reason.find("AIC"), std::string::npos) << dut.reason;
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, AutoChoice,
+                         ::testing::Values(ProcessModelKind::kP1D, ProcessModelKind::kP2D,
+                                           ProcessModelKind::kP2DU, ProcessModelKind::kP1DI),
+                         [](const ::testing::TestParamInfo<ProcessModelKind>& param_info) {
+                           return std::string(ToString(param_info.param));
+                         });
 
 Status Refusal(const IdentifyData& data) {
   IdentifyResult result;

@@ -10,9 +10,11 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "pidlab/figures/figures.h"
 #include "pidlab/identify/csv_data.h"
 #include "pidlab/identify/identify.h"
 #include "pidlab/json/identify_json.h"
+#include "pidlab/replay/log_reader.h"
 
 namespace pidlab::cli {
 namespace {
@@ -66,18 +68,34 @@ std::string Table(const IdentifyResult& r) {
   return os.str();
 }
 
+std::string WhitenessLine(const identify::Whiteness& w) {
+  std::ostringstream os;
+  os << "residuals: Ljung-Box Q " << Num(w.ljung_box_q, 5) << " over " << w.lags
+     << " lags, p = " << Num(w.p_value, 3) << (w.white ? " (white at 5 %)" : " (NOT white at 5 %)") << "; "
+     << w.outside_band << " of " << w.lags << " autocorrelations outside +-" << Num(w.band, 3) << "\n";
+  return os.str();
+}
+
 struct IdentifyCommand {
-  std::string csv, model, out;
+  std::string csv, log, model, out, plot_path;
+  std::vector<long> episode;
   bool json = false;
   identify::IdentifyOptions options;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
         "Fit a process model to a record: the columns t (s, uniform), u and y of a CSV with a header (any "
-        "order, other columns ignored). The record starts at rest: u0 = u[0], y0 = y[0]. Ceres fits the "
-        "exact ZOH response with a continuous delay from several starts (docs/identify.md).");
-    app->add_option("--csv", csv, "the CSV file with columns t, u, y")->required();
-    app->add_option("--model", model, "the model: " + identify::ProcessModelKindNames())->required();
+        "order, other columns ignored), or one episode of an LCM log of the trio (the plant's input u + n "
+        "and "
+        "the measured y of every step). By default the record starts at rest: u0 = u[0], y0 = y[0]. Ceres "
+        "fits the exact ZOH response with a continuous delay from several starts; --model auto fits every "
+        "kind and keeps the lowest AIC (docs/identify.md).");
+    app->add_option("--csv", csv, "the CSV file with columns t, u, y");
+    app->add_option("--log", log, "an LCM log of the trio ('pidlab launch --log')");
+    app->add_option("--episode", episode, "with --log: the episode id (needed when the log holds several)")
+        ->expected(1);
+    app->add_option("--model", model, "the model: " + identify::ProcessModelKindNames() + "|auto")
+        ->required();
     app->add_option("--starts", options.starts, "starting points of the multi-start fit")
         ->capture_default_str();
     app->add_option("--seed", options.seed,
@@ -86,14 +104,74 @@ struct IdentifyCommand {
     app->add_option("--u0", options.u0, "the input's operating point (default: the first sample of u)");
     app->add_option("--y0", options.y0, "the output's operating point (default: the first sample of y)");
     app->add_flag("--json", json, "print one JSON object");
-    app->add_option("--out", out, "also write the JSON object to this file");
+    app->add_option("--out", out,
+                    "also write the JSON object to this file (a model file for --plant model:FILE)");
+    app->add_option("--plot", plot_path,
+                    "also draw a PNG: measured and simulated output, residuals and their autocorrelation");
     return [this] { return Run(); };
   }
 
+  mutable long chosen_episode = 0;
+
+  identify::IdentifyData ReadData() const {
+    identify::IdentifyData data;
+    if (!csv.empty()) {
+      Require(identify::ReadCsvData(csv, &data));
+      return data;
+    }
+    replay::LogContents contents;
+    std::string error;
+    if (!replay::ReadLog(log, replay::ReadOptions{}, &contents, &error))
+      throw BadInput("--log " + Quote(log) + ": " + error);
+    // Without --episode: the one episode whose plant input u + n varies (an
+    // evaluate run logs its undisturbed twin too, whose input is constant).
+    std::vector<const replay::Episode*> found;
+    for (const replay::Episode& e : contents.episodes)
+      if (episode.empty() ? e.has_config && e.Complete() && InputVaries(e) : e.episode_id == episode[0])
+        found.push_back(&e);
+    if (!episode.empty() && found.empty())
+      throw BadInput("--episode " + std::to_string(episode[0]) + " is not in " + Quote(log));
+    if (found.empty())
+      throw BadInput("--log " + Quote(log) + " holds no complete episode whose input u + n varies");
+    if (found.size() > 1) {
+      std::string ids;
+      for (const replay::Episode* e : found) ids += (ids.empty() ? "" : ", ") + std::to_string(e->episode_id);
+      throw BadInput("--log " + Quote(log) + " holds " + std::to_string(found.size()) +
+                     " episodes with a varying input (" + ids + "): choose one with --episode");
+    }
+    chosen_episode = found[0]->episode_id;
+    const replay::Episode& e = *found[0];
+    if (!e.Complete())
+      throw BadInput("--log " + Quote(log) + ": episode " + std::to_string(e.episode_id) +
+                     " is incomplete: " + Truncate(e.CompletenessNote(), 200));
+    // Step k: y_k measured, then u_k + n_k held over [k dt, (k + 1) dt).
+    for (long k = 0; k < e.total_steps; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      data.t.push_back(static_cast<double>(k) * e.spec.dt_s);
+      data.u.push_back(e.u[i] + e.n[i]);
+      data.y.push_back(e.y[i]);
+    }
+    return data;
+  }
+
+  static bool InputVaries(const replay::Episode& e) {
+    for (long k = 1; k < e.total_steps; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      if (e.u[i] + e.n[i] != e.u[0] + e.n[0]) return true;
+    }
+    return false;
+  }
+
+  std::string Source() const { return !csv.empty() ? "--csv " + Quote(csv) : "--log " + Quote(log); }
+
   int Run() {
+    if (csv.empty() == log.empty()) throw BadInput("give exactly one of --csv FILE and --log FILE");
+    if (!episode.empty() && log.empty()) throw BadInput("--episode applies to --log only");
     identify::ProcessModelKind kind = identify::ProcessModelKind::kP1D;
-    if (!identify::Parse(model, &kind))
-      throw BadInput("--model " + Quote(model) + " must be one of " + identify::ProcessModelKindNames());
+    const bool automatic = model == "auto";
+    if (!automatic && !identify::Parse(model, &kind))
+      throw BadInput("--model " + Quote(model) + " must be one of " + identify::ProcessModelKindNames() +
+                     "|auto");
     if (options.starts < 1 || options.starts > 1000)
       throw BadInput("--starts " + std::to_string(options.starts) + " must be in [1, 1000]");
     if (!std::isnan(options.u0) && !std::isfinite(options.u0))
@@ -101,20 +179,58 @@ struct IdentifyCommand {
     if (!std::isnan(options.y0) && !std::isfinite(options.y0))
       throw BadInput("--y0 " + Num(options.y0) + " must be finite");
     if (!out.empty()) CheckOutputFile(out, "--out");
-    identify::IdentifyData data;
-    Require(identify::ReadCsvData(csv, &data));
+    if (!plot_path.empty()) CheckOutputFile(plot_path, "--plot");
+    const identify::IdentifyData data = ReadData();
+    // A log of the trio starts from the plant's zero state: its operating point is 0, not the first sample.
+    if (!log.empty()) {
+      if (std::isnan(options.u0)) options.u0 = 0.0;
+      if (std::isnan(options.y0)) options.y0 = 0.0;
+    }
     IdentifyResult result;
-    const Status status = identify::Identify(data, kind, options, &result);
-    if (status.code() == StatusCode::kInvalidInput)
-      throw BadInput("--csv " + Quote(csv) + ": " + status.message());
-    Require(status);
-    const nlohmann::json j = json::IdentifyResultJson(result);
+    nlohmann::json j;
+    std::string header;
+    if (automatic) {
+      identify::AutoResult a;
+      const Status status = identify::IdentifyAuto(data, options, &a);
+      if (status.code() == StatusCode::kInvalidInput) throw BadInput(Source() + ": " + status.message());
+      Require(status);
+      result = a.candidates[static_cast<std::size_t>(a.chosen)].result;
+      j = json::IdentifyAutoJson(a);
+      std::ostringstream os;
+      os << "auto: " << a.reason << "\n";
+      for (const identify::AutoCandidate& c : a.candidates)
+        os << "  " << std::left << std::setw(6) << identify::ToString(c.kind)
+           << (c.status.ok() ? "AIC " + Num(c.result.aic, 8) + ", fit " + Num(c.result.fit_percent, 6) + " %"
+                             : "failed: " + c.status.message())
+           << "\n";
+      header = os.str();
+    } else {
+      const Status status = identify::Identify(data, kind, options, &result);
+      if (status.code() == StatusCode::kInvalidInput) throw BadInput(Source() + ": " + status.message());
+      Require(status);
+      j = json::IdentifyResultJson(result);
+    }
+    if (!log.empty()) {
+      j["source"] = {{"log", log}, {"episode", chosen_episode}};
+      header = "log " + log + ", episode " + std::to_string(chosen_episode) + " (input u + n, measured y)\n" +
+               header;
+    } else {
+      j["source"] = {{"csv", csv}};
+    }
     if (!out.empty()) {
       std::ofstream f(out);
       f << j.dump(1) << "\n";
       if (!f.flush()) throw BadInput("--out " + Quote(out) + " cannot be written");
     }
-    std::cout << (json ? j.dump() + "\n" : Table(result));
+    if (!plot_path.empty()) {
+      plot::Figure figure;
+      std::string error;
+      if (!figures::IdentifyFigure(data, result, &figure, &error)) throw std::runtime_error(error);
+      figure.output_path = plot_path;
+      if (!plot::DrawPng(figure, &error)) throw std::runtime_error(error);
+    }
+    for (const std::string& w : result.warnings) std::cerr << "warning: " << w << "\n";
+    std::cout << (json ? j.dump() + "\n" : header + Table(result) + WhitenessLine(result.whiteness));
     return 0;
   }
 };

@@ -69,6 +69,26 @@ tf = j['transfer_function']
 assert abs(tf['num'][0] - 2) < 1e-6 and abs(tf['den'][0] - 1.5) < 1e-6 and tf['den'][1] == 1, tf
 assert abs(tf['delay_s'] - 0.25) < 1e-6, tf
 PY"
+pidlab identify --csv step.csv --model auto --json > auto.json 2> err
+check "--model auto fits every kind and chooses p1d by AIC, saying why" "[ $? -eq 0 ] && /usr/bin/python3 - auto.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+a = j['auto']
+assert a['chosen'] == 'p1d' == j['model'], a
+assert [c['model'] for c in a['candidates']] == ['p1d', 'p2d', 'p2du', 'p1di'], a
+best = min(c['aic'] for c in a['candidates'] if c['ok'])
+assert j['aic'] <= best + 2 and 'AIC' in a['reason'], a
+PY"
+pidlab identify --csv step.csv --model p1d --plot fit.png > /dev/null 2> err
+check "--plot draws a PNG of the fit" "[ $? -eq 0 ] && head -c 4 fit.png | grep -q PNG"
+pidlab identify --csv step.csv --model p1d --log x.lcmlog > out 2> err
+check "--csv with --log exits 2 with one line" "[ $? -eq 2 ] && only_line_ok err 'exactly one of --csv FILE and --log FILE'"
+pidlab identify --csv step.csv --model p1d --episode 3 > out 2> err
+check "--episode without --log exits 2 with one line" "[ $? -eq 2 ] && only_line_ok err '--episode applies to --log only'"
+pidlab identify --log missing.lcmlog --model p1d > out 2> err
+check "a missing log exits 2 with one line" "[ $? -eq 2 ] && only_line_ok err 'missing.lcmlog'"
+pidlab identify --csv step.csv --model p1d --u0 inf > out 2> err
+check "--u0 inf exits 2 with one line" "[ $? -eq 2 ] && only_line_ok err '--u0'"
 pidlab identify --csv step.csv --model p2d --out model.json > /dev/null 2> err
 check "--out writes the JSON object" \
   "[ $? -eq 0 ] && /usr/bin/python3 -c 'import json; j = json.load(open(\"model.json\")); assert j[\"model\"] == \"p2d\"'"
@@ -81,7 +101,7 @@ head -n 15 step.csv > short.csv
 awk -F, 'NR == 1 { print; next } { print "1," $2 ",0," $4 }' step.csv > constant.csv
 for case in "nocolumn.csv --model p1d|names no column t" "badcell.csv --model p1d|row 40, column y: 'abc'" \
             "nan.csv --model p1d|not finite: u at sample 38" "short.csv --model p1d|too short: 14 samples" \
-            "constant.csv --model p1d|constant input" "step.csv --model auto|--model 'auto'" \
+            "constant.csv --model p1d|constant input" "step.csv --model p9d|--model 'p9d'" \
             "missing.csv --model p1d|cannot be read"; do
   args=${case%%|*} needle=${case#*|}
   "$pidlab" identify --csv $args > out 2> err

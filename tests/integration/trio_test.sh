@@ -3,7 +3,7 @@
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
 # ever sent outside its loopback. CASE: identity | faults | drop20 | realtime | kill | sigstop | trios | trio_killed | stranger |
-# log | log_repair | motor | delay | excite.
+# log | log_repair | motor | delay | excite | identify_log.
 set -u
 BIN=$1
 CASE=$2
@@ -447,6 +447,46 @@ PY
     else
       echo "FAIL docs/identify.md: $n_docs commands, chirp.csv $(wc -l <"$TMP/docs/chirp.csv" 2>&1)"; fail=1
     fi
+    ;;
+  identify_log)
+    # docs/identify.md, "Identifying a model from a log": an open-loop PRBS
+    # experiment over the trio, logged; identify --log with the figure; every
+    # kind fitted by --model auto, written as a model file. Commands as written
+    # there (its ```shell block), then the figures checked.
+    docs=$(dirname "${BASH_SOURCE[0]}")/../../docs/identify.md
+    mkdir -p "$TMP/idlog"
+    n_docs=0
+    while IFS= read -r cmd; do
+      n_docs=$((n_docs + 1))
+      if ! (cd "$TMP/idlog" && PATH="$BIN:$PATH" bash -c "$cmd") >"$TMP/idlog/out.$n_docs" 2>"$TMP/idlog/err.$n_docs"; then
+        echo "FAIL docs/identify.md: $cmd: $(tail -1 "$TMP/idlog/err.$n_docs")"; fail=1
+      fi
+    done < <(awk '/^```shell/{on=1; next} /^```/{on=0} on && /^pidlab /' "$docs")
+    [ "$n_docs" -eq 3 ] || { echo "FAIL docs/identify.md has $n_docs shell commands, not 3"; fail=1; }
+    if python3 - "$TMP/idlog" <<'PY'
+import json, re, sys
+d = sys.argv[1]
+table = open(d + "/out.2").read()
+values = {m.group(1): (float(m.group(2)), float(m.group(3)))
+          for m in re.finditer(r"^(Kp|Tp1|Tp2|Td) +(\S+) +(\S+)$", table, re.M)}
+truth = {"Kp": 1.0, "Tp1": 1.0, "Tp2": 1.0, "Td": 0.23}
+for name, want in truth.items():
+    v, se = values[name]
+    assert abs(v - want) <= 1.96 * se, (name, v, se, want)
+assert "(white at 5 %)" in table, table
+assert open(d + "/fit.png", "rb").read(4)[1:4] == b"PNG"
+j = json.load(open(d + "/model.json"))
+assert j["source"]["log"] == "id.lcmlog" and j["auto"]["chosen"] in ("p2d", "p2du"), j["auto"]
+assert j["covariance"]["ok"] and len(j["covariance"]["matrix"]) == len(j["parameters"]), j["covariance"]
+print("ok   identify --log: " + ", ".join(f"{n} {values[n][0]:.4g} +- {1.96 * values[n][1]:.2g}" for n in truth)
+      + f"; auto chose {j['auto']['chosen']}")
+PY
+    then :; else echo "FAIL identify --log: the truth is not within the intervals"; fail=1; fi
+    # Bad logs: an episode not in it; a log with two excited episodes.
+    "$PIDLAB" identify --log "$TMP/idlog/id.lcmlog" --model p1d --episode 12345 >/dev/null 2>"$TMP/idlog/bad" ;
+    if [ $? -eq 2 ] && grep -q -- "--episode 12345 is not in" "$TMP/idlog/bad" && [ "$(wc -l <"$TMP/idlog/bad")" -eq 1 ]; then
+      echo "ok   identify --log with an episode not in it exits 2 with one line"
+    else echo "FAIL identify --log --episode 12345: $(cat "$TMP/idlog/bad")"; fail=1; fi
     ;;
   *)
     echo "unknown case $CASE"; exit 2 ;;

@@ -4,6 +4,39 @@
 
 namespace pidlab::json {
 
+nlohmann::json WhitenessJson(const identify::Whiteness& w) {
+  nlohmann::json r = nlohmann::json::array();
+  for (double v : w.autocorrelation) r.push_back(JsonNumber(v));
+  return {{"lags", w.lags},
+          {"autocorrelation", r},
+          {"band", JsonNumber(w.band)},
+          {"outside_band", w.outside_band},
+          {"ljung_box_q", JsonNumber(w.ljung_box_q)},
+          {"p_value", JsonNumber(w.p_value)},
+          {"white", w.white}};
+}
+
+nlohmann::json IdentifyAutoJson(const identify::AutoResult& a) {
+  nlohmann::json j = IdentifyResultJson(a.candidates.at(static_cast<std::size_t>(a.chosen)).result);
+  nlohmann::json candidates = nlohmann::json::array();
+  const double best = a.candidates.at(static_cast<std::size_t>(a.chosen)).result.aic;
+  for (const identify::AutoCandidate& c : a.candidates) {
+    nlohmann::json cj = {{"model", identify::ToString(c.kind)}, {"ok", c.status.ok()}};
+    if (c.status.ok()) {
+      cj["aic"] = JsonNumber(c.result.aic);
+      cj["delta_aic"] = JsonNumber(c.result.aic - best);
+      cj["fit_percent"] = JsonNumber(c.result.fit_percent);
+    } else {
+      cj["message"] = c.status.message();
+    }
+    candidates.push_back(cj);
+  }
+  j["auto"] = {{"chosen", identify::ToString(a.candidates.at(static_cast<std::size_t>(a.chosen)).kind)},
+               {"reason", a.reason},
+               {"candidates", candidates}};
+  return j;
+}
+
 nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
   nlohmann::json parameters = nlohmann::json::object();
   for (std::size_t i = 0; i < r.names.size(); ++i)
@@ -34,6 +67,8 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
           {"starts", r.starts},
           {"starts_at_best", r.starts_at_best},
           {"seed", r.seed},
+          {"whiteness", WhitenessJson(r.whiteness)},
+          {"warnings", r.warnings},
           {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}, {"matrix", matrix}}}};
 }
 

@@ -8,6 +8,7 @@
 #include "pidlab/identify/identify.h"
 
 #include <ceres/ceres.h>
+#include <glog/logging.h>
 
 #include <algorithm>
 #include <cmath>
@@ -165,7 +166,13 @@ bool Covariance(const Record& record, std::vector<double> theta, double cost, st
   covariance_options.num_threads = 1;
   ceres::Covariance covariance(covariance_options);
   std::vector<std::pair<const double*, const double*>> blocks = {{theta.data(), theta.data()}};
-  if (!covariance.Compute(blocks, &problem)) {
+  // Ceres logs a rank-deficient J'J through glog as an error on stderr; the
+  // result says it in its own words (covariance_message), so keep glog quiet.
+  const int log_level = FLAGS_minloglevel;
+  FLAGS_minloglevel = google::GLOG_FATAL;
+  const bool computed = covariance.Compute(blocks, &problem);
+  FLAGS_minloglevel = log_level;
+  if (!computed) {
     *message = "Ceres could not compute the covariance (J'J singular or ill-conditioned)";
     return false;
   }
@@ -177,7 +184,8 @@ bool Covariance(const Record& record, std::vector<double> theta, double cost, st
   // d value / d theta: the value for a logarithm, else 1.
   std::vector<double> d(static_cast<std::size_t>(p));
   for (int i = 0; i < p; ++i)
-    d[static_cast<std::size_t>(i)] = IsLogParameter(record.kind, i) ? values[static_cast<std::size_t>(i)] : 1.0;
+    d[static_cast<std::size_t>(i)] =
+        IsLogParameter(record.kind, i) ? values[static_cast<std::size_t>(i)] : 1.0;
   for (int i = 0; i < p; ++i)
     for (int j = 0; j < p; ++j) {
       const auto ij = static_cast<std::size_t>(i * p + j);
@@ -281,6 +289,39 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
   return best;
 }
 
+// The plain warnings of IdentifyResult::warnings.
+std::vector<std::string> Warnings(const IdentifyResult& r, double dt_s, double length_s, double max_delay_s) {
+  std::vector<std::string> w;
+  if (!r.covariance_ok) w.push_back("no intervals: " + r.covariance_message);
+  for (std::size_t i = 0; i < r.names.size() && r.covariance_ok; ++i) {
+    const double half = 1.96 * r.standard_errors[i];
+    if (half > std::abs(r.values[i]))
+      w.push_back(r.names[i] + " = " + Number(r.values[i]) + " +- " + Number(half) +
+                  " (95 %): the interval is wider than the value, so the data do not determine " +
+                  r.names[i]);
+  }
+  const double td = r.model.td_s;
+  if (td >= max_delay_s * (1 - 1e-6))
+    w.push_back("Td = " + Number(td) + " s is at its bound (" + Number(max_delay_s) +
+                " s, half the record): the delay may be longer than the record can show");
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
+    if (!IsLogParameter(r.model.kind, static_cast<int>(i))) continue;
+    const double t = r.values[i];
+    if (t <= dt_s / kTimeConstantRange * (1 + 1e-6) || t >= length_s * kTimeConstantRange * (1 - 1e-6))
+      w.push_back(r.names[i] + " = " + Number(t) + " s is at its bound [" +
+                  Number(dt_s / kTimeConstantRange) + ", " + Number(length_s * kTimeConstantRange) +
+                  "] s: the model's order may be wrong");
+  }
+  // An exact fit (residual RMS below 1e-9 of the output's spread, as with
+  // noise-free data) leaves rounding in its residuals: not worth a warning.
+  const bool exact = r.fit_percent > 100.0 * (1.0 - 1e-9);
+  if (r.whiteness.lags > 0 && !r.whiteness.white && !exact)
+    w.push_back("the residuals are not white (Ljung-Box Q = " + Number(r.whiteness.ljung_box_q) + " over " +
+                std::to_string(r.whiteness.lags) + " lags, p = " + Number(r.whiteness.p_value) +
+                "): the model leaves dynamics unexplained, or the noise is coloured");
+  return w;
+}
+
 // Figures of merit of the fit at `theta` into *result.
 void Summarise(const Record& record, const IdentifyData& data, const std::vector<double>& theta, double cost,
                IdentifyResult* result) {
@@ -298,6 +339,15 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
   result->aic = n * std::log(2.0 * cost / n) + 2.0 * p;
   result->covariance_ok = Covariance(record, theta, cost, &result->standard_errors, &result->covariance,
                                      &result->covariance_message);
+  std::vector<double> yhat;
+  if (TrySimulate(result->model, record.du, record.dt_s, &yhat)) {
+    for (std::size_t k = 0; k < yhat.size(); ++k) {
+      result->simulated.push_back(result->y0 + yhat[k]);
+      result->residuals.push_back(record.dy[k] - yhat[k]);
+    }
+    result->whiteness = ResidualWhiteness(result->residuals);
+  }
+  result->warnings = Warnings(*result, record.dt_s, record.length_s, record.max_delay_s);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "pidlab/evaluation/evaluation.h"
+#include "pidlab/identify/identify.h"
 #include "pidlab/plot/plot.h"
 
 namespace pidlab::figures {
@@ -22,5 +23,11 @@ bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains,
 /// if the log cannot be read or holds no matching episode.
 bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, plot::Figure* figure,
                std::string* report, std::string* error);
+
+/// `pidlab identify --plot`: the measured output and the model's, the
+/// residuals, and their autocorrelation with the 95 % band of white noise
+/// (three panels). False with *error if the result has no simulated output.
+bool IdentifyFigure(const identify::IdentifyData& data, const identify::IdentifyResult& result,
+                    plot::Figure* figure, std::string* error);
 
 }  // namespace pidlab::figures

@@ -11,8 +11,13 @@ namespace pidlab::json {
 
 /// model (p1d|p2d|p2du|p1di), parameters {name: {value, standard_error}},
 /// transfer_function {num, den, delay_s}, fit_percent, aic, aic_form, cost,
-/// samples, dt_s, u0, y0, starts, starts_at_best, covariance {ok, message}
-/// (null for NaN and +-inf).
+/// samples, dt_s, u0, y0, starts, starts_at_best, seed, whiteness {lags,
+/// autocorrelation, band, outside_band, ljung_box_q, p_value, white},
+/// warnings [text], covariance {ok, message, matrix} (null for NaN and +-inf).
 nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r);
+nlohmann::json WhitenessJson(const identify::Whiteness& w);
+/// The chosen kind's IdentifyResultJson with "auto" {chosen, reason,
+/// candidates [{model, ok, aic, delta_aic, fit_percent | message}]}.
+nlohmann::json IdentifyAutoJson(const identify::AutoResult& a);
 
 }  // namespace pidlab::json

@@ -49,6 +49,24 @@ struct IdentifyOptions {
   bool IsValid(std::string* error) const;
 };
 
+/// Whether the residuals look like white noise: their normalised
+/// autocorrelation r_k = sum e_i e_{i+k} / sum e_i^2 at lags 1..lags, the 95 %
+/// band +-1.96/sqrt(N) of white noise, and the Ljung-Box statistic
+/// Q = N (N + 2) sum r_k^2 / (N - k), chi-square with `lags` degrees of
+/// freedom when the residuals are white (MATLAB's resid draws the same band).
+struct Whiteness {
+  int lags = 0;
+  std::vector<double> autocorrelation;  // r_1 .. r_lags
+  double band = 0.0;                    // 1.96 / sqrt(N)
+  int outside_band = 0;                 // lags with |r_k| > band
+  double ljung_box_q = 0.0;
+  double p_value = std::numeric_limits<double>::quiet_NaN();  // P(chi2_lags > Q)
+  bool white = false;                                         // p_value >= 0.05
+};
+
+/// The whiteness of `residuals` over min(25, N / 4) lags (at least 1).
+Whiteness ResidualWhiteness(const std::vector<double>& residuals);
+
 struct IdentifyResult {
   ProcessModel model;
   std::vector<std::string> names;  // ParameterNames(model.kind)
@@ -71,6 +89,26 @@ struct IdentifyResult {
   std::uint64_t seed = 0;           // the design's shift (IdentifyOptions::seed)
   int starts_at_best = 0;           // starts whose cost is the best's within 1e-8 relative
   std::vector<double> start_costs;  // final cost of every start, in design order
+  /// The model's output y0 + yhat_k at every sample, and y_k - that.
+  std::vector<double> simulated, residuals;
+  Whiteness whiteness;
+  /// Plain sentences on what the data leave undetermined: a parameter whose
+  /// 95 % interval is wider than its value, residuals that are not white, a
+  /// delay or time constant at its bound, no covariance.
+  std::vector<std::string> warnings;
+};
+
+/// `pidlab identify --model auto`: every kind fitted, one chosen by AIC
+/// (IdentifyAuto), and why in one sentence.
+struct AutoCandidate {
+  ProcessModelKind kind = ProcessModelKind::kP1D;
+  Status status;  // of Identify for this kind
+  IdentifyResult result;
+};
+struct AutoResult {
+  std::vector<AutoCandidate> candidates;  // in the order of the kinds
+  int chosen = -1;                        // index into candidates
+  std::string reason;
 };
 
 /// Status kInvalidInput with one plain message naming the reason unless the
@@ -87,5 +125,11 @@ std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<d
 /// (CheckData, IdentifyOptions::IsValid); kRunnerFailed if no start converged.
 Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
                 IdentifyResult* result);
+
+/// Fits every kind (P1D, P2D, P2DU, P1DI) and chooses the lowest AIC, or,
+/// among the kinds within 2 of it (which the data hardly tell apart), the one
+/// of fewest parameters (then the lowest AIC among those).
+/// kInvalidInput as Identify; kRunnerFailed if no kind could be fitted.
+Status IdentifyAuto(const IdentifyData& data, const IdentifyOptions& options, AutoResult* result);
 
 }  // namespace pidlab::identify
