@@ -243,6 +243,66 @@ class Spec(unittest.TestCase):
             pidlab.evaluate("oscillator", (1, 2, 3), horizon="long")
 
 
+class Identify(unittest.TestCase):
+    """pidlab.identify on numpy arrays against `pidlab identify --csv --json` of the same record."""
+
+    @classmethod
+    def setUpClass(cls):
+        import numpy as np
+        import tempfile
+        rng = np.random.default_rng(4)
+        n, dt = 300, 0.1
+        cls.t = np.arange(n) * dt
+        cls.u = np.repeat(rng.uniform(-1.0, 1.0, n // 10), 10)
+        cls.u[:5] = 0.0
+        # A first-order lag with a fractional delay of 0.25 s, exact under ZOH
+        # (a = e^(-dt/Tp1); the held input starts 0.05 s into a sample).
+        kp, tp1, td = 1.5, 2.0, 0.25
+        y = np.zeros(n)
+        state = 0.0
+        for k in range(n - 1):
+            # input held over [k dt, (k+1) dt), delayed by td: in [k dt, (k+1) dt) the
+            # plant sees u[k-3] for 0.05 s then u[k-2] for 0.05 s.
+            for value, h in ((cls.u[k - 3] if k >= 3 else 0.0, 0.05), (cls.u[k - 2] if k >= 2 else 0.0, 0.05)):
+                a = np.exp(-h / tp1)
+                state = a * state + (1 - a) * kp * value
+            y[k + 1] = state
+        cls.y = y + 0.002 * rng.standard_normal(n) * (np.arange(n) > 0)
+        cls.dir = tempfile.mkdtemp()
+        cls.csv = os.path.join(cls.dir, "record.csv")
+        with open(cls.csv, "w") as f:
+            f.write("t,u,y\n")
+            for row in zip(cls.t, cls.u, cls.y):
+                f.write("%.17g,%.17g,%.17g\n" % row)
+
+    def test_numpy_arrays_give_the_cli_json(self):
+        for model in ("p1d", "auto"):
+            got = pidlab.identify(self.t, self.u, self.y, model=model)
+            want = cli("identify", "--csv", self.csv, "--model", model)
+            del want["source"]
+            self.assertEqual(got, want, model)
+        self.assertEqual(got["auto"]["chosen"], "p1d")
+        p = got["parameters"]
+        for name, true in (("Kp", 1.5), ("Tp1", 2.0), ("Td", 0.25)):
+            self.assertLess(abs(p[name]["value"] - true), 4 * p[name]["standard_error"], name)
+
+    def test_lists_and_options_reach_the_fit(self):
+        got = pidlab.identify(list(self.t), list(self.u), list(self.y), model="p1d", starts=3, seed=7, u0=0, y0=0)
+        self.assertEqual((got["starts"], got["seed"], got["u0"], got["y0"]), (3, 7, 0, 0))
+
+    def test_bad_data_and_arguments_raise_value_error_naming_them(self):
+        with self.assertRaisesRegex(ValueError, "too short: 5 samples"):
+            pidlab.identify(self.t[:5], self.u[:5], self.y[:5])
+        with self.assertRaisesRegex(ValueError, "model = 'p9d'"):
+            pidlab.identify(self.t, self.u, self.y, model="p9d")
+        with self.assertRaisesRegex(ValueError, "constant input"):
+            pidlab.identify(self.t, 0 * self.u, self.y)
+        with self.assertRaisesRegex(ValueError, "u must be a sequence"):
+            pidlab.identify(self.t, "abc", self.y)
+        with self.assertRaisesRegex(ValueError, "starts = 0"):
+            pidlab.identify(self.t, self.u, self.y, starts=0)
+
+
 class Messages(unittest.TestCase):
     def test_the_package_also_holds_the_lcm_messages(self):
         m = pidlab.lcmt_control_command()

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "pidlab/evaluation/evaluation.h"
+#include "identify_binding.h"
 #include "pidlab/json/results_json.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
@@ -312,4 +313,5 @@ PYBIND11_MODULE(_pidlab, m) {
       "The fields of evaluate's or tune's spec: key (the keyword), flag, help, unit, default, example, and "
       "whether it travels to the trio (episode).",
       py::arg("which") = "evaluate");
+  DefineIdentify(m);
 }

@@ -1,0 +1,88 @@
+// pidlab.identify(t, u, y, model=...): the fit of `pidlab identify`
+// (pidlab::identify) on arrays, returning the dict of `pidlab identify
+// --json` (the same code builds it: pidlab::json). docs/python.md.
+
+#include "identify_binding.h"
+
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+
+#include "pidlab/identify/identify.h"
+#include "pidlab/json/identify_json.h"
+
+namespace py = pybind11;
+
+namespace pidlab::python {
+namespace {
+
+py::object ToDict(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+// A sequence of numbers (a list, a tuple, a numpy array) as doubles; a
+// ValueError naming the argument otherwise.
+std::vector<double> Column(const py::object& values, const char* name) {
+  try {
+    return values.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+    throw py::value_error(std::string("identify: ") + name + " must be a sequence of numbers");
+  }
+}
+
+double OperatingPoint(const py::object& value, const char* name) {
+  if (value.is_none()) return std::numeric_limits<double>::quiet_NaN();
+  const double v = value.cast<double>();
+  if (!std::isfinite(v)) throw py::value_error(std::string("identify: ") + name + " must be finite");
+  return v;
+}
+
+py::object IdentifyPy(const py::object& t, const py::object& u, const py::object& y, const std::string& model,
+                      int starts, std::uint64_t seed, const py::object& u0, const py::object& y0) {
+  identify::IdentifyData data{Column(t, "t"), Column(u, "u"), Column(y, "y")};
+  identify::IdentifyOptions options;
+  options.starts = starts;
+  options.seed = seed;
+  options.u0 = OperatingPoint(u0, "u0");
+  options.y0 = OperatingPoint(y0, "y0");
+  if (starts < 1 || starts > 1000)
+    throw py::value_error("identify: starts = " + std::to_string(starts) + " must be in [1, 1000]");
+  Status status;
+  nlohmann::json j;
+  if (model == "auto") {
+    identify::AutoResult result;
+    {
+      py::gil_scoped_release release;
+      status = identify::IdentifyAuto(data, options, &result);
+    }
+    if (status.ok()) j = json::IdentifyAutoJson(result);
+  } else {
+    identify::ProcessModelKind kind = identify::ProcessModelKind::kP1D;
+    if (!identify::Parse(model, &kind))
+      throw py::value_error("identify: model = '" + model + "' must be one of " +
+                            identify::ProcessModelKindNames() + "|auto");
+    identify::IdentifyResult result;
+    {
+      py::gil_scoped_release release;
+      status = identify::Identify(data, kind, options, &result);
+    }
+    if (status.ok()) j = json::IdentifyResultJson(result);
+  }
+  if (status.code() == StatusCode::kInvalidInput) throw py::value_error("identify: " + status.message());
+  if (!status.ok()) throw std::runtime_error("identify: " + status.message());
+  return ToDict(j);
+}
+
+}  // namespace
+
+void DefineIdentify(py::module_& m) {
+  m.def("identify", &IdentifyPy,
+        "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None): fits a process model "
+        "(p1d, p2d, p2du, p1di, or auto to choose by AIC) to the record t (s, uniform), u, y (lists or numpy "
+        "arrays) and returns the dict of `pidlab identify --json`. u0, y0: the operating point (None: the "
+        "first sample). Bad data or arguments raise ValueError naming the reason (docs/identify.md).",
+        py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",
+        py::arg("starts") = 16, py::arg("seed") = 0, py::arg("u0") = py::none(), py::arg("y0") = py::none());
+}
+
+}  // namespace pidlab::python
