@@ -67,6 +67,7 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
           {"starts", r.starts},
           {"starts_at_best", r.starts_at_best},
           {"seed", r.seed},
+          {"arx_start", r.arx_start},
           {"whiteness", WhitenessJson(r.whiteness)},
           {"warnings", r.warnings},
           {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}, {"matrix", matrix}}}};

@@ -17,6 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "arx_start.h"
 #include "pidlab/optim/sobol.h"
 #include "pidlab/plant_sim/discrete_plant.h"
 
@@ -99,6 +100,20 @@ void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) 
   problem->SetParameterUpperBound(theta, p - 1, record.max_delay_s);
 }
 
+// Kp by linear least squares at the other parameters of *theta: the model is
+// linear in it. Left at 1 if the model cannot be simulated.
+void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
+  (*theta)[0] = 1.0;
+  std::vector<double> g;
+  if (!TrySimulate(ModelOf(record.kind, theta->data()), record.du, record.dt_s, &g)) return;
+  double gy = 0.0, gg = 0.0;
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    gy += g[k] * record.dy[k];
+    gg += g[k] * g[k];
+  }
+  if (gg > 0.0 && std::isfinite(gy / gg)) (*theta)[0] = gy / gg;
+}
+
 // Start `index` of the design: time constants log-spaced over [dt/2, T/2],
 // Zeta over [0.1, 0.9], Td over [0, min(max delay, T/4)], by the points of a
 // Sobol' sequence (optim/sobol.h, as the tuner's multi-start), digitally
@@ -118,17 +133,49 @@ std::vector<double> StartPoint(const Record& record, const optim::SobolSequence&
     else
       theta[static_cast<std::size_t>(i)] = 0.1 + 0.8 * hi_coordinate;
   }
-  theta[0] = 1.0;
-  std::vector<double> g;
-  if (TrySimulate(ModelOf(record.kind, theta.data()), record.du, record.dt_s, &g)) {
-    double gy = 0.0, gg = 0.0;
-    for (std::size_t k = 0; k < g.size(); ++k) {
-      gy += g[k] * record.dy[k];
-      gg += g[k] * g[k];
-    }
-    if (gg > 0.0 && std::isfinite(gy / gg)) theta[0] = gy / gg;
-  }
+  SetGainByLeastSquares(record, &theta);
   return theta;
+}
+
+// The output-error cost of *theta with Kp set by least squares.
+double ScreenCost(const Record& record, std::vector<double>* theta) {
+  SetGainByLeastSquares(record, theta);
+  std::vector<double> yhat;
+  if (!TrySimulate(ModelOf(record.kind, theta->data()), record.du, record.dt_s, &yhat))
+    return std::numeric_limits<double>::infinity();
+  double cost = 0.0;
+  for (std::size_t k = 0; k < yhat.size(); ++k)
+    cost += 0.5 * (record.dy[k] - yhat[k]) * (record.dy[k] - yhat[k]);
+  return cost;
+}
+
+// The start from the ARX candidates (arx_start.h) of lowest output-error
+// cost, inside the bounds; empty if there is none.
+std::vector<double> ArxStartPoint(const Record& record) {
+  const int p = ParameterCount(record.kind);
+  std::vector<double> best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (const std::vector<double>& values :
+       internal::ArxCandidates(record.kind, record.du, record.dy, record.dt_s, record.max_delay_s)) {
+    std::vector<double> theta(static_cast<std::size_t>(p));
+    for (int i = 1; i < p; ++i) {
+      const double v = values[static_cast<std::size_t>(i)];
+      if (IsLogParameter(record.kind, i))
+        theta[static_cast<std::size_t>(i)] =
+            std::clamp(std::log(v), std::log(record.dt_s / kTimeConstantRange),
+                       std::log(record.length_s * kTimeConstantRange));
+      else if (i == p - 1)
+        theta[static_cast<std::size_t>(i)] = std::clamp(v, 0.0, record.max_delay_s);
+      else
+        theta[static_cast<std::size_t>(i)] = std::clamp(v, kMinZeta, kMaxZeta);
+    }
+    const double cost = ScreenCost(record, &theta);
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = theta;
+    }
+  }
+  return best;
 }
 
 // One start's fit; the final cost, or infinity if Ceres failed.
@@ -271,21 +318,26 @@ namespace {
 
 // The best of the starts: its theta, and every start's cost.
 std::vector<double> MultiStart(const Record& record, const IdentifyOptions& options,
-                               std::vector<double>* costs) {
+                               std::vector<double>* costs, bool* arx_used) {
   std::vector<double> best;
   double best_cost = std::numeric_limits<double>::infinity();
   const int dimensions = ParameterCount(record.kind) - 1;
   const optim::SobolSequence sobol =
       options.seed == 0 ? optim::SobolSequence(dimensions) : optim::SobolSequence(dimensions, options.seed);
-  for (int s = 0; s < options.starts; ++s) {
-    std::vector<double> theta = StartPoint(record, sobol, s);
+  const auto fit = [&](std::vector<double> theta) {
     const double cost = FitFrom(record, options, &theta);
     costs->push_back(cost);
     if (cost < best_cost) {
       best_cost = cost;
       best = theta;
     }
+  };
+  if (options.arx_start) {
+    std::vector<double> theta = ArxStartPoint(record);
+    *arx_used = !theta.empty();
+    if (*arx_used) fit(theta);
   }
+  for (int s = 0; s < options.starts; ++s) fit(StartPoint(record, sobol, s));
   return best;
 }
 
@@ -369,7 +421,7 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   }
   record.length_s = data.t.back() - data.t.front();
   record.max_delay_s = options.max_delay_fraction * record.length_s;
-  std::vector<double> theta = MultiStart(record, options, &result->start_costs);
+  std::vector<double> theta = MultiStart(record, options, &result->start_costs, &result->arx_start);
   if (theta.empty()) return Status::RunnerFailed("no start of the fit converged");
   // P2D's time constants are interchangeable: report Tp1 >= Tp2.
   if (kind == ProcessModelKind::kP2D && theta[2] > theta[1]) std::swap(theta[1], theta[2]);
@@ -380,7 +432,7 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   // cost ~ 0) is measured against 1e-16 of the cost of the zero model.
   const double tolerance = 1e-8 * std::max(best, 1e-16 * scale);
   for (double c : result->start_costs) result->starts_at_best += c - best <= tolerance ? 1 : 0;
-  result->starts = options.starts;
+  result->starts = static_cast<int>(result->start_costs.size());
   result->seed = options.seed;
   result->samples = static_cast<int>(data.y.size());
   result->dt_s = record.dt_s;

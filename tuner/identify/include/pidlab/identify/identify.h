@@ -36,6 +36,10 @@ struct IdentifyOptions {
   /// The design's digital shift (SobolSequence(d, seed)); 0: the unshifted
   /// sequence, whose first start is the lower corner of every range.
   std::uint64_t seed = 0;
+  /// Also start from an ARX least-squares estimate (the poles of a linear
+  /// regression of y on its past and on u delayed by the best of a scan),
+  /// before the design's starts.
+  bool arx_start = true;
   /// The delay's upper bound as a fraction of the record's length, in (0, 1).
   double max_delay_fraction = 0.5;
   /// Levenberg-Marquardt iterations per start, >= 1.
@@ -85,7 +89,8 @@ struct IdentifyResult {
   double u0 = 0.0, y0 = 0.0;        // the operating point used
   double dt_s = 0.0;                // the sampling interval found
   int samples = 0;                  // N
-  int starts = 0;                   // starts run
+  int starts = 0;                   // starts run: the design's, plus the ARX start if used
+  bool arx_start = false;           // start_costs[0] is the ARX start
   std::uint64_t seed = 0;           // the design's shift (IdentifyOptions::seed)
   int starts_at_best = 0;           // starts whose cost is the best's within 1e-8 relative
   std::vector<double> start_costs;  // final cost of every start, in design order
