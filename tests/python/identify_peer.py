@@ -97,6 +97,22 @@ def _gain(model, p, du, dy, dt):
     return (g @ dy) / gg if gg > 0 else 1.0
 
 
+def default_starts(model):
+    """A grid of 9 starts: time constants 0.5, 2 and 5 s, delays 0, 0.5 and
+    1 s (Kp then by linear least squares); P2D's Tp2 a quarter of Tp1, P2DU's
+    Zeta 0.5."""
+    starts = []
+    for tc in (0.5, 2.0, 5.0):
+        for td in (0.0, 0.5, 1.0):
+            if model == "p2d":
+                starts.append([1.0, tc, tc / 4, td])
+            elif model == "p2du":
+                starts.append([1.0, tc, 0.5, td])
+            else:
+                starts.append([1.0, tc, td])
+    return starts
+
+
 def fit(model, t, u, y, starts=None):
     """The output-error fit of `model` to the record (t, u, y) with u0 = u[0]
     and y0 = y[0]: least_squares (trf, 3-point differences, bounds) from a
@@ -115,17 +131,7 @@ def fit(model, t, u, y, starts=None):
     upper = {"p1d": [np.inf, 1e3 * length, length / 2], "p2d": [np.inf, 1e3 * length, 1e3 * length, length / 2],
              "p2du": [np.inf, 1e3 * length, 1 - 1e-9, length / 2], "p1di": [np.inf, 1e3 * length, length / 2]}[model]
     if starts is None:
-        constants = (0.5, 2.0, 5.0)
-        delays = (0.0, 0.5, 1.0)
-        starts = []
-        for tc in constants:
-            for td in delays:
-                if model == "p2d":
-                    starts += [[1.0, tc, tc / 4, td]]
-                elif model == "p2du":
-                    starts += [[1.0, tc, 0.5, td]]
-                else:
-                    starts += [[1.0, tc, td]]
+        starts = default_starts(model)
     best = None
     for p0 in starts:
         p0 = np.array(p0, dtype=float)
