@@ -15,8 +15,10 @@
 # otherwise). Builds nothing.
 #   bench/identify_bench.sh [PIDLAB] [SAMPLES] [REPEATS]   (defaults build/bin/pidlab 10000 3)
 set -euo pipefail
+pidlab=${1:-}
+[ -z "$pidlab" ] || pidlab=$(realpath -m -- "$pidlab")  # relative to where it is run from
 cd "$(dirname "$0")/.."
-pidlab=${1:-build/bin/pidlab}
+pidlab=${pidlab:-build/bin/pidlab}
 samples=${2:-10000}
 repeats=${3:-3}
 [ -x "$pidlab" ] || { echo "identify_bench.sh: $pidlab is not an executable (build pidlab first)" >&2; exit 2; }
