@@ -61,7 +61,8 @@ std::string Table(const IdentifyResult& r) {
   os << "fit " << Num(r.fit_percent, 6) << " %, AIC " << Num(r.aic, 6) << " (N log(2 cost / N) + 2 p), cost "
      << Num(r.cost, 4) << "\n"
      << r.samples << " samples at dt " << Num(r.dt_s) << " s, offsets u0 " << Num(r.u0) << ", y0 "
-     << Num(r.y0) << "\n"
+     << Num(r.y0)
+     << (r.y0_estimated ? " (estimated, standard error " + Num(r.y0_standard_error, 3) + ")" : "") << "\n"
      << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)\n"
      << "num " << Polynomial(tf.num) << " den " << Polynomial(tf.den) << " delay "
      << Num(r.model.delay_s(), 10) << " s\n";
@@ -87,7 +88,8 @@ struct IdentifyCommand {
         "Fit a process model to a record: the columns t (s, uniform), u and y of a CSV with a header (any "
         "order, other columns ignored), or one episode of an LCM log of the trio (the plant's input u + n "
         "and "
-        "the measured y of every step). By default the record starts at rest: u0 = u[0], y0 = y[0]. Ceres "
+        "the measured y of every step). By default the record starts at rest at u0 = u[0] and y0 is "
+        "estimated with the model. Ceres "
         "fits the exact ZOH response with a continuous delay from several starts; --model auto fits every "
         "kind and keeps the lowest AIC (docs/identify.md).");
     app->add_option("--csv", csv, "the CSV file with columns t, u, y");
@@ -101,8 +103,10 @@ struct IdentifyCommand {
     app->add_option("--seed", options.seed,
                     "digital shift of the starts' Sobol' design (0: the unshifted sequence)")
         ->capture_default_str();
-    app->add_option("--u0", options.u0, "the input's operating point (default: the first sample of u)");
-    app->add_option("--y0", options.y0, "the output's operating point (default: the first sample of y)");
+    app->add_option("--u0", options.u0,
+                    "the input's operating point (default: the first sample of u; a log's: 0)");
+    app->add_option("--y0", options.y0,
+                    "the output's operating point (default: estimated with the model; a log's: 0)");
     app->add_flag("--json", json, "print one JSON object");
     app->add_option("--out", out,
                     "also write the JSON object to this file (a model file for --plant model:FILE)");

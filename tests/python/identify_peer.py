@@ -115,16 +115,17 @@ def default_starts(model):
 
 def fit(model, t, u, y, starts=None):
     """The output-error fit of `model` to the record (t, u, y) with u0 = u[0]
-    and y0 = y[0]: least_squares (trf, 3-point differences, bounds) from a
-    grid of starts, the best kept. Returns (parameters, cost = 1/2 sum r^2,
-    the least_squares result)."""
+    and the output offset y0 estimated with the model (pidlab's default), from
+    y[0]: least_squares (trf, 3-point differences, bounds) from a grid of
+    starts, the best kept. Returns (parameters, cost = 1/2 sum r^2, the
+    least_squares result); result.y0 is the estimated y0."""
     t, u, y = (np.asarray(v, dtype=float) for v in (t, u, y))
     dt = (t[-1] - t[0]) / (len(t) - 1)
     length = t[-1] - t[0]
     du, dy = u - u[0], y - y[0]
 
-    def residuals(p):
-        return dy - simulate(model, p, du, dt)
+    def residuals(q):
+        return dy - q[-1] - simulate(model, q[:-1], du, dt)
 
     lower = {"p1d": [-np.inf, dt / 1e3, 0.0], "p2d": [-np.inf, dt / 1e3, dt / 1e3, 0.0],
              "p2du": [-np.inf, dt / 1e3, 1e-3, 0.0], "p1di": [-np.inf, dt / 1e3, 0.0]}[model]
@@ -136,11 +137,14 @@ def fit(model, t, u, y, starts=None):
     for p0 in starts:
         p0 = np.array(p0, dtype=float)
         p0[0] = _gain(model, p0, du, dy, dt)
-        r = optimize.least_squares(residuals, p0, bounds=(lower, upper), method="trf", jac="3-point",
+        q0 = np.append(p0, 0.0)
+        r = optimize.least_squares(residuals, q0, bounds=(lower + [-np.inf], upper + [np.inf]), method="trf",
+                                   jac="3-point",
                                    x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=2000)
         if best is None or r.cost < best.cost:
             best = r
-    p = np.array(best.x)
+    p = np.array(best.x[:-1])
+    best.y0 = y[0] + best.x[-1]
     if model == "p2d" and p[2] > p[1]:
         p[1], p[2] = p[2], p[1]
     return p, best.cost, best

@@ -73,7 +73,7 @@ def main():
                   "%s noise-free, simulated in scipy: pidlab recovers %s, worst relative error %.2g"
                   % (model, dict(zip(peer.NAMES[model], truth)), relative(ours, np.array(truth))))
 
-            # 30 dB; y[0] noisy too: both take y0 = y[0].
+            # 30 dB; y[0] noisy too: both estimate y0 with the model.
             y = clean + rng.normal(0.0, np.std(clean) / np.sqrt(1000.0), SAMPLES) + Y0
             u = du + U0
             path = os.path.join(tmp, model + ".csv")
@@ -83,6 +83,8 @@ def main():
             converged = result.status > 0 and abs(cost - j["cost"]) <= 1e-8 * j["cost"]
             check(converged, "%s noisy: both converge to the same cost (pidlab %.17g, scipy %.17g, status %d)"
                   % (model, j["cost"], cost, result.status))
+            check(abs(j["y0"] - result.y0) <= TOL * abs(result.y0) and j["y0_estimated"],
+                  "%s noisy: the estimated y0 agrees (pidlab %.12g, scipy %.12g)" % (model, j["y0"], result.y0))
             worst = relative(ours, theirs)
             check(worst <= TOL, "%s noisy: pidlab %s, scipy %s, worst relative difference %.2g"
                   % (model, np.array2string(ours, precision=10), np.array2string(theirs, precision=10), worst))

@@ -288,7 +288,8 @@ class Identify(unittest.TestCase):
 
     def test_lists_and_options_reach_the_fit(self):
         got = pidlab.identify(list(self.t), list(self.u), list(self.y), model="p1d", starts=3, seed=7, u0=0, y0=0)
-        self.assertEqual((got["starts"], got["seed"], got["u0"], got["y0"]), (3, 7, 0, 0))
+        self.assertEqual((got["starts"] - got["arx_start"], got["seed"], got["u0"], got["y0"]), (3, 7, 0, 0))
+        self.assertFalse(got["y0_estimated"])
 
     def test_bad_data_and_arguments_raise_value_error_naming_them(self):
         with self.assertRaisesRegex(ValueError, "too short: 5 samples"):

@@ -76,13 +76,15 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
 }  // namespace
 
 void DefineIdentify(py::module_& m) {
-  m.def("identify", &IdentifyPy,
-        "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None): fits a process model "
-        "(p1d, p2d, p2du, p1di, or auto to choose by AIC) to the record t (s, uniform), u, y (lists or numpy "
-        "arrays) and returns the dict of `pidlab identify --json`. u0, y0: the operating point (None: the "
-        "first sample). Bad data or arguments raise ValueError naming the reason (docs/identify.md).",
-        py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",
-        py::arg("starts") = 16, py::arg("seed") = 0, py::arg("u0") = py::none(), py::arg("y0") = py::none());
+  m.def(
+      "identify", &IdentifyPy,
+      "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None): fits a process model "
+      "(p1d, p2d, p2du, p1di, or auto to choose by AIC) to the record t (s, uniform), u, y (lists or numpy "
+      "arrays) and returns the dict of `pidlab identify --json`. u0, y0: the operating point (None: u0 the "
+      "first sample, y0 estimated with the model). Bad data or arguments raise ValueError naming the reason "
+      "(docs/identify.md).",
+      py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",
+      py::arg("starts") = 16, py::arg("seed") = 0, py::arg("u0") = py::none(), py::arg("y0") = py::none());
 }
 
 }  // namespace pidlab::python

@@ -64,6 +64,8 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
           {"dt_s", JsonNumber(r.dt_s)},
           {"u0", JsonNumber(r.u0)},
           {"y0", JsonNumber(r.y0)},
+          {"y0_estimated", r.y0_estimated},
+          {"y0_standard_error", JsonNumber(r.y0_standard_error)},
           {"starts", r.starts},
           {"starts_at_best", r.starts_at_best},
           {"seed", r.seed},

@@ -36,9 +36,16 @@ struct Record {
   ProcessModelKind kind;
   std::vector<double> du, dy;
   double dt_s = 0.0, length_s = 0.0, max_delay_s = 0.0;
+  /// The output offset is a parameter too: theta[p] is added to y0.
+  bool offset = false;
 };
 
 int ParameterCount(ProcessModelKind kind) { return static_cast<int>(ParameterNames(kind).size()); }
+// Ceres's parameter block: the model's parameters, then the offset if estimated.
+int BlockSize(const Record& record) { return ParameterCount(record.kind) + (record.offset ? 1 : 0); }
+double OffsetOf(const Record& record, const double* theta) {
+  return record.offset ? theta[ParameterCount(record.kind)] : 0.0;
+}
 
 // theta[i] is the logarithm of a time constant.
 bool IsLogParameter(ProcessModelKind kind, int i) {
@@ -74,7 +81,8 @@ struct OutputError {
   bool operator()(double const* const* parameters, double* residuals) const {
     std::vector<double> yhat;
     if (!TrySimulate(ModelOf(record->kind, parameters[0]), record->du, record->dt_s, &yhat)) return false;
-    for (std::size_t k = 0; k < yhat.size(); ++k) residuals[k] = record->dy[k] - yhat[k];
+    const double offset = OffsetOf(*record, parameters[0]);
+    for (std::size_t k = 0; k < yhat.size(); ++k) residuals[k] = record->dy[k] - offset - yhat[k];
     return true;
   }
 };
@@ -84,7 +92,7 @@ void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) 
   auto* cost =
       new ceres::DynamicNumericDiffCostFunction<OutputError, ceres::CENTRAL>(new OutputError{&record});
   const int p = ParameterCount(record.kind);
-  cost->AddParameterBlock(p);
+  cost->AddParameterBlock(BlockSize(record));
   cost->SetNumResiduals(static_cast<int>(record.dy.size()));
   problem->AddResidualBlock(cost, nullptr, theta);
   for (int i = 1; i < p - 1; ++i) {
@@ -103,15 +111,31 @@ void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) 
 // Kp by linear least squares at the other parameters of *theta: the model is
 // linear in it. Left at 1 if the model cannot be simulated.
 void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
+  const int p = ParameterCount(record.kind);
   (*theta)[0] = 1.0;
+  if (record.offset) (*theta)[static_cast<std::size_t>(p)] = 0.0;
   std::vector<double> g;
   if (!TrySimulate(ModelOf(record.kind, theta->data()), record.du, record.dt_s, &g)) return;
-  double gy = 0.0, gg = 0.0;
+  // dy ~ Kp g + offset: the normal equations of one or two unknowns.
+  const double n = static_cast<double>(g.size());
+  double gy = 0.0, gg = 0.0, sg = 0.0, sy = 0.0;
   for (std::size_t k = 0; k < g.size(); ++k) {
     gy += g[k] * record.dy[k];
     gg += g[k] * g[k];
+    sg += g[k];
+    sy += record.dy[k];
   }
-  if (gg > 0.0 && std::isfinite(gy / gg)) (*theta)[0] = gy / gg;
+  if (!record.offset) {
+    if (gg > 0.0 && std::isfinite(gy / gg)) (*theta)[0] = gy / gg;
+    return;
+  }
+  const double det = gg * n - sg * sg;
+  if (!(det > 1e-12 * gg * n)) return;
+  const double kp = (gy * n - sg * sy) / det, offset = (gg * sy - sg * gy) / det;
+  if (std::isfinite(kp) && std::isfinite(offset)) {
+    (*theta)[0] = kp;
+    (*theta)[static_cast<std::size_t>(p)] = offset;
+  }
 }
 
 // Start `index` of the design: time constants log-spaced over [dt/2, T/2],
@@ -121,7 +145,7 @@ void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
 // model being linear in it.
 std::vector<double> StartPoint(const Record& record, const optim::SobolSequence& sobol, int index) {
   const int p = ParameterCount(record.kind);
-  std::vector<double> theta(static_cast<std::size_t>(p), 0.0);
+  std::vector<double> theta(static_cast<std::size_t>(BlockSize(record)), 0.0);
   const double lo = std::log(0.5 * record.dt_s), hi = std::log(0.5 * record.length_s);
   const Eigen::VectorXd h = sobol.Point(static_cast<std::uint32_t>(index));
   for (int i = 1; i < p; ++i) {
@@ -143,9 +167,10 @@ double ScreenCost(const Record& record, std::vector<double>* theta) {
   std::vector<double> yhat;
   if (!TrySimulate(ModelOf(record.kind, theta->data()), record.du, record.dt_s, &yhat))
     return std::numeric_limits<double>::infinity();
+  const double offset = OffsetOf(record, theta->data());
   double cost = 0.0;
   for (std::size_t k = 0; k < yhat.size(); ++k)
-    cost += 0.5 * (record.dy[k] - yhat[k]) * (record.dy[k] - yhat[k]);
+    cost += 0.5 * (record.dy[k] - offset - yhat[k]) * (record.dy[k] - offset - yhat[k]);
   return cost;
 }
 
@@ -157,7 +182,7 @@ std::vector<double> ArxStartPoint(const Record& record) {
   double best_cost = std::numeric_limits<double>::infinity();
   for (const std::vector<double>& values :
        internal::ArxCandidates(record.kind, record.du, record.dy, record.dt_s, record.max_delay_s)) {
-    std::vector<double> theta(static_cast<std::size_t>(p));
+    std::vector<double> theta(static_cast<std::size_t>(BlockSize(record)), 0.0);
     for (int i = 1; i < p; ++i) {
       const double v = values[static_cast<std::size_t>(i)];
       if (IsLogParameter(record.kind, i))
@@ -201,8 +226,10 @@ double FitFrom(const Record& record, const IdentifyOptions& options, std::vector
 // p x p, row-major) and their standard errors, scaled by the residual
 // variance; false with the reason if Ceres cannot invert J'J.
 bool Covariance(const Record& record, std::vector<double> theta, double cost, std::vector<double>* errors,
-                std::vector<double>* matrix, std::string* message) {
+                std::vector<double>* matrix, double* offset_error, std::string* message) {
   const int p = ParameterCount(record.kind);
+  const int q = BlockSize(record);
+  *offset_error = kNaN;
   const int n = static_cast<int>(record.dy.size());
   errors->assign(static_cast<std::size_t>(p), kNaN);
   matrix->assign(static_cast<std::size_t>(p * p), kNaN);
@@ -223,9 +250,17 @@ bool Covariance(const Record& record, std::vector<double> theta, double cost, st
     *message = "Ceres could not compute the covariance (J'J singular or ill-conditioned)";
     return false;
   }
+  std::vector<double> full(static_cast<std::size_t>(q * q));
+  covariance.GetCovarianceBlock(theta.data(), theta.data(), full.data());
+  // The model's block (the offset's row and column left out: the marginal
+  // covariance of the model's parameters).
   std::vector<double> c(static_cast<std::size_t>(p * p));
-  covariance.GetCovarianceBlock(theta.data(), theta.data(), c.data());
-  const double variance = 2.0 * cost / std::max(1, n - p);
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j < p; ++j)
+      c[static_cast<std::size_t>(i * p + j)] = full[static_cast<std::size_t>(i * q + j)];
+  const double variance = 2.0 * cost / std::max(1, n - q);
+  if (record.offset)
+    *offset_error = std::sqrt(std::max(0.0, full[static_cast<std::size_t>(q * q - 1)] * variance));
   const ProcessModel model = ModelOf(record.kind, theta.data());
   const std::vector<double> values = ParameterValues(model);
   // d value / d theta: the value for a logarithm, else 1.
@@ -377,7 +412,6 @@ std::vector<std::string> Warnings(const IdentifyResult& r, double dt_s, double l
 // Figures of merit of the fit at `theta` into *result.
 void Summarise(const Record& record, const IdentifyData& data, const std::vector<double>& theta, double cost,
                IdentifyResult* result) {
-  const int p = ParameterCount(record.kind);
   const double n = static_cast<double>(data.y.size());
   result->model = ModelOf(record.kind, theta.data());
   result->names = ParameterNames(record.kind);
@@ -388,14 +422,17 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
   double spread = 0.0;
   for (double v : data.y) spread += (v - mean) * (v - mean);
   result->fit_percent = 100.0 * (1.0 - std::sqrt(2.0 * cost) / std::sqrt(spread));
-  result->aic = n * std::log(2.0 * cost / n) + 2.0 * p;
+  result->aic = n * std::log(2.0 * cost / n) + 2.0 * BlockSize(record);
+  const double offset = OffsetOf(record, theta.data());
+  result->y0 += offset;
+  result->y0_estimated = record.offset;
   result->covariance_ok = Covariance(record, theta, cost, &result->standard_errors, &result->covariance,
-                                     &result->covariance_message);
+                                     &result->y0_standard_error, &result->covariance_message);
   std::vector<double> yhat;
   if (TrySimulate(result->model, record.du, record.dt_s, &yhat)) {
     for (std::size_t k = 0; k < yhat.size(); ++k) {
       result->simulated.push_back(result->y0 + yhat[k]);
-      result->residuals.push_back(record.dy[k] - yhat[k]);
+      result->residuals.push_back(record.dy[k] - offset - yhat[k]);
     }
     result->whiteness = ResidualWhiteness(result->residuals);
   }
@@ -414,7 +451,9 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   if (!status.ok()) return status;
   *result = IdentifyResult{};
   result->u0 = std::isnan(options.u0) ? data.u[0] : options.u0;
+  // Not given: estimated, from the first sample as its start.
   result->y0 = std::isnan(options.y0) ? data.y[0] : options.y0;
+  record.offset = std::isnan(options.y0);
   for (std::size_t k = 0; k < data.u.size(); ++k) {
     record.du.push_back(data.u[k] - result->u0);
     record.dy.push_back(data.y[k] - result->y0);

@@ -44,8 +44,10 @@ struct IdentifyOptions {
   double max_delay_fraction = 0.5;
   /// Levenberg-Marquardt iterations per start, >= 1.
   int max_iterations = 200;
-  /// The operating point subtracted from u and y; NaN means the first sample
-  /// (the record starts at rest).
+  /// The operating point subtracted from u and y. u0 NaN: the first sample
+  /// of u (the record starts at rest). y0 NaN: estimated with the model (an
+  /// output offset fitted from y[0] as its start), so that the noise of one
+  /// sample does not shift every residual.
   double u0 = std::numeric_limits<double>::quiet_NaN();
   double y0 = std::numeric_limits<double>::quiet_NaN();
 
@@ -85,8 +87,10 @@ struct IdentifyResult {
   std::string covariance_message;   // why it failed, else empty
   double cost = 0.0;                // 1/2 sum of squared residuals
   double fit_percent = 0.0;         // 100 (1 - |y - yhat| / |y - mean y|)
-  double aic = 0.0;                 // N log(2 cost / N) + 2 p
+  double aic = 0.0;                 // N log(2 cost / N) + 2 p (p with y0 if estimated)
   double u0 = 0.0, y0 = 0.0;        // the operating point used
+  bool y0_estimated = false;        // y0 was a parameter of the fit
+  double y0_standard_error = std::numeric_limits<double>::quiet_NaN();  // if estimated
   double dt_s = 0.0;                // the sampling interval found
   int samples = 0;                  // N
   int starts = 0;                   // starts run: the design's, plus the ARX start if used
@@ -130,6 +134,19 @@ std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<d
 /// (CheckData, IdentifyOptions::IsValid); kRunnerFailed if no start converged.
 Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
                 IdentifyResult* result);
+
+/// A pole of the identified model with the standard errors of its real and
+/// imaginary parts (the delta method: the parameters' covariance carried
+/// through the pole's derivatives, taken by central differences).
+struct PoleEstimate {
+  double re = 0.0, im = 0.0;
+  double re_se = std::numeric_limits<double>::quiet_NaN();
+  double im_se = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// The poles of `result.model` (roots of its denominator, the upper one of a
+/// complex pair first), with standard errors when the covariance is ok.
+std::vector<PoleEstimate> PoleEstimates(const IdentifyResult& result);
 
 /// Fits every kind (P1D, P2D, P2DU, P1DI) and chooses the lowest AIC, or,
 /// among the kinds within 2 of it (which the data hardly tell apart), the one
