@@ -66,6 +66,14 @@ std::string Table(const IdentifyResult& r) {
      << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)\n"
      << "num " << Polynomial(tf.num) << " den " << Polynomial(tf.den) << " delay "
      << Num(r.model.delay_s(), 10) << " s\n";
+  os << "poles (+- 1.96 standard errors):";
+  for (const identify::PoleEstimate& p : identify::PoleEstimates(r)) {
+    os << " " << Num(p.re, 7) << " (+-" << Num(1.96 * p.re_se, 2) << ")";
+    if (p.im != 0.0)
+      os << (p.im > 0 ? " + " : " - ") << Num(std::abs(p.im), 7) << "j (+-" << Num(1.96 * p.im_se, 2) << ")";
+    os << ";";
+  }
+  os << "\n";
   return os.str();
 }
 

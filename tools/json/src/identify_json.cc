@@ -53,9 +53,16 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
     for (std::size_t j = 0; j < p; ++j) row.push_back(JsonNumber(r.covariance[i * p + j]));
     matrix.push_back(row);
   }
+  nlohmann::json poles = nlohmann::json::array();
+  for (const identify::PoleEstimate& pole : identify::PoleEstimates(r))
+    poles.push_back({{"re", JsonNumber(pole.re)},
+                     {"im", JsonNumber(pole.im)},
+                     {"re_standard_error", JsonNumber(pole.re_se)},
+                     {"im_standard_error", JsonNumber(pole.im_se)}});
   return {{"model", identify::ToString(r.model.kind)},
           {"parameters", parameters},
           {"transfer_function", {{"num", num}, {"den", den}, {"delay_s", JsonNumber(r.model.delay_s())}}},
+          {"poles", poles},
           {"fit_percent", JsonNumber(r.fit_percent)},
           {"aic", JsonNumber(r.aic)},
           {"aic_form", "N log(2 cost / N) + 2 p"},
