@@ -107,7 +107,7 @@ struct EvaluateCommand {
           " rows, more than 1e7: use a coarser --dt or a shorter --horizon");
     if (s.monte_carlo > 0 && backend == "lcm")
       throw BadInput("--monte-carlo runs in process: use --backend local");
-    if (s.monte_carlo > 0 && p.delay_s > 0.0)
+    if (s.monte_carlo > 0 && p.delay_s > 0.0 && !p.model)
       throw BadInput("--monte-carlo with --delay is not supported yet (its draws are undelayed plants)");
     if (s.monte_carlo > 0 && p.nonlinear)
       throw BadInput("--monte-carlo draws linear plants: it does not take --plant " + Quote(p.name));
@@ -170,12 +170,22 @@ struct EvaluateCommand {
     }
   }
 
+  // 100 x, as %g prints it (10, not 10.000000000000002).
+  static std::string Percent(double fraction) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", 100.0 * fraction);
+    return text;
+  }
+
   static std::string FormatMonteCarlo(const MonteCarloOptions& mc, const MonteCarloSummary& s) {
     char line[256];
     std::string out;
-    std::snprintf(line, sizeof line, "monte carlo      %d plants, %s within +/-%g %%, seed %llu\n", s.samples,
-                  s.perturbed.c_str(), 100.0 * mc.spread, static_cast<unsigned long long>(mc.seed));
-    out += line;
+    if (s.perturbed == analysis::kCovariancePerturbed)
+      out += "monte carlo      " + std::to_string(s.samples) + " plants from the " + s.perturbed + " (" +
+             std::to_string(s.redrawn) + " redrawn), seed " + std::to_string(mc.seed) + "\n";
+    else
+      out += "monte carlo      " + std::to_string(s.samples) + " plants, " + s.perturbed + " within +/-" +
+             Percent(mc.spread) + " %, seed " + std::to_string(mc.seed) + "\n";
     std::snprintf(line, sizeof line, "  stable         %d of %d (%.4g %%)%s\n", s.stable, s.samples,
                   100.0 * s.stable_fraction,
                   s.invalid ? (" (" + std::to_string(s.invalid) + " invalid draws)").c_str() : "");

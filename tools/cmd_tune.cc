@@ -42,6 +42,13 @@ using pidlab::tune::TuneSummary;
 namespace pidlab::cli {
 namespace {
 
+// 100 x, as %g prints it (10, not 10.000000000000002).
+std::string Percent(double fraction) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", 100.0 * fraction);
+  return text;
+}
+
 struct TuneCommand {
   SpecFlags flags;
   std::string backend = "local", trace;
@@ -156,7 +163,11 @@ struct TuneCommand {
               << (s.refine.message.empty() ? "" : ": ") << s.refine.message << "\n";
     if (o.robust_samples > 0)
       std::cout << "robust set       " << s.robust_set_size << " plants (nominal + " << o.robust_samples
-                << " draws at " << 100.0 * o.robust_spread << " % spread"
+                << " draws "
+                << (s.robust_perturbed == analysis::kCovariancePerturbed
+                        ? "from the " + s.robust_perturbed + " (" + std::to_string(s.robust_redrawn) +
+                              " redrawn)"
+                        : "at " + Percent(o.robust_spread) + " % spread")
                 << (s.robust_invalid_draws > 0
                         ? ", " + std::to_string(s.robust_invalid_draws) + " invalid left out"
                         : std::string())

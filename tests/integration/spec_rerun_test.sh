@@ -48,6 +48,30 @@ if same delay_lcm.json delay_local.json backend steps_per_second realtime &&
   pass "a delayed plant over the trio, run again in process from its spec: the same numbers"
 else fail "a delayed plant over the trio and its spec in process differ"; fi
 
+# An identified model as the plant (docs/identify.md, "The identified model
+# as a plant"): the episode carries its num/den/delay as a custom plant's (the
+# plant process reads no file); bit for bit in process, and equal to the
+# custom plant of the same num/den/delay over the trio.
+cat >model.json <<'JSON'
+{"model": "p1d",
+ "parameters": {"Kp": {"value": 1, "standard_error": 0.01}, "Tp1": {"value": 1, "standard_error": 0.01},
+                "Td": {"value": 0.3, "standard_error": 0.01}},
+ "transfer_function": {"num": [1], "den": [1, 1], "delay_s": 0.3},
+ "covariance": {"ok": true, "message": "", "matrix": [[1e-4, 0, 0], [0, 1e-4, 0], [0, 0, 1e-4]]}}
+JSON
+run evaluate --backend lcm --model model.json --gains 1,1,0 --horizon 5 \
+  --json >model_lcm.json 2>err || fail "a model plant over the trio: $(tail -1 err)"
+"$bin/pidlab" evaluate --spec model_lcm.json --json >model_local.json 2>err ||
+  fail "evaluate --spec (model): $(tail -1 err)"
+if same model_lcm.json model_local.json backend steps_per_second realtime &&
+  /usr/bin/python3 -c '
+import json, sys
+m, d = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert m["spec"]["plant"] == "model:model.json", m["spec"]["plant"]
+assert m["iae"] == d["iae"] and m["samples"] == d["samples"], (m["iae"], d["iae"])' model_local.json delay_lcm.json; then
+  pass "a model plant over the trio: its spec in process and the custom plant of its num/den/delay give the same numbers"
+else fail "a model plant over the trio differs from its spec in process or from the custom plant"; fi
+
 # A closed-loop PRBS experiment with noise on the measured y
 # (docs/identify.md): the spec echoes "measurement_noise", and runs again bit
 # for bit in process.

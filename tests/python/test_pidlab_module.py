@@ -9,6 +9,7 @@ Run by ctest (cli.python_module) as
 import json
 import os
 import subprocess
+import tempfile
 import unittest
 
 import pidlab
@@ -302,6 +303,54 @@ class Identify(unittest.TestCase):
             pidlab.identify(self.t, "abc", self.y)
         with self.assertRaisesRegex(ValueError, "starts = 0"):
             pidlab.identify(self.t, self.u, self.y, starts=0)
+
+
+class Model(unittest.TestCase):
+    """model=FILE and plant="model:FILE": the file `pidlab identify --out`
+    writes as the plant, the same as the command line's --model FILE."""
+
+    MODEL = {
+        "model": "p1d",
+        "parameters": {"Kp": {"value": 1.8, "standard_error": 0.018},
+                       "Tp1": {"value": 1.3, "standard_error": 0.023},
+                       "Td": {"value": 0.29, "standard_error": 0.008}},
+        "transfer_function": {"num": [1.8], "den": [1.3, 1.0], "delay_s": 0.29},
+        "covariance": {"ok": True, "message": "",
+                       "matrix": [[3.3e-4, 3.1e-4, -6.8e-5], [3.1e-4, 5.2e-4, -1.1e-4], [-6.8e-5, -1.1e-4, 6.4e-5]]},
+    }
+
+    def setUp(self):
+        self.dir = tempfile.TemporaryDirectory()
+        self.path = os.path.join(self.dir.name, "model.json")
+        with open(self.path, "w") as f:
+            json.dump(self.MODEL, f)
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def test_model_keyword_equals_the_cli_and_the_plant_form(self):
+        got = pidlab.evaluate(model=self.path, gains=(0.5, 0.4, 0), loop="sampled")
+        want = cli("evaluate", "--model", self.path, "--gains", "0.5,0.4,0", "--loop", "sampled")
+        self.assertEqual(got, want)
+        self.assertEqual(got["spec"]["plant"], "model:" + self.path)
+        by_plant = pidlab.evaluate("model:" + self.path, (0.5, 0.4, 0), loop="sampled")
+        custom = pidlab.evaluate(([1.8], [1.3, 1.0]), (0.5, 0.4, 0), loop="sampled", delay=0.29)
+        self.assertEqual(by_plant["iae"], got["iae"])
+        self.assertEqual(custom["iae"], got["iae"])
+        self.assertEqual(pidlab.evaluate(**got["spec"]), got)
+
+    def test_tune_draws_the_robust_set_from_the_covariance(self):
+        got = pidlab.tune(model=self.path, loop="sampled", horizon=10, robust_samples=4, seed=1, max_evals=40,
+                          refine=False)
+        want = cli("tune", "--model", self.path, "--loop", "sampled", "--horizon", "10", "--robust-samples", "4",
+                   "--seed", "1", "--max-evals", "40", "--refine", "none")
+        self.assertEqual(got["robust_set"], want["robust_set"])
+        self.assertEqual(got["gains"], want["gains"])
+        self.assertEqual(got["robust_set"]["perturbed"], "identified model's parameter covariance")
+
+    def test_a_bad_model_file_is_a_value_error_naming_the_file(self):
+        with self.assertRaisesRegex(ValueError, "model file '.*missing.json' cannot be read"):
+            pidlab.evaluate(model=os.path.join(self.dir.name, "missing.json"), gains=(1, 1, 0))
 
 
 class Messages(unittest.TestCase):

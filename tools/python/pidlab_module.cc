@@ -155,10 +155,12 @@ void ReadKwargs(const char* function, const py::dict& kwargs, Spec* spec, std::s
   }
 }
 
-/// The keywords with the positional plant (a name, or (num, den)) and gains.
+/// The keywords with the positional plant (a name, or (num, den); None: not
+/// given, e.g. with model=FILE) and gains.
 py::dict WithPositional(const py::object& plant, const py::object* gains, py::kwargs kwargs) {
   py::dict kw(kwargs);
-  if (py::isinstance<py::str>(plant)) {
+  if (plant.is_none()) {
+  } else if (py::isinstance<py::str>(plant)) {
     kw["plant"] = plant;
   } else {
     const py::sequence tf = plant.cast<py::sequence>();
@@ -166,7 +168,7 @@ py::dict WithPositional(const py::object& plant, const py::object* gains, py::kw
     kw["num"] = tf[0];
     kw["den"] = tf[1];
   }
-  if (gains) kw["gains"] = *gains;
+  if (gains && !gains->is_none()) kw["gains"] = *gains;
   // refine=True/False: the flag's ceres/none.
   if (kw.contains("refine") && py::isinstance<py::bool_>(kw["refine"]))
     kw["refine"] = kw["refine"].cast<bool>() ? "ceres" : "none";
@@ -269,19 +271,20 @@ PYBIND11_MODULE(_pidlab, m) {
   m.attr("__version__") = PIDLAB_VERSION;
   m.def("evaluate", &EvaluatePy,
         "evaluate(plant, gains, **spec): evaluates gains (kp, ki, kd) on a plant given by name "
-        "('double_integrator', 'oscillator', 'stepper_motor', 'stepper_nonlinear' and their aliases) or as "
+        "('double_integrator', 'oscillator', 'stepper_motor', 'stepper_nonlinear' and their aliases, or "
+        "'model:FILE', the model `pidlab identify --out` wrote; or model=FILE and no plant) or as "
         "(num, den) in descending powers of s. The keywords are the flags of `pidlab evaluate` with '_' for "
         "'-' "
         "(spec_fields('evaluate')); evaluate(**result['spec']) runs a result again. Returns the dict of "
         "`pidlab evaluate --json`.",
-        py::arg("plant"), py::arg("gains"));
+        py::arg("plant") = py::none(), py::arg("gains") = py::none());
   m.def("tune", &TunePy,
         "tune(plant, **spec): tunes PID gains and returns the dict of `pidlab tune --json`. The keywords are "
         "the "
         "flags of `pidlab tune` with '_' for '-' (spec_fields('tune')); the defaults are the command's. "
         "robust=True applies `pidlab tune --robust`; a keyword of the preset given next to it overrides its "
         "part, as the flags do.",
-        py::arg("plant"));
+        py::arg("plant") = py::none());
   m.def(
       "read_spec",
       [](const std::string& which, py::kwargs kwargs) {

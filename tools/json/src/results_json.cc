@@ -159,12 +159,17 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
                       {"derivative_filter_s", o.loop.pid.derivative_filter_s},
                       {"derivative_filter_ratio", o.loop.derivative_filter_ratio}};
   if (o.robust_samples > 0)
-    j["robust_set"] = {{"samples", o.robust_samples},
-                       {"spread", o.robust_spread},
-                       {"quantile", o.robust_quantile},
-                       {"size", s.robust_set_size},
-                       {"invalid_draws", s.robust_invalid_draws},
-                       {"nominal_objective", JsonNumber(s.nominal_objective)}};
+    j["robust_set"] = {
+        {"samples", o.robust_samples},
+        // null where the draws come from a model's covariance (no spread)
+        {"spread", s.robust_perturbed == analysis::kCovariancePerturbed ? nlohmann::json(nullptr)
+                                                                        : nlohmann::json(o.robust_spread)},
+        {"quantile", o.robust_quantile},
+        {"size", s.robust_set_size},
+        {"invalid_draws", s.robust_invalid_draws},
+        {"redrawn", s.robust_redrawn},
+        {"perturbed", s.robust_perturbed},
+        {"nominal_objective", JsonNumber(s.nominal_objective)}};
   if (s.stable) AddMotor(ev, &j);
   return j;
 }
@@ -233,11 +238,13 @@ nlohmann::json DistributionJson(const Distribution& d) {
 
 nlohmann::json MonteCarloJson(const MonteCarloOptions& mc, const MonteCarloSummary& s) {
   return {{"samples", s.samples},
-          {"spread", mc.spread},
+          {"spread", s.perturbed == analysis::kCovariancePerturbed ? nlohmann::json(nullptr)
+                                                                   : nlohmann::json(mc.spread)},
           {"seed", mc.seed},
           {"perturbed", s.perturbed},
           {"stable", s.stable},
           {"invalid", s.invalid},
+          {"redrawn", s.redrawn},
           {"stable_fraction", s.stable_fraction},
           {"iae", DistributionJson(s.iae)},
           {"overshoot_pct", DistributionJson(s.overshoot_pct)},

@@ -2,6 +2,8 @@
 
 #include "pidlab/analysis/monte_carlo.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,12 +11,73 @@
 #include <sstream>
 
 namespace pidlab::analysis {
+
+using plant_sim::ModelFromValues;
+using plant_sim::ParametersAreValid;
+using plant_sim::ProcessModel;
+using plant_sim::ProcessModelUncertainty;
+
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // u in [-1, 1) from 53 bits of the generator: the same on every platform.
 double Uniform(std::mt19937_64* rng) { return 2.0 * static_cast<double>((*rng)() >> 11) * 0x1.0p-53 - 1.0; }
+
+// A standard normal by Box-Muller from two 53-bit uniforms (u1 in (0, 1]), so
+// that the draws do not depend on the standard library's distributions.
+double StandardNormal(std::mt19937_64* rng) {
+  const double u1 = static_cast<double>(((*rng)() >> 11) + 1) * 0x1.0p-53;
+  const double u2 = static_cast<double>((*rng)() >> 11) * 0x1.0p-53;
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586476925 * u2);
+}
+
+// A square root S of the covariance, S S^T = C: its Cholesky factor, or, for
+// a matrix that is only semi-definite (a parameter the data did not move),
+// V sqrt(max(D, 0)) from its eigendecomposition.
+Eigen::MatrixXd CovarianceRoot(const ProcessModelUncertainty& m) {
+  const auto p = static_cast<Eigen::Index>(m.values.size());
+  const Eigen::MatrixXd c =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          m.covariance.data(), p, p);
+  const Eigen::LLT<Eigen::MatrixXd> llt(c);
+  if (llt.info() == Eigen::Success) return llt.matrixL();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(c);
+  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+}
+
+// The plants of a model's draws: parameter vectors from N(values,
+// covariance), each redrawn while it is not a model's (ParametersAreValid)
+// up to kMaxModelRedraws times; a draw that never is has an empty tf.
+std::vector<Plant> DrawModelPlants(const Plant& nominal, const MonteCarloOptions& o, int* redrawn) {
+  const ProcessModelUncertainty& m = *nominal.model;
+  const Eigen::MatrixXd root = CovarianceRoot(m);
+  const auto p = static_cast<Eigen::Index>(m.values.size());
+  const Eigen::VectorXd mean = Eigen::Map<const Eigen::VectorXd>(m.values.data(), p);
+  std::mt19937_64 rng(o.seed);
+  std::vector<Plant> plants;
+  plants.reserve(static_cast<std::size_t>(o.samples));
+  for (int i = 0; i < o.samples; ++i) {
+    Plant plant;
+    plant.name = nominal.name;
+    for (int attempt = 0; attempt <= kMaxModelRedraws; ++attempt) {
+      if (attempt > 0) ++*redrawn;
+      Eigen::VectorXd z(p);
+      for (Eigen::Index k = 0; k < p; ++k) z(k) = StandardNormal(&rng);
+      const Eigen::VectorXd x = mean + root * z;
+      const std::vector<double> values(x.data(), x.data() + p);
+      if (!ParametersAreValid(m.kind, values, nullptr)) continue;
+      const ProcessModel model = ModelFromValues(m.kind, values);
+      TransferFunction tf = model.ToTransferFunction();
+      if (!tf.IsValid(nullptr)) continue;
+      plant.tf = std::move(tf);
+      plant.delay_s = model.delay_s();
+      break;
+    }
+    plants.push_back(plant);
+  }
+  return plants;
+}
 
 }  // namespace
 
@@ -48,14 +111,30 @@ Distribution Summarize(std::vector<double> v) {
   return d;
 }
 
+std::string PerturbedText(const Plant& nominal, const StepperMotorParameters* stepper) {
+  if (DrawsFromCovariance(nominal)) return kCovariancePerturbed;
+  if (nominal.model)
+    return "transfer-function coefficients (the identified model's covariance is not ok: " +
+           (nominal.model->covariance_message.empty() ? std::string("none given")
+                                                      : nominal.model->covariance_message) +
+           ")";
+  return stepper ? "Table I parameters" : "transfer-function coefficients";
+}
+
 std::vector<Plant> DrawPlants(const Plant& nominal, const StepperMotorParameters* stepper,
-                              const MonteCarloOptions& o) {
+                              const MonteCarloOptions& o, int* redrawn) {
+  int redrawn_here = 0;
+  if (!redrawn) redrawn = &redrawn_here;
+  *redrawn = 0;
+  if (DrawsFromCovariance(nominal)) return DrawModelPlants(nominal, o, redrawn);
   std::mt19937_64 rng(o.seed);
   std::vector<Plant> plants;
   plants.reserve(static_cast<std::size_t>(o.samples));
   for (int i = 0; i < o.samples; ++i) {
     Plant p;
     p.name = nominal.name;
+    // The coefficients' draws keep the dead time (only a model's is drawn).
+    p.delay_s = nominal.delay_s;
     if (stepper) {
       StepperMotorParameters s = *stepper;
       for (double* f :
@@ -87,7 +166,7 @@ bool RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, 
                    const std::function<void(int, int)>& progress) {
   if (!mc.IsValid(error)) return false;
   if (!nominal.tf.IsValid(error) || nominal.tf.den.empty()) return false;
-  if (nominal.delay_s != 0.0) {
+  if (nominal.delay_s != 0.0 && !nominal.model) {
     // Each draw needs the loop's time response (IAE, overshoot) and, sampled,
     // the analysis; neither exists yet with dead time.
     std::ostringstream os;
@@ -104,11 +183,11 @@ bool RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, 
   if (!evaluation::Evaluate(nominal, gains, options, what, &nominal_ev, error)) return false;
   *summary = MonteCarloSummary();
   summary->samples = mc.samples;
-  summary->perturbed = stepper ? "Table I parameters" : "transfer-function coefficients";
+  summary->perturbed = PerturbedText(nominal, stepper);
   LoopAnalysisOptions ao;
   ao.points_per_decade = 50.0;
   std::vector<double> iae, overshoot, ms;
-  const std::vector<Plant> plants = DrawPlants(nominal, stepper, mc);
+  const std::vector<Plant> plants = DrawPlants(nominal, stepper, mc, &summary->redrawn);
   for (std::size_t i = 0; i < plants.size(); ++i) {
     const Plant& p = plants[i];
     evaluation::Evaluation ev;

@@ -4,6 +4,8 @@
 #include <sstream>
 #include <utility>
 
+#include "pidlab/tune/model_file.h"
+
 namespace pidlab::tune {
 
 using spec::Quote;
@@ -123,6 +125,14 @@ bool BuildPlantModel(const spec::PlantSpec& s, NameStyle style, Plant* out, std:
                           " stepper_nonlinear, not " + Quote(s.plant));
   StepperMotorParameters sp;
   if (!BuildStepperParameters(s, style, &sp, error)) return false;
+  std::string path;
+  if (IsModelPlant(s.plant, &path)) {
+    std::string why;
+    if (path.empty()) return Bad(error, name("plant") + " " + Quote(s.plant) + " needs a file: model:FILE");
+    if (!ReadModelFile(path, out, &why))
+      return Bad(error, name("plant") + " " + Quote(s.plant) + ": model file " + Quote(path) + " " + why);
+    return true;
+  }
   // A plant name is printable and short, so Truncate leaves every valid one
   // as it is, and MakePlant's "unknown plant '...'" echoes at most 200 chars.
   return MakePlant(spec::Truncate(s.plant), sp, out, error);
@@ -130,19 +140,28 @@ bool BuildPlantModel(const spec::PlantSpec& s, NameStyle style, Plant* out, std:
 
 }  // namespace
 
-bool BuildPlant(const spec::PlantSpec& s, NameStyle style, Plant* out, std::string* error) {
+bool BuildPlant(const spec::PlantSpec& typed, NameStyle style, Plant* out, std::string* error) {
+  spec::PlantSpec s = typed;
+  s.Normalize();
+  if (!s.model.empty())
+    return Bad(error, spec::DisplayName("model", style) + " " + Quote(s.model) + " cannot be combined with " +
+                          spec::DisplayName("plant", style) + " " + Quote(s.plant));
   if (!CheckSpecNumbers(s, style, error)) return false;
   const std::string delay = spec::DisplayName("delay", style);
   if (!(s.delay_s >= 0.0) || !(s.delay_s <= kMaxDelaySeconds))
     return Bad(error, delay + " " + spec::FormatNumber(s.delay_s) + " s must be >= 0, finite and at most " +
                           spec::FormatNumber(kMaxDelaySeconds) + " s");
+  if (IsModelPlant(s.plant) && s.delay_s != 0.0)
+    return Bad(error, delay + " " + spec::FormatNumber(s.delay_s) +
+                          " s: " + spec::DisplayName("plant", style) + " " + Quote(s.plant) +
+                          " has its own dead time (the model's Td)");
   Plant p;
   if (!BuildPlantModel(s, style, &p, error)) return false;
   if (s.delay_s > 0.0 && p.nonlinear)
     return Bad(error, delay + " " + spec::FormatNumber(s.delay_s) +
                           " s: " + spec::DisplayName("plant", style) + " " + Quote(p.name) +
                           " with dead time is not supported yet");
-  p.delay_s = s.delay_s;
+  if (!p.model) p.delay_s = s.delay_s;
   *out = std::move(p);
   return true;
 }
@@ -275,9 +294,32 @@ bool BuildBounds(const spec::BoundsSpec& s, NameStyle style, analysis::LoopBound
   return true;
 }
 
+namespace {
+
+// A spread other than its default on a model whose draws come from its
+// covariance (which no spread scales) is refused rather than ignored. The
+// default passes, so that an echoed spec, which lists every field, runs again.
+bool CheckSpreadOnModel(spec::PlantSpec plant, const char* key, double spread, double default_spread,
+                        NameStyle style, std::string* error) {
+  plant.Normalize();
+  Plant p;
+  if (!IsModelPlant(plant.plant) || spread == default_spread || !BuildPlant(plant, style, &p, nullptr) ||
+      !analysis::DrawsFromCovariance(p))
+    return true;
+  return Bad(error, spec::DisplayName(key, style) + " " + spec::FormatNumber(spread) + ": " +
+                        spec::DisplayName("plant", style) + " " + Quote(plant.plant) +
+                        " is drawn from its parameter covariance, which no spread scales (leave " +
+                        spec::DisplayName(key, style) + " at its default " +
+                        spec::FormatNumber(default_spread) + ")");
+}
+
+}  // namespace
+
 bool BuildMonteCarlo(const spec::EvaluateSpec& s, NameStyle style, analysis::MonteCarloOptions* out,
                      std::string* error) {
   const auto name = [style](const char* key) { return spec::DisplayName(key, style); };
+  if (!CheckSpreadOnModel(s.plant, "spread", s.spread, spec::EvaluateSpec{}.spread, style, error))
+    return false;
   if (s.monte_carlo < 0)
     return Bad(error, name("monte_carlo") + " " + std::to_string(s.monte_carlo) + " must be >= 0");
   if (!(s.spread >= 0.0) || !(s.spread < 1.0))
@@ -363,7 +405,9 @@ bool BuildTuneOptions(const spec::TuningSpec& s, NameStyle style, TuneOptions* o
   TuneOptions o;
   if (!CheckSpecNumbers(s.tune, style, error) || !BuildLoopOptions(s.loop, style, &o.loop, error) ||
       !BuildSearch(s.tune, style, &o, error) || !BuildBounds(s.bounds, style, &o.bounds, error) ||
-      !BuildStepperParameters(s.plant, style, &o.stepper, error))
+      !BuildStepperParameters(s.plant, style, &o.stepper, error) ||
+      !CheckSpreadOnModel(s.plant, "robust_spread", s.tune.robust_spread, spec::TuneSpec{}.robust_spread,
+                          style, error))
     return false;
   // The tuner's objective runs the noise-free loop: a noisy y would make the
   // IAE a random variable the search cannot minimise (evaluate and the trio

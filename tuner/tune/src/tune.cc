@@ -256,6 +256,7 @@ optim::ObjectiveFunction ConstrainedObjective(const Plant& plant, const TuneOpti
 struct RobustSet {
   std::vector<std::unique_ptr<const evaluation::ObjectiveEvaluator>> draws;
   int invalid = 0;
+  int redrawn = 0;
 };
 
 RobustSet MakeRobustSet(const Plant& plant, const TuneOptions& options,
@@ -266,8 +267,8 @@ RobustSet MakeRobustSet(const Plant& plant, const TuneOptions& options,
   mc.samples = options.robust_samples;
   mc.spread = options.robust_spread;
   mc.seed = options.seed;
-  for (const Plant& p :
-       analysis::DrawPlants(plant, plant.name == "stepper_motor" ? &options.stepper : nullptr, mc)) {
+  for (const Plant& p : analysis::DrawPlants(
+           plant, plant.name == "stepper_motor" ? &options.stepper : nullptr, mc, &set.redrawn)) {
     if (p.tf.num.empty() || p.tf.den.empty()) {
       ++set.invalid;
       continue;
@@ -474,7 +475,8 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
     return false;
   }
   if (!RuleLoopIsRetarded(plant, options, error)) return false;
-  if (plant.delay_s > 0.0 && options.robust_samples > 0) {
+  // A model's draws carry their dead time (DrawPlants); others' are undelayed.
+  if (plant.delay_s > 0.0 && options.robust_samples > 0 && !plant.model) {
     if (error) *error = "a robust set with a plant dead time is not supported yet (its draws are undelayed)";
     return false;
   }
@@ -507,6 +509,8 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
       MakeRobustSet(plant, options, custom_runner ? runner : evaluation::SampledRunner(nullptr));
   summary->robust_set_size = options.robust_samples > 0 ? static_cast<int>(robust_set.draws.size()) + 1 : 0;
   summary->robust_invalid_draws = robust_set.invalid;
+  summary->robust_redrawn = robust_set.redrawn;
+  if (options.robust_samples > 0) summary->robust_perturbed = analysis::PerturbedText(plant, nullptr);
   const optim::ObjectiveFunction f = RobustSetObjective(ConstrainedObjective(plant, options, evaluator),
                                                         robust_set, options.robust_quantile);
   if (!Search(plant, options, f, evaluator, progress, summary, error)) return false;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/plant_sim/process_model.h"
 #include "pidlab/plant_sim/transfer_function.h"
 
 namespace pidlab {
@@ -46,6 +47,10 @@ struct Plant {
   /// Dead time L of the plant, G(s) e^(-sL), s: at least 0 and finite
   /// (docs/deadtime.md). 0 is the plant without delay.
   double delay_s = 0.0;
+  /// Set for an identified model (plant model:FILE): its kind, parameters
+  /// and their covariance, from which the Monte Carlo and robust-set draws
+  /// come (tf and delay_s are the model's at its values).
+  std::shared_ptr<const plant_sim::ProcessModelUncertainty> model = nullptr;
 };
 
 /// Canonical names and aliases accepted by MakePlant.

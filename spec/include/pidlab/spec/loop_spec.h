@@ -34,10 +34,13 @@ inline constexpr double kInf = std::numeric_limits<double>::infinity();
 /// The multi-start's default design (kMultiStartDesignPoints, checked in tuner).
 inline constexpr int kDefaultDesignPoints = 1024;
 
-/// The plant G(s): a built-in by name, a custom num/den, or the nonlinear
-/// stepper with its options.
+/// The plant G(s): a built-in by name, a custom num/den, an identified model
+/// ("model:FILE", or `model` FILE), or the nonlinear stepper with its options.
 struct PlantSpec {
   std::string plant;
+  /// The file of an identified model (`pidlab identify --out`): the same as
+  /// plant "model:FILE", which Normalize makes of it.
+  std::string model;
   std::vector<double> num, den;
   std::map<std::string, double> stepper;  // Table I overrides, NAME -> value
   double detent_torque_nm = 0.0, load_torque_nm = 0.0, load_step_nm = 0.0, load_step_time_s = 0.0;
@@ -45,9 +48,15 @@ struct PlantSpec {
   std::string drive = "linear";
   double delay_s = 0.0;  // dead time L, s (docs/deadtime.md)
 
-  /// A custom plant (num/den given) is named "custom", however it was typed,
-  /// so that a spec echoes one form.
+  /// A custom plant (num/den given) is named "custom", and a model given as
+  /// `model` FILE is plant "model:FILE", however it was typed, so that a spec
+  /// echoes one form. (A `model` next to another plant is left for
+  /// BuildPlant to refuse.)
   void Normalize() {
+    if (!model.empty() && (plant.empty() || plant == "model:" + model)) {
+      plant = "model:" + model;
+      model.clear();
+    }
     if (plant.empty() && (!num.empty() || !den.empty())) plant = "custom";
   }
 
@@ -57,9 +66,15 @@ struct PlantSpec {
         {"plant",
          "double_integrator (alias linear) = 1/s^2, oscillator (alias nonlinear) = 1/(s^2+1), stepper_motor "
          "(alias stepper) = eq. (3), stepper_nonlinear = the nonlinear PM stepper (sampled loop; "
-         "docs/stepper.md), or custom with --num/--den",
+         "docs/stepper.md), custom with --num/--den, or model:FILE, the model pidlab identify --out wrote "
+         "(docs/identify.md)",
          "", kEpisode, R"("oscillator")"},
         &plant);
+    a->Visit({"model",
+              "the model file pidlab identify --out wrote as the plant, the same as --plant model:FILE; its "
+              "draws (--monte-carlo, --robust-samples) come from the parameters' covariance",
+              "", kNone, R"("model.json")"},
+             &model);
     a->Visit({"num", "custom plant numerator, descending powers of s, e.g. 1", "", kEpisode, "[2]"}, &num);
     a->Visit(
         {"den", "custom plant denominator, descending powers of s, e.g. 1,0,0", "", kEpisode, "[1, 3, 1]"},

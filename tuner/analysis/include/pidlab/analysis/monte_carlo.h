@@ -10,7 +10,15 @@
 //    transfer function is first divided by its leading denominator
 //    coefficient, which stays 1; every other coefficient c becomes
 //    c (1 + spread u). A zero coefficient stays zero (1/s^2 keeps its double
-//    pole at 0 and only its gain moves).
+//    pole at 0 and only its gain moves). A dead time is kept as it is;
+//  * an identified model with a covariance (Plant::model, HasCovariance):
+//    its parameter vector is drawn from the multivariate normal N(values,
+//    covariance) (a Cholesky factor times standard normals by Box-Muller),
+//    redrawn while a time constant is <= 0, Zeta is outside (0, 1) or Td < 0
+//    (a truncated normal, at most kMaxModelRedraws redraws per plant), and
+//    made a plant through the process model, its delay Td included. `spread`
+//    does not apply. A model without a covariance is drawn as any other
+//    plant, its coefficients within `spread`, its delay kept.
 
 #include <cstdint>
 #include <functional>
@@ -21,6 +29,15 @@
 #include "pidlab/evaluation/evaluation.h"
 
 namespace pidlab::analysis {
+
+/// How many times one draw of a model is redrawn before it counts as invalid.
+inline constexpr int kMaxModelRedraws = 1000;
+
+/// MonteCarloSummary::perturbed of draws from a model's covariance.
+inline constexpr const char* kCovariancePerturbed = "identified model's parameter covariance";
+
+/// True when `plant`'s draws come from its identified model's covariance.
+inline bool DrawsFromCovariance(const Plant& plant) { return plant.model && plant.model->HasCovariance(); }
 
 struct MonteCarloOptions {
   /// Number of plants drawn, 1 .. 100000.
@@ -55,15 +72,23 @@ struct MonteCarloSummary {
   /// The IAE of options (eq. 4, with its disturbance), the undisturbed step
   /// overshoot (where stepinfo is defined) and Ms of options.loop.
   Distribution iae, overshoot_pct, ms;
-  /// "Table I parameters" or "transfer-function coefficients".
+  /// Redraws of a model's parameter vectors that were not a model's (the
+  /// truncated normal; 0 for other plants).
+  int redrawn = 0;
+  /// "Table I parameters", "transfer-function coefficients" or "identified
+  /// model's parameter covariance" (PerturbedText).
   std::string perturbed;
 };
 
 /// The plants of the draw (samples of them). `stepper` is the stepper
 /// motor's Table I parameters when `nominal` is that motor, else null.
 /// A draw whose parameters are invalid is returned with an empty tf.
+/// *redrawn (when given) counts a model's redraws.
 std::vector<Plant> DrawPlants(const Plant& nominal, const StepperMotorParameters* stepper,
-                              const MonteCarloOptions& options);
+                              const MonteCarloOptions& options, int* redrawn = nullptr);
+
+/// What the draws of `nominal` perturb, in words (MonteCarloSummary::perturbed).
+std::string PerturbedText(const Plant& nominal, const StepperMotorParameters* stepper);
 
 /// Evaluates `gains` on every plant of DrawPlants. False with *error for
 /// invalid input (the nominal evaluation's errors). `progress(done, total)`

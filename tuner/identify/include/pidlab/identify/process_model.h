@@ -1,47 +1,19 @@
 #pragma once
-// The process models of MATLAB's idproc, named as it names them:
-//   P1D   Kp e^(-Td s) / (1 + Tp1 s)
-//   P2D   Kp e^(-Td s) / ((1 + Tp1 s)(1 + Tp2 s))
-//   P2DU  Kp e^(-Td s) / (1 + 2 Zeta Tw s + (Tw s)^2)
-//   P1DI  Kp e^(-Td s) / (s (1 + Tp1 s))
-// Times in seconds; Kp in output units per input unit (per second for P1DI).
+// The process models live with the plants (pidlab/plant_sim/process_model.h),
+// where the Monte Carlo draws of an identified model can reach them; their
+// names are brought into pidlab::identify here, where they were first.
 
-#include <string>
-#include <vector>
-
-#include "pidlab/plant_sim/transfer_function.h"
+#include "pidlab/plant_sim/process_model.h"
 
 namespace pidlab::identify {
 
-enum class ProcessModelKind { kP1D, kP2D, kP2DU, kP1DI };
-
-/// "p1d", "p2d", "p2du", "p1di".
-const char* ToString(ProcessModelKind kind);
-/// The inverse of ToString; false (and *kind untouched) for any other text.
-bool Parse(const std::string& text, ProcessModelKind* kind);
-/// "p1d|p2d|p2du|p1di", for help texts and error messages.
-std::string ProcessModelKindNames();
-
-struct ProcessModel {
-  ProcessModelKind kind = ProcessModelKind::kP1D;
-  double kp = 1.0;     // static gain (P1DI: gain of the integrator)
-  double tp1_s = 1.0;  // P1D, P2D, P1DI
-  double tp2_s = 0.0;  // P2D
-  double tw_s = 1.0;   // P2DU: 1 / natural frequency
-  double zeta = 0.5;   // P2DU: damping, in (0, 1)
-  double td_s = 0.0;   // input delay, >= 0
-
-  /// Kp / den(s), descending powers of s, without the delay (delay_s()).
-  TransferFunction ToTransferFunction() const;
-  double delay_s() const { return td_s; }
-};
-
-/// The names of the model's parameters in a fixed order: P1D Kp Tp1 Td; P2D
-/// Kp Tp1 Tp2 Td; P2DU Kp Tw Zeta Td; P1DI Kp Tp1 Td.
-std::vector<std::string> ParameterNames(ProcessModelKind kind);
-/// The values of `model`'s parameters in the order of ParameterNames.
-std::vector<double> ParameterValues(const ProcessModel& model);
-/// The model of `kind` whose parameters, in the order of ParameterNames, are `values`.
-ProcessModel ModelFromValues(ProcessModelKind kind, const std::vector<double>& values);
+using pidlab::plant_sim::ModelFromValues;
+using pidlab::plant_sim::ParameterNames;
+using pidlab::plant_sim::ParameterValues;
+using pidlab::plant_sim::Parse;
+using pidlab::plant_sim::ProcessModel;
+using pidlab::plant_sim::ProcessModelKind;
+using pidlab::plant_sim::ProcessModelKindNames;
+using pidlab::plant_sim::ToString;
 
 }  // namespace pidlab::identify

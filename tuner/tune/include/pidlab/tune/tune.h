@@ -110,7 +110,8 @@ struct TuneOptions {
   /// the search minimises the `robust_quantile` quantile (nearest rank; 1 =
   /// the worst case) of the objective over the nominal plant and N plants
   /// drawn around it as `evaluate --monte-carlo` draws them (DrawPlants with
-  /// `robust_spread` and `seed`). A draw whose loop is not strictly stable
+  /// `robust_spread` and `seed`; an identified model with a covariance:
+  /// from that covariance, `robust_spread` unused). A draw whose loop is not strictly stable
   /// counts as +inf, so the worst case accepts only gains that stabilise
   /// every draw. The bounds and step constraints apply to the nominal loop.
   int robust_samples = 0;
@@ -263,6 +264,10 @@ struct TuneSummary {
   /// (`objective` is then the quantile).
   int robust_set_size = 0;
   int robust_invalid_draws = 0;
+  /// A model's draws redrawn because they were not a model's, and what the
+  /// draws perturb (analysis::PerturbedText; with a robust set only).
+  int robust_redrawn = 0;
+  std::string robust_perturbed;
   double nominal_objective = std::numeric_limits<double>::infinity();
   /// The bounds of the box the gains found lie on (GainsAtBounds: "kp_lo",
   /// "kp_hi", "ki_lo", ..., within 1e-6 of the box's width): an optimum on

@@ -1,6 +1,11 @@
-#include "pidlab/identify/process_model.h"
+// The process models of MATLAB's idproc (process_model.h).
 
-namespace pidlab::identify {
+#include "pidlab/plant_sim/process_model.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace pidlab::plant_sim {
 
 const char* ToString(ProcessModelKind kind) {
   switch (kind) {
@@ -91,4 +96,28 @@ ProcessModel ModelFromValues(ProcessModelKind kind, const std::vector<double>& v
   return m;
 }
 
-}  // namespace pidlab::identify
+bool ParametersAreValid(ProcessModelKind kind, const std::vector<double>& values, std::string* error) {
+  const std::vector<std::string> names = ParameterNames(kind);
+  std::ostringstream os;
+  if (values.size() != names.size()) {
+    os << ToString(kind) << " has " << names.size() << " parameters, not " << values.size();
+  } else {
+    for (std::size_t i = 0; i < values.size() && os.tellp() == 0; ++i) {
+      const std::string& name = names[i];
+      const double v = values[i];
+      if (!std::isfinite(v))
+        os << name << " " << v << " must be finite";
+      else if ((name == "Tp1" || name == "Tp2" || name == "Tw") && !(v > 0.0))
+        os << name << " " << v << " s must be > 0";
+      else if (name == "Zeta" && !(v > 0.0 && v < 1.0))
+        os << "Zeta " << v << " must be in (0, 1)";
+      else if (name == "Td" && !(v >= 0.0))
+        os << "Td " << v << " s must be >= 0";
+    }
+    if (os.tellp() == 0) return true;
+  }
+  if (error) *error = os.str();
+  return false;
+}
+
+}  // namespace pidlab::plant_sim

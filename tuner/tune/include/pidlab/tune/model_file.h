@@ -1,0 +1,36 @@
+#pragma once
+// An identified model as a plant: the file `pidlab identify --out` writes
+// (tools/json/src/identify_json.cc; docs/identify.md, "The identified model
+// as a plant"), read back. Its "transfer_function" (num, den, delay_s) is
+// the plant G(s) e^(-s Td); its "model" (the kind), "parameters" (value of
+// each, in any order) and "covariance" (ok, message, matrix p x p in the
+// order of ParameterNames) become Plant::model, from which the Monte Carlo
+// and robust-set draws come (analysis::DrawPlants).
+
+#include <string>
+
+#include "pidlab/plant_sim/plants.h"
+
+namespace pidlab::tune {
+
+/// The spec's plant text of a model file: "model:FILE".
+inline constexpr const char* kModelPlantPrefix = "model:";
+/// The name of a model's plant (Plant::name; the episode carries its
+/// num/den/delay as a custom plant's).
+inline constexpr const char* kModelPlantName = "model";
+/// A model file larger than this is refused.
+inline constexpr std::size_t kMaxModelFileBytes = 1u << 20;
+
+/// True when `plant` (a PlantSpec's plant) is "model:FILE"; *path is FILE.
+bool IsModelPlant(const std::string& plant, std::string* path = nullptr);
+
+/// Reads the model file at `path` into *plant (name kModelPlantName, tf,
+/// delay_s, model). False with *error, one line without the file's name,
+/// giving the reason: the file cannot be read or is not JSON, a key is
+/// missing or of the wrong type, a number is not finite, the kind is not
+/// one of ProcessModelKindNames(), a covariance that is ok is not p x p,
+/// the parameters are not a model's (ParametersAreValid), or the transfer
+/// function is not a valid, strictly proper plant.
+bool ReadModelFile(const std::string& path, Plant* plant, std::string* error);
+
+}  // namespace pidlab::tune

@@ -1,0 +1,167 @@
+// An identified model as a plant (model_file.h).
+
+#include "pidlab/tune/model_file.h"
+
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <utility>
+
+#include "pidlab/spec/json.h"
+
+namespace pidlab::tune {
+
+using plant_sim::ParameterNames;
+using plant_sim::ParametersAreValid;
+using plant_sim::Parse;
+using plant_sim::ProcessModelKindNames;
+using plant_sim::ProcessModelUncertainty;
+
+namespace {
+
+bool Bad(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+// j[key] of an object, or false naming the key `where` + key.
+bool Member(const nlohmann::json& j, const char* key, const std::string& where, const nlohmann::json** out,
+            std::string* error) {
+  if (!j.is_object() || !j.contains(key)) return Bad(error, "has no key \"" + where + key + "\"");
+  *out = &j.at(key);
+  return true;
+}
+
+bool Number(const nlohmann::json& j, const std::string& where, double* out, std::string* error) {
+  if (!j.is_number()) return Bad(error, "\"" + where + "\" " + spec::Truncate(j.dump()) + " is not a number");
+  const double v = j.get<double>();
+  if (!std::isfinite(v) || std::abs(v) > spec::kMaxInputMagnitude)
+    return Bad(error, "\"" + where + "\" " + spec::FormatNumber(v) + " is out of range");
+  *out = v;
+  return true;
+}
+
+bool NumberList(const nlohmann::json& j, const std::string& where, std::vector<double>* out,
+                std::string* error) {
+  if (!j.is_array() || j.empty()) return Bad(error, "\"" + where + "\" must be a list of numbers");
+  out->clear();
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    double v = 0.0;
+    if (!Number(j[i], where + "[" + std::to_string(i) + "]", &v, error)) return false;
+    out->push_back(v);
+  }
+  return true;
+}
+
+bool ReadText(const std::string& path, std::string* text, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Bad(error, "cannot be read");
+  std::ostringstream os;
+  os << in.rdbuf();
+  if (os.str().size() > kMaxModelFileBytes) return Bad(error, "is larger than 1 MiB");
+  *text = os.str();
+  return true;
+}
+
+// The kind and its parameter values, in the order of ParameterNames.
+bool ReadParameters(const nlohmann::json& j, ProcessModelUncertainty* m, std::string* error) {
+  const nlohmann::json* kind = nullptr;
+  if (!Member(j, "model", "", &kind, error)) return false;
+  if (!kind->is_string() || !Parse(kind->get<std::string>(), &m->kind))
+    return Bad(error, "\"model\" " + spec::Truncate(kind->dump()) + " must be " + ProcessModelKindNames());
+  const nlohmann::json* parameters = nullptr;
+  if (!Member(j, "parameters", "", &parameters, error)) return false;
+  m->values.clear();
+  for (const std::string& name : ParameterNames(m->kind)) {
+    const nlohmann::json* p = nullptr;
+    const nlohmann::json* value = nullptr;
+    double v = 0.0;
+    if (!Member(*parameters, name.c_str(), "parameters.", &p, error) ||
+        !Member(*p, "value", "parameters." + name + ".", &value, error) ||
+        !Number(*value, "parameters." + name + ".value", &v, error))
+      return false;
+    m->values.push_back(v);
+  }
+  std::string why;
+  if (!ParametersAreValid(m->kind, m->values, &why))
+    return Bad(error, "is not a valid " + std::string(plant_sim::ToString(m->kind)) + " model: " + why);
+  return true;
+}
+
+// The covariance: ok with a p x p matrix of finite numbers, or not ok (then
+// no matrix is read, and the draws fall back to the coefficients).
+bool ReadCovariance(const nlohmann::json& j, ProcessModelUncertainty* m, std::string* error) {
+  const nlohmann::json *c = nullptr, *ok = nullptr, *matrix = nullptr;
+  if (!Member(j, "covariance", "", &c, error) || !Member(*c, "ok", "covariance.", &ok, error)) return false;
+  if (!ok->is_boolean()) return Bad(error, "\"covariance.ok\" must be true or false");
+  m->covariance.clear();
+  if (c->contains("message") && c->at("message").is_string()) m->covariance_message = c->at("message");
+  if (!ok->get<bool>()) return true;
+  if (!Member(*c, "matrix", "covariance.", &matrix, error)) return false;
+  const std::size_t p = m->values.size();
+  std::string names;
+  for (const std::string& name : ParameterNames(m->kind)) names += (names.empty() ? "" : ", ") + name;
+  const std::string shape =
+      "\"covariance.matrix\" must be " + std::to_string(p) + " x " + std::to_string(p) + " (" + names + ")";
+  if (!matrix->is_array() || matrix->size() != p) return Bad(error, shape);
+  for (std::size_t i = 0; i < p; ++i) {
+    const nlohmann::json& row = (*matrix)[i];
+    if (!row.is_array() || row.size() != p) return Bad(error, shape);
+    for (std::size_t k = 0; k < p; ++k) {
+      double v = 0.0;
+      if (!Number(row[k], "covariance.matrix[" + std::to_string(i) + "][" + std::to_string(k) + "]", &v,
+                  error))
+        return false;
+      m->covariance.push_back(v);
+    }
+  }
+  for (std::size_t i = 0; i < p; ++i) {
+    if (!(m->covariance[i * p + i] >= 0.0))
+      return Bad(error, "\"covariance.matrix\" has a negative variance on its diagonal");
+    for (std::size_t k = 0; k < i; ++k)
+      if (std::abs(m->covariance[i * p + k] - m->covariance[k * p + i]) >
+          1e-9 * (std::abs(m->covariance[i * p + k]) + std::abs(m->covariance[k * p + i])))
+        return Bad(error, "\"covariance.matrix\" is not symmetric");
+  }
+  return true;
+}
+
+}  // namespace
+
+bool IsModelPlant(const std::string& plant, std::string* path) {
+  const std::string prefix = kModelPlantPrefix;
+  if (plant.compare(0, prefix.size(), prefix) != 0) return false;
+  if (path) *path = plant.substr(prefix.size());
+  return true;
+}
+
+bool ReadModelFile(const std::string& path, Plant* plant, std::string* error) {
+  std::string text;
+  nlohmann::json j;
+  std::string why;
+  if (!ReadText(path, &text, error)) return false;
+  if (!spec::ParseJsonText(text, &j, error)) return false;  // "is not valid JSON"
+  if (!j.is_object()) return Bad(error, "is not a JSON object");
+  auto m = std::make_shared<ProcessModelUncertainty>();
+  if (!ReadParameters(j, m.get(), error) || !ReadCovariance(j, m.get(), error)) return false;
+  const nlohmann::json *tf = nullptr, *num = nullptr, *den = nullptr, *delay = nullptr;
+  Plant p;
+  if (!Member(j, "transfer_function", "", &tf, error) ||
+      !Member(*tf, "num", "transfer_function.", &num, error) ||
+      !Member(*tf, "den", "transfer_function.", &den, error) ||
+      !Member(*tf, "delay_s", "transfer_function.", &delay, error) ||
+      !NumberList(*num, "transfer_function.num", &p.tf.num, error) ||
+      !NumberList(*den, "transfer_function.den", &p.tf.den, error))
+    return false;
+  if (!MakeCustomPlant(p.tf.num, p.tf.den, &p, &why)) return Bad(error, "is not a valid plant: " + why);
+  if (!Number(*delay, "transfer_function.delay_s", &p.delay_s, error)) return false;
+  if (p.delay_s < 0.0)
+    return Bad(error, "\"transfer_function.delay_s\" " + spec::FormatNumber(p.delay_s) + " must be >= 0");
+  p.name = kModelPlantName;
+  p.model = std::move(m);
+  *plant = std::move(p);
+  return true;
+}
+
+}  // namespace pidlab::tune
