@@ -3,7 +3,7 @@
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
 # ever sent outside its loopback. CASE: identity | faults | drop20 | realtime | kill | sigstop | trios | trio_killed | stranger |
-# log | log_repair | motor | delay | excite | identify_log.
+# log | log_repair | motor | delay | excite | identify_log | identify_motor.
 set -u
 BIN=$1
 CASE=$2
@@ -18,6 +18,12 @@ TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 PIDLAB=$BIN/pidlab
 fail=0
+
+# The lines starting "pidlab " of the ``` blocks in one "## " section of a doc.
+section_commands() {
+  awk -v head="$1" '$0 == head {in_section=1; next} /^## / {in_section=0}
+    in_section && /^```/ {on=!on; next} in_section && on && /^pidlab /' "$2"
+}
 
 # compare NAME ARGS...: local sampled loop vs --backend lcm on the running trio:
 # identical JSON (except backend keys) and identical full trajectory CSV.
@@ -441,7 +447,7 @@ PY
       if ! (cd "$TMP/docs" && PATH="$BIN:$PATH" bash -c "$cmd") >"$TMP/docs/out" 2>&1; then
         echo "FAIL docs/identify.md: $cmd: $(tail -1 "$TMP/docs/out")"; fail=1
       fi
-    done < <(awk '/^```sh/{on=1; next} /^```/{on=0} on && /^pidlab /' "$docs")
+    done < <(section_commands "## Running an experiment and logging it" "$docs")
     if [ "$n_docs" -eq 3 ] && [ "$(wc -l <"$TMP/docs/chirp.csv")" -ge 10002 ]; then
       echo "ok   docs/identify.md: its 3 commands run as written, chirp.csv has $(wc -l <"$TMP/docs/chirp.csv") lines"
     else
@@ -461,7 +467,7 @@ PY
       if ! (cd "$TMP/idlog" && PATH="$BIN:$PATH" bash -c "$cmd") >"$TMP/idlog/out.$n_docs" 2>"$TMP/idlog/err.$n_docs"; then
         echo "FAIL docs/identify.md: $cmd: $(tail -1 "$TMP/idlog/err.$n_docs")"; fail=1
       fi
-    done < <(awk '/^```shell/{on=1; next} /^```/{on=0} on && /^pidlab /' "$docs")
+    done < <(section_commands "## Identifying a model from a log" "$docs")
     [ "$n_docs" -eq 3 ] || { echo "FAIL docs/identify.md has $n_docs shell commands, not 3"; fail=1; }
     if python3 - "$TMP/idlog" <<'PY'
 import json, re, sys
@@ -487,6 +493,49 @@ PY
     if [ $? -eq 2 ] && grep -q -- "--episode 12345 is not in" "$TMP/idlog/bad" && [ "$(wc -l <"$TMP/idlog/bad")" -eq 1 ]; then
       echo "ok   identify --log with an episode not in it exits 2 with one line"
     else echo "FAIL identify --log --episode 12345: $(cat "$TMP/idlog/bad")"; fail=1; fi
+    ;;
+  identify_motor)
+    # docs/identify.md, "End to end: a motor nobody wrote down": an experiment
+    # on the nonlinear motor over the trio, identify on its log, tune --robust
+    # on the model and on eq. (3), both gain sets on eq. (3) and on the motor.
+    # Commands as written there, then the issue's checks on their outputs.
+    docs=$(dirname "${BASH_SOURCE[0]}")/../../docs/identify.md
+    mkdir -p "$TMP/motor"
+    n_docs=0
+    while IFS= read -r cmd; do
+      n_docs=$((n_docs + 1))
+      if ! (cd "$TMP/motor" && PATH="$BIN:$PATH" bash -c "$cmd") >"$TMP/motor/out.$n_docs" 2>"$TMP/motor/err.$n_docs"; then
+        echo "FAIL docs/identify.md: $cmd: $(tail -1 "$TMP/motor/err.$n_docs")"; fail=1
+      fi
+    done < <(section_commands "## End to end: a motor nobody wrote down" "$docs")
+    [ "$n_docs" -eq 8 ] || { echo "FAIL docs/identify.md's end-to-end section has $n_docs commands, not 8"; fail=1; }
+    if /usr/bin/python3 - "$TMP/motor" "$PIDLAB" <<'PY'
+import json, subprocess, sys
+d, pidlab = sys.argv[1], sys.argv[2]
+m = json.load(open(d + "/motor_model.json"))
+assert m["model"] == "p2du" and m["covariance"]["ok"] and m["whiteness"]["white"], m["whiteness"]
+eq3 = json.loads(subprocess.run([pidlab, "evaluate", "--plant", "stepper_motor", "--gains", "0,0,0", "--json"],
+                                capture_output=True, text=True, check=True).stdout)["plant_tf"]
+num, den = eq3["num"], eq3["den"]
+dc = num[-1] / den[-1]
+kp = m["parameters"]["Kp"]
+assert abs(kp["value"] - dc) <= 1.96 * kp["standard_error"], ("DC gain", kp, dc)
+import numpy as np
+poles = np.roots(den)
+pair = poles[np.argmax(poles.imag)]
+upper = max(m["poles"], key=lambda p: p["im"])
+assert abs(upper["re"] - pair.real) <= 1.96 * upper["re_standard_error"], ("Re", upper, pair)
+assert abs(upper["im"] - pair.imag) <= 1.96 * upper["im_standard_error"], ("Im", upper, pair)
+runs = {}
+for i, name in ((5, "model on eq3"), (6, "model on motor"), (7, "eq3 on eq3"), (8, "eq3 on motor")):
+    runs[name] = json.load(open(f"{d}/out.{i}"))
+    assert runs[name]["stable"] and runs[name]["robustness"]["ms"] <= 1.6, (name, runs[name]["robustness"]["ms"])
+print("ok   end to end: Kp %.6f +- %.2g against eq. (3)'s %.6f; pair %.5f%+.5fj against %.5f%+.5fj; Ms %.4f (eq. 3), %.4f (motor); IAE/A on the motor %.6f (tuned on the model) against %.6f (on eq. 3)"
+      % (kp["value"], 1.96 * kp["standard_error"], dc, upper["re"], upper["im"], pair.real, pair.imag,
+         runs["model on eq3"]["robustness"]["ms"], runs["model on motor"]["robustness"]["ms"],
+         runs["model on motor"]["iae_per_unit"], runs["eq3 on motor"]["iae_per_unit"]))
+PY
+    then :; else echo "FAIL the end-to-end run does not hold"; fail=1; fi
     ;;
   *)
     echo "unknown case $CASE"; exit 2 ;;
