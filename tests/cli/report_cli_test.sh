@@ -23,7 +23,13 @@ grep -q "bit for bit" "$md" || fail "trio result differs from the in-process sam
 
 figures=$(grep -o '](fig[^)]*\.png)' "$md" | sed 's/^](//; s/)$//')
 count=$(echo "$figures" | grep -c png)
-(( count == 11 )) || fail "expected 11 figures linked, found $count"
+(( count == 12 )) || fail "expected 12 figures linked, found $count"
+# "Identifying the motor": eq. (3)'s DC gain and pole pair within the fit's intervals, Ms <= 1.6.
+grep -q "^## Identifying the motor" "$md" || fail "section Identifying the motor missing"
+grep -q "^| DC gain | .* | yes |" "$md" || fail "the identified DC gain is not within its interval of eq. (3)'s"
+grep -q "^| pole pair | .* | yes |" "$md" || fail "the identified pole pair is not within its interval of eq. (3)'s"
+grep -q "keep Ms ≤ 1.6 on eq. (3) and on the motor: yes" "$md" || fail "a gain set of the identify section breaks Ms <= 1.6"
+grep -q "fig_motor_identified.png" "$md" || fail "the identification figure is not linked"
 # "The motor itself": its tables hold numbers (IAE/A of the motor and of eq. (3), peaks) for every move.
 grep -q "^## The motor itself" "$md" || fail "section The motor itself missing"
 for row in "| 0.001 | none |" "| 0.01 | none |" "(one tooth pitch) | none |" "| 1 | none |" \

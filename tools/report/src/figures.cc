@@ -266,6 +266,14 @@ bool DrawMotorSectionFigure(ReportData* data, std::string* error) {
   return true;
 }
 
+bool DrawIdentifySectionFigure(ReportData* data, std::string* error) {
+  std::string caption;
+  const std::string file = "fig_motor_identified.png";
+  if (!DrawIdentifyFigure(data->identified, data->options.out_dir, file, &caption, error)) return false;
+  data->figures.push_back({file, caption});
+  return true;
+}
+
 bool DrawRobustSectionFigures(ReportData* data, std::string* error) {
   std::vector<std::pair<std::string, std::string>> drawn;
   if (!DrawRobustFigures(data->robust, data->options.out_dir, &drawn, error)) return false;
@@ -278,7 +286,7 @@ bool DrawRobustSectionFigures(ReportData* data, std::string* error) {
 bool DrawFigures(ReportData* data, std::string* error) {
   return DrawStepFigures(data, error) && DrawDisturbanceFigures(data, error) &&
          DrawVeryHighDisturbanceFigure(data, error) && DrawMotorSectionFigure(data, error) &&
-         DrawRobustSectionFigures(data, error);
+         DrawIdentifySectionFigure(data, error) && DrawRobustSectionFigures(data, error);
 }
 
 }  // namespace pidlab::report

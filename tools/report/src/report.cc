@@ -175,6 +175,13 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
     return ComputeMotorSection(gains, options.quick, options.seed, &data->motor, &e) ? std::string()
                                                                                      : "motor section: " + e;
   });
+  // "Identifying the motor" (identify_section.h), beside the rest too.
+  auto identified = std::async(std::launch::async, [&options, data] {
+    std::string e;
+    return ComputeIdentifySection(options.quick, options.seed, &data->identified, &e)
+               ? std::string()
+               : "identify section: " + e;
+  });
   try {
     if (!EvaluatePaperRows(paper, data, error)) return false;
     if (!RunTunings(options, data, error)) return false;
@@ -182,6 +189,7 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
     if (!ComputeRobust(options, paper, data, error)) return false;
     trio.Collect(options.trio_absent_note, &s);
     if (const std::string e = motor.get(); !e.empty()) throw std::runtime_error(e);
+    if (const std::string e = identified.get(); !e.empty()) throw std::runtime_error(e);
   } catch (const std::exception& e) {
     *error = e.what();
     return false;
@@ -203,6 +211,7 @@ std::string RenderMarkdown(const ReportData& data) {
   RenderDisturbanceTunings(os, data);
   RenderSampledSection(os, data.sampled);
   RenderMotorSection(os, data.motor);
+  RenderIdentifySection(os, data.identified);
   RenderRobustSection(os, data.robust);
   RenderFigureList(os, data.figures);
   return os.str();

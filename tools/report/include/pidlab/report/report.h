@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/report/identify_section.h"
 #include "pidlab/report/motor_section.h"
 #include "pidlab/report/robust_section.h"
 #include "pidlab/tune/tune.h"
@@ -139,6 +140,7 @@ struct ReportData {
   SampledSection sampled;
   std::vector<Figure> figures;
   MotorSection motor;  // "The motor itself" (motor_section.h)
+  IdentifySection identified;  // "Identifying the motor" (identify_section.h)
   RobustSection robust;  // "Robust tuning" (robust_section.h)
   /// Wall time of the computation, s (printed by the command, not in report.md).
   double compute_time_s = 0, figure_time_s = 0;
