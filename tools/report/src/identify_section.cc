@@ -84,8 +84,8 @@ bool RunExperiment(IdentifySection* s, std::string* error) {
   Evaluation ev;
   if (!Evaluate(Motor(), PidGains{}, ExperimentLoop(*s), what, &ev, error)) return false;
   s->data = identify::IdentifyData{};
-  for (std::size_t k = 0; k + 1 < ev.trajectory.size(); ++k) {
-    s->data.t.push_back(ev.trajectory[k].t);
+  for (std::size_t k = 0; k < ev.trajectory.size(); ++k) {  // steps 0 .. total_steps - 1
+    s->data.t.push_back(static_cast<double>(k) * s->dt_s);  // as identify --log reads a log
     s->data.u.push_back(ev.trajectory[k].u + ev.trajectory[k].n);
     s->data.y.push_back(ev.trajectory[k].y);
   }
