@@ -19,6 +19,22 @@ trap 'rm -rf "$TMP"' EXIT
 PIDLAB=$BIN/pidlab
 fail=0
 
+# run_doc_section HEADING DIR COUNT: runs, in DIR, the COUNT commands of that
+# section of docs/identify.md as written there (PATH with BIN first); the
+# i-th command's stdout and stderr go to DIR/out.i and DIR/err.i.
+run_doc_section() {
+  local docs n=0 cmd
+  docs=$(dirname "${BASH_SOURCE[0]}")/../../docs/identify.md
+  mkdir -p "$2"
+  while IFS= read -r cmd; do
+    n=$((n + 1))
+    if ! (cd "$2" && PATH="$BIN:$PATH" bash -c "$cmd") >"$2/out.$n" 2>"$2/err.$n"; then
+      echo "FAIL docs/identify.md: $cmd: $(tail -1 "$2/err.$n")"; fail=1
+    fi
+  done < <(section_commands "$1" "$docs")
+  [ "$n" -eq "$3" ] || { echo "FAIL docs/identify.md, $1: $n commands, not $3"; fail=1; }
+}
+
 # The lines starting "pidlab " of the ``` blocks in one "## " section of a doc.
 section_commands() {
   awk -v head="$1" '$0 == head {in_section=1; next} /^## / {in_section=0}
@@ -459,16 +475,7 @@ PY
     # experiment over the trio, logged; identify --log with the figure; every
     # kind fitted by --model auto, written as a model file. Commands as written
     # there (its ```shell block), then the figures checked.
-    docs=$(dirname "${BASH_SOURCE[0]}")/../../docs/identify.md
-    mkdir -p "$TMP/idlog"
-    n_docs=0
-    while IFS= read -r cmd; do
-      n_docs=$((n_docs + 1))
-      if ! (cd "$TMP/idlog" && PATH="$BIN:$PATH" bash -c "$cmd") >"$TMP/idlog/out.$n_docs" 2>"$TMP/idlog/err.$n_docs"; then
-        echo "FAIL docs/identify.md: $cmd: $(tail -1 "$TMP/idlog/err.$n_docs")"; fail=1
-      fi
-    done < <(section_commands "## Identifying a model from a log" "$docs")
-    [ "$n_docs" -eq 3 ] || { echo "FAIL docs/identify.md has $n_docs shell commands, not 3"; fail=1; }
+    run_doc_section "## Identifying a model from a log" "$TMP/idlog" 3
     if python3 - "$TMP/idlog" <<'PY'
 import json, re, sys
 d = sys.argv[1]
@@ -499,16 +506,7 @@ PY
     # on the nonlinear motor over the trio, identify on its log, tune --robust
     # on the model and on eq. (3), both gain sets on eq. (3) and on the motor.
     # Commands as written there, then the issue's checks on their outputs.
-    docs=$(dirname "${BASH_SOURCE[0]}")/../../docs/identify.md
-    mkdir -p "$TMP/motor"
-    n_docs=0
-    while IFS= read -r cmd; do
-      n_docs=$((n_docs + 1))
-      if ! (cd "$TMP/motor" && PATH="$BIN:$PATH" bash -c "$cmd") >"$TMP/motor/out.$n_docs" 2>"$TMP/motor/err.$n_docs"; then
-        echo "FAIL docs/identify.md: $cmd: $(tail -1 "$TMP/motor/err.$n_docs")"; fail=1
-      fi
-    done < <(section_commands "## End to end: a motor nobody wrote down" "$docs")
-    [ "$n_docs" -eq 8 ] || { echo "FAIL docs/identify.md's end-to-end section has $n_docs commands, not 8"; fail=1; }
+    run_doc_section "## End to end: a motor nobody wrote down" "$TMP/motor" 8
     if /usr/bin/python3 - "$TMP/motor" "$PIDLAB" <<'PY'
 import json, subprocess, sys
 d, pidlab = sys.argv[1], sys.argv[2]
