@@ -61,6 +61,9 @@ ProcessModel Truth(ProcessModelKind kind) {
     case ProcessModelKind::kP1DI:
       m.kp = 0.45, m.tp1_s = 2.2;
       break;
+    case ProcessModelKind::kP2DZ:  // not studied (the four kinds are)
+      m.kp = 1.2, m.tp1_s = 3.0, m.tp2_s = 0.8, m.tz_s = -0.9;
+      break;
   }
   return m;
 }

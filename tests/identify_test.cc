@@ -63,6 +63,9 @@ ProcessModel Truth(ProcessModelKind kind) {
     case ProcessModelKind::kP1DI:
       m.kp = 0.45, m.tp1_s = 2.2;
       break;
+    case ProcessModelKind::kP2DZ:  // a right-half-plane zero: an inverse response
+      m.kp = 1.2, m.tp1_s = 3.0, m.tp2_s = 0.8, m.tz_s = -0.9;
+      break;
   }
   return m;
 }
@@ -88,7 +91,8 @@ TEST_P(NoiseFree, EveryParameterIsRecoveredWithinOnePartInAMillion) {
 
 INSTANTIATE_TEST_SUITE_P(Models, NoiseFree,
                          ::testing::Values(ProcessModelKind::kP1D, ProcessModelKind::kP2D,
-                                           ProcessModelKind::kP2DU, ProcessModelKind::kP1DI),
+                                           ProcessModelKind::kP2DU, ProcessModelKind::kP1DI,
+                                           ProcessModelKind::kP2DZ),
                          [](const auto& name_info) { return std::string(ToString(name_info.param)); });
 
 class Delay : public ::testing::TestWithParam<double> {};
@@ -256,7 +260,7 @@ TEST_P(AutoChoice, TheTrueKindHasTheLowestAicOnANoisyRecord) {
   for (std::size_t k = 1; k < data.y.size(); ++k) data.y[k] += noise(rng);
   AutoResult dut;
   ASSERT_TRUE(IdentifyAuto(data, IdentifyOptions{}, &dut).ok());
-  ASSERT_EQ(dut.candidates.size(), 4u);
+  ASSERT_EQ(dut.candidates.size(), 5u);
   ASSERT_GE(dut.chosen, 0);
   EXPECT_EQ(dut.candidates[static_cast<std::size_t>(dut.chosen)].kind, GetParam()) << dut.reason;
   EXPECT_NE(dut.reason.find("AIC"), std::string::npos) << dut.reason;
@@ -264,7 +268,8 @@ TEST_P(AutoChoice, TheTrueKindHasTheLowestAicOnANoisyRecord) {
 
 INSTANTIATE_TEST_SUITE_P(Models, AutoChoice,
                          ::testing::Values(ProcessModelKind::kP1D, ProcessModelKind::kP2D,
-                                           ProcessModelKind::kP2DU, ProcessModelKind::kP1DI),
+                                           ProcessModelKind::kP2DU, ProcessModelKind::kP1DI,
+                                           ProcessModelKind::kP2DZ),
                          [](const ::testing::TestParamInfo<ProcessModelKind>& param_info) {
                            return std::string(ToString(param_info.param));
                          });

@@ -1,4 +1,4 @@
-// pidlab identify: a process model (P1D, P2D, P2DU, P1DI, as MATLAB's idproc
+// pidlab identify: a process model (P1D, P2D, P2DU, P1DI, P2DZ, as MATLAB's idproc
 // names them) fitted to the t, u, y columns of a CSV (docs/identify.md,
 // "Identifying a model from a CSV").
 
@@ -44,6 +44,8 @@ const char* Formula(identify::ProcessModelKind kind) {
       return "Kp e^(-Td s) / (1 + 2 Zeta Tw s + (Tw s)^2)";
     case identify::ProcessModelKind::kP1DI:
       return "Kp e^(-Td s) / (s (1 + Tp1 s))";
+    case identify::ProcessModelKind::kP2DZ:
+      return "Kp (1 + Tz s) e^(-Td s) / ((1 + Tp1 s)(1 + Tp2 s))";
   }
   return "";
 }

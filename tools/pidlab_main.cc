@@ -22,7 +22,7 @@ const Command kCommands[] = {
     {"batch", "the AMIGO test batch: AMIGO's PID against pidlab's optimum on P1-P9",
      pidlab::cli::RegisterBatch},
     {"evaluate", "evaluate one gain set (IAE, poles, step metrics)", pidlab::cli::RegisterEvaluate},
-    {"identify", "fit a process model (p1d, p2d, p2du, p1di) to t, u, y in a CSV",
+    {"identify", "fit a process model (p1d, p2d, p2du, p1di, p2dz, auto) to t, u, y of a CSV or a log",
      pidlab::cli::RegisterIdentify},
     {"linearize", "transfer function of a nonlinear plant's linearisation (stepper_nonlinear)",
      pidlab::cli::RegisterLinearize},

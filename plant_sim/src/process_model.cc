@@ -17,13 +17,15 @@ const char* ToString(ProcessModelKind kind) {
       return "p2du";
     case ProcessModelKind::kP1DI:
       return "p1di";
+    case ProcessModelKind::kP2DZ:
+      return "p2dz";
   }
   return "unknown";
 }
 
 bool Parse(const std::string& text, ProcessModelKind* kind) {
-  for (ProcessModelKind k :
-       {ProcessModelKind::kP1D, ProcessModelKind::kP2D, ProcessModelKind::kP2DU, ProcessModelKind::kP1DI}) {
+  for (ProcessModelKind k : {ProcessModelKind::kP1D, ProcessModelKind::kP2D, ProcessModelKind::kP2DU,
+                             ProcessModelKind::kP1DI, ProcessModelKind::kP2DZ}) {
     if (text == ToString(k)) {
       *kind = k;
       return true;
@@ -32,7 +34,7 @@ bool Parse(const std::string& text, ProcessModelKind* kind) {
   return false;
 }
 
-std::string ProcessModelKindNames() { return "p1d|p2d|p2du|p1di"; }
+std::string ProcessModelKindNames() { return "p1d|p2d|p2du|p1di|p2dz"; }
 
 TransferFunction ProcessModel::ToTransferFunction() const {
   switch (kind) {
@@ -44,6 +46,9 @@ TransferFunction ProcessModel::ToTransferFunction() const {
       return {{kp}, {tw_s * tw_s, 2.0 * zeta * tw_s, 1.0}};
     case ProcessModelKind::kP1DI:
       return {{kp}, {tp1_s, 1.0, 0.0}};
+    case ProcessModelKind::kP2DZ:
+      if (tz_s == 0.0) return {{kp}, {tp1_s * tp2_s, tp1_s + tp2_s, 1.0}};
+      return {{kp * tz_s, kp}, {tp1_s * tp2_s, tp1_s + tp2_s, 1.0}};
   }
   return {};
 }
@@ -57,6 +62,8 @@ std::vector<std::string> ParameterNames(ProcessModelKind kind) {
       return {"Kp", "Tp1", "Tp2", "Td"};
     case ProcessModelKind::kP2DU:
       return {"Kp", "Tw", "Zeta", "Td"};
+    case ProcessModelKind::kP2DZ:
+      return {"Kp", "Tp1", "Tp2", "Tz", "Td"};
   }
   return {};
 }
@@ -70,6 +77,8 @@ std::vector<double> ParameterValues(const ProcessModel& m) {
       return {m.kp, m.tp1_s, m.tp2_s, m.td_s};
     case ProcessModelKind::kP2DU:
       return {m.kp, m.tw_s, m.zeta, m.td_s};
+    case ProcessModelKind::kP2DZ:
+      return {m.kp, m.tp1_s, m.tp2_s, m.tz_s, m.td_s};
   }
   return {};
 }
@@ -91,6 +100,11 @@ ProcessModel ModelFromValues(ProcessModelKind kind, const std::vector<double>& v
     case ProcessModelKind::kP2DU:
       m.tw_s = v.at(1);
       m.zeta = v.at(2);
+      break;
+    case ProcessModelKind::kP2DZ:
+      m.tp1_s = v.at(1);
+      m.tp2_s = v.at(2);
+      m.tz_s = v.at(3);
       break;
   }
   return m;

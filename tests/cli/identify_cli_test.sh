@@ -75,10 +75,13 @@ import json, sys
 j = json.load(open(sys.argv[1]))
 a = j['auto']
 assert a['chosen'] == 'p1d' == j['model'], a
-assert [c['model'] for c in a['candidates']] == ['p1d', 'p2d', 'p2du', 'p1di'], a
+assert [c['model'] for c in a['candidates']] == ['p1d', 'p2d', 'p2du', 'p1di', 'p2dz'], a
 best = min(c['aic'] for c in a['candidates'] if c['ok'])
 assert j['aic'] <= best + 2 and 'AIC' in a['reason'], a
 PY"
+pidlab identify --csv step.csv --model p2dz --out p2dz.json > p2dz.txt 2> err
+check "--model p2dz fits Kp (1 + Tz s) e^(-Td s)/((1 + Tp1 s)(1 + Tp2 s)), and its file is a plant" \
+  "[ $? -eq 0 ] && grep -q '^Tz ' p2dz.txt && grep -q 'Kp (1 + Tz s)' p2dz.txt && pidlab evaluate --model p2dz.json --gains 0.5,0.4,0 --loop sampled --json > p2dz_eval.json"
 pidlab identify --csv step.csv --model p1d --plot fit.png > /dev/null 2> err
 check "--plot draws a PNG of the fit" "[ $? -eq 0 ] && head -c 4 fit.png | grep -q PNG"
 pidlab identify --csv step.csv --model p1d --log x.lcmlog > out 2> err

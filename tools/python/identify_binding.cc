@@ -79,7 +79,8 @@ void DefineIdentify(py::module_& m) {
   m.def(
       "identify", &IdentifyPy,
       "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None): fits a process model "
-      "(p1d, p2d, p2du, p1di, or auto to choose by AIC) to the record t (s, uniform), u, y (lists or numpy "
+      "(p1d, p2d, p2du, p1di, p2dz, or auto to choose by AIC) to the record t (s, uniform), u, y (lists or "
+      "numpy "
       "arrays) and returns the dict of `pidlab identify --json`. u0, y0: the operating point (None: u0 the "
       "first sample, y0 estimated with the model). Bad data or arguments raise ValueError naming the reason "
       "(docs/identify.md).",

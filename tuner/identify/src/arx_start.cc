@@ -60,6 +60,12 @@ std::optional<std::vector<double>> FromPoles(ProcessModelKind kind,
       const double zeta = std::clamp(-sum / (2.0 * wn), 1e-3, 0.999);
       return std::vector<double>{1.0, 1.0 / wn, zeta, td_s};
     }
+    case ProcessModelKind::kP2DZ: {
+      // P2D's poles and no zero yet (Tz = 0): the fit finds the zero.
+      auto p2d = FromPoles(ProcessModelKind::kP2D, z, dt_s, td_s);
+      if (!p2d) return std::nullopt;
+      return std::vector<double>{1.0, (*p2d)[1], (*p2d)[2], 0.0, td_s};
+    }
     case ProcessModelKind::kP1DI: {
       // The pole nearest z = 1 is the integrator; the other the lag.
       const std::size_t integrator = std::abs(z[0] - 1.0) < std::abs(z[1] - 1.0) ? 0 : 1;

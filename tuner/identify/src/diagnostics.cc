@@ -102,8 +102,8 @@ std::vector<PoleEstimate> PoleEstimates(const IdentifyResult& result) {
 
 Status IdentifyAuto(const IdentifyData& data, const IdentifyOptions& options, AutoResult* result) {
   *result = AutoResult{};
-  for (ProcessModelKind kind :
-       {ProcessModelKind::kP1D, ProcessModelKind::kP2D, ProcessModelKind::kP2DU, ProcessModelKind::kP1DI}) {
+  for (ProcessModelKind kind : {ProcessModelKind::kP1D, ProcessModelKind::kP2D, ProcessModelKind::kP2DU,
+                                ProcessModelKind::kP1DI, ProcessModelKind::kP2DZ}) {
     AutoCandidate c;
     c.kind = kind;
     c.status = Identify(data, kind, options, &c.result);

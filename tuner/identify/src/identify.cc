@@ -50,8 +50,12 @@ double OffsetOf(const Record& record, const double* theta) {
 // theta[i] is the logarithm of a time constant.
 bool IsLogParameter(ProcessModelKind kind, int i) {
   const int p = ParameterCount(kind);
-  return i > 0 && i < p - 1 && !(kind == ProcessModelKind::kP2DU && i == 2);
+  return i > 0 && i < p - 1 && !(kind == ProcessModelKind::kP2DU && i == 2) &&
+         !(kind == ProcessModelKind::kP2DZ && i == 3);
 }
+
+// theta[i] is P2DZ's Tz (any sign).
+bool IsZeroParameter(ProcessModelKind kind, int i) { return kind == ProcessModelKind::kP2DZ && i == 3; }
 
 ProcessModel ModelOf(ProcessModelKind kind, const double* theta) {
   const int p = ParameterCount(kind);
@@ -99,6 +103,9 @@ void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) 
     if (IsLogParameter(record.kind, i)) {
       problem->SetParameterLowerBound(theta, i, std::log(record.dt_s / kTimeConstantRange));
       problem->SetParameterUpperBound(theta, i, std::log(record.length_s * kTimeConstantRange));
+    } else if (IsZeroParameter(record.kind, i)) {
+      problem->SetParameterLowerBound(theta, i, -record.length_s * kTimeConstantRange);
+      problem->SetParameterUpperBound(theta, i, record.length_s * kTimeConstantRange);
     } else {
       problem->SetParameterLowerBound(theta, i, kMinZeta);
       problem->SetParameterUpperBound(theta, i, kMaxZeta);
@@ -154,6 +161,8 @@ std::vector<double> StartPoint(const Record& record, const optim::SobolSequence&
       theta.back() = hi_coordinate * std::min(record.max_delay_s, 0.25 * record.length_s);
     else if (IsLogParameter(record.kind, i))
       theta[static_cast<std::size_t>(i)] = lo + hi_coordinate * (hi - lo);
+    else if (IsZeroParameter(record.kind, i))
+      theta[static_cast<std::size_t>(i)] = (2.0 * hi_coordinate - 1.0) * 0.1 * record.length_s;
     else
       theta[static_cast<std::size_t>(i)] = 0.1 + 0.8 * hi_coordinate;
   }
@@ -191,6 +200,8 @@ std::vector<double> ArxStartPoint(const Record& record) {
                        std::log(record.length_s * kTimeConstantRange));
       else if (i == p - 1)
         theta[static_cast<std::size_t>(i)] = std::clamp(v, 0.0, record.max_delay_s);
+      else if (IsZeroParameter(record.kind, i))
+        theta[static_cast<std::size_t>(i)] = v;
       else
         theta[static_cast<std::size_t>(i)] = std::clamp(v, kMinZeta, kMaxZeta);
     }
@@ -463,7 +474,8 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   std::vector<double> theta = MultiStart(record, options, &result->start_costs, &result->arx_start);
   if (theta.empty()) return Status::RunnerFailed("no start of the fit converged");
   // P2D's time constants are interchangeable: report Tp1 >= Tp2.
-  if (kind == ProcessModelKind::kP2D && theta[2] > theta[1]) std::swap(theta[1], theta[2]);
+  if ((kind == ProcessModelKind::kP2D || kind == ProcessModelKind::kP2DZ) && theta[2] > theta[1])
+    std::swap(theta[1], theta[2]);
   const double best = *std::min_element(result->start_costs.begin(), result->start_costs.end());
   double scale = 0.0;
   for (double v : record.dy) scale += 0.5 * v * v;

@@ -4,6 +4,7 @@
 //   P2D   Kp e^(-Td s) / ((1 + Tp1 s)(1 + Tp2 s))
 //   P2DU  Kp e^(-Td s) / (1 + 2 Zeta Tw s + (Tw s)^2)
 //   P1DI  Kp e^(-Td s) / (s (1 + Tp1 s))
+//   P2DZ  Kp (1 + Tz s) e^(-Td s) / ((1 + Tp1 s)(1 + Tp2 s))
 // Times in seconds; Kp in output units per input unit (per second for P1DI).
 // `pidlab identify` fits them (tuner/identify/); a fitted model, with the
 // covariance of its parameters, is a plant (ProcessModelUncertainty, carried
@@ -17,13 +18,13 @@
 
 namespace pidlab::plant_sim {
 
-enum class ProcessModelKind { kP1D, kP2D, kP2DU, kP1DI };
+enum class ProcessModelKind { kP1D, kP2D, kP2DU, kP1DI, kP2DZ };
 
-/// "p1d", "p2d", "p2du", "p1di".
+/// "p1d", "p2d", "p2du", "p1di", "p2dz".
 const char* ToString(ProcessModelKind kind);
 /// The inverse of ToString; false (and *kind untouched) for any other text.
 bool Parse(const std::string& text, ProcessModelKind* kind);
-/// "p1d|p2d|p2du|p1di", for help texts and error messages.
+/// "p1d|p2d|p2du|p1di|p2dz", for help texts and error messages.
 std::string ProcessModelKindNames();
 
 struct ProcessModel {
@@ -33,15 +34,18 @@ struct ProcessModel {
   double tp2_s = 0.0;  // P2D
   double tw_s = 1.0;   // P2DU: 1 / natural frequency
   double zeta = 0.5;   // P2DU: damping, in (0, 1)
+  double tz_s = 0.0;   // P2DZ: the zero's time constant, any sign (negative: a right-half-plane zero)
   double td_s = 0.0;   // input delay, >= 0
 
-  /// Kp / den(s), descending powers of s, without the delay (delay_s()).
+  /// Kp (1 + Tz s) / den(s), descending powers of s, without the delay
+  /// (delay_s()); the numerator is Kp alone where Tz = 0.
   TransferFunction ToTransferFunction() const;
   double delay_s() const { return td_s; }
 };
 
 /// The names of the model's parameters in a fixed order: P1D Kp Tp1 Td; P2D
-/// Kp Tp1 Tp2 Td; P2DU Kp Tw Zeta Td; P1DI Kp Tp1 Td.
+/// Kp Tp1 Tp2 Td; P2DU Kp Tw Zeta Td; P1DI Kp Tp1 Td; P2DZ Kp Tp1 Tp2 Tz Td
+/// (Td always last).
 std::vector<std::string> ParameterNames(ProcessModelKind kind);
 /// The values of `model`'s parameters in the order of ParameterNames.
 std::vector<double> ParameterValues(const ProcessModel& model);

@@ -148,7 +148,7 @@ struct PoleEstimate {
 /// complex pair first), with standard errors when the covariance is ok.
 std::vector<PoleEstimate> PoleEstimates(const IdentifyResult& result);
 
-/// Fits every kind (P1D, P2D, P2DU, P1DI) and chooses the lowest AIC, or,
+/// Fits every kind (P1D, P2D, P2DU, P1DI, P2DZ) and chooses the lowest AIC, or,
 /// among the kinds within 2 of it (which the data hardly tell apart), the one
 /// of fewest parameters (then the lowest AIC among those).
 /// kInvalidInput as Identify; kRunnerFailed if no kind could be fitted.
