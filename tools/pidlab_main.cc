@@ -18,20 +18,30 @@ struct Command {
   std::function<int()> (*register_flags)(CLI::App* app);
 };
 
+// The sanitised tree's pidlab (tools/CMakeLists.txt) holds only the
+// commands the hostile tests run on it: evaluate, launch and replay.
 const Command kCommands[] = {
+#ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
     {"batch", "the AMIGO test batch: AMIGO's PID against pidlab's optimum on P1-P9",
      pidlab::cli::RegisterBatch},
+#endif
     {"evaluate", "evaluate one gain set (IAE, poles, step metrics)", pidlab::cli::RegisterEvaluate},
+#ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
     {"identify", "fit a process model (p1d, p2d, p2du, p1di, p2dz, auto) to t, u, y of a CSV or a log",
      pidlab::cli::RegisterIdentify},
     {"linearize", "transfer function of a nonlinear plant's linearisation (stepper_nonlinear)",
      pidlab::cli::RegisterLinearize},
+#endif
     {"launch", "start the LCM process trio (plant, controller, disturbance)", pidlab::cli::RegisterLaunch},
+#ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
     {"plot", "PNG figures of y, e, u, n from an evaluation or an LCM log", pidlab::cli::RegisterPlot},
+#endif
     {"replay", "read an LCM log: episodes, IAE, completeness, --redrive", pidlab::cli::RegisterReplay},
+#ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
     {"report", "regenerate the paper's tables and figures (report.md + PNGs)", pidlab::cli::RegisterReport},
     {"tune", "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check",
      pidlab::cli::RegisterTune},
+#endif
 };
 
 // The message of an error as one printable line of at most 270 characters
