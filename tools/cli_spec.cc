@@ -111,7 +111,16 @@ nlohmann::json SpecFlags::ReadSpecFile() const {
   std::string error;
   if (!spec::ParseJsonText(text.str(), &j, &error)) ThrowSpecFileError(error);
   // A --json result: its "spec".
-  if (j.is_object() && j.contains("spec") && j["spec"].is_object()) return j["spec"];
+  if (j.is_object() && j.contains("spec") && j["spec"].is_object()) j = nlohmann::json(j["spec"]);
+  // A plant named on the command line (--plant, --model, --num/--den)
+  // replaces the file's plant, whichever form either was given in: the
+  // file's plant, model, num and den are dropped (its delay and stepper
+  // options stay, and are checked against the new plant).
+  const char* const kPlantKeys[] = {"plant", "model", "num", "den"};
+  bool plant_given = false;
+  for (const char* key : kPlantKeys) plant_given = plant_given || Given(key);
+  if (plant_given && j.is_object())
+    for (const char* key : kPlantKeys) j.erase(key);
   return j;
 }
 
