@@ -217,7 +217,8 @@ bool ContinuousSpectralAbscissa(const TransferFunction& tf, const PidGains& g, d
   thread_local std::vector<frequency::Point> pts;
   // Left from the stable loop's line Re s = 0 by doublings until a root lies
   // right of the line, then bisection of the strip.
-  double hi = 0.0, lo = -1e-3 * SlowestFeature(r);
+  const double start = 1e-3 * SlowestFeature(r);
+  double hi = 0.0, lo = -start;
   std::string why;
   for (int k = 0;; ++k, lo *= 2.0) {
     const int z = k < 200 ? RootsRightOf(r, poles, points_per_decade, &lo, &w, &pts, &out->counts, &why) : -1;
@@ -228,7 +229,8 @@ bool ContinuousSpectralAbscissa(const TransferFunction& tf, const PidGains& g, d
     if (z > 0) break;
     hi = lo;
   }
-  while (hi - lo > kStripFraction * std::abs(hi)) {
+  // (A root within rounding of 0, alpha = -1e-300, stops at the floor.)
+  for (int k = 0; k < 200 && hi - lo > std::max(kStripFraction * std::abs(hi), 1e-15 * start); ++k) {
     double mid = 0.5 * (lo + hi);
     const int z = RootsRightOf(r, poles, points_per_decade, &mid, &w, &pts, &out->counts, &why);
     if (z < 0 || !(mid > lo && mid < hi)) break;
