@@ -91,8 +91,11 @@ TEST(LoopDelay, FirstOrderWithUnitDelayUnderPControlHasTheUltimateGainAndFrequen
   EXPECT_NEAR(dut.phase_crossover_rad_s, 2.0287578381104345, 1e-5);
   EXPECT_TRUE(std::isinf(dut.phase_margin_deg)) << "|L| < 1 for every w > 0";
   EXPECT_EQ(dut.delay_s, 1.0);
-  EXPECT_TRUE(std::isnan(dut.slowest_time_constant_s));
-  EXPECT_FALSE(dut.time_constant_note.empty());
+  // The rightmost roots of s + 1 + e^{-s} = 0 are W_0(-e) - 1 and its conjugate:
+  //   /usr/bin/python3 -c "from scipy.special import lambertw; import numpy as np; print(lambertw(-np.e) - 1)"
+  //   (-0.6050209172927068+1.788188041383629j)
+  EXPECT_NEAR(dut.slowest_time_constant_s, 1.0 / 0.6050209172927068, 1e-9);
+  EXPECT_TRUE(dut.time_constant_note.empty()) << dut.time_constant_note;
 }
 
 TEST(LoopDelay, NyquistCountChangesAtTheUltimateGainOfTheDelayedFirstOrder) {

@@ -156,5 +156,33 @@ TEST(RobustSet, RejectsAQuantileOutsideZeroOneAndASpreadOfOne) {
   EXPECT_FALSE(o.IsValid(&error));
 }
 
+// The preset bounds the slowest closed-loop time constant, which the continuous
+// loop with dead time now has (the spectral abscissa): the preset finds gains
+// on a delayed plant with a small budget, and the full analysis confirms
+// every bound (docs/deadtime.md, "The slowest time constant with dead time").
+TEST(RobustPreset, FindsGainsMeetingEveryBoundOnTheContinuousLoopOfAPlantWithDeadTime) {
+  Plant plant{"custom", TransferFunction{{1.0}, {1.0, 1.0}}};
+  plant.delay_s = 0.5;
+  TuneOptions o;
+  ApplyRobustPreset(&o);
+  o.lower = 0.0;
+  o.upper = 3.0;
+  o.max_evaluations = 80;
+  o.design_points = 40;
+  TuneSummary s;
+  std::string error;
+  ASSERT_TRUE(Tune(plant, o, &s, &error)) << error;
+  ASSERT_TRUE(s.stable) << s.message;
+  EXPECT_LT(s.optimizer.rejected_evaluations, s.evaluations);
+  LoopAnalysis a;
+  ASSERT_TRUE(AnalyzeLoop(plant, s.gains, o.loop, LoopAnalysisOptions{}, &a, &error)) << error;
+  EXPECT_TRUE(a.stable) << a.stability_note;
+  EXPECT_TRUE(a.time_constant_note.empty()) << a.time_constant_note;
+  EXPECT_GT(a.slowest_time_constant_s, 0.0);
+  EXPECT_LE(a.slowest_time_constant_s, 2.5);
+  EXPECT_LE(a.ms, 1.6 * (1.0 + 1e-6));
+  EXPECT_TRUE(LoopBoundsViolations(a, o.bounds).empty());
+}
+
 }  // namespace
 }  // namespace pidlab

@@ -159,8 +159,11 @@ struct TuneCommand {
       std::cout << "ceres            kp = " << s.refine.gains.kp << ", ki = " << s.refine.gains.ki
                 << ", kd = " << s.refine.gains.kd << "  objective " << s.refine.objective << "  ("
                 << ToString(s.refine.termination) << ", " << s.refine.iterations << " iterations)\n";
-    std::cout << "verdict          " << ToString(s.refine.verdict, s.method)
-              << (s.refine.message.empty() ? "" : ": ") << s.refine.message << "\n";
+    // The message may start with the verdict itself ("not run: ...").
+    const std::string verdict = ToString(s.refine.verdict, s.method);
+    std::string message = s.refine.message;
+    if (message.rfind(verdict + ": ", 0) == 0) message.erase(0, verdict.size() + 2);
+    std::cout << "verdict          " << verdict << (message.empty() ? "" : ": ") << message << "\n";
     if (o.robust_samples > 0)
       std::cout << "robust set       " << s.robust_set_size << " plants (nominal + " << o.robust_samples
                 << " draws "

@@ -202,7 +202,26 @@ void SetPeaks(const Response& response, const std::vector<double>& w, const std:
   }
 }
 
-// The frequencies of the open-loop poles and zeros of r, and 1/L.
+// The stable delayed loop's slowest time constant -1/alpha from its spectral
+// abscissa, or NaN with a note saying why not.
+bool SetDelayedTimeConstant(const Plant& plant, const PidGains& g, const LoopAnalysisOptions& ao,
+                            LoopAnalysis* a, std::string* error) {
+  if (!ao.delayed_time_constant) {
+    a->time_constant_note = "dead time: the spectral abscissa was not asked for";
+    return true;
+  }
+  evaluation::SpectralAbscissa sa;
+  if (!evaluation::ContinuousSpectralAbscissa(plant.tf, g, plant.delay_s, ao.points_per_decade, &sa, error))
+    return false;
+  if (sa.found && sa.alpha < 0.0) {
+    a->slowest_time_constant_s = -1.0 / sa.alpha;
+    a->time_constant_note.clear();
+  } else {
+    a->time_constant_note = sa.found ? "dead time: spectral abscissa >= 0" : "dead time: " + sa.note;
+  }
+  return true;
+}
+
 // The continuous loop with dead time: the open-loop features and 1/L on the
 // analysis grid, e^{-jwL} resolved below the band's top, stability by the
 // Nyquist count, crossovers within the band, peaks without the Hamiltonian
@@ -213,8 +232,9 @@ bool AnalyzeDelayedLoop(const Plant& plant, const PidGains& g, const evaluation:
   a->method =
       "log grid + open-loop pole and zero frequencies, points every pi/16 of e^(-jwL) up to where |L| < "
       "0.01 for good, golden-section refinement of every local maximum (no Hamiltonian iteration "
-      "with dead time)";
-  a->time_constant_note = "dead time: the closed-loop poles are not computed";
+      "with dead time); the slowest time constant from the spectral abscissa (Nyquist counts on shifted "
+      "lines, bisection, Newton)";
+  a->time_constant_note = "dead time: unstable loop, no spectral abscissa";
   const ContinuousResponse r(plant.tf, g, plant.delay_s);
   std::vector<double> w;
   std::vector<Point> pts;
@@ -227,6 +247,7 @@ bool AnalyzeDelayedLoop(const Plant& plant, const PidGains& g, const evaluation:
     MarkUnstable(a);
     return true;
   }
+  if (!SetDelayedTimeConstant(plant, g, ao, a, error)) return false;
   Crossings c = FindCrossings(r, w, pts);
   for (auto* list : {&c.gain, &c.phase})
     list->erase(std::remove_if(list->begin(), list->end(), [&](double x) { return x > w_top; }), list->end());

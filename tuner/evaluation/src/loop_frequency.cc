@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace pidlab::evaluation {
 namespace frequency {
@@ -65,32 +66,188 @@ void ContinuousPidPolynomials(const PidGains& g, std::vector<double>* num, std::
 
 bool CountContinuousNyquist(const TransferFunction& tf, const PidGains& g, double delay_s,
                             double points_per_decade, NyquistCount* count, std::string* error) {
-  using frequency::Point;
-  const frequency::ContinuousResponse r(tf, g, delay_s);
-  // The continuous loop's analysis grid: 1e-3 x the slowest to 1e3 x the
-  // fastest open-loop feature (as the analysis, AnalysisGrid).
-  const std::vector<double> special = frequency::OpenLoopFrequencies(r);
-  double lo = frequency::kInf, hi = 0.0;
-  for (double w : special) {
-    if (!(w > 0.0) || !std::isfinite(w)) continue;
-    lo = std::min(lo, w);
-    hi = std::max(hi, w);
-  }
-  if (!(hi > 0.0)) lo = hi = 1.0;
-  const std::vector<double> base = frequency::Grid(1e-3 * lo, 1e3 * hi, points_per_decade, special);
   // Reused per thread: the tuner counts once per evaluation, and a fresh
   // grid of large vectors each time costs more in page faults than the count.
   thread_local std::vector<double> w;
-  thread_local std::vector<Point> pts;
-  w = base;
-  if (delay_s > 0.0) {
-    double w_top = 0.0;
-    if (!frequency::DelayGrid(r, base, &w, &pts, &w_top, error)) return false;
-  } else {
-    pts.resize(w.size());
-    for (std::size_t i = 0; i < w.size(); ++i) pts[i] = r.At(w[i]);
+  thread_local std::vector<frequency::Point> pts;
+  return frequency::CountOnAnalysisGrid(frequency::ContinuousResponse(tf, g, delay_s), points_per_decade, &w,
+                                        &pts, count, error);
+}
+
+namespace frequency {
+
+bool CountOnAnalysisGrid(const ContinuousResponse& r, double per_decade, std::vector<double>* w,
+                         std::vector<Point>* pts, NyquistCount* count, std::string* error) {
+  // The continuous loop's analysis grid: 1e-3 x the slowest to 1e3 x the
+  // fastest open-loop feature (as the analysis, AnalysisGrid).
+  const std::vector<double> special = OpenLoopFrequencies(r);
+  double lo = kInf, hi = 0.0;
+  for (double x : special) {
+    if (!(x > 0.0) || !std::isfinite(x)) continue;
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
   }
-  *count = frequency::CountEncirclements(r, w, pts);
+  if (!(hi > 0.0)) lo = hi = 1.0;
+  const std::vector<double> base = Grid(1e-3 * lo, 1e3 * hi, per_decade, special);
+  *w = base;
+  if (r.delay() > 0.0) {
+    double w_top = 0.0;
+    if (!DelayGrid(r, base, w, pts, &w_top, error)) return false;
+  } else {
+    pts->resize(w->size());
+    for (std::size_t i = 0; i < w->size(); ++i) (*pts)[i] = r.At((*w)[i]);
+  }
+  *count = CountEncirclements(r, *w, *pts);
+  return true;
+}
+
+}  // namespace frequency
+namespace {
+
+using frequency::cd;
+using frequency::kNaN;
+using frequency::Polynomial;
+
+// The strip [lo, hi] that holds alpha is narrowed to this fraction of |hi|.
+constexpr double kStripFraction = 1e-7;
+// Newton's polish from this many of the best points on the strip's line.
+constexpr std::size_t kNewtonStarts = 6;
+
+Polynomial Derivative(const Polynomial& p) {
+  Polynomial d;
+  for (std::size_t i = 0; i + 1 < p.size(); ++i) d.push_back(p[i] * static_cast<double>(p.size() - 1 - i));
+  if (d.empty()) d.push_back(0.0);
+  return d;
+}
+
+// The characteristic function f(s) = b(s) + a(s) e^{-sL} (L = a/b) and f'.
+struct Characteristic {
+  Polynomial a, b, da, db;
+  double delay = 0.0;
+  cd F(cd s) const { return frequency::Eval(b, s) + frequency::Eval(a, s) * std::exp(-s * delay); }
+  cd DF(cd s) const {
+    return frequency::Eval(db, s) +
+           (frequency::Eval(da, s) - delay * frequency::Eval(a, s)) * std::exp(-s * delay);
+  }
+};
+
+// Newton from s: the root (Im >= 0), or NaN when 60 steps do not converge.
+cd NewtonRoot(const Characteristic& f, cd s) {
+  for (int i = 0; i < 60; ++i) {
+    const cd d = f.F(s) / f.DF(s);
+    if (!std::isfinite(std::abs(d))) break;
+    s -= d;
+    if (std::abs(d) <= 1e-14 * std::max(1.0, std::abs(s))) return s.imag() < 0.0 ? std::conj(s) : s;
+  }
+  return {kNaN, kNaN};
+}
+
+// One shifted count on the line *sigma (moved clear of the open-loop poles):
+// the roots right of it, or -1 with *why when the count fails or does not
+// decide.
+int RootsRightOf(const frequency::ContinuousResponse& r, const std::vector<cd>& poles, double per_decade,
+                 double* sigma, std::vector<double>* w, std::vector<frequency::Point>* pts, int* counts,
+                 std::string* why) {
+  *sigma = frequency::LineClearOfPoles(poles, *sigma);
+  NyquistCount n;
+  ++*counts;
+  if (!frequency::CountOnAnalysisGrid(r.Shifted(*sigma), per_decade, w, pts, &n, why)) return -1;
+  if (n.decided) return n.closed_loop_rhp_poles;
+  std::ostringstream os;
+  os << "the count on the line Re s = " << *sigma << " does not decide (" << n.note << ")";
+  *why = os.str();
+  return -1;
+}
+
+// The smallest positive open-loop frequency of r (its poles', zeros' and 1/L).
+double SlowestFeature(const frequency::ContinuousResponse& r) {
+  double lo = frequency::kInf;
+  for (double x : frequency::OpenLoopFrequencies(r))
+    if (x > 0.0 && std::isfinite(x)) lo = std::min(lo, x);
+  return lo;
+}
+
+// Newton from the best local minima of |1 + L| on the line of the strip's
+// middle (its grid w, pts): the rightmost root found inside [lo, hi], widened
+// by the polish's own tolerance, into *out.
+void Polish(const frequency::ContinuousResponse& r, double lo, double hi, const std::vector<double>& w,
+            const std::vector<frequency::Point>& pts, SpectralAbscissa* out) {
+  const Characteristic f{r.a(), r.b(), Derivative(r.a()), Derivative(r.b()), r.delay()};
+  auto residual = [&](std::size_t i) {
+    return std::abs(pts[i].a + pts[i].b) / (std::abs(pts[i].a) + std::abs(pts[i].b));
+  };
+  std::vector<std::pair<double, double>> minima{{0.0, 0.0}};  // (residual, w); w = 0 always tried
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const double ri = residual(i);
+    if ((i == 0 || ri <= residual(i - 1)) && (i + 1 == w.size() || ri <= residual(i + 1)) &&
+        std::isfinite(ri))
+      minima.push_back({ri, w[i]});
+  }
+  std::sort(minima.begin() + 1, minima.end());
+  if (minima.size() > kNewtonStarts) minima.resize(kNewtonStarts);
+  const double mid = 0.5 * (lo + hi), slack = hi - lo + 1e-12 * std::max(1.0, std::abs(hi));
+  for (const auto& [unused, wi] : minima) {
+    const cd root = NewtonRoot(f, cd(mid, wi));
+    if (!(root.real() >= lo - slack && root.real() <= hi + slack)) continue;
+    if (!out->polished || root.real() > out->alpha) {
+      out->polished = true;
+      out->alpha = root.real();
+      out->root = root;
+    }
+  }
+}
+
+}  // namespace
+
+bool ContinuousSpectralAbscissa(const TransferFunction& tf, const PidGains& g, double delay_s,
+                                double points_per_decade, SpectralAbscissa* out, std::string* error) {
+  *out = SpectralAbscissa();
+  if (!(delay_s > 0.0) || !std::isfinite(delay_s) || !(points_per_decade > 0.0)) {
+    if (error) *error = "the spectral abscissa needs a dead time > 0 and a grid density > 0";
+    return false;
+  }
+  const frequency::ContinuousResponse r(tf, g, delay_s);
+  if (frequency::Degree(r.a()) >= frequency::Degree(r.b())) {
+    out->note =
+        "neutral loop: its roots crowd towards a vertical line, the spectral abscissa is not computed";
+    return true;
+  }
+  const std::vector<cd> poles = PolynomialRoots(r.b());
+  thread_local std::vector<double> w;
+  thread_local std::vector<frequency::Point> pts;
+  // Left from the stable loop's line Re s = 0 by doublings until a root lies
+  // right of the line, then bisection of the strip.
+  const double start = 1e-3 * SlowestFeature(r);
+  double hi = 0.0, lo = -start;
+  std::string why;
+  for (int k = 0;; ++k, lo *= 2.0) {
+    const int z = k < 200 ? RootsRightOf(r, poles, points_per_decade, &lo, &w, &pts, &out->counts, &why) : -1;
+    if (z < 0) {
+      out->note = "spectral abscissa not computed: " + (k < 200 ? why : std::string("no root found"));
+      return true;
+    }
+    if (z > 0) break;
+    hi = lo;
+  }
+  // (A root within rounding of 0, alpha = -1e-300, stops at the floor.)
+  for (int k = 0; k < 200 && hi - lo > std::max(kStripFraction * std::abs(hi), 1e-15 * start); ++k) {
+    double mid = 0.5 * (lo + hi);
+    const int z = RootsRightOf(r, poles, points_per_decade, &mid, &w, &pts, &out->counts, &why);
+    if (z < 0 || !(mid > lo && mid < hi)) break;
+    (z > 0 ? lo : hi) = mid;
+  }
+  out->strip_width = hi - lo;
+  double mid = 0.5 * (lo + hi);
+  if (RootsRightOf(r, poles, points_per_decade, &mid, &w, &pts, &out->counts, &why) >= 0)
+    Polish(r, lo, hi, w, pts, out);
+  if (!out->polished) {
+    out->alpha = hi;  // the strip's right edge: no root lies right of it
+    std::ostringstream os;
+    os << "rightmost root not polished by Newton: alpha is the strip's right edge, within "
+       << out->strip_width << " 1/s" << (why.empty() ? "" : " (" + why + ")");
+    out->note = os.str();
+  }
+  out->found = true;
   return true;
 }
 

@@ -96,13 +96,13 @@ double ArgOnePlusL(const Response& r, double w, bool* near_zero) {
   return std::arg(num) - std::arg(p.b);
 }
 
-// The continuous change of arg(1 + L) from w0 to w1, bisecting (on log w)
-// where the wrapped change exceeds pi/4.
+// The continuous change of arg(1 + L) from w0 to w1, bisecting (on log w;
+// linearly from w0 = 0) where the wrapped change exceeds pi/4.
 double ArgChange(const Response& r, double w0, double w1, double arg0, double arg1, int depth,
                  bool* near_zero) {
   const double d = Wrap(arg1 - arg0);
   if (std::abs(d) < 0.25 * kPi || depth >= 48 || !(w1 > w0)) return d;
-  const double wm = std::sqrt(w0 * w1), am = ArgOnePlusL(r, wm, near_zero);
+  const double wm = w0 > 0.0 ? std::sqrt(w0 * w1) : 0.5 * w1, am = ArgOnePlusL(r, wm, near_zero);
   return ArgChange(r, w0, wm, arg0, am, depth + 1, near_zero) +
          ArgChange(r, wm, w1, am, arg1, depth + 1, near_zero);
 }
@@ -125,7 +125,45 @@ double IndentChange(const AxisPole& pole, double arg_lo, double arg_hi) {
   return turn + Wrap(arg_hi - arg_lo - turn);
 }
 
+// q(p) = x(p + sigma), descending powers (repeated synthetic division).
+Polynomial TaylorShift(Polynomial x, double sigma) {
+  const std::size_t n = x.size();
+  for (std::size_t i = 0; i + 1 < n; ++i)
+    for (std::size_t j = 1; j < n - i; ++j) x[j] += sigma * x[j - 1];
+  return x;
+}
+
 }  // namespace
+
+double LineClearOfPoles(const std::vector<cd>& poles, double sigma) {
+  for (int pass = 0; pass < 8; ++pass) {
+    bool moved = false;
+    for (const cd& p : poles) {
+      const double gap = kLineGapFromPoles * std::max(1.0, std::abs(p));
+      if (std::abs(sigma - p.real()) < gap) {
+        sigma = p.real() - gap;
+        moved = true;
+      }
+    }
+    if (!moved) break;
+  }
+  return sigma;
+}
+
+ContinuousResponse ContinuousResponse::Shifted(double sigma) const {
+  ContinuousResponse r = *this;
+  const double gain = delay_ > 0.0 ? std::exp(-sigma * delay_) : 1.0;
+  r.nc_ = TaylorShift(nc_, sigma);
+  r.dc_ = TaylorShift(dc_, sigma);
+  r.ng_ = TaylorShift(ng_, sigma);
+  r.dg_ = TaylorShift(dg_, sigma);
+  r.a_ = TaylorShift(a_, sigma);
+  for (double& x : r.a_) x *= gain;
+  r.b_ = TaylorShift(b_, sigma);
+  r.c_ = TaylorShift(c_, sigma);
+  r.p_ = Add(r.a_, r.b_);
+  return r;
+}
 
 bool DelayGrid(const ContinuousResponse& r, const std::vector<double>& base, std::vector<double>* w,
                std::vector<Point>* pts, double* w_top, std::string* error) {
@@ -167,6 +205,12 @@ NyquistCount CountEncirclements(const ContinuousResponse& r, const std::vector<d
     total += IndentChange(axis[0], -a_eps, a_eps);
     total += 2.0 * ArgChange(r, eps, w_prev, a_eps, arg_prev, 0, &near_zero);
     next_pole = 1;
+  } else {
+    // From w = 0 (1 + L real there) to the grid's first point, taken twice: a
+    // closed-loop root near the contour at w = 0 (a shifted line's) turns the
+    // arg below the grid.
+    const double a_0 = ArgOnePlusL(r, 0.0, &near_zero);
+    total += 2.0 * ArgChange(r, 0.0, w_prev, a_0, arg_prev, 0, &near_zero);
   }
   std::vector<double> radius(axis.size(), 0.0);
   for (std::size_t k = next_pole; k < axis.size(); ++k)
@@ -211,3 +255,17 @@ NyquistCount CountEncirclements(const ContinuousResponse& r, const std::vector<d
 }
 
 }  // namespace pidlab::evaluation::frequency
+
+namespace pidlab::evaluation {
+
+bool CountContinuousRootsRightOf(const TransferFunction& tf, const PidGains& g, double delay_s, double sigma,
+                                 double points_per_decade, NyquistCount* count, std::string* error) {
+  const frequency::ContinuousResponse r(tf, g, delay_s);
+  if (sigma != 0.0) sigma = frequency::LineClearOfPoles(PolynomialRoots(r.b()), sigma);
+  thread_local std::vector<double> w;
+  thread_local std::vector<frequency::Point> pts;
+  return frequency::CountOnAnalysisGrid(sigma == 0.0 ? r : r.Shifted(sigma), points_per_decade, &w, &pts,
+                                        count, error);
+}
+
+}  // namespace pidlab::evaluation

@@ -49,6 +49,11 @@ struct LoopAnalysisOptions {
   /// A closed-loop pole p and a controller zero q cancel nearly when
   /// |p - q| <= cancellation_tolerance * |q| (s-plane; sampled: log(z)/dt).
   double cancellation_tolerance = 0.02;
+  /// With dead time (continuous loop), the slowest time constant -1/alpha from
+  /// the spectral abscissa alpha (evaluation::ContinuousSpectralAbscissa, about
+  /// 30 shifted Nyquist counts). False leaves it NaN with a note (the tuner's
+  /// gate counts once on the line of its bound instead).
+  bool delayed_time_constant = true;
 
   bool IsValid(std::string* error) const;
 };
@@ -90,8 +95,9 @@ struct LoopAnalysis {
   double slowest_time_constant_s = std::numeric_limits<double>::quiet_NaN();
   std::vector<Cancellation> cancellations;
   std::string gain_margin_note, phase_margin_note, noise_gain_note;
-  /// Set when no closed-loop pole is known (dead time): why
-  /// slowest_time_constant_s is NaN and no cancellation is listed.
+  /// Set when slowest_time_constant_s is not known (NaN): why. With dead time
+  /// it comes from the spectral abscissa (no pole is listed, so no
+  /// cancellation either), and stays NaN for an unstable or a neutral loop.
   std::string time_constant_note;
   /// How stability was decided with dead time (the Nyquist count), else "".
   std::string stability_note;

@@ -47,6 +47,47 @@ void ContinuousPidPolynomials(const PidGains& loop_gains, std::vector<double>* n
 bool CountContinuousNyquist(const TransferFunction& tf, const PidGains& loop_gains, double delay_s,
                             double points_per_decade, NyquistCount* count, std::string* error);
 
+/// The closed-loop roots of 1 + C(s) G(s) e^(-s delay_s) = 0 right of the line
+/// Re s = sigma: the Nyquist count of the loop on that line (s = sigma + jw,
+/// the shifted polynomials a(s), b(s) and e^(-sigma L) e^(-jwL)), P the
+/// open-loop poles right of the line, Z = N + P the closed-loop roots right of
+/// it. sigma = 0 is CountContinuousNyquist. A line within 1e-8 max(1, |p|) of
+/// an open-loop pole p's real part is moved left by that much
+/// (frequency::LineClearOfPoles). False with *error as CountContinuousNyquist.
+bool CountContinuousRootsRightOf(const TransferFunction& tf, const PidGains& loop_gains, double delay_s,
+                                 double sigma, double points_per_decade, NyquistCount* count,
+                                 std::string* error);
+
+/// The spectral abscissa of the continuous loop with dead time: alpha = max Re s
+/// over the roots of 1 + C(s) G(s) e^(-sL) = 0 (docs/deadtime.md, "The slowest
+/// time constant with dead time").
+struct SpectralAbscissa {
+  /// False when it is not computed (a neutral loop, a count that does not
+  /// decide, a grid too large): then `note` says why and alpha is NaN.
+  bool found = false;
+  double alpha = std::numeric_limits<double>::quiet_NaN();  // 1/s
+  /// The rightmost root (Im >= 0) when Newton's polish converged inside the
+  /// bisection's strip, else NaN.
+  std::complex<double> root{std::numeric_limits<double>::quiet_NaN(), 0.0};
+  /// The width of the last strip [lo, hi] known to hold alpha (the bisection's
+  /// tolerance; with a polished root, alpha is that root's real part).
+  double strip_width = std::numeric_limits<double>::quiet_NaN();
+  bool polished = false;
+  int counts = 0;  // shifted Nyquist counts taken
+  std::string note;
+};
+
+/// The spectral abscissa of the retarded continuous loop of tf e^(-s delay_s)
+/// (delay_s > 0) with `loop_gains`, known to be stable (Z = 0 on the
+/// imaginary axis): counts on shifted lines (CountContinuousRootsRightOf)
+/// walk left from 0 until a line has a root right of it, bisection narrows the
+/// strip to 1e-7 of its distance from 0, and Newton on b(s) + a(s) e^(-sL)
+/// from the strip's best points polishes the rightmost root. False with
+/// *error for invalid input; true with abscissa->found false when the loop
+/// is neutral or a count fails.
+bool ContinuousSpectralAbscissa(const TransferFunction& tf, const PidGains& loop_gains, double delay_s,
+                                double points_per_decade, SpectralAbscissa* abscissa, std::string* error);
+
 namespace frequency {
 
 using Polynomial = std::vector<double>;
@@ -119,6 +160,10 @@ class ContinuousResponse : public Response {
     c_ = Mul(nc_, dg_);
     p_ = Add(a_, b_);
   }
+  // The loop on the line Re s = sigma as a loop in p = s - sigma: a(p +
+  // sigma) e^{-sigma L}, b(p + sigma), c(p + sigma) (Taylor shifts), the same
+  // delay. At(w) of the result is the loop at s = sigma + jw.
+  ContinuousResponse Shifted(double sigma) const;
   Point At(double w) const override {
     const cd s(0.0, w);
     if (delay_ > 0.0) return {Eval(a_, s) * std::polar(1.0, -w * delay_), Eval(b_, s), Eval(c_, s)};
@@ -169,6 +214,20 @@ inline constexpr double kSmallLoopGain = 0.01;
 inline constexpr std::size_t kMaxDelayGridPoints = 2000000;
 bool DelayGrid(const ContinuousResponse& r, const std::vector<double>& base, std::vector<double>* w,
                std::vector<Point>* pts, double* w_top, std::string* error);
+
+// sigma, or, within kLineGapFromPoles max(1, |p|) of an open-loop pole p's
+// real part, that far left of it (repeated while another pole is that near):
+// a line through a pole would need an indentation of a pole that the shift
+// leaves a rounding error off the axis.
+inline constexpr double kLineGapFromPoles = 1e-8;
+double LineClearOfPoles(const std::vector<cd>& poles, double sigma);
+
+// The Nyquist count of r on its analysis grid (1e-3 x the slowest to 1e3 x
+// the fastest open-loop feature at `per_decade`, e^{-jwL} resolved by
+// DelayGrid), the grid and its points left in *w and *pts. False with *error
+// as DelayGrid.
+bool CountOnAnalysisGrid(const ContinuousResponse& r, double per_decade, std::vector<double>* w,
+                         std::vector<Point>* pts, NyquistCount* count, std::string* error);
 
 // The Nyquist count of the continuous loop over the grid `w` (increasing,
 // reaching where |L| < 1 for good) with its points: encirclements of -1 by
