@@ -127,6 +127,22 @@ TEST(IdentifyTf, TheFitIsStableAndOscillatesNoFasterThanTheSamplesShow) {
   }
 }
 
+// The Sobol' design has two coordinates for the lags whatever their number
+// (optim/sobol.h has at most four), so every order up to six runs.
+TEST(IdentifyTf, EveryOrderUpToSixGivesAStableModel) {
+  const IdentifyData data = RecordOf(ThreePolesOneZero(), 30.0, 300);
+  for (int poles = 1; poles <= plant_sim::kMaxTfPoles; ++poles) {
+    SCOPED_TRACE(poles);
+    IdentifyOptions options = TfOptions(poles, poles - 1);
+    options.starts = 4;
+    IdentifyResult dut;
+    const Status status = Identify(data, ProcessModelKind::kTf, options, &dut);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(dut.values.size(), static_cast<std::size_t>(2 * poles + 1));
+    EXPECT_TRUE(plant_sim::IsHurwitz(dut.model.a));
+  }
+}
+
 void ExpectRefused(ProcessModelKind kind, int poles, int zeros, const std::string& message) {
   IdentifyResult result;
   const Status status = Identify(RecordOf(ThreePolesOneZero()), kind, TfOptions(poles, zeros), &result);

@@ -173,12 +173,11 @@ std::vector<double> StartPoint(const Record& record, const optim::SobolSequence&
   const double lo = std::log(0.5 * record.dt_s), hi = std::log(0.5 * record.length_s);
   const Eigen::VectorXd h = sobol.Point(static_cast<std::uint32_t>(index));
   if (record.kind == ProcessModelKind::kTf) {
-    std::vector<double> taus(static_cast<std::size_t>(record.poles));
-    for (int i = 0; i < record.poles; ++i)
-      taus[static_cast<std::size_t>(i)] = std::exp(lo + h[i] * (hi - lo));
+    const std::vector<double> taus =
+        internal::SpreadLags(record.poles, h[0], record.poles > 1 ? h[1] : 0.0, lo, hi);
     internal::SetDenominatorFromLags(record.zeros, taus, &theta);
     theta[static_cast<std::size_t>(p - 1)] =
-        h[record.poles] * std::min(record.max_delay_s, 0.25 * record.length_s);
+        h[h.size() - 1] * std::min(record.max_delay_s, 0.25 * record.length_s);
     SetGainByLeastSquares(record, &theta);
     return theta;
   }
@@ -405,8 +404,8 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
                                std::vector<double>* costs, bool* arx_used) {
   std::vector<double> best;
   double best_cost = std::numeric_limits<double>::infinity();
-  const int dimensions =
-      ParameterCount(record) - 1 - (record.kind == ProcessModelKind::kTf ? record.zeros : 0);
+  const int dimensions = record.kind == ProcessModelKind::kTf ? internal::TfDesignDimensions(record.poles)
+                                                              : ParameterCount(record) - 1;
   const optim::SobolSequence sobol =
       options.seed == 0 ? optim::SobolSequence(dimensions) : optim::SobolSequence(dimensions, options.seed);
   const auto fit = [&](std::vector<double> theta) {

@@ -69,6 +69,16 @@ void SnapTinyCoefficients(std::vector<double>* values) {
     if (std::abs((*values)[i]) < kMinCoefficientMagnitude) (*values)[i] = 0.0;
 }
 
+int TfDesignDimensions(int poles) { return poles > 1 ? 3 : 2; }
+
+std::vector<double> SpreadLags(int poles, double h_slow, double h_fast, double lo, double hi) {
+  const double slow = lo + h_slow * (hi - lo), fast = lo + h_fast * (slow - lo);
+  std::vector<double> taus(static_cast<std::size_t>(poles));
+  for (int i = 0; i < poles; ++i)
+    taus[static_cast<std::size_t>(i)] = std::exp(poles > 1 ? slow + (fast - slow) * i / (poles - 1) : slow);
+  return taus;
+}
+
 void SetDenominatorFromLags(int zeros, const std::vector<double>& taus_s, std::vector<double>* theta) {
   // Ascending coefficients of prod (s + 1 / tau), built one factor at a time.
   std::vector<double> c = {1.0};

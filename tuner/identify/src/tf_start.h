@@ -28,6 +28,16 @@ bool TfDenominatorIsAdmissible(const std::vector<double>& a, double dt_s);
 /// kMinCoefficientMagnitude set to 0, as TransferFunction::IsValid asks.
 void SnapTinyCoefficients(std::vector<double>* values);
 
+/// The Sobol' design's dimensions for a tf of `poles` poles (optim/sobol.h
+/// has at most 4): the slowest lag, the fastest (poles > 1) and Td.
+int TfDesignDimensions(int poles);
+
+/// `poles` lags log-spaced from the slowest, exp(lo + h_slow (hi - lo)),
+/// down to the fastest, exp(lo + h_fast (log slowest - lo)) (h in [0, 1)):
+/// real poles spread over the record's time scales in two coordinates,
+/// whatever their number.
+std::vector<double> SpreadLags(int poles, double h_slow, double h_fast, double lo, double hi);
+
 /// theta's denominator a_0..a_(n-1) (after the zeros + 1 numerator
 /// coefficients) from the lags: prod (s + 1 / tau_i).
 void SetDenominatorFromLags(int zeros, const std::vector<double>& taus_s, std::vector<double>* theta);
