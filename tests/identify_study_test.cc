@@ -64,6 +64,8 @@ ProcessModel Truth(ProcessModelKind kind) {
     case ProcessModelKind::kP2DZ:  // not studied (the four kinds are)
       m.kp = 1.2, m.tp1_s = 3.0, m.tp2_s = 0.8, m.tz_s = -0.9;
       break;
+    case ProcessModelKind::kTf:  // not studied
+      break;
   }
   return m;
 }

@@ -66,6 +66,8 @@ ProcessModel Truth(ProcessModelKind kind) {
     case ProcessModelKind::kP2DZ:  // a right-half-plane zero: an inverse response
       m.kp = 1.2, m.tp1_s = 3.0, m.tp2_s = 0.8, m.tz_s = -0.9;
       break;
+    case ProcessModelKind::kTf:  // identify_tf_test.cc
+      break;
   }
   return m;
 }

@@ -258,6 +258,61 @@ TEST_F(ModelFile, ABadFileIsRefusedWithOneLineNamingTheFileAndTheReason) {
             "--plant 'model:/nonexistent/model.json': model file '/nonexistent/model.json' cannot be read");
 }
 
+// A tf file (docs/identify.md, "A general transfer function"): 2 poles, 1 zero.
+const char* kTfFile = R"({
+  "model": "tf", "poles": 2, "zeros": 1,
+  "parameters": {"b0": {"value": 1.0}, "b1": {"value": 0.5}, "a0": {"value": 0.8}, "a1": {"value": 1.2},
+                 "Td": {"value": 0.25}},
+  "transfer_function": {"num": [0.5, 1.0], "den": [1.0, 1.2, 0.8], "delay_s": 0.25},
+  "covariance": {"ok": true, "message": "",
+                 "matrix": [[1e-4, 0, 0, 0, 0], [0, 1e-4, 0, 0, 0], [0, 0, 1e-4, 0, 0], [0, 0, 0, 1e-4, 0],
+                            [0, 0, 0, 0, 1e-6]]}
+})";
+
+TEST_F(ModelFile, ATfFileIsAPlantWhoseDrawsPerturbItsCoefficientsAndSaySo) {
+  spec::PlantSpec s;
+  s.plant = "model:" + Write(kTfFile);
+  Plant p;
+  std::string error;
+  ASSERT_TRUE(tune::BuildPlant(s, spec::NameStyle::kFlag, &p, &error)) << error;
+  ASSERT_TRUE(p.model);
+  EXPECT_EQ(p.model->kind, ProcessModelKind::kTf);
+  EXPECT_EQ(p.model->poles, 2);
+  EXPECT_EQ(p.model->zeros, 1);
+  EXPECT_EQ(p.model->values, (std::vector<double>{1.0, 0.5, 0.8, 1.2, 0.25}));
+  EXPECT_EQ(p.tf.den, (std::vector<double>{1.0, 1.2, 0.8}));
+  EXPECT_EQ(p.delay_s, 0.25);
+  // Read and checked, then dropped: the draws perturb the coefficients.
+  EXPECT_FALSE(p.model->HasCovariance());
+  EXPECT_NE(PerturbedText(p, nullptr).find("draws from a tf model's covariance are not built yet"),
+            std::string::npos);
+}
+
+TEST_F(ModelFile, ATfFileWithoutItsShapeOrWithAnUnstableDenominatorIsRefused) {
+  const std::string good = kTfFile;
+  auto replaced = [&good](const std::string& from, const std::string& to) {
+    std::string s = good;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  const std::pair<std::string, std::string> cases[] = {
+      {"has no key \"poles\"", replaced("\"poles\": 2, ", "")},
+      {"\"zeros\" 2 must be an integer in 0..1", replaced("\"zeros\": 1", "\"zeros\": 2")},
+      {"\"poles\" 7 must be an integer in 1..6", replaced("\"poles\": 2", "\"poles\": 7")},
+      {"has no key \"parameters.a2\"", replaced("\"poles\": 2, \"zeros\": 1", "\"poles\": 3, \"zeros\": 0")},
+      {"the denominator has a root with a real part >= 0", replaced("\"value\": 1.2", "\"value\": -1.2")},
+  };
+  for (const auto& [reason, text] : cases) {
+    SCOPED_TRACE(reason);
+    spec::PlantSpec s;
+    s.plant = "model:" + Write(text);
+    Plant p;
+    std::string error;
+    EXPECT_FALSE(tune::BuildPlant(s, spec::NameStyle::kFlag, &p, &error));
+    EXPECT_NE(error.find(reason), std::string::npos) << error;
+  }
+}
+
 TEST_F(ModelFile, ADelayOrASpreadNextToAModelWithACovarianceIsRefused) {
   spec::EvaluateSpec s;
   s.plant.plant = "model:" + Write(kP1dFile);

@@ -1,6 +1,6 @@
 // pidlab identify: a process model (P1D, P2D, P2DU, P1DI, P2DZ, as MATLAB's idproc
-// names them) fitted to the t, u, y columns of a CSV (docs/identify.md,
-// "Identifying a model from a CSV").
+// names them, or a general transfer function TF of --poles and --zeros) fitted to the t, u, y columns of a
+// CSV (docs/identify.md, "Identifying a model from a CSV").
 
 #include <cmath>
 #include <fstream>
@@ -34,8 +34,21 @@ std::string Polynomial(const std::vector<double>& p) {
   return s + "]";
 }
 
-const char* Formula(identify::ProcessModelKind kind) {
-  switch (kind) {
+// "b1 s + b0" or "s^3 + a2 s^2 + a1 s + a0": the tf's polynomials by name.
+std::string TfPolynomial(char letter, int degree, bool monic) {
+  std::string s;
+  const auto power = [](int k) { return k == 0 ? std::string() : k == 1 ? " s" : " s^" + std::to_string(k); };
+  if (monic) s = power(degree).substr(1);
+  for (int k = monic ? degree - 1 : degree; k >= 0; --k)
+    s += (s.empty() ? "" : " + ") + std::string(1, letter) + std::to_string(k) + power(k);
+  return s;
+}
+
+std::string Formula(const identify::ProcessModel& model) {
+  switch (model.kind) {
+    case identify::ProcessModelKind::kTf:
+      return "(" + TfPolynomial('b', model.zeros, false) + ") e^(-Td s) / (" +
+             TfPolynomial('a', model.poles, true) + ")";
     case identify::ProcessModelKind::kP1D:
       return "Kp e^(-Td s) / (1 + Tp1 s)";
     case identify::ProcessModelKind::kP2D:
@@ -52,7 +65,7 @@ const char* Formula(identify::ProcessModelKind kind) {
 
 std::string Table(const IdentifyResult& r) {
   std::ostringstream os;
-  os << "model " << identify::ToString(r.model.kind) << ": " << Formula(r.model.kind) << "\n"
+  os << "model " << identify::ToString(r.model.kind) << ": " << Formula(r.model) << "\n"
      << std::left << std::setw(10) << "parameter" << std::setw(18) << "value"
      << "standard error\n";
   for (std::size_t i = 0; i < r.names.size(); ++i)
@@ -89,6 +102,8 @@ std::string WhitenessLine(const identify::Whiteness& w) {
 
 struct IdentifyCommand {
   std::string csv, log, model, out, plot_path;
+  CLI::Option* poles_option = nullptr;
+  CLI::Option* zeros_option = nullptr;
   std::vector<long> episode;
   bool json = false;
   identify::IdentifyOptions options;
@@ -101,13 +116,19 @@ struct IdentifyCommand {
         "the measured y of every step). By default the record starts at rest at u0 = u[0] and y0 is "
         "estimated with the model. Ceres "
         "fits the exact ZOH response with a continuous delay from several starts; --model auto fits every "
-        "kind and keeps the lowest AIC (docs/identify.md).");
+        "process kind (not tf) and keeps the lowest AIC; --model tf --poles N --zeros M fits a general "
+        "transfer function (docs/identify.md).");
     app->add_option("--csv", csv, "the CSV file with columns t, u, y");
     app->add_option("--log", log, "an LCM log of the trio ('pidlab launch --log')");
     app->add_option("--episode", episode, "with --log: the episode id (needed when the log holds several)")
         ->expected(1);
     app->add_option("--model", model, "the model: " + identify::ProcessModelKindNames() + "|auto")
         ->required();
+    poles_option = app->add_option("--poles", options.poles,
+                                   "with --model tf: the number of poles n, 1.." +
+                                       std::to_string(plant_sim::kMaxTfPoles) + " (required)");
+    zeros_option = app->add_option("--zeros", options.zeros,
+                                   "with --model tf: the number of zeros m, 0..n-1 (default 0)");
     app->add_option("--starts", options.starts, "starting points of the multi-start fit")
         ->capture_default_str();
     app->add_option("--seed", options.seed,
@@ -176,6 +197,25 @@ struct IdentifyCommand {
     return false;
   }
 
+  // --poles and --zeros: given with tf only, within their ranges.
+  void CheckTfShape(identify::ProcessModelKind kind, bool automatic) const {
+    const bool tf = !automatic && kind == identify::ProcessModelKind::kTf;
+    for (const CLI::Option* o : {poles_option, zeros_option})
+      if (!tf && o->count() > 0)
+        throw BadInput(o->get_name() + " " + o->as<std::string>() + " applies to --model tf only, not " +
+                       Quote(model));
+    if (!tf) return;
+    if (poles_option->count() == 0)
+      throw BadInput("--model tf needs --poles N (1.." + std::to_string(plant_sim::kMaxTfPoles) + ")");
+    if (options.poles < 1 || options.poles > plant_sim::kMaxTfPoles)
+      throw BadInput("--poles " + std::to_string(options.poles) + " must be in 1.." +
+                     std::to_string(plant_sim::kMaxTfPoles));
+    if (options.zeros < 0 || options.zeros >= options.poles)
+      throw BadInput("--zeros " + std::to_string(options.zeros) + " must be in 0.." +
+                     std::to_string(options.poles - 1) + " (fewer than --poles " +
+                     std::to_string(options.poles) + ")");
+  }
+
   std::string Source() const { return !csv.empty() ? "--csv " + Quote(csv) : "--log " + Quote(log); }
 
   int Run() {
@@ -186,6 +226,7 @@ struct IdentifyCommand {
     if (!automatic && !identify::Parse(model, &kind))
       throw BadInput("--model " + Quote(model) + " must be one of " + identify::ProcessModelKindNames() +
                      "|auto");
+    CheckTfShape(kind, automatic);
     if (options.starts < 1 || options.starts > 1000)
       throw BadInput("--starts " + std::to_string(options.starts) + " must be in [1, 1000]");
     if (!std::isnan(options.u0) && !std::isfinite(options.u0))

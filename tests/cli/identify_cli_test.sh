@@ -96,6 +96,66 @@ pidlab identify --csv step.csv --model p2d --out model.json > /dev/null 2> err
 check "--out writes the JSON object" \
   "[ $? -eq 0 ] && /usr/bin/python3 -c 'import json; j = json.load(open(\"model.json\")); assert j[\"model\"] == \"p2d\"'"
 
+# A general transfer function (docs/identify.md, "A general transfer function"):
+# tf.csv from scipy's exact response of (0.5 s + 1) e^(-0.25 s) / (s^2 + 1.2 s
+# + 0.8) to a held input (lsim on a 0.05 s grid, on which both dt = 0.1 s and
+# the delay fall, holding u between its points).
+/usr/bin/python3 - <<'PY'
+import numpy as np
+from scipy import signal
+dt, n, fine = 0.1, 400, 2
+rng = np.random.default_rng(3)
+u = np.repeat(rng.uniform(-1, 1, n // 8), 8)
+u[:5] = 0.0
+t_fine = np.arange(n * fine) * dt / fine
+u_fine = np.repeat(u, fine)
+delayed = np.concatenate([np.zeros(5), u_fine[:-5]])  # 0.25 s = 5 fine steps
+_, y, _ = signal.lsim(signal.lti([0.5, 1.0], [1.0, 1.2, 0.8]), delayed, t_fine, interp=False)
+with open('tf.csv', 'w') as f:
+    f.write('t,u,y\n')
+    for k in range(n): f.write('%.17g,%.17g,%.17g\n' % (k * dt, u[k] + 1, y[k * fine] + 3))
+PY
+section=$(awk '/^## A general transfer function/{on=1; next} on && /^## /{on=0} on' "$docs")
+n_tf=0
+while IFS= read -r cmd; do
+  n_tf=$((n_tf + 1))
+  eval "$cmd" > docs.out 2> docs.err
+  check "docs/identify.md: $cmd" "[ $? -eq 0 ] || { cat docs.err; false; }"
+done < <(awk '/^```sh/{on=1; next} /^```/{on=0} on && /^pidlab /' <<<"$section")
+check "the tf section has 3 commands (found $n_tf)" "[ $n_tf -eq 3 ]"
+pidlab identify --csv tf.csv --model tf --poles 2 --zeros 1 --json > tf.json 2> err
+check "identify --model tf --poles 2 --zeros 1 --json recovers b0 b1 a0 a1 Td within 1e-6 relative" \
+  "[ $? -eq 0 ] && /usr/bin/python3 - tf.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert (j['model'], j['poles'], j['zeros']) == ('tf', 2, 1), j
+p = j['parameters']
+assert sorted(p) == ['Td', 'a0', 'a1', 'b0', 'b1'], p
+for name, want in (('b0', 1.0), ('b1', 0.5), ('a0', 0.8), ('a1', 1.2), ('Td', 0.25)):
+    assert abs(p[name]['value'] - want) <= 1e-6 * want, (name, p[name])
+assert j['fit_percent'] > 99.99, j['fit_percent']
+tf = j['transfer_function']
+assert len(tf['num']) == 2 and tf['den'][0] == 1 and len(tf['den']) == 3, tf
+assert abs(tf['delay_s'] - 0.25) < 1e-6, tf
+assert len(j['covariance']['matrix']) == 5 or not j['covariance']['ok'], j['covariance']
+PY"
+pidlab identify --csv tf.csv --model tf --poles 2 --zeros 1 > tf.txt 2> err
+check "the tf table names the formula and every coefficient" \
+  "[ $? -eq 0 ] && grep -q '(b1 s + b0) e^(-Td s) / (s^2 + a1 s + a0)' tf.txt && grep -q '^a1 ' tf.txt && grep -q '^b1 ' tf.txt"
+check "the tf model file is a plant whose Monte Carlo says its coefficients are perturbed" \
+  "pidlab evaluate --model tf_model.json --gains 0.5,0.4,0 --loop sampled --monte-carlo 5 --json > tf_eval.json && grep -q 'tf model' tf_eval.json"
+for case in "--model tf|--model tf needs --poles N" "--model tf --poles 7|--poles 7 must be in 1..6" \
+            "--model tf --poles 0|--poles 0 must be in 1..6" \
+            "--model tf --poles 2 --zeros 2|--zeros 2 must be in 0..1 (fewer than --poles 2)" \
+            "--model tf --poles 2 --zeros -1|--zeros -1 must be in 0..1" \
+            "--model p2d --poles 2|--poles 2 applies to --model tf only" \
+            "--model auto --zeros 1|--zeros 1 applies to --model tf only"; do
+  args=${case%%|*} needle=${case#*|}
+  "$pidlab" identify --csv tf.csv $args > out 2> err
+  check "identify $args exits 2 with one line naming '$needle'" \
+    "[ $? -eq 2 ] && only_line_ok err \"$needle\" && [ ! -s out ]"
+done
+
 # Bad input: exit 2, one line naming the flag, file, column, row or value.
 sed '1s/^u,t,note,y/u,time,note,y/' step.csv > nocolumn.csv
 awk 'NR == 40 { $0 = "0.5,3.8,0,abc" } { print }' step.csv > badcell.csv

@@ -304,6 +304,30 @@ class Identify(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "starts = 0"):
             pidlab.identify(self.t, self.u, self.y, starts=0)
 
+    def test_a_general_transfer_function_gives_the_cli_json(self):
+        got = pidlab.identify(self.t, self.u, self.y, model="tf", poles=1)
+        want = cli("identify", "--csv", self.csv, "--model", "tf", "--poles", "1")
+        del want["source"]
+        self.assertEqual(got, want)
+        self.assertEqual((got["model"], got["poles"], got["zeros"]), ("tf", 1, 0))
+        self.assertEqual(sorted(got["parameters"]), ["Td", "a0", "b0"])
+        # Kp / (1 + Tp1 s) = (Kp / Tp1) / (s + 1 / Tp1).
+        p = got["parameters"]
+        for name, true in (("b0", 0.75), ("a0", 0.5), ("Td", 0.25)):
+            self.assertLess(abs(p[name]["value"] - true), 4 * p[name]["standard_error"], name)
+        two = pidlab.identify(self.t, self.u, self.y, model="tf", poles=2, zeros=1)
+        self.assertEqual(sorted(two["parameters"]), ["Td", "a0", "a1", "b0", "b1"])
+
+    def test_bad_tf_shapes_raise_value_error_naming_them(self):
+        with self.assertRaisesRegex(ValueError, "poles = 7 must be in 1..6"):
+            pidlab.identify(self.t, self.u, self.y, model="tf", poles=7)
+        with self.assertRaisesRegex(ValueError, "zeros = 2 must be in 0..1"):
+            pidlab.identify(self.t, self.u, self.y, model="tf", poles=2, zeros=2)
+        with self.assertRaisesRegex(ValueError, "needs poles=N"):
+            pidlab.identify(self.t, self.u, self.y, model="tf")
+        with self.assertRaisesRegex(ValueError, "apply to model='tf' only"):
+            pidlab.identify(self.t, self.u, self.y, model="p1d", poles=2)
+
 
 class Model(unittest.TestCase):
     """model=FILE and plant="model:FILE": the file `pidlab identify --out`

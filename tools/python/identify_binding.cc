@@ -37,14 +37,37 @@ double OperatingPoint(const py::object& value, const char* name) {
   return v;
 }
 
+// poles and zeros: None (a process model; tf: poles required, zeros 0) or
+// the tf's numbers, checked by Identify.
+void TfShape(const std::string& model, const py::object& poles, const py::object& zeros,
+             identify::IdentifyOptions* options) {
+  if (model != "tf") {
+    if (!poles.is_none() || !zeros.is_none())
+      throw py::value_error("identify: poles and zeros apply to model='tf' only, not '" + model + "'");
+    return;
+  }
+  if (poles.is_none())
+    throw py::value_error("identify: model='tf' needs poles=N (1.." + std::to_string(plant_sim::kMaxTfPoles) +
+                          ")");
+  const auto integer = [](const py::object& value, const char* name) {
+    if (!py::isinstance<py::int_>(value))
+      throw py::value_error(std::string("identify: ") + name + " must be an integer");
+    return value.cast<int>();
+  };
+  options->poles = integer(poles, "poles");
+  options->zeros = zeros.is_none() ? 0 : integer(zeros, "zeros");
+}
+
 py::object IdentifyPy(const py::object& t, const py::object& u, const py::object& y, const std::string& model,
-                      int starts, std::uint64_t seed, const py::object& u0, const py::object& y0) {
+                      int starts, std::uint64_t seed, const py::object& u0, const py::object& y0,
+                      const py::object& poles, const py::object& zeros) {
   identify::IdentifyData data{Column(t, "t"), Column(u, "u"), Column(y, "y")};
   identify::IdentifyOptions options;
   options.starts = starts;
   options.seed = seed;
   options.u0 = OperatingPoint(u0, "u0");
   options.y0 = OperatingPoint(y0, "y0");
+  TfShape(model, poles, zeros, &options);
   if (starts < 1 || starts > 1000)
     throw py::value_error("identify: starts = " + std::to_string(starts) + " must be in [1, 1000]");
   Status status;
@@ -76,16 +99,16 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
 }  // namespace
 
 void DefineIdentify(py::module_& m) {
-  m.def(
-      "identify", &IdentifyPy,
-      "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None): fits a process model "
-      "(p1d, p2d, p2du, p1di, p2dz, or auto to choose by AIC) to the record t (s, uniform), u, y (lists or "
-      "numpy "
-      "arrays) and returns the dict of `pidlab identify --json`. u0, y0: the operating point (None: u0 the "
-      "first sample, y0 estimated with the model). Bad data or arguments raise ValueError naming the reason "
-      "(docs/identify.md).",
-      py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",
-      py::arg("starts") = 16, py::arg("seed") = 0, py::arg("u0") = py::none(), py::arg("y0") = py::none());
+  m.def("identify", &IdentifyPy,
+        "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None, poles=None, zeros=None): fits a "
+        "process model (p1d, p2d, p2du, p1di, p2dz, or auto to choose among them by AIC) or a general "
+        "transfer function (model='tf' with poles=N in 1..6 and zeros=M in 0..N-1, default 0) to the record "
+        "t (s, uniform), u, y (lists or numpy arrays) and returns the dict of `pidlab identify --json`. u0, "
+        "y0: the operating point (None: u0 the first sample, y0 estimated with the model). Bad data or "
+        "arguments raise ValueError naming the reason (docs/identify.md).",
+        py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",
+        py::arg("starts") = 16, py::arg("seed") = 0, py::arg("u0") = py::none(), py::arg("y0") = py::none(),
+        py::arg("poles") = py::none(), py::arg("zeros") = py::none());
 }
 
 }  // namespace pidlab::python

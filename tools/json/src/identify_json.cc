@@ -59,27 +59,34 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
                      {"im", JsonNumber(pole.im)},
                      {"re_standard_error", JsonNumber(pole.re_se)},
                      {"im_standard_error", JsonNumber(pole.im_se)}});
-  return {{"model", identify::ToString(r.model.kind)},
-          {"parameters", parameters},
-          {"transfer_function", {{"num", num}, {"den", den}, {"delay_s", JsonNumber(r.model.delay_s())}}},
-          {"poles", poles},
-          {"fit_percent", JsonNumber(r.fit_percent)},
-          {"aic", JsonNumber(r.aic)},
-          {"aic_form", "N log(2 cost / N) + 2 p"},
-          {"cost", JsonNumber(r.cost)},
-          {"samples", r.samples},
-          {"dt_s", JsonNumber(r.dt_s)},
-          {"u0", JsonNumber(r.u0)},
-          {"y0", JsonNumber(r.y0)},
-          {"y0_estimated", r.y0_estimated},
-          {"y0_standard_error", JsonNumber(r.y0_standard_error)},
-          {"starts", r.starts},
-          {"starts_at_best", r.starts_at_best},
-          {"seed", r.seed},
-          {"arx_start", r.arx_start},
-          {"whiteness", WhitenessJson(r.whiteness)},
-          {"warnings", r.warnings},
-          {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}, {"matrix", matrix}}}};
+  nlohmann::json j = {
+      {"model", identify::ToString(r.model.kind)},
+      {"parameters", parameters},
+      {"transfer_function", {{"num", num}, {"den", den}, {"delay_s", JsonNumber(r.model.delay_s())}}},
+      {"poles", poles},
+      {"fit_percent", JsonNumber(r.fit_percent)},
+      {"aic", JsonNumber(r.aic)},
+      {"aic_form", "N log(2 cost / N) + 2 p"},
+      {"cost", JsonNumber(r.cost)},
+      {"samples", r.samples},
+      {"dt_s", JsonNumber(r.dt_s)},
+      {"u0", JsonNumber(r.u0)},
+      {"y0", JsonNumber(r.y0)},
+      {"y0_estimated", r.y0_estimated},
+      {"y0_standard_error", JsonNumber(r.y0_standard_error)},
+      {"starts", r.starts},
+      {"starts_at_best", r.starts_at_best},
+      {"seed", r.seed},
+      {"arx_start", r.arx_start},
+      {"whiteness", WhitenessJson(r.whiteness)},
+      {"warnings", r.warnings},
+      {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}, {"matrix", matrix}}}};
+  // A tf's shape, which its parameters' names alone do not fix for a reader.
+  if (r.model.kind == identify::ProcessModelKind::kTf) {
+    j["poles"] = r.model.poles;
+    j["zeros"] = r.model.zeros;
+  }
+  return j;
 }
 
 }  // namespace pidlab::json

@@ -15,11 +15,20 @@ constexpr long kDelaysPerScale = 40;
 
 int PoleCount(ProcessModelKind kind) { return kind == ProcessModelKind::kP1D ? 1 : 2; }
 
-// The roots of z^n + a_1 z^(n-1) + ... + a_n, n = 1 or 2.
+// The roots of z^n + a_1 z^(n-1) + ... + a_n: by formula for n = 1 or 2,
+// else the eigenvalues of the companion matrix.
 std::vector<std::complex<double>> Roots(const Eigen::VectorXd& a) {
   if (a.size() == 1) return {std::complex<double>(-a[0], 0.0)};
-  const std::complex<double> disc = std::sqrt(std::complex<double>(a[0] * a[0] - 4.0 * a[1], 0.0));
-  return {(-a[0] + disc) / 2.0, (-a[0] - disc) / 2.0};
+  if (a.size() == 2) {
+    const std::complex<double> disc = std::sqrt(std::complex<double>(a[0] * a[0] - 4.0 * a[1], 0.0));
+    return {(-a[0] + disc) / 2.0, (-a[0] - disc) / 2.0};
+  }
+  const auto n = a.size();
+  Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(n, n);
+  companion.row(0) = -a.transpose();
+  for (Eigen::Index i = 1; i < n; ++i) companion(i, i - 1) = 1.0;
+  const Eigen::VectorXcd eig = companion.eigenvalues();
+  return {eig.data(), eig.data() + n};
 }
 
 // The values of `kind` from its discrete poles; empty if they do not fit it.
@@ -66,6 +75,8 @@ std::optional<std::vector<double>> FromPoles(ProcessModelKind kind,
       if (!p2d) return std::nullopt;
       return std::vector<double>{1.0, (*p2d)[1], (*p2d)[2], 0.0, td_s};
     }
+    case ProcessModelKind::kTf:  // tf_start.h
+      return std::nullopt;
     case ProcessModelKind::kP1DI: {
       // The pole nearest z = 1 is the integrator; the other the lag.
       const std::size_t integrator = std::abs(z[0] - 1.0) < std::abs(z[1] - 1.0) ? 0 : 1;
@@ -79,11 +90,9 @@ std::optional<std::vector<double>> FromPoles(ProcessModelKind kind,
 
 }  // namespace
 
-std::vector<std::vector<double>> ArxCandidates(ProcessModelKind kind, const std::vector<double>& du,
-                                               const std::vector<double>& dy, double dt_s,
-                                               double max_delay_s) {
-  const int n = PoleCount(kind);
-  std::vector<std::vector<double>> candidates;
+std::vector<ArxFit> ArxFits(int n, const std::vector<double>& du, const std::vector<double>& dy, double dt_s,
+                            double max_delay_s) {
+  std::vector<ArxFit> fits;
   const long samples = static_cast<long>(dy.size());
   for (long m = 1; samples / m >= 40L * n; m *= 2) {
     // Every m-th output, and the mean input over each coarse interval.
@@ -114,9 +123,19 @@ std::vector<std::vector<double>> ArxCandidates(ProcessModelKind kind, const std:
       }
       const Eigen::VectorXd theta = phi.colPivHouseholderQr().solve(target);
       if (!theta.allFinite()) continue;
-      auto values = FromPoles(kind, Roots(theta.head(n)), h, static_cast<double>(d) * h);
-      if (values) candidates.push_back(*values);
+      fits.push_back({Roots(theta.head(n)), h, static_cast<double>(d) * h});
     }
+  }
+  return fits;
+}
+
+std::vector<std::vector<double>> ArxCandidates(ProcessModelKind kind, const std::vector<double>& du,
+                                               const std::vector<double>& dy, double dt_s,
+                                               double max_delay_s) {
+  std::vector<std::vector<double>> candidates;
+  for (const ArxFit& fit : ArxFits(PoleCount(kind), du, dy, dt_s, max_delay_s)) {
+    auto values = FromPoles(kind, fit.z, fit.h_s, fit.td_s);
+    if (values) candidates.push_back(*values);
   }
   return candidates;
 }

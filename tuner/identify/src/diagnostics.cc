@@ -79,8 +79,12 @@ std::vector<PoleEstimate> PoleEstimates(const IdentifyResult& result) {
     std::vector<double> up = result.values, down = result.values;
     up[j] += h;
     down[j] -= h;
-    const auto pu = Roots(ModelFromValues(result.model.kind, up).ToTransferFunction().den);
-    const auto pd = Roots(ModelFromValues(result.model.kind, down).ToTransferFunction().den);
+    const auto pu = Roots(ModelFromValues(result.model.kind, up, result.model.poles, result.model.zeros)
+                              .ToTransferFunction()
+                              .den);
+    const auto pd = Roots(ModelFromValues(result.model.kind, down, result.model.poles, result.model.zeros)
+                              .ToTransferFunction()
+                              .den);
     if (pu.size() != poles.size() || pd.size() != poles.size()) return out;
     for (std::size_t i = 0; i < poles.size(); ++i) {
       d_re[i][j] = (pu[i].real() - pd[i].real()) / (2.0 * h);

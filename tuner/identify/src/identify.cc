@@ -3,7 +3,9 @@
 // logarithm (positive, and scaled alike whatever its size), Zeta bounded to
 // (0, 1) and Td bounded to [0, max_delay_fraction of the record]. The delay
 // stays continuous: DiscretePlant splits it over the sample exactly, so the
-// cost is a continuous function of Td and central differences see it.
+// cost is a continuous function of Td and central differences see it. A
+// TF's coefficients are free (tf_start.h; docs/identify.md, "A general
+// transfer function").
 
 #include "pidlab/identify/identify.h"
 
@@ -20,6 +22,7 @@
 #include "arx_start.h"
 #include "pidlab/optim/sobol.h"
 #include "pidlab/plant_sim/discrete_plant.h"
+#include "tf_start.h"
 
 namespace pidlab::identify {
 namespace {
@@ -34,42 +37,50 @@ constexpr double kTimeConstantRange = 1e3;
 // What every start's problem shares: the record without its operating point.
 struct Record {
   ProcessModelKind kind;
+  int poles = 0, zeros = 0;  // TF only
   std::vector<double> du, dy;
   double dt_s = 0.0, length_s = 0.0, max_delay_s = 0.0;
   /// The output offset is a parameter too: theta[p] is added to y0.
   bool offset = false;
 };
 
-int ParameterCount(ProcessModelKind kind) { return static_cast<int>(ParameterNames(kind).size()); }
+int ParameterCount(const Record& record) {
+  return static_cast<int>(ParameterNames(record.kind, record.poles, record.zeros).size());
+}
 // Ceres's parameter block: the model's parameters, then the offset if estimated.
-int BlockSize(const Record& record) { return ParameterCount(record.kind) + (record.offset ? 1 : 0); }
+int BlockSize(const Record& record) { return ParameterCount(record) + (record.offset ? 1 : 0); }
 double OffsetOf(const Record& record, const double* theta) {
-  return record.offset ? theta[ParameterCount(record.kind)] : 0.0;
+  return record.offset ? theta[ParameterCount(record)] : 0.0;
 }
 
 // theta[i] is the logarithm of a time constant.
-bool IsLogParameter(ProcessModelKind kind, int i) {
-  const int p = ParameterCount(kind);
-  return i > 0 && i < p - 1 && !(kind == ProcessModelKind::kP2DU && i == 2) &&
-         !(kind == ProcessModelKind::kP2DZ && i == 3);
+bool IsLogParameter(const Record& record, int i) {
+  const int p = ParameterCount(record);
+  const ProcessModelKind kind = record.kind;
+  return kind != ProcessModelKind::kTf && i > 0 && i < p - 1 &&
+         !(kind == ProcessModelKind::kP2DU && i == 2) && !(kind == ProcessModelKind::kP2DZ && i == 3);
 }
 
 // theta[i] is P2DZ's Tz (any sign).
 bool IsZeroParameter(ProcessModelKind kind, int i) { return kind == ProcessModelKind::kP2DZ && i == 3; }
 
-ProcessModel ModelOf(ProcessModelKind kind, const double* theta) {
-  const int p = ParameterCount(kind);
+ProcessModel ModelOf(const Record& record, const double* theta) {
+  const int p = ParameterCount(record);
   std::vector<double> values(static_cast<std::size_t>(p));
   for (int i = 0; i < p; ++i)
-    values[static_cast<std::size_t>(i)] = IsLogParameter(kind, i) ? std::exp(theta[i]) : theta[i];
+    values[static_cast<std::size_t>(i)] = IsLogParameter(record, i) ? std::exp(theta[i]) : theta[i];
   // A central difference at the bound Td = 0 looks just below it.
   values.back() = std::max(0.0, values.back());
-  return ModelFromValues(kind, values);
+  if (record.kind == ProcessModelKind::kTf) internal::SnapTinyCoefficients(&values);
+  return ModelFromValues(record.kind, values, record.poles, record.zeros);
 }
 
-// yhat of the model, false if it is not a valid plant or diverges.
+// yhat of the model, false if it is not a valid plant or diverges (or, for
+// a TF, not admissible: tf_start.h).
 bool TrySimulate(const ProcessModel& model, const std::vector<double>& du, double dt_s,
                  std::vector<double>* yhat) {
+  if (model.kind == ProcessModelKind::kTf && !internal::TfDenominatorIsAdmissible(model.a, dt_s))
+    return false;
   try {
     *yhat = SimulateModel(model, du, 0.0, dt_s);
   } catch (const std::exception&) {
@@ -84,7 +95,7 @@ struct OutputError {
   const Record* record;
   bool operator()(double const* const* parameters, double* residuals) const {
     std::vector<double> yhat;
-    if (!TrySimulate(ModelOf(record->kind, parameters[0]), record->du, record->dt_s, &yhat)) return false;
+    if (!TrySimulate(ModelOf(*record, parameters[0]), record->du, record->dt_s, &yhat)) return false;
     const double offset = OffsetOf(*record, parameters[0]);
     for (std::size_t k = 0; k < yhat.size(); ++k) residuals[k] = record->dy[k] - offset - yhat[k];
     return true;
@@ -95,12 +106,12 @@ struct OutputError {
 void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) {
   auto* cost =
       new ceres::DynamicNumericDiffCostFunction<OutputError, ceres::CENTRAL>(new OutputError{&record});
-  const int p = ParameterCount(record.kind);
+  const int p = ParameterCount(record);
   cost->AddParameterBlock(BlockSize(record));
   cost->SetNumResiduals(static_cast<int>(record.dy.size()));
   problem->AddResidualBlock(cost, nullptr, theta);
-  for (int i = 1; i < p - 1; ++i) {
-    if (IsLogParameter(record.kind, i)) {
+  for (int i = 1; i < p - 1 && record.kind != ProcessModelKind::kTf; ++i) {
+    if (IsLogParameter(record, i)) {
       problem->SetParameterLowerBound(theta, i, std::log(record.dt_s / kTimeConstantRange));
       problem->SetParameterUpperBound(theta, i, std::log(record.length_s * kTimeConstantRange));
     } else if (IsZeroParameter(record.kind, i)) {
@@ -116,13 +127,19 @@ void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) 
 }
 
 // Kp by linear least squares at the other parameters of *theta: the model is
-// linear in it. Left at 1 if the model cannot be simulated.
+// linear in it. Left at 1 if the model cannot be simulated. A TF's numerator
+// likewise (tf_start.h).
 void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
-  const int p = ParameterCount(record.kind);
+  if (record.kind == ProcessModelKind::kTf) {
+    internal::SetNumeratorByLeastSquares(record.poles, record.zeros, record.du, record.dy, record.dt_s,
+                                         record.offset, theta);
+    return;
+  }
+  const int p = ParameterCount(record);
   (*theta)[0] = 1.0;
   if (record.offset) (*theta)[static_cast<std::size_t>(p)] = 0.0;
   std::vector<double> g;
-  if (!TrySimulate(ModelOf(record.kind, theta->data()), record.du, record.dt_s, &g)) return;
+  if (!TrySimulate(ModelOf(record, theta->data()), record.du, record.dt_s, &g)) return;
   // dy ~ Kp g + offset: the normal equations of one or two unknowns.
   const double n = static_cast<double>(g.size());
   double gy = 0.0, gg = 0.0, sg = 0.0, sy = 0.0;
@@ -151,15 +168,24 @@ void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
 // shifted by the seed unless it is 0; Kp then by linear least squares, the
 // model being linear in it.
 std::vector<double> StartPoint(const Record& record, const optim::SobolSequence& sobol, int index) {
-  const int p = ParameterCount(record.kind);
+  const int p = ParameterCount(record);
   std::vector<double> theta(static_cast<std::size_t>(BlockSize(record)), 0.0);
   const double lo = std::log(0.5 * record.dt_s), hi = std::log(0.5 * record.length_s);
   const Eigen::VectorXd h = sobol.Point(static_cast<std::uint32_t>(index));
+  if (record.kind == ProcessModelKind::kTf) {
+    const std::vector<double> taus =
+        internal::SpreadLags(record.poles, h[0], record.poles > 1 ? h[1] : 0.0, lo, hi);
+    internal::SetDenominatorFromLags(record.zeros, taus, &theta);
+    theta[static_cast<std::size_t>(p - 1)] =
+        h[h.size() - 1] * std::min(record.max_delay_s, 0.25 * record.length_s);
+    SetGainByLeastSquares(record, &theta);
+    return theta;
+  }
   for (int i = 1; i < p; ++i) {
     const double hi_coordinate = h[i - 1];
     if (i == p - 1)
       theta.back() = hi_coordinate * std::min(record.max_delay_s, 0.25 * record.length_s);
-    else if (IsLogParameter(record.kind, i))
+    else if (IsLogParameter(record, i))
       theta[static_cast<std::size_t>(i)] = lo + hi_coordinate * (hi - lo);
     else if (IsZeroParameter(record.kind, i))
       theta[static_cast<std::size_t>(i)] = (2.0 * hi_coordinate - 1.0) * 0.1 * record.length_s;
@@ -174,7 +200,7 @@ std::vector<double> StartPoint(const Record& record, const optim::SobolSequence&
 double ScreenCost(const Record& record, std::vector<double>* theta) {
   SetGainByLeastSquares(record, theta);
   std::vector<double> yhat;
-  if (!TrySimulate(ModelOf(record.kind, theta->data()), record.du, record.dt_s, &yhat))
+  if (!TrySimulate(ModelOf(record, theta->data()), record.du, record.dt_s, &yhat))
     return std::numeric_limits<double>::infinity();
   const double offset = OffsetOf(record, theta->data());
   double cost = 0.0;
@@ -186,15 +212,21 @@ double ScreenCost(const Record& record, std::vector<double>* theta) {
 // The start from the ARX candidates (arx_start.h) of lowest output-error
 // cost, inside the bounds; empty if there is none.
 std::vector<double> ArxStartPoint(const Record& record) {
-  const int p = ParameterCount(record.kind);
+  const int p = ParameterCount(record);
   std::vector<double> best;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (const std::vector<double>& values :
-       internal::ArxCandidates(record.kind, record.du, record.dy, record.dt_s, record.max_delay_s)) {
+  const std::vector<std::vector<double>> candidates =
+      record.kind == ProcessModelKind::kTf
+          ? internal::TfArxCandidates(record.poles, record.zeros, record.du, record.dy, record.dt_s,
+                                      record.max_delay_s)
+          : internal::ArxCandidates(record.kind, record.du, record.dy, record.dt_s, record.max_delay_s);
+  for (const std::vector<double>& values : candidates) {
     std::vector<double> theta(static_cast<std::size_t>(BlockSize(record)), 0.0);
     for (int i = 1; i < p; ++i) {
       const double v = values[static_cast<std::size_t>(i)];
-      if (IsLogParameter(record.kind, i))
+      if (record.kind == ProcessModelKind::kTf)
+        theta[static_cast<std::size_t>(i)] = i == p - 1 ? std::clamp(v, 0.0, record.max_delay_s) : v;
+      else if (IsLogParameter(record, i))
         theta[static_cast<std::size_t>(i)] =
             std::clamp(std::log(v), std::log(record.dt_s / kTimeConstantRange),
                        std::log(record.length_s * kTimeConstantRange));
@@ -227,7 +259,13 @@ double FitFrom(const Record& record, const IdentifyOptions& options, std::vector
   solver.logging_type = ceres::SILENT;
   solver.num_threads = 1;
   ceres::Solver::Summary summary;
+  // A TF's start may walk to the edge of stability, where a central
+  // difference fails and Ceres stops with FAILURE, logged through glog as an
+  // error; the start's cost (infinite) says it, so keep glog quiet.
+  const int log_level = FLAGS_minloglevel;
+  FLAGS_minloglevel = google::GLOG_FATAL;
   ceres::Solve(solver, &problem, &summary);
+  FLAGS_minloglevel = log_level;
   if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost))
     return std::numeric_limits<double>::infinity();
   return summary.final_cost;
@@ -238,7 +276,7 @@ double FitFrom(const Record& record, const IdentifyOptions& options, std::vector
 // variance; false with the reason if Ceres cannot invert J'J.
 bool Covariance(const Record& record, std::vector<double> theta, double cost, std::vector<double>* errors,
                 std::vector<double>* matrix, double* offset_error, std::string* message) {
-  const int p = ParameterCount(record.kind);
+  const int p = ParameterCount(record);
   const int q = BlockSize(record);
   *offset_error = kNaN;
   const int n = static_cast<int>(record.dy.size());
@@ -272,13 +310,12 @@ bool Covariance(const Record& record, std::vector<double> theta, double cost, st
   const double variance = 2.0 * cost / std::max(1, n - q);
   if (record.offset)
     *offset_error = std::sqrt(std::max(0.0, full[static_cast<std::size_t>(q * q - 1)] * variance));
-  const ProcessModel model = ModelOf(record.kind, theta.data());
+  const ProcessModel model = ModelOf(record, theta.data());
   const std::vector<double> values = ParameterValues(model);
   // d value / d theta: the value for a logarithm, else 1.
   std::vector<double> d(static_cast<std::size_t>(p));
   for (int i = 0; i < p; ++i)
-    d[static_cast<std::size_t>(i)] =
-        IsLogParameter(record.kind, i) ? values[static_cast<std::size_t>(i)] : 1.0;
+    d[static_cast<std::size_t>(i)] = IsLogParameter(record, i) ? values[static_cast<std::size_t>(i)] : 1.0;
   for (int i = 0; i < p; ++i)
     for (int j = 0; j < p; ++j) {
       const auto ij = static_cast<std::size_t>(i * p + j);
@@ -367,7 +404,8 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
                                std::vector<double>* costs, bool* arx_used) {
   std::vector<double> best;
   double best_cost = std::numeric_limits<double>::infinity();
-  const int dimensions = ParameterCount(record.kind) - 1;
+  const int dimensions = record.kind == ProcessModelKind::kTf ? internal::TfDesignDimensions(record.poles)
+                                                              : ParameterCount(record) - 1;
   const optim::SobolSequence sobol =
       options.seed == 0 ? optim::SobolSequence(dimensions) : optim::SobolSequence(dimensions, options.seed);
   const auto fit = [&](std::vector<double> theta) {
@@ -388,7 +426,8 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
 }
 
 // The plain warnings of IdentifyResult::warnings.
-std::vector<std::string> Warnings(const IdentifyResult& r, double dt_s, double length_s, double max_delay_s) {
+std::vector<std::string> Warnings(const Record& record, const IdentifyResult& r) {
+  const double dt_s = record.dt_s, length_s = record.length_s, max_delay_s = record.max_delay_s;
   std::vector<std::string> w;
   if (!r.covariance_ok) w.push_back("no intervals: " + r.covariance_message);
   for (std::size_t i = 0; i < r.names.size() && r.covariance_ok; ++i) {
@@ -403,7 +442,7 @@ std::vector<std::string> Warnings(const IdentifyResult& r, double dt_s, double l
     w.push_back("Td = " + Number(td) + " s is at its bound (" + Number(max_delay_s) +
                 " s, half the record): the delay may be longer than the record can show");
   for (std::size_t i = 0; i < r.names.size(); ++i) {
-    if (!IsLogParameter(r.model.kind, static_cast<int>(i))) continue;
+    if (!IsLogParameter(record, static_cast<int>(i))) continue;
     const double t = r.values[i];
     if (t <= dt_s / kTimeConstantRange * (1 + 1e-6) || t >= length_s * kTimeConstantRange * (1 - 1e-6))
       w.push_back(r.names[i] + " = " + Number(t) + " s is at its bound [" +
@@ -424,8 +463,8 @@ std::vector<std::string> Warnings(const IdentifyResult& r, double dt_s, double l
 void Summarise(const Record& record, const IdentifyData& data, const std::vector<double>& theta, double cost,
                IdentifyResult* result) {
   const double n = static_cast<double>(data.y.size());
-  result->model = ModelOf(record.kind, theta.data());
-  result->names = ParameterNames(record.kind);
+  result->model = ModelOf(record, theta.data());
+  result->names = ParameterNames(record.kind, record.poles, record.zeros);
   result->values = ParameterValues(result->model);
   result->cost = cost;
   double mean = 0.0;
@@ -447,7 +486,7 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
     }
     result->whiteness = ResidualWhiteness(result->residuals);
   }
-  result->warnings = Warnings(*result, record.dt_s, record.length_s, record.max_delay_s);
+  result->warnings = Warnings(record, *result);
 }
 
 }  // namespace
@@ -458,6 +497,10 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   if (!options.IsValid(&error)) return Status::InvalidInput(error);
   Record record;
   record.kind = kind;
+  const Status shape = internal::CheckTfShape(kind, options.poles, options.zeros);
+  if (!shape.ok()) return shape;
+  record.poles = options.poles;
+  record.zeros = options.zeros;
   const Status status = CheckData(data, &record.dt_s);
   if (!status.ok()) return status;
   *result = IdentifyResult{};

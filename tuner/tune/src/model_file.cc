@@ -64,16 +64,32 @@ bool ReadText(const std::string& path, std::string* text, std::string* error) {
   return true;
 }
 
+// A tf's "poles" and "zeros": integers in 1..kMaxTfPoles and 0..poles-1.
+bool ReadTfShape(const nlohmann::json& j, ProcessModelUncertainty* m, std::string* error) {
+  const nlohmann::json *poles = nullptr, *zeros = nullptr;
+  if (!Member(j, "poles", "", &poles, error) || !Member(j, "zeros", "", &zeros, error)) return false;
+  if (!poles->is_number_integer() || poles->get<long>() < 1 || poles->get<long>() > plant_sim::kMaxTfPoles)
+    return Bad(error, "\"poles\" " + spec::Truncate(poles->dump()) + " must be an integer in 1.." +
+                          std::to_string(plant_sim::kMaxTfPoles));
+  m->poles = poles->get<int>();
+  if (!zeros->is_number_integer() || zeros->get<long>() < 0 || zeros->get<long>() >= m->poles)
+    return Bad(error, "\"zeros\" " + spec::Truncate(zeros->dump()) + " must be an integer in 0.." +
+                          std::to_string(m->poles - 1));
+  m->zeros = zeros->get<int>();
+  return true;
+}
+
 // The kind and its parameter values, in the order of ParameterNames.
 bool ReadParameters(const nlohmann::json& j, ProcessModelUncertainty* m, std::string* error) {
   const nlohmann::json* kind = nullptr;
   if (!Member(j, "model", "", &kind, error)) return false;
   if (!kind->is_string() || !Parse(kind->get<std::string>(), &m->kind))
     return Bad(error, "\"model\" " + spec::Truncate(kind->dump()) + " must be " + ProcessModelKindNames());
+  if (m->kind == plant_sim::ProcessModelKind::kTf && !ReadTfShape(j, m, error)) return false;
   const nlohmann::json* parameters = nullptr;
   if (!Member(j, "parameters", "", &parameters, error)) return false;
   m->values.clear();
-  for (const std::string& name : ParameterNames(m->kind)) {
+  for (const std::string& name : ParameterNames(m->kind, m->poles, m->zeros)) {
     const nlohmann::json* p = nullptr;
     const nlohmann::json* value = nullptr;
     double v = 0.0;
@@ -84,7 +100,7 @@ bool ReadParameters(const nlohmann::json& j, ProcessModelUncertainty* m, std::st
     m->values.push_back(v);
   }
   std::string why;
-  if (!ParametersAreValid(m->kind, m->values, &why))
+  if (!ParametersAreValid(m->kind, m->values, &why, m->poles, m->zeros))
     return Bad(error, "is not a valid " + std::string(plant_sim::ToString(m->kind)) + " model: " + why);
   return true;
 }
@@ -101,7 +117,8 @@ bool ReadCovariance(const nlohmann::json& j, ProcessModelUncertainty* m, std::st
   if (!Member(*c, "matrix", "covariance.", &matrix, error)) return false;
   const std::size_t p = m->values.size();
   std::string names;
-  for (const std::string& name : ParameterNames(m->kind)) names += (names.empty() ? "" : ", ") + name;
+  for (const std::string& name : ParameterNames(m->kind, m->poles, m->zeros))
+    names += (names.empty() ? "" : ", ") + name;
   const std::string shape =
       "\"covariance.matrix\" must be " + std::to_string(p) + " x " + std::to_string(p) + " (" + names + ")";
   if (!matrix->is_array() || matrix->size() != p) return Bad(error, shape);
@@ -145,6 +162,14 @@ bool ReadModelFile(const std::string& path, Plant* plant, std::string* error) {
   if (!j.is_object()) return Bad(error, "is not a JSON object");
   auto m = std::make_shared<ProcessModelUncertainty>();
   if (!ReadParameters(j, m.get(), error) || !ReadCovariance(j, m.get(), error)) return false;
+  if (m->kind == plant_sim::ProcessModelKind::kTf && m->HasCovariance()) {
+    // The Monte Carlo draws from a covariance know the process models'
+    // parameters, not a tf's coefficients yet: its draws perturb the
+    // transfer function's coefficients, and say why.
+    m->covariance.clear();
+    m->covariance_message =
+        "draws from a tf model's covariance are not built yet, so its coefficients are perturbed instead";
+  }
   const nlohmann::json *tf = nullptr, *num = nullptr, *den = nullptr, *delay = nullptr;
   Plant p;
   if (!Member(j, "transfer_function", "", &tf, error) ||

@@ -50,6 +50,10 @@ struct IdentifyOptions {
   /// sample does not shift every residual.
   double u0 = std::numeric_limits<double>::quiet_NaN();
   double y0 = std::numeric_limits<double>::quiet_NaN();
+  /// The kind TF's numbers of poles (1..kMaxTfPoles) and zeros (0..poles-1);
+  /// both 0 for every other kind (Identify refuses them otherwise).
+  int poles = 0;
+  int zeros = 0;
 
   /// Names the field, its value and the rule on failure.
   bool IsValid(std::string* error) const;
@@ -131,7 +135,8 @@ std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<d
                                   double dt_s);
 
 /// Fits a model of `kind` to `data`. kInvalidInput for bad data or options
-/// (CheckData, IdentifyOptions::IsValid); kRunnerFailed if no start converged.
+/// (CheckData, IdentifyOptions::IsValid, poles and zeros as they say);
+/// kRunnerFailed if no start converged.
 Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
                 IdentifyResult* result);
 
@@ -148,7 +153,7 @@ struct PoleEstimate {
 /// complex pair first), with standard errors when the covariance is ok.
 std::vector<PoleEstimate> PoleEstimates(const IdentifyResult& result);
 
-/// Fits every kind (P1D, P2D, P2DU, P1DI, P2DZ) and chooses the lowest AIC, or,
+/// Fits every process kind (P1D, P2D, P2DU, P1DI, P2DZ; not TF) and chooses the lowest AIC, or,
 /// among the kinds within 2 of it (which the data hardly tell apart), the one
 /// of fewest parameters (then the lowest AIC among those).
 /// kInvalidInput as Identify; kRunnerFailed if no kind could be fitted.

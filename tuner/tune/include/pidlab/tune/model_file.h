@@ -5,7 +5,11 @@
 // the plant G(s) e^(-s Td); its "model" (the kind), "parameters" (value of
 // each, in any order) and "covariance" (ok, message, matrix p x p in the
 // order of ParameterNames) become Plant::model, from which the Monte Carlo
-// and robust-set draws come (analysis::DrawPlants).
+// and robust-set draws come (analysis::DrawPlants). A "tf" model also
+// carries "poles" and "zeros"; its covariance is read and checked, then
+// dropped with a covariance_message saying so, so that its draws perturb the
+// transfer function's coefficients (draws from a tf's covariance are not
+// built yet).
 
 #include <string>
 
