@@ -269,7 +269,7 @@ const char* kTfFile = R"({
                             [0, 0, 0, 0, 1e-6]]}
 })";
 
-TEST_F(ModelFile, ATfFileIsAPlantWhoseDrawsPerturbItsCoefficientsAndSaySo) {
+TEST_F(ModelFile, ATfFileIsAPlantWhoseDrawsComeFromItsCoefficientsCovariance) {
   spec::PlantSpec s;
   s.plant = "model:" + Write(kTfFile);
   Plant p;
@@ -282,10 +282,33 @@ TEST_F(ModelFile, ATfFileIsAPlantWhoseDrawsPerturbItsCoefficientsAndSaySo) {
   EXPECT_EQ(p.model->values, (std::vector<double>{1.0, 0.5, 0.8, 1.2, 0.25}));
   EXPECT_EQ(p.tf.den, (std::vector<double>{1.0, 1.2, 0.8}));
   EXPECT_EQ(p.delay_s, 0.25);
-  // Read and checked, then dropped: the draws perturb the coefficients.
-  EXPECT_FALSE(p.model->HasCovariance());
-  EXPECT_NE(PerturbedText(p, nullptr).find("draws from a tf model's covariance are not built yet"),
-            std::string::npos);
+  ASSERT_TRUE(p.model->HasCovariance());
+  EXPECT_NE(PerturbedText(p, nullptr).find("covariance"), std::string::npos) << PerturbedText(p, nullptr);
+  // 20000 draws: every coefficient and Td with the file's mean and standard
+  // deviation (sigma 0.01 and 0.001, independent) within four sigma of the
+  // estimates' own spread, every denominator stable.
+  MonteCarloOptions mc;
+  mc.samples = 20000;
+  mc.seed = 5;
+  int redrawn = 0;
+  const std::vector<Plant> draws = DrawPlants(p, nullptr, mc, &redrawn);
+  ASSERT_EQ(draws.size(), 20000u);
+  const std::vector<double> sigma = {0.01, 0.01, 0.01, 0.01, 0.001};
+  std::vector<double> sum(5, 0.0), sum2(5, 0.0);
+  for (const Plant& d : draws) {
+    ASSERT_EQ(d.tf.num.size(), 2u);
+    ASSERT_EQ(d.tf.den.size(), 3u);
+    EXPECT_TRUE(d.tf.den[1] > 0.0 && d.tf.den[2] > 0.0);
+    const double x[5] = {d.tf.num[1], d.tf.num[0], d.tf.den[2], d.tf.den[1], d.delay_s};  // b0 b1 a0 a1 Td
+    for (int k = 0; k < 5; ++k) sum[k] += x[k], sum2[k] += x[k] * x[k];
+  }
+  const double n = 20000.0;
+  for (int k = 0; k < 5; ++k) {
+    const double mean = sum[k] / n, sd = std::sqrt(sum2[k] / n - mean * mean);
+    EXPECT_NEAR(mean, p.model->values[static_cast<std::size_t>(k)], 4.0 * sigma[k] / std::sqrt(n)) << k;
+    EXPECT_NEAR(sd, sigma[k], 4.0 * sigma[k] / std::sqrt(2.0 * n)) << k;
+  }
+  EXPECT_EQ(redrawn, 0);  // 80 sigma from instability
 }
 
 TEST_F(ModelFile, ATfFileWithoutItsShapeOrWithAnUnstableDenominatorIsRefused) {

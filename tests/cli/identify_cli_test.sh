@@ -142,8 +142,8 @@ PY"
 pidlab identify --csv tf.csv --model tf --poles 2 --zeros 1 > tf.txt 2> err
 check "the tf table names the formula and every coefficient" \
   "[ $? -eq 0 ] && grep -q '(b1 s + b0) e^(-Td s) / (s^2 + a1 s + a0)' tf.txt && grep -q '^a1 ' tf.txt && grep -q '^b1 ' tf.txt"
-check "the tf model file is a plant whose Monte Carlo says its coefficients are perturbed" \
-  "pidlab evaluate --model tf_model.json --gains 0.5,0.4,0 --loop sampled --monte-carlo 5 --json > tf_eval.json && grep -q 'tf model' tf_eval.json"
+check "the tf model file is a plant whose Monte Carlo draws from its covariance" \
+  "pidlab evaluate --model tf_model.json --gains 0.5,0.4,0 --loop sampled --monte-carlo 5 --json > tf_eval.json && grep -q \"identified model's parameter covariance\" tf_eval.json"
 for case in "--model tf|--model tf needs --poles N" "--model tf --poles 7|--poles 7 must be in 1..6" \
             "--model tf --poles 0|--poles 0 must be in 1..6" \
             "--model tf --poles 2 --zeros 2|--zeros 2 must be in 0..1 (fewer than --poles 2)" \

@@ -66,8 +66,10 @@ std::vector<Plant> DrawModelPlants(const Plant& nominal, const MonteCarloOptions
       for (Eigen::Index k = 0; k < p; ++k) z(k) = StandardNormal(&rng);
       const Eigen::VectorXd x = mean + root * z;
       const std::vector<double> values(x.data(), x.data() + p);
-      if (!ParametersAreValid(m.kind, values, nullptr)) continue;
-      const ProcessModel model = ModelFromValues(m.kind, values);
+      // A tf's draws are its coefficients and Td, redrawn while the
+      // denominator is not stable (ParametersAreValid).
+      if (!ParametersAreValid(m.kind, values, nullptr, m.poles, m.zeros)) continue;
+      const ProcessModel model = ModelFromValues(m.kind, values, m.poles, m.zeros);
       TransferFunction tf = model.ToTransferFunction();
       if (!tf.IsValid(nullptr)) continue;
       plant.tf = std::move(tf);

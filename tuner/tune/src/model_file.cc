@@ -162,14 +162,6 @@ bool ReadModelFile(const std::string& path, Plant* plant, std::string* error) {
   if (!j.is_object()) return Bad(error, "is not a JSON object");
   auto m = std::make_shared<ProcessModelUncertainty>();
   if (!ReadParameters(j, m.get(), error) || !ReadCovariance(j, m.get(), error)) return false;
-  if (m->kind == plant_sim::ProcessModelKind::kTf && m->HasCovariance()) {
-    // The Monte Carlo draws from a covariance know the process models'
-    // parameters, not a tf's coefficients yet: its draws perturb the
-    // transfer function's coefficients, and say why.
-    m->covariance.clear();
-    m->covariance_message =
-        "draws from a tf model's covariance are not built yet, so its coefficients are perturbed instead";
-  }
   const nlohmann::json *tf = nullptr, *num = nullptr, *den = nullptr, *delay = nullptr;
   Plant p;
   if (!Member(j, "transfer_function", "", &tf, error) ||
