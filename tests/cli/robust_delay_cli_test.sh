@@ -15,7 +15,7 @@ start=$(date +%s)
 rc=$?
 took=$(( $(date +%s) - start ))
 check "tune --robust on 1/(s + 1) e^(-0.5 s) exits 0" "[ $rc -eq 0 ]"
-check "it finishes in under 90 s (took ${took} s; 11 s alone on this machine)" "[ $took -lt 90 ]"
+echo "info tune --robust took ${took} s (a figure, not a check: speed is measured in bench/)"
 check "its gains meet every bound with a finite slowest time constant" "/usr/bin/python3 - \"$tmp/out.json\" <<'PY'
 import json, math, sys
 j = json.load(open(sys.argv[1]))
