@@ -137,6 +137,26 @@ TEST(NonUniform, P2dWithAFractionalDelayIsRecoveredFromAJitteredGrid) {
   ExpectRecovered(dut, {1.7, 4.2, 1.3, 0.63});
 }
 
+TEST(NonUniform, AGridOfTwoAlternatingIntervalsIsFittedExactly) {
+  // 0.0625 s and 0.125 s in turn (exact in binary, so that pieces of equal
+  // length recur and come from the cache), a delay of 0.3 s off both grids.
+  IdentifyData data;
+  const std::vector<double> du = StepRichInput(240, 13);
+  for (std::size_t k = 0; k < du.size(); ++k)
+    data.t.push_back(k == 0 ? 0.0 : data.t.back() + (k % 2 == 1 ? 0.0625 : 0.125));
+  const std::vector<double> dy = ClosedFormResponse(1.7, 4.2, 1.3, 0.3, data.t, du);
+  for (std::size_t k = 0; k < du.size(); ++k) {
+    data.u.push_back(du[k]);
+    data.y.push_back(dy[k]);
+  }
+  IdentifyResult dut;
+  ASSERT_TRUE(Identify(data, ProcessModelKind::kP2D, IdentifyOptions{}, &dut).ok());
+  EXPECT_FALSE(dut.sampling.uniform);
+  EXPECT_EQ(dut.sampling.min_interval_s, 0.0625);
+  EXPECT_EQ(dut.sampling.max_interval_s, 0.125);
+  ExpectRecovered(dut, {1.7, 4.2, 1.3, 0.3});
+}
+
 TEST(NonUniform, AUniformRecordKeepsTheUniformPath) {
   // Within the tolerance of uniform sampling: DiscretePlant over the mean
   // interval, as before, so every bit of the result is the same as for the
