@@ -299,12 +299,6 @@ TEST(Identify, TimeGoingBackwardsIsRefused) {
   ExpectRefused(data, "t is not strictly increasing");
 }
 
-TEST(Identify, NonUniformSamplingIsRefused) {
-  IdentifyData data = RecordOf(Truth(ProcessModelKind::kP1D));
-  data.t[30] += 0.03;
-  ExpectRefused(data, "non-uniform sampling");
-}
-
 TEST(Identify, ARecordOfFewerThanTwentySamplesIsRefused) {
   ExpectRefused(RecordOf(Truth(ProcessModelKind::kP1D), 19), "too short: 19 samples");
 }

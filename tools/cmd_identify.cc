@@ -78,6 +78,11 @@ std::string Table(const IdentifyResult& r) {
      << r.samples << " samples at dt " << Num(r.dt_s) << " s, offsets u0 " << Num(r.u0) << ", y0 "
      << Num(r.y0)
      << (r.y0_estimated ? " (estimated, standard error " + Num(r.y0_standard_error, 3) + ")" : "") << "\n"
+     << (r.sampling.uniform
+             ? ""
+             : "sampling is non-uniform (intervals " + Num(r.sampling.min_interval_s) + " to " +
+                   Num(r.sampling.max_interval_s) +
+                   " s, dt above is the mean): the exact response interval by interval is used\n")
      << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)\n"
      << "num " << Polynomial(tf.num) << " den " << Polynomial(tf.den) << " delay "
      << Num(r.model.delay_s(), 10) << " s\n";
@@ -110,7 +115,8 @@ struct IdentifyCommand {
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
-        "Fit a process model to a record: the columns t (s, uniform), u and y of a CSV with a header (any "
+        "Fit a process model to a record: the columns t (s, uniform or not), u and y of a CSV with a header "
+        "(any "
         "order, other columns ignored), or one episode of an LCM log of the trio (the plant's input u + n "
         "and "
         "the measured y of every step). By default the record starts at rest at u0 = u[0] and y0 is "

@@ -27,16 +27,23 @@ while k < n:
     level, hold = random.uniform(-1, 1), random.randint(3, 15)
     for i in range(k, min(n, k + hold)): u[i] = level
     k += hold
-def y(t):  # superposition of the delayed steps of u
+def y(t, times=[j * dt for j in range(n)]):  # superposition of the delayed steps of u
     total, prev = 0.0, 0.0
     for j in range(n):
-        s = t - (j * dt + td)
+        s = t - (times[j] + td)
         if u[j] != prev and s > 0: total += (u[j] - prev) * kp * (1 - math.exp(-s / tp1))
         prev = u[j]
     return total
 with open('step.csv', 'w') as f:
     f.write('u,t,note,y\n')
     for k in range(n): f.write('%.17g,%.17g,0,%.17g\n' % (u[k] + 1, k * dt, y(k * dt) + 3))
+# The same input on a jittered grid: every interval dt (1 + U(-0.3, 0.3)).
+random.seed(5)
+tj = [0.0]
+for k in range(1, n): tj.append(tj[-1] + dt * (1 + random.uniform(-0.3, 0.3)))
+with open('jitter.csv', 'w') as f:
+    f.write('t,u,y\n')
+    for k in range(n): f.write('%.17g,%.17g,%.17g\n' % (tj[k], u[k] + 1, y(tj[k], tj) + 3))
 PY
 
 # The commands of docs/identify.md's section, as written there (its ```bash block).
@@ -46,7 +53,7 @@ while IFS= read -r cmd; do
   (pidlab() { "$pidlab" "$@"; }; eval "$cmd") > docs.out 2>&1
   check "docs/identify.md: $cmd" "[ $? -eq 0 ]"
 done < <(awk '/^```bash/{on=1; next} /^```/{on=0} on && /^pidlab identify /' "$docs")
-check "docs/identify.md has 3 identify commands (found $n_docs)" "[ $n_docs -eq 3 ]"
+check "docs/identify.md has 4 identify commands (found $n_docs)" "[ $n_docs -eq 4 ]"
 pidlab() { "$pidlab" "$@"; }
 pidlab identify --csv step.csv --model p1d > table 2> err
 check "identify --csv step.csv --model p1d exits 0 with the table" \
@@ -155,6 +162,26 @@ for case in "--model tf|--model tf needs --poles N" "--model tf --poles 7|--pole
   check "identify $args exits 2 with one line naming '$needle'" \
     "[ $? -eq 2 ] && only_line_ok err \"$needle\" && [ ! -s out ]"
 done
+
+# Non-uniform sampling: said in one line of the table and in the JSON's
+# sampling; the parameters come back from the exact response interval by
+# interval.
+pidlab identify --csv jitter.csv --model p1d > table 2> err
+check "identify --csv jitter.csv exits 0 and says the sampling is non-uniform" \
+  "[ $? -eq 0 ] && [ ! -s err ] && grep -q '^sampling is non-uniform (intervals 0.07[0-9]* to 0.12[0-9]* s, dt above is the mean): the exact response interval by interval is used$' table"
+pidlab identify --csv jitter.csv --model p1d --json > jitter.json 2> err
+check "the jittered record's JSON: sampling {uniform false, min, max}, Kp, Tp1, Td within 1e-6 relative" \
+  "[ $? -eq 0 ] && /usr/bin/python3 - jitter.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+s = j['sampling']
+assert s['uniform'] is False and 0.07 <= s['min_interval_s'] < 0.075 and 0.125 < s['max_interval_s'] <= 0.13, s
+for name, true in (('Kp', 2.0), ('Tp1', 1.5), ('Td', 0.25)):
+    assert abs(j['parameters'][name]['value'] - true) <= 1e-6 * true, (name, j['parameters'][name])
+PY"
+pidlab identify --csv step.csv --model p1d --json > uniform.json 2> err
+check "a uniform record's JSON says sampling {uniform true}" \
+  "[ $? -eq 0 ] && /usr/bin/python3 -c \"import json; s = json.load(open('uniform.json'))['sampling']; assert s['uniform'] is True and abs(s['min_interval_s'] - 0.1) < 1e-12 and abs(s['max_interval_s'] - 0.1) < 1e-12, s\""
 
 # Bad input: exit 2, one line naming the flag, file, column, row or value.
 sed '1s/^u,t,note,y/u,time,note,y/' step.csv > nocolumn.csv

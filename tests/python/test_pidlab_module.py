@@ -287,6 +287,25 @@ class Identify(unittest.TestCase):
         for name, true in (("Kp", 1.5), ("Tp1", 2.0), ("Td", 0.25)):
             self.assertLess(abs(p[name]["value"] - true), 4 * p[name]["standard_error"], name)
 
+    def test_a_non_uniform_record_gives_the_cli_json(self):
+        import numpy as np
+        # The same samples at times jittered by up to 30 % of dt (the fit is then
+        # of another record, but the binding and the CLI must agree on it).
+        rng = np.random.default_rng(9)
+        t = np.concatenate(([0.0], np.cumsum(0.1 * (1 + rng.uniform(-0.3, 0.3, len(self.t) - 1)))))
+        csv = os.path.join(self.dir, "jitter.csv")
+        with open(csv, "w") as f:
+            f.write("t,u,y\n")
+            for row in zip(t, self.u, self.y):
+                f.write("%.17g,%.17g,%.17g\n" % row)
+        got = pidlab.identify(t, self.u, self.y, model="p1d", starts=3)
+        want = cli("identify", "--csv", csv, "--model", "p1d", "--starts", "3")
+        del want["source"]
+        self.assertEqual(got, want)
+        self.assertFalse(got["sampling"]["uniform"])
+        self.assertEqual(got["sampling"]["min_interval_s"], np.diff(t).min())
+        self.assertEqual(got["sampling"]["max_interval_s"], np.diff(t).max())
+
     def test_lists_and_options_reach_the_fit(self):
         got = pidlab.identify(list(self.t), list(self.u), list(self.y), model="p1d", starts=3, seed=7, u0=0, y0=0)
         self.assertEqual((got["starts"] - got["arx_start"], got["seed"], got["u0"], got["y0"]), (3, 7, 0, 0))

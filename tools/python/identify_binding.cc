@@ -103,7 +103,8 @@ void DefineIdentify(py::module_& m) {
         "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None, poles=None, zeros=None): fits a "
         "process model (p1d, p2d, p2du, p1di, p2dz, or auto to choose among them by AIC) or a general "
         "transfer function (model='tf' with poles=N in 1..6 and zeros=M in 0..N-1, default 0) to the record "
-        "t (s, uniform), u, y (lists or numpy arrays) and returns the dict of `pidlab identify --json`. u0, "
+        "t (s, uniform or not), u, y (lists or numpy arrays) and returns the dict of `pidlab identify "
+        "--json`. u0, "
         "y0: the operating point (None: u0 the first sample, y0 estimated with the model). Bad data or "
         "arguments raise ValueError naming the reason (docs/identify.md).",
         py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",

@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "arx_start.h"
+#include "nonuniform.h"
 #include "pidlab/optim/sobol.h"
 #include "pidlab/plant_sim/discrete_plant.h"
 #include "tf_start.h"
@@ -40,6 +41,9 @@ struct Record {
   int poles = 0, zeros = 0;  // TF only
   std::vector<double> du, dy;
   double dt_s = 0.0, length_s = 0.0, max_delay_s = 0.0;
+  /// Non-uniform sampling: the sample times, simulated interval by interval
+  /// (nonuniform.h); empty when uniform (DiscretePlant over dt_s, the mean).
+  std::vector<double> t;
   /// The output offset is a parameter too: theta[p] is added to y0.
   bool offset = false;
 };
@@ -77,12 +81,12 @@ ProcessModel ModelOf(const Record& record, const double* theta) {
 
 // yhat of the model, false if it is not a valid plant or diverges (or, for
 // a TF, not admissible: tf_start.h).
-bool TrySimulate(const ProcessModel& model, const std::vector<double>& du, double dt_s,
-                 std::vector<double>* yhat) {
-  if (model.kind == ProcessModelKind::kTf && !internal::TfDenominatorIsAdmissible(model.a, dt_s))
+bool TrySimulate(const ProcessModel& model, const Record& record, std::vector<double>* yhat) {
+  if (model.kind == ProcessModelKind::kTf && !internal::TfDenominatorIsAdmissible(model.a, record.dt_s))
     return false;
   try {
-    *yhat = SimulateModel(model, du, 0.0, dt_s);
+    *yhat = record.t.empty() ? SimulateModel(model, record.du, 0.0, record.dt_s)
+                             : internal::SimulateNonUniform(model, record.t, record.du);
   } catch (const std::exception&) {
     return false;
   }
@@ -95,7 +99,7 @@ struct OutputError {
   const Record* record;
   bool operator()(double const* const* parameters, double* residuals) const {
     std::vector<double> yhat;
-    if (!TrySimulate(ModelOf(*record, parameters[0]), record->du, record->dt_s, &yhat)) return false;
+    if (!TrySimulate(ModelOf(*record, parameters[0]), *record, &yhat)) return false;
     const double offset = OffsetOf(*record, parameters[0]);
     for (std::size_t k = 0; k < yhat.size(); ++k) residuals[k] = record->dy[k] - offset - yhat[k];
     return true;
@@ -139,7 +143,7 @@ void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
   (*theta)[0] = 1.0;
   if (record.offset) (*theta)[static_cast<std::size_t>(p)] = 0.0;
   std::vector<double> g;
-  if (!TrySimulate(ModelOf(record, theta->data()), record.du, record.dt_s, &g)) return;
+  if (!TrySimulate(ModelOf(record, theta->data()), record, &g)) return;
   // dy ~ Kp g + offset: the normal equations of one or two unknowns.
   const double n = static_cast<double>(g.size());
   double gy = 0.0, gg = 0.0, sg = 0.0, sy = 0.0;
@@ -200,7 +204,7 @@ std::vector<double> StartPoint(const Record& record, const optim::SobolSequence&
 double ScreenCost(const Record& record, std::vector<double>* theta) {
   SetGainByLeastSquares(record, theta);
   std::vector<double> yhat;
-  if (!TrySimulate(ModelOf(record, theta->data()), record.du, record.dt_s, &yhat))
+  if (!TrySimulate(ModelOf(record, theta->data()), record, &yhat))
     return std::numeric_limits<double>::infinity();
   const double offset = OffsetOf(record, theta->data());
   double cost = 0.0;
@@ -349,7 +353,7 @@ bool IdentifyOptions::IsValid(std::string* error) const {
   return e.empty();
 }
 
-Status CheckData(const IdentifyData& data, double* dt_s) {
+Status CheckData(const IdentifyData& data, Sampling* sampling) {
   const std::size_t n = data.t.size();
   if (data.u.size() != n || data.y.size() != n)
     return Status::InvalidInput("t, u and y have different lengths (" + std::to_string(n) + ", " +
@@ -373,16 +377,20 @@ Status CheckData(const IdentifyData& data, double* dt_s) {
     if (!(data.t[k] > data.t[k - 1]))
       return Status::InvalidInput("t is not strictly increasing: t = " + Number(data.t[k]) + " at sample " +
                                   std::to_string(k) + " after " + Number(data.t[k - 1]));
-  const double dt = (data.t[n - 1] - data.t[0]) / static_cast<double>(n - 1);
-  for (std::size_t k = 1; k < n; ++k)
-    if (std::abs(data.t[k] - data.t[k - 1] - dt) > kUniformSamplingTolerance * dt)
-      return Status::InvalidInput("non-uniform sampling: the interval before sample " + std::to_string(k) +
-                                  " is " + Number(data.t[k] - data.t[k - 1]) + " s, the mean " + Number(dt) +
-                                  " s (only uniform sampling is supported)");
+  Sampling found;
+  found.mean_interval_s = (data.t[n - 1] - data.t[0]) / static_cast<double>(n - 1);
+  found.min_interval_s = found.max_interval_s = data.t[1] - data.t[0];
+  for (std::size_t k = 1; k < n; ++k) {
+    const double h = data.t[k] - data.t[k - 1];
+    found.min_interval_s = std::min(found.min_interval_s, h);
+    found.max_interval_s = std::max(found.max_interval_s, h);
+    if (std::abs(h - found.mean_interval_s) > kUniformSamplingTolerance * found.mean_interval_s)
+      found.uniform = false;
+  }
   if (std::all_of(data.u.begin(), data.u.end(), [&](double v) { return v == data.u[0]; }))
     return Status::InvalidInput("constant input: u is " + Number(data.u[0]) +
                                 " throughout, so nothing can be identified");
-  *dt_s = dt;
+  *sampling = found;
   return Status::Ok();
 }
 
@@ -479,7 +487,7 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
   result->covariance_ok = Covariance(record, theta, cost, &result->standard_errors, &result->covariance,
                                      &result->y0_standard_error, &result->covariance_message);
   std::vector<double> yhat;
-  if (TrySimulate(result->model, record.du, record.dt_s, &yhat)) {
+  if (TrySimulate(result->model, record, &yhat)) {
     for (std::size_t k = 0; k < yhat.size(); ++k) {
       result->simulated.push_back(result->y0 + yhat[k]);
       result->residuals.push_back(record.dy[k] - offset - yhat[k]);
@@ -501,9 +509,13 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   if (!shape.ok()) return shape;
   record.poles = options.poles;
   record.zeros = options.zeros;
-  const Status status = CheckData(data, &record.dt_s);
+  Sampling sampling;
+  const Status status = CheckData(data, &sampling);
   if (!status.ok()) return status;
+  record.dt_s = sampling.mean_interval_s;
+  if (!sampling.uniform) record.t = data.t;
   *result = IdentifyResult{};
+  result->sampling = sampling;
   result->u0 = std::isnan(options.u0) ? data.u[0] : options.u0;
   // Not given: estimated, from the first sample as its start.
   result->y0 = std::isnan(options.y0) ? data.y[0] : options.y0;

@@ -11,7 +11,8 @@ namespace pidlab::json {
 
 /// model (p1d|p2d|p2du|p1di|p2dz), parameters {name: {value, standard_error}},
 /// transfer_function {num, den, delay_s}, fit_percent, aic, aic_form, cost,
-/// samples, dt_s, u0, y0, starts, starts_at_best, seed, whiteness {lags,
+/// samples, dt_s (the mean interval), sampling {uniform, min_interval_s,
+/// max_interval_s}, u0, y0, starts, starts_at_best, seed, whiteness {lags,
 /// autocorrelation, band, outside_band, ljung_box_q, p_value, white},
 /// warnings [text], covariance {ok, message, matrix} (null for NaN and +-inf).
 nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r);

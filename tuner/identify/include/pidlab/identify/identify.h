@@ -2,8 +2,9 @@
 // A process model (process_model.h) fitted to one record of sampled input
 // and output by least squares on the output error: the residuals are
 // y_k - y0 - yhat_k, with yhat the exact zero-order-hold response of the
-// model, its delay included and fractional (DiscretePlant(tf, dt, Td)), to
-// u - u0 from a zero state. Ceres fits from several starts and keeps the
+// model, its delay included and fractional (DiscretePlant(tf, dt, Td), or on
+// a non-uniform grid the same response interval by interval), to u - u0
+// from a zero state. Ceres fits from several starts and keeps the
 // best. docs/identify.md, "Identifying a model from a CSV".
 
 #include <cstdint>
@@ -16,11 +17,23 @@
 
 namespace pidlab::identify {
 
-/// One record: sample times t (s, uniform), input u and output y.
+/// One record: sample times t (s, strictly increasing, uniform or not), input
+/// u and output y. u_k is held from t_k to t_(k+1).
 struct IdentifyData {
   std::vector<double> t;
   std::vector<double> u;
   std::vector<double> y;
+};
+
+/// How a record is sampled (CheckData). Uniform: every interval within
+/// kUniformSamplingTolerance of the mean, relative; the fit then runs
+/// DiscretePlant over the mean interval. Otherwise it simulates the exact
+/// response interval by interval (docs/identify.md, "Non-uniform sampling").
+struct Sampling {
+  bool uniform = true;
+  double mean_interval_s = 0.0;  // (t_(N-1) - t_0) / (N - 1)
+  double min_interval_s = 0.0;
+  double max_interval_s = 0.0;
 };
 
 /// The fewest samples a record may have.
@@ -88,14 +101,15 @@ struct IdentifyResult {
   /// whose diagonal gives `standard_errors`); NaN when it failed.
   std::vector<double> covariance;
   bool covariance_ok = false;
-  std::string covariance_message;   // why it failed, else empty
-  double cost = 0.0;                // 1/2 sum of squared residuals
-  double fit_percent = 0.0;         // 100 (1 - |y - yhat| / |y - mean y|)
-  double aic = 0.0;                 // N log(2 cost / N) + 2 p (p with y0 if estimated)
-  double u0 = 0.0, y0 = 0.0;        // the operating point used
-  bool y0_estimated = false;        // y0 was a parameter of the fit
+  std::string covariance_message;  // why it failed, else empty
+  double cost = 0.0;               // 1/2 sum of squared residuals
+  double fit_percent = 0.0;        // 100 (1 - |y - yhat| / |y - mean y|)
+  double aic = 0.0;                // N log(2 cost / N) + 2 p (p with y0 if estimated)
+  double u0 = 0.0, y0 = 0.0;       // the operating point used
+  bool y0_estimated = false;       // y0 was a parameter of the fit
   double y0_standard_error = std::numeric_limits<double>::quiet_NaN();  // if estimated
-  double dt_s = 0.0;                // the sampling interval found
+  double dt_s = 0.0;                // the sampling interval found (the mean one)
+  Sampling sampling;                // uniform or not, the shortest and longest interval
   int samples = 0;                  // N
   int starts = 0;                   // starts run: the design's, plus the ARX start if used
   bool arx_start = false;           // start_costs[0] is the ARX start
@@ -126,8 +140,8 @@ struct AutoResult {
 
 /// Status kInvalidInput with one plain message naming the reason unless the
 /// record has at least kMinSamples samples, equal lengths, only finite
-/// values, strictly increasing uniform t and a non-constant u. Sets *dt_s.
-Status CheckData(const IdentifyData& data, double* dt_s);
+/// values, strictly increasing t and a non-constant u. Sets *sampling.
+Status CheckData(const IdentifyData& data, Sampling* sampling);
 
 /// yhat_k (without y0) of `model` for the input u - u0 sampled every dt_s.
 /// Throws std::invalid_argument if the model is not a valid plant.
