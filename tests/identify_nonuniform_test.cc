@@ -10,10 +10,12 @@
 #include <random>
 #include <vector>
 
+#include "identify_records.h"
 #include "pidlab/identify/identify.h"
 
 namespace pidlab::identify {
 namespace {
+using test::StepRichInput;
 
 // Sample times 0, h_0, h_0 + h_1, ... with h_k = dt (1 + U(-0.3, 0.3)), seeded.
 std::vector<double> JitteredTimes(std::size_t n, double dt, unsigned seed) {
@@ -22,20 +24,6 @@ std::vector<double> JitteredTimes(std::size_t n, double dt, unsigned seed) {
   std::vector<double> t(n, 0.0);
   for (std::size_t k = 1; k < n; ++k) t[k] = t[k - 1] + dt * (1.0 + jitter(rng));
   return t;
-}
-
-// At rest for five samples, then levels in [-1, 1] held 3 to 15 samples (seeded).
-std::vector<double> StepRichInput(std::size_t n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> level(-1.0, 1.0);
-  std::uniform_int_distribution<int> hold(3, 15);
-  std::vector<double> u(n, 0.0);
-  std::size_t k = 5;
-  while (k < n) {
-    const double v = level(rng);
-    for (int i = hold(rng); i > 0 && k < n; --i) u[k++] = v;
-  }
-  return u;
 }
 
 // The response at every t_k of Kp e^(-Td s) / ((1 + T1 s)(1 + T2 s)) (T2 = 0:

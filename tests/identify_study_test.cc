@@ -12,12 +12,14 @@
 #include <random>
 #include <sstream>
 
+#include "identify_records.h"
 #include "pidlab/identify/identify.h"
 
 namespace pidlab::identify {
 namespace {
+using test::kDt;
+using test::StepRichInput;
 
-constexpr double kDt = 0.1;
 // 200 samples (20 s) for the coverage: several settling times of the slowest
 // model (P2D, Tp1 = 4.2 s) and about 20 input steps. 300 (30 s) for the starts:
 // the longer record has more local optima at long delays (Td up to T/4 is
@@ -27,21 +29,6 @@ constexpr std::size_t kStartStudySamples = 300;
 // 30 dB: the noise variance is the noise-free output's variance / 1000.
 constexpr double kSignalToNoiseDb = 30.0;
 constexpr double kU0 = 0.5, kY0 = 2.0;
-
-// A step-rich input: at rest for five samples, then random levels in [-1, 1]
-// held for 3 to 15 samples each (seeded), as in identify_test.cc.
-std::vector<double> StepRichInput(std::size_t n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> level(-1.0, 1.0);
-  std::uniform_int_distribution<int> hold(3, 15);
-  std::vector<double> u(n, 0.0);
-  std::size_t k = 5;
-  while (k < n) {
-    const double v = level(rng);
-    for (int i = hold(rng); i > 0 && k < n; --i) u[k++] = v;
-  }
-  return u;
-}
 
 // Every delay off the sample grid (0.37 s = 3.7 samples, 0.63 s = 6.3).
 ProcessModel Truth(ProcessModelKind kind) {

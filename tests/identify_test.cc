@@ -11,27 +11,13 @@
 #include <limits>
 #include <random>
 
+#include "identify_records.h"
 #include "pidlab/identify/csv_data.h"
 
 namespace pidlab::identify {
 namespace {
-
-constexpr double kDt = 0.1;
-
-// A step-rich input: at rest for five samples, then random levels in [-1, 1]
-// held for 3 to 15 samples each (seeded).
-std::vector<double> StepRichInput(std::size_t n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> level(-1.0, 1.0);
-  std::uniform_int_distribution<int> hold(3, 15);
-  std::vector<double> u(n, 0.0);
-  std::size_t k = 5;
-  while (k < n) {
-    const double v = level(rng);
-    for (int i = hold(rng); i > 0 && k < n; --i) u[k++] = v;
-  }
-  return u;
-}
+using test::kDt;
+using test::StepRichInput;
 
 // A noise-free record of `model` around the operating point (u0, y0).
 IdentifyData RecordOf(const ProcessModel& model, std::size_t n = 400, double u0 = 0.5, double y0 = 2.0) {

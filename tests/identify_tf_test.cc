@@ -6,27 +6,13 @@
 #include <cmath>
 #include <random>
 
+#include "identify_records.h"
 #include "pidlab/identify/identify.h"
 
 namespace pidlab::identify {
 namespace {
-
-constexpr double kDt = 0.1;
-
-// At rest for five samples, then random levels in [-1, 1] held for 3 to 15
-// samples each (seeded), as identify_test.cc's.
-std::vector<double> StepRichInput(std::size_t n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> level(-1.0, 1.0);
-  std::uniform_int_distribution<int> hold(3, 15);
-  std::vector<double> u(n, 0.0);
-  std::size_t k = 5;
-  while (k < n) {
-    const double v = level(rng);
-    for (int i = hold(rng); i > 0 && k < n; --i) u[k++] = v;
-  }
-  return u;
-}
+using test::kDt;
+using test::StepRichInput;
 
 // A record of `model` around (0.5, 2.0); with `snr_db`, white noise whose
 // RMS is the output's (about its mean) over 10^(snr_db / 20), from sample 1.

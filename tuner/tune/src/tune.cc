@@ -226,6 +226,7 @@ bool MeetsBounds(const Plant& plant, const StateSpace& realization, const TuneOp
   analysis::LoopAnalysisOptions coarse;
   coarse.points_per_decade = 20.0;
   analysis::LoopBounds bounds = options.bounds;
+  // (The delay-free continuous loop returned above.)
   const bool delayed_continuous = options.loop.loop == evaluation::LoopKind::kContinuous;
   // With dead time, the time constant's bound is one count on its line: no
   // closed-loop root right of Re s = -1/max_time_constant (not the bisection
