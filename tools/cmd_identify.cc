@@ -83,6 +83,11 @@ std::string Table(const IdentifyResult& r) {
              : "sampling is non-uniform (intervals " + Num(r.sampling.min_interval_s) + " to " +
                    Num(r.sampling.max_interval_s) +
                    " s, dt above is the mean): the exact response interval by interval is used\n")
+     << (r.intersample == identify::Intersample::kZoh &&
+                 r.initial_condition == identify::InitialCondition::kZero
+             ? ""
+             : "input " + identify::ToString(r.intersample) + " between samples, initial condition " +
+                   identify::ToString(r.initial_condition) + "\n")
      << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)\n"
      << "num " << Polynomial(tf.num) << " den " << Polynomial(tf.den) << " delay "
      << Num(r.model.delay_s(), 10) << " s\n";
@@ -107,6 +112,7 @@ std::string WhitenessLine(const identify::Whiteness& w) {
 
 struct IdentifyCommand {
   std::string csv, log, model, out, plot_path;
+  std::string intersample = "zoh", initial = "zero";
   CLI::Option* poles_option = nullptr;
   CLI::Option* zeros_option = nullptr;
   std::vector<long> episode;
@@ -144,6 +150,14 @@ struct IdentifyCommand {
                     "the input's operating point (default: the first sample of u; a log's: 0)");
     app->add_option("--y0", options.y0,
                     "the output's operating point (default: estimated with the model; a log's: 0)");
+    app->add_option("--intersample", intersample,
+                    "the input between samples: zoh (held) or foh (linear from one sample to the next; a "
+                    "CSV only: the trio's plant holds its input)")
+        ->capture_default_str();
+    app->add_option("--initial-condition", initial,
+                    "the state at the first sample: zero (at rest at u0), steady-state (at rest with u[0] "
+                    "applied) or estimate (fitted with the model, the input before the record at u[0])")
+        ->capture_default_str();
     app->add_flag("--json", json, "print one JSON object");
     app->add_option("--out", out,
                     "also write the JSON object to this file (a model file for --plant model:FILE)");
@@ -239,6 +253,12 @@ struct IdentifyCommand {
       throw BadInput("--u0 " + Num(options.u0) + " must be finite");
     if (!std::isnan(options.y0) && !std::isfinite(options.y0))
       throw BadInput("--y0 " + Num(options.y0) + " must be finite");
+    if (!identify::ParseIntersample(intersample, &options.intersample))
+      throw BadInput("--intersample " + Quote(intersample) + " must be zoh or foh");
+    if (!identify::ParseInitialCondition(initial, &options.initial_condition))
+      throw BadInput("--initial-condition " + Quote(initial) + " must be zero, steady-state or estimate");
+    if (!log.empty() && options.intersample == identify::Intersample::kFoh)
+      throw BadInput("--intersample foh: a log's input u + n is held over each step by the plant (zoh)");
     if (!out.empty()) CheckOutputFile(out, "--out");
     if (!plot_path.empty()) CheckOutputFile(plot_path, "--plot");
     const identify::IdentifyData data = ReadData();

@@ -44,6 +44,30 @@ for k in range(1, n): tj.append(tj[-1] + dt * (1 + random.uniform(-0.3, 0.3)))
 with open('jitter.csv', 'w') as f:
     f.write('t,u,y\n')
     for k in range(n): f.write('%.17g,%.17g,%.17g\n' % (tj[k], u[k] + 1, y(tj[k], tj) + 3))
+# The same record cut in motion: from the first sample c >= 40 after which u
+# changes and before which it has held for more than the delay.
+c = next(c for c in range(40, n - 1) if len(set(u[c - 4:c + 1])) == 1 and u[c + 1] != u[c])
+with open('cut.csv', 'w') as f:
+    f.write('t,u,y\n')
+    for k in range(c, n): f.write('%.17g,%.17g,%.17g\n' % (k * dt, u[k] + 1, y(k * dt) + 3))
+PY
+# A smooth input (a sum of sines, as a sampled chirp) through P2D Kp = 2,
+# Tp1 = 1.5 s, Tp2 = 0.4 s, Td = 0.25 s with the input linear between samples:
+# scipy's lsim with interp=True (a first-order hold) on a 0.05 s grid where
+# the delay is 5 steps and the input is still linear.
+/usr/bin/python3 - <<'PY'
+import numpy as np
+from scipy import signal
+dt, n, fine = 0.1, 300, 2
+t = np.arange(n) * dt
+u = np.sin(0.7 * t) + 0.5 * np.sin(2.3 * t + 1.0) + 0.25 * np.sin(5.1 * t)
+t_fine = np.arange((n - 1) * fine + 1) * dt / fine
+du_fine = np.interp(t_fine, t, u - u[0])
+delayed = np.concatenate([np.zeros(5), du_fine[:-5]])
+_, y, _ = signal.lsim(signal.lti([2.0], np.polymul([1.5, 1.0], [0.4, 1.0])), delayed, t_fine, interp=True)
+with open('smooth.csv', 'w') as f:
+    f.write('t,u,y\n')
+    for k in range(n): f.write('%.17g,%.17g,%.17g\n' % (t[k], u[k] + 1, y[k * fine] + 3))
 PY
 
 # The commands of docs/identify.md's section, as written there (its ```bash block).
@@ -53,7 +77,7 @@ while IFS= read -r cmd; do
   (pidlab() { "$pidlab" "$@"; }; eval "$cmd") > docs.out 2>&1
   check "docs/identify.md: $cmd" "[ $? -eq 0 ]"
 done < <(awk '/^```bash/{on=1; next} /^```/{on=0} on && /^pidlab identify /' "$docs")
-check "docs/identify.md has 4 identify commands (found $n_docs)" "[ $n_docs -eq 4 ]"
+check "docs/identify.md has 6 identify commands (found $n_docs)" "[ $n_docs -eq 6 ]"
 pidlab() { "$pidlab" "$@"; }
 pidlab identify --csv step.csv --model p1d > table 2> err
 check "identify --csv step.csv --model p1d exits 0 with the table" \
@@ -182,6 +206,43 @@ PY"
 pidlab identify --csv step.csv --model p1d --json > uniform.json 2> err
 check "a uniform record's JSON says sampling {uniform true}" \
   "[ $? -eq 0 ] && /usr/bin/python3 -c \"import json; s = json.load(open('uniform.json'))['sampling']; assert s['uniform'] is True and abs(s['min_interval_s'] - 0.1) < 1e-12 and abs(s['max_interval_s'] - 0.1) < 1e-12, s\""
+
+# Intersample behaviour and the initial condition (docs/identify.md, "Intersample
+# behaviour and the initial condition").
+pidlab identify --csv smooth.csv --model p2d --intersample foh --json > foh.json 2> err
+check "--intersample foh recovers scipy's first-order-hold P2D within 1e-6, and says it" \
+  "[ $? -eq 0 ] && /usr/bin/python3 - foh.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j['intersample'] == 'foh' and j['initial_condition'] == 'zero', j
+for name, true in (('Kp', 2.0), ('Tp1', 1.5), ('Tp2', 0.4), ('Td', 0.25)):
+    assert abs(j['parameters'][name]['value'] - true) <= 1e-6 * true, (name, j['parameters'][name])
+PY"
+pidlab identify --csv smooth.csv --model p2d > table 2> err
+check "the same record held (zoh) is misfitted: fit below 99.99 %" \
+  "[ $? -eq 0 ] && awk '/^fit / { exit !(\$2 < 99.99) }' table"
+pidlab identify --csv cut.csv --model p1d --initial-condition estimate --json > cut.json 2> err
+check "--initial-condition estimate recovers P1D from a record cut in motion within 1e-6" \
+  "[ $? -eq 0 ] && /usr/bin/python3 - cut.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j['initial_condition'] == 'estimate' and len(j['initial_state']) == 1 and abs(j['initial_state'][0]) > 1e-3, j
+for name, true in (('Kp', 2.0), ('Tp1', 1.5), ('Td', 0.25)):
+    assert abs(j['parameters'][name]['value'] - true) <= 1e-6 * true, (name, j['parameters'][name])
+PY"
+pidlab identify --csv cut.csv --model p1d --initial-condition estimate > table 2> err
+check "the table says the hold and the initial condition" \
+  "[ $? -eq 0 ] && grep -q '^input zoh between samples, initial condition estimate$' table"
+for case in "--intersample linear|--intersample 'linear' must be zoh or foh" \
+            "--initial-condition rest|--initial-condition 'rest' must be zero, steady-state or estimate"; do
+  args=${case%%|*} needle=${case#*|}
+  "$pidlab" identify --csv step.csv --model p1d $args > out 2> err
+  check "identify $args exits 2 with one line naming it" "[ $? -eq 2 ] && only_line_ok err \"$needle\" && [ ! -s out ]"
+done
+
+pidlab identify --log missing.lcmlog --model p1d --intersample foh > out 2> err
+check "--intersample foh on a log exits 2: the plant holds its input" \
+  "[ $? -eq 2 ] && only_line_ok err \"--intersample foh: a log's input u + n is held\""
 
 # Bad input: exit 2, one line naming the flag, file, column, row or value.
 sed '1s/^u,t,note,y/u,time,note,y/' step.csv > nocolumn.csv

@@ -306,6 +306,20 @@ class Identify(unittest.TestCase):
         self.assertEqual(got["sampling"]["min_interval_s"], np.diff(t).min())
         self.assertEqual(got["sampling"]["max_interval_s"], np.diff(t).max())
 
+    def test_intersample_and_initial_condition_give_the_cli_json(self):
+        got = pidlab.identify(self.t, self.u, self.y, model="p1d", starts=3, intersample="foh",
+                              initial_condition="estimate")
+        want = cli("identify", "--csv", self.csv, "--model", "p1d", "--starts", "3", "--intersample", "foh",
+                   "--initial-condition", "estimate")
+        del want["source"]
+        self.assertEqual(got, want)
+        self.assertEqual((got["intersample"], got["initial_condition"], len(got["initial_state"])),
+                         ("foh", "estimate", 1))
+        with self.assertRaisesRegex(ValueError, "intersample = 'cubic'"):
+            pidlab.identify(self.t, self.u, self.y, intersample="cubic")
+        with self.assertRaisesRegex(ValueError, "initial_condition = 'rest'"):
+            pidlab.identify(self.t, self.u, self.y, initial_condition="rest")
+
     def test_lists_and_options_reach_the_fit(self):
         got = pidlab.identify(list(self.t), list(self.u), list(self.y), model="p1d", starts=3, seed=7, u0=0, y0=0)
         self.assertEqual((got["starts"] - got["arx_start"], got["seed"], got["u0"], got["y0"]), (3, 7, 0, 0))

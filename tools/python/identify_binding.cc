@@ -60,7 +60,8 @@ void TfShape(const std::string& model, const py::object& poles, const py::object
 
 py::object IdentifyPy(const py::object& t, const py::object& u, const py::object& y, const std::string& model,
                       int starts, std::uint64_t seed, const py::object& u0, const py::object& y0,
-                      const py::object& poles, const py::object& zeros) {
+                      const py::object& poles, const py::object& zeros, const std::string& intersample,
+                      const std::string& initial_condition) {
   identify::IdentifyData data{Column(t, "t"), Column(u, "u"), Column(y, "y")};
   identify::IdentifyOptions options;
   options.starts = starts;
@@ -68,6 +69,11 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
   options.u0 = OperatingPoint(u0, "u0");
   options.y0 = OperatingPoint(y0, "y0");
   TfShape(model, poles, zeros, &options);
+  if (!identify::ParseIntersample(intersample, &options.intersample))
+    throw py::value_error("identify: intersample = '" + intersample + "' must be 'zoh' or 'foh'");
+  if (!identify::ParseInitialCondition(initial_condition, &options.initial_condition))
+    throw py::value_error("identify: initial_condition = '" + initial_condition +
+                          "' must be 'zero', 'steady-state' or 'estimate'");
   if (starts < 1 || starts > 1000)
     throw py::value_error("identify: starts = " + std::to_string(starts) + " must be in [1, 1000]");
   Status status;
@@ -100,16 +106,20 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
 
 void DefineIdentify(py::module_& m) {
   m.def("identify", &IdentifyPy,
-        "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None, poles=None, zeros=None): fits a "
+        "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None, poles=None, zeros=None, "
+        "intersample='zoh', initial_condition='zero'): fits a "
         "process model (p1d, p2d, p2du, p1di, p2dz, or auto to choose among them by AIC) or a general "
         "transfer function (model='tf' with poles=N in 1..6 and zeros=M in 0..N-1, default 0) to the record "
         "t (s, uniform or not), u, y (lists or numpy arrays) and returns the dict of `pidlab identify "
         "--json`. u0, "
-        "y0: the operating point (None: u0 the first sample, y0 estimated with the model). Bad data or "
+        "y0: the operating point (None: u0 the first sample, y0 estimated with the model). intersample: "
+        "'zoh' (held) or 'foh' (linear between samples); initial_condition: 'zero', 'steady-state' or "
+        "'estimate', as the CLI's --intersample and --initial-condition. Bad data or "
         "arguments raise ValueError naming the reason (docs/identify.md).",
         py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",
         py::arg("starts") = 16, py::arg("seed") = 0, py::arg("u0") = py::none(), py::arg("y0") = py::none(),
-        py::arg("poles") = py::none(), py::arg("zeros") = py::none());
+        py::arg("poles") = py::none(), py::arg("zeros") = py::none(), py::arg("intersample") = "zoh",
+        py::arg("initial_condition") = "zero");
 }
 
 }  // namespace pidlab::python

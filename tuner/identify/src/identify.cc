@@ -20,9 +20,9 @@
 #include <stdexcept>
 
 #include "arx_start.h"
-#include "nonuniform.h"
 #include "pidlab/optim/sobol.h"
 #include "pidlab/plant_sim/discrete_plant.h"
+#include "piecewise_response.h"
 #include "tf_start.h"
 
 namespace pidlab::identify {
@@ -41,9 +41,13 @@ struct Record {
   int poles = 0, zeros = 0;  // TF only
   std::vector<double> du, dy;
   double dt_s = 0.0, length_s = 0.0, max_delay_s = 0.0;
-  /// Non-uniform sampling: the sample times, simulated interval by interval
-  /// (nonuniform.h); empty when uniform (DiscretePlant over dt_s, the mean).
+  /// The sample times. `piecewise`: simulated interval by interval
+  /// (piecewise_response.h; non-uniform sampling, a first-order hold or an
+  /// initial condition other than zero), else DiscretePlant over dt_s.
   std::vector<double> t;
+  bool piecewise = false;
+  Intersample hold = Intersample::kZoh;
+  InitialCondition initial = InitialCondition::kZero;
   /// The output offset is a parameter too: theta[p] is added to y0.
   bool offset = false;
 };
@@ -55,6 +59,12 @@ int ParameterCount(const Record& record) {
 int BlockSize(const Record& record) { return ParameterCount(record) + (record.offset ? 1 : 0); }
 double OffsetOf(const Record& record, const double* theta) {
   return record.offset ? theta[ParameterCount(record)] : 0.0;
+}
+
+// The initial state's entries fitted by projection (kEstimate): parameters
+// too, for the degrees of freedom and the AIC.
+int FittedStates(const Record& record, const ProcessModel& model) {
+  return record.initial == InitialCondition::kEstimate ? internal::ModelOrder(model) : 0;
 }
 
 // theta[i] is the logarithm of a time constant.
@@ -79,14 +89,35 @@ ProcessModel ModelOf(const Record& record, const double* theta) {
   return ModelFromValues(record.kind, values, record.poles, record.zeros);
 }
 
+// The response from the record's initial condition; with kEstimate and
+// `project`, the free response that best fits dy - offset added (its state
+// in *state).
+std::vector<double> Simulate(const ProcessModel& model, const Record& record, double offset, bool project,
+                             std::vector<double>* state) {
+  if (!record.piecewise) return SimulateModel(model, record.du, 0.0, record.dt_s);
+  internal::PiecewiseStart start;
+  start.input_before = record.initial == InitialCondition::kZero ? 0.0 : record.du[0];
+  if (record.initial == InitialCondition::kSteadyState &&
+      !internal::SteadyState(model, record.du[0], &start.state))
+    throw std::invalid_argument("no steady state");
+  std::vector<double> yhat = internal::SimulatePiecewise(model, record.t, record.du, record.hold, start);
+  if (record.initial == InitialCondition::kEstimate && project) {
+    std::vector<double> target(record.dy);
+    for (double& v : target) v -= offset;
+    start.state = internal::FitInitialState(model, record.t, record.hold, target, &yhat);
+  }
+  if (state) *state = start.state;
+  return yhat;
+}
+
 // yhat of the model, false if it is not a valid plant or diverges (or, for
-// a TF, not admissible: tf_start.h).
-bool TrySimulate(const ProcessModel& model, const Record& record, std::vector<double>* yhat) {
+// a TF, not admissible: tf_start.h). `offset`, `project`, `state`: Simulate's.
+bool TrySimulate(const ProcessModel& model, const Record& record, std::vector<double>* yhat,
+                 double offset = 0.0, bool project = true, std::vector<double>* state = nullptr) {
   if (model.kind == ProcessModelKind::kTf && !internal::TfDenominatorIsAdmissible(model.a, record.dt_s))
     return false;
   try {
-    *yhat = record.t.empty() ? SimulateModel(model, record.du, 0.0, record.dt_s)
-                             : internal::SimulateNonUniform(model, record.t, record.du);
+    *yhat = Simulate(model, record, offset, project, state);
   } catch (const std::exception&) {
     return false;
   }
@@ -99,8 +130,8 @@ struct OutputError {
   const Record* record;
   bool operator()(double const* const* parameters, double* residuals) const {
     std::vector<double> yhat;
-    if (!TrySimulate(ModelOf(*record, parameters[0]), *record, &yhat)) return false;
     const double offset = OffsetOf(*record, parameters[0]);
+    if (!TrySimulate(ModelOf(*record, parameters[0]), *record, &yhat, offset)) return false;
     for (std::size_t k = 0; k < yhat.size(); ++k) residuals[k] = record->dy[k] - offset - yhat[k];
     return true;
   }
@@ -143,7 +174,8 @@ void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
   (*theta)[0] = 1.0;
   if (record.offset) (*theta)[static_cast<std::size_t>(p)] = 0.0;
   std::vector<double> g;
-  if (!TrySimulate(ModelOf(record, theta->data()), record, &g)) return;
+  // Without the estimated initial state's projection, which is not linear in Kp.
+  if (!TrySimulate(ModelOf(record, theta->data()), record, &g, 0.0, false)) return;
   // dy ~ Kp g + offset: the normal equations of one or two unknowns.
   const double n = static_cast<double>(g.size());
   double gy = 0.0, gg = 0.0, sg = 0.0, sy = 0.0;
@@ -204,9 +236,9 @@ std::vector<double> StartPoint(const Record& record, const optim::SobolSequence&
 double ScreenCost(const Record& record, std::vector<double>* theta) {
   SetGainByLeastSquares(record, theta);
   std::vector<double> yhat;
-  if (!TrySimulate(ModelOf(record, theta->data()), record, &yhat))
-    return std::numeric_limits<double>::infinity();
   const double offset = OffsetOf(record, theta->data());
+  if (!TrySimulate(ModelOf(record, theta->data()), record, &yhat, offset))
+    return std::numeric_limits<double>::infinity();
   double cost = 0.0;
   for (std::size_t k = 0; k < yhat.size(); ++k)
     cost += 0.5 * (record.dy[k] - offset - yhat[k]) * (record.dy[k] - offset - yhat[k]);
@@ -311,7 +343,8 @@ bool Covariance(const Record& record, std::vector<double> theta, double cost, st
   for (int i = 0; i < p; ++i)
     for (int j = 0; j < p; ++j)
       c[static_cast<std::size_t>(i * p + j)] = full[static_cast<std::size_t>(i * q + j)];
-  const double variance = 2.0 * cost / std::max(1, n - q);
+  const double variance =
+      2.0 * cost / std::max(1, n - q - FittedStates(record, ModelOf(record, theta.data())));
   if (record.offset)
     *offset_error = std::sqrt(std::max(0.0, full[static_cast<std::size_t>(q * q - 1)] * variance));
   const ProcessModel model = ModelOf(record, theta.data());
@@ -338,61 +371,6 @@ std::string Number(double v) {
 }
 
 }  // namespace
-
-bool IdentifyOptions::IsValid(std::string* error) const {
-  std::string e;
-  if (starts < 1)
-    e = "starts = " + std::to_string(starts) + " must be at least 1";
-  else if (!(max_delay_fraction > 0.0 && max_delay_fraction < 1.0))
-    e = "max_delay_fraction = " + Number(max_delay_fraction) + " must be in (0, 1)";
-  else if (max_iterations < 1)
-    e = "max_iterations = " + std::to_string(max_iterations) + " must be at least 1";
-  else if (std::isinf(u0) || std::isinf(y0))
-    e = "u0 and y0 must be finite, or NaN for the first sample";
-  if (error) *error = e;
-  return e.empty();
-}
-
-Status CheckData(const IdentifyData& data, Sampling* sampling) {
-  const std::size_t n = data.t.size();
-  if (data.u.size() != n || data.y.size() != n)
-    return Status::InvalidInput("t, u and y have different lengths (" + std::to_string(n) + ", " +
-                                std::to_string(data.u.size()) + ", " + std::to_string(data.y.size()) + ")");
-  if (n < kMinSamples)
-    return Status::InvalidInput("too short: " + std::to_string(n) + " samples, at least " +
-                                std::to_string(kMinSamples) + " needed");
-  for (std::size_t k = 0; k < n; ++k) {
-    const char* name = !std::isfinite(data.t[k])   ? "t"
-                       : !std::isfinite(data.u[k]) ? "u"
-                       : !std::isfinite(data.y[k]) ? "y"
-                                                   : nullptr;
-    if (name)
-      return Status::InvalidInput(std::string("not finite: ") + name + " at sample " + std::to_string(k) +
-                                  " is " +
-                                  Number(std::string(name) == "t"   ? data.t[k]
-                                         : std::string(name) == "u" ? data.u[k]
-                                                                    : data.y[k]));
-  }
-  for (std::size_t k = 1; k < n; ++k)
-    if (!(data.t[k] > data.t[k - 1]))
-      return Status::InvalidInput("t is not strictly increasing: t = " + Number(data.t[k]) + " at sample " +
-                                  std::to_string(k) + " after " + Number(data.t[k - 1]));
-  Sampling found;
-  found.mean_interval_s = (data.t[n - 1] - data.t[0]) / static_cast<double>(n - 1);
-  found.min_interval_s = found.max_interval_s = data.t[1] - data.t[0];
-  for (std::size_t k = 1; k < n; ++k) {
-    const double h = data.t[k] - data.t[k - 1];
-    found.min_interval_s = std::min(found.min_interval_s, h);
-    found.max_interval_s = std::max(found.max_interval_s, h);
-    if (std::abs(h - found.mean_interval_s) > kUniformSamplingTolerance * found.mean_interval_s)
-      found.uniform = false;
-  }
-  if (std::all_of(data.u.begin(), data.u.end(), [&](double v) { return v == data.u[0]; }))
-    return Status::InvalidInput("constant input: u is " + Number(data.u[0]) +
-                                " throughout, so nothing can be identified");
-  *sampling = found;
-  return Status::Ok();
-}
 
 std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<double>& u, double u0,
                                   double dt_s) {
@@ -480,14 +458,18 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
   double spread = 0.0;
   for (double v : data.y) spread += (v - mean) * (v - mean);
   result->fit_percent = 100.0 * (1.0 - std::sqrt(2.0 * cost) / std::sqrt(spread));
-  result->aic = n * std::log(2.0 * cost / n) + 2.0 * BlockSize(record);
+  result->aic =
+      n * std::log(2.0 * cost / n) + 2.0 * (BlockSize(record) + FittedStates(record, result->model));
   const double offset = OffsetOf(record, theta.data());
   result->y0 += offset;
   result->y0_estimated = record.offset;
   result->covariance_ok = Covariance(record, theta, cost, &result->standard_errors, &result->covariance,
                                      &result->y0_standard_error, &result->covariance_message);
   std::vector<double> yhat;
-  if (TrySimulate(result->model, record, &yhat)) {
+  result->initial_state.assign(static_cast<std::size_t>(internal::ModelOrder(result->model)), 0.0);
+  if (TrySimulate(result->model, record, &yhat, offset, true, &result->initial_state)) {
+    if (result->initial_state.empty())
+      result->initial_state.assign(static_cast<std::size_t>(internal::ModelOrder(result->model)), 0.0);
     for (std::size_t k = 0; k < yhat.size(); ++k) {
       result->simulated.push_back(result->y0 + yhat[k]);
       result->residuals.push_back(record.dy[k] - offset - yhat[k]);
@@ -513,9 +495,15 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   const Status status = CheckData(data, &sampling);
   if (!status.ok()) return status;
   record.dt_s = sampling.mean_interval_s;
-  if (!sampling.uniform) record.t = data.t;
+  record.t = data.t;
+  record.hold = options.intersample;
+  record.initial = options.initial_condition;
+  record.piecewise =
+      !sampling.uniform || record.hold == Intersample::kFoh || record.initial != InitialCondition::kZero;
   *result = IdentifyResult{};
   result->sampling = sampling;
+  result->intersample = options.intersample;
+  result->initial_condition = options.initial_condition;
   result->u0 = std::isnan(options.u0) ? data.u[0] : options.u0;
   // Not given: estimated, from the first sample as its start.
   result->y0 = std::isnan(options.y0) ? data.y[0] : options.y0;
@@ -524,6 +512,11 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
     record.du.push_back(data.u[k] - result->u0);
     record.dy.push_back(data.y[k] - result->y0);
   }
+  if (record.initial == InitialCondition::kSteadyState && kind == ProcessModelKind::kP1DI &&
+      record.du[0] != 0.0)
+    return Status::InvalidInput(
+        "initial condition steady-state: P1DI integrates, so it has no steady state at u[0] = " +
+        Number(data.u[0]) + " unless u0 is that value too (u0 = " + Number(result->u0) + ")");
   record.length_s = data.t.back() - data.t.front();
   record.max_delay_s = options.max_delay_fraction * record.length_s;
   std::vector<double> theta = MultiStart(record, options, &result->start_costs, &result->arx_start);

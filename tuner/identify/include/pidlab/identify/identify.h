@@ -1,11 +1,11 @@
 #pragma once
 // A process model (process_model.h) fitted to one record of sampled input
 // and output by least squares on the output error: the residuals are
-// y_k - y0 - yhat_k, with yhat the exact zero-order-hold response of the
+// y_k - y0 - yhat_k, with yhat the exact zero-order-hold (or first-order-hold) response of the
 // model, its delay included and fractional (DiscretePlant(tf, dt, Td), or on
 // a non-uniform grid the same response interval by interval), to u - u0
-// from a zero state. Ceres fits from several starts and keeps the
-// best. docs/identify.md, "Identifying a model from a CSV".
+// from a zero state (or a steady or estimated one: InitialCondition). Ceres fits from several starts and
+// keeps the best. docs/identify.md, "Identifying a model from a CSV".
 
 #include <cstdint>
 #include <limits>
@@ -42,6 +42,23 @@ inline constexpr std::size_t kMinSamples = 20;
 /// written with ten significant digits keeps).
 inline constexpr double kUniformSamplingTolerance = 1e-6;
 
+/// How the input behaves between samples (MATLAB's iddata InterSample):
+/// held (ZOH, what a sampled controller or the trio's plant does), or linear
+/// from one sample to the next (FOH, for an input that was continuous, such
+/// as a sampled chirp).
+enum class Intersample { kZoh, kFoh };
+/// The model's state when the record starts. kZero: at rest at the operating
+/// point (x = 0, the input before t[0] at u0). kSteadyState: at rest with the
+/// first input sample u[0] applied since long before (the same as kZero when
+/// u0 = u[0], the default). kEstimate: any state, fitted with the model (the
+/// least-squares combination of its free responses for every parameter
+/// vector), the input before t[0] at u[0]: a record cut from a run in motion.
+enum class InitialCondition { kZero, kSteadyState, kEstimate };
+bool ParseIntersample(const std::string& s, Intersample* v);
+bool ParseInitialCondition(const std::string& s, InitialCondition* v);
+std::string ToString(Intersample v);       // "zoh", "foh"
+std::string ToString(InitialCondition v);  // "zero", "steady-state", "estimate"
+
 struct IdentifyOptions {
   /// Starts of the multi-start design (Sobol' points over the time constants,
   /// Zeta and the delay, optim/sobol.h), >= 1.
@@ -67,6 +84,8 @@ struct IdentifyOptions {
   /// both 0 for every other kind (Identify refuses them otherwise).
   int poles = 0;
   int zeros = 0;
+  Intersample intersample = Intersample::kZoh;
+  InitialCondition initial_condition = InitialCondition::kZero;
 
   /// Names the field, its value and the rule on failure.
   bool IsValid(std::string* error) const;
@@ -108,8 +127,14 @@ struct IdentifyResult {
   double u0 = 0.0, y0 = 0.0;       // the operating point used
   bool y0_estimated = false;       // y0 was a parameter of the fit
   double y0_standard_error = std::numeric_limits<double>::quiet_NaN();  // if estimated
-  double dt_s = 0.0;                // the sampling interval found (the mean one)
-  Sampling sampling;                // uniform or not, the shortest and longest interval
+  double dt_s = 0.0;  // the sampling interval found (the mean one)
+  Sampling sampling;  // uniform or not, the shortest and longest interval
+  Intersample intersample = Intersample::kZoh;
+  InitialCondition initial_condition = InitialCondition::kZero;
+  /// x(t[0]) the fit used, in the coordinates of plant_sim::Realize(model's
+  /// transfer function): fitted with kEstimate, -A^-1 B (u[0] - u0) with
+  /// kSteadyState, zeros with kZero.
+  std::vector<double> initial_state;
   int samples = 0;                  // N
   int starts = 0;                   // starts run: the design's, plus the ARX start if used
   bool arx_start = false;           // start_costs[0] is the ARX start
