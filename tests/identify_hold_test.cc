@@ -239,5 +239,71 @@ TEST(InitialCondition, NamesParseAndPrintBack) {
   EXPECT_FALSE(ParseInitialCondition("rest", &v));
 }
 
+// Kp e^(-Td s) / (s (1 + T s)) from rest, its input held (ZOH): y = Kp times
+// the integral of the unit lag x, both exact between events (for a constant
+// a over h: the integral grows by a h + (x - a) T (1 - e^(-h/T))).
+std::vector<double> IntegratingResponse(double kp, double lag, double td, const std::vector<double>& t,
+                                        const std::vector<double>& u) {
+  const HeldInput input{t, u, false, 0.0};
+  std::vector<double> events(t);
+  for (double tj : t) events.push_back(tj + td);
+  std::sort(events.begin(), events.end());
+  std::vector<double> out;
+  double x = 0.0, integral = 0.0;
+  std::size_t k = 0;
+  for (std::size_t e = 0; e < events.size() && k < t.size(); ++e) {
+    if (events[e] == t[k]) out.push_back(kp * integral), ++k;
+    if (k == t.size() || e + 1 == events.size()) break;
+    const double h = events[e + 1] - events[e];
+    if (h == 0.0) continue;
+    const double a = input.At(events[e] - td, events[e] + 0.5 * h - td).first;
+    const double decay = std::exp(-h / lag);
+    integral += a * h + (x - a) * lag * (1.0 - decay);
+    x = a + (x - a) * decay;
+  }
+  return out;
+}
+
+TEST(Offsets, AnIntegratorsInputBiasIsEstimated) {
+  // The actuator's true zero is 0.3 below the recorded u: a ramp the fit must
+  // explain by u0 (y0 given).
+  const std::vector<double> t = UniformTimes(300);
+  const std::vector<double> u = StepRichInput(t.size(), 5);
+  std::vector<double> biased(u);
+  for (double& v : biased) v -= 0.3;
+  const std::vector<double> y = IntegratingResponse(0.8, 1.2, 0.37, t, biased);
+  IdentifyOptions options;
+  options.y0 = 0.0;
+  options.estimate_u0 = true;
+  IdentifyResult dut;
+  ASSERT_TRUE(Identify({t, u, y}, ProcessModelKind::kP1DI, options, &dut).ok());
+  EXPECT_TRUE(dut.u0_estimated);
+  EXPECT_NEAR(dut.u0, 0.3, 1e-6);
+  EXPECT_TRUE(std::isfinite(dut.u0_standard_error));
+  ExpectRecovered(dut, {0.8, 1.2, 0.37});
+  options.estimate_u0 = false;
+  IdentifyResult given;
+  ASSERT_TRUE(Identify({t, u, y}, ProcessModelKind::kP1DI, options, &given).ok());
+  EXPECT_LT(given.fit_percent, 99.0);
+}
+
+TEST(Offsets, ANonIntegratingModelsInputOffsetIsSeenInTheFirstTransient) {
+  // At rest at u0 = 0.4 before t_0, the record's first sample already 0.9:
+  // the step at t_0 shows u0 (y0 given).
+  const std::vector<double> t = UniformTimes(300);
+  std::vector<double> u = StepRichInput(t.size(), 5);
+  for (std::size_t k = 0; k < 5; ++k) u[k] = 0.9;
+  std::vector<double> du(u);
+  for (double& v : du) v -= 0.4;
+  const std::vector<double> y = Response(2.5, 3.1, 0.0, 0.37, HeldInput{t, du, false, 0.0});
+  IdentifyOptions options;
+  options.y0 = 0.0;
+  options.estimate_u0 = true;
+  IdentifyResult dut;
+  ASSERT_TRUE(Identify({t, u, y}, ProcessModelKind::kP1D, options, &dut).ok());
+  EXPECT_NEAR(dut.u0, 0.4, 1e-6);
+  ExpectRecovered(dut, {2.5, 3.1, 0.37});
+}
+
 }  // namespace
 }  // namespace pidlab::identify

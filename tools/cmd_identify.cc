@@ -77,7 +77,8 @@ std::string Table(const IdentifyResult& r) {
      << Num(r.cost, 4) << "\n"
      << r.samples << " samples at dt " << Num(r.dt_s) << " s, offsets u0 " << Num(r.u0) << ", y0 "
      << Num(r.y0)
-     << (r.y0_estimated ? " (estimated, standard error " + Num(r.y0_standard_error, 3) + ")" : "") << "\n"
+     << (r.y0_estimated ? " (estimated, standard error " + Num(r.y0_standard_error, 3) + ")" : "")
+     << (r.u0_estimated ? ", u0 estimated (standard error " + Num(r.u0_standard_error, 3) + ")" : "") << "\n"
      << (r.sampling.uniform
              ? ""
              : "sampling is non-uniform (intervals " + Num(r.sampling.min_interval_s) + " to " +
@@ -112,7 +113,7 @@ std::string WhitenessLine(const identify::Whiteness& w) {
 
 struct IdentifyCommand {
   std::string csv, log, model, out, plot_path;
-  std::string intersample = "zoh", initial = "zero";
+  std::string intersample = "zoh", initial = "zero", u0_text;
   CLI::Option* poles_option = nullptr;
   CLI::Option* zeros_option = nullptr;
   std::vector<long> episode;
@@ -146,8 +147,9 @@ struct IdentifyCommand {
     app->add_option("--seed", options.seed,
                     "digital shift of the starts' Sobol' design (0: the unshifted sequence)")
         ->capture_default_str();
-    app->add_option("--u0", options.u0,
-                    "the input's operating point (default: the first sample of u; a log's: 0)");
+    app->add_option("--u0", u0_text,
+                    "the input's operating point: a number, or 'estimate' (fitted with the model, from the "
+                    "default as its start); default: the first sample of u; a log's: 0");
     app->add_option("--y0", options.y0,
                     "the output's operating point (default: estimated with the model; a log's: 0)");
     app->add_option("--intersample", intersample,
@@ -236,6 +238,23 @@ struct IdentifyCommand {
                      std::to_string(options.poles) + ")");
   }
 
+  // --u0: a finite number, or 'estimate'.
+  void ParseU0() {
+    if (u0_text.empty()) return;
+    if (u0_text == "estimate") {
+      options.estimate_u0 = true;
+      return;
+    }
+    std::size_t used = 0;
+    try {
+      options.u0 = std::stod(u0_text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != u0_text.size() || !std::isfinite(options.u0))
+      throw BadInput("--u0 " + Quote(u0_text) + " must be a finite number or 'estimate'");
+  }
+
   std::string Source() const { return !csv.empty() ? "--csv " + Quote(csv) : "--log " + Quote(log); }
 
   int Run() {
@@ -249,8 +268,7 @@ struct IdentifyCommand {
     CheckTfShape(kind, automatic);
     if (options.starts < 1 || options.starts > 1000)
       throw BadInput("--starts " + std::to_string(options.starts) + " must be in [1, 1000]");
-    if (!std::isnan(options.u0) && !std::isfinite(options.u0))
-      throw BadInput("--u0 " + Num(options.u0) + " must be finite");
+    ParseU0();
     if (!std::isnan(options.y0) && !std::isfinite(options.y0))
       throw BadInput("--y0 " + Num(options.y0) + " must be finite");
     if (!identify::ParseIntersample(intersample, &options.intersample))

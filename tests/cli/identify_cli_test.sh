@@ -240,6 +240,11 @@ for case in "--intersample linear|--intersample 'linear' must be zoh or foh" \
   check "identify $args exits 2 with one line naming it" "[ $? -eq 2 ] && only_line_ok err \"$needle\" && [ ! -s out ]"
 done
 
+pidlab identify --csv step.csv --model p1d --u0 estimate --y0 3 --json > u0.json 2> err
+check "--u0 estimate --y0 3 fits u0 = 1 (the record's rest) with the model, and says it" \
+  "[ $? -eq 0 ] && /usr/bin/python3 -c \"import json; j = json.load(open('u0.json')); assert j['u0_estimated'] is True and abs(j['u0'] - 1) < 1e-6 and j['u0_standard_error'] is not None and abs(j['parameters']['Kp']['value'] - 2) < 2e-6, j\""
+"$pidlab" identify --csv step.csv --model p1d --u0 abc > out 2> err
+check "--u0 abc exits 2 with one line naming it" "[ $? -eq 2 ] && only_line_ok err \"--u0 'abc' must be a finite number or 'estimate'\""
 pidlab identify --log missing.lcmlog --model p1d --intersample foh > out 2> err
 check "--intersample foh on a log exits 2: the plant holds its input" \
   "[ $? -eq 2 ] && only_line_ok err \"--intersample foh: a log's input u + n is held\""

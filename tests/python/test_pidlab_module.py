@@ -315,6 +315,13 @@ class Identify(unittest.TestCase):
         self.assertEqual(got, want)
         self.assertEqual((got["intersample"], got["initial_condition"], len(got["initial_state"])),
                          ("foh", "estimate", 1))
+        got = pidlab.identify(self.t, self.u, self.y, model="p1d", starts=3, u0="estimate", y0=0)
+        want = cli("identify", "--csv", self.csv, "--model", "p1d", "--starts", "3", "--u0", "estimate", "--y0", "0")
+        del want["source"]
+        self.assertEqual(got, want)
+        self.assertTrue(got["u0_estimated"])
+        with self.assertRaisesRegex(ValueError, "u0 = 'guess'"):
+            pidlab.identify(self.t, self.u, self.y, u0="guess")
         with self.assertRaisesRegex(ValueError, "intersample = 'cubic'"):
             pidlab.identify(self.t, self.u, self.y, intersample="cubic")
         with self.assertRaisesRegex(ValueError, "initial_condition = 'rest'"):

@@ -66,7 +66,14 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
   identify::IdentifyOptions options;
   options.starts = starts;
   options.seed = seed;
-  options.u0 = OperatingPoint(u0, "u0");
+  if (py::isinstance<py::str>(u0)) {
+    if (u0.cast<std::string>() != "estimate")
+      throw py::value_error("identify: u0 = '" + u0.cast<std::string>() +
+                            "' must be a number, None or 'estimate'");
+    options.estimate_u0 = true;
+  } else {
+    options.u0 = OperatingPoint(u0, "u0");
+  }
   options.y0 = OperatingPoint(y0, "y0");
   TfShape(model, poles, zeros, &options);
   if (!identify::ParseIntersample(intersample, &options.intersample))
@@ -112,7 +119,8 @@ void DefineIdentify(py::module_& m) {
         "transfer function (model='tf' with poles=N in 1..6 and zeros=M in 0..N-1, default 0) to the record "
         "t (s, uniform or not), u, y (lists or numpy arrays) and returns the dict of `pidlab identify "
         "--json`. u0, "
-        "y0: the operating point (None: u0 the first sample, y0 estimated with the model). intersample: "
+        "y0: the operating point (None: u0 the first sample, y0 estimated with the model; u0='estimate': "
+        "fitted too). intersample: "
         "'zoh' (held) or 'foh' (linear between samples); initial_condition: 'zero', 'steady-state' or "
         "'estimate', as the CLI's --intersample and --initial-condition. Bad data or "
         "arguments raise ValueError naming the reason (docs/identify.md).",

@@ -81,6 +81,8 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
       {"y0", JsonNumber(r.y0)},
       {"y0_estimated", r.y0_estimated},
       {"y0_standard_error", JsonNumber(r.y0_standard_error)},
+      {"u0_estimated", r.u0_estimated},
+      {"u0_standard_error", JsonNumber(r.u0_standard_error)},
       {"starts", r.starts},
       {"starts_at_best", r.starts_at_best},
       {"seed", r.seed},

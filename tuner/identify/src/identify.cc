@@ -50,13 +50,22 @@ struct Record {
   InitialCondition initial = InitialCondition::kZero;
   /// The output offset is a parameter too: theta[p] is added to y0.
   bool offset = false;
+  /// The input offset is a parameter too (after the output offset, if any):
+  /// it is added to u0, so the model's input is du - it.
+  bool input_offset = false;
 };
 
 int ParameterCount(const Record& record) {
   return static_cast<int>(ParameterNames(record.kind, record.poles, record.zeros).size());
 }
 // Ceres's parameter block: the model's parameters, then the offset if estimated.
-int BlockSize(const Record& record) { return ParameterCount(record) + (record.offset ? 1 : 0); }
+int BlockSize(const Record& record) {
+  return ParameterCount(record) + (record.offset ? 1 : 0) + (record.input_offset ? 1 : 0);
+}
+int InputOffsetIndex(const Record& record) { return ParameterCount(record) + (record.offset ? 1 : 0); }
+double InputOffsetOf(const Record& record, const double* theta) {
+  return record.input_offset ? theta[InputOffsetIndex(record)] : 0.0;
+}
 double OffsetOf(const Record& record, const double* theta) {
   return record.offset ? theta[ParameterCount(record)] : 0.0;
 }
@@ -92,15 +101,17 @@ ProcessModel ModelOf(const Record& record, const double* theta) {
 // The response from the record's initial condition; with kEstimate and
 // `project`, the free response that best fits dy - offset added (its state
 // in *state).
-std::vector<double> Simulate(const ProcessModel& model, const Record& record, double offset, bool project,
-                             std::vector<double>* state) {
-  if (!record.piecewise) return SimulateModel(model, record.du, 0.0, record.dt_s);
+std::vector<double> Simulate(const ProcessModel& model, const Record& record, double offset,
+                             double input_shift, bool project, std::vector<double>* state) {
+  if (!record.piecewise) return SimulateModel(model, record.du, input_shift, record.dt_s);
+  std::vector<double> du(record.du);
+  if (input_shift != 0.0)
+    for (double& v : du) v -= input_shift;
   internal::PiecewiseStart start;
-  start.input_before = record.initial == InitialCondition::kZero ? 0.0 : record.du[0];
-  if (record.initial == InitialCondition::kSteadyState &&
-      !internal::SteadyState(model, record.du[0], &start.state))
+  start.input_before = record.initial == InitialCondition::kZero ? 0.0 : du[0];
+  if (record.initial == InitialCondition::kSteadyState && !internal::SteadyState(model, du[0], &start.state))
     throw std::invalid_argument("no steady state");
-  std::vector<double> yhat = internal::SimulatePiecewise(model, record.t, record.du, record.hold, start);
+  std::vector<double> yhat = internal::SimulatePiecewise(model, record.t, du, record.hold, start);
   if (record.initial == InitialCondition::kEstimate && project) {
     std::vector<double> target(record.dy);
     for (double& v : target) v -= offset;
@@ -113,11 +124,12 @@ std::vector<double> Simulate(const ProcessModel& model, const Record& record, do
 // yhat of the model, false if it is not a valid plant or diverges (or, for
 // a TF, not admissible: tf_start.h). `offset`, `project`, `state`: Simulate's.
 bool TrySimulate(const ProcessModel& model, const Record& record, std::vector<double>* yhat,
-                 double offset = 0.0, bool project = true, std::vector<double>* state = nullptr) {
+                 double offset = 0.0, double input_shift = 0.0, bool project = true,
+                 std::vector<double>* state = nullptr) {
   if (model.kind == ProcessModelKind::kTf && !internal::TfDenominatorIsAdmissible(model.a, record.dt_s))
     return false;
   try {
-    *yhat = Simulate(model, record, offset, project, state);
+    *yhat = Simulate(model, record, offset, input_shift, project, state);
   } catch (const std::exception&) {
     return false;
   }
@@ -131,7 +143,9 @@ struct OutputError {
   bool operator()(double const* const* parameters, double* residuals) const {
     std::vector<double> yhat;
     const double offset = OffsetOf(*record, parameters[0]);
-    if (!TrySimulate(ModelOf(*record, parameters[0]), *record, &yhat, offset)) return false;
+    if (!TrySimulate(ModelOf(*record, parameters[0]), *record, &yhat, offset,
+                     InputOffsetOf(*record, parameters[0])))
+      return false;
     for (std::size_t k = 0; k < yhat.size(); ++k) residuals[k] = record->dy[k] - offset - yhat[k];
     return true;
   }
@@ -175,7 +189,9 @@ void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
   if (record.offset) (*theta)[static_cast<std::size_t>(p)] = 0.0;
   std::vector<double> g;
   // Without the estimated initial state's projection, which is not linear in Kp.
-  if (!TrySimulate(ModelOf(record, theta->data()), record, &g, 0.0, false)) return;
+  if (!TrySimulate(ModelOf(record, theta->data()), record, &g, 0.0, InputOffsetOf(record, theta->data()),
+                   false))
+    return;
   // dy ~ Kp g + offset: the normal equations of one or two unknowns.
   const double n = static_cast<double>(g.size());
   double gy = 0.0, gg = 0.0, sg = 0.0, sy = 0.0;
@@ -237,7 +253,8 @@ double ScreenCost(const Record& record, std::vector<double>* theta) {
   SetGainByLeastSquares(record, theta);
   std::vector<double> yhat;
   const double offset = OffsetOf(record, theta->data());
-  if (!TrySimulate(ModelOf(record, theta->data()), record, &yhat, offset))
+  if (!TrySimulate(ModelOf(record, theta->data()), record, &yhat, offset,
+                   InputOffsetOf(record, theta->data())))
     return std::numeric_limits<double>::infinity();
   double cost = 0.0;
   for (std::size_t k = 0; k < yhat.size(); ++k)
@@ -311,10 +328,11 @@ double FitFrom(const Record& record, const IdentifyOptions& options, std::vector
 // p x p, row-major) and their standard errors, scaled by the residual
 // variance; false with the reason if Ceres cannot invert J'J.
 bool Covariance(const Record& record, std::vector<double> theta, double cost, std::vector<double>* errors,
-                std::vector<double>* matrix, double* offset_error, std::string* message) {
+                std::vector<double>* matrix, double* offset_error, double* input_offset_error,
+                std::string* message) {
   const int p = ParameterCount(record);
   const int q = BlockSize(record);
-  *offset_error = kNaN;
+  *offset_error = *input_offset_error = kNaN;
   const int n = static_cast<int>(record.dy.size());
   errors->assign(static_cast<std::size_t>(p), kNaN);
   matrix->assign(static_cast<std::size_t>(p * p), kNaN);
@@ -346,7 +364,11 @@ bool Covariance(const Record& record, std::vector<double> theta, double cost, st
   const double variance =
       2.0 * cost / std::max(1, n - q - FittedStates(record, ModelOf(record, theta.data())));
   if (record.offset)
-    *offset_error = std::sqrt(std::max(0.0, full[static_cast<std::size_t>(q * q - 1)] * variance));
+    *offset_error = std::sqrt(std::max(0.0, full[static_cast<std::size_t>(p * q + p)] * variance));
+  if (record.input_offset) {
+    const int i = InputOffsetIndex(record);
+    *input_offset_error = std::sqrt(std::max(0.0, full[static_cast<std::size_t>(i * q + i)] * variance));
+  }
   const ProcessModel model = ModelOf(record, theta.data());
   const std::vector<double> values = ParameterValues(model);
   // d value / d theta: the value for a logarithm, else 1.
@@ -463,11 +485,15 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
   const double offset = OffsetOf(record, theta.data());
   result->y0 += offset;
   result->y0_estimated = record.offset;
-  result->covariance_ok = Covariance(record, theta, cost, &result->standard_errors, &result->covariance,
-                                     &result->y0_standard_error, &result->covariance_message);
+  result->u0 += InputOffsetOf(record, theta.data());
+  result->u0_estimated = record.input_offset;
+  result->covariance_ok =
+      Covariance(record, theta, cost, &result->standard_errors, &result->covariance,
+                 &result->y0_standard_error, &result->u0_standard_error, &result->covariance_message);
   std::vector<double> yhat;
   result->initial_state.assign(static_cast<std::size_t>(internal::ModelOrder(result->model)), 0.0);
-  if (TrySimulate(result->model, record, &yhat, offset, true, &result->initial_state)) {
+  if (TrySimulate(result->model, record, &yhat, offset, InputOffsetOf(record, theta.data()), true,
+                  &result->initial_state)) {
     if (result->initial_state.empty())
       result->initial_state.assign(static_cast<std::size_t>(internal::ModelOrder(result->model)), 0.0);
     for (std::size_t k = 0; k < yhat.size(); ++k) {
@@ -508,6 +534,7 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   // Not given: estimated, from the first sample as its start.
   result->y0 = std::isnan(options.y0) ? data.y[0] : options.y0;
   record.offset = std::isnan(options.y0);
+  record.input_offset = options.estimate_u0;
   for (std::size_t k = 0; k < data.u.size(); ++k) {
     record.du.push_back(data.u[k] - result->u0);
     record.dy.push_back(data.y[k] - result->y0);

@@ -80,6 +80,11 @@ struct IdentifyOptions {
   /// sample does not shift every residual.
   double u0 = std::numeric_limits<double>::quiet_NaN();
   double y0 = std::numeric_limits<double>::quiet_NaN();
+  /// Also estimate u0 (MATLAB's InputOffset 'estimate'), from u0 (or the
+  /// first sample) as its start: for an integrating model the input's bias
+  /// is seen as a ramp; for the others it is seen in the transient of a
+  /// record that does not start at rest at u0.
+  bool estimate_u0 = false;
   /// The kind TF's numbers of poles (1..kMaxTfPoles) and zeros (0..poles-1);
   /// both 0 for every other kind (Identify refuses them otherwise).
   int poles = 0;
@@ -127,6 +132,8 @@ struct IdentifyResult {
   double u0 = 0.0, y0 = 0.0;       // the operating point used
   bool y0_estimated = false;       // y0 was a parameter of the fit
   double y0_standard_error = std::numeric_limits<double>::quiet_NaN();  // if estimated
+  bool u0_estimated = false;                                            // u0 was a parameter of the fit
+  double u0_standard_error = std::numeric_limits<double>::quiet_NaN();  // if estimated
   double dt_s = 0.0;  // the sampling interval found (the mean one)
   Sampling sampling;  // uniform or not, the shortest and longest interval
   Intersample intersample = Intersample::kZoh;
