@@ -39,6 +39,7 @@ const Command kCommands[] = {
     {"replay", "read an LCM log: episodes, IAE, completeness, --redrive", pidlab::cli::RegisterReplay},
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
     {"report", "regenerate the paper's tables and figures (report.md + PNGs)", pidlab::cli::RegisterReport},
+    {"serve", "the tuning workbench in the browser (HTTP and WebSocket server)", pidlab::cli::RegisterServe},
     {"tune", "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check",
      pidlab::cli::RegisterTune},
 #endif

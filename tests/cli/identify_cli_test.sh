@@ -221,6 +221,9 @@ PY"
 pidlab identify --csv smooth.csv --model p2d > table 2> err
 check "the same record held (zoh) is misfitted: fit below 99.99 %" \
   "[ $? -eq 0 ] && awk '/^fit / { exit !(\$2 < 99.99) }' table"
+pidlab identify --csv smooth.csv --model p2d --intersample foh --initial-condition estimate --u0 estimate --y0 3 --json > all.json 2> err
+check "README's row: foh, an estimated state and u0 together run, and find Kp within 1e-4" \
+  "[ $? -eq 0 ] && /usr/bin/python3 -c \"import json; j = json.load(open('all.json')); assert abs(j['parameters']['Kp']['value'] - 2) < 2e-4 and j['u0_estimated'], j['parameters']\""
 pidlab identify --csv cut.csv --model p1d --initial-condition estimate --json > cut.json 2> err
 check "--initial-condition estimate recovers P1D from a record cut in motion within 1e-6" \
   "[ $? -eq 0 ] && /usr/bin/python3 - cut.json <<'PY'

@@ -1,0 +1,97 @@
+#pragma once
+// The workbench's HTTP and WebSocket server (docs/workbench.md), on
+// Boost.Beast: static assets, one JSON request route (POST /api/request) and
+// the same requests over a WebSocket (/ws). What a request means is the
+// Handler's business (`pidlab serve` passes the spec evaluation); this
+// library only carries it, safely:
+//  - it binds the address it is given (127.0.0.1 by default) and, when a
+//    token is set (required for any other address), refuses every request
+//    without it (401): `?token=` in the URL or `Authorization: Bearer`;
+//  - the Host header must name this server (no DNS rebinding) and a present
+//    Origin must be this server's own (403), for HTTP and the WebSocket;
+//  - headers, bodies and WebSocket messages are bounded (431, 413, close
+//    1009); a malformed request gets 400 and its connection closes; the
+//    server keeps serving;
+//  - a slow WebSocket client is sent the latest reply, not a growing queue.
+// One thread runs the io_context and the Handler (requests are evaluations of
+// microseconds to milliseconds).
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace pidlab::server {
+
+struct ServerOptions {
+  /// The address to bind (IPv4 or IPv6 literal).
+  std::string bind = "127.0.0.1";
+  /// The port; 0 picks a free one (Server::port() says which).
+  int port = 8080;
+  /// Required on every request when not empty; must be set (>= 16
+  /// characters) unless `bind` is a loopback address.
+  std::string token;
+  std::size_t max_header_bytes = 8 * 1024;
+  std::size_t max_body_bytes = 64 * 1024;
+  std::size_t max_message_bytes = 64 * 1024;
+  /// Connections open at once; more are closed on accept.
+  int max_connections = 64;
+
+  /// Names the field, its value and the rule on failure.
+  bool IsValid(std::string* error) const;
+};
+
+/// Whether `address` is a loopback address (127.0.0.0/8, ::1).
+bool IsLoopback(const std::string& address);
+
+/// A handler's answer: an HTTP status (200, 400 for a bad request) and a JSON body.
+struct Reply {
+  int status = 200;
+  nlohmann::json body;
+};
+/// Answers one request object. Exceptions become 500 with their message.
+using Handler = std::function<Reply(const nlohmann::json& request)>;
+
+/// A static file served at `path` ("/" and "/app.js").
+struct Asset {
+  std::string path;
+  std::string content_type;
+  std::string body;
+};
+
+/// What the server has seen, for tests and the hostile-input test.
+struct ServerCounters {
+  long http_requests = 0;
+  long websocket_messages = 0;
+  long refused = 0;          // 401 and 403
+  long malformed = 0;        // 400, 413, 431 and WebSocket messages that are not JSON objects
+  long dropped_replies = 0;  // replaced by a newer one for a slow client
+};
+
+class Server {
+ public:
+  Server(ServerOptions options, Handler handler, std::vector<Asset> assets);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  /// Binds and listens; false with *error (the address, the port and why).
+  bool Start(std::string* error);
+  /// The bound port (after Start).
+  int port() const;
+  /// Serves until Stop(); call after Start.
+  void Run();
+  /// From any thread: Run returns.
+  void Stop();
+  ServerCounters counters() const;
+
+  /// The implementation (server.cc); public only so that its sessions can hold it.
+  struct Impl;
+
+ private:
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace pidlab::server

@@ -1,0 +1,367 @@
+#include "pidlab/server/server.h"
+
+#include <atomic>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <sstream>
+
+namespace pidlab::server {
+namespace {
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using Request = http::request<http::string_body>;
+using Response = http::response<http::string_body>;
+
+// The value of `name` in a URL's query ("a=1&token=x"), empty if absent.
+std::string QueryValue(const std::string& target, const std::string& name) {
+  const std::size_t q = target.find('?');
+  if (q == std::string::npos) return "";
+  std::istringstream in(target.substr(q + 1));
+  std::string pair;
+  while (std::getline(in, pair, '&'))
+    if (pair.compare(0, name.size() + 1, name + "=") == 0) return pair.substr(name.size() + 1);
+  return "";
+}
+
+std::string PathOf(const std::string& target) { return target.substr(0, target.find('?')); }
+
+// Compares without an early exit, so that timing does not tell a prefix.
+bool SameSecret(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  return diff == 0;
+}
+
+Response JsonResponse(const Request& req, http::status status, const nlohmann::json& body) {
+  Response res{status, req.version()};
+  res.set(http::field::content_type, "application/json");
+  res.set(http::field::cache_control, "no-store");
+  res.keep_alive(req.keep_alive() && status != http::status::bad_request);
+  res.body() = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  res.prepare_payload();
+  return res;
+}
+
+}  // namespace
+
+bool IsLoopback(const std::string& address) {
+  boost::system::error_code ec;
+  const net::ip::address a = net::ip::make_address(address, ec);
+  return !ec && a.is_loopback();
+}
+
+bool ServerOptions::IsValid(std::string* error) const {
+  std::string e;
+  boost::system::error_code ec;
+  net::ip::make_address(bind, ec);
+  if (ec)
+    e = "bind address '" + bind + "' is not an IPv4 or IPv6 address";
+  else if (port < 0 || port > 65535)
+    e = "port " + std::to_string(port) + " must be in 0..65535";
+  else if (!IsLoopback(bind) && token.size() < 16)
+    e = "bind address '" + bind + "' is not loopback: a token of at least 16 characters is required";
+  else if (max_body_bytes < 1024 || max_message_bytes < 1024 || max_header_bytes < 1024)
+    e = "the size limits must be at least 1024 bytes";
+  else if (max_connections < 1)
+    e = "max_connections " + std::to_string(max_connections) + " must be at least 1";
+  if (error) *error = e;
+  return e.empty();
+}
+
+struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
+  ServerOptions options;
+  Handler handler;
+  std::vector<Asset> assets;
+  net::io_context io{1};
+  tcp::acceptor acceptor{io};
+  int port = 0;
+  std::atomic<int> open_connections{0};
+  mutable std::mutex counters_mutex;
+  ServerCounters counters;
+
+  void Count(long ServerCounters::*field) {
+    std::lock_guard<std::mutex> lock(counters_mutex);
+    ++(counters.*field);
+  }
+
+  // Why `req` may not be served (token, host, origin), or empty.
+  std::pair<http::status, std::string> Refusal(const Request& req) const {
+    if (!options.token.empty()) {
+      std::string given = QueryValue(std::string(req.target()), "token");
+      const std::string auth(req[http::field::authorization]);
+      if (given.empty() && auth.rfind("Bearer ", 0) == 0) given = auth.substr(7);
+      if (!SameSecret(given, options.token)) return {http::status::unauthorized, "a valid token is required"};
+    }
+    const std::string host(req[http::field::host]);
+    const std::string suffix = ":" + std::to_string(port);
+    std::set<std::string> hosts = {"127.0.0.1" + suffix, "localhost" + suffix, "[::1]" + suffix};
+    hosts.insert((options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind) +
+                 suffix);
+    // Bound to every address: any Host, as the token guards it.
+    const bool any = options.bind == "0.0.0.0" || options.bind == "::";
+    if (!any && hosts.count(host) == 0)
+      return {http::status::forbidden, "Host '" + host + "' is not this server"};
+    const auto origin = req.find(http::field::origin);
+    if (origin != req.end() && std::string(origin->value()) != "http://" + host)
+      return {http::status::forbidden, "Origin '" + std::string(origin->value()) + "' is not this server's"};
+    return {http::status::ok, ""};
+  }
+
+  // One request object through the handler: the reply's status and body.
+  Reply Answer(const std::string& text) {
+    nlohmann::json request = nlohmann::json::parse(text, nullptr, false);
+    if (request.is_discarded() || !request.is_object()) {
+      Count(&ServerCounters::malformed);
+      return {400, {{"error", "a request must be one JSON object"}}};
+    }
+    Reply reply;
+    try {
+      reply = handler(request);
+    } catch (const std::exception& e) {
+      reply = {500, {{"error", std::string("the server failed: ") + e.what()}}};
+    }
+    if (request.contains("id") && reply.body.is_object()) reply.body["id"] = request["id"];
+    return reply;
+  }
+
+  Response Serve(const Request& req) {
+    Count(&ServerCounters::http_requests);
+    const auto [status, why] = Refusal(req);
+    if (status != http::status::ok) {
+      Count(&ServerCounters::refused);
+      return JsonResponse(req, status, {{"error", why}});
+    }
+    const std::string path = PathOf(std::string(req.target()));
+    if (req.method() == http::verb::get) {
+      for (const Asset& a : assets)
+        if (a.path == path) {
+          Response res{http::status::ok, req.version()};
+          res.set(http::field::content_type, a.content_type);
+          res.set("X-Content-Type-Options", "nosniff");
+          res.set("Content-Security-Policy", "default-src 'self'; connect-src 'self'");
+          res.keep_alive(req.keep_alive());
+          res.body() = a.body;
+          res.prepare_payload();
+          return res;
+        }
+      if (path == "/api/health") return JsonResponse(req, http::status::ok, {{"ok", true}});
+      return JsonResponse(req, http::status::not_found, {{"error", "no such path: " + path}});
+    }
+    if (req.method() == http::verb::post && path == "/api/request") {
+      const Reply r = Answer(req.body());
+      return JsonResponse(req, static_cast<http::status>(r.status), r.body);
+    }
+    return JsonResponse(req, http::status::method_not_allowed, {{"error", "method or path not served"}});
+  }
+};
+
+namespace {
+
+class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
+ public:
+  WebSocketSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
+      : ws_(std::move(socket)), server_(std::move(server)) {
+    ++server_->open_connections;
+  }
+  ~WebSocketSession() { --server_->open_connections; }
+
+  void Run(Request req) {
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.read_message_max(server_->options.max_message_bytes);
+    ws_.async_accept(req, beast::bind_front_handler(&WebSocketSession::OnAccept, shared_from_this()));
+  }
+
+ private:
+  void OnAccept(beast::error_code ec) {
+    if (!ec) Read();
+  }
+  void Read() {
+    ws_.async_read(buffer_, beast::bind_front_handler(&WebSocketSession::OnRead, shared_from_this()));
+  }
+  void OnRead(beast::error_code ec, std::size_t) {
+    if (ec) {
+      if (ec == websocket::error::message_too_big) server_->Count(&ServerCounters::malformed);
+      return;  // closed, too big or broken: the session ends
+    }
+    server_->Count(&ServerCounters::websocket_messages);
+    const std::string text = beast::buffers_to_string(buffer_.data());
+    buffer_.consume(buffer_.size());
+    Send(server_->Answer(text).body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+    Read();
+  }
+  // At most one write in flight and one waiting: a newer reply replaces the waiting one.
+  void Send(std::string message) {
+    if (writing_) {
+      if (waiting_) server_->Count(&ServerCounters::dropped_replies);
+      waiting_ = std::move(message);
+      return;
+    }
+    writing_ = true;
+    out_ = std::move(message);
+    ws_.text(true);
+    ws_.async_write(net::buffer(out_),
+                    beast::bind_front_handler(&WebSocketSession::OnWrite, shared_from_this()));
+  }
+  void OnWrite(beast::error_code ec, std::size_t) {
+    writing_ = false;
+    if (ec || !waiting_) return;
+    std::string next = std::move(*waiting_);
+    waiting_.reset();
+    Send(std::move(next));
+  }
+
+  websocket::stream<beast::tcp_stream> ws_;
+  std::shared_ptr<Server::Impl> server_;
+  beast::flat_buffer buffer_;
+  std::string out_;
+  std::optional<std::string> waiting_;
+  bool writing_ = false;
+};
+
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+ public:
+  HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
+      : stream_(std::move(socket)), server_(std::move(server)) {
+    ++server_->open_connections;
+  }
+  ~HttpSession() { --server_->open_connections; }
+  void Run() { Read(); }
+
+ private:
+  void Read() {
+    parser_.emplace();
+    parser_->header_limit(static_cast<std::uint32_t>(server_->options.max_header_bytes));
+    parser_->body_limit(server_->options.max_body_bytes);
+    stream_.expires_after(std::chrono::seconds(30));
+    http::async_read(stream_, buffer_, *parser_,
+                     beast::bind_front_handler(&HttpSession::OnRead, shared_from_this()));
+  }
+
+  void OnRead(beast::error_code ec, std::size_t) {
+    if (ec == http::error::end_of_stream || ec == beast::error::timeout ||
+        ec == net::error::operation_aborted || ec == net::error::connection_reset || ec == net::error::eof) {
+      Close();
+      return;
+    }
+    if (ec) {
+      server_->Count(&ServerCounters::malformed);
+      const http::status status = ec == http::error::body_limit ? http::status::payload_too_large
+                                  : ec == http::error::header_limit
+                                      ? http::status::request_header_fields_too_large
+                                      : http::status::bad_request;
+      Request bare;
+      bare.version(11);
+      bare.keep_alive(false);
+      Response res = JsonResponse(bare, status, {{"error", "malformed request: " + ec.message()}});
+      res.keep_alive(false);
+      Write(std::move(res));
+      return;
+    }
+    Request req = parser_->release();
+    if (websocket::is_upgrade(req)) {
+      const auto [status, why] = server_->Refusal(req);
+      if (status != http::status::ok || PathOf(std::string(req.target())) != "/ws") {
+        server_->Count(&ServerCounters::refused);
+        Response res = JsonResponse(req, status != http::status::ok ? status : http::status::not_found,
+                                    {{"error", why.empty() ? "the WebSocket is at /ws" : why}});
+        res.keep_alive(false);
+        Write(std::move(res));
+        return;
+      }
+      stream_.expires_never();
+      std::make_shared<WebSocketSession>(stream_.release_socket(), server_)->Run(std::move(req));
+      return;
+    }
+    Write(server_->Serve(req));
+  }
+
+  void Write(Response res) {
+    auto shared = std::make_shared<Response>(std::move(res));
+    http::async_write(stream_, *shared,
+                      [self = shared_from_this(), shared](beast::error_code ec, std::size_t) {
+                        if (ec || !shared->keep_alive())
+                          self->Close();
+                        else
+                          self->Read();
+                      });
+  }
+
+  void Close() {
+    beast::error_code ignored;
+    stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+  }
+
+  beast::tcp_stream stream_;
+  std::shared_ptr<Server::Impl> server_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+};
+
+void Accept(std::shared_ptr<Server::Impl> server) {
+  server->acceptor.async_accept([server](beast::error_code ec, tcp::socket socket) {
+    if (ec == net::error::operation_aborted) return;
+    if (!ec) {
+      if (server->open_connections >= server->options.max_connections) {
+        beast::error_code ignored;
+        socket.close(ignored);
+      } else {
+        std::make_shared<HttpSession>(std::move(socket), server)->Run();
+      }
+    }
+    Accept(server);
+  });
+}
+
+}  // namespace
+
+Server::Server(ServerOptions options, Handler handler, std::vector<Asset> assets)
+    : impl_(std::make_shared<Impl>()) {
+  impl_->options = std::move(options);
+  impl_->handler = std::move(handler);
+  impl_->assets = std::move(assets);
+}
+
+Server::~Server() { Stop(); }
+
+bool Server::Start(std::string* error) {
+  if (!impl_->options.IsValid(error)) return false;
+  beast::error_code ec;
+  const tcp::endpoint endpoint{net::ip::make_address(impl_->options.bind),
+                               static_cast<unsigned short>(impl_->options.port)};
+  impl_->acceptor.open(endpoint.protocol(), ec);
+  if (!ec) impl_->acceptor.set_option(net::socket_base::reuse_address(true), ec);
+  if (!ec) impl_->acceptor.bind(endpoint, ec);
+  if (!ec) impl_->acceptor.listen(net::socket_base::max_listen_connections, ec);
+  if (ec) {
+    if (error)
+      *error = "cannot listen on " + impl_->options.bind + " port " + std::to_string(impl_->options.port) +
+               ": " + ec.message();
+    return false;
+  }
+  impl_->port = impl_->acceptor.local_endpoint().port();
+  Accept(impl_);
+  return true;
+}
+
+int Server::port() const { return impl_->port; }
+
+void Server::Run() { impl_->io.run(); }
+
+void Server::Stop() { impl_->io.stop(); }
+
+ServerCounters Server::counters() const {
+  std::lock_guard<std::mutex> lock(impl_->counters_mutex);
+  return impl_->counters;
+}
+
+}  // namespace pidlab::server

@@ -1,0 +1,24 @@
+#pragma once
+// A spec in its JSON form run to its result's JSON form: what `pidlab serve`
+// answers (docs/workbench.md), built from the same pieces as `pidlab evaluate
+// --spec FILE --json` and Python's pidlab.evaluate (the spec validated by
+// tune/spec_build.h, the object of results_json.h with "robustness" and the
+// "spec" echo).
+
+#include <nlohmann/json.hpp>
+
+#include "pidlab/spec/status.h"
+
+namespace pidlab::json {
+
+/// The object of `pidlab evaluate --json` (backend "local") for the
+/// EvaluateSpec `spec` (keys as the spec's JSON form; a --json result's
+/// "spec" runs again). Status kInvalidInput with one line naming the key and
+/// value for a spec that does not validate; kRunnerFailed if the evaluation
+/// fails.
+Status EvaluateSpecJson(const nlohmann::json& spec, nlohmann::json* result);
+
+/// The fields of EvaluateSpec: [{key, flag, help, unit, default, example}].
+nlohmann::json EvaluateSpecFields();
+
+}  // namespace pidlab::json
