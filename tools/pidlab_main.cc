@@ -19,7 +19,7 @@ struct Command {
 };
 
 // The sanitised tree's pidlab (tools/CMakeLists.txt) holds only the
-// commands the hostile tests run on it: evaluate, launch and replay.
+// commands the hostile tests run on it: evaluate, launch, replay and serve.
 const Command kCommands[] = {
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
     {"batch", "the AMIGO test batch: AMIGO's PID against pidlab's optimum on P1-P9",
@@ -39,7 +39,9 @@ const Command kCommands[] = {
     {"replay", "read an LCM log: episodes, IAE, completeness, --redrive", pidlab::cli::RegisterReplay},
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
     {"report", "regenerate the paper's tables and figures (report.md + PNGs)", pidlab::cli::RegisterReport},
+#endif
     {"serve", "the tuning workbench in the browser (HTTP and WebSocket server)", pidlab::cli::RegisterServe},
+#ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
     {"tune", "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check",
      pidlab::cli::RegisterTune},
 #endif
