@@ -98,5 +98,11 @@ two_dof stepper_motor --robust
 check "tune --two-dof prints the weights and both responses" \
   "grep -q '^two-dof  *setpoint weights b = ' $tmp/tune.txt && [ \$(grep -c 'setpoint IAE' $tmp/tune.txt) -eq 2 ]"
 
+# The commands docs/two_dof.md shows are the ones run above.
+doc="$(dirname "${BASH_SOURCE[0]}")/../../docs/two_dof.md"
+check "docs/two_dof.md shows the commands this test runs" \
+  "grep -qxF 'pidlab evaluate --num 1 --den 1,0.5,0.1 --gains 1.12,0.23,1.3 --derivative-filter 0.122 --setpoint-weights 0.664,0.0136 --sample-time 0.5' $doc &&
+   grep -qxF 'pidlab tune --plant oscillator --objective load-iae --derivative-filter-ratio 10 --max-ms 1.6 --method nelder-mead --max-evals 400 --two-dof' $doc"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
