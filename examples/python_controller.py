@@ -148,14 +148,14 @@ class DiscretePid:
     OK, SATURATED, INVALID_INPUT = 0, 1, 2
 
     def __init__(self, kp, ki, kd, dt_s, derivative_filter_s, output_min, output_max, anti_windup,
-                 back_calculation_gain, derivative_on, integral):
+                 back_calculation_gain, setpoint_weight_b, setpoint_weight_c, integral):
         self.kp, self.ki, self.kd = kp, ki, kd
         self.dt = dt_s
         self.tf = derivative_filter_s
         self.output_min, self.output_max = output_min, output_max
         self.anti_windup = anti_windup
         self.back_calculation_gain = back_calculation_gain
-        self.derivative_on = derivative_on
+        self.b, self.c = setpoint_weight_b, setpoint_weight_c  # the 2-DOF PID's setpoint weights
         self.integral_method = integral
         self.integral = 0.0
         self.derivative = 0.0
@@ -168,7 +168,7 @@ class DiscretePid:
             return self.INVALID_INPUT, None
         dt = self.dt
         e = r - y
-        p = self.kp * e
+        p = self.kp * (self.b * r - y)
         integral = self.integral
         if self.integral_method == "backward-euler":
             integral += self.ki * dt * e
@@ -176,7 +176,7 @@ class DiscretePid:
             integral += self.ki * dt * self.prev_error
         else:  # trapezoidal
             integral += self.ki * (dt * 0.5) * (e + self.prev_error)
-        signal_ = e if self.derivative_on == "error" else -y
+        signal_ = self.c * r - y
         tf = self.tf
         d = (tf / (tf + dt)) * self.derivative + self.kd * (signal_ - self.prev_signal) * (1.0 / (tf + dt))
         unsaturated = p + integral + d
@@ -229,6 +229,12 @@ def config_error(m):
         return "back-calculation gain %r must be positive" % m.back_calculation_gain
     if m.derivative_on not in ("error", "measurement"):
         return "derivative-on '%s' unknown" % m.derivative_on[:80]
+    for name in ("setpoint_weight_b", "setpoint_weight_c"):
+        v = getattr(m, name)
+        if not (math.isfinite(v) and 0.0 <= v <= 1.0):
+            return "setpoint weight %s = %r must be finite and in [0, 1]" % (name[-1], v)
+    if m.derivative_on == "measurement" and m.setpoint_weight_c != 0.0:
+        return "derivative-on measurement with setpoint weight c = %r" % m.setpoint_weight_c
     if m.integral not in ("backward-euler", "forward-euler", "trapezoidal"):
         return "integral '%s' unknown" % m.integral[:80]
     return None
@@ -241,7 +247,8 @@ class Episode:
         self.reference = config.reference
         self.pid = DiscretePid(config.kp, config.ki, config.kd, config.dt_s, config.derivative_filter_s,
                                config.output_min, config.output_max, config.anti_windup,
-                               config.back_calculation_gain, config.derivative_on, config.integral)
+                               config.back_calculation_gain, config.setpoint_weight_b,
+                               config.setpoint_weight_c, config.integral)
         self.expected = 0  # the next step to compute
         self.last = None  # the last command sent (an lcmt_control_command)
 

@@ -19,6 +19,7 @@
 #include <pidlab/lcmt_episode_config_v1.hpp>
 #include <pidlab/lcmt_episode_config_v2.hpp>
 #include <pidlab/lcmt_episode_config_v3.hpp>
+#include <pidlab/lcmt_episode_config_v4.hpp>
 
 #include "pidlab/replay/decoder_table.h"
 #include "pidlab/replay/episode_assembler.h"
@@ -343,7 +344,7 @@ std::vector<uint8_t> Encode(const Msg& m) {
 
 TEST(DecoderTable, FindsEveryPidlabTypeByItsFingerprint) {
   const DecoderTable table;
-  ASSERT_EQ(table.types().size(), 13u);  // ten types and the three configurations of older logs
+  ASSERT_EQ(table.types().size(), 14u);  // ten types and the four configurations of older logs
   for (const MessageType& t : table.types()) {
     const MessageType* found = table.Find(t.fingerprint);
     ASSERT_NE(found, nullptr) << t.name;
@@ -428,9 +429,10 @@ TEST(DecoderTable, AConfigurationOfAnOlderLogIsReadAsOneOfALinearPlant) {
     const std::vector<uint8_t> cut_bytes(whole.begin(), whole.end() - static_cast<std::ptrdiff_t>(cut));
     EXPECT_FALSE(current->decode(cut_bytes.data(), cut_bytes.size(), &message)) << cut;
   }
-  // motor_drive's length ("linear": 4 + 7 bytes, then delay_s's 8 and the
-  // chirp's and the measurement noise's 5 x 8): 2^31 - 1 + ...
-  whole[whole.size() - 59] = 0x7f;
+  // motor_drive's length ("linear": 4 + 7 bytes, then delay_s's 8, the
+  // chirp's and the measurement noise's 5 x 8 and the setpoint weights'
+  // 2 x 8): 2^31 - 1 + ...
+  whole[whole.size() - 75] = 0x7f;
   EXPECT_FALSE(current->decode(whole.data(), whole.size(), &message));
 }
 
@@ -511,6 +513,48 @@ TEST(DecoderTable, AConfigurationWrittenBeforeTheChirpAndMeasurementNoiseIsReadW
   // Cut inside delay_s: refused like every other layout.
   const std::vector<uint8_t> cut(bytes.begin(), bytes.end() - 4);
   EXPECT_FALSE(type->decode(cut.data(), cut.size(), &message));
+}
+
+TEST(DecoderTable, AConfigurationWrittenBeforeTheSetpointWeightsIsReadAsTheOneDofPid) {
+  // lcmt_episode_config before the 2-DOF PID's setpoint weights were
+  // appended: b = 1, and c = 1, or 0 for a derivative on the measurement.
+  for (const std::string derivative_on : {"error", "measurement"}) {
+    pidlab::lcmt_episode_config_v4 old{};
+    old.episode_id = 13;
+    old.plant_name = "custom";
+    old.num = {1.0};
+    old.num_size = 1;
+    old.den = {1.0, 1.0};
+    old.den_size = 2;
+    old.anti_windup = "clamping";
+    old.derivative_on = derivative_on;
+    old.integral = "backward-euler";
+    old.disturbance_kind = "chirp";
+    old.chirp_f1_hz = 2.0;
+    old.measurement_noise = 0.01;
+    old.delay_s = 0.3;
+    ASSERT_NE(pidlab::lcmt_episode_config_v4::getHash(), pidlab::lcmt_episode_config::getHash());
+    ASSERT_NE(pidlab::lcmt_episode_config_v4::getHash(), pidlab::lcmt_episode_config_v3::getHash());
+    std::vector<uint8_t> bytes = Encode(old);
+    const DecoderTable table;
+    const MessageType* type = table.Find(pidlab::lcmt_episode_config_v4::getHash());
+    ASSERT_NE(type, nullptr);
+    EXPECT_EQ(type->name, "lcmt_episode_config");
+    PidlabMessage message;
+    ASSERT_TRUE(type->decode(bytes.data(), bytes.size(), &message));
+    const auto* config = std::get_if<pidlab::lcmt_episode_config>(&message);
+    ASSERT_NE(config, nullptr);
+    EXPECT_EQ(config->episode_id, 13);
+    EXPECT_EQ(config->delay_s, 0.3);
+    EXPECT_EQ(config->chirp_f1_hz, 2.0);
+    EXPECT_EQ(config->measurement_noise, 0.01);
+    EXPECT_EQ(config->derivative_on, derivative_on);
+    EXPECT_EQ(config->setpoint_weight_b, 1.0);
+    EXPECT_EQ(config->setpoint_weight_c, derivative_on == "error" ? 1.0 : 0.0);
+    // Cut inside the measurement noise's seed: refused like every other layout.
+    const std::vector<uint8_t> cut(bytes.begin(), bytes.end() - 4);
+    EXPECT_FALSE(type->decode(cut.data(), cut.size(), &message));
+  }
 }
 
 TEST(DecoderTable, RefusesAnArrayLongerThanThePayloadBeforeTheDecoderAllocatesIt) {

@@ -16,6 +16,7 @@
 #include <pidlab/lcmt_episode_config_v1.hpp>
 #include <pidlab/lcmt_episode_config_v2.hpp>
 #include <pidlab/lcmt_episode_config_v3.hpp>
+#include <pidlab/lcmt_episode_config_v4.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
@@ -69,6 +70,7 @@ TEST(WireLayout, EveryMessageAsEncodedPasses) {
   EXPECT_TRUE(Ok<pidlab::lcmt_episode_config_v1>(Encode(pidlab::lcmt_episode_config_v1{})));
   EXPECT_TRUE(Ok<pidlab::lcmt_episode_config_v2>(Encode(pidlab::lcmt_episode_config_v2{})));
   EXPECT_TRUE(Ok<pidlab::lcmt_episode_config_v3>(Encode(pidlab::lcmt_episode_config_v3{})));
+  EXPECT_TRUE(Ok<pidlab::lcmt_episode_config_v4>(Encode(pidlab::lcmt_episode_config_v4{})));
   pidlab::lcmt_ready ready{};
   ready.role = "plant";
   ready.detail = "nonce";

@@ -98,9 +98,11 @@ struct TuneCommand {
     Evaluation ev;
     LoopAnalysis analysis;
     if (s.stable) {
+      // With --two-dof, the loop with the setpoint weights found.
+      const pidlab::evaluation::LoopOptions loop = pidlab::tune::WithSetpointWeights(o.loop, s.two_dof);
       EvaluateOptions what;
-      Evaluate(p, s.gains, o.loop, what, &ev, &error);
-      analysis = AnalyzeOrThrow(p, s.gains, o.loop);
+      Evaluate(p, s.gains, loop, what, &ev, &error);
+      analysis = AnalyzeOrThrow(p, s.gains, loop);
     }
     if (json) {
       nlohmann::json j = json::TuneJson(p, o, s, ev, backend);
@@ -182,8 +184,22 @@ struct TuneCommand {
       for (std::size_t i = 0; i < s.at_bounds.size(); ++i) std::cout << (i ? ", " : "") << s.at_bounds[i];
       std::cout << "  (an optimum on the box's edge: widen it with --bounds)\n";
     }
+    if (o.two_dof) PrintTwoDof(s.two_dof);
     std::cout << "wall time        " << s.wall_time_s << " s\n\n";
     std::cout << FormatEvaluation(ev);
+  }
+
+  static void PrintTwoDof(const pidlab::tune::TwoDofSummary& t) {
+    if (!t.ran) {
+      std::cout << "two-dof          not run: " << t.message << "\n";
+      return;
+    }
+    std::cout << "two-dof          setpoint weights b = " << t.b << ", c = " << t.c << "  (" << t.evaluations
+              << " evaluations)\n";
+    for (const auto* r : {&t.before, &t.after})
+      std::cout << "  b = " << std::setw(8) << r->b << ", c = " << std::setw(8) << r->c << "  setpoint IAE "
+                << r->setpoint_iae << ", overshoot " << r->overshoot_pct << " %, settling "
+                << r->settling_time_s << " s;  load IAE " << r->load_iae << ", Ms " << r->ms << "\n";
   }
 
   void WriteTrace(const TuneSummary& s) const {

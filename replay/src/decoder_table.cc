@@ -5,6 +5,7 @@
 #include <pidlab/lcmt_episode_config_v1.hpp>
 #include <pidlab/lcmt_episode_config_v2.hpp>
 #include <pidlab/lcmt_episode_config_v3.hpp>
+#include <pidlab/lcmt_episode_config_v4.hpp>
 
 #include "pidlab/transport/wire.h"
 
@@ -67,6 +68,10 @@ void CopyCommonConfig(const Old& o, pidlab::lcmt_episode_config* out) {
   m.seed = o.seed;
   m.retransmit_interval_s = o.retransmit_interval_s;
   m.silence_deadline_s = o.silence_deadline_s;
+  // Before the setpoint weights: the 1-DOF PID, its derivative on the
+  // measurement being c = 0.
+  m.setpoint_weight_b = 1.0;
+  m.setpoint_weight_c = o.derivative_on == "measurement" ? 0.0 : 1.0;
 }
 
 // A configuration written before the motor's fields were appended: decoded
@@ -135,6 +140,24 @@ bool DecodeConfigV3(const uint8_t* data, std::size_t size, PidlabMessage* messag
   return true;
 }
 
+// A configuration written before the setpoint weights were appended: read
+// as an lcmt_episode_config of the 1-DOF PID (CopyCommonConfig's b, c).
+bool DecodeConfigV4(const uint8_t* data, std::size_t size, PidlabMessage* message) {
+  pidlab::lcmt_episode_config_v4 o{};
+  if (!DecodeAs(data, size, &o)) return false;
+  pidlab::lcmt_episode_config m{};
+  CopyCommonConfig(o, &m);
+  CopyMotorConfig(o, &m);
+  m.delay_s = o.delay_s;
+  m.chirp_f0_hz = o.chirp_f0_hz;
+  m.chirp_f1_hz = o.chirp_f1_hz;
+  m.chirp_duration_s = o.chirp_duration_s;
+  m.measurement_noise = o.measurement_noise;
+  m.measurement_noise_seed = o.measurement_noise_seed;
+  *message = std::move(m);
+  return true;
+}
+
 template <typename Msg>
 MessageType Type(const char* name, const char* channel_suffix) {
   return MessageType{name, channel_suffix, Msg::getHash(), &Decode<Msg>};
@@ -160,6 +183,8 @@ DecoderTable::DecoderTable()
                       &DecodeConfigV2},  // logs written before the plant's dead time
           MessageType{"lcmt_episode_config", "EPISODE_CONFIG", pidlab::lcmt_episode_config_v3::getHash(),
                       &DecodeConfigV3},  // logs written before the chirp and the measurement noise
+          MessageType{"lcmt_episode_config", "EPISODE_CONFIG", pidlab::lcmt_episode_config_v4::getHash(),
+                      &DecodeConfigV4},  // logs written before the setpoint weights
           Type<pidlab::lcmt_ready>("lcmt_ready", "READY"),
           Type<pidlab::lcmt_plant_output>("lcmt_plant_output", "PLANT_OUTPUT"),
           Type<pidlab::lcmt_control_command>("lcmt_control_command", "CONTROL"),

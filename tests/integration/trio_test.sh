@@ -3,7 +3,7 @@
 #   unshare -n bash trio_test.sh BIN_DIR CASE
 # inside a private network namespace created for this test only: nothing is
 # ever sent outside its loopback. CASE: identity | faults | drop20 | realtime | kill | sigstop | trios | trio_killed | stranger |
-# log | log_repair | motor | delay | excite | identify_log | identify_motor.
+# log | log_repair | motor | delay | two_dof | excite | identify_log | identify_motor.
 set -u
 BIN=$1
 CASE=$2
@@ -419,6 +419,43 @@ print(f"ok   replay: {len(iaes)} episodes of delayed plants, each live IAE repro
 PY
     then :; else
       echo "FAIL replay of the delay log: $(head -3 "$TMP/delay.replay.err")"; fail=1
+    fi
+    ;;
+  two_dof)
+    # The 2-DOF PID (docs/two_dof.md) on a logged trio: MATLAB's PIDF2
+    # example (b 0.664, c 0.0136) with limits and back-calculation, c = 0
+    # given as --derivative-on measurement with b 0.5, and the delayed
+    # first-order plant with a disturbance and b = 0.3, c = 0.7: the JSON and
+    # y, u, n of every step bit-identical to the in-process loop. Then
+    # pidlab replay of the log, which rebuilds each loop from its logged
+    # configuration (the setpoint weights included), gives each live IAE
+    # exactly.
+    export -f compare
+    export TMP PIDLAB
+    rm -f "$TMP/two_dof.lcmlog"
+    "$PIDLAB" launch --lcm-url "$URL" --log "$TMP/two_dof.lcmlog" -- bash -c 'fail=0
+      compare pidf2 --num 1 --den 1,0.5,0.1 --gains 1.12,0.23,1.3 --derivative-filter 0.122 --setpoint-weights 0.664,0.0136 --dt 0.01 --sample-time 0.1 --horizon 25 --output-limits -1.5,1.5 --anti-windup back-calculation
+      compare on_measurement --num 1 --den 1,0.5,0.1 --gains 1.12,0.23,1.3 --derivative-on measurement --setpoint-weights 0.5,1 --dt 0.01 --sample-time 0.1 --horizon 25
+      compare fopdt_weights --plant custom --num 1 --den 1,1 --delay 0.3 --gains 1,1,0.1 --derivative-filter 0.05 --setpoint-weights 0.3,0.7 --horizon 10 --disturbance square --disturbance-amplitude 0.2
+      exit $fail' || fail=1
+    if "$PIDLAB" replay --json "$TMP/two_dof.lcmlog" >"$TMP/two_dof.replay.json" 2>"$TMP/two_dof.replay.err" &&
+      python3 - "$TMP" <<'PY'
+import json, sys
+tmp = sys.argv[1]
+rep = json.load(open(tmp + "/two_dof.replay.json"))
+assert rep["clean_end"], "log not read cleanly to the end"
+for e in rep["episodes"]:
+    assert e["complete"], e["completeness"]
+iaes = [e["evaluation"]["iae"] for e in rep["episodes"]]
+weights = {"pidf2": [0.664, 0.0136], "on_measurement": [0.5, 1], "fopdt_weights": [0.3, 0.7]}
+for name, w in weights.items():
+    live = json.load(open(f"{tmp}/{name}.lcm.json"))
+    assert live["spec"]["setpoint_weights"] == w, live["spec"]
+    assert live["iae"] in iaes, (name, live["iae"], iaes)
+print(f"ok   replay: {len(iaes)} episodes of the 2-DOF PID, each live IAE reproduced exactly")
+PY
+    then :; else
+      echo "FAIL replay of the two_dof log: $(head -3 "$TMP/two_dof.replay.err")"; fail=1
     fi
     ;;
   excite)

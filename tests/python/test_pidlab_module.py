@@ -128,12 +128,32 @@ class Evaluate(unittest.TestCase):
             pidlab.evaluate("oscillator", (1, 2, 3), loop="discrete")
 
 
+    def test_setpoint_weights_equal_the_cli_json(self):
+        # MATLAB's PIDF2 example (docs/two_dof.md).
+        got = pidlab.evaluate(([1], [1, 0.5, 0.1]), (1.12, 0.23, 1.3), derivative_filter=0.122,
+                              setpoint_weights=(0.664, 0.0136))
+        want = cli("evaluate", "--num", "1", "--den", "1,0.5,0.1", "--gains", "1.12,0.23,1.3",
+                   "--derivative-filter", "0.122", "--setpoint-weights", "0.664,0.0136")
+        self.assertSameResult(got, want)
+        self.assertEqual(got["spec"]["setpoint_weights"], [0.664, 0.0136])
+        with self.assertRaisesRegex(ValueError, "setpoint_weights 1.5,0: each weight must be finite and in"):
+            pidlab.evaluate("oscillator", (2, 1, 1.5), setpoint_weights=(1.5, 0))
+
+
 class Tune(unittest.TestCase):
     def assertSameTune(self, got, want):
         self.assertEqual(sorted(got), sorted(want))
         for key in want:
             if key != "wall_time_s":  # the one value that is not a result
                 self.assertEqual(got[key], want[key], key)
+
+    def test_two_dof_equals_the_cli_json(self):
+        got = pidlab.tune("oscillator", objective="load-iae", derivative_filter_ratio=10, max_ms=1.6,
+                          method="nelder-mead", max_evals=400, two_dof=True)
+        want = cli("tune", "--plant", "oscillator", "--objective", "load-iae", "--derivative-filter-ratio", "10",
+                   "--max-ms", "1.6", "--method", "nelder-mead", "--max-evals", "400", "--two-dof")
+        self.assertSameTune(got, want)
+        self.assertTrue(got["two_dof"]["ran"])
 
     def test_the_default_tune_equals_the_cli_json(self):
         got = pidlab.tune("oscillator", max_evals=400)

@@ -233,8 +233,10 @@ py::object TunePy(const py::object& plant, py::kwargs kwargs) {
     py::gil_scoped_release release;
     ok = Tune(p, o, &summary, &error);
     if (ok && summary.stable) {
-      Evaluate(p, summary.gains, o.loop, EvaluateOptions{}, &ev, &error);
-      ok = AnalyzeLoop(p, summary.gains, o.loop, LoopAnalysisOptions{}, &analysis, &error);
+      // With two_dof, the loop with the setpoint weights found.
+      const auto loop = pidlab::tune::WithSetpointWeights(o.loop, summary.two_dof);
+      Evaluate(p, summary.gains, loop, EvaluateOptions{}, &ev, &error);
+      ok = AnalyzeLoop(p, summary.gains, loop, LoopAnalysisOptions{}, &analysis, &error);
     }
   }
   Require(ok, error);

@@ -9,6 +9,7 @@
 #include <pidlab/lcmt_episode_config_v1.hpp>
 #include <pidlab/lcmt_episode_config_v2.hpp>
 #include <pidlab/lcmt_episode_config_v3.hpp>
+#include <pidlab/lcmt_episode_config_v4.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
@@ -77,9 +78,11 @@ bool WireLayoutOk(int64_t fingerprint, const void* data, int size) {
   LayoutCheck c(static_cast<const uint8_t*>(data), size);
   c.Fixed(kHeader);
   const bool config = fingerprint == pidlab::lcmt_episode_config::getHash();
+  const bool config_v4 = fingerprint == pidlab::lcmt_episode_config_v4::getHash();
   const bool config_v3 = fingerprint == pidlab::lcmt_episode_config_v3::getHash();
   const bool config_v2 = fingerprint == pidlab::lcmt_episode_config_v2::getHash();
-  if (config || config_v3 || config_v2 || fingerprint == pidlab::lcmt_episode_config_v1::getHash()) {
+  if (config || config_v4 || config_v3 || config_v2 ||
+      fingerprint == pidlab::lcmt_episode_config_v1::getHash()) {
     c.String()
         .Array(8, kMaxPolynomialCoefficients)
         .Array(8, kMaxPolynomialCoefficients)
@@ -92,9 +95,11 @@ bool WireLayoutOk(int64_t fingerprint, const void* data, int size) {
         .String()
         .Fixed(6 * 8)
         .Fixed(2 * 8);
-    if (config || config_v3 || config_v2) c.Fixed(17 * 8).String();  // the motor's fields, then motor_drive
-    if (config || config_v3) c.Fixed(8);                             // delay_s
-    if (config) c.Fixed(5 * 8);  // the chirp's band and duration, measurement noise and its seed
+    const bool motor = config || config_v4 || config_v3 || config_v2;
+    if (motor) c.Fixed(17 * 8).String();               // the motor's fields, then motor_drive
+    if (config || config_v4 || config_v3) c.Fixed(8);  // delay_s
+    if (config || config_v4) c.Fixed(5 * 8);  // the chirp's band and duration, measurement noise and its seed
+    if (config) c.Fixed(2 * 8);               // the setpoint weights b, c
   } else if (fingerprint == pidlab::lcmt_ready::getHash()) {
     c.Fixed(1).String().Fixed(4).String();
   } else if (fingerprint == pidlab::lcmt_episode_summary::getHash()) {

@@ -99,6 +99,32 @@ nlohmann::json ToJson(const Evaluation& ev) {
   return j;
 }
 
+namespace {
+
+nlohmann::json TwoDofResponseJson(const tune::TwoDofResponse& r) {
+  return {{"setpoint_weights", {r.b, r.c}},
+          {"setpoint",
+           {{"iae", JsonNumber(r.setpoint_iae)},
+            {"overshoot_pct", JsonNumber(r.overshoot_pct)},
+            {"rise_time_s", JsonNumber(r.rise_time_s)},
+            {"settling_time_s", JsonNumber(r.settling_time_s)}}},
+          {"load", {{"iae", JsonNumber(r.load_iae)}}},
+          {"ms", JsonNumber(r.ms)}};
+}
+
+}  // namespace
+
+nlohmann::json TwoDofJson(const tune::TwoDofSummary& s) {
+  if (!s.ran) return {{"ran", false}, {"message", s.message}};
+  return {{"ran", true},
+          {"setpoint_weights", {s.b, s.c}},
+          {"before", TwoDofResponseJson(s.before)},
+          {"after", TwoDofResponseJson(s.after)},
+          {"evaluations", s.evaluations},
+          {"termination", optim::ToString(s.termination)},
+          {"message", s.message}};
+}
+
 nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary& s, const Evaluation& ev,
                         const std::string& backend) {
   nlohmann::json j;
@@ -171,6 +197,7 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
         {"perturbed", s.robust_perturbed},
         {"nominal_objective", JsonNumber(s.nominal_objective)}};
   if (s.stable) AddMotor(ev, &j);
+  if (o.two_dof) j["two_dof"] = TwoDofJson(s.two_dof);
   return j;
 }
 

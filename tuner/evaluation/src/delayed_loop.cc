@@ -216,7 +216,7 @@ bool DelayedLoopIsRetarded(const TransferFunction& tf, const PidGains& g, std::s
 
 bool BuildDelayedClosedLoop(const TransferFunction& tf, const StateSpace& plant, const PidGains& g,
                             const Disturbance& disturbance, double delay_s, double reference,
-                            DelayedClosedLoop* out, std::string* error) {
+                            DelayedClosedLoop* out, std::string* error, const SetpointWeights& weights) {
   if (!DelayedLoopIsRetarded(tf, g, error)) return false;
   const int n = plant.order();
   const bool filtered = g.tf > 0.0;
@@ -230,18 +230,18 @@ bool BuildDelayedClosedLoop(const TransferFunction& tf, const StateSpace& plant,
   m.block(iz, 0, 1, n) = -plant.c;
   m(iz, ir) = 1.0;
   if (filtered) {
-    // u = (kp + kf) (r - C x) + ki z - kf v, v' = (r - C x - v) / tf.
+    // u = kp (b r - C x) + ki z + kf (c r - C x - v), v' = (c r - C x - v) / tf.
     const double kf = g.kd / g.tf;
     u.head(n) = -(g.kp + kf) * plant.c;
     u(iv) = -kf;
-    u(ir) = g.kp + kf;
+    u(ir) = g.kp * weights.b + kf * weights.c;
     m.block(iv, 0, 1, n) = -plant.c / g.tf;
     m(iv, iv) = -1.0 / g.tf;
-    m(iv, ir) = 1.0 / g.tf;
+    m(iv, ir) = weights.c / g.tf;
   } else {
-    // u = kp (r - C x) + ki z - kd C A x: e' = -C (A x + B p), C B = 0 here.
+    // u = kp (b r - C x) + ki z - kd C A x: e' = -C (A x + B p), C B = 0 here.
     u.head(n) = -g.kp * plant.c - g.kd * (plant.c * plant.a);
-    u(ir) = g.kp;
+    u(ir) = g.kp * weights.b;
   }
   u(iz) = g.ki;
   Eigen::VectorXd w0 = Eigen::VectorXd::Zero(size);
@@ -254,7 +254,7 @@ bool BuildDelayedClosedLoop(const TransferFunction& tf, const StateSpace& plant,
   out->e.head(n) = plant.b;
   out->w0 = std::move(w0);
   out->impulse = Eigen::VectorXd::Zero(size);
-  if (!filtered) out->impulse.head(n) = g.kd * reference * plant.b;
+  if (!filtered) out->impulse.head(n) = g.kd * weights.c * reference * plant.b;
   out->c = plant.c;
   out->plant_order = n;
   out->exo_size = exo;

@@ -121,14 +121,15 @@ Status EvaluateContinuous(const Plant& plant, const PidGains& gains, const LoopO
   const double a = options.reference, ts = options.sample_time_s;
   ContinuousClosedLoop<double> loop;
   std::string error;
-  if (!BuildContinuousClosedLoop<double>(ss, gains, disturbance, &loop, &error, a))
+  const SetpointWeights weights = SetpointWeightsOf(options.pid);
+  if (!BuildContinuousClosedLoop<double>(ss, gains, disturbance, &loop, &error, a, weights))
     return Status::InvalidInput(error);
   ev->stability = ContinuousStability(loop, options.stability_margin);
   if (!ev->stability.stable) return Status::Ok();
   SampleContinuousLoop<double>(loop, disturbance, ts, options.NumSamples(), &ev->y);
   if (options.disturbance.kind != DisturbanceKind::kNone) {
     ContinuousClosedLoop<double> clean;
-    BuildContinuousClosedLoop<double>(ss, gains, none, &clean, &error, a);
+    BuildContinuousClosedLoop<double>(ss, gains, none, &clean, &error, a, weights);
     std::vector<double> y1;
     SampleContinuousLoop<double>(clean, none, ts, options.NumSamples(), &y1);
     ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1, ts, a);
@@ -160,8 +161,9 @@ void ScoreSampled(const Plant& plant, const PidGains& gains, const LoopOptions& 
     // The final value of the continuous loop's step response, as the
     // continuous loop with this disturbance is built.
     ContinuousClosedLoop<double> loop;
-    const bool built = BuildContinuousClosedLoop<double>(Realize(plant.tf), gains,
-                                                         Disturbance(options.disturbance), &loop, nullptr, a);
+    const bool built =
+        BuildContinuousClosedLoop<double>(Realize(plant.tf), gains, Disturbance(options.disturbance), &loop,
+                                          nullptr, a, SetpointWeightsOf(options.pid));
     const bool continuous_stable = built && ContinuousStability(loop, options.stability_margin).stable;
     // With a dead time the sampled loop is stable here and its final value is
     // the undelayed loop's steady state (e^(-sL) = 1 at s = 0), whatever the

@@ -21,7 +21,8 @@ constexpr double kPointsPerDecade = 100.0;
 bool Sample(const Plant& plant, const PidGains& gains, const LoopOptions& options, const Disturbance& d,
             double a, std::vector<double>* y, DelayedTrace* trace, std::string* error) {
   DelayedClosedLoop loop;
-  if (!BuildDelayedClosedLoop(plant.tf, Realize(plant.tf), gains, d, plant.delay_s, a, &loop, error))
+  if (!BuildDelayedClosedLoop(plant.tf, Realize(plant.tf), gains, d, plant.delay_s, a, &loop, error,
+                              SetpointWeightsOf(options.pid)))
     return false;
   return SampleDelayedLoop(loop, d, options.sample_time_s, options.NumSamples(), y, trace, error);
 }
@@ -76,8 +77,8 @@ Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& gains, cons
   if (what.compute_step_info) {
     // e^(-sL) = 1 at s = 0: the undelayed loop's steady state.
     ContinuousClosedLoop<double> undelayed;
-    const bool built =
-        BuildContinuousClosedLoop<double>(Realize(plant.tf), gains, none, &undelayed, nullptr, a);
+    const bool built = BuildContinuousClosedLoop<double>(Realize(plant.tf), gains, none, &undelayed, nullptr,
+                                                         a, SetpointWeightsOf(options.pid));
     const double yf = built ? ContinuousFinalValue(undelayed) : a;
     ev->step = SampledStepInfo(clean.t, clean.y, std::isfinite(yf) ? yf : a);
   }

@@ -492,7 +492,8 @@ double GeneralContinuousObjective(const StateSpace& realization, const Disturban
                                   const LoopOptions& options, ObjectiveKind kind, const PidGains& gains) {
   thread_local std::vector<double> y;  // reused: no allocation per evaluation
   ContinuousClosedLoop<double> loop;
-  if (!BuildContinuousClosedLoop<double>(realization, gains, disturbance, &loop, nullptr, options.reference))
+  if (!BuildContinuousClosedLoop<double>(realization, gains, disturbance, &loop, nullptr, options.reference,
+                                         SetpointWeightsOf(options.pid)))
     return kInf;
   const Stability s = ContinuousStability(loop, options.stability_margin);
   if (!s.stable) return kInf;
@@ -520,7 +521,7 @@ double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {
     if (options_.loop == LoopKind::kContinuous) {
       ContinuousClosedLoop<double> loop;
       stable = BuildContinuousClosedLoop<double>(realization_, gains, disturbance_, &loop, nullptr,
-                                                 options_.reference) &&
+                                                 options_.reference, SetpointWeightsOf(options_.pid)) &&
                ContinuousStability(loop, options_.stability_margin).stable;
       if (stable && kind_ == ObjectiveKind::kSetpointLoad)
         SampleContinuousLoop<double>(loop, disturbance_, ts, options_.NumSamples(), &y);

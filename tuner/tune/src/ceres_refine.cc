@@ -47,7 +47,8 @@ struct ErrorResiduals {
     if (loop->loop == evaluation::LoopKind::kContinuous) {
       evaluation::ContinuousClosedLoop<T> cl;
       if (!evaluation::BuildContinuousClosedLoop<T>(*realization, g, disturbance, &cl, nullptr,
-                                                    loop->reference))
+                                                    loop->reference,
+                                                    evaluation::SetpointWeightsOf(loop->pid)))
         return false;
       evaluation::ContinuousClosedLoop<double> cld;
       if (!evaluation::BuildContinuousClosedLoop<double>(*realization, gd, disturbance, &cld, nullptr,

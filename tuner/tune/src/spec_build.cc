@@ -240,6 +240,26 @@ bool BuildMeasurementNoise(const spec::LoopSpec& s, NameStyle style, Measurement
   return true;
 }
 
+// b, c of the 2-DOF PID; derivative_on measurement is c = 0, the same code
+// path (a c other than the default 1 next to it is refused).
+bool BuildSetpointWeights(const spec::LoopSpec& s, DerivativeOn derivative_on, NameStyle style,
+                          PidOptions* pid, std::string* error) {
+  const auto [b, c] = s.setpoint_weights;
+  const std::string name = spec::DisplayName("setpoint_weights", style);
+  const std::string value = name + " " + spec::FormatNumber(b) + "," + spec::FormatNumber(c);
+  if (!PidOptions::SetpointWeightIsValid(b) || !PidOptions::SetpointWeightIsValid(c))
+    return Bad(error, value + ": each weight must be finite and in [0, 1]");
+  pid->setpoint_weight_p = b;
+  pid->setpoint_weight_d = c;
+  if (derivative_on == DerivativeOn::kMeasurement) {
+    if (c != 0.0 && c != 1.0)
+      return Bad(error, value + ": " + spec::DisplayName("derivative_on", style) +
+                            " measurement is c = 0; give one of the two");
+    pid->setpoint_weight_d = 0.0;
+  }
+  return true;
+}
+
 bool BuildPidOptions(const spec::LoopSpec& s, NameStyle style, PidOptions* pid, std::string* error) {
   const auto name = [style](const char* key) { return spec::DisplayName(key, style); };
   pid->derivative_filter_s = s.derivative_filter_s;
@@ -248,8 +268,10 @@ bool BuildPidOptions(const spec::LoopSpec& s, NameStyle style, PidOptions* pid, 
   if (!ParseAntiWindup(s.anti_windup, &pid->anti_windup))
     return Bad(error, name("anti_windup") + " " + Quote(s.anti_windup) +
                           " must be none, clamping or back-calculation");
-  if (!ParseDerivativeOn(s.derivative_on, &pid->derivative_on))
+  DerivativeOn derivative_on = DerivativeOn::kError;
+  if (!ParseDerivativeOn(s.derivative_on, &derivative_on))
     return Bad(error, name("derivative_on") + " " + Quote(s.derivative_on) + " must be error or measurement");
+  if (!BuildSetpointWeights(s, derivative_on, style, pid, error)) return false;
   if (!ParseIntegralMethod(s.integral, &pid->integral))
     return Bad(error, name("integral") + " " + Quote(s.integral) +
                           " must be backward-euler, forward-euler or trapezoidal");
@@ -381,6 +403,7 @@ bool BuildSearch(const spec::TuneSpec& t, NameStyle style, TuneOptions* o, std::
   o->design_points = t.design_points;
   o->refine_starts = t.refine_starts;
   o->adaptive = t.adaptive;
+  o->two_dof = t.two_dof;
   o->max_overshoot_pct = t.max_overshoot_pct;
   o->max_settling_time_s = t.max_settling_s;
   o->agree_tolerance = t.agree_tolerance;

@@ -565,6 +565,8 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   summary->refine.gains = evaluation::LoopGains(summary->refine.gains, options.loop);
   if (!IsTuningRule(options.method))
     summary->at_bounds = GainsAtBounds(summary->gains, options.lower, options.upper);
+  if (options.two_dof && !TuneSetpointWeights(plant, summary->gains, options.loop, &summary->two_dof, error))
+    return false;
   summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return true;
 }

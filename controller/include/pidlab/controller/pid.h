@@ -5,21 +5,26 @@
 //   u(t) = kp e(t) + ki \int_0^t e dt + kd de/dt,   e = r - y,
 // or with a first-order derivative filter of time constant tf > 0:
 //   C(s) = kp + ki / s + kd s / (tf s + 1)           (tf = 0: the ideal PID).
+// Two degrees of freedom (docs/two_dof.md): setpoint weights b, c in [0, 1]
+// (PidOptions::setpoint_weight_p, setpoint_weight_d) weight r in the
+// proportional and derivative terms,
+//   u = kp (b r - y) + ki/s (r - y) + kd s / (tf s + 1) (c r - y);
+// b = c = 1 is the 1-DOF PID above, c = 0 the derivative on measurement.
 //
 // Discrete, period dt, one call per sample k (t_k = k dt), u_k held over
 // [t_k, t_{k+1}):
 //   e_k = r_k - y_k
-//   P_k = kp e_k
+//   P_k = kp (b r_k - y_k)
 //   I_k = I_{k-1} + ki dt e_k                    (backward Euler, default)
 //       | I_{k-1} + ki dt e_{k-1}                 (forward Euler)
 //       | I_{k-1} + ki dt (e_k + e_{k-1}) / 2     (trapezoidal)
 //   D_k = tf/(tf+dt) D_{k-1} + kd/(tf+dt) (s_k - s_{k-1}),
-//         s = e (derivative on error) or s = -y (on measurement),
+//         s_k = c r_k - y_k (c = 1: on error; c = 0: on measurement),
 //         the backward-Euler image of kd s / (tf s + 1) with the same tf as
 //         the continuous loop (EffectiveDerivativeFilter)
 //   u_k = sat(P_k + I_k + D_k)
 // The loop is at rest before k = 0 (r = y = e = 0), so with the defaults
-// (tf = 0, derivative on error, no limits) a unit step in r gives the
+// (tf = 0, b = c = 1, no limits) a unit step in r gives the
 // derivative kick kd/dt over the first step: area kd, the discrete image of
 // the ideal PID's impulse, and the loop converges to the continuous one as
 // dt -> 0.
@@ -70,6 +75,8 @@ inline bool GainsAreValid(const PidGains& g, std::string* error) {
   return true;
 }
 
+/// The spec's derivative_on (kept for the flag and for logs): kError is
+/// setpoint weight c = 1, kMeasurement c = 0 (SetpointWeightD).
 enum class DerivativeOn { kError, kMeasurement };
 enum class IntegralMethod { kBackwardEuler, kForwardEuler, kTrapezoidal };
 enum class AntiWindup { kNone, kClamping, kBackCalculation };
@@ -89,8 +96,14 @@ struct PidOptions {
   /// back-calculation feeds (u_sat - u) * back_calculation_gain into I.
   AntiWindup anti_windup = AntiWindup::kClamping;
   double back_calculation_gain = 1.0;  // 1/s, > 0
-  DerivativeOn derivative_on = DerivativeOn::kError;
   IntegralMethod integral = IntegralMethod::kBackwardEuler;
+  /// Setpoint weights of the 2-DOF PID, each finite and in [0, 1]: b weights
+  /// r in the proportional term, c in the derivative term (c = 0: derivative
+  /// on measurement). The weights live here, not in the gains: they do not
+  /// change the feedback loop (Ms, margins, load rejection), only how r
+  /// enters. 1, 1: the 1-DOF PID, bit for bit.
+  double setpoint_weight_p = 1.0;  // b
+  double setpoint_weight_d = 1.0;  // c
 
   bool IsValid(std::string* error) const {
     std::ostringstream os;
@@ -100,6 +113,10 @@ struct PidOptions {
       os << "derivative filter " << derivative_filter_s << " s must be >= 0 and finite";
     else if (std::isnan(output_min) || std::isnan(output_max) || !(output_min < output_max))
       os << "output limits [" << output_min << ", " << output_max << "] must satisfy min < max";
+    else if (!SetpointWeightIsValid(setpoint_weight_p))
+      os << "setpoint weight b = " << setpoint_weight_p << " must be finite and in [0, 1]";
+    else if (!SetpointWeightIsValid(setpoint_weight_d))
+      os << "setpoint weight c = " << setpoint_weight_d << " must be finite and in [0, 1]";
     else if (anti_windup == AntiWindup::kBackCalculation &&
              (!(back_calculation_gain > 0.0) || !std::isfinite(back_calculation_gain)))
       os << "back-calculation gain " << back_calculation_gain << " must be positive";
@@ -108,7 +125,13 @@ struct PidOptions {
     if (error) *error = os.str();
     return false;
   }
+
+  static bool SetpointWeightIsValid(double w) { return std::isfinite(w) && w >= 0.0 && w <= 1.0; }
 };
+
+/// The derivative's setpoint weight c that derivative_on stands for: 1 on
+/// the error, 0 on the measurement.
+inline double SetpointWeightD(DerivativeOn v) { return v == DerivativeOn::kError ? 1.0 : 0.0; }
 
 /// The PID's options for a loop of period `loop_dt_s`: `options` with its
 /// sample time set to the loop's. The one place the PID's dt is derived from
@@ -147,7 +170,8 @@ class DiscretePid {
     if (!IsFinite(r) || !IsFinite(y)) return PidStatus::kInvalidInput;
     const double dt = options_.dt_s;
     const T e = r - y;
-    const T p = gains_.kp * e;
+    // The operation order is the exported C's (pidlab export): keep it.
+    const T p = gains_.kp * (T(options_.setpoint_weight_p) * r - y);
     T integral = integral_;
     switch (options_.integral) {
       case IntegralMethod::kBackwardEuler:
@@ -160,7 +184,7 @@ class DiscretePid {
         integral += gains_.ki * T(dt * 0.5) * (e + prev_error_);
         break;
     }
-    const T signal = options_.derivative_on == DerivativeOn::kError ? e : T(-y);
+    const T signal = T(options_.setpoint_weight_d) * r - y;
     const T tf = EffectiveDerivativeFilter(gains_, options_);
     const T d =
         tf / (tf + T(dt)) * derivative_ + gains_.kd * (signal - prev_signal_) * (T(1.0) / (tf + T(dt)));

@@ -138,6 +138,9 @@ struct LoopSpec {
   double derivative_filter_s = 0.0, derivative_filter_ratio = 0.0;
   std::pair<double, double> output_limits{-kInf, kInf};
   std::string anti_windup = "clamping", derivative_on = "error", integral = "backward-euler";
+  /// The 2-DOF PID's setpoint weights b (proportional), c (derivative), each
+  /// in [0, 1] (docs/two_dof.md); 1, 1 = the 1-DOF PID.
+  std::pair<double, double> setpoint_weights{1.0, 1.0};
 
   /// The loop a tuning starts from: stability margin 0.01, because with a
   /// margin near zero the search parks poles a hair left of the imaginary
@@ -219,8 +222,15 @@ struct LoopSpec {
              &output_limits);
     a->Visit({"anti_windup", "sampled PID: none|clamping|back-calculation", "", kEpisode, R"("none")"},
              &anti_windup);
-    a->Visit({"derivative_on", "sampled PID: error|measurement", "", kEpisode, R"("measurement")"},
+    a->Visit({"derivative_on",
+              "error|measurement, both loops: measurement is the setpoint weight c = 0 (--setpoint-weights)",
+              "", kEpisode, R"("measurement")"},
              &derivative_on);
+    a->Visit({"setpoint_weights",
+              "2-DOF PID, both loops: setpoint weights B,C in [0, 1], u = kp (b r - y) + ki/s (r - y) + kd "
+              "s/(tf s + 1) (c r - y) (docs/two_dof.md); 1,1 = the 1-DOF PID",
+              "", kEpisode, "[0.6, 0]"},
+             &setpoint_weights);
     a->Visit({"integral", "sampled PID: backward-euler|forward-euler|trapezoidal", "", kEpisode,
               R"("trapezoidal")"},
              &integral);
@@ -265,6 +275,7 @@ struct TuneSpec {
   bool robust = false;
   int robust_samples = 0;
   double robust_quantile = 1.0, robust_spread = 0.1;
+  bool two_dof = false;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -330,6 +341,11 @@ struct TuneSpec {
     a->Visit({"robust_spread", "relative spread of the robust set's draws, 10% or 0.1, in [0, 1)", "",
               kPercent, "0.2"},
              &robust_spread);
+    a->Visit({"two_dof",
+              "2-DOF PID (docs/two_dof.md): after the feedback gains, the setpoint weights b, c in [0, 1] "
+              "minimising the setpoint step's IAE with the gains fixed; the result reports both responses",
+              "", kNone, "true"},
+             &two_dof);
   }
 };
 

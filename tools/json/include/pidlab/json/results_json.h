@@ -28,6 +28,9 @@ nlohmann::json RobustnessJson(const analysis::LoopAnalysis& a, const analysis::L
 /// The object of `pidlab tune --json`: plant `p`, options `o`, summary `s`,
 /// and `ev`, the evaluation of s.gains on o.loop (unused unless s.stable);
 /// `backend` is "local" or "lcm".
+/// `tune --two-dof`'s second stage: the weights found, the setpoint and
+/// load responses before and after them (docs/two_dof.md).
+nlohmann::json TwoDofJson(const tune::TwoDofSummary& s);
 nlohmann::json TuneJson(const Plant& p, const tune::TuneOptions& o, const tune::TuneSummary& s,
                         const evaluation::Evaluation& ev, const std::string& backend);
 

@@ -156,6 +156,18 @@ PidGainsT<T> LoopGains(const PidGainsT<T>& g, const LoopOptions& o) {
   return out;
 }
 
+/// The 2-DOF PID's setpoint weights as the continuous loops take them
+/// (PidOptions::setpoint_weight_p, setpoint_weight_d): r enters the
+/// proportional term as b r and the derivative's as c r. They change the loop
+/// from r only, never its poles or the loop from the disturbance.
+struct SetpointWeights {
+  double b = 1.0;
+  double c = 1.0;
+};
+inline SetpointWeights SetpointWeightsOf(const PidOptions& o) {
+  return {o.setpoint_weight_p, o.setpoint_weight_d};
+}
+
 /// The continuous closed loop as one linear system w' = M w with
 /// w = [x (plant); z = \int e; v (filter, only when tf > 0); r; exo],
 /// y = C x. The reference and the
@@ -217,7 +229,8 @@ void FinishClosedLoop(const StateSpace& plant, const Disturbance& disturbance, d
 /// The filtered PID's loop (see BuildContinuousClosedLoop); g.tf > 0.
 template <typename T>
 bool BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, const Disturbance& disturbance,
-                             ContinuousClosedLoop<T>* out, std::string* error, double reference) {
+                             ContinuousClosedLoop<T>* out, std::string* error, double reference,
+                             const SetpointWeights& weights = {}) {
   if (!std::isfinite(ToDouble(g.tf))) {
     if (error) *error = "the derivative filter tf is not finite";
     return false;
@@ -230,12 +243,12 @@ bool BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, con
   const T kf = g.kd / g.tf;  // the derivative's high-frequency gain
   const T inv_tf = T(1.0) / g.tf;
   MatrixX<T> m = MatrixX<T>::Zero(size, size);
-  // u = (kp + kf) (r - C x) + ki z - kf v, as a row over w.
+  // u = kp (b r - C x) + ki z + kf (c r - C x - v), as a row over w.
   VectorX<T> u_row = VectorX<T>::Zero(size);
   for (int j = 0; j < n; ++j) u_row(j) = -(g.kp + kf) * plant.c(j);
   u_row(iz) = g.ki;
   u_row(iv) = -kf;
-  u_row(ir) = g.kp + kf;
+  u_row(ir) = g.kp * T(weights.b) + kf * T(weights.c);
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < n; ++j) m(i, j) = T(plant.a(i, j));
     for (int j = 0; j < size; ++j) m(i, j) += plant.b(i) * u_row(j);
@@ -247,7 +260,7 @@ bool BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, con
   }
   m(iz, ir) = T(1.0);
   m(iv, iv) = -inv_tf;
-  m(iv, ir) = inv_tf;
+  m(iv, ir) = inv_tf * T(weights.c);  // v' = (c r - C x - v) / tf
   VectorX<T> w0 = VectorX<T>::Zero(size);
   w0(ir) = T(reference);
   FinishClosedLoop<T>(plant, disturbance, reference, /*filter_order=*/1, exo, std::move(m), std::move(w0),
@@ -264,10 +277,14 @@ bool BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, con
 /// The filtered PID (g.tf > 0) has one more state v = e / (tf s + 1):
 ///   v' = (e - v) / tf,  u = kp e + ki z + (kd / tf) (e - v),
 /// no impulse (x(0+) = 0) and no algebraic loop (the plant is strictly proper).
+/// With setpoint weights b, c (2-DOF) r enters as kp b r and kd c r' (the
+/// impulse kd c A), or as (kp b + kf c) r and v' = (c r - C x - v) / tf.
 template <typename T>
 bool BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, const Disturbance& disturbance,
-                               ContinuousClosedLoop<T>* out, std::string* error, double reference = 1.0) {
-  if (ToDouble(g.tf) > 0.0) return BuildFilteredClosedLoop(plant, g, disturbance, out, error, reference);
+                               ContinuousClosedLoop<T>* out, std::string* error, double reference = 1.0,
+                               const SetpointWeights& weights = {}) {
+  if (ToDouble(g.tf) > 0.0)
+    return BuildFilteredClosedLoop(plant, g, disturbance, out, error, reference, weights);
   const int n = plant.order();
   const DisturbanceKind kind = disturbance.options().kind;
   const int exo = kind == DisturbanceKind::kNone ? 0 : (kind == DisturbanceKind::kSine ? 2 : 1);
@@ -286,7 +303,7 @@ bool BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
   VectorX<T> u_row = VectorX<T>::Zero(size);
   for (int j = 0; j < n; ++j) u_row(j) = -alpha * (g.kp * plant.c(j) + g.kd * ca(j));
   u_row(iz) = alpha * g.ki;
-  u_row(ir) = alpha * g.kp;
+  u_row(ir) = alpha * (g.kp * T(weights.b));
   if (exo > 0) u_row(ie) = -alpha * g.kd * cb;
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < n; ++j) m(i, j) = T(plant.a(i, j));
@@ -296,7 +313,7 @@ bool BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
   for (int j = 0; j < n; ++j) m(iz, j) = T(-plant.c(j));
   m(iz, ir) = T(1.0);
   VectorX<T> w0 = VectorX<T>::Zero(size);
-  for (int i = 0; i < n; ++i) w0(i) = alpha * g.kd * (reference * plant.b(i));
+  for (int i = 0; i < n; ++i) w0(i) = alpha * g.kd * T(weights.c) * (reference * plant.b(i));
   w0(ir) = T(reference);
   FinishClosedLoop<T>(plant, disturbance, reference, /*filter_order=*/0, exo, std::move(m), std::move(w0),
                       out);
@@ -455,10 +472,10 @@ std::optional<bool> CountedSampledStability(const DiscretePlant& plant, const Pi
 // every file that runs them; other scalars (Ceres's Jet) instantiate here.
 extern template bool BuildFilteredClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
                                                      const Disturbance&, ContinuousClosedLoop<double>*,
-                                                     std::string*, double);
+                                                     std::string*, double, const SetpointWeights&);
 extern template bool BuildContinuousClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
                                                        const Disturbance&, ContinuousClosedLoop<double>*,
-                                                       std::string*, double);
+                                                       std::string*, double, const SetpointWeights&);
 extern template void SampleContinuousLoop<double>(const ContinuousClosedLoop<double>&, const Disturbance&,
                                                   double, int, std::vector<double>*);
 extern template PidStatus RunSampledLoop<double>(const DiscretePlant&, const PidGainsT<double>&,

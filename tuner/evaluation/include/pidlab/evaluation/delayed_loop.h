@@ -53,11 +53,11 @@ struct DelayedClosedLoop {
 bool DelayedLoopIsRetarded(const TransferFunction& tf, const PidGains& loop_gains, std::string* error);
 
 /// Builds the delayed loop of `plant` (Realize(tf)) with the loop's gains
-/// (LoopGains), the disturbance and reference A. False with *error as
-/// DelayedLoopIsRetarded.
+/// (LoopGains), the disturbance, reference A and the 2-DOF setpoint weights
+/// (closed_loop.h). False with *error as DelayedLoopIsRetarded.
 bool BuildDelayedClosedLoop(const TransferFunction& tf, const StateSpace& plant, const PidGains& loop_gains,
                             const Disturbance& disturbance, double delay_s, double reference,
-                            DelayedClosedLoop* out, std::string* error);
+                            DelayedClosedLoop* out, std::string* error, const SetpointWeights& weights = {});
 
 /// The step h = L / m, m = ceil(L / h_max), h_max = kDelayedStepFraction /
 /// rho, rho the largest modulus among the eigenvalues of the open system m

@@ -16,6 +16,7 @@
 #include "pidlab/optim/multi_start.h"
 #include "pidlab/optim/optimizer.h"
 #include "pidlab/tune/tuning_rules.h"
+#include "pidlab/tune/two_dof.h"
 #include "pidlab/tune/ziegler_nichols.h"
 
 namespace pidlab::tune {
@@ -97,6 +98,10 @@ struct TuneOptions {
   /// (1, 2, 1/2, 1/2).
   bool adaptive = false;
   std::uint64_t seed = 1;
+  /// `tune --two-dof` (docs/two_dof.md): after the feedback gains, the
+  /// setpoint weights b, c for the setpoint step with the gains fixed
+  /// (TuneSetpointWeights); TuneSummary::two_dof.
+  bool two_dof = false;
   /// Constraints on the undisturbed step response (+inf = none): a candidate
   /// violating them is rejected like an unstable loop.
   double max_overshoot_pct = std::numeric_limits<double>::infinity();
@@ -274,6 +279,8 @@ struct TuneSummary {
   /// an edge the box may have cut short. Empty for a rule (no box) and when
   /// no stable loop was found.
   std::vector<std::string> at_bounds;
+  /// TuneOptions::two_dof: the setpoint weights found and both responses.
+  TwoDofSummary two_dof;
   /// The search's one-line summary, or why no strictly stable loop was found.
   std::string message;
   /// One line: method, gains, objective, evaluations and the refine verdict.

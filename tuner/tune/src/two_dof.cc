@@ -1,0 +1,101 @@
+#include "pidlab/tune/two_dof.h"
+
+#include <cmath>
+#include <limits>
+
+#include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/evaluation/evaluation.h"
+#include "pidlab/optim/nelder_mead.h"
+
+namespace pidlab::tune {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+evaluation::LoopOptions Weighted(evaluation::LoopOptions loop, double b, double c) {
+  loop.pid.setpoint_weight_p = b;
+  loop.pid.setpoint_weight_d = c;
+  return loop;
+}
+
+// The setpoint step's IAE with weights b, c: the loop without its
+// disturbance; +inf where it cannot be evaluated.
+double SetpointIae(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& loop, double b,
+                   double c) {
+  evaluation::LoopOptions o = Weighted(loop, b, c);
+  o.disturbance = DisturbanceOptions{};
+  evaluation::EvaluateOptions what;
+  what.compute_step_info = false;
+  what.compute_iae_continuous = false;
+  evaluation::Evaluation ev;
+  if (!evaluation::Evaluate(plant, gains, o, what, &ev, nullptr) || !ev.stability.stable) return kInf;
+  return std::isfinite(ev.iae) ? ev.iae : kInf;
+}
+
+bool Respond(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& loop, double b,
+             double c, TwoDofResponse* r, std::string* error) {
+  evaluation::LoopOptions o = Weighted(loop, b, c);
+  o.disturbance = DisturbanceOptions{};
+  evaluation::Evaluation ev;
+  if (!evaluation::Evaluate(plant, gains, o, evaluation::EvaluateOptions{}, &ev, error)) return false;
+  analysis::LoopAnalysis a;
+  if (!analysis::AnalyzeLoop(plant, gains, o, analysis::LoopAnalysisOptions{}, &a, error)) return false;
+  r->b = b;
+  r->c = c;
+  r->setpoint_iae = ev.iae;
+  r->overshoot_pct = ev.step.overshoot_pct;
+  r->rise_time_s = ev.step.rise_time_s;
+  r->settling_time_s = ev.step.settling_time_s;
+  r->load_iae = ev.load_iae;
+  r->ms = a.ms;
+  return true;
+}
+
+}  // namespace
+
+bool TuneSetpointWeights(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& loop,
+                         TwoDofSummary* summary, std::string* error) {
+  *summary = TwoDofSummary();
+  const double b0 = loop.pid.setpoint_weight_p, c0 = loop.pid.setpoint_weight_d;
+  if (!Respond(plant, gains, loop, b0, c0, &summary->before, error)) return false;
+  const auto f = [&](const Eigen::VectorXd& x) { return SetpointIae(plant, gains, loop, x(0), x(1)); };
+  // A grid first (the IAE of a weighted loop can have several minima), then
+  // Nelder-Mead in the box from its best point.
+  Eigen::VectorXd best = Eigen::Vector2d(b0, c0);
+  double best_f = f(best);
+  int evaluations = 1;
+  for (int i = 0; i < kTwoDofGridPoints; ++i) {
+    for (int j = 0; j < kTwoDofGridPoints; ++j) {
+      const Eigen::Vector2d x(i / (kTwoDofGridPoints - 1.0), j / (kTwoDofGridPoints - 1.0));
+      const double v = f(x);
+      ++evaluations;
+      if (v < best_f) best_f = v, best = x;
+    }
+  }
+  if (!std::isfinite(best_f)) {
+    summary->evaluations = evaluations;
+    summary->message = "the setpoint response cannot be evaluated for any weights";
+    return true;
+  }
+  optim::NelderMeadOptions nm;
+  nm.x0 = best;
+  nm.max_evaluations = kTwoDofMaxEvaluations;
+  nm.x_tolerance = 1e-7;
+  optim::OptimizerSummary opt;
+  optim::NelderMead(f, optim::Bounds{Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(1.0, 1.0)}, nm, &opt);
+  summary->evaluations = evaluations + opt.evaluations;
+  summary->termination = opt.termination;
+  summary->message = opt.message;
+  if (opt.IsUsable() && opt.f < best_f) best = opt.x;
+  summary->b = best(0);
+  summary->c = best(1);
+  if (!Respond(plant, gains, loop, summary->b, summary->c, &summary->after, error)) return false;
+  summary->ran = true;
+  return true;
+}
+
+evaluation::LoopOptions WithSetpointWeights(evaluation::LoopOptions loop, const TwoDofSummary& summary) {
+  return summary.ran ? Weighted(loop, summary.b, summary.c) : loop;
+}
+
+}  // namespace pidlab::tune
