@@ -156,9 +156,11 @@ class Reference {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+bool IsFixed(Scalar s) { return s == Scalar::kQ31 || s == Scalar::kQ15; }
+
 /// A random controller: every integration rule and anti-windup, filter on
 /// or off, limits or none, derivative on error or measurement.
-Controller RandomController(std::mt19937* rng) {
+Controller RandomController(std::mt19937* rng, Scalar scalar) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   Controller c;
   c.gains.kp = 10.0 * unit(*rng);
@@ -170,6 +172,14 @@ Controller RandomController(std::mt19937* rng) {
   c.pid.output_min = limits == 0 || limits == 2 ? -kInf : -0.5 - 2.0 * unit(*rng);
   c.pid.output_max = limits == 0 || limits == 3 ? kInf : 0.5 + 2.0 * unit(*rng);
   c.pid.anti_windup = static_cast<AntiWindup>(static_cast<int>(3.0 * unit(*rng)));
+  if (IsFixed(scalar)) {
+    // Fixed point: finite limits (they set the output's scale) and an
+    // anti-windup (without one its integrator saturates where DiscretePid's
+    // grows on: documented, tested apart).
+    c.pid.output_min = -0.5 - 2.0 * unit(*rng);
+    c.pid.output_max = 0.5 + 2.0 * unit(*rng);
+    if (c.pid.anti_windup == AntiWindup::kNone) c.pid.anti_windup = AntiWindup::kClamping;
+  }
   c.pid.back_calculation_gain = 0.1 + 50.0 * unit(*rng);
   c.pid.integral = static_cast<IntegralMethod>(static_cast<int>(3.0 * unit(*rng)));
   if (unit(*rng) < 0.5) {
@@ -203,6 +213,8 @@ std::string ShimPath(const char* name) { return std::string(PIDLAB_EXPORT_TEST_D
 GeneratedCode Code(Scalar scalar, const Controller& c) {
   Options o;
   o.scalar = scalar;
+  o.input_min = -4.0;
+  o.input_max = 4.0;
   o.plant = "oscillator = 1/(s^2+1)";
   o.spec_json = "{\"plant\": \"oscillator\", \"gains\": [1, 2, 3]}";
   o.pidlab_version = "test";
@@ -215,6 +227,7 @@ struct Comparison {
   long jumps = 0;
   double worst_relative = 0.0;       // to Scale(u, peak)
   double worst_relative_to_u = 0.0;  // to Scale(u, no peak)
+  double worst_lsb = 0.0;            // fixed point: |u_q - u| in LSB of the output
 };
 
 /// Scale of the output for a relative error: the largest of |u|, the
@@ -228,7 +241,10 @@ double Scale(double u, const Reference& ref, bool peak = true) {
 }
 
 /// An output limit as the scalar holds it.
-double Limit(double v, Scalar scalar) { return scalar == Scalar::kFloat ? static_cast<float>(v) : v; }
+double Limit(double v, Scalar scalar, const CompiledModule& m) {
+  if (IsFixed(scalar)) return m.quantize_output_(v);
+  return scalar == Scalar::kFloat ? static_cast<float>(v) : v;
+}
 
 /// A random event between steps: a gain change, a sample-time change, a
 /// switch of c, manual/auto.
@@ -241,22 +257,30 @@ void RandomEvent(std::mt19937* rng, const CompiledModule& m, void* dut, Referenc
     g.ki = 20.0 * unit(*rng);
     g.kd = unit(*rng);
     g.tf = unit(*rng) < 0.3 ? 0.0 : 0.001 + 0.1 * unit(*rng);
-    ASSERT_EQ(m.set_gains_(dut, g.kp, g.ki, g.kd, g.tf), 0);
+    if (m.quantize_input_) g.kd *= 100.0 * ref->options().dt_s;
+    const int status = m.set_gains_(dut, g.kp, g.ki, g.kd, g.tf);
+    if (status == 3 && m.quantize_input_) return;  // beyond the fixed-point range analysis: refused
+    ASSERT_EQ(status, 0);
     ref->SetGains(g);
   } else if (what < 0.5) {
     const double dt = std::pow(10.0, -4.0 + 2.0 * unit(*rng));
-    ASSERT_EQ(m.set_sample_time_(dut, dt), 0);
+    const int status = m.set_sample_time_(dut, dt);
+    if (status == 3 && m.quantize_input_) return;
+    ASSERT_EQ(status, 0);
     ref->SetSampleTime(dt);
   } else if (what < 0.6) {
     const double c = ref->c() == 1.0 ? 0.0 : 1.0;
-    ASSERT_EQ(m.set_weights_(dut, 1.0, c), 0);
+    const int status = m.set_weights_(dut, 1.0, c);
+    if (status == 3 && m.quantize_input_) return;
+    ASSERT_EQ(status, 0);
     ref->SetC(c);
   } else if (ref->manual() && what < 0.8) {
     m.set_auto_(dut);
     ref->SetAuto();
     ++out->manual_switches;
   } else {
-    const double u = -3.0 + 6.0 * unit(*rng);
+    double u = -3.0 + 6.0 * unit(*rng);
+    if (m.quantize_output_) u = m.quantize_output_(u);
     ASSERT_EQ(m.set_manual_(dut, u), 0);
     ref->SetManual(u);
     ++out->manual_switches;
@@ -266,13 +290,18 @@ void RandomEvent(std::mt19937* rng, const CompiledModule& m, void* dut, Referenc
 
 /// `steps` random steps of the compiled module against the reference.
 /// exact: compare bits; else the relative error's worst case.
-Comparison RunRandom(Scalar scalar, std::uint32_t seed, int controllers, int steps_each) {
+Comparison RunRandom(Scalar scalar, std::uint32_t seed, int controllers, int steps_each,
+                     double lsb_tolerance = 0.0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   Comparison out;
   for (int n = 0; n < controllers; ++n) {
-    const Controller c = RandomController(&rng);
-    CompiledModule m(Code(scalar, c), ShimPath("shim_real.c"));
+    Controller c = RandomController(&rng, scalar);
+    if (IsFixed(scalar)) {
+      // A derivative the fixed-point range analysis takes (kd/dt <= 100).
+      c.gains.kd *= 100.0 * c.pid.dt_s;
+    }
+    CompiledModule m(Code(scalar, c), ShimPath(IsFixed(scalar) ? "shim_fixed.c" : "shim_real.c"));
     PidGains g = c.gains;
     g.tf = EffectiveDerivativeFilter(c.gains, c.pid);
     PidOptions o = c.pid;
@@ -293,14 +322,25 @@ Comparison RunRandom(Scalar scalar, std::uint32_t seed, int controllers, int ste
         r = static_cast<float>(r);
         y = static_cast<float>(y);
       }
+      if (IsFixed(scalar)) {
+        r = m.quantize_input_(r);
+        y = m.quantize_input_(y);
+      }
       if (unit(rng) < 0.004) RandomEvent(&rng, m, dut, &ref, &out);
       double u_ref = 0.0, u_dut = 0.0;
       const int s_ref = ref.Step(r, y, &u_ref);
       const int s_dut = m.step_(dut, r, y, &u_dut);
       ++out.steps;
       if (s_ref == 1) ++out.saturated;
-      const bool same = scalar == Scalar::kDouble ? SameBits(u_ref, u_dut) && s_ref == s_dut
-                                                  : std::fabs(u_dut - u_ref) <= 1e-5 * Scale(u_ref, ref);
+      bool same = false;
+      if (scalar == Scalar::kDouble)
+        same = SameBits(u_ref, u_dut) && s_ref == s_dut;
+      else if (scalar == Scalar::kFloat)
+        same = std::fabs(u_dut - u_ref) <= 1e-5 * Scale(u_ref, ref);
+      else
+        same = std::fabs(u_dut - u_ref) <= lsb_tolerance * m.output_lsb_();
+      if (IsFixed(scalar))
+        out.worst_lsb = std::max(out.worst_lsb, std::fabs(u_dut - u_ref) / m.output_lsb_());
       if (!same && ++out.mismatches <= 5)
         ADD_FAILURE() << "controller " << n << " (dt " << ref.options().dt_s << ", tf " << ref.gains().tf
                       << ", kd " << ref.gains().kd << ", kp " << ref.gains().kp << ", ki " << ref.gains().ki
@@ -310,7 +350,8 @@ Comparison RunRandom(Scalar scalar, std::uint32_t seed, int controllers, int ste
       out.worst_relative = std::max(out.worst_relative, std::fabs(u_dut - u_ref) / Scale(u_ref, ref));
       out.worst_relative_to_u =
           std::max(out.worst_relative_to_u, std::fabs(u_dut - u_ref) / Scale(u_ref, ref, /*peak=*/false));
-      if (u_dut > Limit(ref.options().output_max, scalar) || u_dut < Limit(ref.options().output_min, scalar))
+      if (u_dut > Limit(ref.options().output_max, scalar, m) ||
+          u_dut < Limit(ref.options().output_min, scalar, m))
         ++out.outside_limits;
       // No jump at a manual-to-auto switch: the first automatic output moves
       // from the manual one by no more than the inputs moved it.
@@ -344,6 +385,29 @@ TEST(ExportedPid, FloatIsWithin1e5RelativeOfDiscretePidOver100000RandomSteps) {
       "float: worst |u_float - u_double| / max(|u|, limits' half span, largest term so far) = %.3g; "
       "/ max(|u|, half span) = %.3g\n",
       c.worst_relative, c.worst_relative_to_u);
+}
+
+TEST(ExportedPid, Q31IsWithin2LsbOfDiscretePidOver100000RandomSteps) {
+  const Comparison c = RunRandom(Scalar::kQ31, 31, 20, 5000, 2.0);
+  EXPECT_EQ(c.steps, 100000);
+  EXPECT_GT(c.changes, 200);
+  EXPECT_GT(c.manual_switches, 50);
+  EXPECT_EQ(c.mismatches, 0) << "worst " << c.worst_lsb << " LSB";
+  EXPECT_EQ(c.outside_limits, 0);
+  EXPECT_GT(c.saturated, 1000);
+  EXPECT_EQ(c.jumps, 0);
+  std::printf("q31: worst |u_q31 - u_double| = %.3g LSB; %ld saturated steps, %ld changes\n", c.worst_lsb,
+              c.saturated, c.changes);
+}
+
+TEST(ExportedPid, Q15IsWithin1LsbOfDiscretePidOver100000RandomSteps) {
+  const Comparison c = RunRandom(Scalar::kQ15, 15, 20, 5000, 1.0);
+  EXPECT_EQ(c.steps, 100000);
+  EXPECT_GT(c.changes, 200);
+  EXPECT_EQ(c.mismatches, 0) << "worst " << c.worst_lsb << " LSB";
+  EXPECT_EQ(c.outside_limits, 0);
+  EXPECT_EQ(c.jumps, 0);
+  std::printf("q15: worst |u_q15 - u_double| = %.3g LSB\n", c.worst_lsb);
 }
 
 }  // namespace

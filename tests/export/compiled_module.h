@@ -57,6 +57,11 @@ class CompiledModule {
     Load(&set_gains_, "shim_set_gains");
     Load(&set_weights_, "shim_set_setpoint_weights");
     Load(&set_sample_time_, "shim_set_sample_time");
+    // Fixed point only (shim_fixed.c).
+    quantize_input_ = reinterpret_cast<double (*)(double)>(dlsym(handle_, "shim_quantize_input"));
+    quantize_output_ = reinterpret_cast<double (*)(double)>(dlsym(handle_, "shim_quantize_output"));
+    output_lsb_ = reinterpret_cast<double (*)()>(dlsym(handle_, "shim_output_lsb"));
+    step_raw_ = reinterpret_cast<int (*)(void*, long, long, long*)>(dlsym(handle_, "shim_step_raw"));
   }
   ~CompiledModule() {
     if (handle_) dlclose(handle_);
@@ -74,6 +79,10 @@ class CompiledModule {
   int (*set_gains_)(void*, double, double, double, double) = nullptr;
   int (*set_weights_)(void*, double, double) = nullptr;
   int (*set_sample_time_)(void*, double) = nullptr;
+  double (*quantize_input_)(double) = nullptr;
+  double (*quantize_output_)(double) = nullptr;
+  double (*output_lsb_)() = nullptr;
+  int (*step_raw_)(void*, long, long, long*) = nullptr;
 
  private:
   template <typename F>

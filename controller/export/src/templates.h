@@ -7,6 +7,9 @@ namespace pidlab::controller_export::internal {
 /// (the initializer's lines) in the source.
 extern const char* const kRealHeader;
 extern const char* const kRealSource;
+/// Fixed point (q31, q15): @COMMENT@ and the scalings (fixed_point.cc).
+extern const char* const kFixedHeader;
+extern const char* const kFixedSource;
 
 }  // namespace pidlab::controller_export::internal
 
