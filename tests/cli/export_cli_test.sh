@@ -4,16 +4,18 @@
 # firmware-like harness (tests/export/harness.c) runs clean under
 # AddressSanitizer and UBSan, --from takes a --json result's spec and gains,
 # and bad input exits 2 with one line naming the value.
-# Usage: export_cli_test.sh PIDLAB_BINARY HARNESS_C
+# docs/export.md's command lines run as written and its example loop compiles.
+# Usage: export_cli_test.sh PIDLAB_BINARY HARNESS_C EXPORT_MD
 set -uo pipefail
 source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 
-if [[ $# -ne 2 ]]; then
-  echo "usage: $0 PIDLAB_BINARY HARNESS_C" >&2
+if [[ $# -ne 3 ]]; then
+  echo "usage: $0 PIDLAB_BINARY HARNESS_C EXPORT_MD" >&2
   exit 2
 fi
 pidlab=$(realpath -- "$1")
 harness=$(realpath -- "$2")
+doc=$(realpath -- "$3")
 [[ -x $pidlab ]] || { echo "FAIL: $pidlab is not an executable" >&2; exit 1; }
 
 work=$(mktemp -d)
@@ -126,6 +128,33 @@ bad "q15 without output limits" "--output-limits" --gains 1,1,1 --input-range -1
 bad "an empty input range" "input range" --gains 1,1,1 --output-limits -1,1 --input-range 1,1 --lang c --out x \
   --scalar q31
 bad "unwritable --out" "/proc/pidlab" --gains 1,1,1 --lang c --out /proc/pidlab
+
+# ---- docs/export.md: the sh block's commands as written (pidlab on PATH),
+# the C block compiled against each floating-point module they wrote.
+mkdir doc && cd doc || exit 1
+mkdir bin && ln -s "$pidlab" bin/pidlab
+awk '/^```sh$/{on=1; next} /^```$/{on=0} on' "$doc" >commands.sh
+awk '/^```c$/{on=1; next} /^```$/{on=0} on' "$doc" >example.c
+if [[ $(wc -l <commands.sh) -lt 3 || $(wc -l <example.c) -lt 15 ]]; then
+  fail "docs/export.md: no sh block or no C example ($(wc -l <commands.sh) and $(wc -l <example.c) lines)"
+elif PATH="$PWD/bin:$PATH" bash -euo pipefail commands.sh >commands.out 2>&1; then
+  pass "docs/export.md: its $(wc -l <commands.sh) command lines run as written"
+  for dir in firmware firmware_float; do
+    for cc in gcc clang; do
+      if "$cc" "${strict[@]}" -I"$dir" -c example.c -o /dev/null 2>cc.log &&
+        "$cc" "${strict[@]}" -c "$dir/pidlab_pid.c" -o /dev/null 2>>cc.log; then
+        pass "docs/export.md: the example loop compiles with $cc on $dir"
+      else
+        fail "docs/export.md: the example loop on $dir with $cc: $(head -c 600 cc.log)"
+      fi
+    done
+  done
+  grep -q 'the range analysis' firmware_q31/pidlab_pid.h && pass "docs/export.md: the q31 module has its analysis" ||
+    fail "docs/export.md: firmware_q31 has no range analysis"
+else
+  fail "docs/export.md: its commands: $(tail -c 600 commands.out)"
+fi
+cd .. || exit 1
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]
