@@ -16,7 +16,7 @@ typedef pidlab_q value;
 typedef double parameter;
 #define TO_VALUE_IN(x) PIDLAB_INPUT_Q(x)
 #define TO_VALUE_OUT(x) PIDLAB_OUTPUT_Q(x)
-#define FROM_VALUE_OUT(q) ((double)(q) * PIDLAB_OUTPUT_FULL_SCALE / (double)((int64_t)1 << PIDLAB_Q_BITS))
+#define FROM_VALUE_OUT(q) ((double)(q)*PIDLAB_OUTPUT_FULL_SCALE / (double)((int64_t)1 << PIDLAB_Q_BITS))
 #define HAS_MIN(c) 1
 #define HAS_MAX(c) 1
 #else
@@ -57,10 +57,11 @@ static void run(pidlab_pid *pid) {
                                  pid->config.tf) == PIDLAB_PID_OK,
             "set_gains", k);
     if (k == 9000)
-      check(pidlab_pid_set_sample_time(pid, (parameter)(pid->config.dt_s * 1.5)) == PIDLAB_PID_OK, "set_sample_time",
-            k);
+      check(pidlab_pid_set_sample_time(pid, (parameter)(pid->config.dt_s * 1.5)) == PIDLAB_PID_OK,
+            "set_sample_time", k);
     if (k == 11000)
-      check(pidlab_pid_set_setpoint_weights(pid, (parameter)0.5, (parameter)0) == PIDLAB_PID_OK, "set_weights", k);
+      check(pidlab_pid_set_setpoint_weights(pid, (parameter)0.5, (parameter)0) == PIDLAB_PID_OK,
+            "set_weights", k);
     if (k == 12000) r = -0.5;
     status = pidlab_pid_step(pid, TO_VALUE_IN(r), TO_VALUE_IN(y), &u);
     check(status == PIDLAB_PID_OK || status == PIDLAB_PID_SATURATED, "step status", k);
@@ -84,8 +85,8 @@ static void run(pidlab_pid *pid) {
       pidlab_pid_step(pid, top, bottom, &u);
       check(inside(pid, FROM_VALUE_OUT(u)), "extreme inputs: u inside the limits", k);
       if (k > 2 && pid->config.kp > 0.0)
-        check(FROM_VALUE_OUT(u) > pid->config.output_max - 1e-6 * pid->config.output_max, "extreme inputs saturate high",
-              k);
+        check(FROM_VALUE_OUT(u) > pid->config.output_max - 1e-6 * pid->config.output_max,
+              "extreme inputs saturate high", k);
     }
     pidlab_pid_step(pid, bottom, top, &u);
     check(inside(pid, FROM_VALUE_OUT(u)), "extreme inputs reversed: u inside the limits", k);

@@ -99,4 +99,6 @@ int shim_set_setpoint_weights(void *pid, double b, double c) {
   return (int)pidlab_pid_set_setpoint_weights((pidlab_pid *)pid, b, c);
 }
 
-int shim_set_sample_time(void *pid, double dt_s) { return (int)pidlab_pid_set_sample_time((pidlab_pid *)pid, dt_s); }
+int shim_set_sample_time(void *pid, double dt_s) {
+  return (int)pidlab_pid_set_sample_time((pidlab_pid *)pid, dt_s);
+}

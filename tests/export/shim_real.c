@@ -59,7 +59,9 @@ int shim_step(void *pid, double r, double y, double *u) {
   return status;
 }
 
-int shim_set_manual(void *pid, double u) { return (int)pidlab_pid_set_manual((pidlab_pid *)pid, (pidlab_real)u); }
+int shim_set_manual(void *pid, double u) {
+  return (int)pidlab_pid_set_manual((pidlab_pid *)pid, (pidlab_real)u);
+}
 
 void shim_set_auto(void *pid) { pidlab_pid_set_auto((pidlab_pid *)pid); }
 

@@ -81,8 +81,8 @@ static int finite(double x) { return x - x == 0.0; }
 /* The controller's share of transport::ParseEpisodeConfig: what it uses. */
 static const char *config_error(const pidlab_lcmt_episode_config *m) {
   if (m->episode_id == 0) return "episode id 0";
-  if (!(finite(m->kp) && m->kp >= 0 && m->kp <= MAX_GAIN && finite(m->ki) && m->ki >= 0 && m->ki <= MAX_GAIN &&
-        finite(m->kd) && m->kd >= 0 && m->kd <= MAX_GAIN))
+  if (!(finite(m->kp) && m->kp >= 0 && m->kp <= MAX_GAIN && finite(m->ki) && m->ki >= 0 &&
+        m->ki <= MAX_GAIN && finite(m->kd) && m->kd >= 0 && m->kd <= MAX_GAIN))
     return "a gain is not finite, >= 0 and at most 1e12";
   if (!finite(m->reference)) return "reference not finite";
   if (!(finite(m->dt_s) && m->dt_s > 0)) return "dt not positive and finite";
@@ -96,7 +96,8 @@ static const char *config_error(const pidlab_lcmt_episode_config *m) {
   if (!strcmp(m->anti_windup, "back-calculation") &&
       !(finite(m->back_calculation_gain) && m->back_calculation_gain > 0))
     return "back-calculation gain";
-  if (strcmp(m->derivative_on, "error") && strcmp(m->derivative_on, "measurement")) return "derivative-on unknown";
+  if (strcmp(m->derivative_on, "error") && strcmp(m->derivative_on, "measurement"))
+    return "derivative-on unknown";
   if (strcmp(m->integral, "backward-euler") && strcmp(m->integral, "forward-euler") &&
       strcmp(m->integral, "trapezoidal"))
     return "integral unknown";
@@ -127,7 +128,8 @@ static void to_config(const pidlab_lcmt_episode_config *m, pidlab_pid_config *p)
                                                       : PIDLAB_INTEGRAL_BACKWARD_EULER;
 }
 
-static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_lcmt_episode_config *m, void *user) {
+static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_lcmt_episode_config *m,
+                      void *user) {
   controller *c = (controller *)user;
   pidlab_pid_config config;
   const char *error;
@@ -140,11 +142,12 @@ static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
   }
   error = config_error(m);
   to_config(m, &config);
-  if (!error && pidlab_pid_init(&c->pid, &config) != PIDLAB_PID_OK) error = "the module refused the configuration";
+  if (!error && pidlab_pid_init(&c->pid, &config) != PIDLAB_PID_OK)
+    error = "the module refused the configuration";
   if (error) {
     ++c->bad_configs;
-    fprintf(stderr, "pidlab-controller-c: ignoring configuration of episode %lld: %s\n", (long long)m->episode_id,
-            error);
+    fprintf(stderr, "pidlab-controller-c: ignoring configuration of episode %lld: %s\n",
+            (long long)m->episode_id, error);
     return;
   }
   c->episode_id = m->episode_id;
@@ -170,7 +173,8 @@ static void publish_last(controller *c) {
   pidlab_lcmt_control_command_publish(c->lcm[kControlLane], name, &c->last);
 }
 
-static void on_output(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_lcmt_plant_output *m, void *user) {
+static void on_output(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_lcmt_plant_output *m,
+                      void *user) {
   controller *c = (controller *)user;
   (void)rbuf;
   (void)ch;
