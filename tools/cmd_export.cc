@@ -69,6 +69,17 @@ void LoadResult(const std::string& path, spec::EvaluateSpec* s) {
   }
 }
 
+/// The setpoint weights b, c from the PID options, where PidOptions holds
+/// them (the 2-DOF PID: the spec's --setpoint-weights, and c = 0 for
+/// derivative on measurement); without those fields, nothing.
+template <typename O>
+auto WeightsFromOptions(const O& pid, Controller* c, int) -> decltype(pid.setpoint_weight_p, void()) {
+  c->setpoint_weight_b = pid.setpoint_weight_p;
+  c->setpoint_weight_c = pid.setpoint_weight_d;
+}
+template <typename O>
+void WeightsFromOptions(const O&, Controller*, long) {}
+
 /// One line naming the plant, for the header comment.
 std::string DescribePlant(const spec::PlantSpec& p) {
   if (p.plant.empty()) return "not given (no --plant)";
@@ -137,12 +148,17 @@ struct ExportCommand {
     Controller c;
     c.gains = LoopGains(g, loop);
     c.pid = PidOptionsAt(loop.pid, loop.dt_s);
-    if (c.pid.derivative_on == DerivativeOn::kMeasurement) c.setpoint_weight_c = 0.0;
+    const bool on_measurement = s.loop.derivative_on == "measurement";
+    if (on_measurement) c.setpoint_weight_c = 0.0;
+    WeightsFromOptions(c.pid, &c, 0);
     if (!setpoint_weights.empty()) {
       if (setpoint_weights.size() != 2)
         throw BadInput("--setpoint-weights " + FlagText(setpoint_weights) + " must be two numbers B,C");
       c.setpoint_weight_b = setpoint_weights[0];
       c.setpoint_weight_c = setpoint_weights[1];
+      if (on_measurement && c.setpoint_weight_c != 0.0)
+        throw BadInput("--derivative-on measurement is setpoint weight C = 0, not " +
+                       FlagText(c.setpoint_weight_c));
     }
     Require(controller_export::ControllerIsValid(c, &error), error);
     return c;

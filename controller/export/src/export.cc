@@ -203,8 +203,6 @@ bool ControllerIsValid(const Controller& c, std::string* error) {
     os << "setpoint weight b = " << c.setpoint_weight_b << " must be in [0, 1]";
   else if (!(c.setpoint_weight_c >= 0.0 && c.setpoint_weight_c <= 1.0))
     os << "setpoint weight c = " << c.setpoint_weight_c << " must be in [0, 1]";
-  else if (c.pid.derivative_on == DerivativeOn::kMeasurement && c.setpoint_weight_c != 0.0)
-    os << "derivative on measurement is setpoint weight c = 0, not " << c.setpoint_weight_c;
   else
     return true;
   if (error) *error = os.str();

@@ -35,8 +35,9 @@ struct Controller {
   /// kp, ki, kd and tf (s); tf = 0 takes pid.derivative_filter_s
   /// (EffectiveDerivativeFilter), as DiscretePid does.
   PidGains gains;
-  /// Sample time, limits, anti-windup, integration rule. derivative_on
-  /// measurement sets c = 0 (it must agree with setpoint_weight_c).
+  /// Sample time, limits, anti-windup, integration rule. The derivative's
+  /// signal is setpoint_weight_c's (c = 0: on measurement), whatever else
+  /// the options say.
   PidOptions pid;
   /// Setpoint weight of the proportional term, in [0, 1].
   double setpoint_weight_b = 1.0;
