@@ -17,5 +17,6 @@ std::function<int()> RegisterLinearize(CLI::App* app);
 std::function<int()> RegisterBatch(CLI::App* app);
 std::function<int()> RegisterIdentify(CLI::App* app);
 std::function<int()> RegisterServe(CLI::App* app);
+std::function<int()> RegisterExport(CLI::App* app);
 
 }  // namespace pidlab::cli

@@ -27,6 +27,8 @@ const Command kCommands[] = {
 #endif
     {"evaluate", "evaluate one gain set (IAE, poles, step metrics)", pidlab::cli::RegisterEvaluate},
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
+    {"export", "the discrete PID as a dependency-free C99 module (pidlab_pid.h, pidlab_pid.c)",
+     pidlab::cli::RegisterExport},
     {"identify", "fit a process model (p1d, p2d, p2du, p1di, p2dz, auto) to t, u, y of a CSV or a log",
      pidlab::cli::RegisterIdentify},
     {"linearize", "transfer function of a nonlinear plant's linearisation (stepper_nonlinear)",

@@ -1,0 +1,299 @@
+/* pidlab-controller-c: the controller role of the trio in C, its PID the
+ * module `pidlab export --scalar double` generates (pidlab_pid.c), its
+ * messages lcm-gen -c's, its transport liblcm's C API. It takes
+ * pidlab-controller's place next to `pidlab launch --roles plant,disturbance`
+ * and answers the plant as controller/src/controller_role.cc does
+ * (docs/protocol.md; examples/python_controller.py is the same in Python):
+ * PING -> ALIVE, a configuration -> CONFIG_ACK and a fresh controller,
+ * y_k -> u_k once, a resent y_k -> the same u_k again.
+ *
+ *   pidlab-controller-c [--lcm-url udpm://GROUP:PORT?ttl=N] [--channel-prefix P] [--verbose]
+ *
+ * Not supported: --auth-key (HMAC tags, docs/security.md). */
+#include <lcm/lcm.h>
+#include <signal.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/select.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#include "pidlab_lcmt_control_command.h"
+#include "pidlab_lcmt_episode_config.h"
+#include "pidlab_lcmt_plant_output.h"
+#include "pidlab_lcmt_ready.h"
+#include "pidlab_pid.h"
+
+/* transport/transport.h: PLANT_OUTPUT on the base port + 1, CONTROL on + 2. */
+enum { kPlantOutputLane = 1, kControlLane = 2, kLanes = 3 };
+#define MAX_EPISODE_STEPS 50000000LL
+#define MAX_GAIN 1e12
+
+typedef struct {
+  lcm_t *lcm[kLanes];
+  char prefix[64];
+  int64_t episode_id; /* current episode, 0 before the first */
+  int have_episode;
+  int64_t total_steps, expected;
+  double reference;
+  pidlab_pid pid;
+  pidlab_lcmt_control_command last;
+  int have_last;
+  long episodes, commands, foreign, duplicates, bad_configs, conflicts;
+} controller;
+
+static volatile sig_atomic_t stop = 0;
+static void on_signal(int signo) {
+  (void)signo;
+  stop = 1;
+}
+
+static int64_t now_utime(void) {
+  struct timeval tv;
+  gettimeofday(&tv, NULL);
+  return (int64_t)tv.tv_sec * 1000000 + tv.tv_usec;
+}
+
+static void channel(const controller *c, const char *name, char *out, size_t size) {
+  snprintf(out, size, "%s%s", c->prefix, name);
+}
+
+static void ack(controller *c, int64_t episode_id) {
+  char name[96];
+  char role[] = "controller", detail[] = "";
+  pidlab_lcmt_ready r;
+  memset(&r, 0, sizeof r);
+  r.utime = now_utime();
+  r.episode_id = episode_id;
+  r.step = -1;
+  r.state = episode_id == 0 ? PIDLAB_LCMT_READY_ALIVE : PIDLAB_LCMT_READY_CONFIG_ACK;
+  r.role = role;
+  r.pid = (int32_t)getpid();
+  r.detail = detail;
+  channel(c, "READY", name, sizeof name);
+  pidlab_lcmt_ready_publish(c->lcm[0], name, &r);
+}
+
+static int finite(double x) { return x - x == 0.0; }
+
+/* The controller's share of transport::ParseEpisodeConfig: what it uses. */
+static const char *config_error(const pidlab_lcmt_episode_config *m) {
+  if (m->episode_id == 0) return "episode id 0";
+  if (!(finite(m->kp) && m->kp >= 0 && m->kp <= MAX_GAIN && finite(m->ki) && m->ki >= 0 &&
+        m->ki <= MAX_GAIN && finite(m->kd) && m->kd >= 0 && m->kd <= MAX_GAIN))
+    return "a gain is not finite, >= 0 and at most 1e12";
+  if (!finite(m->reference)) return "reference not finite";
+  if (!(finite(m->dt_s) && m->dt_s > 0)) return "dt not positive and finite";
+  if (m->total_steps < 1 || m->total_steps > MAX_EPISODE_STEPS) return "total steps out of [1, 5e7]";
+  if (!(finite(m->derivative_filter_s) && m->derivative_filter_s >= 0)) return "derivative filter";
+  if (m->output_min != m->output_min || m->output_max != m->output_max || !(m->output_min < m->output_max))
+    return "output limits";
+  if (strcmp(m->anti_windup, "none") && strcmp(m->anti_windup, "clamping") &&
+      strcmp(m->anti_windup, "back-calculation"))
+    return "anti-windup unknown";
+  if (!strcmp(m->anti_windup, "back-calculation") &&
+      !(finite(m->back_calculation_gain) && m->back_calculation_gain > 0))
+    return "back-calculation gain";
+  if (strcmp(m->derivative_on, "error") && strcmp(m->derivative_on, "measurement"))
+    return "derivative-on unknown";
+  if (strcmp(m->integral, "backward-euler") && strcmp(m->integral, "forward-euler") &&
+      strcmp(m->integral, "trapezoidal"))
+    return "integral unknown";
+  return NULL;
+}
+
+/* The episode's configuration as the exported module's: c = 0 is derivative
+ * on measurement, infinite limits are none. */
+static void to_config(const pidlab_lcmt_episode_config *m, pidlab_pid_config *p) {
+  memset(p, 0, sizeof *p);
+  p->kp = m->kp;
+  p->ki = m->ki;
+  p->kd = m->kd;
+  p->tf = m->derivative_filter_s;
+  p->b = 1.0;
+  p->c = strcmp(m->derivative_on, "measurement") ? 1.0 : 0.0;
+  p->dt_s = m->dt_s;
+  p->has_output_min = finite(m->output_min);
+  p->output_min = p->has_output_min ? m->output_min : 0.0;
+  p->has_output_max = finite(m->output_max);
+  p->output_max = p->has_output_max ? m->output_max : 0.0;
+  p->anti_windup = !strcmp(m->anti_windup, "none")       ? PIDLAB_ANTI_WINDUP_NONE
+                   : !strcmp(m->anti_windup, "clamping") ? PIDLAB_ANTI_WINDUP_CLAMPING
+                                                         : PIDLAB_ANTI_WINDUP_BACK_CALCULATION;
+  p->back_calculation_gain = m->back_calculation_gain;
+  p->integral = !strcmp(m->integral, "forward-euler") ? PIDLAB_INTEGRAL_FORWARD_EULER
+                : !strcmp(m->integral, "trapezoidal") ? PIDLAB_INTEGRAL_TRAPEZOIDAL
+                                                      : PIDLAB_INTEGRAL_BACKWARD_EULER;
+}
+
+static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_lcmt_episode_config *m,
+                      void *user) {
+  controller *c = (controller *)user;
+  pidlab_pid_config config;
+  const char *error;
+  (void)rbuf;
+  (void)ch;
+  if (m->episode_id == c->episode_id && c->episode_id != 0) {
+    ++c->duplicates;
+    ack(c, c->episode_id); /* our first acknowledgement may have been lost */
+    return;
+  }
+  error = config_error(m);
+  to_config(m, &config);
+  if (!error && pidlab_pid_init(&c->pid, &config) != PIDLAB_PID_OK)
+    error = "the module refused the configuration";
+  if (error) {
+    ++c->bad_configs;
+    fprintf(stderr, "pidlab-controller-c: ignoring configuration of episode %lld: %s\n",
+            (long long)m->episode_id, error);
+    return;
+  }
+  c->episode_id = m->episode_id;
+  c->have_episode = 1;
+  c->total_steps = m->total_steps;
+  c->reference = m->reference;
+  c->expected = 0;
+  c->have_last = 0;
+  ++c->episodes;
+  ack(c, c->episode_id);
+}
+
+static void on_ready(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_lcmt_ready *m, void *user) {
+  (void)rbuf;
+  (void)ch;
+  if (m->state == PIDLAB_LCMT_READY_PING) ack((controller *)user, 0);
+}
+
+static void publish_last(controller *c) {
+  char name[96];
+  channel(c, "CONTROL", name, sizeof name);
+  c->last.utime = now_utime();
+  pidlab_lcmt_control_command_publish(c->lcm[kControlLane], name, &c->last);
+}
+
+static void on_output(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_lcmt_plant_output *m,
+                      void *user) {
+  controller *c = (controller *)user;
+  (void)rbuf;
+  (void)ch;
+  if (!c->have_episode || m->episode_id != c->episode_id) {
+    ++c->foreign;
+    return;
+  }
+  if (m->step == c->expected && m->step < c->total_steps) {
+    double u = 0.0; /* INVALID_INPUT: the C++ sends the 0.0 its u was initialised with */
+    const pidlab_pid_status status = pidlab_pid_step(&c->pid, c->reference, m->y, &u);
+    c->last.episode_id = c->episode_id;
+    c->last.step = m->step;
+    c->last.t_s = m->t_s;
+    c->last.r = c->reference;
+    c->last.y = m->y;
+    c->last.u = u;
+    c->last.status = status == PIDLAB_PID_OK          ? PIDLAB_LCMT_CONTROL_COMMAND_OK
+                     : status == PIDLAB_PID_SATURATED ? PIDLAB_LCMT_CONTROL_COMMAND_SATURATED
+                                                      : PIDLAB_LCMT_CONTROL_COMMAND_INVALID_INPUT;
+    c->have_last = 1;
+    ++c->expected;
+    ++c->commands;
+    publish_last(c);
+    if (m->step + 1 == c->total_steps)
+      fprintf(stderr, "pidlab-controller-c: episode %lld: done, %lld commands\n", (long long)c->episode_id,
+              (long long)c->expected);
+  } else if (c->have_last && m->step == c->last.step) {
+    if (memcmp(&m->y, &c->last.y, sizeof m->y) != 0)
+      ++c->conflicts; /* a different y for a step already answered: repeat, never compute */
+    else
+      ++c->duplicates; /* the plant did not hear us */
+    publish_last(c);
+  } else {
+    ++c->duplicates;
+  }
+}
+
+/* udpm://GROUP[:PORT][?QUERY] with the port moved by `lane`. */
+static int lane_url(const char *url, int lane, char *out, size_t size) {
+  const char *host = url + 7, *query = strchr(host, '?'), *colon;
+  char address[128];
+  size_t n = query ? (size_t)(query - host) : strlen(host);
+  long port = 7667;
+  if (strncmp(url, "udpm://", 7) != 0 || n == 0 || n >= sizeof address) return 0;
+  memcpy(address, host, n);
+  address[n] = '\0';
+  colon = strrchr(address, ':');
+  if (colon) {
+    char *end;
+    port = strtol(colon + 1, &end, 10);
+    if (*end != '\0' || port < 1 || port > 65535 - kControlLane) return 0;
+    address[colon - address] = '\0';
+  }
+  return snprintf(out, size, "udpm://%s:%ld%s", address, port + lane, query ? query : "") < (int)size;
+}
+
+int main(int argc, char **argv) {
+  static controller c;
+  const char *url = getenv("PIDLAB_LCM_URL"), *prefix = getenv("PIDLAB_CHANNEL_PREFIX");
+  int verbose = 0, i, lane;
+  char name[96];
+  if (!url || !*url) url = "udpm://239.255.76.67:7667?ttl=0";
+  if (!prefix || !*prefix) prefix = "PIDLAB_";
+  for (i = 1; i < argc; ++i) {
+    if (!strcmp(argv[i], "--lcm-url") && i + 1 < argc)
+      url = argv[++i];
+    else if (!strcmp(argv[i], "--channel-prefix") && i + 1 < argc)
+      prefix = argv[++i];
+    else if (!strcmp(argv[i], "--verbose") || !strcmp(argv[i], "-v"))
+      verbose = 1;
+    else {
+      fprintf(stderr, "pidlab-controller-c: error: unknown argument '%.80s'\n", argv[i]);
+      return 2;
+    }
+  }
+  if (strlen(prefix) > 44) {
+    fprintf(stderr, "pidlab-controller-c: error: channel prefix longer than 44 bytes\n");
+    return 2;
+  }
+  snprintf(c.prefix, sizeof c.prefix, "%s", prefix);
+  for (lane = 0; lane < kLanes; ++lane) {
+    char lane_address[256];
+    if (!lane_url(url, lane, lane_address, sizeof lane_address)) {
+      fprintf(stderr, "pidlab-controller-c: error: LCM URL '%.120s' is not udpm://GROUP:PORT\n", url);
+      return 2;
+    }
+    c.lcm[lane] = lcm_create(lane_address);
+    if (!c.lcm[lane]) {
+      fprintf(stderr, "pidlab-controller-c: failed: cannot start LCM on '%.120s'\n", lane_address);
+      return 1;
+    }
+  }
+  channel(&c, "EPISODE_CONFIG", name, sizeof name);
+  pidlab_lcmt_episode_config_subscribe(c.lcm[0], name, on_config, &c);
+  channel(&c, "READY", name, sizeof name);
+  pidlab_lcmt_ready_subscribe(c.lcm[0], name, on_ready, &c);
+  channel(&c, "PLANT_OUTPUT", name, sizeof name);
+  pidlab_lcmt_plant_output_subscribe(c.lcm[kPlantOutputLane], name, on_output, &c);
+  signal(SIGTERM, on_signal);
+  signal(SIGINT, on_signal);
+  while (!stop) {
+    fd_set fds;
+    struct timeval timeout = {0, 50000};
+    int top = 0;
+    FD_ZERO(&fds);
+    for (lane = 0; lane < 2; ++lane) {
+      const int fd = lcm_get_fileno(c.lcm[lane]);
+      FD_SET(fd, &fds);
+      if (fd > top) top = fd;
+    }
+    if (select(top + 1, &fds, NULL, NULL, &timeout) > 0)
+      for (lane = 0; lane < 2; ++lane)
+        if (FD_ISSET(lcm_get_fileno(c.lcm[lane]), &fds)) lcm_handle(c.lcm[lane]);
+  }
+  if (verbose)
+    fprintf(stderr,
+            "pidlab-controller-c: episodes %ld, commands %ld, foreign %ld, duplicates %ld, bad_configs %ld, "
+            "conflicts %ld\n",
+            c.episodes, c.commands, c.foreign, c.duplicates, c.bad_configs, c.conflicts);
+  for (lane = 0; lane < kLanes; ++lane) lcm_destroy(c.lcm[lane]);
+  return 0;
+}

@@ -1,0 +1,221 @@
+// pidlab export: the discrete PID of a gain set and a loop as a
+// dependency-free C99 module (controller/export/, docs/export.md).
+
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <set>
+
+#include "cli_common.h"
+#include "cli_spec.h"
+#include "commands.h"
+#include "pidlab/controller_export/export.h"
+#include "pidlab/evaluation/closed_loop.h"
+#include "pidlab/tune/spec_build.h"
+
+using pidlab::controller_export::Controller;
+using pidlab::controller_export::Generate;
+using pidlab::controller_export::GeneratedCode;
+using pidlab::controller_export::Options;
+using pidlab::controller_export::ParseScalar;
+using pidlab::controller_export::Scalar;
+using pidlab::evaluation::LoopGains;
+using pidlab::evaluation::LoopOptions;
+using pidlab::spec::NameStyle;
+using pidlab::tune::BuildGains;
+using pidlab::tune::BuildLoopOptions;
+
+namespace pidlab::cli {
+namespace {
+
+/// A --json result's file: its echoed spec (an evaluation's or a tuning's)
+/// and its gains.
+nlohmann::json ReadResult(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw BadInput("--from " + Quote(path) + " cannot be read");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  if (text.size() > (1u << 20)) throw BadInput("--from " + Quote(path) + " is larger than 1 MiB");
+  nlohmann::json j;
+  std::string error;
+  if (!spec::ParseJsonText(text, &j, &error)) throw BadInput("--from " + Quote(path) + ": " + error);
+  if (!j.is_object() || !j.contains("spec") || !j["spec"].is_object() || !j.contains("gains") ||
+      !j["gains"].is_object())
+    throw BadInput("--from " + Quote(path) +
+                   " is not the --json output of pidlab tune or evaluate (no \"spec\" and \"gains\")");
+  return j;
+}
+
+/// The spec and gains of a result file into *s (an evaluation's spec as it
+/// is; a tuning's plant and loop).
+void LoadResult(const std::string& path, spec::EvaluateSpec* s) {
+  const nlohmann::json j = ReadResult(path);
+  std::string error;
+  spec::EvaluateSpec evaluate;
+  spec::TuningSpec tuning;
+  if (spec::FromJson(j["spec"], &evaluate, nullptr, &error)) {
+    *s = evaluate;
+  } else if (std::string ignored; spec::FromJson(j["spec"], &tuning, nullptr, &ignored)) {
+    s->plant = tuning.plant;
+    s->loop = tuning.loop;
+  } else {
+    throw BadInput("--from " + Quote(path) + ": " + error);
+  }
+  s->gains.clear();
+  for (const char* key : {"kp", "ki", "kd"}) {
+    const auto it = j["gains"].find(key);
+    if (it == j["gains"].end() || !it->is_number())
+      throw BadInput("--from " + Quote(path) + ": gains." + key + " is not a number");
+    s->gains.push_back(it->get<double>());
+  }
+}
+
+/// The setpoint weights b, c from the PID options, where PidOptions holds
+/// them (the 2-DOF PID: the spec's --setpoint-weights, and c = 0 for
+/// derivative on measurement); without those fields, nothing.
+template <typename O>
+auto WeightsFromOptions(const O& pid, Controller* c, int) -> decltype(pid.setpoint_weight_p, void()) {
+  c->setpoint_weight_b = pid.setpoint_weight_p;
+  c->setpoint_weight_c = pid.setpoint_weight_d;
+}
+template <typename O>
+void WeightsFromOptions(const O&, Controller*, long) {}
+
+/// One line naming the plant, for the header comment.
+std::string DescribePlant(const spec::PlantSpec& p) {
+  if (p.plant.empty()) return "not given (no --plant)";
+  std::string s = p.plant;
+  if (!p.num.empty() || !p.den.empty())
+    s += ", num " + FlagText(p.num) + ", den " + FlagText(p.den) + " (descending powers of s)";
+  if (p.delay_s > 0.0) s += ", dead time " + FlagText(p.delay_s) + " s";
+  return s;
+}
+
+/// The spec's JSON, one field a line (the header comment's form).
+std::string SpecText(const nlohmann::json& j) {
+  std::string s = "{\n";
+  std::size_t i = 0;
+  for (const auto& item : j.items())
+    s += "  " + nlohmann::json(item.key()).dump() + ": " + item.value().dump() +
+         (++i < j.size() ? ",\n" : "\n");
+  return s + "}";
+}
+
+struct ExportCommand {
+  SpecFlags flags;
+  std::string from, lang, out, scalar = "double";
+  std::vector<double> input_range, setpoint_weights;
+
+  std::function<int()> Register(CLI::App* app) {
+    app->description(
+        "Write the discrete PID of a gain set and a loop (--dt, --output-limits, --anti-windup, "
+        "--integral, --derivative-filter, --derivative-on) as a dependency-free C99 module, pidlab_pid.h and "
+        "pidlab_pid.c in --out: the controller DiscretePid runs, in its operation order (--scalar double: "
+        "bit for bit), with manual mode, bumpless transfer and run-time gain and sample-time changes "
+        "(docs/export.md).");
+    flags.Register(app, spec::EvaluateSpec{});
+    app->add_option("--from", from,
+                    "take the spec and the gains from this --json output of pidlab tune or evaluate; flags "
+                    "given as well override it");
+    app->add_option("--lang", lang, "the language of the module: c")->required();
+    app->add_option("--out", out, "write pidlab_pid.h and pidlab_pid.c into this folder")->required();
+    app->add_option("--scalar", scalar,
+                    "the controller's numbers: double (bit-identical to pidlab), float, q31 or q15 "
+                    "(saturating fixed point, needs --input-range)")
+        ->capture_default_str();
+    app->add_option("--input-range", input_range,
+                    "fixed point: LO,HI, the range of r and y the scalings are chosen for (outside it the "
+                    "inputs saturate)")
+        ->delimiter(',');
+    // Until the spec has the weights: export's own flag. Once a spec field
+    // registers --setpoint-weights, that one stands (and BuildController
+    // should read the spec's value).
+    if (app->get_option_no_throw("--setpoint-weights") == nullptr)
+      app->add_option(
+             "--setpoint-weights", setpoint_weights,
+             "B,C in [0, 1]: the 2-DOF weights, p = kp (B r - y), derivative of C r - y (default 1,1; "
+             "C = 0 with --derivative-on measurement)")
+          ->delimiter(',');
+    return [this] { return Run(); };
+  }
+
+  Controller BuildController(const spec::EvaluateSpec& s) const {
+    std::string error;
+    if (s.gains.empty()) throw BadInput("--gains is required (or --from FILE, --spec FILE)");
+    PidGains g;
+    Require(BuildGains(s.gains, NameStyle::kFlag, &g, &error), error);
+    LoopOptions loop;
+    Require(BuildLoopOptions(s.loop, NameStyle::kFlag, &loop, &error), error);
+    Controller c;
+    c.gains = LoopGains(g, loop);
+    c.pid = PidOptionsAt(loop.pid, loop.dt_s);
+    const bool on_measurement = s.loop.derivative_on == "measurement";
+    if (on_measurement) c.setpoint_weight_c = 0.0;
+    WeightsFromOptions(c.pid, &c, 0);
+    if (!setpoint_weights.empty()) {
+      if (setpoint_weights.size() != 2)
+        throw BadInput("--setpoint-weights " + FlagText(setpoint_weights) + " must be two numbers B,C");
+      c.setpoint_weight_b = setpoint_weights[0];
+      c.setpoint_weight_c = setpoint_weights[1];
+      if (on_measurement && c.setpoint_weight_c != 0.0)
+        throw BadInput("--derivative-on measurement is setpoint weight C = 0, not " +
+                       FlagText(c.setpoint_weight_c));
+    }
+    Require(controller_export::ControllerIsValid(c, &error), error);
+    return c;
+  }
+
+  Options BuildOptions(const spec::EvaluateSpec& s) const {
+    Options o;
+    if (!ParseScalar(scalar, &o.scalar))
+      throw BadInput("--scalar " + Quote(scalar) + " is not one of double, float, q31, q15");
+    const bool fixed = o.scalar == Scalar::kQ31 || o.scalar == Scalar::kQ15;
+    if (fixed && input_range.empty()) throw BadInput("--scalar " + scalar + " needs --input-range LO,HI");
+    if (!input_range.empty()) {
+      if (input_range.size() != 2)
+        throw BadInput("--input-range " + FlagText(input_range) + " must be two numbers LO,HI");
+      o.input_min = input_range[0];
+      o.input_max = input_range[1];
+    }
+    std::string error;
+    if (!o.IsValid(&error)) throw BadInput("--input-range: " + error);
+    o.plant = DescribePlant(s.plant);
+    o.spec_json = SpecText(spec::ToJson(s));
+    o.pidlab_version = PIDLAB_VERSION;
+    return o;
+  }
+
+  int Run() {
+    if (lang != "c") throw BadInput("--lang " + Quote(lang) + " is not supported (c is)");
+    if (!from.empty() && flags.Given("spec")) throw BadInput("--from and --spec: give one");
+    spec::EvaluateSpec s;
+    if (!from.empty()) LoadResult(from, &s);
+    std::set<std::string> given;
+    flags.Apply(&s, &given);
+    s.plant.Normalize();
+    const Controller controller = BuildController(s);
+    const Options options = BuildOptions(s);
+    PrepareOutputDir(out, "--out");
+    GeneratedCode code;
+    try {
+      code = Generate(options, controller);
+    } catch (const std::invalid_argument& e) {
+      throw BadInput(e.what());
+    }
+    const std::string header = out + "/pidlab_pid.h", source = out + "/pidlab_pid.c";
+    std::ofstream(header) << code.header;
+    std::ofstream(source) << code.source;
+    if (!std::ifstream(header) || !std::ifstream(source))
+      throw BadInput("--out " + Quote(out) + " cannot be written");
+    std::cout << "wrote " << header << " and " << source << " (" << scalar << ")\n";
+    return 0;
+  }
+};
+
+}  // namespace
+std::function<int()> RegisterExport(CLI::App* app) {
+  auto command = std::make_shared<ExportCommand>();
+  auto action = command->Register(app);
+  return [command, action] { return action(); };
+}
+
+}  // namespace pidlab::cli
