@@ -69,17 +69,6 @@ void LoadResult(const std::string& path, spec::EvaluateSpec* s) {
   }
 }
 
-/// The setpoint weights b, c from the PID options, where PidOptions holds
-/// them (the 2-DOF PID: the spec's --setpoint-weights, and c = 0 for
-/// derivative on measurement); without those fields, nothing.
-template <typename O>
-auto WeightsFromOptions(const O& pid, Controller* c, int) -> decltype(pid.setpoint_weight_p, void()) {
-  c->setpoint_weight_b = pid.setpoint_weight_p;
-  c->setpoint_weight_c = pid.setpoint_weight_d;
-}
-template <typename O>
-void WeightsFromOptions(const O&, Controller*, long) {}
-
 /// One line naming the plant, for the header comment.
 std::string DescribePlant(const spec::PlantSpec& p) {
   if (p.plant.empty()) return "not given (no --plant)";
@@ -103,12 +92,12 @@ std::string SpecText(const nlohmann::json& j) {
 struct ExportCommand {
   SpecFlags flags;
   std::string from, lang, out, scalar = "double";
-  std::vector<double> input_range, setpoint_weights;
+  std::vector<double> input_range;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
         "Write the discrete PID of a gain set and a loop (--dt, --output-limits, --anti-windup, "
-        "--integral, --derivative-filter, --derivative-on) as a dependency-free C99 module, pidlab_pid.h and "
+        "--integral, --derivative-filter, --derivative-on, --setpoint-weights) as a dependency-free C99 module, pidlab_pid.h and "
         "pidlab_pid.c in --out: the controller DiscretePid runs, in its operation order (--scalar double: "
         "bit for bit), with manual mode, bumpless transfer and run-time gain and sample-time changes "
         "(docs/export.md).");
@@ -126,15 +115,6 @@ struct ExportCommand {
                     "fixed point: LO,HI, the range of r and y the scalings are chosen for (outside it the "
                     "inputs saturate)")
         ->delimiter(',');
-    // Until the spec has the weights: export's own flag. Once a spec field
-    // registers --setpoint-weights, that one stands (and BuildController
-    // should read the spec's value).
-    if (app->get_option_no_throw("--setpoint-weights") == nullptr)
-      app->add_option(
-             "--setpoint-weights", setpoint_weights,
-             "B,C in [0, 1]: the 2-DOF weights, p = kp (B r - y), derivative of C r - y (default 1,1; "
-             "C = 0 with --derivative-on measurement)")
-          ->delimiter(',');
     return [this] { return Run(); };
   }
 
@@ -148,18 +128,9 @@ struct ExportCommand {
     Controller c;
     c.gains = LoopGains(g, loop);
     c.pid = PidOptionsAt(loop.pid, loop.dt_s);
-    const bool on_measurement = s.loop.derivative_on == "measurement";
-    if (on_measurement) c.setpoint_weight_c = 0.0;
-    WeightsFromOptions(c.pid, &c, 0);
-    if (!setpoint_weights.empty()) {
-      if (setpoint_weights.size() != 2)
-        throw BadInput("--setpoint-weights " + FlagText(setpoint_weights) + " must be two numbers B,C");
-      c.setpoint_weight_b = setpoint_weights[0];
-      c.setpoint_weight_c = setpoint_weights[1];
-      if (on_measurement && c.setpoint_weight_c != 0.0)
-        throw BadInput("--derivative-on measurement is setpoint weight C = 0, not " +
-                       FlagText(c.setpoint_weight_c));
-    }
+    // The spec's --setpoint-weights (c = 0 for --derivative-on measurement), in the PID's options.
+    c.setpoint_weight_b = c.pid.setpoint_weight_p;
+    c.setpoint_weight_c = c.pid.setpoint_weight_d;
     Require(controller_export::ControllerIsValid(c, &error), error);
     return c;
   }

@@ -118,8 +118,8 @@ bad "unknown language" "rust" --gains 1,1,1 --lang rust --out x
 bad "no gains" "--gains" --lang c --out x
 bad "negative gain" "-1" --gains -1,1,1 --lang c --out x
 bad "setpoint weight above 1" "1.5" --gains 1,1,1 --setpoint-weights 1.5,0 --lang c --out x
-bad "c = 1 with derivative on measurement" "C = 0, not 1" --gains 1,1,1 --derivative-on measurement \
-  --setpoint-weights 1,1 --lang c --out x
+bad "c = 0.5 with derivative on measurement" "0.5" --gains 1,1,1 --derivative-on measurement \
+  --setpoint-weights 1,0.5 --lang c --out x
 bad "unreadable --from" "nothing.json" --from nothing.json --lang c --out x
 echo '{"spec": {"plant": "oscillator"}}' >nogains.json
 bad "--from without gains" "gains" --from nogains.json --lang c --out x

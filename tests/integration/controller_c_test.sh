@@ -91,6 +91,15 @@ check "limits: the loops did saturate" \
 run_case stepper -- --plant stepper_motor --gains 2.6685,30,0.095 --output-limits -5,5 \
   --anti-windup back-calculation --derivative-filter 0.002 --integral trapezoidal
 
+# 2c. 2-DOF setpoint weights on each paper plant, with limits, a filter and
+#     anti-windup (the weights come from the episode's message).
+run_case twodof_oscillator -- --plant oscillator --gains 2,1,1.5 --setpoint-weights 0.664,0.0136 \
+  --output-limits -0.5,0.8 --anti-windup clamping --derivative-filter 0.01
+run_case twodof_double_integrator -- --plant double_integrator --gains 8,3,2 --setpoint-weights 0.5,0.25 \
+  --output-limits -1,1.5 --anti-windup back-calculation --derivative-filter 0.01 --integral trapezoidal
+run_case twodof_stepper -- --plant stepper_motor --gains 2.6685,30,0.095 --setpoint-weights 0.8,0 \
+  --output-limits -5,5 --anti-windup back-calculation --derivative-filter 0.002
+
 # 3. Loss: the plant and the disturbance throw 5 % of what they receive away,
 #    so the plant resends y_k and the controller must repeat u_k.
 run_case loss --drop-rate 0.05 -- --plant oscillator --gains 2,1,1.5

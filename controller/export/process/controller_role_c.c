@@ -98,22 +98,26 @@ static const char *config_error(const pidlab_lcmt_episode_config *m) {
     return "back-calculation gain";
   if (strcmp(m->derivative_on, "error") && strcmp(m->derivative_on, "measurement"))
     return "derivative-on unknown";
+  if (!(finite(m->setpoint_weight_b) && m->setpoint_weight_b >= 0 && m->setpoint_weight_b <= 1 &&
+        finite(m->setpoint_weight_c) && m->setpoint_weight_c >= 0 && m->setpoint_weight_c <= 1))
+    return "setpoint weights not in [0, 1]";
   if (strcmp(m->integral, "backward-euler") && strcmp(m->integral, "forward-euler") &&
       strcmp(m->integral, "trapezoidal"))
     return "integral unknown";
   return NULL;
 }
 
-/* The episode's configuration as the exported module's: c = 0 is derivative
- * on measurement, infinite limits are none. */
+/* The episode's configuration as the exported module's: the setpoint weights
+ * b and c as the message carries them (c = 0 is derivative on measurement),
+ * infinite limits are none. */
 static void to_config(const pidlab_lcmt_episode_config *m, pidlab_pid_config *p) {
   memset(p, 0, sizeof *p);
   p->kp = m->kp;
   p->ki = m->ki;
   p->kd = m->kd;
   p->tf = m->derivative_filter_s;
-  p->b = 1.0;
-  p->c = strcmp(m->derivative_on, "measurement") ? 1.0 : 0.0;
+  p->b = m->setpoint_weight_b;
+  p->c = m->setpoint_weight_c;
   p->dt_s = m->dt_s;
   p->has_output_min = finite(m->output_min);
   p->output_min = p->has_output_min ? m->output_min : 0.0;
