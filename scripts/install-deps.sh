@@ -5,7 +5,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config clang
   libeigen3-dev libceres-dev
   liblcm-dev liblcm-bin libglib2.0-dev
   libgtest-dev libgmock-dev libbenchmark-dev
