@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs, from Debian 12 packages, whatever pidlab needs and the machine
-# lacks. Safe to run again: it installs only missing packages.
+# lacks, then the page's npm packages (package.json, pinned by package-lock.json:
+# uPlot, embedded in pidlab serve; puppeteer-core, for the browser tests) into
+# node_modules/ with npm ci. Safe to run again: it installs only what is missing.
 #   scripts/install-deps.sh [--no-java]   (--no-java: skip the JDK that tools/lcm-spy needs)
 set -euo pipefail
 
@@ -12,13 +14,14 @@ packages=(
   libcli11-dev nlohmann-json3-dev libsodium-dev
   gnuplot-nox libboost-dev pybind11-dev python3-dev
   iproute2 util-linux python3 python3-numpy python3-scipy bc
+  chromium
   default-jdk-headless liblcm-java
 )
 no_java=0
 for arg in "$@"; do
   case "$arg" in
     --no-java) no_java=1 ;;
-    -h|--help) sed -n '2,5p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
     *) echo "install-deps.sh: error: unknown option '$arg'" >&2; exit 2 ;;
   esac
 done
@@ -31,13 +34,26 @@ for p in "${packages[@]}"; do
   [ -n "$p" ] || continue
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Node.js and npm: the machine's own if it has them (any version >= 18), else Debian's.
+command -v node >/dev/null 2>&1 || missing+=(nodejs)
+command -v npm >/dev/null 2>&1 || missing+=(npm)
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
-  exit 0
+else
+  echo "install-deps: installing ${missing[*]}"
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-echo "install-deps: installing ${missing[*]}"
-sudo_cmd=()
-[ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
-export DEBIAN_FRONTEND=noninteractive
-"${sudo_cmd[@]}" apt-get update -qq
-"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+
+# The npm packages, at the versions package-lock.json pins; npm ci again only when the lock changed.
+root=$(cd "$(dirname "$0")/.." && pwd)
+if ! cmp -s "$root/package-lock.json" "$root/node_modules/.pidlab-lock.json"; then
+  echo "install-deps: npm ci (uplot, puppeteer-core; no browser is downloaded)"
+  (cd "$root" && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error)
+  cp "$root/package-lock.json" "$root/node_modules/.pidlab-lock.json"
+else
+  echo "install-deps: npm packages present"
+fi
