@@ -223,6 +223,29 @@ TEST(Report, RobustTuningComparesThePaperTheOptimumAndThePresetOnEveryPlant) {
     EXPECT_NE(text.find(want), std::string::npos) << want;
 }
 
+TEST(Report, TwoDegreesOfFreedomLowerTheOvershootAndLeaveLoadIaeAndMsAlone) {
+  const ReportData& data = SharedReport();
+  ASSERT_EQ(data.two_dof.rows.size(), 3u);
+  for (const TwoDofRow& r : data.two_dof.rows) {
+    const tune::TwoDofSummary& t = r.summary;
+    ASSERT_TRUE(t.ran) << r.plant << ": " << t.message;
+    EXPECT_GE(t.b, 0.0) << r.plant;
+    EXPECT_LE(t.b, 1.0) << r.plant;
+    EXPECT_GE(t.c, 0.0) << r.plant;
+    EXPECT_LE(t.c, 1.0) << r.plant;
+    EXPECT_EQ(t.before.b, 1.0) << r.plant;
+    EXPECT_EQ(t.before.c, 1.0) << r.plant;
+    // The weights act on the reference only.
+    EXPECT_NEAR(t.after.load_iae, t.before.load_iae, 1e-12 * t.before.load_iae) << r.plant;
+    EXPECT_NEAR(t.after.ms, t.before.ms, 1e-12 * t.before.ms) << r.plant;
+    EXPECT_LE(t.after.setpoint_iae, t.before.setpoint_iae) << r.plant;
+    EXPECT_LT(t.after.overshoot_pct, t.before.overshoot_pct) << r.plant;
+  }
+  const std::string md = RenderMarkdown(data);
+  EXPECT_NE(md.find("## Two degrees of freedom"), std::string::npos);
+  EXPECT_NE(md.find("| stepper_motor | "), std::string::npos);
+}
+
 TEST(Report, DeterministicForASeed) {
   EXPECT_EQ(RenderMarkdown(SharedReport()), RenderMarkdown(QuickReport(1)));
 }

@@ -187,6 +187,10 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
     if (!RunTunings(options, data, error)) return false;
     if (!EvaluateSampledLoops(&s, error)) return false;
     if (!ComputeRobust(options, paper, data, error)) return false;
+    if (!ComputeTwoDofSection(data->robust, &data->two_dof, error)) {
+      *error = "two-dof section: " + *error;
+      return false;
+    }
     trio.Collect(options.trio_absent_note, &s);
     if (const std::string e = motor.get(); !e.empty()) throw std::runtime_error(e);
     if (const std::string e = identified.get(); !e.empty()) throw std::runtime_error(e);
@@ -213,6 +217,7 @@ std::string RenderMarkdown(const ReportData& data) {
   RenderMotorSection(os, data.motor);
   RenderIdentifySection(os, data.identified);
   RenderRobustSection(os, data.robust);
+  RenderTwoDofSection(os, data.two_dof);
   RenderFigureList(os, data.figures);
   return os.str();
 }

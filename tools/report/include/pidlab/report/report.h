@@ -20,6 +20,7 @@
 #include "pidlab/report/identify_section.h"
 #include "pidlab/report/motor_section.h"
 #include "pidlab/report/robust_section.h"
+#include "pidlab/report/two_dof_section.h"
 #include "pidlab/tune/tune.h"
 
 namespace pidlab::report {
@@ -142,6 +143,7 @@ struct ReportData {
   MotorSection motor;  // "The motor itself" (motor_section.h)
   IdentifySection identified;  // "Identifying the motor" (identify_section.h)
   RobustSection robust;  // "Robust tuning" (robust_section.h)
+  TwoDofSection two_dof;  // "Two degrees of freedom" (two_dof_section.h)
   /// Wall time of the computation, s (printed by the command, not in report.md).
   double compute_time_s = 0, figure_time_s = 0;
 };
