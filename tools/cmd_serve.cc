@@ -1,7 +1,8 @@
 // pidlab serve: the tuning workbench in the browser (docs/workbench.md).
 
+#include <sodium.h>
+
 #include <csignal>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -68,16 +69,14 @@ struct ServeCommand {
     return 0;
   }
 
-  // 32 hex digits from /dev/urandom.
+  // 32 hex digits: 16 bytes from libsodium's randombytes_buf (the kernel's getrandom).
   static std::string RandomToken() {
-    std::ifstream in("/dev/urandom", std::ios::binary);
+    if (sodium_init() < 0) throw std::runtime_error("libsodium could not be initialised for the token");
     unsigned char bytes[16] = {};
-    in.read(reinterpret_cast<char*>(bytes), sizeof bytes);
-    if (!in) throw std::runtime_error("cannot read /dev/urandom for the token");
-    static const char* hex = "0123456789abcdef";
-    std::string t;
-    for (unsigned char b : bytes) t += hex[b >> 4], t += hex[b & 15];
-    return t;
+    randombytes_buf(bytes, sizeof bytes);
+    char hex[2 * sizeof bytes + 1] = {};
+    sodium_bin2hex(hex, sizeof hex, bytes, sizeof bytes);
+    return hex;
   }
 };
 

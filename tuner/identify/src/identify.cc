@@ -104,9 +104,12 @@ ProcessModel ModelOf(const Record& record, const double* theta) {
 std::vector<double> Simulate(const ProcessModel& model, const Record& record, double offset,
                              double input_shift, bool project, std::vector<double>* state) {
   if (!record.piecewise) return SimulateModel(model, record.du, input_shift, record.dt_s);
-  std::vector<double> du(record.du);
-  if (input_shift != 0.0)
-    for (double& v : du) v -= input_shift;
+  std::vector<double> shifted;  // a copy only when there is a shift to take off
+  if (input_shift != 0.0) {
+    shifted = record.du;
+    for (double& v : shifted) v -= input_shift;
+  }
+  const std::vector<double>& du = input_shift != 0.0 ? shifted : record.du;
   internal::PiecewiseStart start;
   start.input_before = record.initial == InitialCondition::kZero ? 0.0 : du[0];
   if (record.initial == InitialCondition::kSteadyState && !internal::SteadyState(model, du[0], &start.state))
