@@ -59,6 +59,25 @@ struct LaunchFlags {
   std::vector<std::string> command;
 };
 
+// The roles' real-time priority, said in one line when --realtime chose it
+// or when the system refuses it (then the roles run at normal priority and
+// each of them does not say so again).
+void ResolveRtPriority(launcher::LaunchOptions* o) {
+  const int priority = o->EffectiveRtPriority();
+  const bool chosen = o->rt_priority == launcher::LaunchOptions::kRtPriorityDefault;
+  o->rt_priority = priority;
+  if (priority == 0) return;
+  std::string why;
+  if (!launcher::RealtimePriorityAllowed(priority, &why)) {
+    Note("SCHED_FIFO at priority " + std::to_string(priority) + " refused (" + why +
+         "): the roles run at normal priority");
+    o->rt_priority = 0;
+  } else if (chosen) {
+    Note("--realtime: the roles run SCHED_FIFO at priority " + std::to_string(priority) +
+         " with their memory locked (the default with --realtime; --rt-priority N chooses, 0 none)");
+  }
+}
+
 // Starts the trios, runs COMMAND against them and stops everything.
 int RunLaunch(LaunchFlags* flags, const CLI::Option* roles, const CLI::Option* realtime) {
   std::string error;
@@ -71,6 +90,7 @@ int RunLaunch(LaunchFlags* flags, const CLI::Option* roles, const CLI::Option* r
   // An unwritable --log is bad input (exit 2), found before anything starts.
   CheckOutputFile(flags->options.log_file, "--log");
   if (flags->isolated && !launcher::EnterIsolatedNetwork(&error)) throw std::runtime_error(error);
+  ResolveRtPriority(&flags->options);
   struct sigaction sa {};
   sa.sa_handler = OnSignal;
   sigemptyset(&sa.sa_mask);
@@ -156,7 +176,9 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
   app->add_option(
       "--rt-priority", o.rt_priority,
       "run the plant, controller and disturbance SCHED_FIFO at this priority (1-99) with their memory "
-      "locked, if the system allows it (each says so if not)");
+      "locked, if the system allows it (said in one line if not); default 50 with --realtime (docs/trio.md), "
+      "else none; 0: normal scheduling")
+      ->default_str("50 with --realtime, else 0");
   app->add_flag("--verbose,-v", o.verbose, "verbose processes and launcher");
   app->add_flag("--quiet,-q", g_quiet,
                 "no notes from launch and no stderr from the processes: stderr holds only a failure's one "

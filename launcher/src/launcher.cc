@@ -77,8 +77,8 @@ bool LaunchOptions::IsValid(std::string* error) const {
     os << "--ready-timeout " << ready_timeout_s << " must be positive";
   else if (realtime_factor != 0.0 && !transport::RealtimeFactorIsValid(realtime_factor, error))
     return false;
-  else if (rt_priority < 0 || rt_priority > 99)
-    os << "--rt-priority " << rt_priority << " must be in 1..99";
+  else if (rt_priority != kRtPriorityDefault && (rt_priority < 0 || rt_priority > 99))
+    os << "--rt-priority " << rt_priority << " must be in 0..99 (0: normal scheduling)";
   else {
     transport::TransportOptions t;
     t.channel_prefix = channel_prefix;
@@ -86,6 +86,28 @@ bool LaunchOptions::IsValid(std::string* error) const {
   }
   if (error) *error = os.str();
   return false;
+}
+
+int LaunchOptions::EffectiveRtPriority() const {
+  if (rt_priority != kRtPriorityDefault) return rt_priority;
+  return realtime_factor > 0.0 ? kRealtimeRtPriority : 0;
+}
+
+bool RealtimePriorityAllowed(int priority, std::string* why) {
+  const int policy = sched_getscheduler(0);
+  sched_param before{};
+  sched_getparam(0, &before);
+  sched_param param{};
+  param.sched_priority = priority;
+  if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
+    const int err = errno;
+    if (why)
+      *why = std::string(std::strerror(err)) + "; needs root, CAP_SYS_NICE or an RLIMIT_RTPRIO of " +
+             std::to_string(priority) + " or more";
+    return false;
+  }
+  sched_setscheduler(0, policy, &before);  // lowering one's own policy is always allowed
+  return true;
 }
 
 std::string LaunchOptions::EffectiveLcmUrl() const {
@@ -164,8 +186,8 @@ void Launcher::StartRoles() {
       factor << std::setprecision(17) << options_.realtime_factor;
       args.insert(args.end(), {"--realtime", factor.str()});
     }
-    if (options_.rt_priority > 0)  // the whole lockstep loop: a paced plant waits for the others
-      args.insert(args.end(), {"--rt-priority", std::to_string(options_.rt_priority)});
+    if (options_.EffectiveRtPriority() > 0)  // the whole lockstep loop: a paced plant waits for the others
+      args.insert(args.end(), {"--rt-priority", std::to_string(options_.EffectiveRtPriority())});
     if (!options_.auth_key_file.empty()) args.insert(args.end(), {"--auth-key", options_.auth_key_file});
     roles_[role] = supervisor_->Start("pidlab-" + role, args);
     if (options_.verbose) Note("started pidlab-" + role + " (pid " + std::to_string(roles_[role]) + ")");

@@ -124,9 +124,31 @@ case $CASE in
     # most every step missed, and never faster than the schedule.
     ep=(--plant double_integrator --gains 2,1,1.5 --horizon 2 --dt 1e-3)
     "$PIDLAB" evaluate --loop sampled --json "${ep[@]}" >"$TMP/local.json" || { echo "FAIL realtime: local evaluate failed"; fail=1; }
-    "$PIDLAB" launch --lcm-url "$URL" --realtime --rt-priority 10 --log "$TMP/rt.lcmlog" -- \
-      pidlab evaluate --backend lcm --json "${ep[@]}" >"$TMP/rt.json" 2>"$TMP/rt.err" ||
+    # --realtime alone: the roles get SCHED_FIFO 50 (launch's default), said in one line.
+    "$PIDLAB" launch --lcm-url "$URL" --realtime --log "$TMP/rt.lcmlog" -- bash -c \
+      'chrt -p $PIDLAB_PLANT_PID >"$0"; chrt -p $PIDLAB_DISTURBANCE_PID >>"$0"; exec pidlab evaluate "$@"' \
+      "$TMP/sched.txt" --backend lcm --json "${ep[@]}" >"$TMP/rt.json" 2>"$TMP/rt.err" ||
       { echo "FAIL realtime: paced evaluate failed"; cat "$TMP/rt.err"; fail=1; }
+    if [ "$(grep -c 'SCHED_FIFO' "$TMP/sched.txt")" != 2 ] || [ "$(grep -c 'priority: 50' "$TMP/sched.txt")" != 2 ] ||
+      [ "$(grep -c 'the roles run SCHED_FIFO at priority 50' "$TMP/rt.err")" != 1 ]; then
+      echo "FAIL realtime: --realtime alone did not give the roles SCHED_FIFO 50 with one line:"
+      cat "$TMP/sched.txt" "$TMP/rt.err"; fail=1
+    else
+      echo "ok   realtime: --realtime alone: the roles at SCHED_FIFO 50, said once: $(grep -o 'the roles run.*' "$TMP/rt.err")"
+    fi
+    # --rt-priority 0 turns it off; a refusal is one line from launch, and the episode runs.
+    "$PIDLAB" launch --lcm-url "$URL" --realtime --rt-priority 0 -- bash -c 'chrt -p $PIDLAB_PLANT_PID' \
+      >"$TMP/sched0.txt" 2>"$TMP/rt0.err"
+    setpriv --inh-caps=-sys_nice --bounding-set=-sys_nice prlimit --rtprio=0 \
+      "$PIDLAB" launch --lcm-url "$URL" --realtime -- bash -c 'chrt -p $PIDLAB_PLANT_PID' \
+      >"$TMP/schedr.txt" 2>"$TMP/rtr.err"
+    if ! grep -q SCHED_OTHER "$TMP/sched0.txt" || grep -q SCHED_FIFO "$TMP/rt0.err"; then
+      echo "FAIL realtime: --rt-priority 0 still asked for SCHED_FIFO: $(cat "$TMP/sched0.txt" "$TMP/rt0.err")"; fail=1
+    elif ! grep -q SCHED_OTHER "$TMP/schedr.txt" || [ "$(grep -c 'refused' "$TMP/rtr.err")" != 1 ]; then
+      echo "FAIL realtime: a refused SCHED_FIFO is not one line from launch: $(cat "$TMP/schedr.txt" "$TMP/rtr.err")"; fail=1
+    else
+      echo "ok   realtime: --rt-priority 0: normal scheduling; refused: $(grep refused "$TMP/rtr.err")"
+    fi
     "$PIDLAB" launch --lcm-url "$URL" -- pidlab evaluate --backend lcm --json "${ep[@]}" >"$TMP/unpaced.json" ||
       { echo "FAIL realtime: unpaced evaluate failed"; fail=1; }
     a=$(jq -S 'del(.backend, .steps_per_second)' "$TMP/local.json")

@@ -58,8 +58,11 @@ struct LaunchOptions {
   /// Real-time pacing of the plant (pidlab-plant --realtime FACTOR,
   /// transport/pacing.h): 0 off, else positive and finite.
   double realtime_factor = 0.0;
-  /// --rt-priority N for every role (SCHED_FIFO, memory locked), 0 off, else 1..99.
-  int rt_priority = 0;
+  /// --rt-priority N for every role (SCHED_FIFO, memory locked): 1..99; 0
+  /// none; kRtPriorityDefault: kRealtimeRtPriority when paced, else none.
+  static constexpr int kRtPriorityDefault = -1;
+  static constexpr int kRealtimeRtPriority = 50;
+  int rt_priority = kRtPriorityDefault;
   /// The processes append their stderr to this file (empty: ours).
   std::string stderr_path;
   /// Authenticate every message with the key in this file (empty: no key):
@@ -69,7 +72,15 @@ struct LaunchOptions {
 
   bool IsValid(std::string* error) const;
   std::string EffectiveLcmUrl() const;
+  /// The priority the roles are given: rt_priority, or for the default
+  /// kRealtimeRtPriority when realtime_factor > 0 and 0 otherwise.
+  int EffectiveRtPriority() const;
 };
+
+/// Whether this system grants SCHED_FIFO at `priority` to the processes the
+/// launcher starts: tried on the calling thread and undone at once. False
+/// with the system's reason (one line) in *why.
+bool RealtimePriorityAllowed(int priority, std::string* why);
 
 enum class LaunchStatus {
   kReady,         // every process answered (and the logger wrote its first marker)
