@@ -19,7 +19,7 @@ using plant_sim::ProcessModelUncertainty;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 
 // u in [-1, 1) from 53 bits of the generator: the same on every platform.
 double Uniform(std::mt19937_64* rng) { return 2.0 * static_cast<double>((*rng)() >> 11) * 0x1.0p-53 - 1.0; }
@@ -100,7 +100,7 @@ Distribution Summarize(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
   d.count = static_cast<int>(v.size());
   if (v.empty()) {
-    d.min = d.median = d.p95 = d.max = kNaN;
+    d.min = d.median = d.p95 = d.max = kNoValue;
     return d;
   }
   std::sort(v.begin(), v.end());

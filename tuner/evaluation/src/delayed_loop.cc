@@ -3,6 +3,7 @@
 // exact step per piece by an augmented matrix exponential.
 
 #include "pidlab/evaluation/delayed_loop.h"
+#include "evaluation_internal.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -16,7 +17,7 @@
 namespace pidlab::evaluation {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using internal::kInf;
 // Four generator states carry a cubic input: (P, P', P'', P''').
 constexpr int kGen = 4;
 

@@ -14,7 +14,7 @@
 namespace pidlab::evaluation {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using internal::kInf;
 
 // Lost steps: over the last tenth of the horizon the rotor is half a step
 // angle or more away from the reference (another detent, or still moving),

@@ -12,7 +12,7 @@
 namespace pidlab::evaluation::internal {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using internal::kInf;
 // The Nyquist count's grid, as the analysis's default.
 constexpr double kPointsPerDecade = 100.0;
 

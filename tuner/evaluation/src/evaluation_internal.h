@@ -1,9 +1,15 @@
 #pragma once
 // What evaluate.cc and metrics.cc share inside the evaluation library.
 
+#include <limits>
+
 #include "pidlab/evaluation/evaluation.h"
 
 namespace pidlab::evaluation::internal {
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 
 /// sum_m |y_L(m ts)| of the load response of a strictly stable loop: the
 /// continuous loop built with r = 0 (no reference state, no derivative kick)

@@ -1,6 +1,7 @@
 // The continuous-loop objective on fixed-size matrices (fast_objective.h).
 
 #include "pidlab/evaluation/fast_objective.h"
+#include "evaluation_internal.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,7 @@
 namespace pidlab::evaluation {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using internal::kInf;
 constexpr int kMaxDegree = 15;
 
 template <int L>

@@ -19,8 +19,8 @@
 namespace pidlab::evaluation {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using internal::kInf;
+using internal::kNaN;
 // Grid step as a fraction of the time constant 1/|p| of the fastest live pole.
 constexpr double kGridFraction = 0.05;
 // A mode is dead once e^{Re p * tau} < e^-36 (about 2e-16).

@@ -10,7 +10,7 @@
 
 namespace pidlab::identify {
 namespace {
-std::string Number(double v) {
+std::string CheckedNumber(double v) {
   std::ostringstream os;
   os << v;
   return os.str();
@@ -58,7 +58,7 @@ bool IdentifyOptions::IsValid(std::string* error) const {
   if (starts < 1)
     e = "starts = " + std::to_string(starts) + " must be at least 1";
   else if (!(max_delay_fraction > 0.0 && max_delay_fraction < 1.0))
-    e = "max_delay_fraction = " + Number(max_delay_fraction) + " must be in (0, 1)";
+    e = "max_delay_fraction = " + CheckedNumber(max_delay_fraction) + " must be in (0, 1)";
   else if (max_iterations < 1)
     e = "max_iterations = " + std::to_string(max_iterations) + " must be at least 1";
   else if (std::isinf(u0) || std::isinf(y0))
@@ -83,14 +83,14 @@ Status CheckData(const IdentifyData& data, Sampling* sampling) {
     if (name)
       return Status::InvalidInput(std::string("not finite: ") + name + " at sample " + std::to_string(k) +
                                   " is " +
-                                  Number(std::string(name) == "t"   ? data.t[k]
+                                  CheckedNumber(std::string(name) == "t"   ? data.t[k]
                                          : std::string(name) == "u" ? data.u[k]
                                                                     : data.y[k]));
   }
   for (std::size_t k = 1; k < n; ++k)
     if (!(data.t[k] > data.t[k - 1]))
-      return Status::InvalidInput("t is not strictly increasing: t = " + Number(data.t[k]) + " at sample " +
-                                  std::to_string(k) + " after " + Number(data.t[k - 1]));
+      return Status::InvalidInput("t is not strictly increasing: t = " + CheckedNumber(data.t[k]) + " at sample " +
+                                  std::to_string(k) + " after " + CheckedNumber(data.t[k - 1]));
   Sampling found;
   found.mean_interval_s = (data.t[n - 1] - data.t[0]) / static_cast<double>(n - 1);
   found.min_interval_s = found.max_interval_s = data.t[1] - data.t[0];
@@ -102,7 +102,7 @@ Status CheckData(const IdentifyData& data, Sampling* sampling) {
       found.uniform = false;
   }
   if (std::all_of(data.u.begin(), data.u.end(), [&](double v) { return v == data.u[0]; }))
-    return Status::InvalidInput("constant input: u is " + Number(data.u[0]) +
+    return Status::InvalidInput("constant input: u is " + CheckedNumber(data.u[0]) +
                                 " throughout, so nothing can be identified");
   *sampling = found;
   return Status::Ok();

@@ -20,7 +20,7 @@ using plant_sim::ProcessModelUncertainty;
 
 namespace {
 
-bool Bad(std::string* error, const std::string& message) {
+bool FileBad(std::string* error, const std::string& message) {
   if (error) *error = message;
   return false;
 }
@@ -28,23 +28,23 @@ bool Bad(std::string* error, const std::string& message) {
 // j[key] of an object, or false naming the key `where` + key.
 bool Member(const nlohmann::json& j, const char* key, const std::string& where, const nlohmann::json** out,
             std::string* error) {
-  if (!j.is_object() || !j.contains(key)) return Bad(error, "has no key \"" + where + key + "\"");
+  if (!j.is_object() || !j.contains(key)) return FileBad(error, "has no key \"" + where + key + "\"");
   *out = &j.at(key);
   return true;
 }
 
 bool Number(const nlohmann::json& j, const std::string& where, double* out, std::string* error) {
-  if (!j.is_number()) return Bad(error, "\"" + where + "\" " + spec::Truncate(j.dump()) + " is not a number");
+  if (!j.is_number()) return FileBad(error, "\"" + where + "\" " + spec::Truncate(j.dump()) + " is not a number");
   const double v = j.get<double>();
   if (!std::isfinite(v) || std::abs(v) > spec::kMaxInputMagnitude)
-    return Bad(error, "\"" + where + "\" " + spec::FormatNumber(v) + " is out of range");
+    return FileBad(error, "\"" + where + "\" " + spec::FormatNumber(v) + " is out of range");
   *out = v;
   return true;
 }
 
 bool NumberList(const nlohmann::json& j, const std::string& where, std::vector<double>* out,
                 std::string* error) {
-  if (!j.is_array() || j.empty()) return Bad(error, "\"" + where + "\" must be a list of numbers");
+  if (!j.is_array() || j.empty()) return FileBad(error, "\"" + where + "\" must be a list of numbers");
   out->clear();
   for (std::size_t i = 0; i < j.size(); ++i) {
     double v = 0.0;
@@ -56,10 +56,10 @@ bool NumberList(const nlohmann::json& j, const std::string& where, std::vector<d
 
 bool ReadText(const std::string& path, std::string* text, std::string* error) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return Bad(error, "cannot be read");
+  if (!in) return FileBad(error, "cannot be read");
   std::ostringstream os;
   os << in.rdbuf();
-  if (os.str().size() > kMaxModelFileBytes) return Bad(error, "is larger than 1 MiB");
+  if (os.str().size() > kMaxModelFileBytes) return FileBad(error, "is larger than 1 MiB");
   *text = os.str();
   return true;
 }
@@ -69,11 +69,11 @@ bool ReadTfShape(const nlohmann::json& j, ProcessModelUncertainty* m, std::strin
   const nlohmann::json *poles = nullptr, *zeros = nullptr;
   if (!Member(j, "poles", "", &poles, error) || !Member(j, "zeros", "", &zeros, error)) return false;
   if (!poles->is_number_integer() || poles->get<long>() < 1 || poles->get<long>() > plant_sim::kMaxTfPoles)
-    return Bad(error, "\"poles\" " + spec::Truncate(poles->dump()) + " must be an integer in 1.." +
+    return FileBad(error, "\"poles\" " + spec::Truncate(poles->dump()) + " must be an integer in 1.." +
                           std::to_string(plant_sim::kMaxTfPoles));
   m->poles = poles->get<int>();
   if (!zeros->is_number_integer() || zeros->get<long>() < 0 || zeros->get<long>() >= m->poles)
-    return Bad(error, "\"zeros\" " + spec::Truncate(zeros->dump()) + " must be an integer in 0.." +
+    return FileBad(error, "\"zeros\" " + spec::Truncate(zeros->dump()) + " must be an integer in 0.." +
                           std::to_string(m->poles - 1));
   m->zeros = zeros->get<int>();
   return true;
@@ -84,7 +84,7 @@ bool ReadParameters(const nlohmann::json& j, ProcessModelUncertainty* m, std::st
   const nlohmann::json* kind = nullptr;
   if (!Member(j, "model", "", &kind, error)) return false;
   if (!kind->is_string() || !Parse(kind->get<std::string>(), &m->kind))
-    return Bad(error, "\"model\" " + spec::Truncate(kind->dump()) + " must be " + ProcessModelKindNames());
+    return FileBad(error, "\"model\" " + spec::Truncate(kind->dump()) + " must be " + ProcessModelKindNames());
   if (m->kind == plant_sim::ProcessModelKind::kTf && !ReadTfShape(j, m, error)) return false;
   const nlohmann::json* parameters = nullptr;
   if (!Member(j, "parameters", "", &parameters, error)) return false;
@@ -101,7 +101,7 @@ bool ReadParameters(const nlohmann::json& j, ProcessModelUncertainty* m, std::st
   }
   std::string why;
   if (!ParametersAreValid(m->kind, m->values, &why, m->poles, m->zeros))
-    return Bad(error, "is not a valid " + std::string(plant_sim::ToString(m->kind)) + " model: " + why);
+    return FileBad(error, "is not a valid " + std::string(plant_sim::ToString(m->kind)) + " model: " + why);
   return true;
 }
 
@@ -110,7 +110,7 @@ bool ReadParameters(const nlohmann::json& j, ProcessModelUncertainty* m, std::st
 bool ReadCovariance(const nlohmann::json& j, ProcessModelUncertainty* m, std::string* error) {
   const nlohmann::json *c = nullptr, *ok = nullptr, *matrix = nullptr;
   if (!Member(j, "covariance", "", &c, error) || !Member(*c, "ok", "covariance.", &ok, error)) return false;
-  if (!ok->is_boolean()) return Bad(error, "\"covariance.ok\" must be true or false");
+  if (!ok->is_boolean()) return FileBad(error, "\"covariance.ok\" must be true or false");
   m->covariance.clear();
   if (c->contains("message") && c->at("message").is_string()) m->covariance_message = c->at("message");
   if (!ok->get<bool>()) return true;
@@ -121,10 +121,10 @@ bool ReadCovariance(const nlohmann::json& j, ProcessModelUncertainty* m, std::st
     names += (names.empty() ? "" : ", ") + name;
   const std::string shape =
       "\"covariance.matrix\" must be " + std::to_string(p) + " x " + std::to_string(p) + " (" + names + ")";
-  if (!matrix->is_array() || matrix->size() != p) return Bad(error, shape);
+  if (!matrix->is_array() || matrix->size() != p) return FileBad(error, shape);
   for (std::size_t i = 0; i < p; ++i) {
     const nlohmann::json& row = (*matrix)[i];
-    if (!row.is_array() || row.size() != p) return Bad(error, shape);
+    if (!row.is_array() || row.size() != p) return FileBad(error, shape);
     for (std::size_t k = 0; k < p; ++k) {
       double v = 0.0;
       if (!Number(row[k], "covariance.matrix[" + std::to_string(i) + "][" + std::to_string(k) + "]", &v,
@@ -135,11 +135,11 @@ bool ReadCovariance(const nlohmann::json& j, ProcessModelUncertainty* m, std::st
   }
   for (std::size_t i = 0; i < p; ++i) {
     if (!(m->covariance[i * p + i] >= 0.0))
-      return Bad(error, "\"covariance.matrix\" has a negative variance on its diagonal");
+      return FileBad(error, "\"covariance.matrix\" has a negative variance on its diagonal");
     for (std::size_t k = 0; k < i; ++k)
       if (std::abs(m->covariance[i * p + k] - m->covariance[k * p + i]) >
           1e-9 * (std::abs(m->covariance[i * p + k]) + std::abs(m->covariance[k * p + i])))
-        return Bad(error, "\"covariance.matrix\" is not symmetric");
+        return FileBad(error, "\"covariance.matrix\" is not symmetric");
   }
   return true;
 }
@@ -159,7 +159,7 @@ bool ReadModelFile(const std::string& path, Plant* plant, std::string* error) {
   std::string why;
   if (!ReadText(path, &text, error)) return false;
   if (!spec::ParseJsonText(text, &j, error)) return false;  // "is not valid JSON"
-  if (!j.is_object()) return Bad(error, "is not a JSON object");
+  if (!j.is_object()) return FileBad(error, "is not a JSON object");
   auto m = std::make_shared<ProcessModelUncertainty>();
   if (!ReadParameters(j, m.get(), error) || !ReadCovariance(j, m.get(), error)) return false;
   const nlohmann::json *tf = nullptr, *num = nullptr, *den = nullptr, *delay = nullptr;
@@ -171,10 +171,10 @@ bool ReadModelFile(const std::string& path, Plant* plant, std::string* error) {
       !NumberList(*num, "transfer_function.num", &p.tf.num, error) ||
       !NumberList(*den, "transfer_function.den", &p.tf.den, error))
     return false;
-  if (!MakeCustomPlant(p.tf.num, p.tf.den, &p, &why)) return Bad(error, "is not a valid plant: " + why);
+  if (!MakeCustomPlant(p.tf.num, p.tf.den, &p, &why)) return FileBad(error, "is not a valid plant: " + why);
   if (!Number(*delay, "transfer_function.delay_s", &p.delay_s, error)) return false;
   if (p.delay_s < 0.0)
-    return Bad(error, "\"transfer_function.delay_s\" " + spec::FormatNumber(p.delay_s) + " must be >= 0");
+    return FileBad(error, "\"transfer_function.delay_s\" " + spec::FormatNumber(p.delay_s) + " must be >= 0");
   p.name = kModelPlantName;
   p.model = std::move(m);
   *plant = std::move(p);
