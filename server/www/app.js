@@ -305,7 +305,9 @@ async function loadPaperDesigns() {
 }
 
 // ---- Tuning on the server.
+let tuning = false;
 function tuneProgress(m) {
+  if (!tuning) return;
   $('tune-status').textContent = 'tuning: ' + m.evaluations + ' evaluations, best objective ' + fmt(m.best);
 }
 
@@ -321,8 +323,10 @@ function tuningSpec(options) {
 async function tune(options) {
   const s = tuningSpec(options || {});
   $('tune-status').textContent = 'tuning: started';
+  tuning = true;
   try {
     const reply = await ask({ type: 'tune', spec: s });
+    tuning = false;
     pidlab.lastTune = reply.result;
     const g = reply.result.gains;
     $('tune-status').textContent = 'tuned: objective ' + fmt(reply.result.objective) + ', gains ' + [g.kp, g.ki, g.kd].map(fmt).join(', ') +
@@ -334,6 +338,7 @@ async function tune(options) {
     pin('tuned ' + (s.robust ? '--robust ' : '') + [g.kp, g.ki, g.kd].map(fmt).join('/'));
     return reply.result;
   } catch (e) {
+    tuning = false;
     $('tune-status').textContent = 'tuning: ' + e.message;
     throw e;
   }
