@@ -371,6 +371,9 @@ void Accept(std::shared_ptr<Server::Impl> server) {
         beast::error_code ignored;
         socket.close(ignored);
       } else {
+        // Replies of 100 KB (the plot series) must not wait for delayed ACKs.
+        beast::error_code ignored;
+        socket.set_option(tcp::no_delay(true), ignored);
         std::make_shared<HttpSession>(std::move(socket), server)->Run();
       }
     }

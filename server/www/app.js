@@ -137,8 +137,7 @@ function showMetrics(r) {
   }
 }
 
-function show(reply, sent) {
-  const reply_ms = performance.now();
+function show(reply, sent, reply_ms) {
   pidlab.lastResult = reply.result;
   pidlab.lastSeries = reply.series;
   setStatus('');
@@ -154,11 +153,11 @@ function show(reply, sent) {
   });
 }
 
-function onMessage(reply) {
+function onMessage(reply, arrived_ms) {
   if (inflight && reply.id === inflight.seq) {
     const sent = inflight;
     inflight = null;
-    if (reply.error) setStatus(reply.error); else show(reply, sent);
+    if (reply.error) setStatus(reply.error); else show(reply, sent, arrived_ms);
     if (pending) { pending = false; send(); }
     return;
   }
@@ -369,7 +368,7 @@ function connect() {
       (token ? '?token=' + encodeURIComponent(token) : '');
   socket = new WebSocket(url);
   socket.addEventListener('open', () => { send(); loadPaperDesigns(); });
-  socket.addEventListener('message', (e) => onMessage(JSON.parse(e.data)));
+  socket.addEventListener('message', (e) => { const arrived = performance.now(); onMessage(JSON.parse(e.data), arrived); });
   socket.addEventListener('close', () => setStatus('disconnected from the server'));
 }
 
