@@ -86,6 +86,31 @@ TEST(PlotSeries, CommandCancelsTheLoadStepAtSteadyState) {
   }
 }
 
+TEST(PlotSeries, MonteCarloBandOfZeroSpreadIsTheNominalResponse) {
+  nlohmann::json result;
+  const nlohmann::json series = SeriesOf(
+      {{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"monte_carlo", 4}, {"spread", 0.0}}, &result);
+  const nlohmann::json& band = series["monte_carlo"];
+  EXPECT_EQ(band["draws"], 4);
+  EXPECT_EQ(band["stable"], 4);
+  EXPECT_EQ(band["y_min"], series["y"]);
+  EXPECT_EQ(band["y_max"], series["y"]);
+  EXPECT_EQ(result["monte_carlo"]["samples"], 4);
+}
+
+TEST(PlotSeries, MonteCarloBandHoldsEveryDrawsResponse) {
+  const nlohmann::json series =
+      SeriesOf({{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"monte_carlo", 10}, {"spread", 0.2}});
+  const nlohmann::json& band = series["monte_carlo"];
+  ASSERT_EQ(band["y_min"].size(), series["y"].size());
+  bool wider = false;
+  for (std::size_t m = 0; m < series["y"].size(); ++m) {
+    EXPECT_LE(band["y_min"][m].get<double>(), band["y_max"][m].get<double>());
+    wider = wider || band["y_max"][m].get<double>() > band["y_min"][m].get<double>();
+  }
+  EXPECT_TRUE(wider);
+}
+
 TEST(PlotSeries, RefusesAGridOfFewerThanTenPoints) {
   PlotSeriesOptions options;
   options.frequency_points = 3;
