@@ -111,6 +111,22 @@ TEST(PlotSeries, MonteCarloBandHoldsEveryDrawsResponse) {
   EXPECT_TRUE(wider);
 }
 
+TEST(PlotSeries, NonlinearMotorComesWithTheLinearModelOfEq3) {
+  const nlohmann::json loop = {{"gains", {20.8836, 26.607, 12.4866}},
+                               {"loop", "sampled"},
+                               {"dt", 1e-4},
+                               {"horizon", 0.01},
+                               {"sample_time", 1e-4}};
+  nlohmann::json nonlinear = loop, linear = loop;
+  nonlinear["plant"] = "stepper_nonlinear";
+  linear["plant"] = "stepper_motor";
+  const nlohmann::json series = SeriesOf(nonlinear);
+  const evaluation::Evaluation ev = EvaluateDirectly(linear);
+  ASSERT_EQ(series["linear_y"].size(), ev.y.size());
+  for (std::size_t m = 0; m < ev.y.size(); ++m) ASSERT_EQ(series["linear_y"][m].get<double>(), ev.y[m]) << m;
+  EXPECT_TRUE(SeriesOf(linear)["linear_y"].is_null() || !SeriesOf(linear).contains("linear_y"));
+}
+
 TEST(PlotSeries, RefusesAGridOfFewerThanTenPoints) {
   PlotSeriesOptions options;
   options.frequency_points = 3;

@@ -17,7 +17,8 @@ function timeChart(el, title, yLabel, label, pinned, band) {
   const series = [{ label: 't s' }, { label, stroke: colours[0], width: 2 }];
   pinned.forEach((p, i) => series.push({ label: p.label, stroke: pinColour(i), width: 1, dash: [6, 3] }));
   const opts = { title, ...size(el), series, scales: { x: { time: false } }, axes: [{ label: 't (s)' }, { label: yLabel }] };
-  if (band) {  // the Monte-Carlo band: the last two series, filled between
+  if (band) {  // eq. (3)'s linear motor (nonlinear stepper), then the Monte-Carlo band: the last two series, filled between
+    series.push({ label: 'eq. (3) linear model', stroke: '#555', width: 1, dash: [2, 3] });
     const n = series.length;
     series.push({ label: 'Monte Carlo max', stroke: 'rgba(31,119,180,0.3)', width: 1 });
     series.push({ label: 'Monte Carlo min', stroke: 'rgba(31,119,180,0.3)', width: 1 });
@@ -134,7 +135,7 @@ export function drawPlots(plots, series, pinned) {
   const n = series.t.length;
   const pin = (key) => pinned.map((p) => orEmpty(p.series && p.series[key], n));
   const mc = series.monte_carlo || {};
-  plots.step.setData([series.t, series.y, ...pin('y'), orEmpty(mc.y_max, n), orEmpty(mc.y_min, n)]);
+  plots.step.setData([series.t, series.y, ...pin('y'), orEmpty(series.linear_y, n), orEmpty(mc.y_max, n), orEmpty(mc.y_min, n)]);
   plots.effort.setData([series.t, orEmpty(series.u, n), ...pin('u')]);
   plots.load.setData([series.t, orEmpty(series.load_y, n), ...pin('load_y')]);
   const m = series.w.length;

@@ -48,6 +48,25 @@ Status AddMonteCarlo(const spec::EvaluateSpec& s, const Plant& p, const PidGains
   return MonteCarloBand(p, motor, g, options, mc, &(*series)["monte_carlo"]);
 }
 
+// The nonlinear motor's plot: the linear model of eq. (3) (plant
+// stepper_motor with the same Table I) run on the same loop, its y in
+// (*series)["linear_y"] (null if it does not run).
+void AddLinearMotor(const spec::PlantSpec& motor, const PidGains& g, const LoopOptions& options,
+                    nlohmann::json* series) {
+  spec::PlantSpec linear;
+  linear.plant = "stepper_motor";
+  linear.stepper = motor.stepper;
+  Plant p;
+  Evaluation ev;
+  std::string error;
+  evaluation::EvaluateOptions what;
+  what.compute_step_info = false;
+  what.compute_iae_continuous = false;
+  const bool ran =
+      tune::BuildPlant(linear, NameStyle::kKey, &p, &error) && Evaluate(p, g, options, what, &ev, &error);
+  (*series)["linear_y"] = ran ? nlohmann::json(ev.y) : nlohmann::json(nullptr);
+}
+
 }  // namespace
 
 Status EvaluateSpecJson(const nlohmann::json& spec_json, nlohmann::json* result, nlohmann::json* series) {
@@ -79,6 +98,7 @@ Status EvaluateSpecJson(const nlohmann::json& spec_json, nlohmann::json* result,
   if (series) {
     const Status plotted = PlotSeries(p, g, options, ev, analysis, PlotSeriesOptions{}, series);
     if (!plotted.ok()) return plotted;
+    if (p.nonlinear) AddLinearMotor(s.plant, g, options, series);
   }
   return s.monte_carlo > 0 ? AddMonteCarlo(s, p, g, options, result, series) : Status::Ok();
 }
