@@ -47,6 +47,11 @@ start --port 0
 check "serve --port 0 prints its URL on 127.0.0.1 without a token" "[[ $url =~ ^http://127\.0\.0\.1:[0-9]+/$ ]]"
 "$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --json > want.json
 "$pidlab" evaluate --plant stepper_motor --gains 30,0.5,1 --loop sampled --dt 0.001 --json > want_sampled.json
+"$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --samples-csv samples.csv > /dev/null
+"$pidlab" tune --plant double_integrator --robust --json > want_tune.json
+"$pidlab" evaluate --plant oscillator --gains 2,1,1.5 --monte-carlo 20 --spread 0.2 --json > want_mc.json
+echo '{"plant": "oscillator", "gains": [2, 1, 1.5], "loop": "sampled", "output_limits": [-5, 5]}' > export_spec.json
+"$pidlab" export --spec export_spec.json --lang c --out exported > /dev/null
 PYTHONPATH="$here" /usr/bin/python3 - "$port" <<'PY'
 import json, sys
 from serve_client import http, WebSocket
@@ -64,6 +69,40 @@ status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'evaluate'
 got = json.loads(body)
 check('POST evaluate gives evaluate --json\'s object, key for key', status == 200 and got['result'] == want)
 json.dump(got['result'], open('served.json', 'w'))
+import csv
+rows = list(csv.DictReader(open('samples.csv')))
+series = got.get('series', {})
+check('the reply\'s series y is --samples-csv\'s y, bit for bit',
+      [float(r['y']) for r in rows] == series.get('y') and [float(r['t']) for r in rows] == series.get('t'))
+ms = got['result']['robustness']['ms']  # at w = inf here: the grid's end comes within 1e-6
+check('the reply\'s series has |S| peaking at the reported Ms and the Nyquist curve',
+      ms * (1 - 1e-6) <= max(series['s']) <= ms * (1 + 1e-9)
+      and len(series['l_re']) == len(series['w']) == len(series['t_mag']) == len(series['cs']))
+check('the reply carries the server\'s compute time', isinstance(got.get('compute_ms'), float) and got['compute_ms'] > 0)
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'evaluate', 'spec': spec, 'series': False}).encode())
+check('"series": false leaves the series out', status == 200 and 'series' not in json.loads(body))
+mc_spec = {'plant': 'oscillator', 'gains': [2, 1, 1.5], 'monte_carlo': 20, 'spread': 0.2}
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'evaluate', 'spec': mc_spec}).encode())
+got = json.loads(body)
+band = got.get('series', {}).get('monte_carlo', {})
+check('with monte_carlo the result is evaluate --monte-carlo --json\'s and the series has the band of 20 draws',
+      status == 200 and got['result'] == json.load(open('want_mc.json')) and band.get('stable') == 20
+      and all(lo <= hi for lo, hi in zip(band['y_min'], band['y_max'])))
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'evaluate', 'spec': dict(mc_spec, monte_carlo=5000)}).encode())
+check('more than 1000 Monte-Carlo draws are refused with one line', status == 400 and b'monte_carlo 5000' in body)
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'paper_designs'}).encode())
+designs = json.loads(body).get('designs', [])
+table2 = [d for d in designs if d['table'] == 'II' and d['method'] == 'nelder_mead']
+check('paper_designs lists the 13 published gain sets of Tables II-VI',
+      status == 200 and len(designs) == 13 and table2 and table2[0]['gains'] == [29.6558, 0.4977, 28.3216])
+export_spec = json.load(open('export_spec.json'))
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'export', 'spec': export_spec}).encode())
+files = json.loads(body).get('files', {})
+check('export gives the files pidlab export --spec writes, byte for byte',
+      status == 200 and files.get('pidlab_pid.h') == open('exported/pidlab_pid.h').read()
+      and files.get('pidlab_pid.c') == open('exported/pidlab_pid.c').read())
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'export', 'spec': {'plant': 'oscillator'}}).encode())
+check('export without gains is refused with one line', status == 400 and b'gains are required' in body)
 want_sampled = json.load(open('want_sampled.json'))
 ws = WebSocket(port)
 check('the WebSocket upgrade at /ws is accepted', ws.status == 101)
@@ -79,6 +118,28 @@ op, payload = ws.recv()
 check('a message that is not JSON gets an error reply', b'one JSON object' in payload)
 reply = ws.ask({'id': 44, 'type': 'fields'})
 check('the fields request lists the spec\'s keys', any(f['key'] == 'gains' for f in reply['fields']))
+want_tune = json.load(open('want_tune.json'))
+ws.send(json.dumps({'id': 45, 'type': 'tune', 'spec': {'plant': 'double_integrator', 'robust': True}}))
+kinds = []
+while True:
+    reply = json.loads(ws.recv()[1])
+    kinds.append(reply.get('type'))
+    if reply.get('type') != 'tune_progress': break
+check('a tune request sends progress, then tune --robust --json\'s gains and objective',
+      reply.get('id') == 45 and reply['type'] == 'tune_result' and kinds[0] == 'tune_progress'
+      and reply['result']['gains'] == want_tune['gains'] and reply['result']['objective'] == want_tune['objective']
+      and reply['result']['spec'] == want_tune['spec'])
+ws.send(json.dumps({'id': 46, 'type': 'tune', 'spec': {'plant': 'oscillator', 'method': 'ga', 'loop': 'sampled', 'max_evals': 200000}}))
+first = json.loads(ws.recv()[1])
+busy = ws.ask({'id': 47, 'type': 'tune', 'spec': {'plant': 'oscillator'}})
+ws.send(json.dumps({'type': 'tune_cancel'}))
+while True:
+    reply = json.loads(ws.recv()[1])
+    if reply.get('id') == 46 and reply.get('type') != 'tune_progress': break
+check('a second tuning on the connection is refused while one runs', 'already running' in busy.get('error', ''))
+check('tune_cancel stops the running tuning', first.get('type') == 'tune_progress' and reply['type'] == 'tune_cancelled')
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'tune', 'spec': {'plant': 'oscillator'}}).encode())
+check('tune over HTTP is refused: it needs the WebSocket', status == 400 and b'WebSocket' in body)
 ws.send('x' * 70000)
 try:
     op, payload = ws.recv()

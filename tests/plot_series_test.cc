@@ -1,0 +1,145 @@
+// The workbench's plot series (pidlab/json/plot_series.h): the step response
+// is the evaluation's own samples, the |S| curve peaks at the analysis's Ms,
+// and the command and load response agree with the loop's steady state.
+
+#include "pidlab/json/plot_series.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "pidlab/json/spec_run.h"
+#include "pidlab/spec/json.h"
+#include "pidlab/spec/loop_spec.h"
+#include "pidlab/tune/spec_build.h"
+
+namespace pidlab::json {
+namespace {
+
+// The evaluation of `spec` by the library pieces `pidlab evaluate` uses.
+evaluation::Evaluation EvaluateDirectly(const nlohmann::json& spec_json) {
+  spec::EvaluateSpec s;
+  std::string error;
+  EXPECT_TRUE(spec::FromJson(spec_json, &s, nullptr, &error)) << error;
+  s.plant.Normalize();
+  Plant p;
+  PidGains g;
+  evaluation::LoopOptions options;
+  EXPECT_TRUE(tune::BuildPlant(s.plant, spec::NameStyle::kKey, &p, &error) &&
+              tune::BuildGains(s.gains, spec::NameStyle::kKey, &g, &error) &&
+              tune::BuildLoopOptions(s.loop, spec::NameStyle::kKey, &options, &error))
+      << error;
+  evaluation::Evaluation ev;
+  EXPECT_TRUE(evaluation::Evaluate(p, g, options, evaluation::EvaluateOptions{}, &ev, &error)) << error;
+  return ev;
+}
+
+nlohmann::json SeriesOf(const nlohmann::json& spec, nlohmann::json* result = nullptr) {
+  nlohmann::json r, series;
+  const Status status = EvaluateSpecJson(spec, &r, &series);
+  EXPECT_TRUE(status.ok()) << status.message();
+  if (result) *result = r;
+  return series;
+}
+
+TEST(PlotSeries, StepResponseIsTheEvaluationsSamplesBitForBit) {
+  for (const nlohmann::json& spec :
+       {nlohmann::json{{"plant", "double_integrator"}, {"gains", {3.9, 0.06, 4.9}}},
+        nlohmann::json{{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"loop", "sampled"}},
+        nlohmann::json{{"plant", "stepper_motor"}, {"gains", {20.8836, 26.607, 12.4866}}}}) {
+    const nlohmann::json series = SeriesOf(spec);
+    const evaluation::Evaluation ev = EvaluateDirectly(spec);
+    ASSERT_EQ(series["y"].size(), ev.y.size()) << spec;
+    for (std::size_t m = 0; m < ev.y.size(); ++m) {
+      ASSERT_EQ(series["t"][m].get<double>(), ev.t[m]) << spec << " sample " << m;
+      ASSERT_EQ(series["y"][m].get<double>(), ev.y[m]) << spec << " sample " << m;
+    }
+    EXPECT_EQ(series["u"].size(), ev.y.size()) << spec;
+    EXPECT_EQ(series["load_y"].size(), ev.y.size()) << spec;
+  }
+}
+
+TEST(PlotSeries, SensitivityPeakOnTheGridIsTheReportedMs) {
+  for (const char* loop : {"continuous", "sampled"}) {
+    nlohmann::json result;
+    const nlohmann::json series =
+        SeriesOf({{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"loop", loop}, {"dt", 0.01}}, &result);
+    const std::vector<double> s = series["s"].get<std::vector<double>>();
+    const double ms = result["robustness"]["ms"].get<double>();
+    EXPECT_GT(ms, 1.0) << loop;
+    EXPECT_NEAR(*std::max_element(s.begin(), s.end()), ms, 1e-9 * ms) << loop;
+    EXPECT_EQ(series["ms"].get<double>(), ms) << loop;
+    EXPECT_EQ(series["frequency_loop"], loop);
+    EXPECT_EQ(series["w"].size(), s.size()) << loop;
+    EXPECT_EQ(series["l_re"].size(), s.size()) << loop;
+  }
+}
+
+TEST(PlotSeries, CommandCancelsTheLoadStepAtSteadyState) {
+  // With integral action, the unit step at the plant input ends with u = -1
+  // and y = 0, on both loops.
+  for (const char* loop : {"continuous", "sampled"}) {
+    const nlohmann::json series = SeriesOf({{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"loop", loop}});
+    EXPECT_NEAR(series["load_u"].back().get<double>(), -1.0, 1e-3) << loop;
+    EXPECT_NEAR(series["load_y"].back().get<double>(), 0.0, 1e-3) << loop;
+    // The step response's command settles where the plant holds y = 1: u = den(0)/num(0) = 1.
+    EXPECT_NEAR(series["u"].back().get<double>(), 1.0, 1e-3) << loop;
+  }
+}
+
+TEST(PlotSeries, MonteCarloBandOfZeroSpreadIsTheNominalResponse) {
+  nlohmann::json result;
+  const nlohmann::json series = SeriesOf(
+      {{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"monte_carlo", 4}, {"spread", 0.0}}, &result);
+  const nlohmann::json& band = series["monte_carlo"];
+  EXPECT_EQ(band["draws"], 4);
+  EXPECT_EQ(band["stable"], 4);
+  EXPECT_EQ(band["y_min"], series["y"]);
+  EXPECT_EQ(band["y_max"], series["y"]);
+  EXPECT_EQ(result["monte_carlo"]["samples"], 4);
+}
+
+TEST(PlotSeries, MonteCarloBandHoldsEveryDrawsResponse) {
+  const nlohmann::json series =
+      SeriesOf({{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"monte_carlo", 10}, {"spread", 0.2}});
+  const nlohmann::json& band = series["monte_carlo"];
+  ASSERT_EQ(band["y_min"].size(), series["y"].size());
+  bool wider = false;
+  for (std::size_t m = 0; m < series["y"].size(); ++m) {
+    EXPECT_LE(band["y_min"][m].get<double>(), band["y_max"][m].get<double>());
+    wider = wider || band["y_max"][m].get<double>() > band["y_min"][m].get<double>();
+  }
+  EXPECT_TRUE(wider);
+}
+
+TEST(PlotSeries, NonlinearMotorComesWithTheLinearModelOfEq3) {
+  const nlohmann::json loop = {{"gains", {20.8836, 26.607, 12.4866}},
+                               {"loop", "sampled"},
+                               {"dt", 1e-4},
+                               {"horizon", 0.01},
+                               {"sample_time", 1e-4}};
+  nlohmann::json nonlinear = loop, linear = loop;
+  nonlinear["plant"] = "stepper_nonlinear";
+  linear["plant"] = "stepper_motor";
+  const nlohmann::json series = SeriesOf(nonlinear);
+  const evaluation::Evaluation ev = EvaluateDirectly(linear);
+  ASSERT_EQ(series["linear_y"].size(), ev.y.size());
+  for (std::size_t m = 0; m < ev.y.size(); ++m) ASSERT_EQ(series["linear_y"][m].get<double>(), ev.y[m]) << m;
+  EXPECT_TRUE(SeriesOf(linear)["linear_y"].is_null() || !SeriesOf(linear).contains("linear_y"));
+}
+
+TEST(PlotSeries, RefusesAGridOfFewerThanTenPoints) {
+  PlotSeriesOptions options;
+  options.frequency_points = 3;
+  nlohmann::json series;
+  const Status status = PlotSeries(Plant{}, PidGains{}, evaluation::LoopOptions{}, evaluation::Evaluation{},
+                                   analysis::LoopAnalysis{}, options, &series);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("frequency_points 3"), std::string::npos) << status.message();
+}
+
+}  // namespace
+}  // namespace pidlab::json
