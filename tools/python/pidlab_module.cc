@@ -20,6 +20,7 @@
 #include "pidlab/evaluation/evaluation.h"
 #include "identify_binding.h"
 #include "pidlab/json/results_json.h"
+#include "pidlab/json/spec_run.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/tune/search_box.h"
@@ -183,32 +184,15 @@ py::object EvaluatePy(const py::object& plant, const py::object& gains, py::kwar
   spec::EvaluateSpec s;
   std::set<std::string> given;
   ReadKwargs("evaluate", WithPositional(plant, &gains, kwargs), &s, &given);
-  s.plant.Normalize();
-  std::string error;
-  Plant p;
-  PidGains g;
-  LoopOptions options;
-  LoopBounds bounds;
-  Require(BuildPlant(s.plant, NameStyle::kKey, &p, &error) &&
-              BuildGains(s.gains, NameStyle::kKey, &g, &error) &&
-              BuildLoopOptions(s.loop, NameStyle::kKey, &options, &error) &&
-              CheckPlantInLoop(p, options, NameStyle::kKey, &error) &&
-              BuildBounds(s.bounds, NameStyle::kKey, &bounds, &error),
-          error);
-  Evaluation ev;
-  LoopAnalysis analysis;
-  bool ok = false;
+  // The same code as `pidlab evaluate --spec` and `pidlab serve` (json/spec_run.h).
+  nlohmann::json result;
+  Status status;
   {
     py::gil_scoped_release release;
-    ok = Evaluate(p, g, options, EvaluateOptions{}, &ev, &error) &&
-         AnalyzeLoop(p, g, options, LoopAnalysisOptions{}, &analysis, &error);
+    status = json::EvaluateSpecJson(spec::ToJson(s), &result);
   }
-  Require(ok, error);
-  nlohmann::json j = json::ToJson(ev);
-  j["backend"] = "local";
-  j["robustness"] = json::RobustnessJson(analysis, bounds);
-  j["spec"] = spec::ToJson(s);
-  return ToPython(j);
+  Require(status.ok(), status.message());
+  return ToPython(result);
 }
 
 py::object TunePy(const py::object& plant, py::kwargs kwargs) {
