@@ -8,9 +8,9 @@
 
 #include "cli_common.h"
 #include "commands.h"
-#include "pidlab/json/spec_run.h"
 #include "pidlab/server/assets.h"
 #include "pidlab/server/server.h"
+#include "serve_requests.h"
 
 namespace pidlab::cli {
 namespace {
@@ -18,19 +18,6 @@ namespace {
 server::Server* g_server = nullptr;
 extern "C" void StopOnSignal(int) {
   if (g_server) g_server->Stop();
-}
-
-// One request of the page: {"type": "evaluate", "spec": {...}} or {"type": "fields"}.
-server::Reply Answer(const nlohmann::json& request) {
-  const std::string type = request.value("type", std::string());
-  if (type == "fields") return {200, {{"type", "fields"}, {"fields", json::EvaluateSpecFields()}}};
-  if (type != "evaluate")
-    return {400, {{"error", "request type '" + type + "' is not one of evaluate, fields"}}};
-  if (!request.contains("spec")) return {400, {{"error", "an evaluate request needs a spec"}}};
-  nlohmann::json result;
-  const Status status = json::EvaluateSpecJson(request["spec"], &result);
-  if (!status.ok()) return {400, {{"error", status.message()}}};
-  return {200, {{"type", "evaluation"}, {"result", result}}};
 }
 
 struct ServeCommand {
@@ -53,7 +40,7 @@ struct ServeCommand {
     if (!server::IsLoopback(options.bind)) options.token = RandomToken();
     std::string error;
     if (!options.IsValid(&error)) throw BadInput(error);
-    server::Server s(options, Answer, server::WorkbenchAssets());
+    server::Server s(options, AnswerWorkbenchRequest, server::WorkbenchAssets());
     if (!s.Start(&error)) throw BadInput(error);
     const std::string host =
         options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind;

@@ -1,91 +1,387 @@
-// The workbench page: controls -> a spec -> the server (WebSocket /ws) ->
-// the same JSON as `pidlab evaluate --json`. No computation happens here.
-'use strict';
+// The workbench page: the design form -> a spec -> the server (WebSocket /ws)
+// -> the JSON of `pidlab evaluate --json` and the plot series, drawn by
+// uPlot (plots.js). The page computes no result itself (docs/workbench.md).
+import { createPlots, destroyPlots, drawPlots } from './plots.js';
+
 const token = new URLSearchParams(location.search).get('token');
-const plants = ['double_integrator', 'oscillator', 'stepper_motor'];
-const state = { plant: 'double_integrator', kp: 3.9, ki: 0.06, kd: 4.9, seq: 0, lastShown: 0 };
+const plants = ['double_integrator', 'oscillator', 'stepper_motor', 'custom', 'stepper_nonlinear', 'model'];
+// The design: what the form shows. Empty strings are fields left to the spec's defaults.
+const state = {
+  plant: 'double_integrator', num: '1', den: '1,0,0', model: '', delay: '', stepper: '',
+  kp: 3.9, ki: 0.06, kd: 4.9, derivative_filter: '', weight_b: '', weight_c: '', limit_lo: '', limit_hi: '',
+  loop: 'continuous', dt: '', max_ms: '', max_mt: '', max_noise_gain: '', min_phase_margin: '',
+};
+const textFields = ['num', 'den', 'model', 'delay', 'stepper', 'derivative_filter', 'weight_b', 'weight_c',
+  'limit_lo', 'limit_hi', 'dt', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin'];
+const pidlab = window.pidlab = {
+  state, lastResult: null, lastSeries: null, plots: {}, rendered: 0, timings: [], pinned: [],
+  lastTune: null, paperDesigns: [],
+};
 let socket = null;
+let seq = 0;
+let inflight = null;  // the evaluate request awaiting its reply: at most one
+let pending = false;  // the design changed meanwhile: send the latest when it returns
+const waiting = new Map();  // id -> {resolve, reject} of other requests
 
+const $ = (id) => document.getElementById(id);
+const list = (text) => String(text).split(/[\s,]+/).filter((x) => x !== '').map(Number);
+const given = (v) => v !== '' && v !== null && v !== undefined;
+
+// The spec of the current design (docs/spec.md): only the fields the form sets.
 function spec() {
-  return { plant: state.plant, gains: [state.kp, state.ki, state.kd] };
+  const s = {};
+  if (state.plant === 'custom') Object.assign(s, { plant: 'custom', num: list(state.num), den: list(state.den) });
+  else if (state.plant === 'model') s.plant = 'model:' + state.model;
+  else s.plant = state.plant;
+  s.gains = [state.kp, state.ki, state.kd];
+  if (given(state.delay)) s.delay = Number(state.delay);
+  if (given(state.stepper) && state.plant.startsWith('stepper')) s.stepper = JSON.parse(state.stepper);
+  if (state.loop === 'sampled') s.loop = 'sampled';
+  if (state.loop === 'sampled' && given(state.dt)) s.dt = Number(state.dt);
+  if (given(state.derivative_filter)) s.derivative_filter = Number(state.derivative_filter);
+  if (given(state.weight_b) || given(state.weight_c))
+    s.setpoint_weights = [given(state.weight_b) ? Number(state.weight_b) : 1, given(state.weight_c) ? Number(state.weight_c) : 1];
+  if (given(state.limit_lo) || given(state.limit_hi))
+    s.output_limits = [given(state.limit_lo) ? Number(state.limit_lo) : '-inf', given(state.limit_hi) ? Number(state.limit_hi) : 'inf'];
+  for (const k of ['max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin']) if (given(state[k])) s[k] = Number(state[k]);
+  return s;
 }
 
-function command(s) {
-  return 'pidlab evaluate --plant ' + s.plant + ' --gains ' + s.gains.join(',') + ' --json';
+function shellWord(v) {
+  const text = String(v);
+  return /^[\w.,:/+=-]+$/.test(text) ? text : "'" + text.replace(/'/g, "'\\''") + "'";
 }
 
-function slider(name) {
-  const row = document.createElement('div');
-  const label = document.createElement('label');
-  label.textContent = name;
-  const range = document.createElement('input');
-  range.type = 'range'; range.min = -3; range.max = 2; range.step = 0.001; range.id = name + '-slider';
-  const box = document.createElement('input');
-  box.type = 'number'; box.step = 'any'; box.min = 0; box.id = name;
-  const set = (v, from) => {
-    state[name] = v;
-    if (from !== box) box.value = v;
-    if (from !== range) range.value = v > 0 ? Math.log10(v) : -3;
-    send();
-  };
-  range.addEventListener('input', () => set(Number(Math.pow(10, Number(range.value)).toPrecision(6)), range));
-  box.addEventListener('change', () => set(Number(box.value), box));
-  row.append(label, range, box);
-  document.getElementById('gains').append(row);
-  box.value = state[name];
-  range.value = Math.log10(state[name]);
+// The `pidlab` command line of a spec (`verb` evaluate or tune).
+function commandOf(s, verb, extra) {
+  const words = ['pidlab', verb];
+  for (const [key, value] of Object.entries(s)) {
+    const flag = '--' + key.replace(/_/g, '-');
+    if (key === 'stepper') {
+      for (const [k, v] of Object.entries(value)) words.push(flag, shellWord(k + '=' + v));
+    } else if (typeof value === 'boolean') {
+      if (value) words.push(flag);
+    } else {
+      const text = Array.isArray(value) ? value.join(',') : String(value);
+      words.push(text.startsWith('-') ? flag + '=' + shellWord(text) : flag + ' ' + shellWord(text));
+    }
+  }
+  return words.concat(extra || ['--json']).join(' ');
+}
+pidlab.spec = spec;
+pidlab.command = () => commandOf(spec(), 'evaluate');
+
+function setStatus(text) { $('status').textContent = text; }
+
+function rawSend(message) {
+  if (!socket || socket.readyState !== WebSocket.OPEN) return false;
+  socket.send(JSON.stringify(message));
+  return true;
 }
 
-function show(reply) {
-  const status = document.getElementById('status');
-  if (reply.error) { status.textContent = reply.error; return; }
-  if (reply.id < state.lastShown) return;
-  state.lastShown = reply.id;
-  status.textContent = '';
-  const r = reply.result;
-  const rows = [
-    ['IAE (eq. 4)', r.iae], ['ISE', r.ise], ['ITAE', r.itae], ['stable', r.stable],
-    ['overshoot %', r.overshoot_pct], ['settling time s', r.settling_time_s],
-    ['Ms', r.robustness && r.robustness.ms], ['Mt', r.robustness && r.robustness.mt],
-    ['phase margin deg', r.robustness && r.robustness.phase_margin_deg],
+// Asks the server; resolves with the reply (rejects with its error).
+function ask(message) {
+  const id = ++seq;
+  return new Promise((resolve, reject) => {
+    waiting.set(id, { resolve, reject });
+    if (!rawSend({ ...message, id })) { waiting.delete(id); reject(new Error('not connected')); }
+  });
+}
+
+// Evaluates the current design: latest wins, no queue.
+function send() {
+  writeHash();
+  if (inflight) { pending = true; return; }
+  let s;
+  try { s = spec(); } catch (e) { setStatus('bad design: ' + e.message); return; }
+  inflight = { seq: ++seq, sent_ms: performance.now() };
+  if (!rawSend({ id: inflight.seq, type: 'evaluate', spec: s })) inflight = null;
+}
+
+function fmt(v) {
+  if (v === null || v === undefined) return '-';
+  if (typeof v === 'boolean') return v ? 'yes' : 'no';
+  if (typeof v !== 'number') return String(v);
+  return Math.abs(v) >= 1e4 || (Math.abs(v) < 1e-3 && v !== 0) ? v.toExponential(4) : String(Number(v.toPrecision(5)));
+}
+
+// [key, label, value, the bound's name in the violations] of a result.
+function metricRows(r) {
+  const rb = r.robustness || {};
+  return [
+    ['iae', 'IAE (eq. 4)', r.iae], ['ise', 'ISE', r.ise], ['itae', 'ITAE', r.itae],
+    ['iae_continuous', 'IAE continuous', r.iae_continuous], ['load_iae', 'load IAE', r.load_iae],
+    ['stable', 'stable', r.stable], ['rise_time', 'rise time s', r.rise_time_s],
+    ['overshoot', 'overshoot %', r.overshoot_pct], ['settling_time', 'settling time s', r.settling_time_s],
+    ['ms', 'Ms', rb.ms, 'Ms'], ['mt', 'Mt', rb.mt, 'Mt'], ['noise_gain', 'noise gain', rb.noise_gain, 'noise gain'],
+    ['phase_margin', 'phase margin deg', rb.phase_margin_deg, 'phase margin'],
+    ['gain_margin', 'gain margin', rb.gain_margin, 'gain margin'], ['delay_margin', 'delay margin s', rb.delay_margin_s],
+    ['time_constant', 'slowest time constant s', rb.slowest_time_constant_s, 'time constant'],
   ];
+}
+
+function showMetrics(r) {
+  const violations = (r.robustness && r.robustness.violations) || [];
   const body = document.querySelector('#metrics tbody');
   body.textContent = '';
-  for (const [name, value] of rows) {
+  for (const [key, name, value, bound] of metricRows(r)) {
     const tr = document.createElement('tr');
-    const a = document.createElement('th'); a.textContent = name;
-    const b = document.createElement('td'); b.textContent = value === null || value === undefined ? '-' : String(value);
-    b.dataset.key = name;
-    tr.append(a, b);
+    const th = document.createElement('th'); th.textContent = name;
+    const td = document.createElement('td'); td.id = 'metric-' + key;
+    td.textContent = fmt(value);
+    td.dataset.value = value === undefined ? 'null' : String(value);
+    const broken = violations.filter((v) => (bound && v.toLowerCase().startsWith(bound.toLowerCase())) || v === 'unstable loop');
+    if (broken.length && (bound || key === 'stable')) { td.classList.add('violated'); td.title = broken.join('; '); }
+    tr.append(th, td);
     body.append(tr);
   }
-  document.getElementById('spec').textContent = JSON.stringify(r.spec);
-  document.getElementById('command').textContent = command(spec());
 }
 
-function send() {
-  if (!socket || socket.readyState !== WebSocket.OPEN) return;
-  state.seq += 1;
-  socket.send(JSON.stringify({ id: state.seq, type: 'evaluate', spec: spec() }));
+function show(reply, sent) {
+  const reply_ms = performance.now();
+  pidlab.lastResult = reply.result;
+  pidlab.lastSeries = reply.series;
+  setStatus('');
+  showMetrics(reply.result);
+  $('notes').textContent = (reply.series.notes || []).join('; ') + ((reply.result.robustness || {}).violations || []).map((v) => '; breaks ' + v).join('');
+  drawPlots(pidlab.plots, reply.series, pidlab.pinned);
+  $('spec').textContent = JSON.stringify(reply.result.spec);
+  $('command').textContent = pidlab.command();
+  renderDiff();
+  queueMicrotask(() => {  // after uPlot's own commit (a microtask queued by setData)
+    pidlab.timings.push({ seq: sent.seq, sent_ms: sent.sent_ms, reply_ms, drawn_ms: performance.now(), server_ms: reply.compute_ms });
+    pidlab.rendered += 1;
+  });
 }
 
+function onMessage(reply) {
+  if (inflight && reply.id === inflight.seq) {
+    const sent = inflight;
+    inflight = null;
+    if (reply.error) setStatus(reply.error); else show(reply, sent);
+    if (pending) { pending = false; send(); }
+    return;
+  }
+  if (reply.type === 'tune_progress') { tuneProgress(reply); return; }
+  const w = waiting.get(reply.id);
+  if (!w) return;
+  waiting.delete(reply.id);
+  if (reply.error) w.reject(new Error(reply.error)); else w.resolve(reply);
+}
+
+// ---- The form.
+function slider(name) {
+  const row = document.createElement('div');
+  row.className = 'row';
+  const label = document.createElement('label');
+  label.textContent = name; label.htmlFor = name;
+  const range = document.createElement('input');
+  range.type = 'range'; range.min = -3; range.max = 2.5; range.step = 0.001; range.id = name + '-slider';
+  const box = document.createElement('input');
+  box.type = 'number'; box.step = 'any'; box.min = 0; box.id = name;
+  range.addEventListener('input', () => setGain(name, Number(Math.pow(10, Number(range.value)).toPrecision(6)), range));
+  box.addEventListener('change', () => setGain(name, Number(box.value), box));
+  row.append(label, range, box);
+  $('gains').append(row);
+}
+
+function setGain(name, v, from) {
+  state[name] = v;
+  if (from !== $(name)) $(name).value = v;
+  if (from !== $(name + '-slider')) $(name + '-slider').value = v > 0 ? Math.log10(v) : -3;
+  send();
+}
+
+function showForm() {
+  $('plant').value = state.plant;
+  $('loop').value = state.loop;
+  for (const k of textFields) $(k).value = state[k];
+  for (const g of ['kp', 'ki', 'kd']) setGainBoxes(g);
+  for (const el of document.querySelectorAll('.plant-custom')) el.classList.toggle('hidden', state.plant !== 'custom');
+  for (const el of document.querySelectorAll('.plant-model')) el.classList.toggle('hidden', state.plant !== 'model');
+  for (const el of document.querySelectorAll('.plant-stepper')) el.classList.toggle('hidden', !state.plant.startsWith('stepper'));
+}
+
+function setGainBoxes(g) {
+  $(g).value = state[g];
+  $(g + '-slider').value = state[g] > 0 ? Math.log10(state[g]) : -3;
+}
+
+// Sets the design from a spec-like object (a paper design, a tuning, a pin).
+function setDesign(d) {
+  if (d.plant !== undefined) state.plant = d.plant;
+  if (d.gains) [state.kp, state.ki, state.kd] = d.gains;
+  showForm();
+  send();
+}
+pidlab.setDesign = setDesign;
+
+function writeHash() {
+  history.replaceState(null, '', location.pathname + location.search + '#' + encodeURIComponent(JSON.stringify(state)));
+}
+
+function readHash() {
+  if (location.hash.length < 2) return;
+  try {
+    const saved = JSON.parse(decodeURIComponent(location.hash.slice(1)));
+    for (const k of Object.keys(state)) if (k in saved) state[k] = saved[k];
+  } catch (e) { setStatus('the URL does not hold a design: ' + e.message); }
+}
+
+// ---- Pins and the paper's designs.
+function rebuildPlots() {
+  destroyPlots(pidlab.plots);
+  const el = (k) => $('plot-' + k);
+  pidlab.plots = createPlots({ step: el('step'), effort: el('effort'), load: el('load'), freq: el('freq'), nyquist: el('nyquist') }, pidlab.pinned);
+  if (pidlab.lastSeries) drawPlots(pidlab.plots, pidlab.lastSeries, pidlab.pinned);
+}
+
+function pin(label) {
+  if (!pidlab.lastResult) return null;
+  const r = pidlab.lastResult;
+  const g = r.gains;
+  const design = {
+    label: label || 'P' + (pidlab.pinned.length + 1) + ' ' + r.plant + ' ' + [g.kp, g.ki, g.kd].map(fmt).join('/'),
+    spec: r.spec, result: r, series: pidlab.lastSeries,
+  };
+  pidlab.pinned.push(design);
+  renderPinned();
+  rebuildPlots();
+  return design;
+}
+pidlab.pin = () => pin();
+
+function renderPinned() {
+  const listEl = $('pinned-list');
+  listEl.textContent = '';
+  pidlab.pinned.forEach((p, i) => {
+    const div = document.createElement('div');
+    div.className = 'pinned-design';
+    const name = document.createElement('span'); name.textContent = p.label + ' ';
+    const load = document.createElement('button'); load.textContent = 'load';
+    load.addEventListener('click', () => { Object.assign(state, p.state || {}); setDesign({ plant: p.result.plant === 'model' ? state.plant : p.spec.plant, gains: p.spec.gains }); });
+    const drop = document.createElement('button'); drop.textContent = 'unpin';
+    drop.addEventListener('click', () => { pidlab.pinned.splice(i, 1); renderPinned(); rebuildPlots(); });
+    div.append(name, load, drop);
+    listEl.append(div);
+  });
+  renderDiff();
+}
+
+// Metrics of the current design and every pinned one, and the difference.
+function renderDiff() {
+  const table = $('diff-table');
+  table.textContent = '';
+  if (!pidlab.pinned.length || !pidlab.lastResult) return;
+  const head = document.createElement('tr');
+  for (const h of ['metric', 'current', ...pidlab.pinned.map((p) => p.label), ...pidlab.pinned.map((p) => 'current - ' + p.label.split(' ')[0])]) {
+    const th = document.createElement('th'); th.textContent = h; head.append(th);
+  }
+  table.append(head);
+  const rows = metricRows(pidlab.lastResult);
+  const pinnedRows = pidlab.pinned.map((p) => metricRows(p.result));
+  rows.forEach(([key, name, value], i) => {
+    const tr = document.createElement('tr');
+    const cells = [name, fmt(value), ...pinnedRows.map((r) => fmt(r[i][2])),
+      ...pinnedRows.map((r) => (typeof value === 'number' && typeof r[i][2] === 'number' ? fmt(value - r[i][2]) : '-'))];
+    cells.forEach((c, j) => { const td = document.createElement(j ? 'td' : 'th'); td.textContent = c; tr.append(td); });
+    tr.dataset.key = key;
+    table.append(tr);
+  });
+}
+
+async function loadPaperDesigns() {
+  try {
+    const reply = await ask({ type: 'paper_designs' });
+    pidlab.paperDesigns = reply.designs;
+    for (const d of reply.designs) {
+      const b = document.createElement('button');
+      b.className = 'paper-design';
+      b.textContent = 'Table ' + d.table + ' ' + d.plant + ' ' + d.method + (d.disturbance_amplitude ? ' ±' + d.disturbance_amplitude : '');
+      b.addEventListener('click', () => setDesign({ plant: d.plant, gains: d.gains }));
+      $('paper-designs').append(b);
+    }
+  } catch (e) { setStatus('paper designs: ' + e.message); }
+}
+
+// ---- Tuning on the server.
+function tuneProgress(m) {
+  $('tune-status').textContent = 'tuning: ' + m.evaluations + ' evaluations, best objective ' + fmt(m.best);
+}
+
+function tuningSpec(options) {
+  const s = spec();
+  delete s.gains;
+  if (options.robust) s.robust = true;
+  for (const k of ['method', 'objective', 'bounds', 'max_evals', 'max_iter', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin', 'refine'])
+    if (options[k] !== undefined) s[k] = options[k];
+  return s;
+}
+
+async function tune(options) {
+  const s = tuningSpec(options || {});
+  $('tune-status').textContent = 'tuning: started';
+  try {
+    const reply = await ask({ type: 'tune', spec: s });
+    pidlab.lastTune = reply.result;
+    const g = reply.result.gains;
+    $('tune-status').textContent = 'tuned: objective ' + fmt(reply.result.objective) + ', gains ' + [g.kp, g.ki, g.kd].map(fmt).join(', ') +
+      (reply.result.refine ? ', Ceres: ' + (reply.result.refine.verdict || JSON.stringify(reply.result.refine)) : '');
+    state.kp = g.kp; state.ki = g.ki; state.kd = g.kd;
+    if (g.tf > 0) state.derivative_filter = g.tf;
+    showForm();
+    await evaluated();
+    pin('tuned ' + (s.robust ? '--robust ' : '') + [g.kp, g.ki, g.kd].map(fmt).join('/'));
+    return reply.result;
+  } catch (e) {
+    $('tune-status').textContent = 'tuning: ' + e.message;
+    throw e;
+  }
+}
+
+// Resolves once the current design's reply is drawn.
+function evaluated() {
+  send();
+  const target = seq;
+  return new Promise((resolve) => {
+    const poll = () => (!inflight && !pending && pidlab.timings.length && pidlab.timings[pidlab.timings.length - 1].seq >= target ? resolve() : setTimeout(poll, 10));
+    poll();
+  });
+}
+
+pidlab.tune = tune;
+pidlab.cancelTune = () => rawSend({ type: 'tune_cancel' });
+
+function formTuneOptions() {
+  const o = { method: $('tune-method').value, objective: $('tune-objective').value };
+  if ($('tune-robust').checked) return { robust: true };
+  return o;
+}
+
+// ---- Start.
 function connect() {
   const url = (location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + '/ws' +
       (token ? '?token=' + encodeURIComponent(token) : '');
   socket = new WebSocket(url);
-  socket.addEventListener('open', send);
-  socket.addEventListener('message', (e) => show(JSON.parse(e.data)));
-  socket.addEventListener('close', () => {
-    document.getElementById('status').textContent = 'disconnected from the server';
-  });
+  socket.addEventListener('open', () => { send(); loadPaperDesigns(); });
+  socket.addEventListener('message', (e) => onMessage(JSON.parse(e.data)));
+  socket.addEventListener('close', () => setStatus('disconnected from the server'));
 }
 
-const select = document.getElementById('plant');
 for (const p of plants) {
   const o = document.createElement('option');
   o.value = p; o.textContent = p;
-  select.append(o);
+  $('plant').append(o);
 }
-select.addEventListener('change', () => { state.plant = select.value; send(); });
 for (const name of ['kp', 'ki', 'kd']) slider(name);
+$('plant').addEventListener('change', () => { state.plant = $('plant').value; showForm(); send(); });
+$('loop').addEventListener('change', () => { state.loop = $('loop').value; send(); });
+for (const k of textFields) $(k).addEventListener('change', () => { state[k] = $(k).value; send(); });
+$('pin-button').addEventListener('click', () => pin());
+$('tune-button').addEventListener('click', () => tune(formTuneOptions()).catch(() => {}));
+$('tune-cancel').addEventListener('click', () => pidlab.cancelTune());
+$('copy-command').addEventListener('click', () => navigator.clipboard.writeText(pidlab.command()).catch((e) => setStatus('copy: ' + e.message)));
+readHash();
+showForm();
+rebuildPlots();
 connect();

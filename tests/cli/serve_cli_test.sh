@@ -47,6 +47,7 @@ start --port 0
 check "serve --port 0 prints its URL on 127.0.0.1 without a token" "[[ $url =~ ^http://127\.0\.0\.1:[0-9]+/$ ]]"
 "$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --json > want.json
 "$pidlab" evaluate --plant stepper_motor --gains 30,0.5,1 --loop sampled --dt 0.001 --json > want_sampled.json
+"$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --samples-csv samples.csv > /dev/null
 PYTHONPATH="$here" /usr/bin/python3 - "$port" <<'PY'
 import json, sys
 from serve_client import http, WebSocket
@@ -64,6 +65,23 @@ status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'evaluate'
 got = json.loads(body)
 check('POST evaluate gives evaluate --json\'s object, key for key', status == 200 and got['result'] == want)
 json.dump(got['result'], open('served.json', 'w'))
+import csv
+rows = list(csv.DictReader(open('samples.csv')))
+series = got.get('series', {})
+check('the reply\'s series y is --samples-csv\'s y, bit for bit',
+      [float(r['y']) for r in rows] == series.get('y') and [float(r['t']) for r in rows] == series.get('t'))
+ms = got['result']['robustness']['ms']  # at w = inf here: the grid's end comes within 1e-6
+check('the reply\'s series has |S| peaking at the reported Ms and the Nyquist curve',
+      ms * (1 - 1e-6) <= max(series['s']) <= ms * (1 + 1e-9)
+      and len(series['l_re']) == len(series['w']) == len(series['t_mag']) == len(series['cs']))
+check('the reply carries the server\'s compute time', isinstance(got.get('compute_ms'), float) and got['compute_ms'] > 0)
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'evaluate', 'spec': spec, 'series': False}).encode())
+check('"series": false leaves the series out', status == 200 and 'series' not in json.loads(body))
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'paper_designs'}).encode())
+designs = json.loads(body).get('designs', [])
+table2 = [d for d in designs if d['table'] == 'II' and d['method'] == 'nelder_mead']
+check('paper_designs lists the 13 published gain sets of Tables II-VI',
+      status == 200 and len(designs) == 13 and table2 and table2[0]['gains'] == [29.6558, 0.4977, 28.3216])
 want_sampled = json.load(open('want_sampled.json'))
 ws = WebSocket(port)
 check('the WebSocket upgrade at /ws is accepted', ws.status == 101)

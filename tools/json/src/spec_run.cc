@@ -4,6 +4,7 @@
 #include <string>
 
 #include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/json/plot_series.h"
 #include "pidlab/json/results_json.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
@@ -20,7 +21,7 @@ using evaluation::Evaluation;
 using evaluation::LoopOptions;
 using spec::NameStyle;
 
-Status EvaluateSpecJson(const nlohmann::json& spec_json, nlohmann::json* result) {
+Status EvaluateSpecJson(const nlohmann::json& spec_json, nlohmann::json* result, nlohmann::json* series) {
   spec::EvaluateSpec s;
   std::string error;
   if (!spec::FromJson(spec_json, &s, nullptr, &error)) return Status::InvalidInput(error);
@@ -37,13 +38,16 @@ Status EvaluateSpecJson(const nlohmann::json& spec_json, nlohmann::json* result)
     return Status::InvalidInput(error);
   Evaluation ev;
   LoopAnalysis analysis;
-  if (!(Evaluate(p, g, options, EvaluateOptions{}, &ev, &error) &&
+  EvaluateOptions what;
+  what.record_trajectory = series != nullptr && options.loop == evaluation::LoopKind::kSampled;
+  if (!(Evaluate(p, g, options, what, &ev, &error) &&
         AnalyzeLoop(p, g, options, LoopAnalysisOptions{}, &analysis, &error)))
     return Status::RunnerFailed(error);
   *result = ToJson(ev);
   (*result)["backend"] = "local";
   (*result)["robustness"] = RobustnessJson(analysis, bounds);
   (*result)["spec"] = spec::ToJson(s);
+  if (series) return PlotSeries(p, g, options, ev, analysis, PlotSeriesOptions{}, series);
   return Status::Ok();
 }
 

@@ -15,8 +15,9 @@ namespace pidlab::json {
 /// EvaluateSpec `spec` (keys as the spec's JSON form; a --json result's
 /// "spec" runs again). Status kInvalidInput with one line naming the key and
 /// value for a spec that does not validate; kRunnerFailed if the evaluation
-/// fails.
-Status EvaluateSpecJson(const nlohmann::json& spec, nlohmann::json* result);
+/// fails. With `series`, also the plot data of that loop there
+/// (plot_series.h: PlotSeries), for the workbench's plots.
+Status EvaluateSpecJson(const nlohmann::json& spec, nlohmann::json* result, nlohmann::json* series = nullptr);
 
 /// The fields of EvaluateSpec: [{key, flag, help, unit, default, example}].
 nlohmann::json EvaluateSpecFields();

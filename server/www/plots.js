@@ -1,0 +1,121 @@
+// The workbench's charts, all drawn by uPlot (the global `uPlot` of
+// uPlot.iife.min.js): step response, control effort, load response,
+// |S| |T| |CS| with the Ms line, Nyquist with the 1/Ms circle. The data
+// comes from the server's `series` (docs/workbench.md); the page only draws.
+
+const colours = ['#1f77b4', '#d62728', '#2ca02c', '#9467bd', '#ff7f0e', '#8c564b', '#e377c2', '#17becf'];
+const pinColour = (i) => colours[(i + 1) % colours.length];
+// Nyquist points beyond this are clipped for drawing (L grows without bound
+// at low frequencies on loops with integrators).
+const kNyquistClip = 1e3;
+
+function size(el) {
+  return { width: Math.max(300, el.clientWidth || 560), height: 220 };
+}
+
+function timeChart(el, title, yLabel, label, pinned) {
+  const series = [{ label: 't s' }, { label, stroke: colours[0], width: 2 }];
+  pinned.forEach((p, i) => series.push({ label: p.label, stroke: pinColour(i), width: 1, dash: [6, 3] }));
+  return new uPlot({
+    title, ...size(el), series,
+    scales: { x: { time: false } },
+    axes: [{ label: 't (s)' }, { label: yLabel }],
+  }, [[], [], ...pinned.map(() => [])], el);
+}
+
+function freqChart(el, pinned) {
+  const series = [{ label: 'w rad/s' },
+    { label: '|S|', stroke: colours[0], width: 2 },
+    { label: '|T|', stroke: colours[2], width: 2 },
+    { label: '|CS|', stroke: colours[4], width: 1 },
+    { label: 'Ms', stroke: '#888', width: 1, dash: [4, 4] }];
+  pinned.forEach((p, i) => {
+    series.push({ label: p.label + ' |S|', stroke: pinColour(i), width: 1, dash: [6, 3] });
+    series.push({ label: p.label + ' |T|', stroke: pinColour(i), width: 1, dash: [2, 2] });
+  });
+  return new uPlot({
+    title: '|S|, |T|, |CS| (Ms dashed)', ...size(el), series,
+    scales: { x: { time: false, distr: 3 }, y: { distr: 3 } },
+    axes: [{ label: 'w (rad/s)' }, { label: 'gain' }],
+  }, [[], [], [], [], [], ...pinned.flatMap(() => [[], []])], el);
+}
+
+function nyquistChart(el, pinned) {
+  const series = [null, { label: 'L(jw)', stroke: colours[0], width: 2 },
+    { label: '1/Ms circle', stroke: '#888', width: 1, dash: [4, 4] },
+    { label: '-1', stroke: '#000', width: 1, points: { show: true, size: 6 } }];
+  pinned.forEach((p, i) => series.push({ label: p.label, stroke: pinColour(i), width: 1, dash: [6, 3] }));
+  return new uPlot({
+    mode: 2, title: 'Nyquist of L (1/Ms circle around -1)', ...size(el), series,
+    legend: { show: false }, cursor: { show: false },
+    scales: { x: { time: false, auto: false, range: [-4, 2] }, y: { auto: false, range: [-3, 3] } },
+    axes: [{ label: 'Re L' }, { label: 'Im L' }],
+  }, [null, [[], []], [[], []], [[-1], [0]], ...pinned.map(() => [[], []])], el);
+}
+
+const clip = (v) => (v === null || !isFinite(v) ? null : Math.max(-kNyquistClip, Math.min(kNyquistClip, v)));
+
+function nyquistCurve(s) {
+  if (!s) return [[], []];
+  return [s.l_re.map(clip), s.l_im.map(clip)];
+}
+
+function circle(ms) {
+  if (!(ms > 0) || !isFinite(ms)) return [[], []];
+  const xs = [], ys = [];
+  for (let i = 0; i <= 120; i++) {
+    const a = (2 * Math.PI * i) / 120;
+    xs.push(-1 + Math.cos(a) / ms);
+    ys.push(Math.sin(a) / ms);
+  }
+  return [xs, ys];
+}
+
+// v (given at the increasing frequencies w) at the frequencies `at`, linear
+// in log w; null outside w.
+function resample(w, v, at) {
+  const out = [];
+  let j = 0;
+  for (const x of at) {
+    while (j + 1 < w.length && w[j + 1] < x) j++;
+    if (x < w[0] || x > w[w.length - 1] || j + 1 >= w.length) { out.push(x === w[j] ? v[j] : null); continue; }
+    const f = (Math.log(x) - Math.log(w[j])) / (Math.log(w[j + 1]) - Math.log(w[j]));
+    out.push(v[j] === null || v[j + 1] === null ? null : v[j] + f * (v[j + 1] - v[j]));
+  }
+  return out;
+}
+
+const orEmpty = (v, n) => (Array.isArray(v) ? v : new Array(n).fill(null));
+
+// Builds the five charts in `elements` ({step, effort, load, freq, nyquist})
+// with a dashed series per pinned design.
+export function createPlots(elements, pinned) {
+  return {
+    step: timeChart(elements.step, 'Setpoint step response y', 'y', 'y', pinned),
+    effort: timeChart(elements.effort, 'Control effort u (step response)', 'u', 'u', pinned),
+    load: timeChart(elements.load, 'Load response y (unit step at the plant input)', 'y', 'y', pinned),
+    freq: freqChart(elements.freq, pinned),
+    nyquist: nyquistChart(elements.nyquist, pinned),
+  };
+}
+
+export function destroyPlots(plots) {
+  for (const k of Object.keys(plots || {})) plots[k].destroy();
+}
+
+// Sets every chart's data: the current design's `series` and the pinned ones'.
+export function drawPlots(plots, series, pinned) {
+  const n = series.t.length;
+  const pin = (key) => pinned.map((p) => orEmpty(p.series && p.series[key], n));
+  plots.step.setData([series.t, series.y, ...pin('y')]);
+  plots.effort.setData([series.t, orEmpty(series.u, n), ...pin('u')]);
+  plots.load.setData([series.t, orEmpty(series.load_y, n), ...pin('load_y')]);
+  const m = series.w.length;
+  // A pinned design has its own grid: its curve is drawn at this grid's
+  // frequencies by interpolation on log w (drawing only; its numbers are its reply's).
+  const onGrid = (p, key) => (p.series ? resample(p.series.w, p.series[key], series.w) : new Array(m).fill(null));
+  plots.freq.setData([series.w, series.s, series.t_mag, series.cs, new Array(m).fill(series.ms),
+    ...pinned.flatMap((p) => [onGrid(p, 's'), onGrid(p, 't_mag')])]);
+  plots.nyquist.setData([null, nyquistCurve(series), circle(series.ms), [[-1], [0]],
+    ...pinned.map((p) => nyquistCurve(p.series))]);
+}

@@ -1,0 +1,100 @@
+// The workbench's plot series (pidlab/json/plot_series.h): the step response
+// is the evaluation's own samples, the |S| curve peaks at the analysis's Ms,
+// and the command and load response agree with the loop's steady state.
+
+#include "pidlab/json/plot_series.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "pidlab/json/spec_run.h"
+#include "pidlab/spec/json.h"
+#include "pidlab/spec/loop_spec.h"
+#include "pidlab/tune/spec_build.h"
+
+namespace pidlab::json {
+namespace {
+
+// The evaluation of `spec` by the library pieces `pidlab evaluate` uses.
+evaluation::Evaluation EvaluateDirectly(const nlohmann::json& spec_json) {
+  spec::EvaluateSpec s;
+  std::string error;
+  EXPECT_TRUE(spec::FromJson(spec_json, &s, nullptr, &error)) << error;
+  s.plant.Normalize();
+  Plant p;
+  PidGains g;
+  evaluation::LoopOptions options;
+  EXPECT_TRUE(tune::BuildPlant(s.plant, spec::NameStyle::kKey, &p, &error) &&
+              tune::BuildGains(s.gains, spec::NameStyle::kKey, &g, &error) &&
+              tune::BuildLoopOptions(s.loop, spec::NameStyle::kKey, &options, &error))
+      << error;
+  evaluation::Evaluation ev;
+  EXPECT_TRUE(evaluation::Evaluate(p, g, options, evaluation::EvaluateOptions{}, &ev, &error)) << error;
+  return ev;
+}
+
+nlohmann::json SeriesOf(const nlohmann::json& spec, nlohmann::json* result = nullptr) {
+  nlohmann::json r, series;
+  const Status status = EvaluateSpecJson(spec, &r, &series);
+  EXPECT_TRUE(status.ok()) << status.message();
+  if (result) *result = r;
+  return series;
+}
+
+TEST(PlotSeries, StepResponseIsTheEvaluationsSamplesBitForBit) {
+  for (const nlohmann::json& spec :
+       {nlohmann::json{{"plant", "double_integrator"}, {"gains", {3.9, 0.06, 4.9}}},
+        nlohmann::json{{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"loop", "sampled"}},
+        nlohmann::json{{"plant", "stepper_motor"}, {"gains", {20.8836, 26.607, 12.4866}}}}) {
+    const nlohmann::json series = SeriesOf(spec);
+    const evaluation::Evaluation ev = EvaluateDirectly(spec);
+    ASSERT_EQ(series["y"].size(), ev.y.size()) << spec;
+    for (std::size_t m = 0; m < ev.y.size(); ++m) {
+      ASSERT_EQ(series["t"][m].get<double>(), ev.t[m]) << spec << " sample " << m;
+      ASSERT_EQ(series["y"][m].get<double>(), ev.y[m]) << spec << " sample " << m;
+    }
+    EXPECT_EQ(series["u"].size(), ev.y.size()) << spec;
+    EXPECT_EQ(series["load_y"].size(), ev.y.size()) << spec;
+  }
+}
+
+TEST(PlotSeries, SensitivityPeakOnTheGridIsTheReportedMs) {
+  nlohmann::json result;
+  const nlohmann::json series = SeriesOf({{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}}, &result);
+  const std::vector<double> s = series["s"].get<std::vector<double>>();
+  const double ms = result["robustness"]["ms"].get<double>();
+  EXPECT_GT(ms, 1.0);
+  EXPECT_NEAR(*std::max_element(s.begin(), s.end()), ms, 1e-9 * ms);
+  EXPECT_EQ(series["ms"].get<double>(), ms);
+  EXPECT_EQ(series["w"].size(), s.size());
+  EXPECT_EQ(series["l_re"].size(), s.size());
+}
+
+TEST(PlotSeries, CommandCancelsTheLoadStepAtSteadyState) {
+  // With integral action, the unit step at the plant input ends with u = -1
+  // and y = 0, on both loops.
+  for (const char* loop : {"continuous", "sampled"}) {
+    const nlohmann::json series = SeriesOf({{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"loop", loop}});
+    EXPECT_NEAR(series["load_u"].back().get<double>(), -1.0, 1e-3) << loop;
+    EXPECT_NEAR(series["load_y"].back().get<double>(), 0.0, 1e-3) << loop;
+    // The step response's command settles where the plant holds y = 1: u = den(0)/num(0) = 1.
+    EXPECT_NEAR(series["u"].back().get<double>(), 1.0, 1e-3) << loop;
+  }
+}
+
+TEST(PlotSeries, RefusesAGridOfFewerThanTenPoints) {
+  PlotSeriesOptions options;
+  options.frequency_points = 3;
+  nlohmann::json series;
+  const Status status = PlotSeries(Plant{}, PidGains{}, evaluation::LoopOptions{}, evaluation::Evaluation{},
+                                   analysis::LoopAnalysis{}, options, &series);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("frequency_points 3"), std::string::npos) << status.message();
+}
+
+}  // namespace
+}  // namespace pidlab::json

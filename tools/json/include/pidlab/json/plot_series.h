@@ -1,0 +1,43 @@
+#pragma once
+// The workbench's plot data for one loop (docs/workbench.md, "The series"):
+// what the page draws, computed by the code of the evaluation and of the
+// loop analysis, never by the page.
+
+#include <nlohmann/json.hpp>
+
+#include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/evaluation/evaluation.h"
+#include "pidlab/spec/status.h"
+
+namespace pidlab::json {
+
+struct PlotSeriesOptions {
+  /// Points of the log frequency grid (plus the frequencies of Ms, Mt and the
+  /// noise gain, so that the grid's peaks are the reported ones). 10..5000.
+  int frequency_points = 300;
+  /// The grid spans this factor below and above the gain crossover (1 rad/s
+  /// without one). > 1.
+  double decades_around_crossover = 3.0;
+};
+
+/// The series of the loop `evaluation` ran (Evaluate of `plant`, `typed_gains`,
+/// `options`; a sampled loop evaluated with record_trajectory) and `analysis`
+/// found (AnalyzeLoop of the same loop), as the JSON object
+///   t, y          the evaluation's sample times and y (== `--samples-csv`)
+///   u             the command at those times: the sampled loop's recorded u;
+///                 the continuous loop's u of the undisturbed step response
+///                 (null with dead time)
+///   load_y, load_u  the load response (r = 0, unit step at the plant input,
+///                 the load IAE's run; null for a nonlinear plant or the
+///                 continuous loop with dead time)
+///   w, s, t_mag, cs |S|, |T|, |C S| on a log grid (rad/s) of the continuous
+///                 loop (with its dead time; the sampled loop's C(s) G(s) too,
+///                 "frequency_loop" says which), ms, mt, noise_gain (the analysis)
+///   l_re, l_im    L(jw) on that grid (the Nyquist curve)
+///   notes         what is missing and why.
+/// kRunnerFailed with the message if the frequency response fails.
+Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
+                  const evaluation::Evaluation& evaluation, const analysis::LoopAnalysis& analysis,
+                  const PlotSeriesOptions& series_options, nlohmann::json* series);
+
+}  // namespace pidlab::json

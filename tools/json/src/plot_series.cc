@@ -1,0 +1,150 @@
+#include "pidlab/json/plot_series.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "pidlab/plant_sim/matrix_exp.h"
+
+namespace pidlab::json {
+namespace {
+using analysis::LoopAnalysis;
+using analysis::LoopFrequencyPoint;
+using evaluation::BuildContinuousClosedLoop;
+using evaluation::ContinuousClosedLoop;
+using evaluation::Evaluation;
+using evaluation::LoopKind;
+using evaluation::LoopOptions;
+
+// y and u of a continuous loop (no breakpoints: no disturbance, or the load
+// step from t = 0) at t = 0, ts, ...: the loop's state propagated by
+// e^{M ts} as SampleContinuousLoop does, and u from the plant's row of
+// w' = M w: B u = x' - A x - B n.
+void ContinuousResponseAndCommand(const StateSpace& ss, const ContinuousClosedLoop<double>& loop, double ts,
+                                  int samples, std::vector<double>* y, std::vector<double>* u) {
+  const Eigen::MatrixXd phi = MatrixExp<double>(Eigen::MatrixXd(loop.m * ts));
+  const int n = loop.plant_order;
+  const double bb = ss.b.squaredNorm();
+  Eigen::VectorXd w = loop.w0, next(w.size());
+  y->clear();
+  u->clear();
+  for (int k = 0; k < samples; ++k) {
+    if (k > 0) {
+      next.noalias() = phi * w;
+      w.swap(next);
+    }
+    const Eigen::VectorXd x = w.head(n);
+    const Eigen::VectorXd dx = (loop.m * w).head(n);
+    const double disturbance = loop.exo_size == 1 ? w(loop.exo_index()) : 0.0;
+    y->push_back(loop.Output(w));
+    u->push_back(ss.b.dot(dx - ss.a * x) / bb - disturbance);
+  }
+}
+
+// The command and the load response of the loop at the sample times.
+void TimeSeries(const Plant& plant, const PidGains& gains, const LoopOptions& options, const Evaluation& ev,
+                nlohmann::json* out, std::vector<std::string>* notes) {
+  std::vector<double> u, load_y, load_u;
+  const Disturbance load_step(evaluation::UnitLoadStep());
+  if (options.loop == LoopKind::kSampled) {
+    const int every = options.StepsPerSample();
+    for (std::size_t m = 0; m < ev.t.size() && !ev.trajectory.empty(); ++m)
+      u.push_back(ev.trajectory[std::min(m * every, ev.trajectory.size() - 1)].u);
+    if (plant.nonlinear) {
+      notes->push_back("no load response for the nonlinear motor");
+    } else {
+      std::vector<evaluation::SampledStep> steps;
+      evaluation::RunSampledLoop<double>(evaluation::SampledPlant(plant, options.dt_s), gains, options.Pid(),
+                                         load_step, options.TotalSteps(), every, &load_y, &steps, 0.0);
+      for (std::size_t m = 0; m < load_y.size(); ++m)
+        load_u.push_back(steps[std::min(m * every, steps.size() - 1)].u);
+    }
+  } else if (plant.delay_s > 0.0) {
+    notes->push_back("no command or load response for the continuous loop with dead time");
+  } else {
+    const StateSpace ss = Realize(plant.tf);
+    ContinuousClosedLoop<double> loop, load;
+    std::vector<double> y_clean;
+    const Disturbance none{DisturbanceOptions{}};
+    if (BuildContinuousClosedLoop<double>(ss, gains, none, &loop, nullptr, options.reference,
+                                          evaluation::SetpointWeightsOf(options.pid)))
+      ContinuousResponseAndCommand(ss, loop, options.sample_time_s, options.NumSamples(), &y_clean, &u);
+    if (BuildContinuousClosedLoop<double>(ss, gains, load_step, &load, nullptr, 0.0))
+      ContinuousResponseAndCommand(ss, load, options.sample_time_s, options.NumSamples(), &load_y, &load_u);
+    if (options.disturbance.kind != DisturbanceKind::kNone)
+      notes->push_back("u is the command of the undisturbed step response");
+  }
+  (*out)["t"] = ev.t;
+  (*out)["y"] = ev.y;
+  (*out)["u"] = u.empty() ? nlohmann::json(nullptr) : nlohmann::json(u);
+  (*out)["load_y"] = load_y.empty() ? nlohmann::json(nullptr) : nlohmann::json(load_y);
+  (*out)["load_u"] = load_u.empty() ? nlohmann::json(nullptr) : nlohmann::json(load_u);
+}
+
+// The log grid around the gain crossover, with the peaks' frequencies.
+std::vector<double> FrequencyGrid(const LoopAnalysis& a, const PlotSeriesOptions& o) {
+  const double centre =
+      std::isfinite(a.gain_crossover_rad_s) && a.gain_crossover_rad_s > 0.0 ? a.gain_crossover_rad_s : 1.0;
+  const double lo = std::log10(centre) - o.decades_around_crossover;
+  const double hi = std::log10(centre) + o.decades_around_crossover;
+  std::vector<double> w;
+  for (int i = 0; i < o.frequency_points; ++i)
+    w.push_back(std::pow(10.0, lo + (hi - lo) * i / (o.frequency_points - 1)));
+  for (double peak : {a.ms_rad_s, a.mt_rad_s, a.noise_gain_rad_s})
+    if (std::isfinite(peak) && peak > 0.0) w.push_back(peak);
+  std::sort(w.begin(), w.end());
+  w.erase(std::unique(w.begin(), w.end()), w.end());
+  return w;
+}
+
+}  // namespace
+
+Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
+                  const Evaluation& evaluation, const LoopAnalysis& analysis,
+                  const PlotSeriesOptions& series_options, nlohmann::json* series) {
+  if (!(series_options.frequency_points >= 10 && series_options.frequency_points <= 5000))
+    return Status::InvalidInput("frequency_points " + std::to_string(series_options.frequency_points) +
+                                " must be in 10..5000");
+  const PidGains gains = evaluation::LoopGains(typed_gains, options);
+  std::vector<std::string> notes;
+  *series = nlohmann::json::object();
+  TimeSeries(plant, gains, options, evaluation, series, &notes);
+  LoopOptions continuous = options;
+  continuous.loop = LoopKind::kContinuous;
+  const std::vector<double> w = FrequencyGrid(analysis, series_options);
+  std::vector<LoopFrequencyPoint> response;
+  std::string error;
+  if (!analysis::LoopFrequencyResponse(plant, typed_gains, continuous, w, &response, &error))
+    return Status::RunnerFailed(error);
+  std::vector<double> c_num, c_den, s, t, cs, l_re, l_im;
+  evaluation::ContinuousPidPolynomials(gains, &c_num, &c_den);
+  for (const LoopFrequencyPoint& p : response) {
+    const std::complex<double> jw(0.0, p.w_rad_s);
+    const std::complex<double> c =
+        evaluation::frequency::Eval(c_num, jw) / evaluation::frequency::Eval(c_den, jw);
+    s.push_back(std::abs(p.s));
+    t.push_back(std::abs(p.t));
+    cs.push_back(std::abs(c * p.s));
+    l_re.push_back(p.l.real());
+    l_im.push_back(p.l.imag());
+  }
+  if (options.loop == LoopKind::kSampled)
+    notes.push_back(
+        "the frequency plots are of the continuous loop C(s) G(s); Ms and Mt of the sampled loop");
+  (*series)["w"] = w;
+  (*series)["s"] = s;
+  (*series)["t_mag"] = t;
+  (*series)["cs"] = cs;
+  (*series)["l_re"] = l_re;
+  (*series)["l_im"] = l_im;
+  (*series)["frequency_loop"] = "continuous";
+  (*series)["ms"] = analysis.ms;
+  (*series)["mt"] = analysis.mt;
+  (*series)["noise_gain"] = analysis.noise_gain;
+  (*series)["stable"] = analysis.stable;
+  (*series)["notes"] = notes;
+  return Status::Ok();
+}
+
+}  // namespace pidlab::json

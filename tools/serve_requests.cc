@@ -1,0 +1,65 @@
+#include "serve_requests.h"
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "pidlab/json/spec_run.h"
+#ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
+#include "pidlab/report/report.h"
+#endif
+
+namespace pidlab::cli {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// {"type": "evaluate", "spec": SPEC, "series": true}: the result, the plot
+// series (unless "series" is false) and the server's compute time.
+server::Reply Evaluate(const nlohmann::json& request) {
+  if (!request.contains("spec")) return {400, {{"error", "an evaluate request needs a spec"}}};
+  const auto series_flag = request.find("series");
+  if (series_flag != request.end() && !series_flag->is_boolean())
+    return {400, {{"error", "series " + series_flag->dump() + " must be true or false"}}};
+  const bool with_series = series_flag == request.end() || series_flag->get<bool>();
+  const auto start = std::chrono::steady_clock::now();
+  nlohmann::json result, series;
+  const Status status = json::EvaluateSpecJson(request["spec"], &result, with_series ? &series : nullptr);
+  if (!status.ok()) return {400, {{"error", status.message()}}};
+  nlohmann::json reply = {{"type", "evaluation"}, {"result", result}};
+  if (with_series) reply["series"] = series;
+  reply["compute_ms"] = MillisecondsSince(start);
+  return {200, reply};
+}
+
+}  // namespace
+
+nlohmann::json PaperDesigns() {
+  nlohmann::json designs = nlohmann::json::array();
+#ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
+  std::vector<report::PaperRow> rows;
+  std::string error;
+  if (!report::ParsePaperTables(report::BuiltinPaperTablesCsv(), "paper_tables.csv", &rows, &error))
+    throw std::runtime_error(error);
+  for (const report::PaperRow& r : rows)
+    designs.push_back({{"table", r.table},
+                       {"plant", r.plant},
+                       {"method", r.method},
+                       {"disturbance_amplitude", r.disturbance_amplitude},
+                       {"gains", {r.gains.kp, r.gains.ki, r.gains.kd}},
+                       {"paper_iae", r.paper_iae}});
+#endif
+  return designs;
+}
+
+server::Reply AnswerWorkbenchRequest(const nlohmann::json& request) {
+  const std::string type = request.value("type", std::string());
+  if (type == "fields") return {200, {{"type", "fields"}, {"fields", json::EvaluateSpecFields()}}};
+  if (type == "paper_designs") return {200, {{"type", "paper_designs"}, {"designs", PaperDesigns()}}};
+  if (type == "evaluate") return Evaluate(request);
+  return {400, {{"error", "request type '" + type + "' is not one of evaluate, fields, paper_designs"}}};
+}
+
+}  // namespace pidlab::cli
