@@ -8,7 +8,9 @@
 //   server           the server's compute time (server_ms, its own clock)
 //   render           reply received -> redraw complete (drawn_ms - reply_ms)
 //   wire             the rest of the round trip: reply_ms - sent_ms - server_ms
-//                    (the WebSocket both ways, the server's queueing)
+//                    (the request and the 80 KB reply through the WebSocket, the
+//                    reply's JSON written by the server and parsed by the page,
+//                    the wait for the processes to be scheduled)
 //   node workbench_bench.js --url URL --modules DIR --chromium BIN --tmp DIR --moves N
 'use strict';
 const path = require('path');

@@ -6,8 +6,9 @@
 # decade, seeded), each waiting for its redraw; input -> drawn, the server's
 # compute and the browser's render (reply -> drawn) reported apart, from the
 # page's pidlab.timings (bench/workbench_bench.js). Prints the machine's load
-# and, when built (PIDLAB_BUILD_BENCH=ON), bench/wakeup_bench's floor over 5 s,
-# so a loaded VM shows. Exit 1 when a plant misses a target.
+# and, when it is built (next to PIDLAB with PIDLAB_BUILD_BENCH=ON, or where
+# WAKEUP_BENCH says), bench/wakeup_bench's floor over 5 s, so that a loaded
+# machine shows. Exit 1 when a plant misses a target.
 #   bench/workbench_bench.sh [PIDLAB] [MOVES]     (root; defaults build/bin/pidlab 200)
 set -euo pipefail
 pidlab=${1:-}
@@ -27,7 +28,7 @@ if [[ ${PIDLAB_BENCH_IN_NAMESPACE:-} != 1 ]]; then
 fi
 ip link set lo up
 echo "machine: $(nproc) processors; uptime:$(uptime)"
-wakeup=$(dirname "$pidlab")/wakeup_bench
+wakeup=${WAKEUP_BENCH:-$(dirname "$pidlab")/wakeup_bench}
 if [ -x "$wakeup" ]; then
   echo "floor: $("$wakeup" 0.001 5 | tr '\n' ' ')"
 else

@@ -27,7 +27,7 @@ if [[ ${PIDLAB_TEST_IN_NAMESPACE:-} != 1 ]]; then
   PIDLAB_TEST_IN_NAMESPACE=1 exec unshare -n bash "$0" "$@"
 fi
 ip link set lo up || { echo "FAIL: cannot bring up the private namespace's loopback"; exit 1; }
-mkdir -p "$out_dir"
+mkdir -p "$out_dir" && rm -f "$out_dir"/workbench-*.png  # no stale screenshot from an earlier run
 tmp=$(mktemp -d)
 server=
 trap '[ -n "$server" ] && kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
