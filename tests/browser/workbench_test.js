@@ -69,6 +69,11 @@ async function main() {
       process.exit(1);
     }
   };
+  // For docs/workbench.png: the top of the page in the 1400x1000 viewport.
+  const docsShot = async () => {
+    await page.evaluate(() => window.scrollTo(0, 0));
+    await page.screenshot({ path: path.join(args.out, 'workbench-docs-1400x1000.png') });
+  };
   const iaeCell = () => page.$eval('#metric-iae', (e) => e.dataset.value);
 
   await step('(a) the page loads with no console error, page error or failed request', async () => {
@@ -139,6 +144,7 @@ async function main() {
       expectClose('pin "' + p.label + '" IAE', p.iae, cli.iae, 1e-12);
     }
     await shot('pinned');
+    await docsShot();  // taken again after the tuning, if it passes
   });
 
   await step('(d) pidlab.tune({robust: true}) on the oscillator gives the gains of pidlab tune --robust --json', async () => {
@@ -171,9 +177,7 @@ async function main() {
   await step('no console error, page error or failed request during the whole run', async () => {
     if (log.errors.length) throw new Error(log.errors.length + ' of them, the first: ' + log.errors[0]);
   });
-  // For docs/workbench.png: the viewport, 1400x1000, scrolled to the top.
-  await page.evaluate(() => window.scrollTo(0, 0));
-  await page.screenshot({ path: path.join(args.out, 'workbench-docs-1400x1000.png') });
+  await docsShot();
   console.log('screenshots in ' + args.out);
   await browser.close();
 }
