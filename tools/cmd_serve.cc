@@ -40,7 +40,7 @@ struct ServeCommand {
     if (!server::IsLoopback(options.bind)) options.token = RandomToken();
     std::string error;
     if (!options.IsValid(&error)) throw BadInput(error);
-    server::Server s(options, AnswerWorkbenchRequest, server::WorkbenchAssets());
+    server::Server s(options, server::ConnectionHandler(AnswerWorkbenchRequest), server::WorkbenchAssets());
     if (!s.Start(&error)) throw BadInput(error);
     const std::string host =
         options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind;

@@ -54,12 +54,21 @@ nlohmann::json PaperDesigns() {
   return designs;
 }
 
-server::Reply AnswerWorkbenchRequest(const nlohmann::json& request) {
+server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
+                                     const std::shared_ptr<server::Connection>& connection) {
   const std::string type = request.value("type", std::string());
   if (type == "fields") return {200, {{"type", "fields"}, {"fields", json::EvaluateSpecFields()}}};
   if (type == "paper_designs") return {200, {{"type", "paper_designs"}, {"designs", PaperDesigns()}}};
   if (type == "evaluate") return Evaluate(request);
-  return {400, {{"error", "request type '" + type + "' is not one of evaluate, fields, paper_designs"}}};
+#ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
+  if (type == "tune") return AnswerTune(request, connection);
+  if (type == "tune_cancel") return AnswerTuneCancel(connection);
+#else
+  (void)connection;
+#endif
+  return {400,
+          {{"error",
+            "request type '" + type + "' is not one of evaluate, fields, paper_designs, tune, tune_cancel"}}};
 }
 
 }  // namespace pidlab::cli

@@ -6,6 +6,8 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
+#include <deque>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -80,7 +82,7 @@ bool ServerOptions::IsValid(std::string* error) const {
 
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   ServerOptions options;
-  Handler handler;
+  ConnectionHandler handler;
   std::vector<Asset> assets;
   net::io_context io{1};
   tcp::acceptor acceptor{io};
@@ -118,7 +120,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   }
 
   // One request object through the handler: the reply's status and body.
-  Reply Answer(const std::string& text) {
+  Reply Answer(const std::string& text, const std::shared_ptr<Connection>& connection = nullptr) {
     nlohmann::json request = nlohmann::json::parse(text, nullptr, false);
     if (request.is_discarded() || !request.is_object()) {
       Count(&ServerCounters::malformed);
@@ -126,7 +128,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     }
     Reply reply;
     try {
-      reply = handler(request);
+      reply = handler(request, connection);
     } catch (const std::exception& e) {
       reply = {500, {{"error", std::string("the server failed: ") + e.what()}}};
     }
@@ -167,15 +169,36 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
 
 namespace {
 
+class WebSocketSession;
+
+// The handler's view of a session: posts onto the session's executor.
+class SessionConnection : public Connection {
+ public:
+  SessionConnection(net::any_io_executor executor, std::weak_ptr<WebSocketSession> session)
+      : executor_(std::move(executor)), session_(std::move(session)) {}
+  bool Post(const nlohmann::json& message, const std::string& replace_key) override;
+  bool closed() const override { return closed_; }
+  void Close() { closed_ = true; }
+
+ private:
+  net::any_io_executor executor_;
+  std::weak_ptr<WebSocketSession> session_;
+  std::atomic<bool> closed_{false};
+};
+
 class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
  public:
   WebSocketSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
       : ws_(std::move(socket)), server_(std::move(server)) {
     ++server_->open_connections;
   }
-  ~WebSocketSession() { --server_->open_connections; }
+  ~WebSocketSession() {
+    if (connection_) connection_->Close();
+    --server_->open_connections;
+  }
 
   void Run(Request req) {
+    connection_ = std::make_shared<SessionConnection>(ws_.get_executor(), weak_from_this());
     ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
     ws_.read_message_max(server_->options.max_message_bytes);
     ws_.async_accept(req, beast::bind_front_handler(&WebSocketSession::OnAccept, shared_from_this()));
@@ -191,19 +214,31 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
   void OnRead(beast::error_code ec, std::size_t) {
     if (ec) {
       if (ec == websocket::error::message_too_big) server_->Count(&ServerCounters::malformed);
-      return;  // closed, too big or broken: the session ends
+      connection_->Close();
+      connection_->state.reset();  // the handler's state (a running tuning) ends with the connection
+      return;                      // closed, too big or broken: the session ends
     }
     server_->Count(&ServerCounters::websocket_messages);
     const std::string text = beast::buffers_to_string(buffer_.data());
     buffer_.consume(buffer_.size());
-    Send(server_->Answer(text).body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+    const Reply reply = server_->Answer(text, connection_);
+    if (!reply.body.is_null())
+      Send(reply.body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), "reply");
     Read();
   }
-  // At most one write in flight and one waiting: a newer reply replaces the waiting one.
-  void Send(std::string message) {
+
+ public:
+  // At most one write in flight. Waiting: the messages without a key in
+  // order, then one per key, a newer one replacing the older (a slow client
+  // is sent the latest reply, not a growing queue).
+  void Send(std::string message, const std::string& replace_key) {
     if (writing_) {
-      if (waiting_) server_->Count(&ServerCounters::dropped_replies);
-      waiting_ = std::move(message);
+      if (replace_key.empty()) {
+        ordered_.push_back(std::move(message));
+      } else {
+        if (waiting_.count(replace_key)) server_->Count(&ServerCounters::dropped_replies);
+        waiting_[replace_key] = std::move(message);
+      }
       return;
     }
     writing_ = true;
@@ -212,21 +247,42 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
     ws_.async_write(net::buffer(out_),
                     beast::bind_front_handler(&WebSocketSession::OnWrite, shared_from_this()));
   }
+
+ private:
   void OnWrite(beast::error_code ec, std::size_t) {
     writing_ = false;
-    if (ec || !waiting_) return;
-    std::string next = std::move(*waiting_);
-    waiting_.reset();
-    Send(std::move(next));
+    if (ec) return;
+    std::string next;
+    if (!ordered_.empty()) {
+      next = std::move(ordered_.front());
+      ordered_.pop_front();
+    } else if (!waiting_.empty()) {
+      next = std::move(waiting_.begin()->second);
+      waiting_.erase(waiting_.begin());
+    } else {
+      return;
+    }
+    Send(std::move(next), "");
   }
 
   websocket::stream<beast::tcp_stream> ws_;
   std::shared_ptr<Server::Impl> server_;
+  std::shared_ptr<SessionConnection> connection_;
   beast::flat_buffer buffer_;
   std::string out_;
-  std::optional<std::string> waiting_;
+  std::deque<std::string> ordered_;
+  std::map<std::string, std::string> waiting_;
   bool writing_ = false;
 };
+
+bool SessionConnection::Post(const nlohmann::json& message, const std::string& replace_key) {
+  if (closed_) return false;
+  std::string text = message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  net::post(executor_, [session = session_, text = std::move(text), replace_key]() mutable {
+    if (auto s = session.lock()) s->Send(std::move(text), replace_key);
+  });
+  return true;
+}
 
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
@@ -315,6 +371,9 @@ void Accept(std::shared_ptr<Server::Impl> server) {
         beast::error_code ignored;
         socket.close(ignored);
       } else {
+        // Replies of 100 KB (the plot series) must not wait for delayed ACKs.
+        beast::error_code ignored;
+        socket.set_option(tcp::no_delay(true), ignored);
         std::make_shared<HttpSession>(std::move(socket), server)->Run();
       }
     }
@@ -325,6 +384,14 @@ void Accept(std::shared_ptr<Server::Impl> server) {
 }  // namespace
 
 Server::Server(ServerOptions options, Handler handler, std::vector<Asset> assets)
+    : Server(std::move(options),
+             ConnectionHandler([handler = std::move(handler)](const nlohmann::json& request,
+                                                              const std::shared_ptr<Connection>&) {
+               return handler(request);
+             }),
+             std::move(assets)) {}
+
+Server::Server(ServerOptions options, ConnectionHandler handler, std::vector<Asset> assets)
     : impl_(std::make_shared<Impl>()) {
   impl_->options = std::move(options);
   impl_->handler = std::move(handler);

@@ -137,8 +137,7 @@ function showMetrics(r) {
   }
 }
 
-function show(reply, sent) {
-  const reply_ms = performance.now();
+function show(reply, sent, reply_ms) {
   pidlab.lastResult = reply.result;
   pidlab.lastSeries = reply.series;
   setStatus('');
@@ -154,11 +153,11 @@ function show(reply, sent) {
   });
 }
 
-function onMessage(reply) {
+function onMessage(reply, arrived_ms) {
   if (inflight && reply.id === inflight.seq) {
     const sent = inflight;
     inflight = null;
-    if (reply.error) setStatus(reply.error); else show(reply, sent);
+    if (reply.error) setStatus(reply.error); else show(reply, sent, arrived_ms);
     if (pending) { pending = false; send(); }
     return;
   }
@@ -305,7 +304,9 @@ async function loadPaperDesigns() {
 }
 
 // ---- Tuning on the server.
+let tuning = false;
 function tuneProgress(m) {
+  if (!tuning) return;
   $('tune-status').textContent = 'tuning: ' + m.evaluations + ' evaluations, best objective ' + fmt(m.best);
 }
 
@@ -321,8 +322,10 @@ function tuningSpec(options) {
 async function tune(options) {
   const s = tuningSpec(options || {});
   $('tune-status').textContent = 'tuning: started';
+  tuning = true;
   try {
     const reply = await ask({ type: 'tune', spec: s });
+    tuning = false;
     pidlab.lastTune = reply.result;
     const g = reply.result.gains;
     $('tune-status').textContent = 'tuned: objective ' + fmt(reply.result.objective) + ', gains ' + [g.kp, g.ki, g.kd].map(fmt).join(', ') +
@@ -334,6 +337,7 @@ async function tune(options) {
     pin('tuned ' + (s.robust ? '--robust ' : '') + [g.kp, g.ki, g.kd].map(fmt).join('/'));
     return reply.result;
   } catch (e) {
+    tuning = false;
     $('tune-status').textContent = 'tuning: ' + e.message;
     throw e;
   }
@@ -364,7 +368,7 @@ function connect() {
       (token ? '?token=' + encodeURIComponent(token) : '');
   socket = new WebSocket(url);
   socket.addEventListener('open', () => { send(); loadPaperDesigns(); });
-  socket.addEventListener('message', (e) => onMessage(JSON.parse(e.data)));
+  socket.addEventListener('message', (e) => { const arrived = performance.now(); onMessage(JSON.parse(e.data), arrived); });
   socket.addEventListener('close', () => setStatus('disconnected from the server'));
 }
 

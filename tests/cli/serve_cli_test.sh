@@ -48,6 +48,7 @@ check "serve --port 0 prints its URL on 127.0.0.1 without a token" "[[ $url =~ ^
 "$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --json > want.json
 "$pidlab" evaluate --plant stepper_motor --gains 30,0.5,1 --loop sampled --dt 0.001 --json > want_sampled.json
 "$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --samples-csv samples.csv > /dev/null
+"$pidlab" tune --plant double_integrator --robust --json > want_tune.json
 PYTHONPATH="$here" /usr/bin/python3 - "$port" <<'PY'
 import json, sys
 from serve_client import http, WebSocket
@@ -97,6 +98,28 @@ op, payload = ws.recv()
 check('a message that is not JSON gets an error reply', b'one JSON object' in payload)
 reply = ws.ask({'id': 44, 'type': 'fields'})
 check('the fields request lists the spec\'s keys', any(f['key'] == 'gains' for f in reply['fields']))
+want_tune = json.load(open('want_tune.json'))
+ws.send(json.dumps({'id': 45, 'type': 'tune', 'spec': {'plant': 'double_integrator', 'robust': True}}))
+kinds = []
+while True:
+    reply = json.loads(ws.recv()[1])
+    kinds.append(reply.get('type'))
+    if reply.get('type') != 'tune_progress': break
+check('a tune request sends progress, then tune --robust --json\'s gains and objective',
+      reply.get('id') == 45 and reply['type'] == 'tune_result' and kinds[0] == 'tune_progress'
+      and reply['result']['gains'] == want_tune['gains'] and reply['result']['objective'] == want_tune['objective']
+      and reply['result']['spec'] == want_tune['spec'])
+ws.send(json.dumps({'id': 46, 'type': 'tune', 'spec': {'plant': 'oscillator', 'method': 'ga', 'loop': 'sampled', 'max_evals': 200000}}))
+first = json.loads(ws.recv()[1])
+busy = ws.ask({'id': 47, 'type': 'tune', 'spec': {'plant': 'oscillator'}})
+ws.send(json.dumps({'type': 'tune_cancel'}))
+while True:
+    reply = json.loads(ws.recv()[1])
+    if reply.get('id') == 46 and reply.get('type') != 'tune_progress': break
+check('a second tuning on the connection is refused while one runs', 'already running' in busy.get('error', ''))
+check('tune_cancel stops the running tuning', first.get('type') == 'tune_progress' and reply['type'] == 'tune_cancelled')
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'tune', 'spec': {'plant': 'oscillator'}}).encode())
+check('tune over HTTP is refused: it needs the WebSocket', status == 400 and b'WebSocket' in body)
 ws.send('x' * 70000)
 try:
     op, payload = ws.recv()

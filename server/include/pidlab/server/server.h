@@ -54,6 +54,26 @@ struct Reply {
 /// Answers one request object. Exceptions become 500 with their message.
 using Handler = std::function<Reply(const nlohmann::json& request)>;
 
+/// A WebSocket connection as its requests' handler sees it: messages sent
+/// later, from any thread (a tuning's progress and result). A message posted
+/// with a `replace_key` replaces the one of the same key still waiting to be
+/// written (progress: only the latest matters); one without is always sent,
+/// in order.
+class Connection {
+ public:
+  virtual ~Connection() = default;
+  /// Queues `message` on the connection; false if it has closed.
+  virtual bool Post(const nlohmann::json& message, const std::string& replace_key = "") = 0;
+  virtual bool closed() const = 0;
+  /// The handler's own state for this connection (its running tuning),
+  /// touched on the server's thread only; released when the connection closes.
+  std::shared_ptr<void> state;
+};
+
+/// Answers one request with the connection it came on (null over HTTP).
+using ConnectionHandler =
+    std::function<Reply(const nlohmann::json& request, const std::shared_ptr<Connection>& connection)>;
+
 /// A static file served at `path` ("/" and "/app.js").
 struct Asset {
   std::string path;
@@ -73,6 +93,7 @@ struct ServerCounters {
 class Server {
  public:
   Server(ServerOptions options, Handler handler, std::vector<Asset> assets);
+  Server(ServerOptions options, ConnectionHandler handler, std::vector<Asset> assets);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;

@@ -1,0 +1,24 @@
+#pragma once
+// A tuning spec in its JSON form run to the object of `pidlab tune --json`
+// (backend "local"): what `pidlab serve` answers a tune request with
+// (docs/workbench.md). The same steps as the command: the spec read with
+// the keys it has counted as given (the --robust preset and the search box
+// resolved from them), validated by tune/spec_build.h, Tune, then the
+// evaluation and the loop analysis of the gains found.
+
+#include <nlohmann/json.hpp>
+
+#include "pidlab/optim/optimizer.h"
+#include "pidlab/spec/status.h"
+
+namespace pidlab::json {
+
+/// The object of `pidlab tune --spec FILE --json` for the TuningSpec `spec`;
+/// `progress` is called once per iteration of the search (it may throw to
+/// stop the tuning: the exception leaves this function). kInvalidInput with
+/// one line naming the key and value for a spec that does not validate or a
+/// method that does not apply; kRunnerFailed if the evaluation fails.
+Status TuneSpecJson(const nlohmann::json& spec, const optim::ProgressCallback& progress,
+                    nlohmann::json* result);
+
+}  // namespace pidlab::json

@@ -1,0 +1,97 @@
+// The page's tune and tune_cancel requests (docs/workbench.md): a tuning runs
+// on a thread of its own, one at a time per WebSocket connection, sends its
+// progress at most ten times a second and ends with the object of `pidlab
+// tune --json` (json::TuneSpecJson) or an error.
+
+#include <atomic>
+#include <cmath>
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "pidlab/json/tune_run.h"
+#include "serve_requests.h"
+
+namespace pidlab::cli {
+namespace {
+
+struct TuneJob {
+  std::atomic<bool> cancel{false};
+  std::atomic<bool> done{false};
+};
+
+// The connection's state: its latest tuning, cancelled when the connection closes.
+struct TuneSlot {
+  std::shared_ptr<TuneJob> job;
+  ~TuneSlot() {
+    if (job) job->cancel = true;
+  }
+};
+
+struct Cancelled {};
+
+optim::ProgressCallback ProgressPoster(std::shared_ptr<TuneJob> job, std::shared_ptr<server::Connection> out,
+                                       nlohmann::json id) {
+  auto last = std::make_shared<std::chrono::steady_clock::time_point>();
+  return [job, out, id, last](const optim::TracePoint& tp) {
+    if (job->cancel || out->closed()) throw Cancelled{};
+    const auto now = std::chrono::steady_clock::now();
+    if (now - *last < std::chrono::milliseconds(100)) return;
+    *last = now;
+    nlohmann::json m = {
+        {"type", "tune_progress"}, {"iteration", tp.iteration}, {"evaluations", tp.evaluations}};
+    m["best"] = std::isfinite(tp.best_f) ? nlohmann::json(tp.best_f) : nlohmann::json(nullptr);
+    m["id"] = id;
+    out->Post(m, "tune_progress");
+  };
+}
+
+void RunTuning(std::shared_ptr<TuneJob> job, std::shared_ptr<server::Connection> out, nlohmann::json spec,
+               nlohmann::json id) {
+  nlohmann::json reply;
+  try {
+    nlohmann::json result;
+    const Status status = json::TuneSpecJson(spec, ProgressPoster(job, out, id), &result);
+    if (status.ok())
+      reply = {{"type", "tune_result"}, {"result", result}};
+    else
+      reply = {{"type", "tune_result"}, {"error", status.message()}};
+  } catch (const Cancelled&) {
+    reply = {{"type", "tune_cancelled"}, {"error", "the tuning was cancelled"}};
+  } catch (const std::exception& e) {
+    reply = {{"type", "tune_result"}, {"error", std::string("the tuning failed: ") + e.what()}};
+  }
+  reply["id"] = id;
+  job->done = true;
+  out->Post(reply);
+}
+
+}  // namespace
+
+server::Reply AnswerTune(const nlohmann::json& request,
+                         const std::shared_ptr<server::Connection>& connection) {
+  if (!connection) return {400, {{"error", "tune runs over the WebSocket /ws, which carries its progress"}}};
+  if (!request.contains("spec") || !request["spec"].is_object())
+    return {400, {{"error", "a tune request needs a spec object"}}};
+  auto slot = std::static_pointer_cast<TuneSlot>(connection->state);
+  if (slot && slot->job && !slot->job->done)
+    return {400, {{"error", "a tuning is already running on this connection: tune_cancel it first"}}};
+  if (!slot) {
+    slot = std::make_shared<TuneSlot>();
+    connection->state = slot;
+  }
+  slot->job = std::make_shared<TuneJob>();
+  std::thread(RunTuning, slot->job, connection, request["spec"], request.value("id", nlohmann::json(nullptr)))
+      .detach();
+  return {200, nullptr};  // the progress and the result follow on the connection
+}
+
+server::Reply AnswerTuneCancel(const std::shared_ptr<server::Connection>& connection) {
+  auto slot = connection ? std::static_pointer_cast<TuneSlot>(connection->state) : nullptr;
+  const bool running = slot && slot->job && !slot->job->done;
+  if (running) slot->job->cancel = true;
+  return {200, {{"type", "tune_cancel"}, {"cancelling", running}}};
+}
+
+}  // namespace pidlab::cli
