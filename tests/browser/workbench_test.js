@@ -58,8 +58,8 @@ async function main() {
   const shot = (name) => page.screenshot({ path: path.join(args.out, 'workbench-' + name + '.png'), fullPage: true });
   const step = async (name, body) => {
     try {
-      await body();
-      console.log('ok   ' + name);
+      const detail = await body();
+      console.log('ok   ' + name + (detail ? ' [' + detail + ']' : ''));
     } catch (e) {
       console.log('FAIL ' + name + ': ' + (e && e.message ? e.message : String(e)));
       console.log('--- the page\'s console (' + log.lines.length + ' lines):');
@@ -109,6 +109,7 @@ async function main() {
       expectSeries('plots.step.data[0] (t)', shown.t, samples.t, 1e-12);
       expectSeries('plots.step.data[1] (y)', shown.y, samples.y, 1e-12);
       await shot(plant);
+      return 'kp ' + gain + ', IAE ' + before + ' -> ' + shown.iae + ', ' + shown.y.length + ' samples';
     });
   }
 
@@ -120,6 +121,7 @@ async function main() {
     const env = Object.assign({}, process.env, { PATH: path.dirname(args.pidlab) + ':' + process.env.PATH });
     const out = execFileSync('bash', ['-c', command], { encoding: 'utf8', env, cwd: args.tmp, timeout: 60000 });
     expectClose('the command\'s IAE against #metric-iae', JSON.parse(out).iae, Number(await iaeCell()), 1e-12);
+    return command;
   });
 
   await step('(c) two pinned designs: two .pinned-design, the diff table, each pin\'s IAE that of its spec', async () => {
@@ -147,8 +149,8 @@ async function main() {
     await docsShot();  // taken again after the tuning, if it passes
   });
 
-  await step('(d) pidlab.tune({robust: true}) on the oscillator gives the gains of pidlab tune --robust --json', async () => {
-    await selectPlant(session, 'oscillator', redrawMs);
+  await step('(d) pidlab.tune({robust: true}) on the stepper motor (kp, kd, tf inside the box) gives the gains of pidlab tune --robust --json', async () => {
+    await selectPlant(session, 'stepper_motor', redrawMs);
     const before = await page.evaluate(() => {
       const before = window.pidlab.lastTune;
       window.pidlab.tune({ robust: true });
@@ -161,9 +163,10 @@ async function main() {
       cancel: !!document.getElementById('tune-cancel'), button: !!document.getElementById('tune-button'),
     }));
     if (!tune.button || !tune.cancel) throw new Error('#tune-button or #tune-cancel is missing');
+    if (tune.reply.plant !== 'stepper_motor') throw new Error('pidlab.lastTune is for plant ' + tune.reply.plant);
     if (!tune.reply.gains) throw new Error('pidlab.lastTune has no gains: ' + JSON.stringify(tune.reply).slice(0, 300));
     // The same tuning twice: the CLI's flags, and the spec the page's reply echoes.
-    const runs = [['tune', '--plant', 'oscillator', '--robust', '--json']];
+    const runs = [['tune', '--plant', 'stepper_motor', '--robust', '--json']];
     if (tune.reply.spec) runs.push(['tune', '--spec', specFile(tune.reply.spec), '--json']);
     for (const argv of runs) {
       const cli = JSON.parse(pidlab(argv));
@@ -172,6 +175,8 @@ async function main() {
           throw new Error('lastTune.gains.' + g + ' ' + tune.reply.gains[g] + ', pidlab ' + argv.join(' ') + ': ' + cli.gains[g]);
     }
     await shot('tuned');
+    const g = tune.reply.gains;
+    return 'kp ' + g.kp + ', ki ' + g.ki + ', kd ' + g.kd + ', tf ' + g.tf + '; ' + runs.length + ' CLI runs';
   });
 
   await step('no console error, page error or failed request during the whole run', async () => {
