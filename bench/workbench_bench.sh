@@ -8,7 +8,8 @@
 # page's pidlab.timings (bench/workbench_bench.js). Prints the machine's load
 # and, when it is built (next to PIDLAB with PIDLAB_BUILD_BENCH=ON, or where
 # WAKEUP_BENCH says), bench/wakeup_bench's floor over 5 s, so that a loaded
-# machine shows. Exit 1 when a plant misses a target.
+# machine shows; then the same number of requests from a Python WebSocket
+# client, without the browser. Exit 1 when a plant misses a target.
 #   bench/workbench_bench.sh [PIDLAB] [MOVES]     (root; defaults build/bin/pidlab 200)
 set -euo pipefail
 pidlab=${1:-}
@@ -46,5 +47,28 @@ echo "chromium: $("$chromium" --version 2>/dev/null | head -1); pidlab serve at 
 status=0
 node bench/workbench_bench.js --url "$url" --modules "$root/node_modules" --chromium "$chromium" \
   --tmp "$tmp" --moves "$moves" || status=$?
+# The same requests without the browser: what the server and the loopback
+# take, and Python's parse of the reply (its round trip), for comparison
+# with the browser's "wire".
+port=$(sed -E 's#^http://[^/]*:([0-9]+)/.*#\1#' <<<"$url")
+PYTHONPATH="$root/tests/cli" /usr/bin/python3 - "$port" "$moves" <<'PY' || status=1
+import math, random, sys, time
+from serve_client import WebSocket
+port, moves = int(sys.argv[1]), int(sys.argv[2])
+rng = random.Random(26)
+ws = WebSocket(port)
+pct = lambda v, q: sorted(v)[max(0, math.ceil(q * len(v)) - 1)]  # nearest rank
+print('without the browser (a Python WebSocket client, %d requests per plant, kp = 3.9 * 10^(u - 0.5)):' % moves)
+for plant in ['double_integrator', 'oscillator', 'stepper_motor']:
+    trip, server = [], []
+    for i in range(moves):
+        spec = {'plant': plant, 'gains': [float('%.6g' % (3.9 * 10 ** (rng.random() - 0.5))), 0.06, 4.9]}
+        t0 = time.perf_counter()
+        reply = ws.ask({'id': i + 1, 'type': 'evaluate', 'spec': spec})
+        trip.append(1e3 * (time.perf_counter() - t0))
+        server.append(reply['compute_ms'])
+    print('  %-18s round trip med/p99 %5.1f %6.1f ms   server med/p99 %5.1f %5.1f ms' %
+          (plant, pct(trip, 0.5), pct(trip, 0.99), pct(server, 0.5), pct(server, 0.99)))
+PY
 echo "uptime after:$(uptime)"
 exit $status
