@@ -113,15 +113,22 @@ async function main() {
     });
   }
 
-  await step('(e) pidlab.command() run by a shell gives the page\'s IAE; #command shows it', async () => {
+  await step('(e) #copy-command copies pidlab.command(), #command shows it; run by a shell it gives the page\'s IAE', async () => {
     const command = await page.evaluate(() => window.pidlab.command());
     const shown = await page.$eval('#command', (e) => e.textContent.trim());
     if (shown !== command) throw new Error('#command shows "' + shown + '", pidlab.command() is "' + command + '"');
-    if (!/^pidlab evaluate /.test(command)) throw new Error('the command is not a pidlab evaluate command: ' + command);
+    await browser.defaultBrowserContext().overridePermissions(new URL(args.url).origin, ['clipboard-read', 'clipboard-write', 'clipboard-sanitized-write']);
+    await page.evaluate(() => navigator.clipboard.writeText('(nothing copied yet)'));
+    await page.click('#copy-command');
+    await waitForPage(session, 'the clipboard did not receive the command', redrawMs,
+                      (command) => navigator.clipboard.readText().then((t) => t === command), command);
+    const copied = await page.evaluate(() => navigator.clipboard.readText());
+    if (!/^pidlab evaluate /.test(copied)) throw new Error('the command is not a pidlab evaluate command: ' + copied);
+    // What a user pastes into a shell: the copied text, with this build's pidlab first on the PATH.
     const env = Object.assign({}, process.env, { PATH: path.dirname(args.pidlab) + ':' + process.env.PATH });
-    const out = execFileSync('bash', ['-c', command], { encoding: 'utf8', env, cwd: args.tmp, timeout: 60000 });
+    const out = execFileSync('bash', ['-c', copied], { encoding: 'utf8', env, cwd: args.tmp, timeout: 60000 });
     expectClose('the command\'s IAE against #metric-iae', JSON.parse(out).iae, Number(await iaeCell()), 1e-12);
-    return command;
+    return copied;
   });
 
   await step('(c) two pinned designs: two .pinned-design, the diff table, each pin\'s IAE that of its spec', async () => {
@@ -140,6 +147,8 @@ async function main() {
     if (pins.designs !== base + 2) throw new Error('#pinned has ' + pins.designs + ' .pinned-design children, want ' + (base + 2));
     if (pins.diffRows < 2 || !pins.diffText.trim()) throw new Error('#diff-table is missing or empty (' + pins.diffRows + ' rows)');
     const [a, b] = pins.pinned.slice(-2);
+    for (const p of [a, b])
+      if (!pins.diffText.includes(p.label)) throw new Error('#diff-table does not name the pin "' + p.label + '"');
     if (canonical(a.spec) === canonical(b.spec)) throw new Error('the two pins have the same spec');
     for (const p of [a, b]) {
       const cli = JSON.parse(pidlab(['evaluate', '--spec', specFile(p.spec), '--json']));
