@@ -188,6 +188,18 @@ async function main() {
     return 'kp ' + g.kp + ', ki ' + g.ki + ', kd ' + g.kd + ', tf ' + g.tf + '; ' + runs.length + ' CLI runs';
   });
 
+  await step('pidlab.timings: one entry per redraw, sent <= reply <= drawn, the server\'s time inside the round trip', async () => {
+    const { timings, rendered } = await page.evaluate(() => ({ timings: window.pidlab.timings, rendered: window.pidlab.rendered }));
+    if (timings.length !== rendered) throw new Error(timings.length + ' timings for ' + rendered + ' redraws');
+    for (const t of timings) {
+      const ok = ['seq', 'sent_ms', 'reply_ms', 'drawn_ms', 'server_ms'].every((k) => typeof t[k] === 'number') &&
+                 t.sent_ms <= t.reply_ms && t.reply_ms <= t.drawn_ms && t.server_ms >= 0 &&
+                 t.server_ms <= t.reply_ms - t.sent_ms;
+      if (!ok) throw new Error('the entry ' + JSON.stringify(t));
+    }
+    return rendered + ' redraws';
+  });
+
   await step('no console error, page error or failed request during the whole run', async () => {
     if (log.errors.length) throw new Error(log.errors.length + ' of them, the first: ' + log.errors[0]);
   });
