@@ -9,6 +9,7 @@
 #include "cli_common.h"
 #include "cli_spec.h"
 #include "commands.h"
+#include "export_spec.h"
 #include "pidlab/controller_export/export.h"
 #include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/tune/spec_build.h"
@@ -19,11 +20,7 @@ using pidlab::controller_export::GeneratedCode;
 using pidlab::controller_export::Options;
 using pidlab::controller_export::ParseScalar;
 using pidlab::controller_export::Scalar;
-using pidlab::evaluation::LoopGains;
-using pidlab::evaluation::LoopOptions;
 using pidlab::spec::NameStyle;
-using pidlab::tune::BuildGains;
-using pidlab::tune::BuildLoopOptions;
 
 namespace pidlab::cli {
 namespace {
@@ -69,26 +66,6 @@ void LoadResult(const std::string& path, spec::EvaluateSpec* s) {
   }
 }
 
-/// One line naming the plant, for the header comment.
-std::string DescribePlant(const spec::PlantSpec& p) {
-  if (p.plant.empty()) return "not given (no --plant)";
-  std::string s = p.plant;
-  if (!p.num.empty() || !p.den.empty())
-    s += ", num " + FlagText(p.num) + ", den " + FlagText(p.den) + " (descending powers of s)";
-  if (p.delay_s > 0.0) s += ", dead time " + FlagText(p.delay_s) + " s";
-  return s;
-}
-
-/// The spec's JSON, one field a line (the header comment's form).
-std::string SpecText(const nlohmann::json& j) {
-  std::string s = "{\n";
-  std::size_t i = 0;
-  for (const auto& item : j.items())
-    s += "  " + nlohmann::json(item.key()).dump() + ": " + item.value().dump() +
-         (++i < j.size() ? ",\n" : "\n");
-  return s + "}";
-}
-
 struct ExportCommand {
   SpecFlags flags;
   std::string from, lang, out, scalar = "double";
@@ -97,7 +74,8 @@ struct ExportCommand {
   std::function<int()> Register(CLI::App* app) {
     app->description(
         "Write the discrete PID of a gain set and a loop (--dt, --output-limits, --anti-windup, "
-        "--integral, --derivative-filter, --derivative-on, --setpoint-weights) as a dependency-free C99 module, pidlab_pid.h and "
+        "--integral, --derivative-filter, --derivative-on, --setpoint-weights) as a dependency-free C99 "
+        "module, pidlab_pid.h and "
         "pidlab_pid.c in --out: the controller DiscretePid runs, in its operation order (--scalar double: "
         "bit for bit), with manual mode, bumpless transfer and run-time gain and sample-time changes "
         "(docs/export.md).");
@@ -120,18 +98,8 @@ struct ExportCommand {
 
   Controller BuildController(const spec::EvaluateSpec& s) const {
     std::string error;
-    if (s.gains.empty()) throw BadInput("--gains is required (or --from FILE, --spec FILE)");
-    PidGains g;
-    Require(BuildGains(s.gains, NameStyle::kFlag, &g, &error), error);
-    LoopOptions loop;
-    Require(BuildLoopOptions(s.loop, NameStyle::kFlag, &loop, &error), error);
     Controller c;
-    c.gains = LoopGains(g, loop);
-    c.pid = PidOptionsAt(loop.pid, loop.dt_s);
-    // The spec's --setpoint-weights (c = 0 for --derivative-on measurement), in the PID's options.
-    c.setpoint_weight_b = c.pid.setpoint_weight_p;
-    c.setpoint_weight_c = c.pid.setpoint_weight_d;
-    Require(controller_export::ControllerIsValid(c, &error), error);
+    Require(ExportController(s, NameStyle::kFlag, &c, &error), error);
     return c;
   }
 

@@ -1,12 +1,15 @@
 #include "serve_requests.h"
 
 #include <chrono>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "pidlab/json/spec_run.h"
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
+#include "export_spec.h"
 #include "pidlab/report/report.h"
+#include "pidlab/spec/json.h"
 #endif
 
 namespace pidlab::cli {
@@ -33,6 +36,32 @@ server::Reply Evaluate(const nlohmann::json& request) {
   reply["compute_ms"] = MillisecondsSince(start);
   return {200, reply};
 }
+
+#ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
+// {"type": "export", "spec": SPEC}: the C module `pidlab export --spec SPEC
+// --lang c --out DIR` writes (double), as text.
+server::Reply Export(const nlohmann::json& request) {
+  if (!request.contains("spec")) return {400, {{"error", "an export request needs a spec"}}};
+  spec::EvaluateSpec s;
+  std::string error;
+  controller_export::Controller controller;
+  if (!spec::FromJson(request["spec"], &s, nullptr, &error)) return {400, {{"error", error}}};
+  s.plant.Normalize();
+  if (!ExportController(s, spec::NameStyle::kKey, &controller, &error)) return {400, {{"error", error}}};
+  controller_export::Options options;
+  options.plant = DescribePlant(s.plant);
+  options.spec_json = SpecText(spec::ToJson(s));
+  options.pidlab_version = PIDLAB_VERSION;
+  controller_export::GeneratedCode code;
+  try {
+    code = controller_export::Generate(options, controller);
+  } catch (const std::invalid_argument& e) {
+    return {400, {{"error", e.what()}}};
+  }
+  return {200,
+          {{"type", "export"}, {"files", {{"pidlab_pid.h", code.header}, {"pidlab_pid.c", code.source}}}}};
+}
+#endif
 
 }  // namespace
 
@@ -61,14 +90,15 @@ server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
   if (type == "paper_designs") return {200, {{"type", "paper_designs"}, {"designs", PaperDesigns()}}};
   if (type == "evaluate") return Evaluate(request);
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
+  if (type == "export") return Export(request);
   if (type == "tune") return AnswerTune(request, connection);
   if (type == "tune_cancel") return AnswerTuneCancel(connection);
 #else
   (void)connection;
 #endif
   return {400,
-          {{"error",
-            "request type '" + type + "' is not one of evaluate, fields, paper_designs, tune, tune_cancel"}}};
+          {{"error", "request type '" + type +
+                         "' is not one of evaluate, fields, paper_designs, export, tune, tune_cancel"}}};
 }
 
 }  // namespace pidlab::cli

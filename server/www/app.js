@@ -362,6 +362,18 @@ function formTuneOptions() {
   return o;
 }
 
+// ---- The design as C (the export request: pidlab export's module, as text).
+async function exportC() {
+  const reply = await ask({ type: 'export', spec: spec() });
+  pidlab.lastExport = reply.files;
+  for (const [id, name] of [['export-h', 'pidlab_pid.h'], ['export-c', 'pidlab_pid.c']]) {
+    $(id).textContent = '// ' + name + '\n' + reply.files[name];
+    $(id).classList.remove('hidden');
+  }
+  return reply.files;
+}
+pidlab.exportC = exportC;
+
 // ---- Start.
 function connect() {
   const url = (location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + '/ws' +
@@ -385,6 +397,8 @@ $('pin-button').addEventListener('click', () => pin());
 $('tune-button').addEventListener('click', () => tune(formTuneOptions()).catch(() => {}));
 $('tune-cancel').addEventListener('click', () => pidlab.cancelTune());
 $('copy-command').addEventListener('click', () => navigator.clipboard.writeText(pidlab.command()).catch((e) => setStatus('copy: ' + e.message)));
+$('copy-spec').addEventListener('click', () => navigator.clipboard.writeText(JSON.stringify(spec())).catch((e) => setStatus('copy: ' + e.message)));
+$('export-button').addEventListener('click', () => exportC().catch((e) => setStatus('export: ' + e.message)));
 readHash();
 showForm();
 rebuildPlots();

@@ -49,6 +49,8 @@ check "serve --port 0 prints its URL on 127.0.0.1 without a token" "[[ $url =~ ^
 "$pidlab" evaluate --plant stepper_motor --gains 30,0.5,1 --loop sampled --dt 0.001 --json > want_sampled.json
 "$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --samples-csv samples.csv > /dev/null
 "$pidlab" tune --plant double_integrator --robust --json > want_tune.json
+echo '{"plant": "oscillator", "gains": [2, 1, 1.5], "loop": "sampled", "output_limits": [-5, 5]}' > export_spec.json
+"$pidlab" export --spec export_spec.json --lang c --out exported > /dev/null
 PYTHONPATH="$here" /usr/bin/python3 - "$port" <<'PY'
 import json, sys
 from serve_client import http, WebSocket
@@ -83,6 +85,14 @@ designs = json.loads(body).get('designs', [])
 table2 = [d for d in designs if d['table'] == 'II' and d['method'] == 'nelder_mead']
 check('paper_designs lists the 13 published gain sets of Tables II-VI',
       status == 200 and len(designs) == 13 and table2 and table2[0]['gains'] == [29.6558, 0.4977, 28.3216])
+export_spec = json.load(open('export_spec.json'))
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'export', 'spec': export_spec}).encode())
+files = json.loads(body).get('files', {})
+check('export gives the files pidlab export --spec writes, byte for byte',
+      status == 200 and files.get('pidlab_pid.h') == open('exported/pidlab_pid.h').read()
+      and files.get('pidlab_pid.c') == open('exported/pidlab_pid.c').read())
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'export', 'spec': {'plant': 'oscillator'}}).encode())
+check('export without gains is refused with one line', status == 400 and b'gains are required' in body)
 want_sampled = json.load(open('want_sampled.json'))
 ws = WebSocket(port)
 check('the WebSocket upgrade at /ws is accepted', ws.status == 101)

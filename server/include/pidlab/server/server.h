@@ -14,7 +14,8 @@
 //    server keeps serving;
 //  - a slow WebSocket client is sent the latest reply, not a growing queue.
 // One thread runs the io_context and the Handler (requests are evaluations of
-// microseconds to milliseconds).
+// microseconds to milliseconds); longer work (a tuning) runs on threads of the
+// handler's, which send their messages later through the request's Connection.
 
 #include <cstddef>
 #include <functional>
