@@ -1,7 +1,7 @@
 // The workbench's interactivity in the real browser (run by
 // bench/workbench_bench.sh inside its network namespace): for each paper
 // plant, MOVES kp slider moves, each to a random kp within one decade around
-// the plant's default (seeded), each waiting for its redraw; the figures come
+// the page's first kp (seeded), each waiting for its redraw; the figures come
 // from the page's own clock, pidlab.timings (performance.now()):
 //   input -> drawn   the slider's `input` event to the end of the redraw
 //   page             the `input` event to the request's send (sent_ms)
@@ -44,13 +44,13 @@ async function main() {
   const { browser, page, log } = session;
   await page.goto(args.url, { waitUntil: 'load', timeout: 30000 });
   await page.waitForFunction(() => window.pidlab && window.pidlab.rendered >= 1, { timeout: 30000, polling: 50 });
+  const centre = await page.$eval('#kp-slider', (e) => Number(e.value));  // log10 of the page's first kp
   const random = generator(26);
   let failed = false;
   console.log('plant              moves   input->drawn med/p99/max ms   page med/p99   server med/p99 ms   render med/p99 ms' +
               '   wire med/p99 ms   target (med < ' + target.median + ', p99 < ' + target.p99 + ')');
   for (const plant of plants) {
     await selectPlant(session, plant, 30000);
-    const centre = await page.$eval('#kp-slider', (e) => Number(e.value));
     const total = [], server = [], render = [], wire = [], before = [];
     let at = centre;
     for (let i = 0; i < moves; ++i) {
