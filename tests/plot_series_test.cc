@@ -86,6 +86,47 @@ TEST(PlotSeries, CommandCancelsTheLoadStepAtSteadyState) {
   }
 }
 
+TEST(PlotSeries, MonteCarloBandOfZeroSpreadIsTheNominalResponse) {
+  nlohmann::json result;
+  const nlohmann::json series = SeriesOf(
+      {{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"monte_carlo", 4}, {"spread", 0.0}}, &result);
+  const nlohmann::json& band = series["monte_carlo"];
+  EXPECT_EQ(band["draws"], 4);
+  EXPECT_EQ(band["stable"], 4);
+  EXPECT_EQ(band["y_min"], series["y"]);
+  EXPECT_EQ(band["y_max"], series["y"]);
+  EXPECT_EQ(result["monte_carlo"]["samples"], 4);
+}
+
+TEST(PlotSeries, MonteCarloBandHoldsEveryDrawsResponse) {
+  const nlohmann::json series =
+      SeriesOf({{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"monte_carlo", 10}, {"spread", 0.2}});
+  const nlohmann::json& band = series["monte_carlo"];
+  ASSERT_EQ(band["y_min"].size(), series["y"].size());
+  bool wider = false;
+  for (std::size_t m = 0; m < series["y"].size(); ++m) {
+    EXPECT_LE(band["y_min"][m].get<double>(), band["y_max"][m].get<double>());
+    wider = wider || band["y_max"][m].get<double>() > band["y_min"][m].get<double>();
+  }
+  EXPECT_TRUE(wider);
+}
+
+TEST(PlotSeries, NonlinearMotorComesWithTheLinearModelOfEq3) {
+  const nlohmann::json loop = {{"gains", {20.8836, 26.607, 12.4866}},
+                               {"loop", "sampled"},
+                               {"dt", 1e-4},
+                               {"horizon", 0.01},
+                               {"sample_time", 1e-4}};
+  nlohmann::json nonlinear = loop, linear = loop;
+  nonlinear["plant"] = "stepper_nonlinear";
+  linear["plant"] = "stepper_motor";
+  const nlohmann::json series = SeriesOf(nonlinear);
+  const evaluation::Evaluation ev = EvaluateDirectly(linear);
+  ASSERT_EQ(series["linear_y"].size(), ev.y.size());
+  for (std::size_t m = 0; m < ev.y.size(); ++m) ASSERT_EQ(series["linear_y"][m].get<double>(), ev.y[m]) << m;
+  EXPECT_TRUE(SeriesOf(linear)["linear_y"].is_null() || !SeriesOf(linear).contains("linear_y"));
+}
+
 TEST(PlotSeries, RefusesAGridOfFewerThanTenPoints) {
   PlotSeriesOptions options;
   options.frequency_points = 3;

@@ -15,6 +15,8 @@
 namespace pidlab::cli {
 namespace {
 
+constexpr int kMaxServedDraws = 1000;
+
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -27,6 +29,12 @@ server::Reply Evaluate(const nlohmann::json& request) {
   if (series_flag != request.end() && !series_flag->is_boolean())
     return {400, {{"error", "series " + series_flag->dump() + " must be true or false"}}};
   const bool with_series = series_flag == request.end() || series_flag->get<bool>();
+  // The server answers one request at a time: a Monte-Carlo run is bounded here.
+  const nlohmann::json& spec = request["spec"];
+  if (spec.is_object() && spec.contains("monte_carlo") && spec["monte_carlo"].is_number() &&
+      spec["monte_carlo"].get<double>() > kMaxServedDraws)
+    return {400, {{"error", "monte_carlo " + spec["monte_carlo"].dump() + " is more than the " +
+                                std::to_string(kMaxServedDraws) + " draws pidlab serve runs (pidlab evaluate takes more)"}}};
   const auto start = std::chrono::steady_clock::now();
   nlohmann::json result, series;
   const Status status = json::EvaluateSpecJson(request["spec"], &result, with_series ? &series : nullptr);

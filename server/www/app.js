@@ -10,9 +10,10 @@ const state = {
   plant: 'double_integrator', num: '1', den: '1,0,0', model: '', delay: '', stepper: '',
   kp: 3.9, ki: 0.06, kd: 4.9, derivative_filter: '', weight_b: '', weight_c: '', limit_lo: '', limit_hi: '',
   loop: 'continuous', dt: '', max_ms: '', max_mt: '', max_noise_gain: '', min_phase_margin: '',
+  monte_carlo: '', spread: '',
 };
 const textFields = ['num', 'den', 'model', 'delay', 'stepper', 'derivative_filter', 'weight_b', 'weight_c',
-  'limit_lo', 'limit_hi', 'dt', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin'];
+  'limit_lo', 'limit_hi', 'dt', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin', 'monte_carlo', 'spread'];
 const pidlab = window.pidlab = {
   state, lastResult: null, lastSeries: null, plots: {}, rendered: 0, timings: [], pinned: [],
   lastTune: null, paperDesigns: [],
@@ -44,6 +45,10 @@ function spec() {
   if (given(state.limit_lo) || given(state.limit_hi))
     s.output_limits = [given(state.limit_lo) ? Number(state.limit_lo) : '-inf', given(state.limit_hi) ? Number(state.limit_hi) : 'inf'];
   for (const k of ['max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin']) if (given(state[k])) s[k] = Number(state[k]);
+  if (given(state.monte_carlo) && Number(state.monte_carlo) > 0) {
+    s.monte_carlo = Number(state.monte_carlo);
+    if (given(state.spread)) s.spread = Number(state.spread);
+  }
   return s;
 }
 

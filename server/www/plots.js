@@ -5,22 +5,26 @@
 
 const colours = ['#1f77b4', '#d62728', '#2ca02c', '#9467bd', '#ff7f0e', '#8c564b', '#e377c2', '#17becf'];
 const pinColour = (i) => colours[(i + 1) % colours.length];
-// Nyquist points beyond this are clipped for drawing (L grows without bound
-// at low frequencies on loops with integrators).
-const kNyquistClip = 1e3;
+// Nyquist points farther than this from the origin are left out of the
+// drawing (a gap): L grows without bound near the loop's poles on the axis.
+const kNyquistReach = 8;
 
 function size(el) {
   return { width: Math.max(300, el.clientWidth || 560), height: 220 };
 }
 
-function timeChart(el, title, yLabel, label, pinned) {
+function timeChart(el, title, yLabel, label, pinned, band) {
   const series = [{ label: 't s' }, { label, stroke: colours[0], width: 2 }];
   pinned.forEach((p, i) => series.push({ label: p.label, stroke: pinColour(i), width: 1, dash: [6, 3] }));
-  return new uPlot({
-    title, ...size(el), series,
-    scales: { x: { time: false } },
-    axes: [{ label: 't (s)' }, { label: yLabel }],
-  }, [[], [], ...pinned.map(() => [])], el);
+  const opts = { title, ...size(el), series, scales: { x: { time: false } }, axes: [{ label: 't (s)' }, { label: yLabel }] };
+  if (band) {  // eq. (3)'s linear motor (nonlinear stepper), then the Monte-Carlo band: the last two series, filled between
+    series.push({ label: 'eq. (3) linear model', stroke: '#555', width: 1, dash: [2, 3] });
+    const n = series.length;
+    series.push({ label: 'Monte Carlo max', stroke: 'rgba(31,119,180,0.3)', width: 1 });
+    series.push({ label: 'Monte Carlo min', stroke: 'rgba(31,119,180,0.3)', width: 1 });
+    opts.bands = [{ series: [n, n + 1], fill: 'rgba(31,119,180,0.15)' }];
+  }
+  return new uPlot(opts, series.map((_, i) => (i === 0 ? [] : [])), el);
 }
 
 function freqChart(el, pinned) {
@@ -40,24 +44,47 @@ function freqChart(el, pinned) {
   }, [[], [], [], [], [], ...pinned.flatMap(() => [[], []])], el);
 }
 
+// Each design's Nyquist curve is drawn as up to kSegments series, one per
+// stretch within kNyquistReach: uPlot's x-y mode would join the ends of a
+// gap with a straight line.
+const kSegments = 4;
+
 function nyquistChart(el, pinned) {
-  const series = [null, { label: 'L(jw)', stroke: colours[0], width: 2 },
+  const segments = (label, stroke, width, dash) =>
+    Array.from({ length: kSegments }, () => ({ label, stroke, width, dash }));
+  const series = [null, ...segments('L(jw)', colours[0], 2),
     { label: '1/Ms circle', stroke: '#888', width: 1, dash: [4, 4] },
     { label: '-1', stroke: '#000', width: 1, points: { show: true, size: 6 } }];
-  pinned.forEach((p, i) => series.push({ label: p.label, stroke: pinColour(i), width: 1, dash: [6, 3] }));
+  pinned.forEach((p, i) => series.push(...segments(p.label, pinColour(i), 1, [6, 3])));
+  const empty = () => [[], []];
   return new uPlot({
     mode: 2, title: 'Nyquist of L (1/Ms circle around -1)', ...size(el), series,
     legend: { show: false }, cursor: { show: false },
     scales: { x: { time: false, auto: false, range: [-4, 2] }, y: { auto: false, range: [-3, 3] } },
     axes: [{ label: 'Re L' }, { label: 'Im L' }],
-  }, [null, [[], []], [[], []], [[-1], [0]], ...pinned.map(() => [[], []])], el);
+  }, [null, ...Array.from({ length: kSegments }, empty), empty(), [[-1], [0]],
+    ...pinned.flatMap(() => Array.from({ length: kSegments }, empty))], el);
 }
 
-const clip = (v) => (v === null || !isFinite(v) ? null : Math.max(-kNyquistClip, Math.min(kNyquistClip, v)));
-
-function nyquistCurve(s) {
-  if (!s) return [[], []];
-  return [s.l_re.map(clip), s.l_im.map(clip)];
+// The stretches of L(jw) within kNyquistReach of the origin, as kSegments
+// [xs, ys] pairs (the shortest left out when there are more).
+function nyquistSegments(s) {
+  const out = [];
+  let cur = null;
+  if (s) {
+    s.l_re.forEach((re, i) => {
+      const im = s.l_im[i];
+      if (re !== null && im !== null && Math.hypot(re, im) <= kNyquistReach) {
+        if (!cur) { cur = [[], []]; out.push(cur); }
+        cur[0].push(re); cur[1].push(im);
+      } else {
+        cur = null;
+      }
+    });
+  }
+  out.sort((a, b) => b[0].length - a[0].length);
+  while (out.length < kSegments) out.push([[], []]);
+  return out.slice(0, kSegments);
 }
 
 function circle(ms) {
@@ -91,7 +118,7 @@ const orEmpty = (v, n) => (Array.isArray(v) ? v : new Array(n).fill(null));
 // with a dashed series per pinned design.
 export function createPlots(elements, pinned) {
   return {
-    step: timeChart(elements.step, 'Setpoint step response y', 'y', 'y', pinned),
+    step: timeChart(elements.step, 'Setpoint step response y (Monte-Carlo band on request)', 'y', 'y', pinned, true),
     effort: timeChart(elements.effort, 'Control effort u (step response)', 'u', 'u', pinned),
     load: timeChart(elements.load, 'Load response y (unit step at the plant input)', 'y', 'y', pinned),
     freq: freqChart(elements.freq, pinned),
@@ -107,7 +134,8 @@ export function destroyPlots(plots) {
 export function drawPlots(plots, series, pinned) {
   const n = series.t.length;
   const pin = (key) => pinned.map((p) => orEmpty(p.series && p.series[key], n));
-  plots.step.setData([series.t, series.y, ...pin('y')]);
+  const mc = series.monte_carlo || {};
+  plots.step.setData([series.t, series.y, ...pin('y'), orEmpty(series.linear_y, n), orEmpty(mc.y_max, n), orEmpty(mc.y_min, n)]);
   plots.effort.setData([series.t, orEmpty(series.u, n), ...pin('u')]);
   plots.load.setData([series.t, orEmpty(series.load_y, n), ...pin('load_y')]);
   const m = series.w.length;
@@ -116,6 +144,6 @@ export function drawPlots(plots, series, pinned) {
   const onGrid = (p, key) => (p.series ? resample(p.series.w, p.series[key], series.w) : new Array(m).fill(null));
   plots.freq.setData([series.w, series.s, series.t_mag, series.cs, new Array(m).fill(series.ms),
     ...pinned.flatMap((p) => [onGrid(p, 's'), onGrid(p, 't_mag')])]);
-  plots.nyquist.setData([null, nyquistCurve(series), circle(series.ms), [[-1], [0]],
-    ...pinned.map((p) => nyquistCurve(p.series))]);
+  plots.nyquist.setData([null, ...nyquistSegments(series), circle(series.ms), [[-1], [0]],
+    ...pinned.flatMap((p) => nyquistSegments(p.series))]);
 }

@@ -49,6 +49,7 @@ check "serve --port 0 prints its URL on 127.0.0.1 without a token" "[[ $url =~ ^
 "$pidlab" evaluate --plant stepper_motor --gains 30,0.5,1 --loop sampled --dt 0.001 --json > want_sampled.json
 "$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --samples-csv samples.csv > /dev/null
 "$pidlab" tune --plant double_integrator --robust --json > want_tune.json
+"$pidlab" evaluate --plant oscillator --gains 2,1,1.5 --monte-carlo 20 --spread 0.2 --json > want_mc.json
 echo '{"plant": "oscillator", "gains": [2, 1, 1.5], "loop": "sampled", "output_limits": [-5, 5]}' > export_spec.json
 "$pidlab" export --spec export_spec.json --lang c --out exported > /dev/null
 PYTHONPATH="$here" /usr/bin/python3 - "$port" <<'PY'
@@ -80,6 +81,15 @@ check('the reply\'s series has |S| peaking at the reported Ms and the Nyquist cu
 check('the reply carries the server\'s compute time', isinstance(got.get('compute_ms'), float) and got['compute_ms'] > 0)
 status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'evaluate', 'spec': spec, 'series': False}).encode())
 check('"series": false leaves the series out', status == 200 and 'series' not in json.loads(body))
+mc_spec = {'plant': 'oscillator', 'gains': [2, 1, 1.5], 'monte_carlo': 20, 'spread': 0.2}
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'evaluate', 'spec': mc_spec}).encode())
+got = json.loads(body)
+band = got.get('series', {}).get('monte_carlo', {})
+check('with monte_carlo the result is evaluate --monte-carlo --json\'s and the series has the band of 20 draws',
+      status == 200 and got['result'] == json.load(open('want_mc.json')) and band.get('stable') == 20
+      and all(lo <= hi for lo, hi in zip(band['y_min'], band['y_max'])))
+status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'evaluate', 'spec': dict(mc_spec, monte_carlo=5000)}).encode())
+check('more than 1000 Monte-Carlo draws are refused with one line', status == 400 and b'monte_carlo 5000' in body)
 status, body = http(port, 'POST', '/api/request', json.dumps({'type': 'paper_designs'}).encode())
 designs = json.loads(body).get('designs', [])
 table2 = [d for d in designs if d['table'] == 'II' and d['method'] == 'nelder_mead']

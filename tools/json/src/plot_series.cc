@@ -147,4 +147,38 @@ Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const LoopOpt
   return Status::Ok();
 }
 
+Status MonteCarloBand(const Plant& nominal, const StepperMotorParameters* stepper,
+                      const PidGains& typed_gains, const LoopOptions& options,
+                      const analysis::MonteCarloOptions& mc, nlohmann::json* band) {
+  const std::vector<Plant> draws = analysis::DrawPlants(nominal, stepper, mc);
+  std::vector<double> lo, hi;
+  int stable = 0, invalid = 0;
+  evaluation::EvaluateOptions what;
+  what.compute_step_info = false;
+  what.compute_iae_continuous = false;
+  for (const Plant& draw : draws) {
+    if (draw.tf.den.empty()) {
+      ++invalid;
+      continue;
+    }
+    Evaluation ev;
+    std::string error;
+    if (!evaluation::Evaluate(draw, typed_gains, options, what, &ev, &error))
+      return Status::RunnerFailed(error);
+    if (!ev.stability.stable) continue;
+    if (stable++ == 0) {
+      lo = hi = ev.y;
+      continue;
+    }
+    for (std::size_t m = 0; m < ev.y.size() && m < lo.size(); ++m) {
+      lo[m] = std::min(lo[m], ev.y[m]);
+      hi[m] = std::max(hi[m], ev.y[m]);
+    }
+  }
+  *band = {{"draws", draws.size()}, {"stable", stable}, {"invalid", invalid}};
+  (*band)["y_min"] = stable > 0 ? nlohmann::json(lo) : nlohmann::json(nullptr);
+  (*band)["y_max"] = stable > 0 ? nlohmann::json(hi) : nlohmann::json(nullptr);
+  return Status::Ok();
+}
+
 }  // namespace pidlab::json

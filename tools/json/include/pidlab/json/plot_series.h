@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/analysis/monte_carlo.h"
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/spec/status.h"
 
@@ -39,5 +40,16 @@ struct PlotSeriesOptions {
 Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
                   const evaluation::Evaluation& evaluation, const analysis::LoopAnalysis& analysis,
                   const PlotSeriesOptions& series_options, nlohmann::json* series);
+
+/// The Monte-Carlo band around the step response: the plants of
+/// analysis::DrawPlants (the draws of `evaluate --monte-carlo`, same seed and
+/// spread), each evaluated with `typed_gains` on `options`, and per sample
+/// time the least and the largest y over the stable draws:
+///   {draws, stable, invalid, y_min, y_max} (y_min, y_max null with no stable draw).
+/// `stepper` as for DrawPlants. kRunnerFailed with the message if an
+/// evaluation fails.
+Status MonteCarloBand(const Plant& nominal, const StepperMotorParameters* stepper,
+                      const PidGains& typed_gains, const evaluation::LoopOptions& options,
+                      const analysis::MonteCarloOptions& mc, nlohmann::json* band);
 
 }  // namespace pidlab::json

@@ -16,7 +16,8 @@ namespace pidlab::json {
 /// "spec" runs again). Status kInvalidInput with one line naming the key and
 /// value for a spec that does not validate; kRunnerFailed if the evaluation
 /// fails. With `series`, also the plot data of that loop there
-/// (plot_series.h: PlotSeries), for the workbench's plots.
+/// (plot_series.h: PlotSeries), for the workbench's plots; for the nonlinear
+/// stepper also "linear_y", the linear model of eq. (3) on the same loop.
 Status EvaluateSpecJson(const nlohmann::json& spec, nlohmann::json* result, nlohmann::json* series = nullptr);
 
 /// The fields of EvaluateSpec: [{key, flag, help, unit, default, example}].
