@@ -317,7 +317,7 @@ function tuneProgress(m) {
 
 function tuningSpec(options) {
   const s = spec();
-  delete s.gains;
+  for (const k of ['gains', 'monte_carlo', 'spread']) delete s[k];  // evaluate's keys, not a tuning's
   if (options.robust) s.robust = true;
   for (const k of ['method', 'objective', 'bounds', 'max_evals', 'max_iter', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin', 'refine'])
     if (options[k] !== undefined) s[k] = options[k];
