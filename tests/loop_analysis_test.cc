@@ -145,7 +145,8 @@ TEST(LoopAnalysis, IdealDerivativeHasAnUnboundedNoiseGainAndTheFilterBoundsIt) {
 }
 
 TEST(LoopAnalysis, ReportsTheNearCancellationOfTheSlowPole) {
-  // The default tune of 1/s^2: kp 0.2999, ki 0, kd 30 on 1/s^2 leaves a pole near -0.01 on the PID zero -kp/kd.
+  // The default tune of 1/s^2: kp 0.2999, ki 0, kd 30 on 1/s^2 leaves a pole near -0.01 on the PID zero
+  // -kp/kd.
   const LoopAnalysis dut = AnalyzeOrFail({{1.0}, {1.0, 0.0, 0.0}}, {0.2999, 0.0, 30.0});
   ASSERT_TRUE(dut.stable);
   ASSERT_EQ(dut.cancellations.size(), 1u);
@@ -283,16 +284,35 @@ TEST(LoopFrequencyResponse, FilteredPidOnTheOscillatorMatchesTheDirectProduct) {
   EXPECT_EQ(r[0].t, std::complex<double>(1.0, 0.0));
 }
 
-TEST(LoopFrequencyResponse, RejectsTheSampledLoopAndNonPositiveFrequencies) {
+TEST(LoopFrequencyResponse, RejectsFrequenciesOutsideTheLoopsRange) {
   std::vector<LoopFrequencyPoint> r;
   std::string error;
   const Plant p{"custom", TransferFunction{{1.0}, {1.0, 0.0}}};
   LoopOptions sampled;
   sampled.loop = LoopKind::kSampled;
-  EXPECT_FALSE(LoopFrequencyResponse(p, PidGains{1.0, 0.0, 0.0}, sampled, {1.0}, &r, &error));
-  EXPECT_NE(error.find("continuous"), std::string::npos) << error;
+  EXPECT_FALSE(
+      LoopFrequencyResponse(p, PidGains{1.0, 0.0, 0.0}, sampled, {1.1 * M_PI / sampled.dt_s}, &r, &error));
+  EXPECT_NE(error.find("pi/dt"), std::string::npos) << error;
   EXPECT_FALSE(LoopFrequencyResponse(p, PidGains{1.0, 0.0, 0.0}, LoopOptions{}, {0.0}, &r, &error));
   EXPECT_NE(error.find("frequency"), std::string::npos) << error;
+}
+
+TEST(LoopFrequencyResponse, SampledLoopPeaksAtTheAnalysisMsMtAndNoiseGain) {
+  const Plant p{"custom", TransferFunction{{1.0}, {1.0, 0.0, 1.0}}};
+  LoopOptions sampled;
+  sampled.loop = LoopKind::kSampled;
+  sampled.dt_s = 0.05;
+  const PidGains g{2.0, 1.0, 1.5, 0.1};
+  pidlab::analysis::LoopAnalysis a;
+  std::string error;
+  ASSERT_TRUE(pidlab::analysis::AnalyzeLoop(p, g, sampled, {}, &a, &error)) << error;
+  std::vector<LoopFrequencyPoint> r;
+  ASSERT_TRUE(LoopFrequencyResponse(p, g, sampled, {a.ms_rad_s, a.mt_rad_s, a.noise_gain_rad_s}, &r, &error))
+      << error;
+  EXPECT_NEAR(std::abs(r[0].s), a.ms, 1e-9 * a.ms);
+  EXPECT_NEAR(std::abs(r[1].t), a.mt, 1e-9 * a.mt);
+  EXPECT_NEAR(std::abs(r[2].cs), a.noise_gain, 1e-9 * a.noise_gain);
+  EXPECT_NEAR(std::abs(r[0].s + r[0].t), 1.0, 1e-12);
 }
 
 }  // namespace

@@ -63,15 +63,19 @@ TEST(PlotSeries, StepResponseIsTheEvaluationsSamplesBitForBit) {
 }
 
 TEST(PlotSeries, SensitivityPeakOnTheGridIsTheReportedMs) {
-  nlohmann::json result;
-  const nlohmann::json series = SeriesOf({{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}}, &result);
-  const std::vector<double> s = series["s"].get<std::vector<double>>();
-  const double ms = result["robustness"]["ms"].get<double>();
-  EXPECT_GT(ms, 1.0);
-  EXPECT_NEAR(*std::max_element(s.begin(), s.end()), ms, 1e-9 * ms);
-  EXPECT_EQ(series["ms"].get<double>(), ms);
-  EXPECT_EQ(series["w"].size(), s.size());
-  EXPECT_EQ(series["l_re"].size(), s.size());
+  for (const char* loop : {"continuous", "sampled"}) {
+    nlohmann::json result;
+    const nlohmann::json series =
+        SeriesOf({{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"loop", loop}, {"dt", 0.01}}, &result);
+    const std::vector<double> s = series["s"].get<std::vector<double>>();
+    const double ms = result["robustness"]["ms"].get<double>();
+    EXPECT_GT(ms, 1.0) << loop;
+    EXPECT_NEAR(*std::max_element(s.begin(), s.end()), ms, 1e-9 * ms) << loop;
+    EXPECT_EQ(series["ms"].get<double>(), ms) << loop;
+    EXPECT_EQ(series["frequency_loop"], loop);
+    EXPECT_EQ(series["w"].size(), s.size()) << loop;
+    EXPECT_EQ(series["l_re"].size(), s.size()) << loop;
+  }
 }
 
 TEST(PlotSeries, CommandCancelsTheLoadStepAtSteadyState) {

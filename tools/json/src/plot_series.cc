@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -82,17 +83,21 @@ void TimeSeries(const Plant& plant, const PidGains& gains, const LoopOptions& op
   (*out)["load_u"] = load_u.empty() ? nlohmann::json(nullptr) : nlohmann::json(load_u);
 }
 
-// The log grid around the gain crossover, with the peaks' frequencies.
-std::vector<double> FrequencyGrid(const LoopAnalysis& a, const PlotSeriesOptions& o) {
+// The log grid around the gain crossover (the sampled loop's up to pi/dt),
+// with the peaks' frequencies.
+std::vector<double> FrequencyGrid(const LoopAnalysis& a, const LoopOptions& options,
+                                  const PlotSeriesOptions& o) {
+  const double top = options.loop == LoopKind::kSampled ? 3.14159265358979323846 / options.dt_s
+                                                        : std::numeric_limits<double>::infinity();
   const double centre =
       std::isfinite(a.gain_crossover_rad_s) && a.gain_crossover_rad_s > 0.0 ? a.gain_crossover_rad_s : 1.0;
   const double lo = std::log10(centre) - o.decades_around_crossover;
-  const double hi = std::log10(centre) + o.decades_around_crossover;
+  const double hi = std::min(std::log10(centre) + o.decades_around_crossover, std::log10(top));
   std::vector<double> w;
   for (int i = 0; i < o.frequency_points; ++i)
-    w.push_back(std::pow(10.0, lo + (hi - lo) * i / (o.frequency_points - 1)));
+    w.push_back(std::min(top, std::pow(10.0, lo + (hi - lo) * i / (o.frequency_points - 1))));
   for (double peak : {a.ms_rad_s, a.mt_rad_s, a.noise_gain_rad_s})
-    if (std::isfinite(peak) && peak > 0.0) w.push_back(peak);
+    if (std::isfinite(peak) && peak > 0.0 && peak <= top) w.push_back(peak);
   std::sort(w.begin(), w.end());
   w.erase(std::unique(w.begin(), w.end()), w.end());
   return w;
@@ -110,35 +115,26 @@ Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const LoopOpt
   std::vector<std::string> notes;
   *series = nlohmann::json::object();
   TimeSeries(plant, gains, options, evaluation, series, &notes);
-  LoopOptions continuous = options;
-  continuous.loop = LoopKind::kContinuous;
-  const std::vector<double> w = FrequencyGrid(analysis, series_options);
+  const std::vector<double> w = FrequencyGrid(analysis, options, series_options);
   std::vector<LoopFrequencyPoint> response;
   std::string error;
-  if (!analysis::LoopFrequencyResponse(plant, typed_gains, continuous, w, &response, &error))
+  if (!analysis::LoopFrequencyResponse(plant, typed_gains, options, w, &response, &error))
     return Status::RunnerFailed(error);
-  std::vector<double> c_num, c_den, s, t, cs, l_re, l_im;
-  evaluation::ContinuousPidPolynomials(gains, &c_num, &c_den);
+  std::vector<double> s, t, cs, l_re, l_im;
   for (const LoopFrequencyPoint& p : response) {
-    const std::complex<double> jw(0.0, p.w_rad_s);
-    const std::complex<double> c =
-        evaluation::frequency::Eval(c_num, jw) / evaluation::frequency::Eval(c_den, jw);
     s.push_back(std::abs(p.s));
     t.push_back(std::abs(p.t));
-    cs.push_back(std::abs(c * p.s));
+    cs.push_back(std::abs(p.cs));
     l_re.push_back(p.l.real());
     l_im.push_back(p.l.imag());
   }
-  if (options.loop == LoopKind::kSampled)
-    notes.push_back(
-        "the frequency plots are of the continuous loop C(s) G(s); Ms and Mt of the sampled loop");
   (*series)["w"] = w;
   (*series)["s"] = s;
   (*series)["t_mag"] = t;
   (*series)["cs"] = cs;
   (*series)["l_re"] = l_re;
   (*series)["l_im"] = l_im;
-  (*series)["frequency_loop"] = "continuous";
+  (*series)["frequency_loop"] = evaluation::ToString(options.loop);
   (*series)["ms"] = analysis.ms;
   (*series)["mt"] = analysis.mt;
   (*series)["noise_gain"] = analysis.noise_gain;

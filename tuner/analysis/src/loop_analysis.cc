@@ -328,37 +328,56 @@ bool CountNyquist(const Plant& plant, const PidGains& typed_gains, const evaluat
   return evaluation::CountContinuousNyquist(plant.tf, g, plant.delay_s, ao.points_per_decade, count, error);
 }
 
+namespace {
+
+// One point of the response from the loop's L = a/b and C S = c/(a + b).
+LoopFrequencyPoint FrequencyPoint(double w, cd a, cd b, cd c) {
+  const cd sum = a + b;
+  LoopFrequencyPoint p;
+  p.w_rad_s = w;
+  p.l = b == 0.0 ? cd(kInf, 0.0) : a / b;
+  p.s = b / sum;
+  p.t = a / sum;
+  p.cs = c / sum;
+  return p;
+}
+
+}  // namespace
+
 bool LoopFrequencyResponse(const Plant& plant, const PidGains& typed_gains,
                            const evaluation::LoopOptions& options, const std::vector<double>& w_rad_s,
                            std::vector<LoopFrequencyPoint>* response, std::string* error) {
   if (!GainsAreValid(typed_gains, error) || !options.IsValid(error) || !plant.tf.IsValid(error) ||
       !DelayIsValid(plant, options, error))
     return false;
-  if (options.loop != evaluation::LoopKind::kContinuous) {
-    if (error) *error = "LoopFrequencyResponse: the loop must be continuous";
-    return false;
-  }
   const PidGains g = evaluation::LoopGains(typed_gains, options);
   if (!GainsAreValid(g, error)) return false;
-  Polynomial c_num, c_den;
-  ContinuousPidPolynomials(g, &c_num, &c_den);
-  const Polynomial a = Mul(c_num, plant.tf.num), b = Mul(c_den, plant.tf.den);
-  response->clear();
-  response->reserve(w_rad_s.size());
-  for (const double w : w_rad_s) {
-    if (!(std::isfinite(w) && w > 0.0)) {
-      if (error) *error = "LoopFrequencyResponse: frequency " + std::to_string(w) + " is not finite and > 0";
+  const bool sampled = options.loop == evaluation::LoopKind::kSampled;
+  const double nyquist = sampled ? kPi / options.dt_s : kInf;
+  for (const double w : w_rad_s)
+    if (!(std::isfinite(w) && w > 0.0 && w <= nyquist)) {
+      if (error)
+        *error = "LoopFrequencyResponse: frequency " + std::to_string(w) + " is not finite and > 0" +
+                 (sampled ? " and <= pi/dt" : "");
       return false;
     }
+  response->clear();
+  response->reserve(w_rad_s.size());
+  if (sampled) {
+    const SampledResponse r(evaluation::SampledPlant(plant, options.dt_s), g, options.Pid());
+    for (const double w : w_rad_s) {
+      const Point p = r.At(w);
+      response->push_back(FrequencyPoint(w, p.a, p.b, p.c));
+    }
+    return true;
+  }
+  Polynomial c_num, c_den;
+  ContinuousPidPolynomials(g, &c_num, &c_den);
+  const Polynomial a = Mul(c_num, plant.tf.num), b = Mul(c_den, plant.tf.den), c = Mul(c_num, plant.tf.den);
+  for (const double w : w_rad_s) {
     cd av = Eval(a, cd(0.0, w));
     if (plant.delay_s > 0.0) av *= std::polar(1.0, -w * plant.delay_s);
-    const cd bv = Eval(b, cd(0.0, w)), sum = av + bv;
-    LoopFrequencyPoint p;
-    p.w_rad_s = w;
-    p.l = bv == 0.0 ? cd(kInf, 0.0) : av / bv;
-    p.s = bv / sum;
-    p.t = av / sum;
-    response->push_back(p);
+    response->push_back(FrequencyPoint(w, av, Eval(b, cd(0.0, w)), Eval(c, cd(0.0, w))));
   }
   return true;
 }

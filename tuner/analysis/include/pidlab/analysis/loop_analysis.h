@@ -122,18 +122,21 @@ bool CountNyquist(const Plant& plant, const PidGains& gains, const evaluation::L
 bool AnalyzeLoop(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
                  const LoopAnalysisOptions& analysis_options, LoopAnalysis* analysis, std::string* error);
 
-/// The continuous loop at one frequency: L(jw) = C(jw) G(jw), S = 1/(1+L),
-/// T = L/(1+L) (the report's Bode and Nyquist figures).
+/// The loop at one frequency: L = C G, S = 1/(1+L), T = L/(1+L) and the
+/// noise gain's C S (the report's Bode and Nyquist figures, the workbench's plots).
 struct LoopFrequencyPoint {
   double w_rad_s = 0.0;
-  std::complex<double> l, s, t;
+  std::complex<double> l, s, t, cs;
 };
 
-/// L, S and T of the continuous loop of `plant` with `gains` (LoopGains of
-/// `options`, so with its derivative filter; L with e^{-jw plant.delay_s}) at every w of `w_rad_s` (finite,
-/// > 0), in that order. S and T are computed as b/(a+b) and a/(a+b) from
-/// L = a/b, so they stay finite where L has a pole on the axis (L infinite,
-/// S = 0, T = 1). False with *error for invalid input or options.loop sampled.
+/// L, S, T and C S of the loop of `plant` with `gains` (LoopGains of
+/// `options`, so with its derivative filter) at every w of `w_rad_s`, in that
+/// order: the continuous loop at s = jw (L with e^{-jw plant.delay_s}; w
+/// finite, > 0), or the sampled loop options.loop names at z = e^{jw dt}
+/// (the DiscretePid and the exact ZOH plant, as AnalyzeLoop; 0 < w <= pi/dt).
+/// S, T and C S are computed as b/(a+b), a/(a+b) and c/(a+b) from L = a/b,
+/// so they stay finite where L has a pole on the axis (L infinite, S = 0,
+/// T = 1). False with *error for invalid input or a frequency out of range.
 bool LoopFrequencyResponse(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
                            const std::vector<double>& w_rad_s, std::vector<LoopFrequencyPoint>* response,
                            std::string* error);
