@@ -48,9 +48,12 @@ else
   "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# The npm packages, at the versions package-lock.json pins; npm ci again only when the lock changed.
+# The npm packages, at the versions package-lock.json pins; npm ci again only when the lock changed
+# or a package's files are gone (the build embeds uPlot's dist; the browser tests need puppeteer-core).
 root=$(cd "$(dirname "$0")/.." && pwd)
-if ! cmp -s "$root/package-lock.json" "$root/node_modules/.pidlab-lock.json"; then
+if ! cmp -s "$root/package-lock.json" "$root/node_modules/.pidlab-lock.json" ||
+   [ ! -f "$root/node_modules/uplot/dist/uPlot.iife.min.js" ] ||
+   [ ! -f "$root/node_modules/puppeteer-core/lib/cjs/puppeteer/puppeteer-core.js" ]; then
   echo "install-deps: npm ci (uplot, puppeteer-core; no browser is downloaded)"
   (cd "$root" && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error)
   cp "$root/package-lock.json" "$root/node_modules/.pidlab-lock.json"

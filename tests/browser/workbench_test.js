@@ -1,0 +1,214 @@
+// browser.workbench (run by workbench_test.sh inside its network namespace):
+// the real page in headless Chromium, read back and compared with the CLI.
+//   node workbench_test.js --url URL --pidlab BIN --modules DIR --chromium BIN --out DIR --tmp DIR
+// Each step prints "ok   <step>" or "FAIL <step>: <what differed>"; on a
+// failure the page's console follows and the test stops (exit 1).
+'use strict';
+const fs = require('fs');
+const path = require('path');
+const { execFileSync } = require('child_process');
+const { parseArgs, launch, waitForPage, moveSlider, selectPlant } = require('./page_driver.js');
+
+const args = parseArgs(process.argv.slice(2), ['url', 'pidlab', 'modules', 'chromium', 'out', 'tmp']);
+const plants = ['double_integrator', 'oscillator', 'stepper_motor'];  // the paper's three
+const redrawMs = 15000;  // one evaluation and redraw; generous for a loaded machine
+const tuneMs = 90000;    // a --robust tuning on the server
+let files = 0;
+
+// The CLI, as a user runs it; the page's spec is written to a file for --spec.
+function pidlab(argv) {
+  return execFileSync(args.pidlab, argv, { encoding: 'utf8', maxBuffer: 64 << 20, timeout: 120000 });
+}
+function specFile(spec) {
+  const file = path.join(args.tmp, 'spec' + (++files) + '.json');
+  fs.writeFileSync(file, JSON.stringify(spec));
+  return file;
+}
+function readCsv(file) {
+  const lines = fs.readFileSync(file, 'utf8').trim().split('\n');
+  const head = lines[0].split(',');
+  const cols = Object.fromEntries(head.map((h) => [h, []]));
+  for (const line of lines.slice(1)) line.split(',').forEach((v, i) => cols[head[i]].push(Number(v)));
+  return cols;
+}
+function relDiff(a, b) { return Math.abs(a - b) / Math.max(Math.abs(a), Math.abs(b), 1e-300); }
+function expectClose(what, got, want, tol) {
+  if (typeof got !== 'number' || typeof want !== 'number' || !(relDiff(got, want) <= tol))
+    throw new Error(what + ': page ' + got + ', CLI ' + want + (typeof got === 'number' && typeof want === 'number'
+                                                                  ? ' (relative ' + relDiff(got, want).toExponential(2) + ' > ' + tol + ')' : ''));
+}
+function expectSeries(what, got, want, tol) {
+  got = Array.from(got || []);
+  if (got.length !== want.length) throw new Error(what + ': page has ' + got.length + ' points, CLI ' + want.length);
+  for (let i = 0; i < want.length; ++i)
+    if (!(Math.abs(got[i] - want[i]) <= tol * Math.max(1, Math.abs(want[i]))))
+      throw new Error(what + '[' + i + ']: page ' + got[i] + ', CLI ' + want[i]);
+}
+function canonical(v) {
+  if (Array.isArray(v)) return '[' + v.map(canonical).join(',') + ']';
+  if (v && typeof v === 'object') return '{' + Object.keys(v).sort().map((k) => JSON.stringify(k) + ':' + canonical(v[k])).join(',') + '}';
+  return JSON.stringify(v);
+}
+
+async function main() {
+  fs.mkdirSync(args.out, { recursive: true });
+  const session = await launch({ modules: args.modules, chromium: args.chromium,
+                                 profileDir: path.join(args.tmp, 'profile') });
+  const { browser, page, log } = session;
+  const shot = (name) => page.screenshot({ path: path.join(args.out, 'workbench-' + name + '.png'), fullPage: true });
+  const step = async (name, body) => {
+    try {
+      const detail = await body();
+      console.log('ok   ' + name + (detail ? ' [' + detail + ']' : ''));
+    } catch (e) {
+      console.log('FAIL ' + name + ': ' + (e && e.message ? e.message : String(e)));
+      console.log('--- the page\'s console (' + log.lines.length + ' lines):');
+      for (const line of log.lines) console.log('  ' + line);
+      await shot('failure').catch(() => {});
+      await browser.close().catch(() => {});
+      process.exit(1);
+    }
+  };
+  // For docs/workbench.png: the top of the page in the 1400x1000 viewport.
+  const docsShot = async () => {
+    await page.evaluate(() => window.scrollTo(0, 0));
+    await page.screenshot({ path: path.join(args.out, 'workbench-docs-1400x1000.png') });
+  };
+  const iaeCell = () => page.$eval('#metric-iae', (e) => e.dataset.value);
+
+  await step('(a) the page loads with no console error, page error or failed request', async () => {
+    const response = await page.goto(args.url, { waitUntil: 'load', timeout: 30000 });
+    if (!response || response.status() !== 200) throw new Error('GET ' + args.url + ' answered ' + (response && response.status()));
+    await waitForPage(session, 'no first redraw (window.pidlab.rendered >= 1)', redrawMs,
+                      () => window.pidlab && window.pidlab.rendered >= 1 && window.pidlab.lastResult);
+    if (log.errors.length) throw new Error(log.errors[0]);
+    await shot('loaded');
+  });
+
+  for (const plant of plants) {
+    await step('(b) ' + plant + ': the kp slider moves the IAE cell and the step plot to evaluate --json and --samples-csv (1e-12)', async () => {
+      await selectPlant(session, plant, redrawMs);
+      const before = await iaeCell();
+      const at = await page.$eval('#kp-slider', (e) => Number(e.value));
+      const { gain } = await moveSlider(session, 'kp', at + 0.137, redrawMs);
+      const shown = await page.evaluate(() => ({
+        spec: window.pidlab.spec(), result: window.pidlab.lastResult,
+        iae: document.getElementById('metric-iae').dataset.value,
+        t: Array.from(window.pidlab.plots.step.data[0]), y: Array.from(window.pidlab.plots.step.data[1]),
+      }));
+      if (shown.spec.gains[0] !== gain) throw new Error('pidlab.spec() has kp ' + shown.spec.gains[0] + ', the slider set ' + gain);
+      if (shown.iae === before) throw new Error('the IAE cell did not change (' + before + ')');
+      const csv = path.join(args.tmp, plant + '.csv');
+      const cli = JSON.parse(pidlab(['evaluate', '--spec', specFile(shown.spec), '--json', '--samples-csv', csv]));
+      if (canonical(cli.spec) !== canonical(shown.result.spec))
+        throw new Error('pidlab.lastResult.spec differs from the spec evaluate --spec echoes: ' +
+                        JSON.stringify(shown.result.spec) + ' vs ' + JSON.stringify(cli.spec));
+      expectClose('#metric-iae data-value', Number(shown.iae), cli.iae, 1e-12);
+      if (shown.iae !== String(cli.iae)) throw new Error('#metric-iae data-value ' + shown.iae + ' is not String(' + cli.iae + ')');
+      const samples = readCsv(csv);
+      expectSeries('plots.step.data[0] (t)', shown.t, samples.t, 1e-12);
+      expectSeries('plots.step.data[1] (y)', shown.y, samples.y, 1e-12);
+      await shot(plant);
+      return 'kp ' + gain + ', IAE ' + before + ' -> ' + shown.iae + ', ' + shown.y.length + ' samples';
+    });
+  }
+
+  await step('(e) #copy-command copies pidlab.command(), #command shows it; run by a shell it gives the page\'s IAE', async () => {
+    const command = await page.evaluate(() => window.pidlab.command());
+    const shown = await page.$eval('#command', (e) => e.textContent.trim());
+    if (shown !== command) throw new Error('#command shows "' + shown + '", pidlab.command() is "' + command + '"');
+    await browser.defaultBrowserContext().overridePermissions(new URL(args.url).origin, ['clipboard-read', 'clipboard-write', 'clipboard-sanitized-write']);
+    await page.evaluate(() => navigator.clipboard.writeText('(nothing copied yet)'));
+    await page.click('#copy-command');
+    await waitForPage(session, 'the clipboard did not receive the command', redrawMs,
+                      (command) => navigator.clipboard.readText().then((t) => t === command), command);
+    const copied = await page.evaluate(() => navigator.clipboard.readText());
+    if (!/^pidlab evaluate /.test(copied)) throw new Error('the command is not a pidlab evaluate command: ' + copied);
+    // What a user pastes into a shell: the copied text, with this build's pidlab first on the PATH.
+    const env = Object.assign({}, process.env, { PATH: path.dirname(args.pidlab) + ':' + process.env.PATH });
+    const out = execFileSync('bash', ['-c', copied], { encoding: 'utf8', env, cwd: args.tmp, timeout: 60000 });
+    expectClose('the command\'s IAE against #metric-iae', JSON.parse(out).iae, Number(await iaeCell()), 1e-12);
+    return copied;
+  });
+
+  await step('(c) two pinned designs: two .pinned-design, the diff table, each pin\'s IAE that of its spec', async () => {
+    const base = await page.evaluate(() => window.pidlab.pinned.length);
+    await page.evaluate(() => window.pidlab.pin());
+    const at = await page.$eval('#kp-slider', (e) => Number(e.value));
+    await moveSlider(session, 'kp', at - 0.2, redrawMs);
+    await page.evaluate(() => window.pidlab.pin());
+    const pins = await page.evaluate(() => ({
+      pinned: window.pidlab.pinned.map((p) => ({ label: p.label, spec: p.spec, iae: p.result && p.result.iae })),
+      designs: document.querySelectorAll('#pinned .pinned-design').length,
+      diffRows: document.querySelectorAll('#diff-table tr').length,
+      diffText: (document.getElementById('diff-table') || { textContent: '' }).textContent,
+    }));
+    if (pins.pinned.length !== base + 2) throw new Error('pidlab.pinned has ' + pins.pinned.length + ' designs, want ' + (base + 2));
+    if (pins.designs !== base + 2) throw new Error('#pinned has ' + pins.designs + ' .pinned-design children, want ' + (base + 2));
+    if (pins.diffRows < 2 || !pins.diffText.trim()) throw new Error('#diff-table is missing or empty (' + pins.diffRows + ' rows)');
+    const [a, b] = pins.pinned.slice(-2);
+    for (const p of [a, b])
+      if (!pins.diffText.includes(p.label)) throw new Error('#diff-table does not name the pin "' + p.label + '"');
+    if (canonical(a.spec) === canonical(b.spec)) throw new Error('the two pins have the same spec');
+    for (const p of [a, b]) {
+      const cli = JSON.parse(pidlab(['evaluate', '--spec', specFile(p.spec), '--json']));
+      expectClose('pin "' + p.label + '" IAE', p.iae, cli.iae, 1e-12);
+    }
+    await shot('pinned');
+    await docsShot();  // taken again after the tuning, if it passes
+  });
+
+  await step('(d) pidlab.tune({robust: true}) on the stepper motor (kp, kd, tf inside the box) gives the gains of pidlab tune --robust --json', async () => {
+    await selectPlant(session, 'stepper_motor', redrawMs);
+    const before = await page.evaluate(() => {
+      const before = window.pidlab.lastTune;
+      window.pidlab.tune({ robust: true });
+      return before === undefined ? null : before;
+    });
+    await waitForPage(session, 'no new pidlab.lastTune', tuneMs,
+                      (before) => window.pidlab.lastTune && window.pidlab.lastTune !== before, before);
+    const tune = await page.evaluate(() => ({
+      reply: window.pidlab.lastTune, status: (document.getElementById('tune-status') || {}).textContent,
+      cancel: !!document.getElementById('tune-cancel'), button: !!document.getElementById('tune-button'),
+    }));
+    if (!tune.button || !tune.cancel) throw new Error('#tune-button or #tune-cancel is missing');
+    if (tune.reply.plant !== 'stepper_motor') throw new Error('pidlab.lastTune is for plant ' + tune.reply.plant);
+    if (!tune.reply.gains) throw new Error('pidlab.lastTune has no gains: ' + JSON.stringify(tune.reply).slice(0, 300));
+    // The same tuning twice: the CLI's flags, and the spec the page's reply echoes.
+    const runs = [['tune', '--plant', 'stepper_motor', '--robust', '--json']];
+    if (tune.reply.spec) runs.push(['tune', '--spec', specFile(tune.reply.spec), '--json']);
+    for (const argv of runs) {
+      const cli = JSON.parse(pidlab(argv));
+      for (const g of ['kp', 'ki', 'kd', 'tf'])
+        if (tune.reply.gains[g] !== cli.gains[g])
+          throw new Error('lastTune.gains.' + g + ' ' + tune.reply.gains[g] + ', pidlab ' + argv.join(' ') + ': ' + cli.gains[g]);
+    }
+    await shot('tuned');
+    const g = tune.reply.gains;
+    return 'kp ' + g.kp + ', ki ' + g.ki + ', kd ' + g.kd + ', tf ' + g.tf + '; ' + runs.length + ' CLI runs';
+  });
+
+  await step('pidlab.timings: one entry per redraw, sent <= reply <= drawn, the server\'s time inside the round trip', async () => {
+    const { timings, rendered } = await page.evaluate(() => ({ timings: window.pidlab.timings, rendered: window.pidlab.rendered }));
+    if (timings.length !== rendered) throw new Error(timings.length + ' timings for ' + rendered + ' redraws');
+    for (const t of timings) {
+      const ok = ['seq', 'sent_ms', 'reply_ms', 'drawn_ms', 'server_ms'].every((k) => typeof t[k] === 'number') &&
+                 t.sent_ms <= t.reply_ms && t.reply_ms <= t.drawn_ms && t.server_ms >= 0 &&
+                 t.server_ms <= t.reply_ms - t.sent_ms;
+      if (!ok) throw new Error('the entry ' + JSON.stringify(t));
+    }
+    return rendered + ' redraws';
+  });
+
+  await step('no console error, page error or failed request during the whole run', async () => {
+    if (log.errors.length) throw new Error(log.errors.length + ' of them, the first: ' + log.errors[0]);
+  });
+  await docsShot();
+  console.log('screenshots in ' + args.out);
+  await browser.close();
+}
+
+main().catch((e) => {
+  console.log('FAIL the browser test itself: ' + (e && e.stack ? e.stack : String(e)));
+  process.exit(1);
+});

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# browser.workbench: the workbench page of `pidlab serve` driven in Debian's
+# headless Chromium by puppeteer-core (tests/browser/workbench_test.js), in a
+# private network namespace of its own (loopback only, nothing leaves it):
+# the page loads cleanly, the kp slider's IAE and step plot equal `pidlab
+# evaluate --json` and `--samples-csv` for the three paper plants, two pinned
+# designs, a --robust tuning from the page equals `pidlab tune --robust
+# --json`, the page's command reruns to its IAE; screenshots under OUT_DIR.
+#   workbench_test.sh PIDLAB_BINARY SOURCE_DIR OUT_DIR
+set -uo pipefail
+if [[ $# -ne 3 ]]; then
+  echo "usage: $0 PIDLAB_BINARY SOURCE_DIR OUT_DIR" >&2
+  exit 2
+fi
+pidlab=$(realpath -- "$1") source_dir=$(realpath -- "$2") out_dir=$(realpath -m -- "$3")
+# Not a skip: without the browser or the npm packages the test fails, with one line.
+chromium=/usr/bin/chromium
+missing=
+command -v node >/dev/null 2>&1 || missing="node"
+[ -x "$chromium" ] || missing="$missing $chromium"
+[ -f "$source_dir/node_modules/puppeteer-core/package.json" ] || missing="$missing $source_dir/node_modules/puppeteer-core"
+if [ -n "$missing" ]; then
+  echo "FAIL: ${missing# } missing: run scripts/install-deps.sh"
+  exit 1
+fi
+if [[ ${PIDLAB_TEST_IN_NAMESPACE:-} != 1 ]]; then
+  PIDLAB_TEST_IN_NAMESPACE=1 exec unshare -n bash "$0" "$@"
+fi
+ip link set lo up || { echo "FAIL: cannot bring up the private namespace's loopback"; exit 1; }
+mkdir -p "$out_dir" && rm -f "$out_dir"/workbench-*.png  # no stale screenshot from an earlier run
+tmp=$(mktemp -d)
+server=
+trap '[ -n "$server" ] && kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
+"$pidlab" serve --port 0 --bind 127.0.0.1 > "$tmp/serve.out" 2> "$tmp/serve.err" &
+server=$!
+for _ in $(seq 200); do grep -q '^pidlab serve: http' "$tmp/serve.out" && break; sleep 0.05; done
+url=$(sed -n 's/^pidlab serve: //p' "$tmp/serve.out" | head -1)
+if [[ ! $url =~ ^http://127\.0\.0\.1:[0-9]+/ ]]; then
+  echo "FAIL: pidlab serve --port 0 printed no URL on 127.0.0.1: $(head -c 300 "$tmp/serve.out" "$tmp/serve.err")"
+  exit 1
+fi
+# Bounded: the whole test well under ctest's TIMEOUT.
+timeout 170 node "$source_dir/tests/browser/workbench_test.js" \
+  --url "$url" --pidlab "$pidlab" --modules "$source_dir/node_modules" --chromium "$chromium" \
+  --out "$out_dir" --tmp "$tmp"
+status=$?
+[ $status -eq 124 ] && echo "FAIL: the browser test did not finish in 170 s"
+kill -0 "$server" 2>/dev/null || { echo "FAIL: pidlab serve is no longer running"; status=1; }
+exit $status
