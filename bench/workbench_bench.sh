@@ -12,6 +12,7 @@
 # client, without the browser. Exit 1 when a plant misses a target.
 #   bench/workbench_bench.sh [PIDLAB] [MOVES]     (root; defaults build/bin/pidlab 200)
 set -euo pipefail
+case "${1:-}" in -h|--help) sed -n '2,13p' "$0"; exit 0 ;; esac
 pidlab=${1:-}
 [ -z "$pidlab" ] || pidlab=$(realpath -m -- "$pidlab")  # relative to where it is run from
 cd "$(dirname "$0")/.."

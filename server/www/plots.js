@@ -9,6 +9,12 @@ const pinColour = (i) => colours[(i + 1) % colours.length];
 // drawing (a gap): L grows without bound near the loop's poles on the axis.
 const kNyquistReach = 8;
 
+// Tick labels of a log axis: 1e-4, 0.001, ..., 1000, 1e4 (uPlot's default
+// rounds values below 0.001 to 0).
+function logTicks(u, splits) {
+  return splits.map((v) => (v == null ? "" : v >= 1e-3 && v < 1e4 ? String(+v.toPrecision(3)) : v.toExponential(0)));
+}
+
 function size(el) {
   return { width: Math.max(300, el.clientWidth || 560), height: 220 };
 }
@@ -40,7 +46,7 @@ function freqChart(el, pinned) {
   return new uPlot({
     title: '|S|, |T|, |CS| (Ms dashed)', ...size(el), series,
     scales: { x: { time: false, distr: 3 }, y: { distr: 3 } },
-    axes: [{ label: 'w (rad/s)' }, { label: 'gain' }],
+    axes: [{ label: 'w (rad/s)', values: logTicks }, { label: 'gain', values: logTicks }],
   }, [[], [], [], [], [], ...pinned.flatMap(() => [[], []])], el);
 }
 
