@@ -174,10 +174,11 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
           ->expected(0, 1)
           ->default_str("1");
   app->add_option(
-      "--rt-priority", o.rt_priority,
-      "run the plant, controller and disturbance SCHED_FIFO at this priority (1-99) with their memory "
-      "locked, if the system allows it (said in one line if not); default 50 with --realtime (docs/trio.md), "
-      "else none; 0: normal scheduling")
+         "--rt-priority", o.rt_priority,
+         "run the plant, controller and disturbance SCHED_FIFO at this priority (1-99) with their memory "
+         "locked, if the system allows it (said in one line if not); default 50 with --realtime "
+         "(docs/trio.md), "
+         "else none; 0: normal scheduling")
       ->default_str("50 with --realtime, else 0");
   app->add_flag("--verbose,-v", o.verbose, "verbose processes and launcher");
   app->add_flag("--quiet,-q", g_quiet,

@@ -33,8 +33,10 @@ server::Reply Evaluate(const nlohmann::json& request) {
   const nlohmann::json& spec = request["spec"];
   if (spec.is_object() && spec.contains("monte_carlo") && spec["monte_carlo"].is_number() &&
       spec["monte_carlo"].get<double>() > kMaxServedDraws)
-    return {400, {{"error", "monte_carlo " + spec["monte_carlo"].dump() + " is more than the " +
-                                std::to_string(kMaxServedDraws) + " draws pidlab serve runs (pidlab evaluate takes more)"}}};
+    return {400,
+            {{"error", "monte_carlo " + spec["monte_carlo"].dump() + " is more than the " +
+                           std::to_string(kMaxServedDraws) +
+                           " draws pidlab serve runs (pidlab evaluate takes more)"}}};
   const auto start = std::chrono::steady_clock::now();
   nlohmann::json result, series;
   const Status status = json::EvaluateSpecJson(request["spec"], &result, with_series ? &series : nullptr);

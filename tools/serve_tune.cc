@@ -4,8 +4,8 @@
 // tune --json` (json::TuneSpecJson) or an error.
 
 #include <atomic>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <thread>

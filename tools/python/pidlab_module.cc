@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/evaluation/evaluation.h"
 #include "identify_binding.h"
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/json/results_json.h"
 #include "pidlab/json/spec_run.h"
 #include "pidlab/spec/json.h"

@@ -3,7 +3,6 @@
 // exact step per piece by an augmented matrix exponential.
 
 #include "pidlab/evaluation/delayed_loop.h"
-#include "evaluation_internal.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -12,6 +11,7 @@
 #include <map>
 #include <sstream>
 
+#include "evaluation_internal.h"
 #include "pidlab/plant_sim/matrix_exp.h"
 
 namespace pidlab::evaluation {

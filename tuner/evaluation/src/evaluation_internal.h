@@ -10,7 +10,6 @@ namespace pidlab::evaluation::internal {
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-
 /// sum_m |y_L(m ts)| of the load response of a strictly stable loop: the
 /// continuous loop built with r = 0 (no reference state, no derivative kick)
 /// and the step as its exosystem state, or the sampled loop run with r_k = 0.

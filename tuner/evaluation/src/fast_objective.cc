@@ -1,12 +1,13 @@
 // The continuous-loop objective on fixed-size matrices (fast_objective.h).
 
 #include "pidlab/evaluation/fast_objective.h"
-#include "evaluation_internal.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include "evaluation_internal.h"
 
 namespace pidlab::evaluation {
 namespace {

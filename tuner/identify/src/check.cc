@@ -84,13 +84,14 @@ Status CheckData(const IdentifyData& data, Sampling* sampling) {
       return Status::InvalidInput(std::string("not finite: ") + name + " at sample " + std::to_string(k) +
                                   " is " +
                                   CheckedNumber(std::string(name) == "t"   ? data.t[k]
-                                         : std::string(name) == "u" ? data.u[k]
-                                                                    : data.y[k]));
+                                                : std::string(name) == "u" ? data.u[k]
+                                                                           : data.y[k]));
   }
   for (std::size_t k = 1; k < n; ++k)
     if (!(data.t[k] > data.t[k - 1]))
-      return Status::InvalidInput("t is not strictly increasing: t = " + CheckedNumber(data.t[k]) + " at sample " +
-                                  std::to_string(k) + " after " + CheckedNumber(data.t[k - 1]));
+      return Status::InvalidInput("t is not strictly increasing: t = " + CheckedNumber(data.t[k]) +
+                                  " at sample " + std::to_string(k) + " after " +
+                                  CheckedNumber(data.t[k - 1]));
   Sampling found;
   found.mean_interval_s = (data.t[n - 1] - data.t[0]) / static_cast<double>(n - 1);
   found.min_interval_s = found.max_interval_s = data.t[1] - data.t[0];

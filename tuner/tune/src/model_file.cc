@@ -34,7 +34,8 @@ bool Member(const nlohmann::json& j, const char* key, const std::string& where, 
 }
 
 bool Number(const nlohmann::json& j, const std::string& where, double* out, std::string* error) {
-  if (!j.is_number()) return FileBad(error, "\"" + where + "\" " + spec::Truncate(j.dump()) + " is not a number");
+  if (!j.is_number())
+    return FileBad(error, "\"" + where + "\" " + spec::Truncate(j.dump()) + " is not a number");
   const double v = j.get<double>();
   if (!std::isfinite(v) || std::abs(v) > spec::kMaxInputMagnitude)
     return FileBad(error, "\"" + where + "\" " + spec::FormatNumber(v) + " is out of range");
@@ -70,11 +71,11 @@ bool ReadTfShape(const nlohmann::json& j, ProcessModelUncertainty* m, std::strin
   if (!Member(j, "poles", "", &poles, error) || !Member(j, "zeros", "", &zeros, error)) return false;
   if (!poles->is_number_integer() || poles->get<long>() < 1 || poles->get<long>() > plant_sim::kMaxTfPoles)
     return FileBad(error, "\"poles\" " + spec::Truncate(poles->dump()) + " must be an integer in 1.." +
-                          std::to_string(plant_sim::kMaxTfPoles));
+                              std::to_string(plant_sim::kMaxTfPoles));
   m->poles = poles->get<int>();
   if (!zeros->is_number_integer() || zeros->get<long>() < 0 || zeros->get<long>() >= m->poles)
     return FileBad(error, "\"zeros\" " + spec::Truncate(zeros->dump()) + " must be an integer in 0.." +
-                          std::to_string(m->poles - 1));
+                              std::to_string(m->poles - 1));
   m->zeros = zeros->get<int>();
   return true;
 }
@@ -84,7 +85,8 @@ bool ReadParameters(const nlohmann::json& j, ProcessModelUncertainty* m, std::st
   const nlohmann::json* kind = nullptr;
   if (!Member(j, "model", "", &kind, error)) return false;
   if (!kind->is_string() || !Parse(kind->get<std::string>(), &m->kind))
-    return FileBad(error, "\"model\" " + spec::Truncate(kind->dump()) + " must be " + ProcessModelKindNames());
+    return FileBad(error,
+                   "\"model\" " + spec::Truncate(kind->dump()) + " must be " + ProcessModelKindNames());
   if (m->kind == plant_sim::ProcessModelKind::kTf && !ReadTfShape(j, m, error)) return false;
   const nlohmann::json* parameters = nullptr;
   if (!Member(j, "parameters", "", &parameters, error)) return false;

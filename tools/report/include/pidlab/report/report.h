@@ -140,10 +140,10 @@ struct ReportData {
   std::vector<Tuning> tunings;
   SampledSection sampled;
   std::vector<Figure> figures;
-  MotorSection motor;  // "The motor itself" (motor_section.h)
+  MotorSection motor;          // "The motor itself" (motor_section.h)
   IdentifySection identified;  // "Identifying the motor" (identify_section.h)
-  RobustSection robust;  // "Robust tuning" (robust_section.h)
-  TwoDofSection two_dof;  // "Two degrees of freedom" (two_dof_section.h)
+  RobustSection robust;        // "Robust tuning" (robust_section.h)
+  TwoDofSection two_dof;       // "Two degrees of freedom" (two_dof_section.h)
   /// Wall time of the computation, s (printed by the command, not in report.md).
   double compute_time_s = 0, figure_time_s = 0;
 };
