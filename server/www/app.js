@@ -201,6 +201,7 @@ function showForm() {
   $('loop').value = state.loop;
   for (const k of textFields) $(k).value = state[k];
   for (const g of ['kp', 'ki', 'kd']) setGainBoxes(g);
+  for (const k of ['max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin']) if ($(k + '-slider')) syncBoundSlider(k);
   for (const el of document.querySelectorAll('.plant-custom')) el.classList.toggle('hidden', state.plant !== 'custom');
   for (const el of document.querySelectorAll('.plant-model')) el.classList.toggle('hidden', state.plant !== 'model');
   for (const el of document.querySelectorAll('.plant-stepper')) el.classList.toggle('hidden', !state.plant.startsWith('stepper'));
@@ -398,6 +399,31 @@ for (const name of ['kp', 'ki', 'kd']) slider(name);
 $('plant').addEventListener('change', () => { state.plant = $('plant').value; showForm(); send(); });
 $('loop').addEventListener('change', () => { state.loop = $('loop').value; send(); });
 for (const k of textFields) $(k).addEventListener('change', () => { state[k] = $(k).value; send(); });
+// The bounds also as sliders (linear, or log10 for the noise gain): moving
+// one sets its number box and the bound; an empty box is no bound.
+const boundSliders = { max_ms: [1.05, 4, 0.01, false], max_mt: [1, 4, 0.01, false],
+  max_noise_gain: [-1, 4, 0.01, true], min_phase_margin: [0, 90, 0.5, false] };
+function syncBoundSlider(k) {
+  const [lo, hi, , log] = boundSliders[k];
+  const v = Number(state[k]);
+  const r = $(k + '-slider');
+  if (state[k] === '' || !isFinite(v)) { r.value = lo; return; }
+  r.value = Math.min(hi, Math.max(lo, log ? Math.log10(v) : v));
+}
+for (const [k, [lo, hi, step, log]] of Object.entries(boundSliders)) {
+  const r = document.createElement('input');
+  r.type = 'range'; r.id = k + '-slider'; r.min = lo; r.max = hi; r.step = step;
+  r.title = k + ' (slider)';
+  $(k).after(r);
+  r.addEventListener('input', () => {
+    const x = Number(r.value);
+    state[k] = String(log ? Number(Math.pow(10, x).toPrecision(4)) : x);
+    $(k).value = state[k];
+    send();
+  });
+  $(k).addEventListener('change', () => syncBoundSlider(k));
+  syncBoundSlider(k);
+}
 $('pin-button').addEventListener('click', () => pin());
 $('tune-button').addEventListener('click', () => tune(formTuneOptions()).catch(() => {}));
 $('tune-cancel').addEventListener('click', () => pidlab.cancelTune());

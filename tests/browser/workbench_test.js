@@ -131,6 +131,30 @@ async function main() {
     return copied;
   });
 
+  await step('(b2) the Ms bound slider sets max_ms in the spec the page runs; an Ms above it is marked; clearing the box removes it', async () => {
+    const moveMs = async (value) => {
+      const before = await page.evaluate(() => window.pidlab.rendered);
+      await page.evaluate((v) => {
+        const r = document.getElementById('max_ms-slider');
+        r.value = String(v);
+        r.dispatchEvent(new Event('input', { bubbles: true }));
+      }, value);
+      await waitForPage(session, 'no redraw with max_ms ' + value, redrawMs,
+                        (before, v) => window.pidlab.rendered > before && window.pidlab.lastResult.spec.max_ms === v, before, value);
+    };
+    await moveMs(1.05);
+    const box = await page.$eval('#max_ms', (e) => e.value);
+    if (box !== '1.05') throw new Error('#max_ms shows "' + box + '" after the slider moved to 1.05');
+    const ms = await page.evaluate(() => window.pidlab.lastResult.robustness.ms);
+    const marked = await page.$eval('#metric-ms', (e) => e.classList.contains('violated'));
+    if (!(ms > 1.05) || !marked) throw new Error('Ms ' + ms + ' against the bound 1.05: marked ' + marked);
+    const before = await page.evaluate(() => window.pidlab.rendered);
+    await page.evaluate(() => { const b = document.getElementById('max_ms'); b.value = ''; b.dispatchEvent(new Event('change')); });
+    await waitForPage(session, 'no redraw after the bound was cleared', redrawMs,
+                      (before) => window.pidlab.rendered > before && !('max_ms' in window.pidlab.lastResult.spec && window.pidlab.lastResult.spec.max_ms !== null && isFinite(window.pidlab.lastResult.spec.max_ms)), before);
+    return 'Ms ' + ms + ' marked against 1.05, then cleared';
+  });
+
   await step('(c) two pinned designs: two .pinned-design, the diff table, each pin\'s IAE that of its spec', async () => {
     const base = await page.evaluate(() => window.pidlab.pinned.length);
     await page.evaluate(() => window.pidlab.pin());
