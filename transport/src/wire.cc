@@ -11,6 +11,7 @@
 #include <pidlab/lcmt_episode_config_v3.hpp>
 #include <pidlab/lcmt_episode_config_v4.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_pacing_progress.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
@@ -112,7 +113,8 @@ bool WireLayoutOk(int64_t fingerprint, const void* data, int size) {
              fingerprint != pidlab::lcmt_control_command::getHash() &&
              fingerprint != pidlab::lcmt_disturbance_request::getHash() &&
              fingerprint != pidlab::lcmt_disturbance_sample::getHash() &&
-             fingerprint != pidlab::lcmt_trajectory_request::getHash()) {
+             fingerprint != pidlab::lcmt_trajectory_request::getHash() &&
+             fingerprint != pidlab::lcmt_pacing_progress::getHash()) {
     return false;
   }
   return c.ok();

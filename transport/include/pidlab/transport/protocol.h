@@ -34,6 +34,7 @@ inline constexpr const char* kDisturbanceBlockChannel = "DISTURBANCE_BLOCK";
 inline constexpr const char* kSummaryChannel = "SUMMARY";
 inline constexpr const char* kTrajectoryRequestChannel = "TRAJECTORY_REQUEST";
 inline constexpr const char* kTrajectoryChannel = "TRAJECTORY";
+inline constexpr const char* kPacingChannel = "PACING";
 
 /// Samples per lcmt_disturbance_block: one datagram.
 inline constexpr long kNoiseBlock = 128;
