@@ -124,5 +124,60 @@ TEST(Pacer, StatsBeforeAnyStepArePacedAndEmpty) {
   EXPECT_EQ(s.rate_hz, 0.0);
 }
 
+TEST(LatenessHistogram, BinsArePowersOfTwoMicrosecondsWithTheEndsOpen) {
+  EXPECT_EQ(LatenessBin(0.0), 0);
+  EXPECT_EQ(LatenessBin(-1e-9), 0);
+  EXPECT_EQ(LatenessBin(0.999e-6), 0);
+  EXPECT_EQ(LatenessBin(1e-6), 1);  // [1, 2) us
+  EXPECT_EQ(LatenessBin(1.99e-6), 1);
+  EXPECT_EQ(LatenessBin(2e-6), 2);    // [2, 4) us
+  EXPECT_EQ(LatenessBin(100e-6), 7);  // [64, 128) us
+  EXPECT_EQ(LatenessBin(std::ldexp(1e-6, 21) * 1.5), 22);
+  EXPECT_EQ(LatenessBin(10.0), kLatenessBins - 1);
+  EXPECT_EQ(LatenessBin(std::numeric_limits<double>::quiet_NaN()), 0);
+  EXPECT_DOUBLE_EQ(LatenessBinUpperEdge(0), 1e-6);
+  EXPECT_DOUBLE_EQ(LatenessBinUpperEdge(7), 128e-6);
+  EXPECT_TRUE(std::isinf(LatenessBinUpperEdge(kLatenessBins - 1)));
+}
+
+TEST(PacingProgress, PercentilesAreTheUpperEdgesOfTheNearestRankBinsCappedByTheMaximum) {
+  PacingProgress p;
+  EXPECT_EQ(p.UpperPercentile(0.5), 0.0);  // no steps yet
+  p.steps = 100;
+  p.lateness_max_s = 300e-6;
+  p.histogram[static_cast<std::size_t>(LatenessBin(10e-6))] = 50;  // ranks 1..50: [8, 16) us
+  p.histogram[static_cast<std::size_t>(LatenessBin(40e-6))] = 49;  // ranks 51..99: [32, 64) us
+  p.histogram[static_cast<std::size_t>(LatenessBin(300e-6))] = 1;  // rank 100: [256, 512) us
+  EXPECT_DOUBLE_EQ(p.UpperPercentile(0.50), 16e-6);
+  EXPECT_DOUBLE_EQ(p.UpperPercentile(0.99), 64e-6);
+  EXPECT_DOUBLE_EQ(p.UpperPercentile(1.0), 300e-6);  // the bin's edge, 512 us, capped by the maximum
+  pidlab::lcmt_pacing_progress m{};
+  SetPacingProgress(p, &m);
+  EXPECT_EQ(m.step, 100);
+  EXPECT_EQ(m.lateness_histogram[LatenessBin(40e-6)], 49);
+  EXPECT_DOUBLE_EQ(m.lateness_p50_upper_s, 16e-6);
+  EXPECT_DOUBLE_EQ(m.lateness_p99_upper_s, 64e-6);
+}
+
+TEST(Pacer, ProgressAgreesWithTheExactStatsAndBoundsTheirPercentiles) {
+  Pacer dut(/*factor=*/10.0, /*dt_s=*/0.01, /*total_steps=*/30);
+  dut.Start();
+  for (long k = 1; k <= 30; ++k) dut.WaitForStep(k);
+  const RealtimeStats exact = dut.Stats();
+  const PacingProgress live = dut.Progress();
+  EXPECT_EQ(live.steps, exact.steps);
+  EXPECT_EQ(live.missed_deadlines, exact.missed_deadlines);
+  EXPECT_EQ(live.lateness_max_s, exact.lateness_max_s);
+  EXPECT_EQ(live.rate_hz, exact.rate_hz);
+  long counted = 0;
+  for (long c : live.histogram) counted += c;
+  EXPECT_EQ(counted, 30);
+  // An upper bound within one bin: at most twice the exact figure (or 1 us).
+  EXPECT_GE(live.UpperPercentile(0.50), exact.lateness_p50_s);
+  EXPECT_LE(live.UpperPercentile(0.50), std::max(2 * exact.lateness_p50_s, 1e-6));
+  EXPECT_GE(live.UpperPercentile(0.99), exact.lateness_p99_s);
+  EXPECT_LE(live.UpperPercentile(0.99), std::max(2 * exact.lateness_p99_s, 1e-6));
+}
+
 }  // namespace
 }  // namespace pidlab::transport

@@ -8,6 +8,7 @@
 #include <pidlab/lcmt_disturbance_block.hpp>
 #include <pidlab/lcmt_disturbance_request.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_pacing_progress.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <sstream>
 
@@ -181,6 +182,12 @@ void PlantRole::StreamTrajectory(long upto) {
     e.streamed = last;
   }
   e.stream_last_s = NowSeconds();
+  if (e.pacer) {  // the live pacing figures, for watchers (pidlab serve --lcm-url)
+    pidlab::lcmt_pacing_progress p;
+    p.episode_id = e.spec.episode_id;
+    transport::SetPacingProgress(e.pacer->Progress(), &p);
+    transport_->Publish(transport::kPacingChannel, &p);
+  }
 }
 
 void PlantRole::PublishOutput() {

@@ -194,6 +194,8 @@ DecoderTable::DecoderTable()
           Type<pidlab::lcmt_episode_summary>("lcmt_episode_summary", "SUMMARY"),
           Type<pidlab::lcmt_trajectory_request>("lcmt_trajectory_request", "TRAJECTORY_REQUEST"),
           Type<pidlab::lcmt_trajectory_chunk>("lcmt_trajectory_chunk", "TRAJECTORY"),
+          Type<pidlab::lcmt_pacing_progress>("lcmt_pacing_progress",
+                                             "PACING"),  // live figures: the SUMMARY's are final
       } {}
 
 const MessageType* DecoderTable::Find(int64_t fingerprint) const {

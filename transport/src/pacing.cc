@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 namespace pidlab::transport {
@@ -85,6 +86,42 @@ void SetRealtime(const RealtimeStats& s, pidlab::lcmt_episode_summary* m) {
   m->rate_hz = s.rate_hz;
 }
 
+int LatenessBin(double lateness_s) {
+  const double us = lateness_s * 1e6;
+  if (!(us >= 1.0)) return 0;          // below 1 us (and NaN)
+  const int bin = std::ilogb(us) + 1;  // [2^(i-1), 2^i) us
+  return std::min(bin, kLatenessBins - 1);
+}
+
+double LatenessBinUpperEdge(int bin) {
+  if (bin >= kLatenessBins - 1) return std::numeric_limits<double>::infinity();
+  return std::ldexp(1e-6, std::max(bin, 0));
+}
+
+double PacingProgress::UpperPercentile(double q) const {
+  if (steps <= 0) return 0.0;
+  const auto rank = std::clamp<long>(static_cast<long>(std::ceil(q * static_cast<double>(steps))), 1, steps);
+  long seen = 0;
+  for (int bin = 0; bin < kLatenessBins; ++bin) {
+    seen += histogram[static_cast<std::size_t>(bin)];
+    if (seen >= rank) return std::min(LatenessBinUpperEdge(bin), lateness_max_s);
+  }
+  return lateness_max_s;
+}
+
+void SetPacingProgress(const PacingProgress& p, pidlab::lcmt_pacing_progress* m) {
+  m->step = p.steps;
+  m->realtime_factor = p.factor;
+  m->period_s = p.period_s;
+  m->missed_deadlines = p.missed_deadlines;
+  m->lateness_max_s = p.lateness_max_s;
+  m->rate_hz = p.rate_hz;
+  for (int bin = 0; bin < kLatenessBins; ++bin)
+    m->lateness_histogram[bin] = p.histogram[static_cast<std::size_t>(bin)];
+  m->lateness_p50_upper_s = p.UpperPercentile(0.50);
+  m->lateness_p99_upper_s = p.UpperPercentile(0.99);
+}
+
 Pacer::Pacer(double factor, double dt_s, long total_steps) : factor_(factor), period_s_(dt_s / factor) {
   lateness_s_.reserve(static_cast<std::size_t>(std::max(0L, total_steps)));
 }
@@ -93,6 +130,9 @@ void Pacer::Start() {
   t0_ns_ = last_start_ns_ = MonotonicNs();
   last_step_ = 0;
   lateness_s_.clear();
+  progress_ = PacingProgress{};
+  progress_.factor = factor_;
+  progress_.period_s = period_s_;
 }
 
 void Pacer::WaitForStep(long k) {
@@ -104,9 +144,21 @@ void Pacer::WaitForStep(long k) {
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, nullptr) == EINTR) {
   }
   const int64_t now_ns = MonotonicNs();
-  lateness_s_.push_back(static_cast<double>(now_ns - due_ns) * 1e-9);
+  const double lateness_s = static_cast<double>(now_ns - due_ns) * 1e-9;
+  lateness_s_.push_back(lateness_s);
   last_start_ns_ = now_ns;
   last_step_ = k;
+  ++progress_.steps;
+  if (lateness_s > period_s_) ++progress_.missed_deadlines;
+  progress_.lateness_max_s = std::max(progress_.lateness_max_s, lateness_s);
+  ++progress_.histogram[static_cast<std::size_t>(LatenessBin(lateness_s))];
+}
+
+PacingProgress Pacer::Progress() const {
+  PacingProgress p = progress_;
+  const double span = static_cast<double>(last_start_ns_ - t0_ns_) * 1e-9;
+  p.rate_hz = span > 0.0 ? static_cast<double>(last_step_) / span : 0.0;
+  return p;
 }
 
 RealtimeStats Pacer::Stats() const {

@@ -14,6 +14,7 @@
 #include <pidlab/lcmt_disturbance_sample.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_pacing_progress.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
@@ -25,10 +26,11 @@
 namespace pidlab::replay {
 
 /// One decoded pidlab message.
-using PidlabMessage = std::variant<
-    pidlab::lcmt_episode_config, pidlab::lcmt_ready, pidlab::lcmt_plant_output, pidlab::lcmt_control_command,
-    pidlab::lcmt_disturbance_sample, pidlab::lcmt_disturbance_block, pidlab::lcmt_disturbance_request,
-    pidlab::lcmt_episode_summary, pidlab::lcmt_trajectory_request, pidlab::lcmt_trajectory_chunk>;
+using PidlabMessage = std::variant<pidlab::lcmt_episode_config, pidlab::lcmt_ready, pidlab::lcmt_plant_output,
+                                   pidlab::lcmt_control_command, pidlab::lcmt_disturbance_sample,
+                                   pidlab::lcmt_disturbance_block, pidlab::lcmt_disturbance_request,
+                                   pidlab::lcmt_episode_summary, pidlab::lcmt_trajectory_request,
+                                   pidlab::lcmt_trajectory_chunk, pidlab::lcmt_pacing_progress>;
 
 /// A pidlab message type.
 struct MessageType {

@@ -66,6 +66,7 @@ class EpisodeAssembler {
   void On(const std::string&, const pidlab::lcmt_ready&) {}
   void On(const std::string&, const pidlab::lcmt_disturbance_request&) {}
   void On(const std::string&, const pidlab::lcmt_trajectory_request&) {}
+  void On(const std::string&, const pidlab::lcmt_pacing_progress&) {}
 
   std::map<std::pair<std::string, int64_t>, std::size_t> index_;
   std::vector<std::unique_ptr<Building>> building_;

@@ -17,8 +17,10 @@
 //   p50, p99      nearest-rank percentiles of lateness_1..N
 //   rate_hz       N / (start of step N - t0): steps per second achieved
 
+#include <array>
 #include <cstdint>
 #include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_pacing_progress.hpp>
 #include <string>
 #include <vector>
 
@@ -55,6 +57,33 @@ void SetRealtime(const RealtimeStats& stats, pidlab::lcmt_episode_summary* summa
 /// with *error naming it.
 bool RealtimeFactorIsValid(double factor, std::string* error);
 
+/// Bins of the live lateness histogram (lcmt_pacing_progress): bin 0 holds
+/// lateness below 1 us, bin i (1..22) [2^(i-1), 2^i) us, bin 23 at least 2^22 us.
+inline constexpr int kLatenessBins = 24;
+static_assert(kLatenessBins == pidlab::lcmt_pacing_progress::HISTOGRAM_BINS);
+/// The histogram bin of a lateness in seconds.
+int LatenessBin(double lateness_s);
+/// The upper edge of a bin in seconds (+inf for the last).
+double LatenessBinUpperEdge(int bin);
+
+/// What a paced episode's plant publishes while it runs (PACING), kept up to
+/// date in O(1) per step: counts, the exact maximum and the rate, with p50 and
+/// p99 read off the histogram as upper bounds (the SUMMARY's exact
+/// nearest-rank figures come at the end, from Pacer::Stats).
+struct PacingProgress {
+  double factor = 0.0;
+  double period_s = 0.0;
+  long steps = 0;
+  long missed_deadlines = 0;
+  double lateness_max_s = 0.0;
+  double rate_hz = 0.0;
+  std::array<long, kLatenessBins> histogram{};
+  /// The upper edge of the bin holding the nearest-rank q-quantile, at most
+  /// the maximum (0 with no steps).
+  double UpperPercentile(double q) const;
+};
+void SetPacingProgress(const PacingProgress& progress, pidlab::lcmt_pacing_progress* message);
+
 class Pacer {
  public:
   /// factor > 0 (RealtimeFactorIsValid), dt_s > 0.
@@ -65,6 +94,9 @@ class Pacer {
   void WaitForStep(long k);
   /// The statistics of the steps waited for so far.
   RealtimeStats Stats() const;
+  /// The live figures of the steps waited for so far (no sorting: cheap
+  /// enough to publish with every trajectory chunk).
+  PacingProgress Progress() const;
   double period_s() const { return period_s_; }
 
  private:
@@ -72,6 +104,7 @@ class Pacer {
   int64_t t0_ns_ = 0, last_start_ns_ = 0;
   long last_step_ = 0;
   std::vector<double> lateness_s_;  // of steps 1..last_step_
+  PacingProgress progress_;         // counts, max and histogram, updated per step
 };
 
 }  // namespace pidlab::transport
