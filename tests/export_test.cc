@@ -317,13 +317,22 @@ Comparison RunRandom(Scalar scalar, std::uint32_t seed, int controllers, int ste
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   Comparison out;
+  // A double or float module takes every gain and option at run time
+  // (shim_new), so one compiled module serves every random controller; a
+  // fixed-point module is compiled for each, its Q formats coming from that
+  // controller's range analysis.
+  std::unique_ptr<CompiledModule> shared, own;
   for (int n = 0; n < controllers; ++n) {
     Controller c = RandomController(&rng, scalar);
     if (IsFixed(scalar)) {
       // A derivative the fixed-point range analysis takes (kd/dt <= 100).
       c.gains.kd *= 100.0 * c.pid.dt_s;
     }
-    CompiledModule m(Code(scalar, c), ShimPath(IsFixed(scalar) ? "shim_fixed.c" : "shim_real.c"));
+    std::unique_ptr<CompiledModule>& slot = IsFixed(scalar) ? own : shared;
+    if (!slot || IsFixed(scalar))
+      slot = std::make_unique<CompiledModule>(Code(scalar, c),
+                                              ShimPath(IsFixed(scalar) ? "shim_fixed.c" : "shim_real.c"));
+    CompiledModule& m = *slot;
     PidGains g = c.gains;
     g.tf = EffectiveDerivativeFilter(c.gains, c.pid);
     PidOptions o = c.pid;
