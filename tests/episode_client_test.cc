@@ -9,13 +9,16 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <memory>
+#include <pidlab/lcmt_tune_progress.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "pidlab/controller/controller_role.h"
+#include "pidlab/episode_client/tune_progress.h"
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/plant_sim/disturbance_role.h"
 #include "pidlab/plant_sim/plant_role.h"
@@ -286,6 +289,46 @@ TEST(EpisodeClient, RunOfAnInvalidLoopReturnsFalseWithoutStartingAnEpisode) {
   EXPECT_NE(error.find("invalid episode: horizon 1.01"), std::string::npos) << error;
   EXPECT_EQ(trio.plant.counters().episodes, 0);
   EXPECT_EQ(trio.client->stats().episodes, 0);
+}
+
+TEST(TuneProgressPublisher, SendsTheSearchAtMostOnceAnIntervalAndTheResultAtTheEnd) {
+  lcm::LCM lcm("memq://");
+  EpisodeClientOptions trio;
+  trio.lcm_url = "memq://";
+  transport::Transport listener(&lcm, trio.transport);
+  std::vector<pidlab::lcmt_tune_progress> heard;
+  listener.Subscribe<pidlab::lcmt_tune_progress>(
+      transport::kTuneProgressChannel, [&](const pidlab::lcmt_tune_progress& m) { heard.push_back(m); });
+  episode_client::TuneProgressPublisher dut(&lcm, trio, /*trios=*/3, "nelder-mead", "iae",
+                                            /*min_interval_s=*/3600.0);
+  optim::TracePoint none;  // before any feasible point
+  none.iteration = 1;
+  none.evaluations = 4;
+  dut.Running(none);
+  optim::TracePoint better = none;
+  better.iteration = 2;
+  better.evaluations = 8;
+  better.best_f = 1.5;
+  better.best_x = Eigen::Vector3d(1, 2, 3);
+  dut.Running(better);  // within the interval: not sent
+  dut.Finished(true, PidGains{1, 2, 3}, 1.25);
+  while (listener.WaitAndHandle(0.0) > 0) {
+  }
+  ASSERT_EQ(heard.size(), 2u);
+  EXPECT_EQ(heard[0].status, pidlab::lcmt_tune_progress::RUNNING);
+  EXPECT_EQ(heard[0].evaluations, 4);
+  EXPECT_TRUE(std::isinf(heard[0].best_objective));
+  EXPECT_TRUE(std::isnan(heard[0].best_gains[0]));
+  EXPECT_EQ(heard[1].status, pidlab::lcmt_tune_progress::DONE);
+  EXPECT_EQ(heard[1].step, 2);  // the last point seen, sent or not
+  EXPECT_EQ(heard[1].evaluations, 8);
+  EXPECT_EQ(heard[1].best_objective, 1.25);
+  EXPECT_EQ(heard[1].best_gains[2], 3.0);
+  EXPECT_EQ(heard[1].trios, 3);
+  EXPECT_EQ(heard[1].method, "nelder-mead");
+  EXPECT_EQ(heard[1].objective, "iae");
+  EXPECT_EQ(heard[0].episode_id, dut.id());
+  EXPECT_EQ(heard[1].episode_id, dut.id());
 }
 
 }  // namespace

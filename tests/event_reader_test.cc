@@ -344,7 +344,7 @@ std::vector<uint8_t> Encode(const Msg& m) {
 
 TEST(DecoderTable, FindsEveryPidlabTypeByItsFingerprint) {
   const DecoderTable table;
-  ASSERT_EQ(table.types().size(), 15u);  // eleven types and the four configurations of older logs
+  ASSERT_EQ(table.types().size(), 16u);  // twelve types and the four configurations of older logs
   for (const MessageType& t : table.types()) {
     const MessageType* found = table.Find(t.fingerprint);
     ASSERT_NE(found, nullptr) << t.name;

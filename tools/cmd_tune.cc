@@ -15,6 +15,7 @@
 #include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/episode_client/episode_client.h"
+#include "pidlab/episode_client/tune_progress.h"
 #include "pidlab/tune/search_box.h"
 #include "pidlab/tune/spec_build.h"
 #include "pidlab/tune/tune.h"
@@ -55,6 +56,7 @@ struct TuneCommand {
   bool json = false;
   LcmFlags lcm;
   std::unique_ptr<EpisodePool> pool;
+  std::unique_ptr<pidlab::episode_client::TuneProgressPublisher> publisher;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
@@ -91,8 +93,19 @@ struct TuneCommand {
     const SampledRunner runner = MakeRunner(o);
     if (pool) o.parallel_for = pool->AsParallelFor();  // the starts on idle trios
     const bool tty = isatty(STDERR_FILENO) != 0;
+    ProgressCallback progress = MakeProgress(tty);
+    if (pool) {  // watchers of the first trio see the search as it runs (docs/live.md)
+      publisher = std::make_unique<pidlab::episode_client::TuneProgressPublisher>(
+          lcm.ClientOptions(lcm.Url()), pool->size(), ToString(o.method), ToString(o.objective));
+      progress = [terminal = progress, this](const TracePoint& tp) {
+        terminal(tp);
+        publisher->Running(tp);
+      };
+    }
     TuneSummary s;
-    Require(Tune(p, o, &s, &error, MakeProgress(tty), runner), error);
+    const bool tuned = Tune(p, o, &s, &error, progress, runner);
+    if (publisher) publisher->Finished(tuned && s.stable, s.gains, s.objective);
+    Require(tuned, error);
     if (tty) std::fprintf(stderr, "\r%70s\r", "");
     if (!trace.empty()) WriteTrace(s);
     Evaluation ev;

@@ -196,6 +196,7 @@ DecoderTable::DecoderTable()
           Type<pidlab::lcmt_trajectory_chunk>("lcmt_trajectory_chunk", "TRAJECTORY"),
           Type<pidlab::lcmt_pacing_progress>("lcmt_pacing_progress",
                                              "PACING"),  // live figures: the SUMMARY's are final
+          Type<pidlab::lcmt_tune_progress>("lcmt_tune_progress", "TUNE_PROGRESS"),  // a tuning's progress
       } {}
 
 const MessageType* DecoderTable::Find(int64_t fingerprint) const {

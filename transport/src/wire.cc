@@ -16,6 +16,7 @@
 #include <pidlab/lcmt_ready.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <pidlab/lcmt_trajectory_request.hpp>
+#include <pidlab/lcmt_tune_progress.hpp>
 
 #include "pidlab/transport/protocol.h"
 
@@ -107,6 +108,8 @@ bool WireLayoutOk(int64_t fingerprint, const void* data, int size) {
     c.Fixed(1).Fixed(8).Fixed(8).String().String().Fixed(6 * 8);
   } else if (fingerprint == pidlab::lcmt_trajectory_chunk::getHash()) {
     c.Array(3 * 8, kMaxTrajectoryChunk);
+  } else if (fingerprint == pidlab::lcmt_tune_progress::getHash()) {
+    c.Fixed(1 + 4 + 8 + 3 * 8 + 4).String().String();
   } else if (fingerprint == pidlab::lcmt_disturbance_block::getHash()) {
     c.Fixed(8).Array(8, kMaxNoiseRequest);
   } else if (fingerprint != pidlab::lcmt_plant_output::getHash() &&

@@ -19,6 +19,7 @@
 #include <pidlab/lcmt_ready.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <pidlab/lcmt_trajectory_request.hpp>
+#include <pidlab/lcmt_tune_progress.hpp>
 #include <string>
 #include <variant>
 #include <vector>
@@ -26,11 +27,12 @@
 namespace pidlab::replay {
 
 /// One decoded pidlab message.
-using PidlabMessage = std::variant<pidlab::lcmt_episode_config, pidlab::lcmt_ready, pidlab::lcmt_plant_output,
-                                   pidlab::lcmt_control_command, pidlab::lcmt_disturbance_sample,
-                                   pidlab::lcmt_disturbance_block, pidlab::lcmt_disturbance_request,
-                                   pidlab::lcmt_episode_summary, pidlab::lcmt_trajectory_request,
-                                   pidlab::lcmt_trajectory_chunk, pidlab::lcmt_pacing_progress>;
+using PidlabMessage =
+    std::variant<pidlab::lcmt_episode_config, pidlab::lcmt_ready, pidlab::lcmt_plant_output,
+                 pidlab::lcmt_control_command, pidlab::lcmt_disturbance_sample,
+                 pidlab::lcmt_disturbance_block, pidlab::lcmt_disturbance_request,
+                 pidlab::lcmt_episode_summary, pidlab::lcmt_trajectory_request, pidlab::lcmt_trajectory_chunk,
+                 pidlab::lcmt_pacing_progress, pidlab::lcmt_tune_progress>;
 
 /// A pidlab message type.
 struct MessageType {

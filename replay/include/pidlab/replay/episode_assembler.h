@@ -67,6 +67,7 @@ class EpisodeAssembler {
   void On(const std::string&, const pidlab::lcmt_disturbance_request&) {}
   void On(const std::string&, const pidlab::lcmt_trajectory_request&) {}
   void On(const std::string&, const pidlab::lcmt_pacing_progress&) {}
+  void On(const std::string&, const pidlab::lcmt_tune_progress&) {}
 
   std::map<std::pair<std::string, int64_t>, std::size_t> index_;
   std::vector<std::unique_ptr<Building>> building_;

@@ -35,6 +35,7 @@ inline constexpr const char* kSummaryChannel = "SUMMARY";
 inline constexpr const char* kTrajectoryRequestChannel = "TRAJECTORY_REQUEST";
 inline constexpr const char* kTrajectoryChannel = "TRAJECTORY";
 inline constexpr const char* kPacingChannel = "PACING";
+inline constexpr const char* kTuneProgressChannel = "TUNE_PROGRESS";
 
 /// Samples per lcmt_disturbance_block: one datagram.
 inline constexpr long kNoiseBlock = 128;
