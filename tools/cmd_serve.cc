@@ -52,9 +52,10 @@ struct ServeCommand {
     if (!server::IsLoopback(options.bind)) options.token = RandomToken();
     std::string error;
     if (!options.IsValid(&error)) throw BadInput(error);
-    const std::unique_ptr<LiveService> live = StartLive();  // outlives the server
+    std::unique_ptr<LiveService> live = StartLive();
     server::Server s(options, server::ConnectionHandler(AnswerWorkbenchRequest), server::WorkbenchAssets());
     if (!s.Start(&error)) throw BadInput(error);
+    SetLiveService(live.get());
     const std::string host =
         options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind;
     std::cout << "pidlab serve: http://" << host << ":" << s.port() << "/"
@@ -63,7 +64,10 @@ struct ServeCommand {
     std::signal(SIGINT, StopOnSignal);
     std::signal(SIGTERM, StopOnSignal);
     s.Run();
+    // The live threads post to the server's connections: they stop (and a
+    // run_on_trio episode ends) while the server still exists.
     SetLiveService(nullptr);
+    live.reset();
     g_server = nullptr;
     std::cerr << "pidlab serve: stopped\n";
     return 0;
@@ -85,7 +89,6 @@ struct ServeCommand {
     } catch (const std::runtime_error& e) {
       throw BadInput("--lcm-url " + Quote(lcm.lcm_url) + ": " + e.what());
     }
-    SetLiveService(live.get());
     return live;
   }
 
