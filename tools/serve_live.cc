@@ -45,6 +45,7 @@ nlohmann::json PacingJson(const monitor::PacingProgress& p) {
 
 nlohmann::json EpisodeJson(const EpisodeInfo& e) {
   return {{"episode_id", e.episode_id},
+          {"episode_id_text", std::to_string(e.episode_id)},  // exact where a JSON number is not (JavaScript)
           {"plant", e.plant},
           {"gains", {JsonNumber(e.kp), JsonNumber(e.ki), JsonNumber(e.kd)}},
           {"r", JsonNumber(e.r)},
@@ -78,6 +79,28 @@ monitor::FrameInfo InfoOf(const EpisodeInfo& e, long dropped_frames) {
   return {e.episode_id, e.dt_s, e.total_steps, e.steps_done, dropped_frames};
 }
 
+// request["episode_id"]: a whole number, or its decimal text (JavaScript's
+// numbers hold only 53 bits of a 64-bit id). False if neither.
+bool EpisodeIdOf(const nlohmann::json& request, int64_t* id) {
+  const auto v = request.find("episode_id");
+  if (v == request.end()) return false;
+  if (v->is_number_integer()) {
+    *id = v->get<int64_t>();
+    return true;
+  }
+  if (!v->is_string()) return false;
+  const std::string& text = v->get_ref<const std::string&>();
+  if (text.empty() || text.size() > 20 || text.find_first_not_of("-0123456789") != std::string::npos)
+    return false;
+  try {
+    std::size_t used = 0;
+    *id = std::stoll(text, &used);
+    return used == text.size();
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
 // One subscribed connection, touched by the sender thread (and by the
 // server's thread under the service's mutex).
 struct Subscriber {
@@ -108,20 +131,23 @@ nlohmann::json LiveStatusJson(const MonitorSnapshot& s, const std::string& lcm_u
                              : nlohmann::json(std::max(0.0, s.now_s - h.last_heard_s))},
         {"pid", h.pid != 0 ? nlohmann::json(h.pid) : nlohmann::json(nullptr)}};
   }
-  return {{"type", "live_status"},
-          {"lcm_url", lcm_url},
-          {"channel_prefix", channel_prefix},
-          {"selected_episode_id",
-           selected_episode_id ? nlohmann::json(*selected_episode_id) : nlohmann::json(nullptr)},
-          {"episodes", episodes},
-          {"health",
-           {{"roles", roles},
-            {"received", s.counters.received},
-            {"undecodable", s.counters.undecodable},
-            {"unauthenticated", s.counters.unauthenticated},
-            {"replayed", s.counters.replayed},
-            {"trajectory_requests", s.trajectory_requests}}},
-          {"dropped_frames", dropped_frames}};
+  return {
+      {"type", "live_status"},
+      {"lcm_url", lcm_url},
+      {"channel_prefix", channel_prefix},
+      {"selected_episode_id",
+       selected_episode_id ? nlohmann::json(*selected_episode_id) : nlohmann::json(nullptr)},
+      {"selected_episode_id_text",
+       selected_episode_id ? nlohmann::json(std::to_string(*selected_episode_id)) : nlohmann::json(nullptr)},
+      {"episodes", episodes},
+      {"health",
+       {{"roles", roles},
+        {"received", s.counters.received},
+        {"undecodable", s.counters.undecodable},
+        {"unauthenticated", s.counters.unauthenticated},
+        {"replayed", s.counters.replayed},
+        {"trajectory_requests", s.trajectory_requests}}},
+      {"dropped_frames", dropped_frames}};
 }
 
 struct LiveService::Impl {
@@ -247,26 +273,30 @@ struct LiveService::Impl {
   }
 
   server::Reply Select(const nlohmann::json& request, const std::shared_ptr<server::Connection>& c) {
-    const auto id = request.find("episode_id");
-    if (id == request.end() || !id->is_number_integer())
-      return {400, {{"error", "live_select needs a whole-number episode_id"}}};
-    if (!monitor.WithEpisode(id->get<int64_t>(), [](const EpisodeTrace&) {}))
-      return {400, {{"error", "live_select: episode_id " + id->dump() + " is not one of the episodes kept"}}};
+    int64_t id = 0;
+    if (!EpisodeIdOf(request, &id))
+      return {400, {{"error", "live_select needs an episode_id (a whole number or its decimal text)"}}};
+    if (!monitor.WithEpisode(id, [](const EpisodeTrace&) {}))
+      return {
+          400,
+          {{"error", "live_select: episode_id " + std::to_string(id) + " is not one of the episodes kept"}}};
     std::lock_guard<std::mutex> lock(mutex);
     auto it = subscribers.find(c.get());
     if (it == subscribers.end()) return {400, {{"error", "live_select: live_subscribe first"}}};
-    it->second.chosen = id->get<int64_t>();
+    it->second.chosen = id;
     it->second.episode_set.clear();  // live_status at once, with the new selection
-    return {200, {{"type", "live_selected"}, {"episode_id", *id}}};
+    return {200, {{"type", "live_selected"}, {"episode_id", id}, {"episode_id_text", std::to_string(id)}}};
   }
 
   server::Reply Data(const nlohmann::json& request, const std::shared_ptr<server::Connection>& c) {
-    const auto id = request.find("episode_id");
-    if (id == request.end() || !id->is_number_integer())
-      return {400, {{"error", "live_data needs a whole-number episode_id"}}};
-    std::string frame = DataFrame(id->get<int64_t>(), c->dropped());
+    int64_t id = 0;
+    if (!EpisodeIdOf(request, &id))
+      return {400, {{"error", "live_data needs an episode_id (a whole number or its decimal text)"}}};
+    std::string frame = DataFrame(id, c->dropped());
     if (frame.empty())
-      return {400, {{"error", "live_data: episode_id " + id->dump() + " is not one of the episodes kept"}}};
+      return {
+          400,
+          {{"error", "live_data: episode_id " + std::to_string(id) + " is not one of the episodes kept"}}};
     c->PostBinary(std::move(frame));
     return {200, nullptr};  // the frame is the answer
   }

@@ -117,8 +117,16 @@ else:
     check('the health counts received messages and no forged ones',
           status and status['health']['received'] > 0 and status['health']['unauthenticated'] == 0)
 
-# live_data: the same bytes as the final frame, never dropped.
-ws.send(json.dumps({'type': 'live_data', 'episode_id': ep.get('episode_id', 0)}))
+check('live_status gives each id as exact decimal text too (JavaScript holds 53 bits)',
+      ep.get('episode_id_text') == str(ep.get('episode_id')) and
+      status.get('selected_episode_id_text') == str(ep.get('episode_id')))
+ws.send(json.dumps({'type': 'live_select', 'episode_id': ep.get('episode_id_text', '')}))
+while True:
+    op, payload = ws.recv()
+    if op == 1 and json.loads(payload).get('type') in ('live_selected', None): break
+check('live_select takes the id as its text', json.loads(payload).get('episode_id') == ep.get('episode_id'))
+# live_data (the id as text): the same bytes as the final frame, never dropped.
+ws.send(json.dumps({'type': 'live_data', 'episode_id': ep.get('episode_id_text', '')}))
 data = None
 while data is None:
     op, payload = ws.recv()
