@@ -9,6 +9,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "pidlab/episode_client/episode_pool.h"
 #include "pidlab/server/assets.h"
 #include "pidlab/server/server.h"
 #include "serve_live.h"
@@ -21,6 +22,8 @@ server::Server* g_server = nullptr;
 extern "C" void StopOnSignal(int) {
   if (g_server) g_server->Stop();
 }
+
+constexpr std::size_t kMaxWatchedTrios = 64;  // pidlab launch --trios' bound
 
 struct ServeCommand {
   server::ServerOptions options;
@@ -37,8 +40,9 @@ struct ServeCommand {
                     "address to listen on; anything but loopback requires the token, printed once")
         ->capture_default_str();
     app->add_option("--lcm-url", lcm.lcm_url,
-                    "watch the trio on this LCM URL: the live scope, episodes on demand (docs/live.md); "
-                    "without it the live requests answer 400");
+                    "watch the trio on this LCM URL, or the trios of several, comma-separated (pidlab launch "
+                    "--trios K: $PIDLAB_LCM_URLS): the live scope, episodes on demand on the first "
+                    "(docs/live.md); without it the live requests answer 400");
     app->add_option(
         "--channel-prefix", lcm.channel_prefix,
         "with --lcm-url: the trio's channel prefix (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
@@ -82,10 +86,15 @@ struct ServeCommand {
         throw BadInput("--channel-prefix " + Quote(lcm.channel_prefix) + " needs --lcm-url");
       return nullptr;
     }
-    const episode_client::EpisodeClientOptions client = lcm.ClientOptions(lcm.Url());
+    const std::vector<std::string> urls = episode_client::SplitUrlList(lcm.lcm_url);
+    if (urls.empty() || urls.size() > kMaxWatchedTrios)
+      throw BadInput("--lcm-url " + Quote(lcm.lcm_url) + " must name 1 to " +
+                     std::to_string(kMaxWatchedTrios) + " URLs");
+    std::vector<episode_client::EpisodeClientOptions> trios;
+    for (const std::string& url : urls) trios.push_back(lcm.ClientOptions(url));
     std::unique_ptr<LiveService> live;
     try {
-      live = std::make_unique<LiveService>(client);
+      live = std::make_unique<LiveService>(trios, lcm.lcm_url);
     } catch (const std::runtime_error& e) {
       throw BadInput("--lcm-url " + Quote(lcm.lcm_url) + ": " + e.what());
     }

@@ -82,6 +82,7 @@ struct LiveMonitor::State {
     }
     EpisodeTrace e;
     e.info.episode_id = m.episode_id;
+    e.info.first_heard_s = transport::NowSeconds();
     e.info.plant = m.plant_name;
     e.info.kp = m.kp, e.info.ki = m.ki, e.info.kd = m.kd;
     e.info.r = m.reference;

@@ -7,7 +7,8 @@
 # prediction bit for bit; without --lcm-url the live requests answer 400 and
 # --auth-key or --channel-prefix exit 2 with one line; with an auth key a
 # forged message is not shown and is counted. The trio parts run the commands
-# of docs/live.md as written there.
+# of docs/live.md as written there. Two trios of `pidlab launch --trios 2` are
+# watched at once while `pidlab tune` runs its episodes on both.
 set -uo pipefail
 if [[ $# -ne 2 ]]; then
   echo "usage: $0 PIDLAB_BINARY PYTHON_MESSAGES_DIR" >&2
@@ -98,6 +99,52 @@ while IFS= read -r -d $'\x1e' block; do
   run_block "$mode" "$launch" "$serve" "$evaluate"
 done < <(awk '/^```bash/{on=1; next} /^```/{if (on) printf "\x1e"; on=0} on' "$docs")
 check "docs/live.md has 2 blocks of commands (found $n_blocks)" "[ $n_blocks -eq 2 ]"
+
+# Several trios (`pidlab launch --trios 2`) watched at once while a tuning
+# runs its episodes on both: every episode shown with its trio, each trio's
+# health listed with its URL.
+cat > trios.sh <<'TRIOS'
+set -u
+pidlab=$1 here=$2
+"$pidlab" serve --port 0 --lcm-url "$PIDLAB_LCM_URLS" > trios_serve.out 2> trios_serve.err &
+server=$!
+for _ in $(seq 200); do grep -q '^pidlab serve: http' trios_serve.out && break; sleep 0.05; done
+port=$(sed -nE 's#^pidlab serve: http://[^/]*:([0-9]+)/.*#\1#p' trios_serve.out | head -1)
+PYTHONPATH="$here" timeout 120 /usr/bin/python3 - "$port" "$pidlab" "$PIDLAB_LCM_URLS" <<'PY'
+import json, re, subprocess, sys, time
+from serve_client import WebSocket
+port, pidlab, urls = int(sys.argv[1]), sys.argv[2], re.split('[ ,]+', sys.argv[3].strip())
+ws = WebSocket(port); ws.s.settimeout(30)
+ws.send(json.dumps({'type': 'live_subscribe'}))
+tune = subprocess.run([pidlab, 'tune', '--backend', 'lcm', '--plant', 'oscillator', '--loop', 'sampled', '--dt', '0.01',
+                       '--horizon', '2', '--max-evals', '12', '--starts', '2', '--json', '--quiet'],
+                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+print(('ok   ' if tune.returncode == 0 else 'FAIL ') + 'pidlab tune --backend lcm ran over both trios')
+status, deadline = None, time.monotonic() + 20
+while time.monotonic() < deadline:
+    op, payload = ws.recv()
+    if op != 1: continue
+    m = json.loads(payload)
+    if m.get('type') != 'live_status': continue
+    status = m
+    eps = m['episodes']
+    if eps and all(e['status'] == 'complete' for e in eps) and {1, 2} <= {e['trio'] for e in eps}: break
+eps = status['episodes'] if status else []
+ok = bool(eps) and all(e['status'] == 'complete' for e in eps) and {e['trio'] for e in eps} == {1, 2}
+print(('ok   ' if ok else 'FAIL ') + 'the tuning\'s %d episodes show complete, from trio 1 and trio 2' % len(eps))
+trios = status.get('trios', []) if status else []
+ok = [t['lcm_url'] for t in trios] == urls and all(t['health']['roles']['plant']['pid'] for t in trios)
+print(('ok   ' if ok else 'FAIL ') + 'live_status lists each trio with its URL and its plant heard')
+PY
+status=$?
+kill -TERM "$server"; wait "$server" || status=1
+exit $status
+TRIOS
+timeout 200 "$pidlab" launch --quiet --trios 2 -- bash trios.sh "$pidlab" "$here" > trios.out 2> trios.err
+status=$?
+sed 's/^/  [trios] /' trios.out
+check "two trios watched at once (exit $status)" "[ $status -eq 0 ] && ! grep -q '^FAIL' trios.out"
+[ $status -eq 0 ] || tail -n 5 trios.err
 
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -67,6 +67,9 @@ struct PacingProgress {
 /// One episode's figures, without its trajectory.
 struct EpisodeInfo {
   int64_t episode_id = 0;
+  /// transport::NowSeconds() when its configuration was heard (orders the
+  /// episodes of several monitors).
+  double first_heard_s = 0.0;
   std::string plant;
   double kp = 0.0, ki = 0.0, kd = 0.0;
   double r = 0.0;
