@@ -42,6 +42,11 @@ struct LiveMonitorOptions {
   /// Longest episode kept (total_steps); a configuration beyond it is
   /// counted in rejected and not shown. 1..1e8 (three doubles per step).
   long max_total_steps = 10000000;
+  /// Steps of all the episodes kept together: the oldest are dropped to
+  /// make room for a new one (memory: about 25 bytes a step, so at most
+  /// about 500 MB however many configurations a stranger sends).
+  /// max_total_steps..1e9.
+  long max_kept_steps = 20000000;
 
   /// Names the field, its value and the rule on failure.
   bool IsValid(std::string* error) const;
