@@ -3,7 +3,9 @@
 episode on the trio, and checks the live scope's contract (docs/live.md).
 With auth, a forged EPISODE_CONFIG (a well-formed message with a wrong MAC)
 is sent to the trio's group first: it must not be shown, and be counted.
-usage: serve_live_client.py PORT WORKDIR plain|auth PYTHON_MESSAGES_DIR PIDLAB EVALUATE_ARGS...
+With realtime (a trio paced by `pidlab launch --realtime`), the episode's
+realtime in live_status must equal evaluate --json's realtime object.
+usage: serve_live_client.py PORT WORKDIR plain|auth|realtime PYTHON_MESSAGES_DIR PIDLAB EVALUATE_ARGS...
 (the command gets --json --trajectory-csv FILE appended)"""
 import json, math, os, socket, struct, subprocess, sys, time
 from serve_client import WebSocket
@@ -106,6 +108,12 @@ ep = status['episodes'][-1] if status and status['episodes'] else {}
 check('live_status shows the episode complete with every step',
       ep.get('status') == 'complete' and ep.get('steps_done') == steps and ep.get('plant') == 'oscillator' and
       ep.get('gains') == [2, 1, 1.5] and ep.get('total_steps') == steps - 1)
+evaluated = json.loads(evaluate_out) if evaluate.returncode == 0 else {}
+if mode == 'realtime':
+    check('a paced episode shows the realtime object evaluate --json prints, exactly',
+          'realtime' in evaluated and ep.get('realtime') == evaluated['realtime'])
+else:
+    check('an unpaced episode shows realtime null', 'realtime' not in evaluated and ep.get('realtime') is None)
 roles = status['health']['roles'] if status else {}
 check('live_status hears the plant, controller, disturbance and client',
       all(roles.get(r, {}).get('last_heard_s') is not None for r in ('plant', 'controller', 'disturbance', 'client')))

@@ -94,11 +94,11 @@ while IFS= read -r -d $'\x1e' block; do
   launch=$(grep '^pidlab launch' <<<"$block") serve=$(grep '^pidlab serve' <<<"$block")
   evaluate=$(grep '^pidlab evaluate' <<<"$block")
   grep -v '^pidlab ' <<<"$block" | grep . > setup.sh && bash setup.sh
-  mode=plain; [[ $serve == *--auth-key* ]] && mode=auth
+  mode=plain; [[ $serve == *--auth-key* ]] && mode=auth; [[ $launch == *--realtime* ]] && mode=realtime
   n_blocks=$((n_blocks + 1))
   run_block "$mode" "$launch" "$serve" "$evaluate"
 done < <(awk '/^```bash/{on=1; next} /^```/{if (on) printf "\x1e"; on=0} on' "$docs")
-check "docs/live.md has 2 blocks of commands (found $n_blocks)" "[ $n_blocks -eq 2 ]"
+check "docs/live.md has 3 blocks of commands (found $n_blocks)" "[ $n_blocks -eq 3 ]"
 
 # Several trios (`pidlab launch --trios 2`) watched at once while a tuning
 # runs its episodes on both: every episode shown with its trio, each trio's
