@@ -9,8 +9,10 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "pidlab/episode_client/episode_pool.h"
 #include "pidlab/server/assets.h"
 #include "pidlab/server/server.h"
+#include "serve_live.h"
 #include "serve_requests.h"
 
 namespace pidlab::cli {
@@ -21,19 +23,32 @@ extern "C" void StopOnSignal(int) {
   if (g_server) g_server->Stop();
 }
 
+constexpr std::size_t kMaxWatchedTrios = 64;  // pidlab launch --trios' bound
+
 struct ServeCommand {
   server::ServerOptions options;
   std::string token;
+  LcmFlags lcm;  // --lcm-url, --channel-prefix, --auth-key: the live scope (docs/live.md)
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
         "Serve the tuning workbench: an HTTP and WebSocket server (Boost.Beast) with the page, answering "
         "evaluate requests with the JSON of 'pidlab evaluate --json' (docs/workbench.md). Open the printed "
-        "URL.");
+        "URL. With --lcm-url it also watches a running trio: the live scope (docs/live.md).");
     app->add_option("--port", options.port, "TCP port (0: any free port, printed)")->capture_default_str();
     app->add_option("--bind", options.bind,
                     "address to listen on; anything but loopback requires the token, printed once")
         ->capture_default_str();
+    app->add_option("--lcm-url", lcm.lcm_url,
+                    "watch the trio on this LCM URL, or the trios of several, comma-separated (pidlab launch "
+                    "--trios K: $PIDLAB_LCM_URLS): the live scope, episodes on demand on the first "
+                    "(docs/live.md); without it the live requests answer 400");
+    app->add_option(
+        "--channel-prefix", lcm.channel_prefix,
+        "with --lcm-url: the trio's channel prefix (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
+    app->add_option("--auth-key", lcm.auth_key_file,
+                    "with --lcm-url: check every message's MAC with the key in this file, and sign the "
+                    "episodes run on the trio (docs/security.md; default $PIDLAB_AUTH_KEY_FILE)");
     return [this] { return Run(); };
   }
 
@@ -41,8 +56,10 @@ struct ServeCommand {
     if (!server::IsLoopback(options.bind)) options.token = RandomToken();
     std::string error;
     if (!options.IsValid(&error)) throw BadInput(error);
+    std::unique_ptr<LiveService> live = StartLive();
     server::Server s(options, server::ConnectionHandler(AnswerWorkbenchRequest), server::WorkbenchAssets());
     if (!s.Start(&error)) throw BadInput(error);
+    SetLiveService(live.get());
     const std::string host =
         options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind;
     std::cout << "pidlab serve: http://" << host << ":" << s.port() << "/"
@@ -51,9 +68,37 @@ struct ServeCommand {
     std::signal(SIGINT, StopOnSignal);
     std::signal(SIGTERM, StopOnSignal);
     s.Run();
+    // The live threads post to the server's connections: they stop (and a
+    // run_on_trio episode ends) while the server still exists.
+    SetLiveService(nullptr);
+    live.reset();
     g_server = nullptr;
     std::cerr << "pidlab serve: stopped\n";
     return 0;
+  }
+
+  // The live scope on the trio of --lcm-url, or null without it.
+  std::unique_ptr<LiveService> StartLive() const {
+    if (lcm.lcm_url.empty()) {
+      if (!lcm.auth_key_file.empty())
+        throw BadInput("--auth-key " + Quote(lcm.auth_key_file) + " needs --lcm-url");
+      if (!lcm.channel_prefix.empty())
+        throw BadInput("--channel-prefix " + Quote(lcm.channel_prefix) + " needs --lcm-url");
+      return nullptr;
+    }
+    const std::vector<std::string> urls = episode_client::SplitUrlList(lcm.lcm_url);
+    if (urls.empty() || urls.size() > kMaxWatchedTrios)
+      throw BadInput("--lcm-url " + Quote(lcm.lcm_url) + " must name 1 to " +
+                     std::to_string(kMaxWatchedTrios) + " URLs");
+    std::vector<episode_client::EpisodeClientOptions> trios;
+    for (const std::string& url : urls) trios.push_back(lcm.ClientOptions(url));
+    std::unique_ptr<LiveService> live;
+    try {
+      live = std::make_unique<LiveService>(trios, lcm.lcm_url);
+    } catch (const std::runtime_error& e) {
+      throw BadInput("--lcm-url " + Quote(lcm.lcm_url) + ": " + e.what());
+    }
+    return live;
   }
 
   // 32 hex digits: 16 bytes from libsodium's randombytes_buf (the kernel's getrandom).

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "pidlab/json/spec_run.h"
+#include "serve_live.h"
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
 #include "export_spec.h"
 #include "pidlab/report/report.h"
@@ -99,6 +100,7 @@ server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
   if (type == "fields") return {200, {{"type", "fields"}, {"fields", json::EvaluateSpecFields()}}};
   if (type == "paper_designs") return {200, {{"type", "paper_designs"}, {"designs", PaperDesigns()}}};
   if (type == "evaluate") return Evaluate(request);
+  if (IsLiveRequest(type)) return AnswerLive(type, request, connection);
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
   if (type == "export") return Export(request);
   if (type == "tune") return AnswerTune(request, connection);
