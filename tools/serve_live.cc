@@ -158,6 +158,30 @@ nlohmann::json HealthJson(const MonitorSnapshot& s) {
           {"trajectory_requests", s.trajectory_requests}};
 }
 
+// The tunings the trios' monitors heard (a tuning publishes on its first
+// trio), oldest first.
+nlohmann::json TuningsJson(const LiveView& v) {
+  std::vector<monitor::TuningInfo> all;
+  for (const MonitorSnapshot& s : v.trios) all.insert(all.end(), s.tunings.begin(), s.tunings.end());
+  std::stable_sort(all.begin(), all.end(),
+                   [](const auto& a, const auto& b) { return a.first_heard_s < b.first_heard_s; });
+  nlohmann::json out = nlohmann::json::array();
+  for (const monitor::TuningInfo& t : all) {
+    const bool any = std::isfinite(t.best_objective);
+    out.push_back({{"tuning_id", t.tuning_id},
+                   {"tuning_id_text", std::to_string(t.tuning_id)},
+                   {"status", monitor::TuningStatusName(t.status)},
+                   {"method", t.method},
+                   {"objective", t.objective},
+                   {"trios", t.trios},
+                   {"iterations", t.iterations},
+                   {"evaluations", t.evaluations},
+                   {"best_objective", any ? nlohmann::json(t.best_objective) : nlohmann::json(nullptr)},
+                   {"best_gains", any ? nlohmann::json(t.best_gains) : nlohmann::json(nullptr)}});
+  }
+  return out;
+}
+
 }  // namespace
 
 nlohmann::json LiveStatusJson(const LiveView& v, const std::string& lcm_url,
@@ -175,6 +199,7 @@ nlohmann::json LiveStatusJson(const LiveView& v, const std::string& lcm_url,
       {"selected_episode_id_text",
        selected_episode_id ? nlohmann::json(std::to_string(*selected_episode_id)) : nlohmann::json(nullptr)},
       {"episodes", episodes},
+      {"tunings", TuningsJson(v)},
       {"health", v.trios.empty() ? nlohmann::json(nullptr) : HealthJson(v.trios.front())},
       {"dropped_frames", dropped_frames}};
   if (v.trios.size() > 1) {

@@ -12,6 +12,7 @@
 #include <pidlab/lcmt_ready.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <pidlab/lcmt_trajectory_request.hpp>
+#include <pidlab/lcmt_tune_progress.hpp>
 #include <stdexcept>
 
 namespace pidlab::monitor {
@@ -35,6 +36,18 @@ bool LiveMonitorOptions::IsValid(std::string* error) const {
   return e.empty();
 }
 
+const char* TuningStatusName(TuningStatus status) {
+  switch (status) {
+    case TuningStatus::kDone:
+      return "done";
+    case TuningStatus::kFailed:
+      return "failed";
+    case TuningStatus::kRunning:
+      break;
+  }
+  return "running";
+}
+
 const char* StatusName(EpisodeStatus status) {
   switch (status) {
     case EpisodeStatus::kComplete:
@@ -55,6 +68,7 @@ const char* RoleName(Role role) {
 struct LiveMonitor::State {
   mutable std::mutex mutex;
   std::deque<EpisodeTrace> episodes;  // oldest first
+  std::deque<TuningInfo> tunings;     // oldest first
   std::array<RoleHealth, kRoleCount> roles;
   transport::TransportCounters counters;
   long trajectory_requests = 0;
@@ -163,6 +177,34 @@ struct LiveMonitor::State {
     Changed();
   }
 
+  void OnTuneProgress(const pidlab::lcmt_tune_progress& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    const double now = transport::NowSeconds();
+    auto it = std::find_if(tunings.begin(), tunings.end(),
+                           [&](const TuningInfo& t) { return t.tuning_id == m.episode_id; });
+    if (it == tunings.end()) {
+      if (tunings.size() >= LiveMonitor::kMaxTunings) tunings.pop_front();
+      TuningInfo fresh;
+      fresh.tuning_id = m.episode_id;
+      fresh.first_heard_s = now;
+      tunings.push_back(fresh);
+      it = tunings.end() - 1;
+    }
+    TuningInfo& t = *it;
+    t.last_heard_s = now;
+    t.status = m.status == pidlab::lcmt_tune_progress::DONE     ? TuningStatus::kDone
+               : m.status == pidlab::lcmt_tune_progress::FAILED ? TuningStatus::kFailed
+                                                                : TuningStatus::kRunning;
+    t.iterations = static_cast<long>(m.step);
+    t.evaluations = m.evaluations;
+    t.best_objective = m.best_objective;
+    for (std::size_t i = 0; i < 3; ++i) t.best_gains[i] = m.best_gains[i];
+    t.trios = m.trios;
+    t.method = m.method;
+    t.objective = m.objective;
+    Changed();
+  }
+
   void OnReady(const pidlab::lcmt_ready& m) {
     std::lock_guard<std::mutex> lock(mutex);
     for (int r = 0; r < kRoleCount; ++r)
@@ -212,6 +254,8 @@ void LiveMonitor::Subscribe() {
       transport::kSummaryChannel, [s](const pidlab::lcmt_episode_summary& m) { s->OnSummary(m); });
   transport_->Subscribe<pidlab::lcmt_pacing_progress>(
       transport::kPacingChannel, [s](const pidlab::lcmt_pacing_progress& m) { s->OnPacing(m); });
+  transport_->Subscribe<pidlab::lcmt_tune_progress>(
+      transport::kTuneProgressChannel, [s](const pidlab::lcmt_tune_progress& m) { s->OnTuneProgress(m); });
   transport_->Subscribe<pidlab::lcmt_disturbance_request>(
       transport::kDisturbanceRequestChannel,
       [s](const pidlab::lcmt_disturbance_request&) { s->OnHeard(Role::kPlant, false); });
@@ -240,6 +284,7 @@ MonitorSnapshot LiveMonitor::Snapshot() const {
   std::lock_guard<std::mutex> lock(state_->mutex);
   out.episodes.reserve(state_->episodes.size());
   for (const EpisodeTrace& e : state_->episodes) out.episodes.push_back(e.info);
+  out.tunings.assign(state_->tunings.begin(), state_->tunings.end());
   out.roles = state_->roles;
   out.counters = state_->counters;
   out.trajectory_requests = state_->trajectory_requests;

@@ -119,8 +119,9 @@ ws = WebSocket(port); ws.s.settimeout(30)
 ws.send(json.dumps({'type': 'live_subscribe'}))
 tune = subprocess.run([pidlab, 'tune', '--backend', 'lcm', '--plant', 'oscillator', '--loop', 'sampled', '--dt', '0.01',
                        '--horizon', '2', '--max-evals', '12', '--starts', '2', '--json', '--quiet'],
-                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
 print(('ok   ' if tune.returncode == 0 else 'FAIL ') + 'pidlab tune --backend lcm ran over both trios')
+tuned = json.loads(tune.stdout) if tune.returncode == 0 else {}
 status, deadline = None, time.monotonic() + 20
 while time.monotonic() < deadline:
     op, payload = ws.recv()
@@ -129,13 +130,20 @@ while time.monotonic() < deadline:
     if m.get('type') != 'live_status': continue
     status = m
     eps = m['episodes']
-    if eps and all(e['status'] == 'complete' for e in eps) and {1, 2} <= {e['trio'] for e in eps}: break
+    done = [t for t in m.get('tunings', []) if t['status'] == 'done']
+    if eps and all(e['status'] == 'complete' for e in eps) and {1, 2} <= {e['trio'] for e in eps} and done: break
 eps = status['episodes'] if status else []
 ok = bool(eps) and all(e['status'] == 'complete' for e in eps) and {e['trio'] for e in eps} == {1, 2}
 print(('ok   ' if ok else 'FAIL ') + 'the tuning\'s %d episodes show complete, from trio 1 and trio 2' % len(eps))
 trios = status.get('trios', []) if status else []
 ok = [t['lcm_url'] for t in trios] == urls and all(t['health']['roles']['plant']['pid'] for t in trios)
 print(('ok   ' if ok else 'FAIL ') + 'live_status lists each trio with its URL and its plant heard')
+tunings = status.get('tunings', []) if status else []
+t = tunings[-1] if tunings else {}
+ok = (len(tunings) == 1 and t['status'] == 'done' and t['trios'] == 2 and t['evaluations'] > 0
+      and t['best_gains'] == [tuned['gains'][k] for k in ('kp', 'ki', 'kd')] and t['best_objective'] == tuned.get('objective'))
+print(('ok   ' if ok else 'FAIL ') + 'the tuning is in live_status: done over 2 trios, its best gains and objective '
+      'those tune --json printed: %s' % json.dumps(t))
 PY
 status=$?
 kill -TERM "$server"; wait "$server" || status=1

@@ -2,7 +2,9 @@
 // LiveMonitor: a running trio as a watcher hears it (docs/live.md). It joins
 // the trio's LCM group on the base URL only and subscribes to the channels
 // that carry an episode's story: EPISODE_CONFIG, READY, TRAJECTORY, SUMMARY,
-// PACING, DISTURBANCE_REQUEST, DISTURBANCE_BLOCK and TRAJECTORY_REQUEST.
+// PACING, DISTURBANCE_REQUEST, DISTURBANCE_BLOCK and TRAJECTORY_REQUEST,
+// and TUNE_PROGRESS (a tuning over the trio, as `pidlab tune --backend lcm`
+// publishes it).
 // It never listens to the step lanes (PLANT_OUTPUT, CONTROL): a watcher
 // that woke for every lockstep message would slow the lockstep; the plant's
 // TRAJECTORY chunks carry every y_k, u_k and n_k on the base URL anyway.
@@ -98,6 +100,25 @@ struct EpisodeTrace {
   std::vector<bool> received;
 };
 
+enum class TuningStatus { kRunning, kDone, kFailed };
+/// "running", "done", "failed".
+const char* TuningStatusName(TuningStatus status);
+
+/// A tuning over the trio as its latest lcmt_tune_progress tells it.
+struct TuningInfo {
+  int64_t tuning_id = 0;
+  /// transport::NowSeconds() when first and last heard.
+  double first_heard_s = 0.0, last_heard_s = 0.0;
+  TuningStatus status = TuningStatus::kRunning;
+  long iterations = 0;
+  long evaluations = 0;
+  /// +inf before a feasible point; its gains NaN then.
+  double best_objective = std::numeric_limits<double>::infinity();
+  std::array<double, 3> best_gains{};
+  int trios = 0;
+  std::string method, objective;
+};
+
 enum class Role { kPlant, kController, kDisturbance, kClient };
 inline constexpr int kRoleCount = 4;
 /// "plant", "controller", "disturbance", "client".
@@ -113,6 +134,8 @@ struct RoleHealth {
 struct MonitorSnapshot {
   /// Oldest first.
   std::vector<EpisodeInfo> episodes;
+  /// Oldest first, at most kMaxTunings.
+  std::vector<TuningInfo> tunings;
   std::array<RoleHealth, kRoleCount> roles;
   transport::TransportCounters counters;
   long trajectory_requests = 0;
@@ -125,6 +148,8 @@ struct MonitorSnapshot {
 
 class LiveMonitor {
  public:
+  /// Tunings kept, oldest dropped first.
+  static constexpr std::size_t kMaxTunings = 8;
   /// Joins options.lcm_url. Options must be valid; throws std::runtime_error
   /// if LCM cannot start on the URL.
   explicit LiveMonitor(const LiveMonitorOptions& options);
