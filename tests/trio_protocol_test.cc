@@ -96,7 +96,10 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
                                                    });
   RecoveryOptions recovery;
   recovery.retransmit_interval_s = 0.001;
-  recovery.silence_deadline_s = 0.2;
+  // Short where a role is missing on purpose (the plant must name it); long
+  // otherwise: the roles share this one thread, and a machine that stalls the
+  // process for 0.2 s must not look like a silent role.
+  recovery.silence_deadline_s = with_controller && with_disturbance ? 5.0 : 0.2;
   auto config = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
       id, e.plant, e.gains, e.options, e.options.disturbance, recovery));
   client_t.Publish(kEpisodeConfigChannel, &config);
