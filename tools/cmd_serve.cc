@@ -3,6 +3,7 @@
 #include <sodium.h>
 
 #include <csignal>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -11,6 +12,7 @@
 #include "commands.h"
 #include "pidlab/server/assets.h"
 #include "pidlab/server/server.h"
+#include "serve_logs.h"
 #include "serve_requests.h"
 
 namespace pidlab::cli {
@@ -24,6 +26,8 @@ extern "C" void StopOnSignal(int) {
 struct ServeCommand {
   server::ServerOptions options;
   std::string token;
+  std::string log_dir = ".";
+  long max_upload_mb = 64;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
@@ -34,6 +38,11 @@ struct ServeCommand {
     app->add_option("--bind", options.bind,
                     "address to listen on; anything but loopback requires the token, printed once")
         ->capture_default_str();
+    // The Logs tab (serve_logs.h).
+    app->add_option("--log-dir", log_dir,
+                    "the directory log_open paths are relative to (default: the current one)");
+    app->add_option("--max-upload-mb", max_upload_mb, "largest uploaded log, MiB (1..4096)")
+        ->capture_default_str();
     return [this] { return Run(); };
   }
 
@@ -41,7 +50,10 @@ struct ServeCommand {
     if (!server::IsLoopback(options.bind)) options.token = RandomToken();
     std::string error;
     if (!options.IsValid(&error)) throw BadInput(error);
+    std::unique_ptr<LogStore> logs = ServedLogs();
     server::Server s(options, server::ConnectionHandler(AnswerWorkbenchRequest), server::WorkbenchAssets());
+    s.SetUploadHandler(
+        [&logs](const std::string& name, const std::string& body) { return logs->Upload(name, body); });
     if (!s.Start(&error)) throw BadInput(error);
     const std::string host =
         options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind;
@@ -52,8 +64,22 @@ struct ServeCommand {
     std::signal(SIGTERM, StopOnSignal);
     s.Run();
     g_server = nullptr;
+    ServeLogs(nullptr);
     std::cerr << "pidlab serve: stopped\n";
     return 0;
+  }
+
+  // --log-dir and --max-upload-mb checked; the store of the Logs tab.
+  std::unique_ptr<LogStore> ServedLogs() {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(log_dir, ec))
+      throw BadInput("--log-dir " + Quote(log_dir) + " is not a directory");
+    if (max_upload_mb < 1 || max_upload_mb > 4096)
+      throw BadInput("--max-upload-mb " + std::to_string(max_upload_mb) + " must be in 1..4096");
+    options.max_upload_bytes = static_cast<std::size_t>(max_upload_mb) * 1024 * 1024;
+    auto store = std::make_unique<LogStore>(log_dir);
+    ServeLogs(store.get());
+    return store;
   }
 
   // 32 hex digits: 16 bytes from libsodium's randombytes_buf (the kernel's getrandom).
