@@ -1,5 +1,6 @@
 #include "pidlab/server/server.h"
 
+#include <algorithm>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
@@ -334,7 +335,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void Read() {
     parser_.emplace();
     parser_->header_limit(static_cast<std::uint32_t>(server_->options.max_header_bytes));
-    parser_->body_limit(server_->options.max_body_bytes);
+    // The larger limit while the headers are parsed (Beast checks a
+    // Content-Length against it there); OnHeader sets the request's own.
+    parser_->body_limit(std::max(server_->options.max_body_bytes, server_->options.max_upload_bytes));
     stream_.expires_after(std::chrono::seconds(30));
     http::async_read_header(stream_, buffer_, *parser_,
                             beast::bind_front_handler(&HttpSession::OnHeader, shared_from_this()));
@@ -354,6 +357,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
         return;
       }
       parser_->body_limit(server_->options.max_upload_bytes);
+    } else if (!ec) {
+      parser_->body_limit(server_->options.max_body_bytes);
+      const auto length = parser_->content_length();
+      if (length && *length > server_->options.max_body_bytes) ec = http::error::body_limit;
     }
     if (ec || parser_->is_done()) {
       OnRead(ec, 0);

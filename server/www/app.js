@@ -2,6 +2,8 @@
 // -> the JSON of `pidlab evaluate --json` and the plot series, drawn by
 // uPlot (plots.js). The page computes no result itself (docs/workbench.md).
 import { createPlots, destroyPlots, drawPlots } from './plots.js';
+import { initLive, initTrio } from './live.js';
+import { initLogs } from './logs.js';
 
 const token = new URLSearchParams(location.search).get('token');
 const plants = ['double_integrator', 'oscillator', 'stepper_motor', 'custom', 'stepper_nonlinear', 'model'];
@@ -167,6 +169,9 @@ function onMessage(reply, arrived_ms) {
     return;
   }
   if (reply.type === 'tune_progress') { tuneProgress(reply); return; }
+  if (views.live.onMessage(reply) || views.trio.onMessage(reply)) {
+    if (reply.id === undefined || !waiting.has(reply.id)) return;
+  }
   const w = waiting.get(reply.id);
   if (!w) return;
   waiting.delete(reply.id);
@@ -385,8 +390,12 @@ function connect() {
   const url = (location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + '/ws' +
       (token ? '?token=' + encodeURIComponent(token) : '');
   socket = new WebSocket(url);
-  socket.addEventListener('open', () => { send(); loadPaperDesigns(); });
-  socket.addEventListener('message', (e) => { const arrived = performance.now(); onMessage(JSON.parse(e.data), arrived); });
+  socket.binaryType = 'arraybuffer';  // the live view's frames (live.js)
+  socket.addEventListener('open', () => { send(); loadPaperDesigns(); serverInfo(); });
+  socket.addEventListener('message', (e) => {
+    const arrived = performance.now();
+    if (e.data instanceof ArrayBuffer) views.live.onFrame(e.data); else onMessage(JSON.parse(e.data), arrived);
+  });
   socket.addEventListener('close', () => setStatus('disconnected from the server'));
 }
 
@@ -430,6 +439,32 @@ $('tune-cancel').addEventListener('click', () => pidlab.cancelTune());
 $('copy-command').addEventListener('click', () => navigator.clipboard.writeText(pidlab.command()).catch((e) => setStatus('copy: ' + e.message)));
 $('copy-spec').addEventListener('click', () => navigator.clipboard.writeText(JSON.stringify(spec())).catch((e) => setStatus('copy: ' + e.message)));
 $('export-button').addEventListener('click', () => exportC().catch((e) => setStatus('export: ' + e.message)));
+// ---- The Live and Logs tabs (live.js, logs.js) and "Run on the trio".
+const views = {};
+views.live = initLive({ rawSend });
+views.trio = initTrio({ ask, spec, setStatus });
+initLogs({ ask, token });
+// server_info: live when pidlab serve has --lcm-url (an older server does not know the request).
+async function serverInfo() {
+  try {
+    pidlab.serverInfo = await ask({ type: 'server_info' });
+  } catch (e) {
+    pidlab.serverInfo = { live: false };
+  }
+  views.trio.enable(!!pidlab.serverInfo.live);
+  if (pidlab.view === 'live') views.live.show(true);
+}
+function showView(name) {
+  pidlab.view = name;
+  for (const v of ['design', 'live', 'logs']) {
+    $('view-' + v).classList.toggle('hidden', v !== name);
+    $('tab-' + v).classList.toggle('active', v === name);
+  }
+  views.live.show(name === 'live');
+}
+pidlab.showView = showView;
+for (const b of document.querySelectorAll('#tabs .tab')) b.addEventListener('click', () => showView(b.dataset.view));
+pidlab.view = 'design';
 readHash();
 showForm();
 rebuildPlots();
