@@ -26,6 +26,7 @@ level = {
     'pidlab_server': 1,
     'pidlab_transport': 2, 'pidlab_evaluation': 2, 'pidlab_controller_export': 2,
     'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_analysis': 3,
+    'pidlab_monitor': 3,
     'pidlab_tune': 4, 'pidlab_identify': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
     'pidlab_tuner': 5, 'pidlab_json': 5, 'pidlab_replay': 5, 'pidlab_launcher': 5,
     'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_figures': 6, 'pidlab_cli': 7,
@@ -69,9 +70,9 @@ for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
     else: print(f'ok   {exe} links only ' + ', '.join(sorted(d for d in closure(exe) if d.startswith("pidlab"))))
 # Sources: a folder includes only headers of its own level or below.
 header_level = {'spec': 1, 'plant_sim': 1, 'controller': 1, 'optim': 1, 'plot': 1, 'server': 1, 'transport': 2, 'evaluation': 2, 'controller_export': 2,
-                'analysis': 3, 'tune': 4, 'identify': 4, 'episode_client': 4, 'replay': 4, 'json': 5, 'launcher': 5, 'report': 6,
+                'analysis': 3, 'monitor': 3, 'tune': 4, 'identify': 4, 'episode_client': 4, 'replay': 4, 'json': 5, 'launcher': 5, 'report': 6,
                 'figures': 6}
-lib_dirs = {'spec': 1, 'server': 1, 'transport': 2, 'tuner/optim': 1, 'tuner/evaluation': 2, 'tuner/analysis': 3,
+lib_dirs = {'spec': 1, 'server': 1, 'transport': 2, 'tuner/optim': 1, 'tuner/evaluation': 2, 'tuner/analysis': 3, 'monitor': 3,
             'tuner/tune': 4, 'tuner/identify': 4, 'tuner/episode_client': 4, 'replay': 5, 'launcher': 5}
 for d, lv in lib_dirs.items():
     for root, _, files in os.walk(os.path.join(src, d)):
@@ -99,6 +100,14 @@ for d in ('optim', 'evaluation', 'analysis', 'tune', 'identify'):
                     fail(f'{rel} includes {inc}, whose folder has no level in this test')
                 elif header_level[m.group(1)] > lv:
                     fail(f'{rel} (level {lv}) includes {inc} (level {header_level[m.group(1)]}) from above')
+# The live monitor watches the trio for the server: it includes no server
+# header and nothing of tools/ (the server's requests are tools/serve_live.cc's).
+for root, _, files in os.walk(os.path.join(src, 'monitor')):
+    for f in files:
+        path = os.path.join(root, f)
+        for inc in re.findall(r'#include\s*"([^"]+)"', open(path).read()):
+            if not re.match(r'pidlab/(monitor|transport)/', inc):
+                fail(f'{os.path.relpath(path, src)} includes "{inc}": the monitor includes only its own and the transport\'s headers')
 # plant_sim and controller models (not their roles) include no transport header.
 for d in ('plant_sim', 'controller'):
     for root, _, files in os.walk(os.path.join(src, d)):

@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "pidlab/server/assets.h"
 #include "pidlab/server/server.h"
+#include "serve_live.h"
 #include "serve_logs.h"
 #include "serve_requests.h"
 
@@ -28,12 +29,13 @@ struct ServeCommand {
   std::string token;
   std::string log_dir = ".";
   long max_upload_mb = 64;
+  LcmFlags lcm;  // --lcm-url, --channel-prefix, --auth-key: the live scope (docs/live.md)
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
         "Serve the tuning workbench: an HTTP and WebSocket server (Boost.Beast) with the page, answering "
         "evaluate requests with the JSON of 'pidlab evaluate --json' (docs/workbench.md). Open the printed "
-        "URL.");
+        "URL. With --lcm-url it also watches a running trio: the live scope (docs/live.md).");
     app->add_option("--port", options.port, "TCP port (0: any free port, printed)")->capture_default_str();
     app->add_option("--bind", options.bind,
                     "address to listen on; anything but loopback requires the token, printed once")
@@ -43,6 +45,15 @@ struct ServeCommand {
                     "the directory log_open paths are relative to (default: the current one)");
     app->add_option("--max-upload-mb", max_upload_mb, "largest uploaded log, MiB (1..4096)")
         ->capture_default_str();
+    app->add_option("--lcm-url", lcm.lcm_url,
+                    "watch the trio on this LCM URL: the live scope, episodes on demand (docs/live.md); "
+                    "without it the live requests answer 400");
+    app->add_option(
+        "--channel-prefix", lcm.channel_prefix,
+        "with --lcm-url: the trio's channel prefix (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
+    app->add_option("--auth-key", lcm.auth_key_file,
+                    "with --lcm-url: check every message's MAC with the key in this file, and sign the "
+                    "episodes run on the trio (docs/security.md; default $PIDLAB_AUTH_KEY_FILE)");
     return [this] { return Run(); };
   }
 
@@ -51,6 +62,7 @@ struct ServeCommand {
     std::string error;
     if (!options.IsValid(&error)) throw BadInput(error);
     std::unique_ptr<LogStore> logs = ServedLogs();
+    const std::unique_ptr<LiveService> live = StartLive();  // outlives the server
     server::Server s(options, server::ConnectionHandler(AnswerWorkbenchRequest), server::WorkbenchAssets());
     s.SetUploadHandler(
         [&logs](const std::string& name, const std::string& body) { return logs->Upload(name, body); });
@@ -63,6 +75,7 @@ struct ServeCommand {
     std::signal(SIGINT, StopOnSignal);
     std::signal(SIGTERM, StopOnSignal);
     s.Run();
+    SetLiveService(nullptr);
     g_server = nullptr;
     ServeLogs(nullptr);
     std::cerr << "pidlab serve: stopped\n";
@@ -80,6 +93,26 @@ struct ServeCommand {
     auto store = std::make_unique<LogStore>(log_dir);
     ServeLogs(store.get());
     return store;
+  }
+
+  // The live scope on the trio of --lcm-url, or null without it.
+  std::unique_ptr<LiveService> StartLive() const {
+    if (lcm.lcm_url.empty()) {
+      if (!lcm.auth_key_file.empty())
+        throw BadInput("--auth-key " + Quote(lcm.auth_key_file) + " needs --lcm-url");
+      if (!lcm.channel_prefix.empty())
+        throw BadInput("--channel-prefix " + Quote(lcm.channel_prefix) + " needs --lcm-url");
+      return nullptr;
+    }
+    const episode_client::EpisodeClientOptions client = lcm.ClientOptions(lcm.Url());
+    std::unique_ptr<LiveService> live;
+    try {
+      live = std::make_unique<LiveService>(client);
+    } catch (const std::runtime_error& e) {
+      throw BadInput("--lcm-url " + Quote(lcm.lcm_url) + ": " + e.what());
+    }
+    SetLiveService(live.get());
+    return live;
   }
 
   // 32 hex digits: 16 bytes from libsodium's randombytes_buf (the kernel's getrandom).

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "pidlab/json/spec_run.h"
+#include "serve_live.h"
 #include "serve_logs.h"
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
 #include "export_spec.h"
@@ -102,6 +103,7 @@ server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
   if (type == "evaluate") return Evaluate(request);
   if (type == "log_open") return AnswerLogOpen(request);
   if (type == "log_episode") return AnswerLogEpisode(request);
+  if (IsLiveRequest(type)) return AnswerLive(type, request, connection);
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
   if (type == "export") return Export(request);
   if (type == "tune") return AnswerTune(request, connection);

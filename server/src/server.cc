@@ -215,8 +215,10 @@ class SessionConnection : public Connection {
   SessionConnection(net::any_io_executor executor, std::weak_ptr<WebSocketSession> session)
       : executor_(std::move(executor)), session_(std::move(session)) {}
   bool Post(const nlohmann::json& message, const std::string& replace_key) override;
+  bool PostBinary(std::string bytes, const std::string& replace_key) override;
   bool closed() const override { return closed_; }
   void Close() { closed_ = true; }
+  void CountDropped() { ++dropped_; }
 
  private:
   net::any_io_executor executor_;
@@ -269,19 +271,22 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
   // At most one write in flight. Waiting: the messages without a key in
   // order, then one per key, a newer one replacing the older (a slow client
   // is sent the latest reply, not a growing queue).
-  void Send(std::string message, const std::string& replace_key) {
+  void Send(std::string message, const std::string& replace_key, bool binary = false) {
     if (writing_) {
       if (replace_key.empty()) {
-        ordered_.push_back(std::move(message));
+        ordered_.push_back({std::move(message), binary});
       } else {
-        if (waiting_.count(replace_key)) server_->Count(&ServerCounters::dropped_replies);
-        waiting_[replace_key] = std::move(message);
+        if (waiting_.count(replace_key)) {
+          server_->Count(&ServerCounters::dropped_replies);
+          connection_->CountDropped();
+        }
+        waiting_[replace_key] = {std::move(message), binary};
       }
       return;
     }
     writing_ = true;
     out_ = std::move(message);
-    ws_.text(true);
+    ws_.binary(binary);
     ws_.async_write(net::buffer(out_),
                     beast::bind_front_handler(&WebSocketSession::OnWrite, shared_from_this()));
   }
@@ -290,7 +295,7 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
   void OnWrite(beast::error_code ec, std::size_t) {
     writing_ = false;
     if (ec) return;
-    std::string next;
+    Outgoing next;
     if (!ordered_.empty()) {
       next = std::move(ordered_.front());
       ordered_.pop_front();
@@ -300,16 +305,21 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
     } else {
       return;
     }
-    Send(std::move(next), "");
+    Send(std::move(next.bytes), "", next.binary);
   }
+
+  struct Outgoing {
+    std::string bytes;
+    bool binary = false;  // a binary message (a frame), else text (JSON)
+  };
 
   websocket::stream<beast::tcp_stream> ws_;
   std::shared_ptr<Server::Impl> server_;
   std::shared_ptr<SessionConnection> connection_;
   beast::flat_buffer buffer_;
   std::string out_;
-  std::deque<std::string> ordered_;
-  std::map<std::string, std::string> waiting_;
+  std::deque<Outgoing> ordered_;
+  std::map<std::string, Outgoing> waiting_;
   bool writing_ = false;
 };
 
@@ -318,6 +328,14 @@ bool SessionConnection::Post(const nlohmann::json& message, const std::string& r
   std::string text = message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   net::post(executor_, [session = session_, text = std::move(text), replace_key]() mutable {
     if (auto s = session.lock()) s->Send(std::move(text), replace_key);
+  });
+  return true;
+}
+
+bool SessionConnection::PostBinary(std::string bytes, const std::string& replace_key) {
+  if (closed_) return false;
+  net::post(executor_, [session = session_, bytes = std::move(bytes), replace_key]() mutable {
+    if (auto s = session.lock()) s->Send(std::move(bytes), replace_key, true);
   });
   return true;
 }

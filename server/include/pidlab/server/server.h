@@ -17,6 +17,7 @@
 // microseconds to milliseconds); longer work (a tuning) runs on threads of the
 // handler's, which send their messages later through the request's Connection.
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <memory>
@@ -67,10 +68,19 @@ class Connection {
   virtual ~Connection() = default;
   /// Queues `message` on the connection; false if it has closed.
   virtual bool Post(const nlohmann::json& message, const std::string& replace_key = "") = 0;
+  /// Queues `bytes` as one binary WebSocket message, with the same
+  /// replace-latest rule (the live scope's frames); false if it has closed.
+  virtual bool PostBinary(std::string bytes, const std::string& replace_key = "") = 0;
   virtual bool closed() const = 0;
+  /// This connection's messages replaced by a newer one of the same key
+  /// before they were written (also counted in ServerCounters::dropped_replies).
+  long dropped() const { return dropped_; }
   /// The handler's own state for this connection (its running tuning),
   /// touched on the server's thread only; released when the connection closes.
   std::shared_ptr<void> state;
+
+ protected:
+  std::atomic<long> dropped_{0};
 };
 
 /// Answers one request with the connection it came on (null over HTTP).

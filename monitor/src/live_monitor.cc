@@ -1,0 +1,249 @@
+#include "pidlab/monitor/live_monitor.h"
+
+#include <algorithm>
+#include <atomic>
+#include <deque>
+#include <limits>
+#include <pidlab/lcmt_disturbance_block.hpp>
+#include <pidlab/lcmt_disturbance_request.hpp>
+#include <pidlab/lcmt_episode_config.hpp>
+#include <pidlab/lcmt_episode_summary.hpp>
+#include <pidlab/lcmt_pacing_progress.hpp>
+#include <pidlab/lcmt_ready.hpp>
+#include <pidlab/lcmt_trajectory_chunk.hpp>
+#include <pidlab/lcmt_trajectory_request.hpp>
+#include <stdexcept>
+
+namespace pidlab::monitor {
+
+bool LiveMonitorOptions::IsValid(std::string* error) const {
+  std::string e;
+  if (lcm_url.empty())
+    e = "lcm_url is empty";
+  else if (max_episodes < 1 || max_episodes > 1024)
+    e = "max_episodes " + std::to_string(max_episodes) + " must be in 1..1024";
+  else if (max_total_steps < 1 || max_total_steps > 100000000)
+    e = "max_total_steps " + std::to_string(max_total_steps) + " must be in 1..1e8";
+  else if (transport.drop_rate != 0.0)
+    e = "a monitor does not inject faults: drop_rate must be 0";
+  else
+    transport.IsValid(&e);
+  if (error) *error = e;
+  return e.empty();
+}
+
+const char* StatusName(EpisodeStatus status) {
+  switch (status) {
+    case EpisodeStatus::kComplete:
+      return "complete";
+    case EpisodeStatus::kFailed:
+      return "failed";
+    case EpisodeStatus::kRunning:
+      break;
+  }
+  return "running";
+}
+
+const char* RoleName(Role role) {
+  static const char* const names[kRoleCount] = {"plant", "controller", "disturbance", "client"};
+  return names[static_cast<int>(role)];
+}
+
+struct LiveMonitor::State {
+  mutable std::mutex mutex;
+  std::deque<EpisodeTrace> episodes;  // oldest first
+  std::array<RoleHealth, kRoleCount> roles;
+  transport::TransportCounters counters;
+  long trajectory_requests = 0;
+  long rejected = 0;
+  std::atomic<long> version{0};
+  int max_episodes = 32;
+  long max_total_steps = 0;
+
+  EpisodeTrace* Find(int64_t id) {
+    for (EpisodeTrace& e : episodes)
+      if (e.info.episode_id == id) return &e;
+    return nullptr;
+  }
+  void Heard(Role role, int pid = 0) {
+    RoleHealth& h = roles[static_cast<std::size_t>(role)];
+    h.last_heard_s = transport::NowSeconds();
+    if (pid != 0) h.pid = pid;
+  }
+  void Changed() { ++version; }
+
+  void OnConfig(const pidlab::lcmt_episode_config& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    Heard(Role::kClient);
+    if (Find(m.episode_id)) return;  // a resend
+    if (m.total_steps < 0 || m.total_steps > max_total_steps) {
+      ++rejected;
+      return;
+    }
+    EpisodeTrace e;
+    e.info.episode_id = m.episode_id;
+    e.info.plant = m.plant_name;
+    e.info.kp = m.kp, e.info.ki = m.ki, e.info.kd = m.kd;
+    e.info.r = m.reference;
+    e.info.dt_s = m.dt_s;
+    e.info.total_steps = static_cast<long>(m.total_steps);
+    const std::size_t size = static_cast<std::size_t>(m.total_steps) + 1;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    e.y.assign(size, nan), e.u.assign(size, nan), e.n.assign(size, nan);
+    e.received.assign(size, false);
+    while (static_cast<int>(episodes.size()) >= max_episodes) episodes.pop_front();
+    episodes.push_back(std::move(e));
+    Changed();
+  }
+
+  void OnChunk(const pidlab::lcmt_trajectory_chunk& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    Heard(Role::kPlant);
+    EpisodeTrace* e = Find(m.episode_id);
+    const long last = e ? e->info.total_steps : -1;
+    if (!e || m.step < 0 || m.count < 0 || m.step > last || m.count > last + 1 - m.step) {
+      ++rejected;  // an unknown episode, or steps outside it
+      return;
+    }
+    for (int32_t i = 0; i < m.count; ++i) {
+      const std::size_t k = static_cast<std::size_t>(m.step + i);
+      e->y[k] = m.y[static_cast<std::size_t>(i)];
+      e->u[k] = m.u[static_cast<std::size_t>(i)];
+      e->n[k] = m.n[static_cast<std::size_t>(i)];
+      if (!e->received[k]) {
+        e->received[k] = true;
+        ++e->info.steps_done;
+      }
+    }
+    if (m.count > 0) e->info.highest_step = std::max<long>(e->info.highest_step, m.step + m.count - 1);
+    Changed();
+  }
+
+  void OnSummary(const pidlab::lcmt_episode_summary& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    Heard(Role::kPlant);
+    EpisodeTrace* e = Find(m.episode_id);
+    if (!e) return;
+    e->info.status =
+        m.status == pidlab::lcmt_episode_summary::OK ? EpisodeStatus::kComplete : EpisodeStatus::kFailed;
+    e->info.message = m.message;
+    e->info.realtime = transport::RealtimeFromSummary(m);
+    Changed();
+  }
+
+  void OnPacing(const pidlab::lcmt_pacing_progress& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    Heard(Role::kPlant);
+    EpisodeTrace* e = Find(m.episode_id);
+    if (!e) return;
+    PacingProgress p;
+    p.step = static_cast<long>(m.step);
+    p.realtime_factor = m.realtime_factor;
+    p.period_s = m.period_s;
+    p.missed_deadlines = static_cast<long>(m.missed_deadlines);
+    p.lateness_max_s = m.lateness_max_s;
+    p.rate_hz = m.rate_hz;
+    p.lateness_p50_upper_s = m.lateness_p50_upper_s;
+    p.lateness_p99_upper_s = m.lateness_p99_upper_s;
+    for (std::size_t i = 0; i < p.histogram.size(); ++i)
+      p.histogram[i] = static_cast<long>(m.lateness_histogram[i]);
+    e->info.pacing = p;
+    Changed();
+  }
+
+  void OnReady(const pidlab::lcmt_ready& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    for (int r = 0; r < kRoleCount; ++r)
+      if (m.role == RoleName(static_cast<Role>(r))) Heard(static_cast<Role>(r), m.pid);
+    Changed();
+  }
+
+  void OnHeard(Role role, bool trajectory_request) {
+    std::lock_guard<std::mutex> lock(mutex);
+    Heard(role);
+    if (trajectory_request) ++trajectory_requests;
+  }
+};
+
+LiveMonitor::LiveMonitor(const LiveMonitorOptions& options) : options_(options) {
+  std::string error;
+  if (!options_.IsValid(&error)) throw std::invalid_argument("LiveMonitor: " + error);
+  own_lcm_ = std::make_unique<lcm::LCM>(options_.lcm_url);
+  if (!own_lcm_->good()) throw std::runtime_error("LCM cannot start on '" + options_.lcm_url + "'");
+  transport_ = std::make_unique<transport::Transport>(own_lcm_.get(), options_.transport);
+  Subscribe();
+}
+
+LiveMonitor::LiveMonitor(lcm::LCM* lcm, const LiveMonitorOptions& options) : options_(options) {
+  std::string error;
+  if (!options_.IsValid(&error)) throw std::invalid_argument("LiveMonitor: " + error);
+  transport_ = std::make_unique<transport::Transport>(lcm, options_.transport);
+  Subscribe();
+}
+
+LiveMonitor::~LiveMonitor() = default;
+
+void LiveMonitor::Subscribe() {
+  state_ = std::make_unique<State>();
+  state_->max_episodes = options_.max_episodes;
+  state_->max_total_steps = options_.max_total_steps;
+  State* s = state_.get();
+  using transport::Transport;
+  transport_->Subscribe<pidlab::lcmt_episode_config>(
+      transport::kEpisodeConfigChannel, [s](const pidlab::lcmt_episode_config& m) { s->OnConfig(m); });
+  transport_->Subscribe<pidlab::lcmt_ready>(transport::kReadyChannel,
+                                            [s](const pidlab::lcmt_ready& m) { s->OnReady(m); });
+  transport_->Subscribe<pidlab::lcmt_trajectory_chunk>(
+      transport::kTrajectoryChannel, [s](const pidlab::lcmt_trajectory_chunk& m) { s->OnChunk(m); });
+  transport_->Subscribe<pidlab::lcmt_episode_summary>(
+      transport::kSummaryChannel, [s](const pidlab::lcmt_episode_summary& m) { s->OnSummary(m); });
+  transport_->Subscribe<pidlab::lcmt_pacing_progress>(
+      transport::kPacingChannel, [s](const pidlab::lcmt_pacing_progress& m) { s->OnPacing(m); });
+  transport_->Subscribe<pidlab::lcmt_disturbance_request>(
+      transport::kDisturbanceRequestChannel,
+      [s](const pidlab::lcmt_disturbance_request&) { s->OnHeard(Role::kPlant, false); });
+  transport_->Subscribe<pidlab::lcmt_disturbance_block>(
+      transport::kDisturbanceBlockChannel,
+      [s](const pidlab::lcmt_disturbance_block&) { s->OnHeard(Role::kDisturbance, false); });
+  transport_->Subscribe<pidlab::lcmt_trajectory_request>(
+      transport::kTrajectoryRequestChannel,
+      [s](const pidlab::lcmt_trajectory_request&) { s->OnHeard(Role::kClient, true); });
+}
+
+int LiveMonitor::Poll(double timeout_s) {
+  const int handled = transport_->WaitAndHandle(timeout_s);
+  std::lock_guard<std::mutex> lock(state_->mutex);
+  const transport::TransportCounters& c = transport_->counters();
+  if (c.received != state_->counters.received || c.undecodable != state_->counters.undecodable ||
+      c.unauthenticated != state_->counters.unauthenticated || c.replayed != state_->counters.replayed) {
+    state_->counters = c;
+    state_->Changed();
+  }
+  return handled;
+}
+
+MonitorSnapshot LiveMonitor::Snapshot() const {
+  MonitorSnapshot out;
+  std::lock_guard<std::mutex> lock(state_->mutex);
+  out.episodes.reserve(state_->episodes.size());
+  for (const EpisodeTrace& e : state_->episodes) out.episodes.push_back(e.info);
+  out.roles = state_->roles;
+  out.counters = state_->counters;
+  out.trajectory_requests = state_->trajectory_requests;
+  out.rejected = state_->rejected;
+  out.now_s = transport::NowSeconds();
+  return out;
+}
+
+bool LiveMonitor::WithEpisode(int64_t episode_id,
+                              const std::function<void(const EpisodeTrace&)>& read) const {
+  std::lock_guard<std::mutex> lock(state_->mutex);
+  const EpisodeTrace* e = state_->Find(episode_id);
+  if (!e) return false;
+  read(*e);
+  return true;
+}
+
+long LiveMonitor::version() const { return state_->version.load(); }
+
+}  // namespace pidlab::monitor

@@ -1,0 +1,411 @@
+#include "serve_live.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/json/replay_json.h"
+#include "pidlab/json/results_json.h"
+#include "pidlab/monitor/frames.h"
+#include "pidlab/spec/json.h"
+#include "pidlab/tune/spec_build.h"
+
+namespace pidlab::cli {
+namespace {
+
+using json::JsonNumber;
+using monitor::EpisodeInfo;
+using monitor::EpisodeTrace;
+using monitor::MonitorSnapshot;
+using Clock = std::chrono::steady_clock;
+
+constexpr auto kStatusPeriod = std::chrono::milliseconds(100);  // at most 10 live_status a second
+constexpr auto kFramePeriod = std::chrono::milliseconds(33);    // at most 30 frames a second
+constexpr int kDefaultColumns = 1000;
+
+nlohmann::json PacingJson(const monitor::PacingProgress& p) {
+  return {{"step", p.step},
+          {"realtime_factor", JsonNumber(p.realtime_factor)},
+          {"period_s", JsonNumber(p.period_s)},
+          {"missed_deadlines", p.missed_deadlines},
+          {"lateness_max_s", JsonNumber(p.lateness_max_s)},
+          {"rate_hz", JsonNumber(p.rate_hz)},
+          {"lateness_p50_upper_s", JsonNumber(p.lateness_p50_upper_s)},
+          {"lateness_p99_upper_s", JsonNumber(p.lateness_p99_upper_s)},
+          {"histogram", p.histogram}};
+}
+
+nlohmann::json EpisodeJson(const EpisodeInfo& e) {
+  return {{"episode_id", e.episode_id},
+          {"plant", e.plant},
+          {"gains", {JsonNumber(e.kp), JsonNumber(e.ki), JsonNumber(e.kd)}},
+          {"r", JsonNumber(e.r)},
+          {"dt_s", JsonNumber(e.dt_s)},
+          {"total_steps", e.total_steps},
+          {"steps_done", e.steps_done},
+          {"status", monitor::StatusName(e.status)},
+          {"message", e.message},
+          {"realtime", e.realtime.paced() ? json::RealtimeJson(e.realtime) : nlohmann::json(nullptr)},
+          {"pacing", e.pacing ? PacingJson(*e.pacing) : nlohmann::json(nullptr)}};
+}
+
+// The selected episode of a subscriber: the one chosen if still kept, else the newest.
+const EpisodeInfo* Selected(const MonitorSnapshot& s, const std::optional<int64_t>& chosen) {
+  if (s.episodes.empty()) return nullptr;
+  if (chosen)
+    for (const EpisodeInfo& e : s.episodes)
+      if (e.episode_id == *chosen) return &e;
+  return chosen ? nullptr : &s.episodes.back();
+}
+
+// Which episodes there are and how each ended: a change posts live_status at once.
+std::string EpisodeSetKey(const MonitorSnapshot& s) {
+  std::string key;
+  for (const EpisodeInfo& e : s.episodes)
+    key += std::to_string(e.episode_id) + ":" + monitor::StatusName(e.status) + ",";
+  return key;
+}
+
+monitor::FrameInfo InfoOf(const EpisodeInfo& e, long dropped_frames) {
+  return {e.episode_id, e.dt_s, e.total_steps, e.steps_done, dropped_frames};
+}
+
+// One subscribed connection, touched by the sender thread (and by the
+// server's thread under the service's mutex).
+struct Subscriber {
+  std::weak_ptr<server::Connection> connection;
+  int columns = kDefaultColumns;
+  std::optional<int64_t> chosen;
+  Clock::time_point last_status{}, last_frame{};
+  long status_version = -1;
+  std::string episode_set;
+  int64_t framed_episode = 0;
+  long framed_steps = -1;
+  std::map<int64_t, bool> final_sent;
+};
+
+}  // namespace
+
+nlohmann::json LiveStatusJson(const MonitorSnapshot& s, const std::string& lcm_url,
+                              const std::string& channel_prefix, const int64_t* selected_episode_id,
+                              long dropped_frames) {
+  nlohmann::json episodes = nlohmann::json::array();
+  for (const EpisodeInfo& e : s.episodes) episodes.push_back(EpisodeJson(e));
+  nlohmann::json roles = nlohmann::json::object();
+  for (int r = 0; r < monitor::kRoleCount; ++r) {
+    const monitor::RoleHealth& h = s.roles[static_cast<std::size_t>(r)];
+    roles[monitor::RoleName(static_cast<monitor::Role>(r))] = {
+        {"last_heard_s", std::isnan(h.last_heard_s)
+                             ? nlohmann::json(nullptr)
+                             : nlohmann::json(std::max(0.0, s.now_s - h.last_heard_s))},
+        {"pid", h.pid != 0 ? nlohmann::json(h.pid) : nlohmann::json(nullptr)}};
+  }
+  return {{"type", "live_status"},
+          {"lcm_url", lcm_url},
+          {"channel_prefix", channel_prefix},
+          {"selected_episode_id",
+           selected_episode_id ? nlohmann::json(*selected_episode_id) : nlohmann::json(nullptr)},
+          {"episodes", episodes},
+          {"health",
+           {{"roles", roles},
+            {"received", s.counters.received},
+            {"undecodable", s.counters.undecodable},
+            {"unauthenticated", s.counters.unauthenticated},
+            {"replayed", s.counters.replayed},
+            {"trajectory_requests", s.trajectory_requests}}},
+          {"dropped_frames", dropped_frames}};
+}
+
+struct LiveService::Impl {
+  episode_client::EpisodeClientOptions client;
+  monitor::LiveMonitor monitor;
+  std::atomic<bool> stop{false};
+  std::mutex mutex;  // subscribers, the worker
+  std::condition_variable wake;
+  std::map<const server::Connection*, Subscriber> subscribers;
+  std::thread monitor_thread, sender_thread, worker;
+  std::atomic<bool> worker_busy{false};
+
+  static monitor::LiveMonitorOptions MonitorOptions(const episode_client::EpisodeClientOptions& c) {
+    monitor::LiveMonitorOptions o;
+    o.lcm_url = c.lcm_url;
+    o.transport.channel_prefix = c.transport.channel_prefix;
+    o.transport.auth_key = c.transport.auth_key;
+    return o;
+  }
+
+  explicit Impl(const episode_client::EpisodeClientOptions& c) : client(c), monitor(MonitorOptions(c)) {
+    monitor_thread = std::thread([this] {
+      while (!stop)
+        if (monitor.Poll(0.05) < 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    });
+    sender_thread = std::thread([this] { SendLoop(); });
+  }
+
+  ~Impl() {
+    stop = true;
+    wake.notify_all();
+    monitor_thread.join();
+    sender_thread.join();
+    if (worker.joinable()) worker.join();
+  }
+
+  void SendLoop() {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stop) {
+      wake.wait_for(lock, std::chrono::milliseconds(10));
+      if (stop || subscribers.empty()) continue;
+      const long version = monitor.version();
+      const MonitorSnapshot snapshot = monitor.Snapshot();
+      for (auto it = subscribers.begin(); it != subscribers.end();) {
+        auto connection = it->second.connection.lock();
+        if (!connection || connection->closed()) {
+          it = subscribers.erase(it);
+          continue;
+        }
+        Serve(snapshot, version, connection, &it->second);
+        ++it;
+      }
+    }
+  }
+
+  // The subscriber's live_status and frames that are due.
+  void Serve(const MonitorSnapshot& s, long version, const std::shared_ptr<server::Connection>& out,
+             Subscriber* sub) {
+    const auto now = Clock::now();
+    const EpisodeInfo* selected = Selected(s, sub->chosen);
+    const std::string set = EpisodeSetKey(s);
+    if (set != sub->episode_set ||
+        (version != sub->status_version && now - sub->last_status >= kStatusPeriod)) {
+      const int64_t id = selected ? selected->episode_id : 0;
+      out->Post(LiveStatusJson(s, client.lcm_url, client.transport.channel_prefix, selected ? &id : nullptr,
+                               out->dropped()),
+                "live_status");
+      sub->episode_set = set, sub->status_version = version, sub->last_status = now;
+    }
+    if (!selected) return;
+    const bool fresh =
+        selected->episode_id != sub->framed_episode || selected->steps_done != sub->framed_steps;
+    if (fresh && now - sub->last_frame >= kFramePeriod) {
+      std::string frame;
+      monitor.WithEpisode(selected->episode_id, [&](const EpisodeTrace& e) {
+        frame = monitor::EncodeViewFrame(InfoOf(e.info, out->dropped()), e.y.data(), e.u.data(), e.n.data(),
+                                         e.info.highest_step + 1, sub->columns);
+      });
+      out->PostBinary(std::move(frame), "live_view");
+      sub->framed_episode = selected->episode_id, sub->framed_steps = selected->steps_done;
+      sub->last_frame = now;
+    }
+    // The whole episode once it has ended and every step is in (resent
+    // chunks may follow the SUMMARY), never dropped: the page's final arrays.
+    const bool whole = selected->steps_done == selected->total_steps + 1 ||
+                       selected->status == monitor::EpisodeStatus::kFailed;
+    if (selected->status != monitor::EpisodeStatus::kRunning && whole &&
+        !sub->final_sent[selected->episode_id]) {
+      sub->final_sent[selected->episode_id] = true;
+      out->PostBinary(DataFrame(selected->episode_id, out->dropped()));
+    }
+  }
+
+  // A kind-2 frame of the whole episode (empty if it is not kept).
+  std::string DataFrame(int64_t id, long dropped) const {
+    std::string frame;
+    monitor.WithEpisode(id, [&](const EpisodeTrace& e) {
+      frame = monitor::EncodeDataFrame(InfoOf(e.info, dropped), 0, e.y.data(), e.u.data(), e.n.data(),
+                                       e.info.total_steps + 1);
+    });
+    return frame;
+  }
+
+  server::Reply Subscribe(const nlohmann::json& request, const std::shared_ptr<server::Connection>& c) {
+    int columns = kDefaultColumns;
+    if (request.contains("columns")) {
+      const nlohmann::json& v = request["columns"];
+      if (!v.is_number_integer() || v.get<long>() < monitor::kMinColumns ||
+          v.get<long>() > monitor::kMaxColumns)
+        return {400,
+                {{"error", "live_subscribe: columns " + v.dump() + " must be a whole number in " +
+                               std::to_string(monitor::kMinColumns) + ".." +
+                               std::to_string(monitor::kMaxColumns)}}};
+      columns = v.get<int>();
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    Subscriber& sub = subscribers[c.get()];
+    sub = Subscriber{};
+    sub.connection = c;
+    sub.columns = columns;
+    wake.notify_all();
+    return {200, {{"type", "live_subscribed"}, {"columns", columns}}};
+  }
+
+  server::Reply Select(const nlohmann::json& request, const std::shared_ptr<server::Connection>& c) {
+    const auto id = request.find("episode_id");
+    if (id == request.end() || !id->is_number_integer())
+      return {400, {{"error", "live_select needs a whole-number episode_id"}}};
+    if (!monitor.WithEpisode(id->get<int64_t>(), [](const EpisodeTrace&) {}))
+      return {400, {{"error", "live_select: episode_id " + id->dump() + " is not one of the episodes kept"}}};
+    std::lock_guard<std::mutex> lock(mutex);
+    auto it = subscribers.find(c.get());
+    if (it == subscribers.end()) return {400, {{"error", "live_select: live_subscribe first"}}};
+    it->second.chosen = id->get<int64_t>();
+    it->second.episode_set.clear();  // live_status at once, with the new selection
+    return {200, {{"type", "live_selected"}, {"episode_id", *id}}};
+  }
+
+  server::Reply Data(const nlohmann::json& request, const std::shared_ptr<server::Connection>& c) {
+    const auto id = request.find("episode_id");
+    if (id == request.end() || !id->is_number_integer())
+      return {400, {{"error", "live_data needs a whole-number episode_id"}}};
+    std::string frame = DataFrame(id->get<int64_t>(), c->dropped());
+    if (frame.empty())
+      return {400, {{"error", "live_data: episode_id " + id->dump() + " is not one of the episodes kept"}}};
+    c->PostBinary(std::move(frame));
+    return {200, nullptr};  // the frame is the answer
+  }
+
+  server::Reply RunOnTrio(const nlohmann::json& request, const std::shared_ptr<server::Connection>& c);
+};
+
+namespace {
+
+// The object of `pidlab evaluate --json` for one evaluation of the spec.
+nlohmann::json ResultJson(const evaluation::Evaluation& ev, const analysis::LoopAnalysis& analysis,
+                          const analysis::LoopBounds& bounds, const spec::EvaluateSpec& s,
+                          const char* backend) {
+  nlohmann::json j = json::ToJson(ev);
+  j["backend"] = backend;
+  j["robustness"] = json::RobustnessJson(analysis, bounds);
+  j["spec"] = spec::ToJson(s);
+  return j;
+}
+
+bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
+// The spec on the trio and in process, both on the sampled loop: the trio_result object.
+nlohmann::json TrioResult(const nlohmann::json& spec_json,
+                          const episode_client::EpisodeClientOptions& client) {
+  spec::EvaluateSpec s;
+  std::string error;
+  if (!spec::FromJson(spec_json, &s, nullptr, &error)) throw std::invalid_argument(error);
+  s.plant.Normalize();
+  s.loop.loop = "sampled";  // the trio runs the sampled loop
+  Plant p;
+  PidGains g;
+  evaluation::LoopOptions options;
+  analysis::LoopBounds bounds;
+  using spec::NameStyle;
+  if (!(tune::BuildPlant(s.plant, NameStyle::kKey, &p, &error) &&
+        tune::BuildGains(s.gains, NameStyle::kKey, &g, &error) &&
+        tune::BuildLoopOptions(s.loop, NameStyle::kKey, &options, &error) &&
+        tune::CheckPlantInLoop(p, options, NameStyle::kKey, &error) &&
+        tune::BuildBounds(s.bounds, NameStyle::kKey, &bounds, &error)))
+    throw std::invalid_argument(error);
+  evaluation::Evaluation local, trio;
+  analysis::LoopAnalysis analysis;
+  evaluation::EvaluateOptions what;
+  if (!evaluation::Evaluate(p, g, options, what, &local, &error) ||
+      !analysis::AnalyzeLoop(p, g, options, analysis::LoopAnalysisOptions{}, &analysis, &error))
+    throw std::invalid_argument(error);
+  episode_client::EpisodeClient runner(client);
+  if (!evaluation::Evaluate(p, g, options, what, &trio, &error, runner.AsRunner()))
+    throw std::runtime_error(error);
+  nlohmann::json result = ResultJson(trio, analysis, bounds, s, "lcm");
+  result["steps_per_second"] = JsonNumber(runner.stats().StepsPerSecond());
+  if (runner.stats().realtime.paced()) result["realtime"] = json::RealtimeJson(runner.stats().realtime);
+  double max_diff = 0.0;
+  for (std::size_t i = 0; i < std::min(trio.y.size(), local.y.size()); ++i)
+    max_diff = std::max(max_diff, std::fabs(trio.y[i] - local.y[i]));
+  return {{"type", "trio_result"},
+          {"loop", "sampled"},
+          {"result", result},
+          {"prediction", ResultJson(local, analysis, bounds, s, "local")},
+          {"series", {{"t", trio.t}, {"y", trio.y}}},
+          {"prediction_series", {{"t", local.t}, {"y", local.y}}},
+          {"max_abs_difference", JsonNumber(max_diff)},
+          {"bit_identical", SameBits(trio.t, local.t) && SameBits(trio.y, local.y)}};
+}
+
+}  // namespace
+
+server::Reply LiveService::Impl::RunOnTrio(const nlohmann::json& request,
+                                           const std::shared_ptr<server::Connection>& c) {
+  if (!c) return {400, {{"error", "run_on_trio runs over the WebSocket /ws, which carries its result"}}};
+  if (!request.contains("spec") || !request["spec"].is_object())
+    return {400, {{"error", "a run_on_trio request needs a spec object"}}};
+  std::lock_guard<std::mutex> lock(mutex);
+  if (worker_busy) return {400, {{"error", "run_on_trio: an episode is already running on the trio"}}};
+  if (worker.joinable()) worker.join();  // the last one, finished
+  worker_busy = true;
+  const nlohmann::json id = request.contains("id") ? request["id"] : nlohmann::json(nullptr);
+  worker = std::thread([this, spec = request["spec"], out = c, id] {
+    nlohmann::json reply;
+    try {
+      reply = TrioResult(spec, client);
+    } catch (const std::exception& e) {
+      reply = {{"type", "trio_error"}, {"error", std::string("run_on_trio: ") + e.what()}};
+    }
+    if (!id.is_null()) reply["id"] = id;
+    out->Post(reply);
+    worker_busy = false;
+  });
+  return {200, {{"type", "run_on_trio_started"}, {"loop", "sampled"}}};
+}
+
+LiveService::LiveService(const episode_client::EpisodeClientOptions& client)
+    : impl_(std::make_unique<Impl>(client)) {}
+
+LiveService::~LiveService() = default;
+
+server::Reply LiveService::Answer(const std::string& type, const nlohmann::json& request,
+                                  const std::shared_ptr<server::Connection>& connection) {
+  const bool auth = impl_->client.transport.auth_key.has_value();
+  if (type == "server_info")
+    return {200,
+            {{"type", "server_info"},
+             {"live", true},
+             {"lcm_url", impl_->client.lcm_url},
+             {"channel_prefix", impl_->client.transport.channel_prefix},
+             {"auth", auth}}};
+  if (type == "run_on_trio") return impl_->RunOnTrio(request, connection);
+  if (!connection) return {400, {{"error", type + " runs over the WebSocket /ws, which carries its frames"}}};
+  if (type == "live_subscribe") return impl_->Subscribe(request, connection);
+  if (type == "live_select") return impl_->Select(request, connection);
+  if (type == "live_data") return impl_->Data(request, connection);
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->subscribers.erase(connection.get());
+  return {200, {{"type", "live_unsubscribed"}}};
+}
+
+namespace {
+std::atomic<LiveService*> g_live{nullptr};
+}
+
+bool IsLiveRequest(const std::string& type) {
+  return type == "server_info" || type == "live_subscribe" || type == "live_unsubscribe" ||
+         type == "live_select" || type == "live_data" || type == "run_on_trio";
+}
+
+void SetLiveService(LiveService* service) { g_live = service; }
+
+server::Reply AnswerLive(const std::string& type, const nlohmann::json& request,
+                         const std::shared_ptr<server::Connection>& connection) {
+  if (LiveService* live = g_live.load()) return live->Answer(type, request, connection);
+  if (type == "server_info")
+    return {
+        200,
+        {{"type", "server_info"}, {"live", false}, {"lcm_url", ""}, {"channel_prefix", ""}, {"auth", false}}};
+  return {400, {{"error", "live: pidlab serve was started without --lcm-url"}}};
+}
+
+}  // namespace pidlab::cli
