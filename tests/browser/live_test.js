@@ -21,17 +21,22 @@ const longArgs = ['evaluate', '--backend', 'lcm', '--lcm-url', args['lcm-url'], 
 function pidlab(argv) {
   return execFileSync(args.pidlab, argv, { encoding: 'utf8', maxBuffer: 256 << 20, timeout: 120000, cwd: args.tmp });
 }
-// The log's steps as `pidlab replay --csv` writes them (17 digits: every double exactly).
-function replayCsv(file, episodeId) {
-  const csv = path.join(args.tmp, 'replay-' + episodeId + '.csv');
-  pidlab(['replay', file, '--episode', episodeId, '--csv', csv]);
-  const lines = fs.readFileSync(csv, 'utf8').trim().split('\n').slice(1);
-  const out = { y: [], u: [], n: [] };
-  for (const line of lines) {
+// The steps of the log's episode with `steps` steps, as `pidlab replay --csv`
+// writes them (17 digits: every double exactly), with its id as text (an
+// int64 id is above 2^53: JSON.parse would round it).
+function replayCsv(file, steps, pageId) {
+  const csv = path.join(args.tmp, 'replay.csv');
+  pidlab(['replay', file, '--csv', csv]);
+  const byId = new Map();
+  for (const line of fs.readFileSync(csv, 'utf8').trim().split('\n').slice(1)) {
     const c = line.split(',');
-    out.y.push(Number(c[4])); out.u.push(Number(c[5])); out.n.push(Number(c[6]));
+    if (!byId.has(c[0])) byId.set(c[0], { id: c[0], y: [], u: [], n: [] });
+    const e = byId.get(c[0]);
+    e.y.push(Number(c[4])); e.u.push(Number(c[5])); e.n.push(Number(c[6]));
   }
-  return out;
+  const found = [...byId.values()].filter((e) => e.y.length === steps + 1 && Number(e.id) === pageId);
+  if (found.length !== 1) throw new Error(found.length + ' episodes of ' + steps + ' steps and id ' + pageId + ' in the log');
+  return found[0];
 }
 // Bit for bit: NaN equals NaN (u and n at total_steps), 0 is not -0.
 function sameBits(what, got, want) {
@@ -108,8 +113,12 @@ async function main() {
         const s = window.pidlab.live.status;
         const e = s.episodes[s.episodes.length - 1];
         const f = window.pidlab.live.final[e.episode_id];
-        return { id: e.episode_id, y: Array.from(f.y), u: Array.from(f.u), n: Array.from(f.n), frames: window.pidlab.live.frames };
+        // The doubles' bytes, base64 (JSON would turn NaN into null).
+        const b64 = (a) => { let t = ''; const b = new Uint8Array(a.buffer, a.byteOffset, a.byteLength); for (let i = 0; i < b.length; i += 8192) t += String.fromCharCode(...b.subarray(i, i + 8192)); return btoa(t); };
+        return { id: e.episode_id, y: b64(f.y), u: b64(f.u), n: b64(f.n), frames: window.pidlab.live.frames };
       });
+      const doubles = (t) => { const b = Buffer.from(t, 'base64'); return Array.from(new Float64Array(b.buffer, b.byteOffset, b.length / 8)); };
+      for (const k of ['y', 'u', 'n']) liveFinal[k] = doubles(liveFinal[k]);
       await page.screenshot({ path: path.join(args.out, 'live.png') });
       fs.copyFileSync(path.join(args.out, 'live.png'), path.join(args.docs, 'live.png'));
       // Run on the trio while it still runs (launch's COMMAND waits on the fifo).
@@ -127,9 +136,9 @@ async function main() {
 
     await step('the final y, u, n equal the log\'s (pidlab replay --csv) bit for bit', async () => {
       const replay = JSON.parse(pidlab(['replay', '--json', log25]));
-      const e = replay.episodes.find((x) => x.total_steps === 25000);
-      if (!e || !e.complete) throw new Error('the log has no complete 25000-step episode');
-      const want = replayCsv(log25, String(e.episode_id));
+      const e = replay.episodes.find((x) => x.episode_id === liveFinal.id);
+      if (!e || !e.complete) throw new Error('the log has no complete episode ' + liveFinal.id);
+      const want = replayCsv(log25, 25000, liveFinal.id);
       sameBits('y', liveFinal.y, want.y);
       sameBits('u', liveFinal.u, want.u);
       sameBits('n', liveFinal.n, want.n);
@@ -170,7 +179,7 @@ async function main() {
 
   await step('the log opened by path (log_open) and scrubbed: #log-iae equals pidlab replay --json', async () => {
     const replay = JSON.parse(pidlab(['replay', '--json', log25]));
-    const index = replay.episodes.findIndex((x) => x.total_steps === 25000);
+    const index = replay.episodes.findIndex((x) => (episodeId === null ? x.total_steps === 25000 : x.episode_id === episodeId));
     const want = replay.episodes[index].evaluation.iae;
     await page.click('#tab-logs');
     await page.$eval('#log-path', (el) => { el.value = 'run.lcmlog'; });
@@ -202,14 +211,13 @@ async function main() {
     const got = await page.evaluate(async (b64) => {
       const raw = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
       const reply = await window.pidlab.logs.upload(new File([raw], 'uploaded.lcmlog'));
-      const index = reply.episodes.findIndex((x) => x.total_steps === 25000);
-      const ep = await window.pidlab.logs.openEpisode(index);
+      const ep = await window.pidlab.logs.openEpisode(0);
       let refused = '';
       try { await window.pidlab.logs.openPath('../../etc/passwd'); } catch (e) { refused = e.message; }
       return { name: reply.name, iae: ep.replay.evaluation.iae, shown: document.getElementById('log-iae').dataset.value, refused };
     }, bytes);
     const replay = JSON.parse(pidlab(['replay', '--json', log25]));
-    const want = replay.episodes.find((x) => x.total_steps === 25000).evaluation.iae;
+    const want = replay.episodes[0].evaluation.iae;
     if (!Object.is(got.iae, want) || !Object.is(Number(got.shown), want)) throw new Error('uploaded: ' + JSON.stringify(got) + ', replay ' + want);
     if (!/outside the log directory/.test(got.refused)) throw new Error('../../etc/passwd: ' + (got.refused || 'opened'));
     await page.evaluate(() => { document.getElementById('log-status').textContent = ''; });
