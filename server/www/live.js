@@ -16,7 +16,7 @@ function bandChart(el, title, label, colour, extra) {
   for (const e of extra || []) series.push(e);
   const fill = colour === '#1f77b4' ? 'rgba(31,119,180,0.25)' : colour === '#d62728' ? 'rgba(214,39,40,0.25)' : 'rgba(44,160,44,0.25)';
   return new uPlot({
-    title, width: Math.max(400, el.clientWidth || 800), height: 200, series,
+    title, width: Math.max(400, el.clientWidth || 800), height: 170, series,
     scales: { x: { time: false } }, axes: [{ label: 't (s)' }, { label }],
     bands: [{ series: [1, 2], fill }],
   }, series.map(() => []), el);
@@ -48,7 +48,7 @@ export function parseFrame(buffer) {
 const nanToNull = (a) => Array.from(a, (v) => (Number.isNaN(v) ? null : v));
 
 export function initLive({ rawSend }) {
-  const live = { status: null, frames: 0, fps: 0, final: {}, drawn: 0, dropped_frames: 0, subscribed: false };
+  const live = { status: null, frames: 0, fps: 0, ticks: 0, final: {}, drawn: 0, dropped_frames: 0, subscribed: false };
   window.pidlab.live = live;
   let charts = null;
   let latest = null;  // the newest frame not yet drawn
@@ -81,6 +81,7 @@ export function initLive({ rawSend }) {
 
   // One draw per animation frame at most; the frame rate over the last second.
   function tick(now) {
+    live.ticks += 1;
     ticks.push(now);
     while (ticks.length && ticks[0] < now - 1000) ticks.shift();
     if (ticks.length > 1) live.fps = ((ticks.length - 1) * 1000) / (ticks[ticks.length - 1] - ticks[0]);
