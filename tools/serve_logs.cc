@@ -108,8 +108,11 @@ server::Reply LogStore::OpenFile(const std::string& file, const std::string& nam
   log->name = name;
   std::string error;
   replay::ReadOptions options;  // every prefix, as `pidlab replay` without flags
-  if (!replay::ReadLog(file, options, &log->contents, &error))
+  if (!replay::ReadLog(file, options, &log->contents, &error)) {
+    // The page is told the name it gave, never the server's own path.
+    for (std::size_t at; (at = error.find(file)) != std::string::npos;) error.replace(at, file.size(), name);
     return Bad("log " + Quote(name) + ": " + Truncate(error, 200));
+  }
   const std::string id = NewId();
   nlohmann::json reply = json::LogJson(log->contents, name);
   reply["type"] = "log";

@@ -37,6 +37,29 @@ trap '[ -n "$server" ] && kill "$server" 2>/dev/null; rm -rf "$tmp"' EXIT
 lcm_url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"
 live_flags=()
 [ "$parts" = all ] && live_flags=(--lcm-url "$lcm_url")
+# docs/workbench.md's example, as written (port 8080 is free in this namespace),
+# answering over HTTP; then the two flags' bad values (exit 2, one line).
+mkdir "$tmp/doc" "$tmp/doc/logs"
+cp "$source_dir/tests/browser/live_test.sh" "$tmp/doc/logs/not-a-log.lcmlog"
+(cd "$tmp/doc" && exec "$pidlab" serve --log-dir logs --max-upload-mb 16) > "$tmp/doc/serve.out" 2>&1 &
+doc_server=$!
+deadline=$((SECONDS + 10))
+until grep -q '^pidlab serve: http' "$tmp/doc/serve.out" || ((SECONDS > deadline)); do sleep 0.05; done
+reply=$(curl -s --data-binary '{"type":"log_open","path":"not-a-log.lcmlog"}' http://127.0.0.1:8080/api/request)
+kill "$doc_server"; wait "$doc_server" 2>/dev/null
+if ! grep -qx 'pidlab serve: http://127.0.0.1:8080/' "$tmp/doc/serve.out" || [[ $reply != *"is not an LCM log"* && $reply != *"not-a-log.lcmlog"* ]]; then
+  echo "FAIL: pidlab serve --log-dir logs --max-upload-mb 16: $(head -c 200 "$tmp/doc/serve.out") / $reply"
+  exit 1
+fi
+echo "ok   pidlab serve --log-dir logs --max-upload-mb 16: $reply"
+for bad in "--max-upload-mb 0" "--log-dir $tmp/missing"; do
+  # shellcheck disable=SC2086
+  "$pidlab" serve --port 0 $bad > "$tmp/bad.out" 2>&1 && code=0 || code=$?
+  if [[ $code != 2 || $(wc -l < "$tmp/bad.out") != 1 ]]; then
+    echo "FAIL: pidlab serve $bad: exit $code, $(head -c 200 "$tmp/bad.out")"; exit 1
+  fi
+  echo "ok   pidlab serve $bad: exit 2, $(cat "$tmp/bad.out")"
+done
 mkdir "$tmp/server-tmp"  # the server's TMPDIR: its uploads' directory is made there
 TMPDIR="$tmp/server-tmp" "$pidlab" serve --port 0 --bind 127.0.0.1 --log-dir "$tmp" --max-upload-mb 16 "${live_flags[@]}" \
   > "$tmp/serve.out" 2> "$tmp/serve.err" &
