@@ -47,166 +47,169 @@ export function parseFrame(buffer) {
 
 const nanToNull = (a) => Array.from(a, (v) => (Number.isNaN(v) ? null : v));
 
-export function initLive({ rawSend }) {
-  const live = { status: null, frames: 0, fps: 0, ticks: 0, final: {}, drawn: 0, dropped_frames: 0, subscribed: false };
-  window.pidlab.live = live;
-  let charts = null;
-  let latest = null;  // the newest frame not yet drawn
-  const asked = new Set();  // episodes whose live_data was asked for
-  const ticks = [];
+let live = null;  // window.pidlab.live
+let rawSend = null;
+let charts = null;
+let latest = null;  // the newest frame not yet drawn
+const asked = new Set();  // episodes whose live_data was asked for
+const ticks = [];
 
-  function buildCharts() {
-    if (charts) return;
-    charts = {
-      y: bandChart($('live-plot-y'), 'y (min/max per column) and r', 'y', '#1f77b4', [{ label: 'r', stroke: '#555', dash: [4, 4], width: 1 }]),
-      u: bandChart($('live-plot-u'), 'u (min/max per column)', 'u', '#d62728'),
-      n: bandChart($('live-plot-n'), 'n (min/max per column)', 'n', '#2ca02c'),
-    };
-  }
+function buildCharts() {
+  if (charts) return;
+  charts = {
+    y: bandChart($('live-plot-y'), 'y (min/max per column) and r', 'y', '#1f77b4', [{ label: 'r', stroke: '#555', dash: [4, 4], width: 1 }]),
+    u: bandChart($('live-plot-u'), 'u (min/max per column)', 'u', '#d62728'),
+    n: bandChart($('live-plot-n'), 'n (min/max per column)', 'n', '#2ca02c'),
+  };
+}
 
-  function draw(f) {
-    buildCharts();
-    const x = new Array(f.columns);
-    for (let j = 0; j < f.columns; j++) x[j] = (f.first_step + Math.floor((j * f.steps) / f.columns)) * f.dt_s;
-    const ep = ((live.status && live.status.episodes) || []).find((e) => e.episode_id === f.episode_id);
-    const r = ep ? new Array(f.columns).fill(ep.r) : [];
-    charts.y.setData([x, nanToNull(f.y_max), nanToNull(f.y_min), r]);
-    charts.u.setData([x, nanToNull(f.u_max), nanToNull(f.u_min)]);
-    charts.n.setData([x, nanToNull(f.n_max), nanToNull(f.n_min)]);
-    live.drawn += 1;
-    $('live-frames').textContent = 'episode ' + f.episode_id + ': ' + f.steps_done + ' of ' + (f.total_steps + 1) +
-      ' steps, ' + live.frames + ' frames received, ' + live.drawn + ' drawn, ' + f.dropped_frames +
-      ' dropped by the server, ' + live.fps.toFixed(0) + ' fps';
-  }
+function draw(f) {
+  buildCharts();
+  const x = new Array(f.columns);
+  for (let j = 0; j < f.columns; j++) x[j] = (f.first_step + Math.floor((j * f.steps) / f.columns)) * f.dt_s;
+  const ep = ((live.status && live.status.episodes) || []).find((e) => e.episode_id === f.episode_id);
+  const r = ep ? new Array(f.columns).fill(ep.r) : [];
+  charts.y.setData([x, nanToNull(f.y_max), nanToNull(f.y_min), r]);
+  charts.u.setData([x, nanToNull(f.u_max), nanToNull(f.u_min)]);
+  charts.n.setData([x, nanToNull(f.n_max), nanToNull(f.n_min)]);
+  live.drawn += 1;
+  $('live-frames').textContent = 'episode ' + f.episode_id + ': ' + f.steps_done + ' of ' + (f.total_steps + 1) +
+    ' steps, ' + live.frames + ' frames received, ' + live.drawn + ' drawn, ' + f.dropped_frames +
+    ' dropped by the server, ' + live.fps.toFixed(0) + ' fps';
+}
 
-  // One draw per animation frame at most; the frame rate over the last second.
-  function tick(now) {
-    live.ticks += 1;
-    ticks.push(now);
-    while (ticks.length && ticks[0] < now - 1000) ticks.shift();
-    if (ticks.length > 1) live.fps = ((ticks.length - 1) * 1000) / (ticks[ticks.length - 1] - ticks[0]);
-    if (latest) { const f = latest; latest = null; draw(f); }
-    requestAnimationFrame(tick);
-  }
+// One draw per animation frame at most; the frame rate over the last second.
+function tick(now) {
+  live.ticks += 1;
+  ticks.push(now);
+  while (ticks.length && ticks[0] < now - 1000) ticks.shift();
+  if (ticks.length > 1) live.fps = ((ticks.length - 1) * 1000) / (ticks[ticks.length - 1] - ticks[0]);
+  if (latest) { const f = latest; latest = null; draw(f); }
   requestAnimationFrame(tick);
+}
+function cell(tr, text, cls) {
+  const td = document.createElement('td');
+  td.textContent = text;
+  if (cls) td.className = cls;
+  tr.append(td);
+  return td;
+}
 
-  function cell(tr, text, cls) {
-    const td = document.createElement('td');
-    td.textContent = text;
-    if (cls) td.className = cls;
-    tr.append(td);
-    return td;
+function renderEpisodes(s) {
+  const body = $('live-episodes').querySelector('tbody');
+  body.textContent = '';
+  for (const e of s.episodes) {
+    const tr = document.createElement('tr');
+    tr.dataset.episodeId = String(e.episode_id);
+    if (e.episode_id === s.selected_episode_id) tr.classList.add('selected');
+    cell(tr, String(e.episode_id));
+    cell(tr, e.plant);
+    cell(tr, (e.gains || []).map((g) => String(+Number(g).toPrecision(6))).join(','));
+    cell(tr, e.steps_done + '/' + (e.total_steps + 1));
+    const st = cell(tr, e.status + (e.message ? ': ' + e.message : ''), 'status status-' + e.status);
+    st.dataset.status = e.status;
+    const rt = cell(tr, e.realtime ? e.realtime.missed_deadlines + ' missed' : '-', 'realtime');
+    if (e.realtime) rt.dataset.realtime = JSON.stringify(e.realtime);
+    tr.addEventListener('click', () => rawSend({ type: 'live_select', episode_id: e.episode_id }));
+    body.append(tr);
   }
+}
 
-  function renderEpisodes(s) {
-    const body = $('live-episodes').querySelector('tbody');
-    body.textContent = '';
-    for (const e of s.episodes) {
-      const tr = document.createElement('tr');
-      tr.dataset.episodeId = String(e.episode_id);
-      if (e.episode_id === s.selected_episode_id) tr.classList.add('selected');
-      cell(tr, String(e.episode_id));
-      cell(tr, e.plant);
-      cell(tr, (e.gains || []).map((g) => String(+Number(g).toPrecision(6))).join(','));
-      cell(tr, e.steps_done + '/' + (e.total_steps + 1));
-      const st = cell(tr, e.status + (e.message ? ': ' + e.message : ''), 'status status-' + e.status);
-      st.dataset.status = e.status;
-      const rt = cell(tr, e.realtime ? e.realtime.missed_deadlines + ' missed' : '-', 'realtime');
-      if (e.realtime) rt.dataset.realtime = JSON.stringify(e.realtime);
-      tr.addEventListener('click', () => rawSend({ type: 'live_select', episode_id: e.episode_id }));
-      body.append(tr);
+function renderHealth(s) {
+  const h = s.health || {};
+  const lines = Object.entries(h.roles || {}).map(([role, r]) => role + ': ' +
+    (r.last_heard_s === null ? 'not heard' : 'heard ' + r.last_heard_s.toFixed(2) + ' s ago') +
+    (r.pid === null || r.pid === undefined ? '' : ' (pid ' + r.pid + ')'));
+  lines.push(['received', 'undecodable', 'unauthenticated', 'replayed', 'trajectory_requests']
+    .map((k) => k + ' ' + h[k]).join(', '));
+  lines.push('dropped frames (this page) ' + s.dropped_frames);
+  $('live-health').textContent = '';
+  for (const line of lines) { const div = document.createElement('div'); div.textContent = line; $('live-health').append(div); }
+  for (const k of ['received', 'undecodable', 'unauthenticated', 'replayed']) $('live-health').dataset[k] = String(h[k]);
+}
+
+function rows(tbody, entries) {
+  tbody.textContent = '';
+  for (const [k, v] of entries) {
+    const tr = document.createElement('tr');
+    const th = document.createElement('th'); th.textContent = k;
+    const td = document.createElement('td'); td.textContent = v === null ? '-' : String(v);
+    td.dataset.key = k; td.dataset.value = v === null ? 'null' : String(v);
+    tr.append(th, td);
+    tbody.append(tr);
+  }
+}
+
+// The selected (else newest) episode's pacing progress and, when it has
+// ended, its SUMMARY's realtime object.
+function renderPacing(s) {
+  const e = s.episodes.find((x) => x.episode_id === s.selected_episode_id) || s.episodes[s.episodes.length - 1];
+  const box = $('live-pacing');
+  box.dataset.episodeId = e ? String(e.episode_id) : '';
+  const p = e && e.pacing;
+  rows(box.querySelector('table.pacing tbody'), p ? Object.entries(p).filter(([k]) => k !== 'histogram') : []);
+  const hist = box.querySelector('.histogram');
+  hist.textContent = '';
+  if (p && p.histogram) {
+    const top = Math.max(1, ...p.histogram);
+    p.histogram.forEach((c, i) => {
+      const bar = document.createElement('div');
+      bar.style.height = (100 * c) / top + '%';
+      bar.title = 'bin ' + i + ': ' + c;
+      hist.append(bar);
+    });
+  }
+  rows(box.querySelector('table.realtime tbody'), e && e.realtime ? Object.entries(e.realtime) : []);
+}
+
+function onStatus(s) {
+  live.status = s;
+  live.dropped_frames = s.dropped_frames;
+  $('live-source').textContent = s.lcm_url + ' prefix ' + s.channel_prefix;
+  renderEpisodes(s);
+  renderHealth(s);
+  renderPacing(s);
+  for (const e of s.episodes) {
+    if (e.status === 'complete' && !asked.has(e.episode_id)) {
+      asked.add(e.episode_id);
+      // The reply is one kind-2 binary frame (onFrame), or an error line.
+      if (!rawSend({ type: 'live_data', episode_id: e.episode_id })) asked.delete(e.episode_id);
     }
   }
+}
 
-  function renderHealth(s) {
-    const h = s.health || {};
-    const lines = Object.entries(h.roles || {}).map(([role, r]) => role + ': ' +
-      (r.last_heard_s === null ? 'not heard' : 'heard ' + r.last_heard_s.toFixed(2) + ' s ago') +
-      (r.pid === null || r.pid === undefined ? '' : ' (pid ' + r.pid + ')'));
-    lines.push(['received', 'undecodable', 'unauthenticated', 'replayed', 'trajectory_requests']
-      .map((k) => k + ' ' + h[k]).join(', '));
-    lines.push('dropped frames (this page) ' + s.dropped_frames);
-    $('live-health').textContent = '';
-    for (const line of lines) { const div = document.createElement('div'); div.textContent = line; $('live-health').append(div); }
-    for (const k of ['received', 'undecodable', 'unauthenticated', 'replayed']) $('live-health').dataset[k] = String(h[k]);
+function onFrame(buffer) {
+  const f = parseFrame(buffer);
+  if (!f) { console.warn('live: a binary frame that is not PLV1'); return; }
+  if (f.kind === 2) {
+    live.final[f.episode_id] = { y: f.y, u: f.u, n: f.n };
+    return;
   }
+  live.frames += 1;
+  latest = f;  // the server sends the selected episode's frames only
+}
 
-  function rows(tbody, entries) {
-    tbody.textContent = '';
-    for (const [k, v] of entries) {
-      const tr = document.createElement('tr');
-      const th = document.createElement('th'); th.textContent = k;
-      const td = document.createElement('td'); td.textContent = v === null ? '-' : String(v);
-      td.dataset.key = k; td.dataset.value = v === null ? 'null' : String(v);
-      tr.append(th, td);
-      tbody.append(tr);
-    }
+function onMessage(m) {
+  if (m.type === 'live_status') { onStatus(m); return true; }
+  if (m.type === 'live_subscribed' || m.type === 'live_unsubscribed') return true;
+  return false;
+}
+
+function show(active) {
+  if (active && !live.subscribed) {
+    const columns = Math.max(16, Math.min(4096, Math.round($('live-plots').clientWidth || 1000)));
+    live.subscribed = rawSend({ type: 'live_subscribe', columns });
+  } else if (!active && live.subscribed) {
+    live.subscribed = !rawSend({ type: 'live_unsubscribe' });
   }
+}
 
-  // The selected (else newest) episode's pacing progress and, when it has
-  // ended, its SUMMARY's realtime object.
-  function renderPacing(s) {
-    const e = s.episodes.find((x) => x.episode_id === s.selected_episode_id) || s.episodes[s.episodes.length - 1];
-    const box = $('live-pacing');
-    box.dataset.episodeId = e ? String(e.episode_id) : '';
-    const p = e && e.pacing;
-    rows(box.querySelector('table.pacing tbody'), p ? Object.entries(p).filter(([k]) => k !== 'histogram') : []);
-    const hist = box.querySelector('.histogram');
-    hist.textContent = '';
-    if (p && p.histogram) {
-      const top = Math.max(1, ...p.histogram);
-      p.histogram.forEach((c, i) => {
-        const bar = document.createElement('div');
-        bar.style.height = (100 * c) / top + '%';
-        bar.title = 'bin ' + i + ': ' + c;
-        hist.append(bar);
-      });
-    }
-    rows(box.querySelector('table.realtime tbody'), e && e.realtime ? Object.entries(e.realtime) : []);
-  }
-
-  function onStatus(s) {
-    live.status = s;
-    live.dropped_frames = s.dropped_frames;
-    $('live-source').textContent = s.lcm_url + ' prefix ' + s.channel_prefix;
-    renderEpisodes(s);
-    renderHealth(s);
-    renderPacing(s);
-    for (const e of s.episodes) {
-      if (e.status === 'complete' && !asked.has(e.episode_id)) {
-        asked.add(e.episode_id);
-        // The reply is one kind-2 binary frame (onFrame), or an error line.
-        if (!rawSend({ type: 'live_data', episode_id: e.episode_id })) asked.delete(e.episode_id);
-      }
-    }
-  }
-
-  function onFrame(buffer) {
-    const f = parseFrame(buffer);
-    if (!f) { console.warn('live: a binary frame that is not PLV1'); return; }
-    if (f.kind === 2) {
-      live.final[f.episode_id] = { y: f.y, u: f.u, n: f.n };
-      return;
-    }
-    live.frames += 1;
-    latest = f;  // the server sends the selected episode's frames only
-  }
-
-  function onMessage(m) {
-    if (m.type === 'live_status') { onStatus(m); return true; }
-    if (m.type === 'live_subscribed' || m.type === 'live_unsubscribed') return true;
-    return false;
-  }
-
-  function show(active) {
-    if (active && !live.subscribed) {
-      const columns = Math.max(16, Math.min(4096, Math.round($('live-plots').clientWidth || 1000)));
-      live.subscribed = rawSend({ type: 'live_subscribe', columns });
-    } else if (!active && live.subscribed) {
-      live.subscribed = !rawSend({ type: 'live_unsubscribe' });
-    }
-  }
-
+// Starts the Live tab: `send` sends one request without awaiting a reply.
+export function initLive({ rawSend: send }) {
+  live = { status: null, frames: 0, fps: 0, ticks: 0, final: {}, drawn: 0, dropped_frames: 0, subscribed: false };
+  window.pidlab.live = live;
+  rawSend = send;
+  requestAnimationFrame(tick);
   return { onMessage, onFrame, show };
 }
 
