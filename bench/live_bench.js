@@ -48,8 +48,10 @@ async function main() {
     }
   }
   const ratio = median(rate.watched) / median(rate.none);
+  const pairRatios = rate.watched.map((w, i) => w / rate.none[i]);
   console.log('lockstep steps/s: none median ' + median(rate.none).toFixed(0) + ', watched median ' +
-              median(rate.watched).toFixed(0) + ', ratio ' + ratio.toFixed(3) + ' (target >= 0.9)');
+              median(rate.watched).toFixed(0) + ', ratio ' + ratio.toFixed(3) + ' (target >= 0.9); pairs ' +
+              pairRatios.map((r) => r.toFixed(2)).join(' ') + ' (median ' + median(pairRatios).toFixed(3) + ')');
 
   // The page's frame rate while a dt = 1e-4 s trio streams (unpaced: as fast as it goes).
   await setWatched(true);
