@@ -1,5 +1,6 @@
 #include "serve_logs.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -64,20 +65,24 @@ nlohmann::json Repairs(const replay::Episode& e) {
   return Ranges(e.u.size(), [&](std::size_t k) { return e.has_u[k] && e.status[k] < 0; });
 }
 
+// An episode may have up to transport::kMaxEpisodeSteps steps: above this
+// many the series holds every stride-th step (the replay object's metrics are
+// still the whole episode's).
+constexpr std::size_t kMaxSeriesSteps = 500000;
+
 nlohmann::json Series(const replay::Episode& e) {
   nlohmann::json t = nlohmann::json::array(), y = t, u = t, n = t;
   const double dt = e.has_config ? e.spec.dt_s : std::nan("");
-  for (std::size_t i = 0; i < e.y.size(); ++i) {
+  const std::size_t stride = std::max<std::size_t>(1, (e.y.size() + kMaxSeriesSteps - 1) / kMaxSeriesSteps);
+  for (std::size_t i = 0; i < e.y.size(); i += stride) {
     t.push_back(json::JsonNumber(static_cast<double>(i) * dt));
     y.push_back(json::JsonNumber(e.y[i]));
     u.push_back(json::JsonNumber(e.u[i]));
     n.push_back(json::JsonNumber(e.n[i]));
   }
-  return {{"t", t},
-          {"y", y},
-          {"u", u},
-          {"n", n},
-          {"r", e.has_config ? json::JsonNumber(e.spec.reference) : nlohmann::json(nullptr)}};
+  return {{"t", t}, {"stride", stride},
+          {"y", y}, {"u", u},
+          {"n", n}, {"r", e.has_config ? json::JsonNumber(e.spec.reference) : nlohmann::json(nullptr)}};
 }
 
 }  // namespace

@@ -81,7 +81,7 @@ function scrub(k) {
   logs.cursor = k;
   $('log-scrub').value = String(k);
   const at = (a) => fmt(a[k]);
-  $('log-cursor').textContent = 'k = ' + k + ', t = ' + at(s.t) + ' s: y ' + at(s.y) + ', u ' + at(s.u) + ', n ' + at(s.n) +
+  $('log-cursor').textContent = 'k = ' + k * (s.stride || 1) + ', t = ' + at(s.t) + ' s: y ' + at(s.y) + ', u ' + at(s.u) + ', n ' + at(s.n) +
     ', e ' + fmt(s.y[k] === null || s.r === null ? null : s.r - s.y[k]);
   for (const c of charts) {
     const left = c.valToPos(s.t[k], 'x');
@@ -158,5 +158,8 @@ export function initLogs({ ask: askServer, token: urlToken }) {
     upload(f).catch((e) => status(e.message));
   });
   $('log-scrub').addEventListener('input', () => scrub(Number($('log-scrub').value)));
+  $('log-redrive').addEventListener('change', () => {
+    if (logs.episode) openEpisode(logs.episode.index).catch((e) => status(e.message));
+  });
   Object.assign(logs, { openPath, openEpisode, upload, scrub });
 }
