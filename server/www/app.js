@@ -98,6 +98,7 @@ function ask(message) {
 // Evaluates the current design: latest wins, no queue.
 function send() {
   writeHash();
+  pidlab.trioOverlay = null;  // a trio run belongs to the design it ran
   if (inflight) { pending = true; return; }
   let s;
   try { s = spec(); } catch (e) { setStatus('bad design: ' + e.message); return; }
@@ -150,7 +151,7 @@ function show(reply, sent, reply_ms) {
   setStatus('');
   showMetrics(reply.result);
   $('notes').textContent = (reply.series.notes || []).join('; ') + ((reply.result.robustness || {}).violations || []).map((v) => '; breaks ' + v).join('');
-  drawPlots(pidlab.plots, reply.series, pidlab.pinned);
+  drawPlots(pidlab.plots, reply.series, pidlab.pinned, pidlab.trioOverlay);
   $('spec').textContent = JSON.stringify(reply.result.spec);
   $('command').textContent = pidlab.command();
   renderDiff();
@@ -243,7 +244,7 @@ function rebuildPlots() {
   destroyPlots(pidlab.plots);
   const el = (k) => $('plot-' + k);
   pidlab.plots = createPlots({ step: el('step'), effort: el('effort'), load: el('load'), freq: el('freq'), nyquist: el('nyquist') }, pidlab.pinned);
-  if (pidlab.lastSeries) drawPlots(pidlab.plots, pidlab.lastSeries, pidlab.pinned);
+  if (pidlab.lastSeries) drawPlots(pidlab.plots, pidlab.lastSeries, pidlab.pinned, pidlab.trioOverlay);
 }
 
 function pin(label) {
@@ -442,7 +443,7 @@ $('export-button').addEventListener('click', () => exportC().catch((e) => setSta
 // ---- The Live and Logs tabs (live.js, logs.js) and "Run on the trio".
 const views = {};
 views.live = initLive({ rawSend });
-views.trio = initTrio({ ask, spec, setStatus });
+views.trio = initTrio({ ask, spec, setStatus, redraw: rebuildPlots });
 initLogs({ ask, token });
 // server_info: live when pidlab serve has --lcm-url (an older server does not know the request).
 async function serverInfo() {

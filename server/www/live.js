@@ -216,7 +216,7 @@ export function initLive({ rawSend: send }) {
 // "Run on the trio" (Design view): the design's spec runs on the running
 // trio (always the sampled loop); its y is drawn over the exact prediction
 // and their agreement shown in #trio-agreement.
-export function initTrio({ ask, spec, setStatus }) {
+export function initTrio({ ask, spec, setStatus, redraw }) {
   const trio = { last: null, running: false };
   window.pidlab.trio = trio;
   let chart = null;
@@ -239,6 +239,8 @@ export function initTrio({ ask, spec, setStatus }) {
         scales: { x: { time: false } }, axes: [{ label: 't (s)' }, { label: 'y' }],
       }, [[], [], []], el);
     }
+    window.pidlab.trioOverlay = m.series;  // on the step plot too
+    redraw();
     const p = m.prediction_series, s = m.series;
     const n = Math.min(p.t.length, s.t.length);
     chart.setData([p.t.slice(0, n), p.y.slice(0, n), s.y.slice(0, n)]);

@@ -127,11 +127,17 @@ async function main() {
       await page.click('#run-on-trio');
       await waitForPage(session, 'no trio result', 60000, () => window.pidlab.trio.last !== null);
       const agreement = await page.$eval('#trio-agreement', (a) => ({ bit: a.dataset.bitIdentical, text: a.textContent }));
+      const overlaid = await page.evaluate(() => {
+        const d = window.pidlab.plots.step.data;
+        return d[d.length - 1].filter((v) => v !== null).length;
+      });
+      await page.screenshot({ path: path.join(args.out, 'live-trio.png'), fullPage: true });
+      if (!(overlaid > 0)) throw new Error('the trio\'s y is not on the step plot');
       fs.writeFileSync(fifo, 'x');
       await running;
       if (agreement.bit !== 'true') throw new Error('#trio-agreement: ' + agreement.text);
       episodeId = liveFinal.id;
-      return 'IAE ' + long.iae + ', ' + liveFinal.frames + ' frames; #trio-agreement ' + agreement.text;
+      return 'IAE ' + long.iae + ', ' + liveFinal.frames + ' frames; #trio-agreement ' + agreement.text + '; ' + overlaid + ' trio points on the step plot';
     });
 
     await step('the final y, u, n equal the log\'s (pidlab replay --csv) bit for bit', async () => {
