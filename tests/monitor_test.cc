@@ -102,6 +102,10 @@ TEST(LiveMonitorOptions, IsValidNamesTheFieldAndValue) {
   o.max_total_steps = -5;
   EXPECT_FALSE(o.IsValid(&error));
   EXPECT_NE(error.find("max_total_steps -5"), std::string::npos) << error;
+  o = LiveMonitorOptions{};
+  o.max_kept_steps = o.max_total_steps - 1;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("max_kept_steps 9999999"), std::string::npos) << error;
 }
 
 // Handles everything waiting on a memq:// instance.
@@ -239,6 +243,24 @@ TEST(LiveMonitor, ChunksOutsideTheirEpisodeAndOverlongEpisodesAreCountedAndIgnor
     EXPECT_TRUE(std::isnan(e.y[3]));
     EXPECT_EQ(e.y[10], 10.0);
   });
+}
+
+TEST(LiveMonitor, KeepsAtMostMaxKeptStepsOverAllEpisodesDroppingTheOldest) {
+  lcm::LCM lcm{"memq://"};
+  LiveMonitorOptions o = MemqOptions();
+  o.max_total_steps = 100;
+  o.max_kept_steps = 250;
+  LiveMonitor dut(&lcm, o);
+  transport::Transport t{&lcm, {}};
+  for (int64_t id : {21, 22, 23}) {  // 101 steps each: the third pushes the first out
+    auto c = Config(id, 100);
+    t.Publish(transport::kEpisodeConfigChannel, &c);
+  }
+  Drain(&dut);
+  const MonitorSnapshot s = dut.Snapshot();
+  ASSERT_EQ(s.episodes.size(), 2u);
+  EXPECT_EQ(s.episodes[0].episode_id, 22);
+  EXPECT_EQ(s.episodes[1].episode_id, 23);
 }
 
 TEST(LiveMonitor, KeepsAtMostMaxEpisodesDroppingTheOldest) {

@@ -10,6 +10,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "pidlab/episode_client/episode_pool.h"
 #include "pidlab/server/assets.h"
 #include "pidlab/server/server.h"
 #include "serve_live.h"
@@ -23,6 +24,8 @@ server::Server* g_server = nullptr;
 extern "C" void StopOnSignal(int) {
   if (g_server) g_server->Stop();
 }
+
+constexpr std::size_t kMaxWatchedTrios = 64;  // pidlab launch --trios' bound
 
 struct ServeCommand {
   server::ServerOptions options;
@@ -46,8 +49,9 @@ struct ServeCommand {
     app->add_option("--max-upload-mb", max_upload_mb, "largest uploaded log, MiB (1..4096)")
         ->capture_default_str();
     app->add_option("--lcm-url", lcm.lcm_url,
-                    "watch the trio on this LCM URL: the live scope, episodes on demand (docs/live.md); "
-                    "without it the live requests answer 400");
+                    "watch the trio on this LCM URL, or the trios of several, comma-separated (pidlab launch "
+                    "--trios K: $PIDLAB_LCM_URLS): the live scope, episodes on demand on the first "
+                    "(docs/live.md); without it the live requests answer 400");
     app->add_option(
         "--channel-prefix", lcm.channel_prefix,
         "with --lcm-url: the trio's channel prefix (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)");
@@ -62,11 +66,12 @@ struct ServeCommand {
     std::string error;
     if (!options.IsValid(&error)) throw BadInput(error);
     std::unique_ptr<LogStore> logs = ServedLogs();
-    const std::unique_ptr<LiveService> live = StartLive();  // outlives the server
+    std::unique_ptr<LiveService> live = StartLive();
     server::Server s(options, server::ConnectionHandler(AnswerWorkbenchRequest), server::WorkbenchAssets());
     s.SetUploadHandler(
         [&logs](const std::string& name, const std::string& body) { return logs->Upload(name, body); });
     if (!s.Start(&error)) throw BadInput(error);
+    SetLiveService(live.get());
     const std::string host =
         options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind;
     std::cout << "pidlab serve: http://" << host << ":" << s.port() << "/"
@@ -75,7 +80,10 @@ struct ServeCommand {
     std::signal(SIGINT, StopOnSignal);
     std::signal(SIGTERM, StopOnSignal);
     s.Run();
+    // The live threads post to the server's connections: they stop (and a
+    // run_on_trio episode ends) while the server still exists.
     SetLiveService(nullptr);
+    live.reset();
     g_server = nullptr;
     ServeLogs(nullptr);
     std::cerr << "pidlab serve: stopped\n";
@@ -104,14 +112,18 @@ struct ServeCommand {
         throw BadInput("--channel-prefix " + Quote(lcm.channel_prefix) + " needs --lcm-url");
       return nullptr;
     }
-    const episode_client::EpisodeClientOptions client = lcm.ClientOptions(lcm.Url());
+    const std::vector<std::string> urls = episode_client::SplitUrlList(lcm.lcm_url);
+    if (urls.empty() || urls.size() > kMaxWatchedTrios)
+      throw BadInput("--lcm-url " + Quote(lcm.lcm_url) + " must name 1 to " +
+                     std::to_string(kMaxWatchedTrios) + " URLs");
+    std::vector<episode_client::EpisodeClientOptions> trios;
+    for (const std::string& url : urls) trios.push_back(lcm.ClientOptions(url));
     std::unique_ptr<LiveService> live;
     try {
-      live = std::make_unique<LiveService>(client);
+      live = std::make_unique<LiveService>(trios, lcm.lcm_url);
     } catch (const std::runtime_error& e) {
       throw BadInput("--lcm-url " + Quote(lcm.lcm_url) + ": " + e.what());
     }
-    SetLiveService(live.get());
     return live;
   }
 

@@ -1,5 +1,6 @@
 #include "serve_live.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -43,8 +44,10 @@ nlohmann::json PacingJson(const monitor::PacingProgress& p) {
           {"histogram", p.histogram}};
 }
 
-nlohmann::json EpisodeJson(const EpisodeInfo& e) {
+nlohmann::json EpisodeJson(const EpisodeInfo& e, int trio) {
   return {{"episode_id", e.episode_id},
+          {"trio", trio},
+          {"episode_id_text", std::to_string(e.episode_id)},  // exact where a JSON number is not (JavaScript)
           {"plant", e.plant},
           {"gains", {JsonNumber(e.kp), JsonNumber(e.ki), JsonNumber(e.kd)}},
           {"r", JsonNumber(e.r)},
@@ -58,24 +61,46 @@ nlohmann::json EpisodeJson(const EpisodeInfo& e) {
 }
 
 // The selected episode of a subscriber: the one chosen if still kept, else the newest.
-const EpisodeInfo* Selected(const MonitorSnapshot& s, const std::optional<int64_t>& chosen) {
-  if (s.episodes.empty()) return nullptr;
+const EpisodeInfo* Selected(const LiveView& v, const std::optional<int64_t>& chosen) {
+  if (v.episodes.empty()) return nullptr;
   if (chosen)
-    for (const EpisodeInfo& e : s.episodes)
+    for (const EpisodeInfo& e : v.episodes)
       if (e.episode_id == *chosen) return &e;
-  return chosen ? nullptr : &s.episodes.back();
+  return chosen ? nullptr : &v.episodes.back();
 }
 
 // Which episodes there are and how each ended: a change posts live_status at once.
-std::string EpisodeSetKey(const MonitorSnapshot& s) {
+std::string EpisodeSetKey(const LiveView& v) {
   std::string key;
-  for (const EpisodeInfo& e : s.episodes)
+  for (const EpisodeInfo& e : v.episodes)
     key += std::to_string(e.episode_id) + ":" + monitor::StatusName(e.status) + ",";
   return key;
 }
 
 monitor::FrameInfo InfoOf(const EpisodeInfo& e, long dropped_frames) {
   return {e.episode_id, e.dt_s, e.total_steps, e.steps_done, dropped_frames};
+}
+
+// request["episode_id"]: a whole number, or its decimal text (JavaScript's
+// numbers hold only 53 bits of a 64-bit id). False if neither.
+bool EpisodeIdOf(const nlohmann::json& request, int64_t* id) {
+  const auto v = request.find("episode_id");
+  if (v == request.end()) return false;
+  if (v->is_number_integer()) {
+    *id = v->get<int64_t>();
+    return true;
+  }
+  if (!v->is_string()) return false;
+  const std::string& text = v->get_ref<const std::string&>();
+  if (text.empty() || text.size() > 20 || text.find_first_not_of("-0123456789") != std::string::npos)
+    return false;
+  try {
+    std::size_t used = 0;
+    *id = std::stoll(text, &used);
+    return used == text.size();
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 // One subscribed connection, touched by the sender thread (and by the
@@ -94,11 +119,28 @@ struct Subscriber {
 
 }  // namespace
 
-nlohmann::json LiveStatusJson(const MonitorSnapshot& s, const std::string& lcm_url,
-                              const std::string& channel_prefix, const int64_t* selected_episode_id,
-                              long dropped_frames) {
-  nlohmann::json episodes = nlohmann::json::array();
-  for (const EpisodeInfo& e : s.episodes) episodes.push_back(EpisodeJson(e));
+LiveView MergeTrios(std::vector<MonitorSnapshot> trios, std::vector<std::string> urls, long version) {
+  LiveView v;
+  std::vector<std::pair<const EpisodeInfo*, int>> all;
+  for (std::size_t t = 0; t < trios.size(); ++t)
+    for (const EpisodeInfo& e : trios[t].episodes) all.push_back({&e, static_cast<int>(t) + 1});
+  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
+    return a.first->first_heard_s < b.first->first_heard_s;
+  });
+  const std::size_t first = all.size() > kMaxShownEpisodes ? all.size() - kMaxShownEpisodes : 0;
+  for (std::size_t i = first; i < all.size(); ++i) {
+    v.episodes.push_back(*all[i].first);
+    v.trio_of.push_back(all[i].second);
+  }
+  v.trios = std::move(trios);
+  v.trio_urls = std::move(urls);
+  v.version = version;
+  return v;
+}
+
+namespace {
+
+nlohmann::json HealthJson(const MonitorSnapshot& s) {
   nlohmann::json roles = nlohmann::json::object();
   for (int r = 0; r < monitor::kRoleCount; ++r) {
     const monitor::RoleHealth& h = s.roles[static_cast<std::size_t>(r)];
@@ -108,30 +150,53 @@ nlohmann::json LiveStatusJson(const MonitorSnapshot& s, const std::string& lcm_u
                              : nlohmann::json(std::max(0.0, s.now_s - h.last_heard_s))},
         {"pid", h.pid != 0 ? nlohmann::json(h.pid) : nlohmann::json(nullptr)}};
   }
-  return {{"type", "live_status"},
-          {"lcm_url", lcm_url},
-          {"channel_prefix", channel_prefix},
-          {"selected_episode_id",
-           selected_episode_id ? nlohmann::json(*selected_episode_id) : nlohmann::json(nullptr)},
-          {"episodes", episodes},
-          {"health",
-           {{"roles", roles},
-            {"received", s.counters.received},
-            {"undecodable", s.counters.undecodable},
-            {"unauthenticated", s.counters.unauthenticated},
-            {"replayed", s.counters.replayed},
-            {"trajectory_requests", s.trajectory_requests}}},
-          {"dropped_frames", dropped_frames}};
+  return {{"roles", roles},
+          {"received", s.counters.received},
+          {"undecodable", s.counters.undecodable},
+          {"unauthenticated", s.counters.unauthenticated},
+          {"replayed", s.counters.replayed},
+          {"trajectory_requests", s.trajectory_requests}};
+}
+
+}  // namespace
+
+nlohmann::json LiveStatusJson(const LiveView& v, const std::string& lcm_url,
+                              const std::string& channel_prefix, const int64_t* selected_episode_id,
+                              long dropped_frames) {
+  nlohmann::json episodes = nlohmann::json::array();
+  for (std::size_t i = 0; i < v.episodes.size(); ++i)
+    episodes.push_back(EpisodeJson(v.episodes[i], v.trio_of[i]));
+  nlohmann::json status = {
+      {"type", "live_status"},
+      {"lcm_url", lcm_url},
+      {"channel_prefix", channel_prefix},
+      {"selected_episode_id",
+       selected_episode_id ? nlohmann::json(*selected_episode_id) : nlohmann::json(nullptr)},
+      {"selected_episode_id_text",
+       selected_episode_id ? nlohmann::json(std::to_string(*selected_episode_id)) : nlohmann::json(nullptr)},
+      {"episodes", episodes},
+      {"health", v.trios.empty() ? nlohmann::json(nullptr) : HealthJson(v.trios.front())},
+      {"dropped_frames", dropped_frames}};
+  if (v.trios.size() > 1) {
+    nlohmann::json trios = nlohmann::json::array();
+    for (std::size_t t = 0; t < v.trios.size(); ++t)
+      trios.push_back({{"trio", t + 1}, {"lcm_url", v.trio_urls[t]}, {"health", HealthJson(v.trios[t])}});
+    status["trios"] = trios;
+  }
+  return status;
 }
 
 struct LiveService::Impl {
-  episode_client::EpisodeClientOptions client;
-  monitor::LiveMonitor monitor;
+  episode_client::EpisodeClientOptions client;  // the first trio's: run_on_trio
+  std::string lcm_url;                          // as given
+  std::vector<std::string> urls;                // one per trio
+  std::vector<std::unique_ptr<monitor::LiveMonitor>> monitors;
   std::atomic<bool> stop{false};
   std::mutex mutex;  // subscribers, the worker
   std::condition_variable wake;
   std::map<const server::Connection*, Subscriber> subscribers;
-  std::thread monitor_thread, sender_thread, worker;
+  std::vector<std::thread> monitor_threads;
+  std::thread sender_thread, worker;
   std::atomic<bool> worker_busy{false};
 
   static monitor::LiveMonitorOptions MonitorOptions(const episode_client::EpisodeClientOptions& c) {
@@ -142,20 +207,42 @@ struct LiveService::Impl {
     return o;
   }
 
-  explicit Impl(const episode_client::EpisodeClientOptions& c) : client(c), monitor(MonitorOptions(c)) {
-    monitor_thread = std::thread([this] {
-      while (!stop)
-        if (monitor.Poll(0.05) < 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    });
+  Impl(const std::vector<episode_client::EpisodeClientOptions>& trios, const std::string& url_text)
+      : client(trios.at(0)), lcm_url(url_text) {
+    for (const episode_client::EpisodeClientOptions& c : trios) {
+      urls.push_back(c.lcm_url);
+      monitors.push_back(std::make_unique<monitor::LiveMonitor>(MonitorOptions(c)));
+    }
+    for (const auto& m : monitors)
+      monitor_threads.emplace_back([this, dut = m.get()] {
+        while (!stop)
+          if (dut->Poll(0.05) < 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      });
     sender_thread = std::thread([this] { SendLoop(); });
   }
 
   ~Impl() {
     stop = true;
     wake.notify_all();
-    monitor_thread.join();
+    for (std::thread& t : monitor_threads) t.join();
     sender_thread.join();
     if (worker.joinable()) worker.join();
+  }
+
+  LiveView View() const {
+    long version = 0;
+    std::vector<MonitorSnapshot> trios;
+    for (const auto& m : monitors) {
+      version += m->version();  // before the snapshot: a change in between shows next time
+      trios.push_back(m->Snapshot());
+    }
+    return MergeTrios(std::move(trios), urls, version);
+  }
+
+  bool WithEpisode(int64_t id, const std::function<void(const EpisodeTrace&)>& read) const {
+    for (const auto& m : monitors)
+      if (m->WithEpisode(id, read)) return true;
+    return false;
   }
 
   void SendLoop() {
@@ -163,30 +250,29 @@ struct LiveService::Impl {
     while (!stop) {
       wake.wait_for(lock, std::chrono::milliseconds(10));
       if (stop || subscribers.empty()) continue;
-      const long version = monitor.version();
-      const MonitorSnapshot snapshot = monitor.Snapshot();
+      const LiveView view = View();
       for (auto it = subscribers.begin(); it != subscribers.end();) {
         auto connection = it->second.connection.lock();
         if (!connection || connection->closed()) {
           it = subscribers.erase(it);
           continue;
         }
-        Serve(snapshot, version, connection, &it->second);
+        Serve(view, connection, &it->second);
         ++it;
       }
     }
   }
 
   // The subscriber's live_status and frames that are due.
-  void Serve(const MonitorSnapshot& s, long version, const std::shared_ptr<server::Connection>& out,
-             Subscriber* sub) {
+  void Serve(const LiveView& s, const std::shared_ptr<server::Connection>& out, Subscriber* sub) {
+    const long version = s.version;
     const auto now = Clock::now();
     const EpisodeInfo* selected = Selected(s, sub->chosen);
     const std::string set = EpisodeSetKey(s);
     if (set != sub->episode_set ||
         (version != sub->status_version && now - sub->last_status >= kStatusPeriod)) {
       const int64_t id = selected ? selected->episode_id : 0;
-      out->Post(LiveStatusJson(s, client.lcm_url, client.transport.channel_prefix, selected ? &id : nullptr,
+      out->Post(LiveStatusJson(s, lcm_url, client.transport.channel_prefix, selected ? &id : nullptr,
                                out->dropped()),
                 "live_status");
       sub->episode_set = set, sub->status_version = version, sub->last_status = now;
@@ -196,7 +282,7 @@ struct LiveService::Impl {
         selected->episode_id != sub->framed_episode || selected->steps_done != sub->framed_steps;
     if (fresh && now - sub->last_frame >= kFramePeriod) {
       std::string frame;
-      monitor.WithEpisode(selected->episode_id, [&](const EpisodeTrace& e) {
+      WithEpisode(selected->episode_id, [&](const EpisodeTrace& e) {
         frame = monitor::EncodeViewFrame(InfoOf(e.info, out->dropped()), e.y.data(), e.u.data(), e.n.data(),
                                          e.info.highest_step + 1, sub->columns);
       });
@@ -218,7 +304,7 @@ struct LiveService::Impl {
   // A kind-2 frame of the whole episode (empty if it is not kept).
   std::string DataFrame(int64_t id, long dropped) const {
     std::string frame;
-    monitor.WithEpisode(id, [&](const EpisodeTrace& e) {
+    WithEpisode(id, [&](const EpisodeTrace& e) {
       frame = monitor::EncodeDataFrame(InfoOf(e.info, dropped), 0, e.y.data(), e.u.data(), e.n.data(),
                                        e.info.total_steps + 1);
     });
@@ -247,26 +333,30 @@ struct LiveService::Impl {
   }
 
   server::Reply Select(const nlohmann::json& request, const std::shared_ptr<server::Connection>& c) {
-    const auto id = request.find("episode_id");
-    if (id == request.end() || !id->is_number_integer())
-      return {400, {{"error", "live_select needs a whole-number episode_id"}}};
-    if (!monitor.WithEpisode(id->get<int64_t>(), [](const EpisodeTrace&) {}))
-      return {400, {{"error", "live_select: episode_id " + id->dump() + " is not one of the episodes kept"}}};
+    int64_t id = 0;
+    if (!EpisodeIdOf(request, &id))
+      return {400, {{"error", "live_select needs an episode_id (a whole number or its decimal text)"}}};
+    if (!WithEpisode(id, [](const EpisodeTrace&) {}))
+      return {
+          400,
+          {{"error", "live_select: episode_id " + std::to_string(id) + " is not one of the episodes kept"}}};
     std::lock_guard<std::mutex> lock(mutex);
     auto it = subscribers.find(c.get());
     if (it == subscribers.end()) return {400, {{"error", "live_select: live_subscribe first"}}};
-    it->second.chosen = id->get<int64_t>();
+    it->second.chosen = id;
     it->second.episode_set.clear();  // live_status at once, with the new selection
-    return {200, {{"type", "live_selected"}, {"episode_id", *id}}};
+    return {200, {{"type", "live_selected"}, {"episode_id", id}, {"episode_id_text", std::to_string(id)}}};
   }
 
   server::Reply Data(const nlohmann::json& request, const std::shared_ptr<server::Connection>& c) {
-    const auto id = request.find("episode_id");
-    if (id == request.end() || !id->is_number_integer())
-      return {400, {{"error", "live_data needs a whole-number episode_id"}}};
-    std::string frame = DataFrame(id->get<int64_t>(), c->dropped());
+    int64_t id = 0;
+    if (!EpisodeIdOf(request, &id))
+      return {400, {{"error", "live_data needs an episode_id (a whole number or its decimal text)"}}};
+    std::string frame = DataFrame(id, c->dropped());
     if (frame.empty())
-      return {400, {{"error", "live_data: episode_id " + id->dump() + " is not one of the episodes kept"}}};
+      return {
+          400,
+          {{"error", "live_data: episode_id " + std::to_string(id) + " is not one of the episodes kept"}}};
     c->PostBinary(std::move(frame));
     return {200, nullptr};  // the frame is the answer
   }
@@ -362,8 +452,9 @@ server::Reply LiveService::Impl::RunOnTrio(const nlohmann::json& request,
   return {200, {{"type", "run_on_trio_started"}, {"loop", "sampled"}}};
 }
 
-LiveService::LiveService(const episode_client::EpisodeClientOptions& client)
-    : impl_(std::make_unique<Impl>(client)) {}
+LiveService::LiveService(const std::vector<episode_client::EpisodeClientOptions>& trios,
+                         const std::string& lcm_url)
+    : impl_(std::make_unique<Impl>(trios, lcm_url)) {}
 
 LiveService::~LiveService() = default;
 
@@ -374,7 +465,7 @@ server::Reply LiveService::Answer(const std::string& type, const nlohmann::json&
     return {200,
             {{"type", "server_info"},
              {"live", true},
-             {"lcm_url", impl_->client.lcm_url},
+             {"lcm_url", impl_->lcm_url},
              {"channel_prefix", impl_->client.transport.channel_prefix},
              {"auth", auth}}};
   if (type == "run_on_trio") return impl_->RunOnTrio(request, connection);

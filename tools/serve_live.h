@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "pidlab/episode_client/episode_client.h"
 #include "pidlab/monitor/live_monitor.h"
@@ -18,10 +19,11 @@ namespace pidlab::cli {
 
 class LiveService {
  public:
-  /// Joins the trio of client.lcm_url with client.transport's prefix and
-  /// key; run_on_trio runs its episodes with `client`. Throws
-  /// std::runtime_error if LCM cannot start on the URL.
-  explicit LiveService(const episode_client::EpisodeClientOptions& client);
+  /// Watches the trio of each entry's lcm_url (one or several: `pidlab
+  /// launch --trios K`) with its prefix and key; run_on_trio runs its
+  /// episodes on the first. `lcm_url` is the --lcm-url text, echoed.
+  /// Throws std::runtime_error if LCM cannot start on a URL.
+  LiveService(const std::vector<episode_client::EpisodeClientOptions>& trios, const std::string& lcm_url);
   /// Stops the monitor and sender threads and joins them, and the
   /// run_on_trio worker (after its episode).
   ~LiveService();
@@ -48,8 +50,25 @@ void SetLiveService(LiveService* service);
 server::Reply AnswerLive(const std::string& type, const nlohmann::json& request,
                          const std::shared_ptr<server::Connection>& connection);
 
-/// The live_status object of `snapshot` (docs/live.md).
-nlohmann::json LiveStatusJson(const monitor::MonitorSnapshot& snapshot, const std::string& lcm_url,
+/// What the monitors of the trios watched hear, merged.
+struct LiveView {
+  /// Each trio's snapshot, in --lcm-url's order, and its URL.
+  std::vector<monitor::MonitorSnapshot> trios;
+  std::vector<std::string> trio_urls;
+  /// The episodes of every trio, oldest first (by when their configuration
+  /// was heard), at most kMaxShownEpisodes; trio_of[i] is episodes[i]'s trio, 1..K.
+  std::vector<monitor::EpisodeInfo> episodes;
+  std::vector<int> trio_of;
+  /// Moves when anything shown changes.
+  long version = 0;
+};
+inline constexpr std::size_t kMaxShownEpisodes = 32;
+/// Merges the trios' snapshots (taken in that order) into a LiveView.
+LiveView MergeTrios(std::vector<monitor::MonitorSnapshot> trios, std::vector<std::string> urls, long version);
+
+/// The live_status object of `view` (docs/live.md): health is the first
+/// trio's, and with several trios "trios" lists each one's URL and health.
+nlohmann::json LiveStatusJson(const LiveView& view, const std::string& lcm_url,
                               const std::string& channel_prefix, const int64_t* selected_episode_id,
                               long dropped_frames);
 

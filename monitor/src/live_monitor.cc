@@ -24,6 +24,9 @@ bool LiveMonitorOptions::IsValid(std::string* error) const {
     e = "max_episodes " + std::to_string(max_episodes) + " must be in 1..1024";
   else if (max_total_steps < 1 || max_total_steps > 100000000)
     e = "max_total_steps " + std::to_string(max_total_steps) + " must be in 1..1e8";
+  else if (max_kept_steps < max_total_steps || max_kept_steps > 1000000000)
+    e = "max_kept_steps " + std::to_string(max_kept_steps) + " must be in max_total_steps (" +
+        std::to_string(max_total_steps) + ")..1e9";
   else if (transport.drop_rate != 0.0)
     e = "a monitor does not inject faults: drop_rate must be 0";
   else
@@ -59,6 +62,8 @@ struct LiveMonitor::State {
   std::atomic<long> version{0};
   int max_episodes = 32;
   long max_total_steps = 0;
+  long max_kept_steps = 0;
+  long kept_steps = 0;  // total_steps + 1 summed over the episodes kept
 
   EpisodeTrace* Find(int64_t id) {
     for (EpisodeTrace& e : episodes)
@@ -82,6 +87,7 @@ struct LiveMonitor::State {
     }
     EpisodeTrace e;
     e.info.episode_id = m.episode_id;
+    e.info.first_heard_s = transport::NowSeconds();
     e.info.plant = m.plant_name;
     e.info.kp = m.kp, e.info.ki = m.ki, e.info.kd = m.kd;
     e.info.r = m.reference;
@@ -91,7 +97,13 @@ struct LiveMonitor::State {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     e.y.assign(size, nan), e.u.assign(size, nan), e.n.assign(size, nan);
     e.received.assign(size, false);
-    while (static_cast<int>(episodes.size()) >= max_episodes) episodes.pop_front();
+    const long steps = static_cast<long>(size);
+    while (!episodes.empty() &&
+           (static_cast<int>(episodes.size()) >= max_episodes || kept_steps + steps > max_kept_steps)) {
+      kept_steps -= episodes.front().info.total_steps + 1;
+      episodes.pop_front();
+    }
+    kept_steps += steps;
     episodes.push_back(std::move(e));
     Changed();
   }
@@ -187,6 +199,7 @@ void LiveMonitor::Subscribe() {
   state_ = std::make_unique<State>();
   state_->max_episodes = options_.max_episodes;
   state_->max_total_steps = options_.max_total_steps;
+  state_->max_kept_steps = options_.max_kept_steps;
   State* s = state_.get();
   using transport::Transport;
   transport_->Subscribe<pidlab::lcmt_episode_config>(

@@ -45,6 +45,8 @@ export function parseFrame(buffer) {
   return f;
 }
 
+// An episode's id as exact decimal text (live_status gives it: a double holds 53 bits).
+const idText = (e) => e.episode_id_text || String(e.episode_id);
 const nanToNull = (a) => Array.from(a, (v) => (Number.isNaN(v) ? null : v));
 
 let live = null;  // window.pidlab.live
@@ -100,9 +102,10 @@ function renderEpisodes(s) {
   body.textContent = '';
   for (const e of s.episodes) {
     const tr = document.createElement('tr');
-    tr.dataset.episodeId = String(e.episode_id);
-    if (e.episode_id === s.selected_episode_id) tr.classList.add('selected');
-    cell(tr, String(e.episode_id));
+    const id = idText(e);
+    tr.dataset.episodeId = id;
+    if (id === (s.selected_episode_id_text || String(s.selected_episode_id))) tr.classList.add('selected');
+    cell(tr, id + (e.trio > 1 ? ' (trio ' + e.trio + ')' : ''));
     cell(tr, e.plant);
     cell(tr, (e.gains || []).map((g) => String(+Number(g).toPrecision(6))).join(','));
     cell(tr, e.steps_done + '/' + (e.total_steps + 1));
@@ -110,7 +113,7 @@ function renderEpisodes(s) {
     st.dataset.status = e.status;
     const rt = cell(tr, e.realtime ? e.realtime.missed_deadlines + ' missed' : '-', 'realtime');
     if (e.realtime) rt.dataset.realtime = JSON.stringify(e.realtime);
-    tr.addEventListener('click', () => rawSend({ type: 'live_select', episode_id: e.episode_id }));
+    tr.addEventListener('click', () => rawSend({ type: 'live_select', episode_id: id }));
     body.append(tr);
   }
 }
@@ -170,10 +173,11 @@ function onStatus(s) {
   renderHealth(s);
   renderPacing(s);
   for (const e of s.episodes) {
-    if (e.status === 'complete' && !asked.has(e.episode_id)) {
-      asked.add(e.episode_id);
+    const id = idText(e);
+    if (e.status === 'complete' && !asked.has(id)) {
+      asked.add(id);
       // The reply is one kind-2 binary frame (onFrame), or an error line.
-      if (!rawSend({ type: 'live_data', episode_id: e.episode_id })) asked.delete(e.episode_id);
+      if (!rawSend({ type: 'live_data', episode_id: id })) asked.delete(id);
     }
   }
 }
@@ -182,7 +186,11 @@ function onFrame(buffer) {
   const f = parseFrame(buffer);
   if (!f) { console.warn('live: a binary frame that is not PLV1'); return; }
   if (f.kind === 2) {
-    live.final[f.episode_id] = { y: f.y, u: f.u, n: f.n };
+    // Keyed by the header's id (a double) and, when the status names it, by its exact text.
+    const data = { y: f.y, u: f.u, n: f.n };
+    live.final[f.episode_id] = data;
+    const e = ((live.status && live.status.episodes) || []).find((x) => x.episode_id === f.episode_id);
+    if (e && e.episode_id_text) live.final[e.episode_id_text] = data;
     return;
   }
   live.frames += 1;

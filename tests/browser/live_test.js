@@ -34,7 +34,7 @@ function replayCsv(file, steps, pageId) {
     const e = byId.get(c[0]);
     e.y.push(Number(c[4])); e.u.push(Number(c[5])); e.n.push(Number(c[6]));
   }
-  const found = [...byId.values()].filter((e) => e.y.length === steps + 1 && Number(e.id) === pageId);
+  const found = [...byId.values()].filter((e) => e.y.length === steps + 1 && e.id === pageId);
   if (found.length !== 1) throw new Error(found.length + ' episodes of ' + steps + ' steps and id ' + pageId + ' in the log');
   return found[0];
 }
@@ -106,7 +106,7 @@ async function main() {
         const s = window.pidlab.live.status;
         if (!s || !s.episodes.length) return false;
         const e = s.episodes[s.episodes.length - 1];
-        const row = document.querySelector('#live-episodes tr[data-episode-id="' + e.episode_id + '"] .status');
+        const row = document.querySelector('#live-episodes tr[data-episode-id="' + (e.episode_id_text || e.episode_id) + '"] .status');
         return e.status === 'complete' && row && row.dataset.status === 'complete' && window.pidlab.live.final[e.episode_id];
       });
       liveFinal = await page.evaluate(() => {
@@ -115,7 +115,7 @@ async function main() {
         const f = window.pidlab.live.final[e.episode_id];
         // The doubles' bytes, base64 (JSON would turn NaN into null).
         const b64 = (a) => { let t = ''; const b = new Uint8Array(a.buffer, a.byteOffset, a.byteLength); for (let i = 0; i < b.length; i += 8192) t += String.fromCharCode(...b.subarray(i, i + 8192)); return btoa(t); };
-        return { id: e.episode_id, y: b64(f.y), u: b64(f.u), n: b64(f.n), frames: window.pidlab.live.frames };
+        return { id: e.episode_id, idText: e.episode_id_text || String(e.episode_id), y: b64(f.y), u: b64(f.u), n: b64(f.n), frames: window.pidlab.live.frames };
       });
       const doubles = (t) => { const b = Buffer.from(t, 'base64'); return Array.from(new Float64Array(b.buffer, b.byteOffset, b.length / 8)); };
       for (const k of ['y', 'u', 'n']) liveFinal[k] = doubles(liveFinal[k]);
@@ -144,7 +144,7 @@ async function main() {
       const replay = JSON.parse(pidlab(['replay', '--json', log25]));
       const e = replay.episodes.find((x) => x.episode_id === liveFinal.id);
       if (!e || !e.complete) throw new Error('the log has no complete episode ' + liveFinal.id);
-      const want = replayCsv(log25, 25000, liveFinal.id);
+      const want = replayCsv(log25, 25000, liveFinal.idText);
       sameBits('y', liveFinal.y, want.y);
       sameBits('u', liveFinal.u, want.u);
       sameBits('n', liveFinal.n, want.n);

@@ -1,12 +1,19 @@
 """The client side of tests/cli/serve_live_test.sh: watches `pidlab serve
 --lcm-url` over its WebSocket while `pidlab evaluate --backend lcm` runs one
 episode on the trio, and checks the live scope's contract (docs/live.md).
-usage: serve_live_client.py PORT PIDLAB WORKDIR"""
-import json, math, struct, subprocess, sys, time
+With auth, a forged EPISODE_CONFIG (a well-formed message with a wrong MAC)
+is sent to the trio's group first: it must not be shown, and be counted.
+With realtime (a trio paced by `pidlab launch --realtime`), the episode's
+realtime in live_status must equal evaluate --json's realtime object.
+usage: serve_live_client.py PORT WORKDIR plain|auth|realtime PYTHON_MESSAGES_DIR PIDLAB EVALUATE_ARGS...
+(the command gets --json --trajectory-csv FILE appended)"""
+import json, math, os, socket, struct, subprocess, sys, time
 from serve_client import WebSocket
 
-port, pidlab, work = int(sys.argv[1]), sys.argv[2], sys.argv[3]
+port, work, mode, messages_dir, evaluate_command = int(sys.argv[1]), sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5:]
+# evaluate_command: the binary, then docs/live.md's arguments after 'pidlab'
 failures = 0
+FORGED_ID = 777
 
 
 def check(name, ok):
@@ -30,6 +37,21 @@ def frame(payload):
     return kind, h, arrays
 
 
+def send_forged_config():
+    """A well-formed lcmt_episode_config on PIDLAB_EPISODE_CONFIG with 32 random
+    bytes for its MAC, as LCM's UDP short message (docs/live.md)."""
+    sys.path.insert(0, messages_dir)
+    from pidlab import lcmt_episode_config
+    m = lcmt_episode_config()
+    m.episode_id, m.plant_name, m.total_steps, m.dt_s = FORGED_ID, 'forged', 10, 0.01
+    payload = m.encode() + os.urandom(32)
+    datagram = struct.pack('>II', 0x4c433032, 0) + b'PIDLAB_EPISODE_CONFIG\0' + payload
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+    s.sendto(datagram, ('239.255.76.67', 7667))
+    s.close()
+
+
 def same_bits(a, b):
     return len(a) == len(b) and all(struct.pack('<d', x) == struct.pack('<d', y) for x, y in zip(a, b))
 
@@ -37,16 +59,16 @@ def same_bits(a, b):
 ws = WebSocket(port)
 ws.s.settimeout(30)
 info = ws.ask({'type': 'server_info'})
-check('server_info says live, with the URL and prefix', info.get('live') is True and info.get('lcm_url') and
-      info.get('channel_prefix') == 'PIDLAB_' and info.get('auth') is False)
+check('server_info says live, with the URL, prefix and auth', info.get('live') is True and info.get('lcm_url') and
+      info.get('channel_prefix') == 'PIDLAB_' and info.get('auth') is (mode == 'auth'))
 bad = ws.ask({'type': 'live_subscribe', 'columns': 5})
 check('live_subscribe with 5 columns is refused naming them', 'columns 5' in bad.get('error', ''))
 ws.send(json.dumps({'type': 'live_subscribe', 'columns': 200}))
 
-# One episode over the trio: 2001 steps at dt = 1 ms.
-evaluate = subprocess.Popen([pidlab, 'evaluate', '--backend', 'lcm', '--plant', 'oscillator', '--gains', '2,1,1.5',
-                             '--loop', 'sampled', '--dt', '0.001', '--horizon', '2', '--json',
-                             '--trajectory-csv', work + '/trajectory.csv'], stdout=subprocess.PIPE)
+if mode == 'auth': send_forged_config()
+# One episode over the trio (docs/live.md's: 2001 steps at dt = 1 ms).
+evaluate = subprocess.Popen(evaluate_command + ['--json', '--trajectory-csv', work + '/trajectory.csv'],
+                            stdout=subprocess.PIPE)
 views, final, status, subscribed = [], None, None, False
 deadline = time.monotonic() + 60
 while time.monotonic() < deadline and (final is None or status is None or
@@ -86,14 +108,33 @@ ep = status['episodes'][-1] if status and status['episodes'] else {}
 check('live_status shows the episode complete with every step',
       ep.get('status') == 'complete' and ep.get('steps_done') == steps and ep.get('plant') == 'oscillator' and
       ep.get('gains') == [2, 1, 1.5] and ep.get('total_steps') == steps - 1)
+evaluated = json.loads(evaluate_out) if evaluate.returncode == 0 else {}
+if mode == 'realtime':
+    check('a paced episode shows the realtime object evaluate --json prints, exactly',
+          'realtime' in evaluated and ep.get('realtime') == evaluated['realtime'])
+else:
+    check('an unpaced episode shows realtime null', 'realtime' not in evaluated and ep.get('realtime') is None)
 roles = status['health']['roles'] if status else {}
 check('live_status hears the plant, controller, disturbance and client',
       all(roles.get(r, {}).get('last_heard_s') is not None for r in ('plant', 'controller', 'disturbance', 'client')))
-check('the health counts received messages and no forged ones',
-      status and status['health']['received'] > 0 and status['health']['unauthenticated'] == 0)
+if mode == 'auth':
+    check('the forged configuration is not shown and is counted unauthenticated',
+          status and all(e['episode_id'] != FORGED_ID for e in status['episodes']) and
+          status['health']['unauthenticated'] >= 1)
+else:
+    check('the health counts received messages and no forged ones',
+          status and status['health']['received'] > 0 and status['health']['unauthenticated'] == 0)
 
-# live_data: the same bytes as the final frame, never dropped.
-ws.send(json.dumps({'type': 'live_data', 'episode_id': ep.get('episode_id', 0)}))
+check('live_status gives each id as exact decimal text too (JavaScript holds 53 bits)',
+      ep.get('episode_id_text') == str(ep.get('episode_id')) and
+      status.get('selected_episode_id_text') == str(ep.get('episode_id')))
+ws.send(json.dumps({'type': 'live_select', 'episode_id': ep.get('episode_id_text', '')}))
+while True:
+    op, payload = ws.recv()
+    if op == 1 and json.loads(payload).get('type') in ('live_selected', None): break
+check('live_select takes the id as its text', json.loads(payload).get('episode_id') == ep.get('episode_id'))
+# live_data (the id as text): the same bytes as the final frame, never dropped.
+ws.send(json.dumps({'type': 'live_data', 'episode_id': ep.get('episode_id_text', '')}))
 data = None
 while data is None:
     op, payload = ws.recv()

@@ -5,14 +5,17 @@
 # final kind-2 frame equals the episode's trajectory bit for bit, the status
 # shows it complete, live_data answers the same, run_on_trio agrees with the
 # prediction bit for bit; without --lcm-url the live requests answer 400 and
-# --auth-key or --channel-prefix exit 2 with one line; the commands of
-# docs/live.md run.
+# --auth-key or --channel-prefix exit 2 with one line; with an auth key a
+# forged message is not shown and is counted. The trio parts run the commands
+# of docs/live.md as written there. Two trios of `pidlab launch --trios 2` are
+# watched at once while `pidlab tune` runs its episodes on both.
 set -uo pipefail
-if [[ $# -ne 1 ]]; then
-  echo "usage: $0 PIDLAB_BINARY" >&2
+if [[ $# -ne 2 ]]; then
+  echo "usage: $0 PIDLAB_BINARY PYTHON_MESSAGES_DIR" >&2
   exit 2
 fi
 pidlab=$(realpath -- "$1")
+messages=$(realpath -- "$2")  # the messages as Python classes (lcm-gen), to forge one
 here=$(cd "$(dirname -- "$0")" && pwd)
 if [[ ${PIDLAB_TEST_IN_NAMESPACE:-} != 1 ]]; then
   PIDLAB_TEST_IN_NAMESPACE=1 exec unshare -n bash "$0" "$@"
@@ -22,6 +25,7 @@ ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev
   exit 1
 }
 source "$here/stderr_shape.sh"
+docs=$(cd "$here/../../docs" && pwd)/live.md
 pass=0; fail=0
 check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
@@ -59,24 +63,88 @@ check "without --lcm-url live_subscribe answers the contract's error" \
 kill -TERM "$server"; wait "$server"
 check "SIGTERM stops the server with status 0" "[ $? -eq 0 ]"
 
-# The live scope on a trio: `pidlab launch` runs this script's second half.
-cat > inner.sh <<'INNER'
+# The live scope on a trio, with the commands of docs/live.md as written there:
+# each bash block starts the trio (`pidlab launch ...`, waited for until it
+# says it is ready), the server (`pidlab serve ...`, until it prints its URL)
+# and has the client run the block's `pidlab evaluate ...` while it watches.
+# A block's other lines (the key file) run first.
+run_block() {
+  local mode=$1 launch=$2 serve=$3 evaluate=$4 line words
+  rm -f launch.err serve.out
+  eval "words=($launch)"; "$pidlab" "${words[@]:1}" > launch.out 2> launch.err &
+  local trio=$!
+  for _ in $(seq 200); do grep -q 'trio ready' launch.err && break; sleep 0.05; done
+  eval "words=($serve)"; "$pidlab" "${words[@]:1}" > serve.out 2> serve.err &
+  local server=$!
+  for _ in $(seq 200); do grep -q '^pidlab serve: http' serve.out && break; sleep 0.05; done
+  port=$(sed -nE 's#^pidlab serve: http://[^/]*:([0-9]+)/.*#\1#p' serve.out | head -1)
+  eval "words=($evaluate)"
+  PYTHONPATH="$here" timeout 200 /usr/bin/python3 "$here/serve_live_client.py" "$port" "$PWD" "$mode" \
+    "$messages" "$pidlab" "${words[@]:1}" > client.out 2>&1
+  local status=$?
+  sed "s/^/  [$mode] /" client.out
+  check "docs/live.md block $mode: the live scope's checks pass (exit $status)" \
+    "[ $status -eq 0 ] && ! grep -q '^FAIL' client.out"
+  kill -TERM "$server"; wait "$server"
+  check "docs/live.md block $mode: SIGTERM stops the live server with status 0" "[ $? -eq 0 ]"
+  kill -INT "$trio"; wait "$trio"
+}
+n_blocks=0
+while IFS= read -r -d $'\x1e' block; do
+  launch=$(grep '^pidlab launch' <<<"$block") serve=$(grep '^pidlab serve' <<<"$block")
+  evaluate=$(grep '^pidlab evaluate' <<<"$block")
+  grep -v '^pidlab ' <<<"$block" | grep . > setup.sh && bash setup.sh
+  mode=plain; [[ $serve == *--auth-key* ]] && mode=auth; [[ $launch == *--realtime* ]] && mode=realtime
+  n_blocks=$((n_blocks + 1))
+  run_block "$mode" "$launch" "$serve" "$evaluate"
+done < <(awk '/^```bash/{on=1; next} /^```/{if (on) printf "\x1e"; on=0} on' "$docs")
+check "docs/live.md has 3 blocks of commands (found $n_blocks)" "[ $n_blocks -eq 3 ]"
+
+# Several trios (`pidlab launch --trios 2`) watched at once while a tuning
+# runs its episodes on both: every episode shown with its trio, each trio's
+# health listed with its URL.
+cat > trios.sh <<'TRIOS'
 set -u
 pidlab=$1 here=$2
-"$pidlab" serve --port 0 --lcm-url "$PIDLAB_LCM_URL" > serve.out 2> serve.err &
+"$pidlab" serve --port 0 --lcm-url "$PIDLAB_LCM_URLS" > trios_serve.out 2> trios_serve.err &
 server=$!
-for _ in $(seq 200); do grep -q '^pidlab serve: http' serve.out && break; sleep 0.05; done
-port=$(sed -nE 's#^pidlab serve: http://[^/]*:([0-9]+)/.*#\1#p' serve.out | head -1)
-PYTHONPATH="$here" /usr/bin/python3 "$here/serve_live_client.py" "$port" "$pidlab" "$PWD"
+for _ in $(seq 200); do grep -q '^pidlab serve: http' trios_serve.out && break; sleep 0.05; done
+port=$(sed -nE 's#^pidlab serve: http://[^/]*:([0-9]+)/.*#\1#p' trios_serve.out | head -1)
+PYTHONPATH="$here" timeout 120 /usr/bin/python3 - "$port" "$pidlab" "$PIDLAB_LCM_URLS" <<'PY'
+import json, re, subprocess, sys, time
+from serve_client import WebSocket
+port, pidlab, urls = int(sys.argv[1]), sys.argv[2], re.split('[ ,]+', sys.argv[3].strip())
+ws = WebSocket(port); ws.s.settimeout(30)
+ws.send(json.dumps({'type': 'live_subscribe'}))
+tune = subprocess.run([pidlab, 'tune', '--backend', 'lcm', '--plant', 'oscillator', '--loop', 'sampled', '--dt', '0.01',
+                       '--horizon', '2', '--max-evals', '12', '--starts', '2', '--json', '--quiet'],
+                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+print(('ok   ' if tune.returncode == 0 else 'FAIL ') + 'pidlab tune --backend lcm ran over both trios')
+status, deadline = None, time.monotonic() + 20
+while time.monotonic() < deadline:
+    op, payload = ws.recv()
+    if op != 1: continue
+    m = json.loads(payload)
+    if m.get('type') != 'live_status': continue
+    status = m
+    eps = m['episodes']
+    if eps and all(e['status'] == 'complete' for e in eps) and {1, 2} <= {e['trio'] for e in eps}: break
+eps = status['episodes'] if status else []
+ok = bool(eps) and all(e['status'] == 'complete' for e in eps) and {e['trio'] for e in eps} == {1, 2}
+print(('ok   ' if ok else 'FAIL ') + 'the tuning\'s %d episodes show complete, from trio 1 and trio 2' % len(eps))
+trios = status.get('trios', []) if status else []
+ok = [t['lcm_url'] for t in trios] == urls and all(t['health']['roles']['plant']['pid'] for t in trios)
+print(('ok   ' if ok else 'FAIL ') + 'live_status lists each trio with its URL and its plant heard')
+PY
 status=$?
 kill -TERM "$server"; wait "$server" || status=1
 exit $status
-INNER
-timeout 240 "$pidlab" launch --quiet -- bash inner.sh "$pidlab" "$here" > live.out 2> live.err
+TRIOS
+timeout 200 "$pidlab" launch --quiet --trios 2 -- bash trios.sh "$pidlab" "$here" > trios.out 2> trios.err
 status=$?
-cat live.out
-check "the live scope's checks pass over a launched trio (exit $status)" "[ $status -eq 0 ] && ! grep -q '^FAIL' live.out"
-[ $status -eq 0 ] || { echo "--- stderr"; tail -n 20 live.err; tail -n 5 serve.err 2>/dev/null; }
+sed 's/^/  [trios] /' trios.out
+check "two trios watched at once (exit $status)" "[ $status -eq 0 ] && ! grep -q '^FAIL' trios.out"
+[ $status -eq 0 ] || tail -n 5 trios.err
 
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -42,6 +42,11 @@ struct LiveMonitorOptions {
   /// Longest episode kept (total_steps); a configuration beyond it is
   /// counted in rejected and not shown. 1..1e8 (three doubles per step).
   long max_total_steps = 10000000;
+  /// Steps of all the episodes kept together: the oldest are dropped to
+  /// make room for a new one (memory: about 25 bytes a step, so at most
+  /// about 500 MB however many configurations a stranger sends).
+  /// max_total_steps..1e9.
+  long max_kept_steps = 20000000;
 
   /// Names the field, its value and the rule on failure.
   bool IsValid(std::string* error) const;
@@ -67,6 +72,9 @@ struct PacingProgress {
 /// One episode's figures, without its trajectory.
 struct EpisodeInfo {
   int64_t episode_id = 0;
+  /// transport::NowSeconds() when its configuration was heard (orders the
+  /// episodes of several monitors).
+  double first_heard_s = 0.0;
   std::string plant;
   double kp = 0.0, ki = 0.0, kd = 0.0;
   double r = 0.0;
