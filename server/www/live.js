@@ -163,6 +163,9 @@ function renderPacing(s) {
     });
   }
   rows(box.querySelector('table.realtime tbody'), e && e.realtime ? Object.entries(e.realtime) : []);
+  box.querySelector('.note').textContent = !e ? 'no episode yet'
+    : p || e.realtime ? (e.realtime ? 'the episode\'s deadline statistics (its SUMMARY):' : 'running, paced')
+      : 'episode ' + idText(e) + ' is not paced (pidlab launch --realtime paces the plant)';
 }
 
 function onStatus(s) {
