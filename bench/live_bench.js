@@ -6,7 +6,31 @@ const path = require('path');
 const { execFile, spawn } = require('child_process');
 const { parseArgs, launch, waitForPage } = require('../tests/browser/page_driver.js');
 
-const args = parseArgs(process.argv.slice(2), ['url', 'pidlab', 'modules', 'chromium', 'tmp', 'lcm-url', 'pairs']);
+const args = parseArgs(process.argv.slice(2), ['url', 'pidlab', 'modules', 'chromium', 'tmp', 'lcm-url', 'pairs', 'server-pid']);
+// The CPU seconds (user + system) process PID has used so far.
+function cpuSeconds(pid) {
+  const stat = fs.readFileSync('/proc/' + pid + '/stat', 'utf8');
+  const f = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
+  return (Number(f[11]) + Number(f[12])) / 100;  // utime, stime in clock ticks (USER_HZ 100)
+}
+// The CPU seconds of process ROOT and all its descendants (Chromium's processes).
+function treeCpuSeconds(root) {
+  const parent = new Map();
+  for (const d of fs.readdirSync('/proc')) {
+    if (!/^\d+$/.test(d)) continue;
+    try {
+      const stat = fs.readFileSync('/proc/' + d + '/stat', 'utf8');
+      parent.set(Number(d), Number(stat.slice(stat.lastIndexOf(')') + 2).split(' ')[1]));
+    } catch (e) { /* gone meanwhile */ }
+  }
+  let total = 0;
+  for (const pid of parent.keys()) {
+    let p = pid;
+    while (p > 1 && p !== root) p = parent.get(p) || 0;
+    if (p === root) { try { total += cpuSeconds(pid); } catch (e) { /* gone */ } }
+  }
+  return total;
+}
 const median = (a) => { const s = [...a].sort((x, y) => x - y); const m = s.length >> 1; return s.length % 2 ? s[m] : (s[m - 1] + s[m]) / 2; };
 
 function evaluate(dt, horizon) {
@@ -38,16 +62,28 @@ async function main() {
     await waitForPage(session, 'subscription state', 10000, (w) => window.pidlab.live.subscribed === w, watched);
   };
   const rate = { none: [], watched: [] };
+  const cpu = { none: [], watched: [] };  // the server's CPU microseconds per lockstep step
+  const browserCpu = { none: [], watched: [] };  // Chromium's, all its processes
+  const chromium = browser.process().pid;
   await evaluate(0.001, 2);  // warm-up
   for (let i = 0; i < Number(args.pairs); ++i) {
     for (const mode of ['none', 'watched']) {
       await setWatched(mode === 'watched');
+      const cpu0 = cpuSeconds(args['server-pid']), browser0 = treeCpuSeconds(chromium);
       const r = await evaluate(0.001, 10);
+      const perStep = ((cpuSeconds(args['server-pid']) - cpu0) / 10000) * 1e6;
+      browserCpu[mode].push(((treeCpuSeconds(chromium) - browser0) / 10000) * 1e6);
       rate[mode].push(r.steps_per_second);
-      console.log('run ' + (2 * i + (mode === 'watched' ? 2 : 1)) + ' ' + mode.padEnd(7) + ' ' + r.steps_per_second.toFixed(0) + ' steps/s');
+      cpu[mode].push(perStep);
+      console.log('run ' + (2 * i + (mode === 'watched' ? 2 : 1)) + ' ' + mode.padEnd(7) + ' ' + r.steps_per_second.toFixed(0) +
+                  ' steps/s, server ' + perStep.toFixed(1) + ' us CPU per step, Chromium ' +
+                  browserCpu[mode][browserCpu[mode].length - 1].toFixed(1) + ' us');
     }
   }
   const ratio = median(rate.watched) / median(rate.none);
+  console.log('server CPU per step (10 ms resolution over 10000 steps: 1 us): none median ' + median(cpu.none).toFixed(1) +
+              ' us, watched median ' + median(cpu.watched).toFixed(1) + ' us; Chromium none ' +
+              median(browserCpu.none).toFixed(1) + ' us, watched ' + median(browserCpu.watched).toFixed(1) + ' us');
   const pairRatios = rate.watched.map((w, i) => w / rate.none[i]);
   console.log('lockstep steps/s: none median ' + median(rate.none).toFixed(0) + ', watched median ' +
               median(rate.watched).toFixed(0) + ', ratio ' + ratio.toFixed(3) + ' (target >= 0.9); pairs ' +

@@ -7,11 +7,12 @@
 # (requestAnimationFrame, counted in the browser) while a trio at dt = 1e-4 s
 # (10 kHz of simulated time, unpaced) streams. Headless Chromium through
 # puppeteer-core (bench/live_bench.js), all in a private network namespace.
-# Targets: ratio watched/none >= 0.9, page >= 30 fps. Prints the machine's
-# load; exit 1 when a target is missed.
+# Also the server's CPU time per lockstep step in each mode (/proc). Targets:
+# ratio watched/none >= 0.9, page >= 30 fps. Prints the machine's load; exit 1
+# when a target is missed.
 #   bench/live_bench.sh [PIDLAB] [PAIRS]     (root; defaults build/bin/pidlab 5)
 set -euo pipefail
-case "${1:-}" in -h|--help) sed -n '2,12p' "$0"; exit 0 ;; esac
+case "${1:-}" in -h|--help) sed -n '2,14p' "$0"; exit 0 ;; esac
 pidlab=${1:-}
 [ -z "$pidlab" ] || pidlab=$(realpath -m -- "$pidlab")
 cd "$(dirname "$0")/.."
@@ -41,4 +42,4 @@ until grep -q '^pidlab serve: http' "$tmp/serve.out" || ((SECONDS > deadline)); 
 url=$(sed -n 's/^pidlab serve: //p' "$tmp/serve.out" | head -1)
 [ -n "$url" ] || { echo "live_bench.sh: pidlab serve printed no URL: $(head -c 300 "$tmp/serve.err")" >&2; exit 1; }
 node bench/live_bench.js --url "$url" --pidlab "$(realpath "$pidlab")" --modules "$PWD/node_modules" \
-  --chromium "$chromium" --tmp "$tmp" --lcm-url "$lcm_url" --pairs "$pairs"
+  --chromium "$chromium" --tmp "$tmp" --lcm-url "$lcm_url" --pairs "$pairs" --server-pid "$server"

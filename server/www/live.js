@@ -87,7 +87,13 @@ function tick(now) {
   while (ticks.length && ticks[0] < now - 1000) ticks.shift();
   if (ticks.length > 1) live.fps = ((ticks.length - 1) * 1000) / (ticks[ticks.length - 1] - ticks[0]);
   if (latest) { const f = latest; latest = null; draw(f); }
-  requestAnimationFrame(tick);
+  // Only while the Live tab is subscribed: a hidden tab costs no frames.
+  if (live.subscribed) requestAnimationFrame(tick); else { looping = false; ticks.length = 0; live.fps = 0; }
+}
+
+let looping = false;
+function startLoop() {
+  if (!looping) { looping = true; requestAnimationFrame(tick); }
 }
 function cell(tr, text, cls) {
   const td = document.createElement('td');
@@ -210,6 +216,7 @@ function show(active) {
   if (active && !live.subscribed) {
     const columns = Math.max(16, Math.min(4096, Math.round($('live-plots').clientWidth || 1000)));
     live.subscribed = rawSend({ type: 'live_subscribe', columns });
+    if (live.subscribed) startLoop();
   } else if (!active && live.subscribed) {
     live.subscribed = !rawSend({ type: 'live_unsubscribe' });
   }
@@ -220,7 +227,6 @@ export function initLive({ rawSend: send }) {
   live = { status: null, frames: 0, fps: 0, ticks: 0, final: {}, drawn: 0, dropped_frames: 0, subscribed: false };
   window.pidlab.live = live;
   rawSend = send;
-  requestAnimationFrame(tick);
   return { onMessage, onFrame, show };
 }
 
