@@ -80,6 +80,12 @@ if [[ $code != 413 ]] || ! grep -q "limit of 16777216 bytes" "$tmp/413.json"; th
   exit 1
 fi
 echo "ok   a 17 MiB upload with --max-upload-mb 16 is refused: 413 $(cat "$tmp/413.json")"
+# The token, Host and Origin rules of /api/request, on the upload's headers.
+for header in "Origin: http://evil.example" "Host: evil.example:80"; do
+  code=$(curl -s -o "$tmp/refused.json" -w '%{http_code}' -H "$header" --data-binary 'x' "$base/api/upload?name=a.lcmlog")
+  if [[ $code != 403 ]]; then echo "FAIL: an upload with '$header': HTTP $code"; exit 1; fi
+  echo "ok   an upload with '$header': 403 $(cat "$tmp/refused.json")"
+done
 code=$(curl -s -o "$tmp/bad.json" -w '%{http_code}' --data-binary 'x' "$base/api/upload?name=../x")
 if [[ $code != 400 ]]; then echo "FAIL: upload name ../x: HTTP $code"; exit 1; fi
 echo "ok   upload name ../x: 400 $(cat "$tmp/bad.json")"
