@@ -198,6 +198,7 @@ struct LiveService::Impl {
   std::vector<std::thread> monitor_threads;
   std::thread sender_thread, worker;
   std::atomic<bool> worker_busy{false};
+  bool dirty = false;  // a subscriber came or chose: serve it even if nothing was heard (under mutex)
 
   static monitor::LiveMonitorOptions MonitorOptions(const episode_client::EpisodeClientOptions& c) {
     monitor::LiveMonitorOptions o;
@@ -229,6 +230,12 @@ struct LiveService::Impl {
     if (worker.joinable()) worker.join();
   }
 
+  long Version() const {
+    long version = 0;
+    for (const auto& m : monitors) version += m->version();
+    return version;
+  }
+
   LiveView View() const {
     long version = 0;
     std::vector<MonitorSnapshot> trios;
@@ -247,28 +254,42 @@ struct LiveService::Impl {
 
   void SendLoop() {
     std::unique_lock<std::mutex> lock(mutex);
+    long served_version = -1;
+    auto served_at = Clock::now();
     while (!stop) {
       wake.wait_for(lock, std::chrono::milliseconds(10));
       if (stop || subscribers.empty()) continue;
+      // Nothing heard and nobody new: nothing to send (a closed connection
+      // is let go within a second).
+      const auto now = Clock::now();
+      if (Version() == served_version && !dirty && now - served_at < std::chrono::seconds(1)) continue;
+      dirty = false;
+      served_at = now;
       const LiveView view = View();
+      bool all_sent = true;
       for (auto it = subscribers.begin(); it != subscribers.end();) {
         auto connection = it->second.connection.lock();
         if (!connection || connection->closed()) {
           it = subscribers.erase(it);
           continue;
         }
-        Serve(view, connection, &it->second);
+        all_sent = Serve(view, connection, &it->second) && all_sent;
         ++it;
       }
+      served_version = all_sent ? view.version : -1;  // held back by a rate: look again
     }
   }
 
-  // The subscriber's live_status and frames that are due.
-  void Serve(const LiveView& s, const std::shared_ptr<server::Connection>& out, Subscriber* sub) {
+  // Posts the subscriber's live_status and frames that are due; false if a
+  // change was held back by the rates (10 statuses, 30 frames a second).
+  bool Serve(const LiveView& s, const std::shared_ptr<server::Connection>& out, Subscriber* sub) {
+    bool all_sent = true;
     const long version = s.version;
     const auto now = Clock::now();
     const EpisodeInfo* selected = Selected(s, sub->chosen);
     const std::string set = EpisodeSetKey(s);
+    const bool status_due = set != sub->episode_set || version != sub->status_version;
+    if (status_due && set == sub->episode_set && now - sub->last_status < kStatusPeriod) all_sent = false;
     if (set != sub->episode_set ||
         (version != sub->status_version && now - sub->last_status >= kStatusPeriod)) {
       const int64_t id = selected ? selected->episode_id : 0;
@@ -277,9 +298,10 @@ struct LiveService::Impl {
                 "live_status");
       sub->episode_set = set, sub->status_version = version, sub->last_status = now;
     }
-    if (!selected) return;
+    if (!selected) return all_sent;
     const bool fresh =
         selected->episode_id != sub->framed_episode || selected->steps_done != sub->framed_steps;
+    if (fresh && now - sub->last_frame < kFramePeriod) all_sent = false;
     if (fresh && now - sub->last_frame >= kFramePeriod) {
       std::string frame;
       WithEpisode(selected->episode_id, [&](const EpisodeTrace& e) {
@@ -299,6 +321,13 @@ struct LiveService::Impl {
       sub->final_sent[selected->episode_id] = true;
       out->PostBinary(DataFrame(selected->episode_id, out->dropped()));
     }
+    if (sub->final_sent.size() > 2 * kMaxShownEpisodes) {  // forget the episodes no longer kept
+      std::map<int64_t, bool> kept;
+      for (const EpisodeInfo& e : s.episodes)
+        if (sub->final_sent.count(e.episode_id)) kept[e.episode_id] = true;
+      sub->final_sent = std::move(kept);
+    }
+    return all_sent;
   }
 
   // A kind-2 frame of the whole episode (empty if it is not kept).
@@ -328,6 +357,7 @@ struct LiveService::Impl {
     sub = Subscriber{};
     sub.connection = c;
     sub.columns = columns;
+    dirty = true;
     wake.notify_all();
     return {200, {{"type", "live_subscribed"}, {"columns", columns}}};
   }
@@ -345,6 +375,7 @@ struct LiveService::Impl {
     if (it == subscribers.end()) return {400, {{"error", "live_select: live_subscribe first"}}};
     it->second.chosen = id;
     it->second.episode_set.clear();  // live_status at once, with the new selection
+    dirty = true;
     return {200, {{"type", "live_selected"}, {"episode_id", id}, {"episode_id_text", std::to_string(id)}}};
   }
 

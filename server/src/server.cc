@@ -276,9 +276,10 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
       if (replace_key.empty()) {
         ordered_.push_back({std::move(message), binary});
       } else {
-        if (waiting_.count(replace_key)) {
+        const auto replaced = waiting_.find(replace_key);
+        if (replaced != waiting_.end()) {
           server_->Count(&ServerCounters::dropped_replies);
-          connection_->CountDropped();
+          if (replaced->second.binary) connection_->CountDropped();
         }
         waiting_[replace_key] = {std::move(message), binary};
       }

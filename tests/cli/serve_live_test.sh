@@ -8,7 +8,8 @@
 # --auth-key or --channel-prefix exit 2 with one line; with an auth key a
 # forged message is not shown and is counted. The trio parts run the commands
 # of docs/live.md as written there. Two trios of `pidlab launch --trios 2` are
-# watched at once while `pidlab tune` runs its episodes on both.
+# watched at once while `pidlab tune` runs its episodes on both. A slow
+# client's view frames are dropped (latest wins) and counted.
 set -uo pipefail
 if [[ $# -ne 2 ]]; then
   echo "usage: $0 PIDLAB_BINARY PYTHON_MESSAGES_DIR" >&2
@@ -145,6 +146,59 @@ status=$?
 sed 's/^/  [trios] /' trios.out
 check "two trios watched at once (exit $status)" "[ $status -eq 0 ] && ! grep -q '^FAIL' trios.out"
 [ $status -eq 0 ] || tail -n 5 trios.err
+
+# A slow client (a 4 KiB receive buffer, not reading while a 50 001-step
+# episode streams 4096-column views of 98 KB): views are replaced, not
+# queued, and counted in its frames' headers and its live_status; the final
+# kind-2 frame is never dropped.
+cat > slow.sh <<'SLOW'
+set -u
+pidlab=$1 here=$2
+"$pidlab" serve --port 0 --lcm-url "$PIDLAB_LCM_URL" > slow_serve.out 2> slow_serve.err &
+server=$!
+for _ in $(seq 200); do grep -q '^pidlab serve: http' slow_serve.out && break; sleep 0.05; done
+port=$(sed -nE 's#^pidlab serve: http://[^/]*:([0-9]+)/.*#\1#p' slow_serve.out | head -1)
+PYTHONPATH="$here" timeout 120 /usr/bin/python3 - "$port" "$pidlab" <<'PY'
+import json, socket, struct, subprocess, sys
+import serve_client
+def small_buffer_connection(address, timeout=None):
+    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    s.settimeout(timeout)
+    s.connect(address)
+    return s
+serve_client.socket.create_connection = small_buffer_connection
+ws = serve_client.WebSocket(int(sys.argv[1])); ws.s.settimeout(60)
+ws.send(json.dumps({'type': 'live_subscribe', 'columns': 4096}))
+run = subprocess.run([sys.argv[2], 'evaluate', '--backend', 'lcm', '--plant', 'oscillator', '--gains', '2,1,1.5',
+                      '--loop', 'sampled', '--dt', '0.0001', '--horizon', '5'], stdout=subprocess.DEVNULL)
+final = None
+while final is None:
+    op, payload = ws.recv()
+    if op == 2 and struct.unpack_from('<I', payload, 4)[0] == 2: final = struct.unpack_from('<8d', payload, 8)
+ws.send(json.dumps({'type': 'server_info'}))
+dropped = None
+while True:
+    op, payload = ws.recv()
+    m = json.loads(payload) if op == 1 else {}
+    if m.get('type') == 'live_status': dropped = m['dropped_frames']
+    if m.get('type') == 'server_info': break
+def check(name, ok): print(('ok   ' if ok else 'FAIL ') + name)
+check('the episode ran', run.returncode == 0)
+check('the final frame came whole (50 001 steps) with dropped views counted (%d)' % final[7],
+      final[2] == 50001 and final[6] == 50001 and final[7] > 0)
+check('live_status counts the same connection\'s dropped frames (%s)' % dropped,
+      dropped is not None and dropped >= final[7])
+PY
+status=$?
+kill -TERM "$server"; wait "$server" || status=1
+exit $status
+SLOW
+timeout 200 "$pidlab" launch --quiet -- bash slow.sh "$pidlab" "$here" > slow.out 2> slow.err
+status=$?
+sed 's/^/  [slow] /' slow.out
+check "a slow client's views are dropped and counted (exit $status)" "[ $status -eq 0 ] && ! grep -q '^FAIL' slow.out"
+[ $status -eq 0 ] || tail -n 5 slow.err
 
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

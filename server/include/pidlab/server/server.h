@@ -72,8 +72,9 @@ class Connection {
   /// replace-latest rule (the live scope's frames); false if it has closed.
   virtual bool PostBinary(std::string bytes, const std::string& replace_key = "") = 0;
   virtual bool closed() const = 0;
-  /// This connection's messages replaced by a newer one of the same key
-  /// before they were written (also counted in ServerCounters::dropped_replies).
+  /// This connection's binary messages (frames) replaced by a newer one of
+  /// the same key before they were written (ServerCounters::dropped_replies
+  /// counts every replaced message of every connection).
   long dropped() const { return dropped_; }
   /// The handler's own state for this connection (its running tuning),
   /// touched on the server's thread only; released when the connection closes.
