@@ -199,16 +199,10 @@ struct ReplayCommand {
   // Appends the episode's JSON to *episodes_json and its lines to *table;
   // false if --redrive found a mismatch.
   bool ReportEpisode(const replay::Episode& e, nlohmann::json* episodes_json, std::ostream* table) const {
-    nlohmann::json j = json::EpisodeJson(e);
     Evaluation ev;
-    std::string why;
-    const bool evaluated = replay::EvaluateEpisode(e, &ev, &why);
-    if (evaluated) {
-      j["evaluation"] = cli::ToJson(ev);
-    } else {
-      j["evaluation"] = nullptr;
-      j["evaluation_error"] = why;
-    }
+    bool evaluated = false;
+    nlohmann::json j = json::EvaluatedEpisodeJson(e, &ev, &evaluated);
+    const std::string why = evaluated ? "" : j["evaluation_error"].get<std::string>();
     TableRow(e, evaluated ? Full(ev.iae) : "-", table);
     StreamDetails("plant outputs", e.outputs, table);
     StreamDetails("commands", e.commands, table);

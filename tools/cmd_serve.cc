@@ -3,6 +3,7 @@
 #include <sodium.h>
 
 #include <csignal>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -13,6 +14,7 @@
 #include "pidlab/server/assets.h"
 #include "pidlab/server/server.h"
 #include "serve_live.h"
+#include "serve_logs.h"
 #include "serve_requests.h"
 
 namespace pidlab::cli {
@@ -28,6 +30,8 @@ constexpr std::size_t kMaxWatchedTrios = 64;  // pidlab launch --trios' bound
 struct ServeCommand {
   server::ServerOptions options;
   std::string token;
+  std::string log_dir = ".";
+  long max_upload_mb = 64;
   LcmFlags lcm;  // --lcm-url, --channel-prefix, --auth-key: the live scope (docs/live.md)
 
   std::function<int()> Register(CLI::App* app) {
@@ -38,6 +42,11 @@ struct ServeCommand {
     app->add_option("--port", options.port, "TCP port (0: any free port, printed)")->capture_default_str();
     app->add_option("--bind", options.bind,
                     "address to listen on; anything but loopback requires the token, printed once")
+        ->capture_default_str();
+    // The Logs tab (serve_logs.h).
+    app->add_option("--log-dir", log_dir,
+                    "the directory log_open paths are relative to (default: the current one)");
+    app->add_option("--max-upload-mb", max_upload_mb, "largest uploaded log, MiB (1..4096)")
         ->capture_default_str();
     app->add_option("--lcm-url", lcm.lcm_url,
                     "watch the trio on this LCM URL, or the trios of several, comma-separated (pidlab launch "
@@ -56,8 +65,11 @@ struct ServeCommand {
     if (!server::IsLoopback(options.bind)) options.token = RandomToken();
     std::string error;
     if (!options.IsValid(&error)) throw BadInput(error);
+    std::unique_ptr<LogStore> logs = ServedLogs();
     std::unique_ptr<LiveService> live = StartLive();
     server::Server s(options, server::ConnectionHandler(AnswerWorkbenchRequest), server::WorkbenchAssets());
+    s.SetUploadHandler(
+        [&logs](const std::string& name, const std::string& body) { return logs->Upload(name, body); });
     if (!s.Start(&error)) throw BadInput(error);
     SetLiveService(live.get());
     const std::string host =
@@ -73,8 +85,22 @@ struct ServeCommand {
     SetLiveService(nullptr);
     live.reset();
     g_server = nullptr;
+    ServeLogs(nullptr);
     std::cerr << "pidlab serve: stopped\n";
     return 0;
+  }
+
+  // --log-dir and --max-upload-mb checked; the store of the Logs tab.
+  std::unique_ptr<LogStore> ServedLogs() {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(log_dir, ec))
+      throw BadInput("--log-dir " + Quote(log_dir) + " is not a directory");
+    if (max_upload_mb < 1 || max_upload_mb > 4096)
+      throw BadInput("--max-upload-mb " + std::to_string(max_upload_mb) + " must be in 1..4096");
+    options.max_upload_bytes = static_cast<std::size_t>(max_upload_mb) * 1024 * 1024;
+    auto store = std::make_unique<LogStore>(log_dir);
+    ServeLogs(store.get());
+    return store;
   }
 
   // The live scope on the trio of --lcm-url, or null without it.

@@ -7,6 +7,7 @@
 
 #include "pidlab/json/spec_run.h"
 #include "serve_live.h"
+#include "serve_logs.h"
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
 #include "export_spec.h"
 #include "pidlab/report/report.h"
@@ -100,6 +101,8 @@ server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
   if (type == "fields") return {200, {{"type", "fields"}, {"fields", json::EvaluateSpecFields()}}};
   if (type == "paper_designs") return {200, {{"type", "paper_designs"}, {"designs", PaperDesigns()}}};
   if (type == "evaluate") return Evaluate(request);
+  if (type == "log_open") return AnswerLogOpen(request);
+  if (type == "log_episode") return AnswerLogEpisode(request);
   if (IsLiveRequest(type)) return AnswerLive(type, request, connection);
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
   if (type == "export") return Export(request);
@@ -108,9 +111,11 @@ server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
 #else
   (void)connection;
 #endif
-  return {400,
-          {{"error", "request type '" + type +
-                         "' is not one of evaluate, fields, paper_designs, export, tune, tune_cancel"}}};
+  return {
+      400,
+      {{"error", "request type '" + type +
+                     "' is not one of evaluate, fields, paper_designs, export, tune, tune_cancel, log_open, "
+                     "log_episode"}}};
 }
 
 }  // namespace pidlab::cli

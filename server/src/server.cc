@@ -1,10 +1,12 @@
 #include "pidlab/server/server.h"
 
+#include <algorithm>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
+#include <cctype>
 #include <chrono>
 #include <deque>
 #include <map>
@@ -35,6 +37,28 @@ std::string QueryValue(const std::string& target, const std::string& name) {
 }
 
 std::string PathOf(const std::string& target) { return target.substr(0, target.find('?')); }
+
+// "%41+b" -> "A b"; a malformed escape is kept as it is.
+std::string PercentDecoded(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '+') {
+      out += ' ';
+    } else if (text[i] == '%' && i + 2 < text.size() &&
+               std::isxdigit(static_cast<unsigned char>(text[i + 1])) &&
+               std::isxdigit(static_cast<unsigned char>(text[i + 2]))) {
+      out += static_cast<char>(std::stoi(text.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += text[i];
+    }
+  }
+  return out;
+}
+
+bool IsUpload(const Request& req) {
+  return req.method() == http::verb::post && PathOf(std::string(req.target())) == "/api/upload";
+}
 
 // Compares without an early exit, so that timing does not tell a prefix.
 bool SameSecret(const std::string& a, const std::string& b) {
@@ -72,7 +96,8 @@ bool ServerOptions::IsValid(std::string* error) const {
     e = "port " + std::to_string(port) + " must be in 0..65535";
   else if (!IsLoopback(bind) && token.size() < 16)
     e = "bind address '" + bind + "' is not loopback: a token of at least 16 characters is required";
-  else if (max_body_bytes < 1024 || max_message_bytes < 1024 || max_header_bytes < 1024)
+  else if (max_body_bytes < 1024 || max_message_bytes < 1024 || max_header_bytes < 1024 ||
+           max_upload_bytes < 1024)
     e = "the size limits must be at least 1024 bytes";
   else if (max_connections < 1)
     e = "max_connections " + std::to_string(max_connections) + " must be at least 1";
@@ -83,6 +108,7 @@ bool ServerOptions::IsValid(std::string* error) const {
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   ServerOptions options;
   ConnectionHandler handler;
+  UploadHandler upload_handler;
   std::vector<Asset> assets;
   net::io_context io{1};
   tcp::acceptor acceptor{io};
@@ -136,6 +162,17 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     return reply;
   }
 
+  Response Upload(const Request& req) {
+    Reply r;
+    try {
+      r = upload_handler(PercentDecoded(QueryValue(std::string(req.target()), "name")), req.body());
+    } catch (const std::exception& e) {
+      r = {500, {{"error", std::string("the server failed: ") + e.what()}}};
+    }
+    if (r.status == 400) Count(&ServerCounters::malformed);
+    return JsonResponse(req, static_cast<http::status>(r.status), r.body);
+  }
+
   Response Serve(const Request& req) {
     Count(&ServerCounters::http_requests);
     const auto [status, why] = Refusal(req);
@@ -163,6 +200,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
       const Reply r = Answer(req.body());
       return JsonResponse(req, static_cast<http::status>(r.status), r.body);
     }
+    if (IsUpload(req) && upload_handler) return Upload(req);
     return JsonResponse(req, http::status::method_not_allowed, {{"error", "method or path not served"}});
   }
 };
@@ -316,8 +354,37 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void Read() {
     parser_.emplace();
     parser_->header_limit(static_cast<std::uint32_t>(server_->options.max_header_bytes));
-    parser_->body_limit(server_->options.max_body_bytes);
+    // The larger limit while the headers are parsed (Beast checks a
+    // Content-Length against it there); OnHeader sets the request's own.
+    parser_->body_limit(std::max(server_->options.max_body_bytes, server_->options.max_upload_bytes));
     stream_.expires_after(std::chrono::seconds(30));
+    http::async_read_header(stream_, buffer_, *parser_,
+                            beast::bind_front_handler(&HttpSession::OnHeader, shared_from_this()));
+  }
+
+  // An upload gets its own body limit, and is refused on its headers (token,
+  // Host, Origin) before its body is read.
+  void OnHeader(beast::error_code ec, std::size_t) {
+    if (!ec && IsUpload(parser_->get())) {
+      const auto [status, why] = server_->Refusal(parser_->get());
+      if (status != http::status::ok) {
+        server_->Count(&ServerCounters::http_requests);
+        server_->Count(&ServerCounters::refused);
+        Response res = JsonResponse(parser_->get(), status, {{"error", why}});
+        res.keep_alive(false);
+        Write(std::move(res));
+        return;
+      }
+      parser_->body_limit(server_->options.max_upload_bytes);
+    } else if (!ec) {
+      parser_->body_limit(server_->options.max_body_bytes);
+      const auto length = parser_->content_length();
+      if (length && *length > server_->options.max_body_bytes) ec = http::error::body_limit;
+    }
+    if (ec || parser_->is_done()) {
+      OnRead(ec, 0);
+      return;
+    }
     http::async_read(stream_, buffer_, *parser_,
                      beast::bind_front_handler(&HttpSession::OnRead, shared_from_this()));
   }
@@ -337,7 +404,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       Request bare;
       bare.version(11);
       bare.keep_alive(false);
-      Response res = JsonResponse(bare, status, {{"error", "malformed request: " + ec.message()}});
+      const std::string why = ec == http::error::body_limit ? "the body is larger than the limit of " +
+                                                                  std::to_string(BodyLimit()) + " bytes"
+                                                            : "malformed request: " + ec.message();
+      Response res = JsonResponse(bare, status, {{"error", why}});
       res.keep_alive(false);
       Write(std::move(res));
       return;
@@ -358,6 +428,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       return;
     }
     Write(server_->Serve(req));
+  }
+
+  std::size_t BodyLimit() const {
+    return parser_ && IsUpload(parser_->get()) ? server_->options.max_upload_bytes
+                                               : server_->options.max_body_bytes;
   }
 
   void Write(Response res) {
@@ -418,6 +493,8 @@ Server::Server(ServerOptions options, ConnectionHandler handler, std::vector<Ass
 }
 
 Server::~Server() { Stop(); }
+
+void Server::SetUploadHandler(UploadHandler handler) { impl_->upload_handler = std::move(handler); }
 
 bool Server::Start(std::string* error) {
   if (!impl_->options.IsValid(error)) return false;

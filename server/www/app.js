@@ -2,6 +2,8 @@
 // -> the JSON of `pidlab evaluate --json` and the plot series, drawn by
 // uPlot (plots.js). The page computes no result itself (docs/workbench.md).
 import { createPlots, destroyPlots, drawPlots } from './plots.js';
+import { initLive, initTrio } from './live.js';
+import { initLogs } from './logs.js';
 
 const token = new URLSearchParams(location.search).get('token');
 const plants = ['double_integrator', 'oscillator', 'stepper_motor', 'custom', 'stepper_nonlinear', 'model'];
@@ -96,6 +98,7 @@ function ask(message) {
 // Evaluates the current design: latest wins, no queue.
 function send() {
   writeHash();
+  pidlab.trioOverlay = null;  // a trio run belongs to the design it ran
   if (inflight) { pending = true; return; }
   let s;
   try { s = spec(); } catch (e) { setStatus('bad design: ' + e.message); return; }
@@ -148,7 +151,7 @@ function show(reply, sent, reply_ms) {
   setStatus('');
   showMetrics(reply.result);
   $('notes').textContent = (reply.series.notes || []).join('; ') + ((reply.result.robustness || {}).violations || []).map((v) => '; breaks ' + v).join('');
-  drawPlots(pidlab.plots, reply.series, pidlab.pinned);
+  drawPlots(pidlab.plots, reply.series, pidlab.pinned, pidlab.trioOverlay);
   $('spec').textContent = JSON.stringify(reply.result.spec);
   $('command').textContent = pidlab.command();
   renderDiff();
@@ -167,6 +170,9 @@ function onMessage(reply, arrived_ms) {
     return;
   }
   if (reply.type === 'tune_progress') { tuneProgress(reply); return; }
+  if (views.live.onMessage(reply) || views.trio.onMessage(reply)) {
+    if (reply.id === undefined || !waiting.has(reply.id)) return;
+  }
   const w = waiting.get(reply.id);
   if (!w) return;
   waiting.delete(reply.id);
@@ -238,7 +244,7 @@ function rebuildPlots() {
   destroyPlots(pidlab.plots);
   const el = (k) => $('plot-' + k);
   pidlab.plots = createPlots({ step: el('step'), effort: el('effort'), load: el('load'), freq: el('freq'), nyquist: el('nyquist') }, pidlab.pinned);
-  if (pidlab.lastSeries) drawPlots(pidlab.plots, pidlab.lastSeries, pidlab.pinned);
+  if (pidlab.lastSeries) drawPlots(pidlab.plots, pidlab.lastSeries, pidlab.pinned, pidlab.trioOverlay);
 }
 
 function pin(label) {
@@ -385,8 +391,12 @@ function connect() {
   const url = (location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + '/ws' +
       (token ? '?token=' + encodeURIComponent(token) : '');
   socket = new WebSocket(url);
-  socket.addEventListener('open', () => { send(); loadPaperDesigns(); });
-  socket.addEventListener('message', (e) => { const arrived = performance.now(); onMessage(JSON.parse(e.data), arrived); });
+  socket.binaryType = 'arraybuffer';  // the live view's frames (live.js)
+  socket.addEventListener('open', () => { send(); loadPaperDesigns(); serverInfo(); });
+  socket.addEventListener('message', (e) => {
+    const arrived = performance.now();
+    if (e.data instanceof ArrayBuffer) views.live.onFrame(e.data); else onMessage(JSON.parse(e.data), arrived);
+  });
   socket.addEventListener('close', () => setStatus('disconnected from the server'));
 }
 
@@ -430,6 +440,32 @@ $('tune-cancel').addEventListener('click', () => pidlab.cancelTune());
 $('copy-command').addEventListener('click', () => navigator.clipboard.writeText(pidlab.command()).catch((e) => setStatus('copy: ' + e.message)));
 $('copy-spec').addEventListener('click', () => navigator.clipboard.writeText(JSON.stringify(spec())).catch((e) => setStatus('copy: ' + e.message)));
 $('export-button').addEventListener('click', () => exportC().catch((e) => setStatus('export: ' + e.message)));
+// ---- The Live and Logs tabs (live.js, logs.js) and "Run on the trio".
+const views = {};
+views.live = initLive({ rawSend });
+views.trio = initTrio({ ask, spec, setStatus, redraw: rebuildPlots });
+initLogs({ ask, token });
+// server_info: live when pidlab serve has --lcm-url (an older server does not know the request).
+async function serverInfo() {
+  try {
+    pidlab.serverInfo = await ask({ type: 'server_info' });
+  } catch (e) {
+    pidlab.serverInfo = { live: false };
+  }
+  views.trio.enable(!!pidlab.serverInfo.live);
+  if (pidlab.view === 'live') views.live.show(true);
+}
+function showView(name) {
+  pidlab.view = name;
+  for (const v of ['design', 'live', 'logs']) {
+    $('view-' + v).classList.toggle('hidden', v !== name);
+    $('tab-' + v).classList.toggle('active', v === name);
+  }
+  views.live.show(name === 'live');
+}
+pidlab.showView = showView;
+for (const b of document.querySelectorAll('#tabs .tab')) b.addEventListener('click', () => showView(b.dataset.view));
+pidlab.view = 'design';
 readHash();
 showForm();
 rebuildPlots();

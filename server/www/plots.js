@@ -29,6 +29,8 @@ function timeChart(el, title, yLabel, label, pinned, band) {
     series.push({ label: 'Monte Carlo max', stroke: 'rgba(31,119,180,0.3)', width: 1 });
     series.push({ label: 'Monte Carlo min', stroke: 'rgba(31,119,180,0.3)', width: 1 });
     opts.bands = [{ series: [n, n + 1], fill: 'rgba(31,119,180,0.15)' }];
+    // "Run on the trio": the trio's y at the same sample times, last.
+    series.push({ label: 'trio y', stroke: '#ff7f0e', width: 2, dash: [3, 3] });
   }
   return new uPlot(opts, series.map((_, i) => (i === 0 ? [] : [])), el);
 }
@@ -137,11 +139,15 @@ export function destroyPlots(plots) {
 }
 
 // Sets every chart's data: the current design's `series` and the pinned ones'.
-export function drawPlots(plots, series, pinned) {
+// `trio` ({t, y}, optional): the trio's run, drawn on the step plot where
+// its sample times are the series' own.
+export function drawPlots(plots, series, pinned, trio) {
   const n = series.t.length;
+  const atT = trio ? new Map(trio.t.map((t, i) => [t, trio.y[i]])) : null;
+  const trioY = series.t.map((t) => (atT && atT.has(t) ? atT.get(t) : null));
   const pin = (key) => pinned.map((p) => orEmpty(p.series && p.series[key], n));
   const mc = series.monte_carlo || {};
-  plots.step.setData([series.t, series.y, ...pin('y'), orEmpty(series.linear_y, n), orEmpty(mc.y_max, n), orEmpty(mc.y_min, n)]);
+  plots.step.setData([series.t, series.y, ...pin('y'), orEmpty(series.linear_y, n), orEmpty(mc.y_max, n), orEmpty(mc.y_min, n), trioY]);
   plots.effort.setData([series.t, orEmpty(series.u, n), ...pin('u')]);
   plots.load.setData([series.t, orEmpty(series.load_y, n), ...pin('load_y')]);
   const m = series.w.length;

@@ -84,4 +84,21 @@ nlohmann::json RedriveJson(const replay::RedriveResult& r) {
   return j;
 }
 
+nlohmann::json EvaluatedEpisodeJson(const replay::Episode& e, evaluation::Evaluation* evaluation,
+                                    bool* evaluated) {
+  nlohmann::json j = EpisodeJson(e);
+  evaluation::Evaluation ev;
+  std::string why;
+  const bool ok = replay::EvaluateEpisode(e, &ev, &why);
+  if (ok) {
+    j["evaluation"] = ToJson(ev);
+  } else {
+    j["evaluation"] = nullptr;
+    j["evaluation_error"] = why;
+  }
+  if (evaluation) *evaluation = std::move(ev);
+  if (evaluated) *evaluated = ok;
+  return j;
+}
+
 }  // namespace pidlab::json

@@ -38,6 +38,8 @@ struct ServerOptions {
   std::size_t max_header_bytes = 8 * 1024;
   std::size_t max_body_bytes = 64 * 1024;
   std::size_t max_message_bytes = 64 * 1024;
+  /// The body of POST /api/upload (a log); 413 above.
+  std::size_t max_upload_bytes = 64 * 1024 * 1024;
   /// Connections open at once; more are closed on accept.
   int max_connections = 64;
 
@@ -86,6 +88,12 @@ class Connection {
 using ConnectionHandler =
     std::function<Reply(const nlohmann::json& request, const std::shared_ptr<Connection>& connection)>;
 
+/// Answers `POST /api/upload?name=NAME` (NAME percent-decoded, as sent) with
+/// the raw body, at most ServerOptions::max_upload_bytes (413 above, before the
+/// handler); the token, Host and Origin rules of /api/request apply, checked
+/// on the headers before the body is read.
+using UploadHandler = std::function<Reply(const std::string& name, const std::string& body)>;
+
 /// A static file served at `path` ("/" and "/app.js").
 struct Asset {
   std::string path;
@@ -110,6 +118,8 @@ class Server {
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
+  /// Serves POST /api/upload with `handler` (404 without one); call before Start.
+  void SetUploadHandler(UploadHandler handler);
   /// Binds and listens; false with *error (the address, the port and why).
   bool Start(std::string* error);
   /// The bound port (after Start).

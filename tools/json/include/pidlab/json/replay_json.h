@@ -24,5 +24,11 @@ nlohmann::json LogJson(const replay::LogContents& log, const std::string& path);
 nlohmann::json EpisodeJson(const replay::Episode& e);
 /// The `redrive` object of an episode.
 nlohmann::json RedriveJson(const replay::RedriveResult& r);
+/// One episode's object of `pidlab replay --json` without its redrive:
+/// EpisodeJson with "evaluation" (the object of `pidlab evaluate --json`,
+/// recomputed by replay::EvaluateEpisode) or null and "evaluation_error".
+/// *evaluation (if given) receives the evaluation, *evaluated whether it ran.
+nlohmann::json EvaluatedEpisodeJson(const replay::Episode& e, evaluation::Evaluation* evaluation = nullptr,
+                                    bool* evaluated = nullptr);
 
 }  // namespace pidlab::json

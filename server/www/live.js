@@ -1,0 +1,296 @@
+// The Live tab: the running trio seen through `pidlab serve --lcm-url`
+// (docs/live.md has the protocol, docs/workbench.md the page). The server
+// posts live_status (JSON) and binary frames of the selected episode: min/max
+// per column, never averaged, drawn as bands. Frames are kept as they come and
+// drawn once per animation frame (the latest only); when an episode completes
+// its whole data (live_data, Float64) lands in window.pidlab.live.final.
+
+const kMagic = 0x31564c50;  // "PLV1"
+const $ = (id) => document.getElementById(id);
+
+// A band chart: x, then [max, min] filled between, then extra lines.
+function bandChart(el, title, label, colour, extra) {
+  const series = [{ label: 't s' },
+    { label: label + ' max', stroke: colour, width: 1 },
+    { label: label + ' min', stroke: colour, width: 1 }];
+  for (const e of extra || []) series.push(e);
+  const fill = colour === '#1f77b4' ? 'rgba(31,119,180,0.25)' : colour === '#d62728' ? 'rgba(214,39,40,0.25)' : 'rgba(44,160,44,0.25)';
+  return new uPlot({
+    title, width: Math.max(400, el.clientWidth || 800), height: 170, series,
+    scales: { x: { time: false } }, axes: [{ label: 't (s)' }, { label }],
+    bands: [{ series: [1, 2], fill }],
+  }, series.map(() => []), el);
+}
+
+// Parses a binary frame: the header's eight numbers and the arrays.
+export function parseFrame(buffer) {
+  const view = new DataView(buffer);
+  if (buffer.byteLength < 72 || view.getUint32(0, true) !== kMagic) return null;
+  const h = new Float64Array(buffer.slice(8, 72));
+  const f = { kind: view.getUint32(4, true), episode_id: h[0], first_step: h[1], steps: h[2], columns: h[3],
+    dt_s: h[4], total_steps: h[5], steps_done: h[6], dropped_frames: h[7] };
+  if (f.kind === 1) {
+    const c = f.columns;
+    if (buffer.byteLength < 72 + 24 * c) return null;
+    const a = (i) => new Float32Array(buffer, 72 + 4 * c * i, c);
+    Object.assign(f, { y_min: a(0), y_max: a(1), u_min: a(2), u_max: a(3), n_min: a(4), n_max: a(5) });
+  } else if (f.kind === 2) {
+    const s = f.steps;
+    if (buffer.byteLength < 72 + 24 * s) return null;
+    const a = (i) => new Float64Array(buffer.slice(72 + 8 * s * i, 72 + 8 * s * (i + 1)));
+    Object.assign(f, { y: a(0), u: a(1), n: a(2) });
+  } else {
+    return null;
+  }
+  return f;
+}
+
+// An episode's id as exact decimal text (live_status gives it: a double holds 53 bits).
+const idText = (e) => e.episode_id_text || String(e.episode_id);
+const nanToNull = (a) => Array.from(a, (v) => (Number.isNaN(v) ? null : v));
+
+let live = null;  // window.pidlab.live
+let rawSend = null;
+let charts = null;
+let latest = null;  // the newest frame not yet drawn
+const asked = new Set();  // episodes whose live_data was asked for
+const ticks = [];
+
+function buildCharts() {
+  if (charts) return;
+  charts = {
+    y: bandChart($('live-plot-y'), 'y (min/max per column) and r', 'y', '#1f77b4', [{ label: 'r', stroke: '#555', dash: [4, 4], width: 1 }]),
+    u: bandChart($('live-plot-u'), 'u (min/max per column)', 'u', '#d62728'),
+    n: bandChart($('live-plot-n'), 'n (min/max per column)', 'n', '#2ca02c'),
+  };
+}
+
+function draw(f) {
+  buildCharts();
+  const x = new Array(f.columns);
+  for (let j = 0; j < f.columns; j++) x[j] = (f.first_step + Math.floor((j * f.steps) / f.columns)) * f.dt_s;
+  const ep = ((live.status && live.status.episodes) || []).find((e) => e.episode_id === f.episode_id);
+  const r = ep ? new Array(f.columns).fill(ep.r) : [];
+  charts.y.setData([x, nanToNull(f.y_max), nanToNull(f.y_min), r]);
+  charts.u.setData([x, nanToNull(f.u_max), nanToNull(f.u_min)]);
+  charts.n.setData([x, nanToNull(f.n_max), nanToNull(f.n_min)]);
+  live.drawn += 1;
+  $('live-frames').textContent = 'episode ' + f.episode_id + ': ' + f.steps_done + ' of ' + (f.total_steps + 1) +
+    ' steps, ' + live.frames + ' frames received, ' + live.drawn + ' drawn, ' + f.dropped_frames +
+    ' dropped by the server, ' + live.fps.toFixed(0) + ' fps';
+}
+
+// One draw per animation frame at most; the frame rate over the last second.
+function tick(now) {
+  live.ticks += 1;
+  ticks.push(now);
+  while (ticks.length && ticks[0] < now - 1000) ticks.shift();
+  if (ticks.length > 1) live.fps = ((ticks.length - 1) * 1000) / (ticks[ticks.length - 1] - ticks[0]);
+  if (latest) { const f = latest; latest = null; draw(f); }
+  // Only while the Live tab is subscribed: a hidden tab costs no frames.
+  if (live.subscribed) requestAnimationFrame(tick); else { looping = false; ticks.length = 0; live.fps = 0; }
+}
+
+let looping = false;
+function startLoop() {
+  if (!looping) { looping = true; requestAnimationFrame(tick); }
+}
+function cell(tr, text, cls) {
+  const td = document.createElement('td');
+  td.textContent = text;
+  if (cls) td.className = cls;
+  tr.append(td);
+  return td;
+}
+
+function renderEpisodes(s) {
+  const body = $('live-episodes').querySelector('tbody');
+  body.textContent = '';
+  for (const e of s.episodes) {
+    const tr = document.createElement('tr');
+    const id = idText(e);
+    tr.dataset.episodeId = id;
+    if (id === (s.selected_episode_id_text || String(s.selected_episode_id))) tr.classList.add('selected');
+    cell(tr, id + (e.trio > 1 ? ' (trio ' + e.trio + ')' : ''));
+    cell(tr, e.plant);
+    cell(tr, (e.gains || []).map((g) => String(+Number(g).toPrecision(6))).join(','));
+    cell(tr, e.steps_done + '/' + (e.total_steps + 1));
+    const st = cell(tr, e.status + (e.message ? ': ' + e.message : ''), 'status status-' + e.status);
+    st.dataset.status = e.status;
+    const rt = cell(tr, e.realtime ? e.realtime.missed_deadlines + ' missed' : '-', 'realtime');
+    if (e.realtime) rt.dataset.realtime = JSON.stringify(e.realtime);
+    tr.addEventListener('click', () => rawSend({ type: 'live_select', episode_id: id }));
+    body.append(tr);
+  }
+}
+
+function renderHealth(s) {
+  const h = s.health || {};
+  const lines = Object.entries(h.roles || {}).map(([role, r]) => role + ': ' +
+    (r.last_heard_s === null ? 'not heard' : 'heard ' + r.last_heard_s.toFixed(2) + ' s ago') +
+    (r.pid === null || r.pid === undefined ? '' : ' (pid ' + r.pid + ')'));
+  lines.push(['received', 'undecodable', 'unauthenticated', 'replayed', 'trajectory_requests']
+    .map((k) => k + ' ' + h[k]).join(', '));
+  lines.push('dropped frames (this page) ' + s.dropped_frames);
+  $('live-health').textContent = '';
+  for (const line of lines) { const div = document.createElement('div'); div.textContent = line; $('live-health').append(div); }
+  for (const k of ['received', 'undecodable', 'unauthenticated', 'replayed']) $('live-health').dataset[k] = String(h[k]);
+}
+
+function rows(tbody, entries) {
+  tbody.textContent = '';
+  for (const [k, v] of entries) {
+    const tr = document.createElement('tr');
+    const th = document.createElement('th'); th.textContent = k;
+    const td = document.createElement('td'); td.textContent = v === null ? '-' : String(v);
+    td.dataset.key = k; td.dataset.value = v === null ? 'null' : String(v);
+    tr.append(th, td);
+    tbody.append(tr);
+  }
+}
+
+// The selected (else newest) episode's pacing progress and, when it has
+// ended, its SUMMARY's realtime object.
+function renderPacing(s) {
+  const e = s.episodes.find((x) => x.episode_id === s.selected_episode_id) || s.episodes[s.episodes.length - 1];
+  const box = $('live-pacing');
+  box.dataset.episodeId = e ? String(e.episode_id) : '';
+  const p = e && e.pacing;
+  rows(box.querySelector('table.pacing tbody'), p ? Object.entries(p).filter(([k]) => k !== 'histogram') : []);
+  const hist = box.querySelector('.histogram');
+  hist.textContent = '';
+  if (p && p.histogram) {
+    const top = Math.max(1, ...p.histogram);
+    p.histogram.forEach((c, i) => {
+      const bar = document.createElement('div');
+      bar.style.height = (100 * c) / top + '%';
+      bar.title = 'bin ' + i + ': ' + c;
+      hist.append(bar);
+    });
+  }
+  rows(box.querySelector('table.realtime tbody'), e && e.realtime ? Object.entries(e.realtime) : []);
+  box.querySelector('.note').textContent = !e ? 'no episode yet'
+    : p || e.realtime ? (e.realtime ? 'the episode\'s deadline statistics (its SUMMARY):' : 'running, paced')
+      : 'episode ' + idText(e) + ' is not paced (pidlab launch --realtime paces the plant)';
+}
+
+function onStatus(s) {
+  live.status = s;
+  live.dropped_frames = s.dropped_frames;
+  $('live-source').textContent = s.lcm_url + ' prefix ' + s.channel_prefix;
+  renderEpisodes(s);
+  renderHealth(s);
+  renderPacing(s);
+  for (const e of s.episodes) {
+    const id = idText(e);
+    if (e.status === 'complete' && !asked.has(id)) {
+      asked.add(id);
+      // The reply is one kind-2 binary frame (onFrame), or an error line.
+      if (!rawSend({ type: 'live_data', episode_id: id })) asked.delete(id);
+    }
+  }
+}
+
+function onFrame(buffer) {
+  const f = parseFrame(buffer);
+  if (!f) { console.warn('live: a binary frame that is not PLV1'); return; }
+  if (f.kind === 2) {
+    // Keyed by the header's id (a double) and, when the status names it, by its exact text.
+    const data = { y: f.y, u: f.u, n: f.n };
+    live.final[f.episode_id] = data;
+    const e = ((live.status && live.status.episodes) || []).find((x) => x.episode_id === f.episode_id);
+    if (e && e.episode_id_text) live.final[e.episode_id_text] = data;
+    return;
+  }
+  live.frames += 1;
+  latest = f;  // the server sends the selected episode's frames only
+}
+
+function onMessage(m) {
+  if (m.type === 'live_status') { onStatus(m); return true; }
+  if (m.type === 'live_subscribed' || m.type === 'live_unsubscribed') return true;
+  return false;
+}
+
+function show(active) {
+  if (active && !live.subscribed) {
+    const columns = Math.max(16, Math.min(4096, Math.round($('live-plots').clientWidth || 1000)));
+    live.subscribed = rawSend({ type: 'live_subscribe', columns });
+    if (live.subscribed) startLoop();
+  } else if (!active && live.subscribed) {
+    live.subscribed = !rawSend({ type: 'live_unsubscribe' });
+  }
+}
+
+// Starts the Live tab: `send` sends one request without awaiting a reply.
+export function initLive({ rawSend: send }) {
+  live = { status: null, frames: 0, fps: 0, ticks: 0, final: {}, drawn: 0, dropped_frames: 0, subscribed: false };
+  window.pidlab.live = live;
+  rawSend = send;
+  return { onMessage, onFrame, show };
+}
+
+// "Run on the trio" (Design view): the design's spec runs on the running
+// trio (always the sampled loop); its y is drawn over the exact prediction
+// and their agreement shown in #trio-agreement.
+export function initTrio({ ask, spec, setStatus, redraw }) {
+  const trio = { last: null, running: false };
+  window.pidlab.trio = trio;
+  let chart = null;
+
+  function show(m) {
+    trio.last = m;
+    trio.running = false;
+    $('run-on-trio').disabled = false;
+    $('trio-box').classList.remove('hidden');
+    if (m.type === 'trio_error') {
+      $('trio-agreement').textContent = 'the trio failed: ' + m.error;
+      $('trio-agreement').dataset.bitIdentical = 'false';
+      return;
+    }
+    if (!chart) {
+      const el = $('plot-trio');
+      chart = new uPlot({
+        title: 'Step response on the trio (sampled loop) over the prediction', width: Math.max(300, el.clientWidth || 560), height: 220,
+        series: [{ label: 't s' }, { label: 'prediction y', stroke: '#1f77b4', width: 3 }, { label: 'trio y', stroke: '#ff7f0e', width: 1.5, dash: [5, 3] }],
+        scales: { x: { time: false } }, axes: [{ label: 't (s)' }, { label: 'y' }],
+      }, [[], [], []], el);
+    }
+    window.pidlab.trioOverlay = m.series;  // on the step plot too
+    redraw();
+    const p = m.prediction_series, s = m.series;
+    const n = Math.min(p.t.length, s.t.length);
+    chart.setData([p.t.slice(0, n), p.y.slice(0, n), s.y.slice(0, n)]);
+    const a = $('trio-agreement');
+    a.dataset.bitIdentical = String(m.bit_identical);
+    a.dataset.maxAbsDifference = String(m.max_abs_difference);
+    a.textContent = (m.bit_identical ? 'bit for bit' : 'NOT bit for bit') + ' (max |difference| ' + m.max_abs_difference +
+      ', IAE trio ' + m.result.iae + ', prediction ' + m.prediction.iae + ', loop ' + (m.loop || 'sampled') + ')';
+  }
+
+  async function run() {
+    trio.running = true;
+    $('run-on-trio').disabled = true;
+    $('trio-agreement').textContent = 'running on the trio...';
+    try {
+      await ask({ type: 'run_on_trio', spec: spec() });
+    } catch (e) {
+      show({ type: 'trio_error', error: e.message });
+    }
+  }
+
+  function onMessage(m) {
+    if (m.type === 'trio_result' || m.type === 'trio_error') { show(m); return true; }
+    return m.type === 'run_on_trio_started';
+  }
+
+  function enable(live) {
+    $('run-on-trio').disabled = !live;
+    $('run-on-trio').title = live ? 'run this design (sampled loop) on the trio the server watches'
+      : 'pidlab serve was started without --lcm-url';
+  }
+
+  $('run-on-trio').addEventListener('click', () => run().catch((e) => setStatus('trio: ' + e.message)));
+  trio.run = run;
+  return { onMessage, enable };
+}
