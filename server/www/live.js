@@ -2,7 +2,7 @@
 // (docs/live.md has the protocol, docs/workbench.md the page). The server
 // posts live_status (JSON) and binary frames of the selected episode: min/max
 // per column, never averaged, drawn as bands. Frames are kept as they come and
-// drawn once per animation frame (the latest only); when an episode completes
+// drawn at the next animation frame (the latest only, once); when an episode completes
 // its whole data (live_data, Float64) lands in window.pidlab.live.final.
 
 const kMagic = 0x31564c50;  // "PLV1"
@@ -54,7 +54,6 @@ let rawSend = null;
 let charts = null;
 let latest = null;  // the newest frame not yet drawn
 const asked = new Set();  // episodes whose live_data was asked for
-const ticks = [];
 
 function buildCharts() {
   if (charts) return;
@@ -77,23 +76,19 @@ function draw(f) {
   live.drawn += 1;
   $('live-frames').textContent = 'episode ' + f.episode_id + ': ' + f.steps_done + ' of ' + (f.total_steps + 1) +
     ' steps, ' + live.frames + ' frames received, ' + live.drawn + ' drawn, ' + f.dropped_frames +
-    ' dropped by the server, ' + live.fps.toFixed(0) + ' fps';
+    ' dropped by the server';
 }
 
-// One draw per animation frame at most; the frame rate over the last second.
-function tick(now) {
-  live.ticks += 1;
-  ticks.push(now);
-  while (ticks.length && ticks[0] < now - 1000) ticks.shift();
-  if (ticks.length > 1) live.fps = ((ticks.length - 1) * 1000) / (ticks[ticks.length - 1] - ticks[0]);
-  if (latest) { const f = latest; latest = null; draw(f); }
-  // Only while the Live tab is subscribed: a hidden tab costs no frames.
-  if (live.subscribed) requestAnimationFrame(tick); else { looping = false; ticks.length = 0; live.fps = 0; }
+// One draw per animation frame at most, and an animation frame only when a
+// frame waits to be drawn: no loop runs while nothing arrives (an idle
+// animation loop alone cost the trio on the same 2-core machine about 5 %).
+let scheduled = false;
+function drawLatest() {
+  scheduled = false;
+  if (latest && live.subscribed) { const f = latest; latest = null; draw(f); }
 }
-
-let looping = false;
-function startLoop() {
-  if (!looping) { looping = true; requestAnimationFrame(tick); }
+function scheduleDraw() {
+  if (!scheduled) { scheduled = true; requestAnimationFrame(drawLatest); }
 }
 function cell(tr, text, cls) {
   const td = document.createElement('td');
@@ -103,25 +98,75 @@ function cell(tr, text, cls) {
   return td;
 }
 
+// Sets a cell's text only when it changed: the status arrives ten times a
+// second, and rewriting unchanged cells would make the browser lay the table
+// out again each time (CPU the trio on the same machine would miss).
+function setText(el, text) {
+  if (el.textContent !== text) el.textContent = text;
+}
+
+// The rows of `body` keyed by `key` (kept in order, reused when their key
+// stays): fill(tr, entry) writes the cells of a row made by make(entry).
+function keyedRows(body, entries, key, make, fill) {
+  const old = new Map([...body.children].map((tr) => [tr.dataset.key, tr]));
+  let at = body.firstElementChild;
+  for (const entry of entries) {
+    const k = key(entry);
+    let tr = old.get(k);
+    if (!tr) { tr = make(entry); tr.dataset.key = k; }
+    old.delete(k);
+    fill(tr, entry);
+    if (tr !== at) body.insertBefore(tr, at); else at = at.nextElementSibling;
+  }
+  for (const tr of old.values()) tr.remove();
+}
+
 function renderEpisodes(s) {
-  const body = $('live-episodes').querySelector('tbody');
-  body.textContent = '';
-  for (const e of s.episodes) {
+  const selected = s.selected_episode_id_text || String(s.selected_episode_id);
+  keyedRows($('live-episodes').querySelector('tbody'), s.episodes, idText, (e) => {
     const tr = document.createElement('tr');
     const id = idText(e);
     tr.dataset.episodeId = id;
-    if (id === (s.selected_episode_id_text || String(s.selected_episode_id))) tr.classList.add('selected');
-    cell(tr, id + (e.trio > 1 ? ' (trio ' + e.trio + ')' : ''));
-    cell(tr, e.plant);
-    cell(tr, (e.gains || []).map((g) => String(+Number(g).toPrecision(6))).join(','));
-    cell(tr, e.steps_done + '/' + (e.total_steps + 1));
-    const st = cell(tr, e.status + (e.message ? ': ' + e.message : ''), 'status status-' + e.status);
-    st.dataset.status = e.status;
-    const rt = cell(tr, e.realtime ? e.realtime.missed_deadlines + ' missed' : '-', 'realtime');
-    if (e.realtime) rt.dataset.realtime = JSON.stringify(e.realtime);
+    for (const cls of ['', '', '', 'steps', 'status', 'realtime']) cell(tr, '', cls);
     tr.addEventListener('click', () => rawSend({ type: 'live_select', episode_id: id }));
-    body.append(tr);
-  }
+    return tr;
+  }, (tr, e) => {
+    const id = idText(e);
+    tr.classList.toggle('selected', id === selected);
+    const [idCell, plant, gains, steps, st, rt] = tr.children;
+    setText(idCell, id + (e.trio > 1 ? ' (trio ' + e.trio + ')' : ''));
+    setText(plant, e.plant);
+    setText(gains, (e.gains || []).map((g) => String(+Number(g).toPrecision(6))).join(','));
+    setText(steps, e.steps_done + '/' + (e.total_steps + 1));
+    setText(st, e.status + (e.message ? ': ' + e.message : ''));
+    st.className = 'status status-' + e.status;
+    st.dataset.status = e.status;
+    setText(rt, e.realtime ? e.realtime.missed_deadlines + ' missed' : '-');
+    if (e.realtime) rt.dataset.realtime = JSON.stringify(e.realtime);
+  });
+}
+
+// The tunings over the trio (pidlab tune --backend lcm) with their best so far.
+function renderTunings(s) {
+  const fmt = (v) => String(+Number(v).toPrecision(6));
+  keyedRows($('live-tunings').querySelector('tbody'), s.tunings || [], (t) => t.tuning_id_text, (t) => {
+    const tr = document.createElement('tr');
+    tr.dataset.tuningId = t.tuning_id_text;
+    for (const cls of ['', '', '', 'evaluations', 'best-objective', 'best-gains', 'status']) cell(tr, '', cls);
+    return tr;
+  }, (tr, t) => {
+    const [id, method, trios, evaluations, best, gains, st] = tr.children;
+    setText(id, t.tuning_id_text);
+    setText(method, t.method + ', ' + t.objective);
+    setText(trios, String(t.trios));
+    setText(evaluations, String(t.evaluations));
+    setText(best, t.best_objective === null ? '-' : fmt(t.best_objective));
+    best.dataset.value = String(t.best_objective);
+    setText(gains, t.best_gains ? t.best_gains.map(fmt).join(',') : '-');
+    gains.dataset.gains = JSON.stringify(t.best_gains);
+    setText(st, t.status);
+    st.dataset.status = t.status;
+  });
 }
 
 function renderHealth(s) {
@@ -132,21 +177,25 @@ function renderHealth(s) {
   lines.push(['received', 'undecodable', 'unauthenticated', 'replayed', 'trajectory_requests']
     .map((k) => k + ' ' + h[k]).join(', '));
   lines.push('dropped frames (this page) ' + s.dropped_frames);
-  $('live-health').textContent = '';
-  for (const line of lines) { const div = document.createElement('div'); div.textContent = line; $('live-health').append(div); }
+  const box = $('live-health');
+  while (box.children.length > lines.length) box.lastElementChild.remove();
+  while (box.children.length < lines.length) box.append(document.createElement('div'));
+  lines.forEach((line, i) => setText(box.children[i], line));
   for (const k of ['received', 'undecodable', 'unauthenticated', 'replayed']) $('live-health').dataset[k] = String(h[k]);
 }
 
 function rows(tbody, entries) {
-  tbody.textContent = '';
-  for (const [k, v] of entries) {
+  keyedRows(tbody, entries, ([k]) => k, ([k]) => {
     const tr = document.createElement('tr');
     const th = document.createElement('th'); th.textContent = k;
-    const td = document.createElement('td'); td.textContent = v === null ? '-' : String(v);
-    td.dataset.key = k; td.dataset.value = v === null ? 'null' : String(v);
+    const td = document.createElement('td'); td.dataset.key = k;
     tr.append(th, td);
-    tbody.append(tr);
-  }
+    return tr;
+  }, (tr, [, v]) => {
+    const td = tr.children[1];
+    setText(td, v === null ? '-' : String(v));
+    td.dataset.value = v === null ? 'null' : String(v);
+  });
 }
 
 // The selected (else newest) episode's pacing progress and, when it has
@@ -158,16 +207,16 @@ function renderPacing(s) {
   const p = e && e.pacing;
   rows(box.querySelector('table.pacing tbody'), p ? Object.entries(p).filter(([k]) => k !== 'histogram') : []);
   const hist = box.querySelector('.histogram');
-  hist.textContent = '';
-  if (p && p.histogram) {
-    const top = Math.max(1, ...p.histogram);
-    p.histogram.forEach((c, i) => {
-      const bar = document.createElement('div');
-      bar.style.height = (100 * c) / top + '%';
-      bar.title = 'bin ' + i + ': ' + c;
-      hist.append(bar);
-    });
-  }
+  const counts = (p && p.histogram) || [];
+  while (hist.children.length > counts.length) hist.lastElementChild.remove();
+  while (hist.children.length < counts.length) hist.append(document.createElement('div'));
+  const top = Math.max(1, ...counts);
+  counts.forEach((c, i) => {
+    const bar = hist.children[i];
+    const height = (100 * c) / top + '%';
+    if (bar.style.height !== height) bar.style.height = height;
+    bar.title = 'bin ' + i + ': ' + c;
+  });
   rows(box.querySelector('table.realtime tbody'), e && e.realtime ? Object.entries(e.realtime) : []);
   box.querySelector('.note').textContent = !e ? 'no episode yet'
     : p || e.realtime ? (e.realtime ? 'the episode\'s deadline statistics (its SUMMARY):' : 'running, paced')
@@ -179,6 +228,7 @@ function onStatus(s) {
   live.dropped_frames = s.dropped_frames;
   $('live-source').textContent = s.lcm_url + ' prefix ' + s.channel_prefix;
   renderEpisodes(s);
+  renderTunings(s);
   renderHealth(s);
   renderPacing(s);
   for (const e of s.episodes) {
@@ -204,6 +254,7 @@ function onFrame(buffer) {
   }
   live.frames += 1;
   latest = f;  // the server sends the selected episode's frames only
+  scheduleDraw();
 }
 
 function onMessage(m) {
@@ -216,7 +267,6 @@ function show(active) {
   if (active && !live.subscribed) {
     const columns = Math.max(16, Math.min(4096, Math.round($('live-plots').clientWidth || 1000)));
     live.subscribed = rawSend({ type: 'live_subscribe', columns });
-    if (live.subscribed) startLoop();
   } else if (!active && live.subscribed) {
     live.subscribed = !rawSend({ type: 'live_unsubscribe' });
   }
@@ -224,7 +274,7 @@ function show(active) {
 
 // Starts the Live tab: `send` sends one request without awaiting a reply.
 export function initLive({ rawSend: send }) {
-  live = { status: null, frames: 0, fps: 0, ticks: 0, final: {}, drawn: 0, dropped_frames: 0, subscribed: false };
+  live = { status: null, frames: 0, final: {}, drawn: 0, dropped_frames: 0, subscribed: false };
   window.pidlab.live = live;
   rawSend = send;
   return { onMessage, onFrame, show };

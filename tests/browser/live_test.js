@@ -176,6 +176,26 @@ async function main() {
       if (Object.keys(shown.cells).length !== Object.keys(rt).length) throw new Error('keys differ: ' + Object.keys(shown.cells));
       return JSON.stringify(rt);
     });
+
+    await step('a tuning over the trio: listed with its best so far, done with the gains and objective of tune --json', async () => {
+      await launchTrio(['--lcm-url', args['lcm-url']],
+        '"$PIDLAB" tune --backend lcm --lcm-url \'' + args['lcm-url'] + '\' --plant oscillator --loop sampled --dt 0.01 ' +
+        '--horizon 2 --max-evals 12 --starts 2 --json > tune.json');
+      const tuned = JSON.parse(fs.readFileSync(path.join(args.tmp, 'tune.json'), 'utf8'));
+      await waitForPage(session, 'no finished tuning in #live-tunings', 30000,
+        () => document.querySelector('#live-tunings tbody tr:last-child .status[data-status="done"]'));
+      const shown = await page.evaluate(() => {
+        const tr = document.querySelector('#live-tunings tbody tr:last-child');
+        return { gains: JSON.parse(tr.querySelector('.best-gains').dataset.gains),
+          objective: Number(tr.querySelector('.best-objective').dataset.value),
+          evaluations: Number(tr.querySelector('.evaluations').textContent) };
+      });
+      const want = [tuned.gains.kp, tuned.gains.ki, tuned.gains.kd];
+      if (!want.every((g, i) => Object.is(shown.gains[i], g)) || !Object.is(shown.objective, tuned.objective))
+        throw new Error('page ' + JSON.stringify(shown) + ', tune --json ' + JSON.stringify(want) + ' ' + tuned.objective);
+      if (!(shown.evaluations > 0)) throw new Error('no evaluations shown');
+      return shown.evaluations + ' evaluations, best ' + JSON.stringify(shown.gains);
+    });
   } else {
     await step('(logs only) a 25 s episode at dt = 1 ms recorded by pidlab launch --log', async () => {
       await launchTrio(['--lcm-url', args['lcm-url'], '--log', log25], '"$PIDLAB" ' + longArgs.map((a) => "'" + a + "'").join(' ') + ' > long.json');
