@@ -157,6 +157,13 @@ TEST(PacingProgress, PercentilesAreTheUpperEdgesOfTheNearestRankBinsCappedByTheM
   EXPECT_EQ(m.lateness_histogram[LatenessBin(40e-6)], 49);
   EXPECT_DOUBLE_EQ(m.lateness_p50_upper_s, 16e-6);
   EXPECT_DOUBLE_EQ(m.lateness_p99_upper_s, 64e-6);
+  // A watcher reads the same figures back, and the same bounds from them.
+  const PacingProgress back = PacingProgressFromMessage(m);
+  EXPECT_EQ(back.steps, p.steps);
+  EXPECT_EQ(back.histogram, p.histogram);
+  EXPECT_EQ(back.lateness_max_s, p.lateness_max_s);
+  EXPECT_EQ(back.UpperPercentile(0.50), m.lateness_p50_upper_s);
+  EXPECT_EQ(back.UpperPercentile(0.99), m.lateness_p99_upper_s);
 }
 
 TEST(Pacer, ProgressAgreesWithTheExactStatsAndBoundsTheirPercentiles) {

@@ -32,15 +32,15 @@ constexpr auto kStatusPeriod = std::chrono::milliseconds(100);  // at most 10 li
 constexpr auto kFramePeriod = std::chrono::milliseconds(33);    // at most 30 frames a second
 constexpr int kDefaultColumns = 1000;
 
-nlohmann::json PacingJson(const monitor::PacingProgress& p) {
-  return {{"step", p.step},
-          {"realtime_factor", JsonNumber(p.realtime_factor)},
+nlohmann::json PacingJson(const transport::PacingProgress& p) {
+  return {{"step", p.steps},
+          {"realtime_factor", JsonNumber(p.factor)},
           {"period_s", JsonNumber(p.period_s)},
           {"missed_deadlines", p.missed_deadlines},
           {"lateness_max_s", JsonNumber(p.lateness_max_s)},
           {"rate_hz", JsonNumber(p.rate_hz)},
-          {"lateness_p50_upper_s", JsonNumber(p.lateness_p50_upper_s)},
-          {"lateness_p99_upper_s", JsonNumber(p.lateness_p99_upper_s)},
+          {"lateness_p50_upper_s", JsonNumber(p.UpperPercentile(0.50))},
+          {"lateness_p99_upper_s", JsonNumber(p.UpperPercentile(0.99))},
           {"histogram", p.histogram}};
 }
 

@@ -162,18 +162,7 @@ struct LiveMonitor::State {
     Heard(Role::kPlant);
     EpisodeTrace* e = Find(m.episode_id);
     if (!e) return;
-    PacingProgress p;
-    p.step = static_cast<long>(m.step);
-    p.realtime_factor = m.realtime_factor;
-    p.period_s = m.period_s;
-    p.missed_deadlines = static_cast<long>(m.missed_deadlines);
-    p.lateness_max_s = m.lateness_max_s;
-    p.rate_hz = m.rate_hz;
-    p.lateness_p50_upper_s = m.lateness_p50_upper_s;
-    p.lateness_p99_upper_s = m.lateness_p99_upper_s;
-    for (std::size_t i = 0; i < p.histogram.size(); ++i)
-      p.histogram[i] = static_cast<long>(m.lateness_histogram[i]);
-    e->info.pacing = p;
+    e->info.pacing = transport::PacingProgressFromMessage(m);
     Changed();
   }
 

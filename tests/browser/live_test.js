@@ -10,7 +10,7 @@
 const fs = require('fs');
 const path = require('path');
 const { execFileSync, spawn } = require('child_process');
-const { parseArgs, launch, waitForPage } = require('./page_driver.js');
+const { parseArgs, launch, waitForPage, makeStep } = require('./page_driver.js');
 
 const args = parseArgs(process.argv.slice(2), ['url', 'pidlab', 'modules', 'chromium', 'out', 'tmp', 'lcm-url', 'docs']);
 const live = (args.parts || 'all') === 'all';
@@ -66,19 +66,8 @@ async function main() {
   fs.mkdirSync(args.out, { recursive: true });
   const session = await launch({ modules: args.modules, chromium: args.chromium, profileDir: path.join(args.tmp, 'profile') });
   const { browser, page, log } = session;
-  const step = async (name, body) => {
-    try {
-      const detail = await body();
-      console.log('ok   ' + name + (detail ? ' [' + detail + ']' : ''));
-    } catch (e) {
-      console.log('FAIL ' + name + ': ' + (e && e.message ? e.message : String(e)));
-      console.log('--- the page\'s console (' + log.lines.length + ' lines):');
-      for (const line of log.lines) console.log('  ' + line);
-      await page.screenshot({ path: path.join(args.out, 'live-failure.png'), fullPage: true }).catch(() => {});
-      await browser.close().catch(() => {});
-      process.exit(1);
-    }
-  };
+  const step = makeStep(session,
+    () => page.screenshot({ path: path.join(args.out, 'live-failure.png'), fullPage: true }));
 
   await step('the page loads; the Live tab subscribes', async () => {
     await page.goto(args.url, { waitUntil: 'load', timeout: 30000 });

@@ -110,4 +110,22 @@ async function selectPlant(session, plant, timeoutMs) {
   }, before, plant);
 }
 
-module.exports = { parseArgs, launch, waitForPage, moveSlider, selectPlant };
+// A test step: prints "ok   NAME [detail]", or on failure "FAIL NAME: why", the page's console and a
+// screenshot (failureShot()), then closes the browser and exits 1.
+function makeStep({ browser, log }, failureShot) {
+  return async (name, body) => {
+    try {
+      const detail = await body();
+      console.log('ok   ' + name + (detail ? ' [' + detail + ']' : ''));
+    } catch (e) {
+      console.log('FAIL ' + name + ': ' + (e && e.message ? e.message : String(e)));
+      console.log('--- the page\'s console (' + log.lines.length + ' lines):');
+      for (const line of log.lines) console.log('  ' + line);
+      await failureShot().catch(() => {});
+      await browser.close().catch(() => {});
+      process.exit(1);
+    }
+  };
+}
+
+module.exports = { parseArgs, launch, waitForPage, moveSlider, selectPlant, makeStep };

@@ -7,7 +7,7 @@
 const fs = require('fs');
 const path = require('path');
 const { execFileSync } = require('child_process');
-const { parseArgs, launch, waitForPage, moveSlider, selectPlant } = require('./page_driver.js');
+const { parseArgs, launch, waitForPage, moveSlider, selectPlant, makeStep } = require('./page_driver.js');
 
 const args = parseArgs(process.argv.slice(2), ['url', 'pidlab', 'modules', 'chromium', 'out', 'tmp']);
 const plants = ['double_integrator', 'oscillator', 'stepper_motor'];  // the paper's three
@@ -56,19 +56,7 @@ async function main() {
                                  profileDir: path.join(args.tmp, 'profile') });
   const { browser, page, log } = session;
   const shot = (name) => page.screenshot({ path: path.join(args.out, 'workbench-' + name + '.png'), fullPage: true });
-  const step = async (name, body) => {
-    try {
-      const detail = await body();
-      console.log('ok   ' + name + (detail ? ' [' + detail + ']' : ''));
-    } catch (e) {
-      console.log('FAIL ' + name + ': ' + (e && e.message ? e.message : String(e)));
-      console.log('--- the page\'s console (' + log.lines.length + ' lines):');
-      for (const line of log.lines) console.log('  ' + line);
-      await shot('failure').catch(() => {});
-      await browser.close().catch(() => {});
-      process.exit(1);
-    }
-  };
+  const step = makeStep(session, () => shot('failure'));
   // For docs/workbench.png: the top of the page in the 1400x1000 viewport.
   const docsShot = async () => {
     await page.evaluate(() => window.scrollTo(0, 0));

@@ -14,15 +14,7 @@ if [[ $# -ne 3 ]]; then
 fi
 pidlab=$(realpath -- "$1") source_dir=$(realpath -- "$2") out_dir=$(realpath -m -- "$3")
 # Not a skip: without the browser or the npm packages the test fails, with one line.
-chromium=/usr/bin/chromium
-missing=
-command -v node >/dev/null 2>&1 || missing="node"
-[ -x "$chromium" ] || missing="$missing $chromium"
-[ -f "$source_dir/node_modules/puppeteer-core/package.json" ] || missing="$missing $source_dir/node_modules/puppeteer-core"
-if [ -n "$missing" ]; then
-  echo "FAIL: ${missing# } missing: run scripts/install-deps.sh"
-  exit 1
-fi
+source "$(dirname -- "${BASH_SOURCE[0]}")/require_browser.sh" "$source_dir" || exit 1
 if [[ ${PIDLAB_TEST_IN_NAMESPACE:-} != 1 ]]; then
   PIDLAB_TEST_IN_NAMESPACE=1 exec unshare -n bash "$0" "$@"
 fi

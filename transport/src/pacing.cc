@@ -122,6 +122,19 @@ void SetPacingProgress(const PacingProgress& p, pidlab::lcmt_pacing_progress* m)
   m->lateness_p99_upper_s = p.UpperPercentile(0.99);
 }
 
+PacingProgress PacingProgressFromMessage(const pidlab::lcmt_pacing_progress& m) {
+  PacingProgress p;
+  p.factor = m.realtime_factor;
+  p.period_s = m.period_s;
+  p.steps = static_cast<long>(m.step);
+  p.missed_deadlines = static_cast<long>(m.missed_deadlines);
+  p.lateness_max_s = m.lateness_max_s;
+  p.rate_hz = m.rate_hz;
+  for (int bin = 0; bin < kLatenessBins; ++bin)
+    p.histogram[static_cast<std::size_t>(bin)] = static_cast<long>(m.lateness_histogram[bin]);
+  return p;
+}
+
 Pacer::Pacer(double factor, double dt_s, long total_steps) : factor_(factor), period_s_(dt_s / factor) {
   lateness_s_.reserve(static_cast<std::size_t>(std::max(0L, total_steps)));
 }

@@ -58,19 +58,6 @@ enum class EpisodeStatus { kRunning, kComplete, kFailed };
 /// "running", "complete", "failed".
 const char* StatusName(EpisodeStatus status);
 
-/// The latest lcmt_pacing_progress of an episode.
-struct PacingProgress {
-  long step = 0;
-  double realtime_factor = 0.0;
-  double period_s = 0.0;
-  long missed_deadlines = 0;
-  double lateness_max_s = 0.0;
-  double rate_hz = 0.0;
-  double lateness_p50_upper_s = 0.0;
-  double lateness_p99_upper_s = 0.0;
-  std::array<long, 24> histogram{};
-};
-
 /// One episode's figures, without its trajectory.
 struct EpisodeInfo {
   int64_t episode_id = 0;
@@ -89,7 +76,8 @@ struct EpisodeInfo {
   EpisodeStatus status = EpisodeStatus::kRunning;
   std::string message;                // the SUMMARY's
   transport::RealtimeStats realtime;  // from the SUMMARY (unpaced before it)
-  std::optional<PacingProgress> pacing;
+  /// The latest lcmt_pacing_progress of the episode.
+  std::optional<transport::PacingProgress> pacing;
 };
 
 /// An episode with its trajectory: y, u, n of steps 0..total_steps, the

@@ -83,6 +83,9 @@ struct PacingProgress {
   double UpperPercentile(double q) const;
 };
 void SetPacingProgress(const PacingProgress& progress, pidlab::lcmt_pacing_progress* message);
+/// The figures a PACING message carries (its p50 and p99 upper bounds are
+/// UpperPercentile of these, as the plant computed them).
+PacingProgress PacingProgressFromMessage(const pidlab::lcmt_pacing_progress& message);
 
 class Pacer {
  public:
