@@ -7,7 +7,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config clang
+  build-essential cmake ninja-build pkg-config clang
   libeigen3-dev libceres-dev
   liblcm-dev liblcm-bin libglib2.0-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -29,7 +29,9 @@ if [ "$fast" = 1 ]; then
 fi
 # -O1 -g1: what the sanitisers' own documentation recommends, with line
 # tables enough for a report's stack (and half the compile time of -O2 -g).
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
+generator=()  # Ninja for a new tree, as scripts/build.sh
+[ -f build-asan/CMakeCache.txt ] || ! command -v ninja >/dev/null 2>&1 || generator=(-G Ninja)
+cmake -S . -B build-asan "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
   -DPIDLAB_SANITIZE=ON -DPIDLAB_WERROR=ON -DPIDLAB_BUILD_BENCH=OFF >/dev/null
 cmake --build build-asan -j"$(nproc)" --target pidlab pidlab-plant pidlab-controller pidlab-disturbance \
   hostile_stranger hostile_protocol_test

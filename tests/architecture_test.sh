@@ -28,7 +28,7 @@ level = {
     'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_analysis': 3,
     'pidlab_monitor': 3,
     'pidlab_tune': 4, 'pidlab_identify': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
-    'pidlab_tuner': 5, 'pidlab_json': 5, 'pidlab_replay': 5, 'pidlab_launcher': 5,
+    'pidlab_tuner': 5, 'pidlab_json': 5, 'pidlab_identify_json': 6, 'pidlab_replay': 5, 'pidlab_launcher': 5,
     'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_figures': 6, 'pidlab_cli': 7,
     'pidlab': 8, 'pidlab_python': 8,
 }

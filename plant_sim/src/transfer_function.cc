@@ -81,15 +81,17 @@ bool TransferFunction::IsValid(std::string* error) const {
       return fail(std::string(name) + " has " + std::to_string(poly->size()) + " coefficients, more than " +
                   std::to_string(kMaxTransferFunctionCoefficients));
     for (double v : *poly) {
+      const double a = std::abs(v);
+      const bool finite = std::isfinite(v);
+      if (finite && (v == 0.0 || (a <= kMaxCoefficientMagnitude && a >= kMinCoefficientMagnitude))) continue;
+      // The message is formatted only for a coefficient refused: every
+      // simulation validates its plant, an identification thousands of times.
       std::ostringstream os;
       os << name << " coefficient " << v;
-      if (!std::isfinite(v)) return fail(os.str() + " is not finite");
-      const double a = std::abs(v);
-      if (v != 0.0 && (a > kMaxCoefficientMagnitude || a < kMinCoefficientMagnitude)) {
-        os << " must be 0 or of magnitude between " << kMinCoefficientMagnitude << " and "
-           << kMaxCoefficientMagnitude;
-        return fail(os.str());
-      }
+      if (!finite) return fail(os.str() + " is not finite");
+      os << " must be 0 or of magnitude between " << kMinCoefficientMagnitude << " and "
+         << kMaxCoefficientMagnitude;
+      return fail(os.str());
     }
   }
   const auto d = StripLeadingZeros(den);
