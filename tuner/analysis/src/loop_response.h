@@ -94,15 +94,9 @@ class SampledResponse : public Response {
   }
   Point At(double w) const override {
     const cd z = std::polar(1.0, w * dt_);
-    const int n = static_cast<int>(phi_.rows());
-    Eigen::MatrixXcd m = -phi_.cast<cd>();
-    for (int i = 0; i < n; ++i) m(i, i) += z;
     // The plant with its dead time: z^-d C (zI - Phi)^-1 (Gamma0 z + Gamma1)
     // (docs/deadtime.md); without one, C (zI - Phi)^-1 Gamma.
-    const Eigen::VectorXcd x =
-        delay_steps_ == 0 ? m.partialPivLu().solve(gamma1_.cast<cd>()).eval()
-                          : m.partialPivLu().solve(gamma1_.cast<cd>() + gamma0_.cast<cd>() * z).eval();
-    cd g = (c_.cast<cd>() * x)(0);
+    cd g = static_cast<int>(phi_.rows()) <= kSmallOrder ? SmallPlantAt(z) : PlantAt(z);
     if (delay_steps_ > 0) g *= std::polar(1.0, -w * dt_ * static_cast<double>(delay_steps_));
     const cd nc = Eval(nc_, z);
     return {nc * g, Eval(dc_, z), nc};
@@ -110,6 +104,58 @@ class SampledResponse : public Response {
   const Polynomial& controller_num() const { return nc_; }
 
  private:
+  // Up to this order the plant's response is solved on the stack: the
+  // analysis asks for it at thousands of frequencies per loop (a tuning's
+  // Ms bound at every evaluation), where Eigen's dynamic LU spent more time
+  // allocating and scoring pivots by hypot than solving.
+  static constexpr int kSmallOrder = 8;
+
+  cd PlantAt(cd z) const {
+    const int n = static_cast<int>(phi_.rows());
+    Eigen::MatrixXcd m = -phi_.cast<cd>();
+    for (int i = 0; i < n; ++i) m(i, i) += z;
+    const Eigen::VectorXcd x =
+        delay_steps_ == 0 ? m.partialPivLu().solve(gamma1_.cast<cd>()).eval()
+                          : m.partialPivLu().solve(gamma1_.cast<cd>() + gamma0_.cast<cd>() * z).eval();
+    return (c_.cast<cd>() * x)(0);
+  }
+
+  // (zI - Phi) x = Gamma1 + z Gamma0 by Gaussian elimination with partial
+  // pivoting on |Re| + |Im| (LAPACK's zgetrf choice), then C x.
+  cd SmallPlantAt(cd z) const {
+    const int n = static_cast<int>(phi_.rows());
+    cd m[kSmallOrder][kSmallOrder], x[kSmallOrder];
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) m[i][j] = cd(-phi_(i, j), 0.0);
+      m[i][i] += z;
+      x[i] = delay_steps_ == 0 ? cd(gamma1_(i), 0.0) : gamma1_(i) + gamma0_(i) * z;
+    }
+    const auto modulus1 = [](cd v) { return std::abs(v.real()) + std::abs(v.imag()); };
+    for (int k = 0; k < n; ++k) {
+      int p = k;
+      for (int i = k + 1; i < n; ++i)
+        if (modulus1(m[i][k]) > modulus1(m[p][k])) p = i;
+      if (p != k) {
+        for (int j = k; j < n; ++j) std::swap(m[k][j], m[p][j]);
+        std::swap(x[k], x[p]);
+      }
+      if (m[k][k] == cd(0.0, 0.0)) return PlantAt(z);  // singular here: Eigen's answer (inf or NaN)
+      const cd inverse = 1.0 / m[k][k];
+      for (int i = k + 1; i < n; ++i) {
+        const cd f = m[i][k] * inverse;
+        for (int j = k + 1; j < n; ++j) m[i][j] -= f * m[k][j];
+        x[i] -= f * x[k];
+      }
+    }
+    cd g = 0.0;
+    for (int i = n - 1; i >= 0; --i) {
+      for (int j = i + 1; j < n; ++j) x[i] -= m[i][j] * x[j];
+      x[i] /= m[i][i];
+      g += c_(i) * x[i];
+    }
+    return g;
+  }
+
   Eigen::MatrixXd phi_;
   Eigen::VectorXd gamma1_, gamma0_;
   Eigen::RowVectorXd c_;
