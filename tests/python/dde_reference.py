@@ -181,7 +181,9 @@ def simulate(args, n, r):
     return [loop.output(k * args.ts) for k in range(count)]
 
 
-def main():
+def reference(argv=None):
+    """The reference's result for these arguments (sys.argv[1:] by default),
+    as the object main() prints."""
     p = argparse.ArgumentParser()
     p.add_argument("--num", required=True)
     p.add_argument("--den", required=True)
@@ -192,7 +194,7 @@ def main():
     p.add_argument("--ts", type=float, default=0.05)
     p.add_argument("--horizon", type=float, default=25.0)
     p.add_argument("--reference", type=float, default=1.0)
-    args = p.parse_args()
+    args = p.parse_args(argv)
     n = Zero()
     if args.square:
         amp, period = (float(v) for v in args.square.split(","))
@@ -207,7 +209,11 @@ def main():
         "itae": sum(k * args.ts * v for k, v in enumerate(e)),
         "load_iae": sum(abs(v) for v in load),
     }
-    json.dump(out, sys.stdout)
+    return out
+
+
+def main():
+    json.dump(reference(), sys.stdout)
 
 
 if __name__ == "__main__":

@@ -20,6 +20,8 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import dde_reference  # noqa: E402  (tests/python/dde_reference.py, beside this file)
 TOL = 1e-6
 HORIZON = "10"
 
@@ -70,11 +72,13 @@ def run_pidlab(pidlab, args, csv_path=None):
 
 
 def run_reference(num, den, delay, gains, tf, amp):
-    args = [sys.executable, os.path.join(HERE, "dde_reference.py"), "--num", num, "--den", den, "--delay",
-            repr(delay), "--gains", gains, "--tf", repr(tf), "--horizon", HORIZON]
+    # In this interpreter (scipy imported once, not once per case): the same
+    # arguments and the same object as `dde_reference.py ARGS` prints.
+    args = ["--num", num, "--den", den, "--delay", repr(delay), "--gains", gains, "--tf", repr(tf),
+            "--horizon", HORIZON]
     if amp > 0.0:
         args += ["--square", "%r,2" % amp]
-    return json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
+    return dde_reference.reference(args)
 
 
 def rel(a, b):
