@@ -2,7 +2,7 @@
 // Live and Logs tabs in headless Chromium against a trio run by `pidlab
 // launch`, read back and compared with pidlab's own tools.
 //   node live_test.js --url URL --pidlab BIN --modules DIR --chromium BIN --out DIR --tmp DIR --lcm-url URL
-//                     --docs DIR [--parts all|logs]
+//                     [--parts all|logs]
 // --parts logs runs only what needs no live server (a log recorded without
 // the page watching, opened, uploaded and scrubbed). Each step prints "ok
 // <step>" or "FAIL <step>: <what differed>" and the test stops at a failure.
@@ -12,7 +12,7 @@ const path = require('path');
 const { execFileSync, spawn } = require('child_process');
 const { parseArgs, launch, waitForPage, makeStep } = require('./page_driver.js');
 
-const args = parseArgs(process.argv.slice(2), ['url', 'pidlab', 'modules', 'chromium', 'out', 'tmp', 'lcm-url', 'docs']);
+const args = parseArgs(process.argv.slice(2), ['url', 'pidlab', 'modules', 'chromium', 'out', 'tmp', 'lcm-url']);
 const live = (args.parts || 'all') === 'all';
 const log25 = path.join(args.tmp, 'run.lcmlog');
 const longArgs = ['evaluate', '--backend', 'lcm', '--lcm-url', args['lcm-url'], '--plant', 'oscillator',
@@ -109,7 +109,6 @@ async function main() {
       const doubles = (t) => { const b = Buffer.from(t, 'base64'); return Array.from(new Float64Array(b.buffer, b.byteOffset, b.length / 8)); };
       for (const k of ['y', 'u', 'n']) liveFinal[k] = doubles(liveFinal[k]);
       await page.screenshot({ path: path.join(args.out, 'live.png') });
-      fs.copyFileSync(path.join(args.out, 'live.png'), path.join(args.docs, 'live.png'));
       // Run on the trio while it still runs (launch's COMMAND waits on the fifo).
       await page.click('#tab-design');
       await waitForPage(session, '#run-on-trio is not enabled', 15000, () => !document.getElementById('run-on-trio').disabled);
