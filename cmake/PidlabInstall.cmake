@@ -35,7 +35,7 @@ function(pidlab_install_package)
   # The libraries in link order (each before what it links); lcmtypes is
   # headers only.
   set(PIDLAB_PC_LIBS "-lpidlab_report -lpidlab_figures -lpidlab_replay_json -lpidlab_identify_json -lpidlab_json -lpidlab_plot -lpidlab_launcher -lpidlab_replay")
-  string(APPEND PIDLAB_PC_LIBS " -lpidlab_episode_client -lpidlab_log_reader -lpidlab_tune -lpidlab_identify -lpidlab_analysis -lpidlab_evaluation -lpidlab_spec")
+  string(APPEND PIDLAB_PC_LIBS " -lpidlab_episode_client -lpidlab_log_reader -lpidlab_tune -lpidlab_identify -lpidlab_analysis -lpidlab_evaluation -lpidlab_io -lpidlab_spec")
   string(APPEND PIDLAB_PC_LIBS " -lpidlab_optim")
   string(APPEND PIDLAB_PC_LIBS " -lpidlab_role_main -lpidlab_plant_roles -lpidlab_controller_role")
   string(APPEND PIDLAB_PC_LIBS " -lpidlab_transport -lpidlab_plant_sim -lpidlab_controller")

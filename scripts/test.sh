@@ -34,7 +34,7 @@ generator=()  # Ninja for a new tree, as scripts/build.sh
 cmake -S . -B build-asan "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
   -DPIDLAB_SANITIZE=ON -DPIDLAB_WERROR=ON -DPIDLAB_BUILD_BENCH=OFF >/dev/null
 cmake --build build-asan -j"$(nproc)" --target pidlab pidlab-plant pidlab-controller pidlab-disturbance \
-  hostile_stranger hostile_protocol_test
+  hostile_stranger hostile_protocol_test hostile_files
 # No test runs the benchmark programs (bench/): the full run does not build
 # them (about 17 s of compile CPU and four links); scripts/build.sh alone builds them again.
 bash scripts/build.sh -DPIDLAB_SANITIZED_BIN_DIR="$PWD/build-asan/bin" -DPIDLAB_BUILD_BENCH=OFF

@@ -255,7 +255,8 @@ TEST_F(ModelFile, ABadFileIsRefusedWithOneLineNamingTheFileAndTheReason) {
   std::string error;
   EXPECT_FALSE(tune::BuildPlant(missing, spec::NameStyle::kFlag, &p, &error));
   EXPECT_EQ(error,
-            "--plant 'model:/nonexistent/model.json': model file '/nonexistent/model.json' cannot be read");
+            "--plant 'model:/nonexistent/model.json': model file '/nonexistent/model.json' cannot be read: "
+            "No such file or directory");
 }
 
 // A tf file (docs/identify.md, "A general transfer function"): 2 poles, 1 zero.

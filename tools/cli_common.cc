@@ -93,6 +93,7 @@ void CheckOutputFile(const std::string& path, const std::string& flag) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw BadInput(flag + " " + Quote(path) + " is a folder, not a file");
+  if (Status s = io::CheckWritableTarget(path); !s.ok()) throw BadInput(flag + " " + s.message());
   const bool existed = std::filesystem::exists(std::filesystem::symlink_status(path, ec));
   // O_NONBLOCK: a FIFO without a reader fails with ENXIO instead of blocking.
   const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_NONBLOCK | O_CLOEXEC, 0666);
@@ -417,14 +418,21 @@ std::string FormatEvaluation(const Evaluation& ev) {
 }
 
 void WriteSamplesCsv(const Evaluation& ev, const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw BadInput("--samples-csv " + Quote(path) + " cannot be written");
+  std::ostringstream f;
   f << std::setprecision(17) << "t,r,y,e,n\n";
   for (std::size_t m = 0; m < ev.y.size(); ++m)
     f << ev.t[m] << "," << ev.options.reference << "," << ev.y[m] << "," << ev.options.reference - ev.y[m]
       << "," << ev.n[m] << "\n";
-  f.close();
-  if (!f) throw std::runtime_error("writing " + path + " failed");
+  WriteOutputFile(path, f.str());
 }
+
+std::string ReadInputFile(const std::string& path, const std::string& flag, std::size_t max_bytes) {
+  std::string text;
+  Status s = io::ReadFile(path, max_bytes, &text);
+  if (!s.ok()) Require(Status(s.code(), flag + " " + s.message()));
+  return text;
+}
+
+void WriteOutputFile(const std::string& path, const std::string& text) { Require(io::WriteFile(path, text)); }
 
 }  // namespace pidlab::cli

@@ -16,6 +16,7 @@
 #include "pidlab/episode_client/episode_client.h"
 #include "pidlab/episode_client/episode_pool.h"
 #include "pidlab/evaluation/evaluation.h"
+#include "pidlab/io/files.h"
 #include "pidlab/json/replay_json.h"
 #include "pidlab/json/results_json.h"
 #include "pidlab/spec/field.h"
@@ -53,6 +54,15 @@ CLI::Validator WholeNumber();
 /// Bad input unless `path` can be opened for writing (created if absent, then
 /// removed again; an existing file is left as it is). Run before any work.
 void CheckOutputFile(const std::string& path, const std::string& flag);
+/// The most a spec, a model file or a result file (--spec, --model,
+/// --from) may hold.
+inline constexpr std::size_t kMaxSpecFileBytes = 1 << 20;
+/// The whole of the file `path` named by `flag`, at most `max_bytes`; bad
+/// input otherwise ("--from 'x.json' cannot be read: No such file or directory").
+std::string ReadInputFile(const std::string& path, const std::string& flag, std::size_t max_bytes);
+/// `text` into `path`, whole or not at all (io::WriteFile): a full disk is a
+/// runtime failure naming the path and the errno's words; the old file stays.
+void WriteOutputFile(const std::string& path, const std::string& text);
 /// Creates the folder `dir` if needed; bad input unless a file can be written in it.
 void PrepareOutputDir(const std::string& dir, const std::string& flag);
 

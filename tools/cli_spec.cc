@@ -102,14 +102,12 @@ void SpecFlags::AddList(const spec::Field& f, const std::string& default_text) {
 bool SpecFlags::Given(const std::string& key) const { return app_->count(spec::FlagName(key)) > 0; }
 
 nlohmann::json SpecFlags::ReadSpecFile() const {
-  std::ifstream in(spec_file_);
-  if (!in) ThrowSpecFileError("cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (text.str().size() > (1u << 20)) ThrowSpecFileError("is larger than 1 MiB");
+  std::string text;
+  if (Status s = io::ReadFile(spec_file_, kMaxSpecFileBytes, &text); !s.ok())
+    Require(Status(s.code(), "--spec " + s.message()));
   nlohmann::json j;
   std::string error;
-  if (!spec::ParseJsonText(text.str(), &j, &error)) ThrowSpecFileError(error);
+  if (!spec::ParseJsonText(text, &j, &error)) ThrowSpecFileError(error);
   // A --json result: its "spec".
   if (j.is_object() && j.contains("spec") && j["spec"].is_object()) j = nlohmann::json(j["spec"]);
   // A plant named on the command line (--plant, --model, --num/--den)

@@ -104,11 +104,7 @@ void DrawFigure(const std::vector<BatchResult>& results, const std::string& path
   if (!plot::DrawPng(fig, &error)) throw std::runtime_error(error);
 }
 
-void WriteFile(const std::string& path, const std::string& text) {
-  std::ofstream f(path);
-  f << text;
-  if (!f.flush()) throw std::runtime_error(path + " cannot be written");
-}
+void WriteFile(const std::string& path, const std::string& text) { WriteOutputFile(path, text); }
 
 struct BatchCommand {
   std::string set = "amigo", families, loop = "sampled", out_dir;

@@ -202,12 +202,17 @@ struct EvaluateCommand {
   }
 
   static void WriteTrajectoryCsv(const Evaluation& ev, const std::string& path) {
-    FILE* f = std::fopen(path.c_str(), "w");
-    if (!f) throw BadInput("--trajectory-csv " + Quote(path) + " cannot be written");
-    std::fprintf(f, "k,t,r,y,u,n\n");
-    for (const SampledStep& s : ev.trajectory)
-      std::fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.k, s.t, s.r, s.y, s.u, s.n);
-    if (std::fclose(f) != 0) throw std::runtime_error("writing " + path + " failed");
+    std::unique_ptr<io::AtomicFile> f;
+    Status opened = io::AtomicFile::Open(path, &f);
+    if (!opened.ok()) Require(Status(opened.code(), "--trajectory-csv " + opened.message()));
+    f->Write("k,t,r,y,u,n\n");
+    char row[200];
+    for (const SampledStep& s : ev.trajectory) {
+      const int n =
+          std::snprintf(row, sizeof row, "%ld,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.k, s.t, s.r, s.y, s.u, s.n);
+      f->Write(std::string_view(row, static_cast<std::size_t>(n)));
+    }
+    Require(f->Commit());
   }
 };
 

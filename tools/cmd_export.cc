@@ -28,10 +28,7 @@ namespace {
 /// A --json result's file: its echoed spec (an evaluation's or a tuning's)
 /// and its gains.
 nlohmann::json ReadResult(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw BadInput("--from " + Quote(path) + " cannot be read");
-  std::string text((std::istreambuf_iterator<char>(in)), {});
-  if (text.size() > (1u << 20)) throw BadInput("--from " + Quote(path) + " is larger than 1 MiB");
+  const std::string text = ReadInputFile(path, "--from", kMaxSpecFileBytes);
   nlohmann::json j;
   std::string error;
   if (!spec::ParseJsonText(text, &j, &error)) throw BadInput("--from " + Quote(path) + ": " + error);
@@ -141,10 +138,9 @@ struct ExportCommand {
       throw BadInput(e.what());
     }
     const std::string header = out + "/pidlab_pid.h", source = out + "/pidlab_pid.c";
-    std::ofstream(header) << code.header;
-    std::ofstream(source) << code.source;
-    if (!std::ifstream(header) || !std::ifstream(source))
-      throw BadInput("--out " + Quote(out) + " cannot be written");
+    // Both files or neither: a header beside a source of another run would
+    // compile into a controller nobody generated.
+    Require(io::WriteFiles({{header, code.header}, {source, code.source}}));
     std::cout << "wrote " << header << " and " << source << " (" << scalar << ")\n";
     return 0;
   }

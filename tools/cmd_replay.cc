@@ -99,7 +99,7 @@ struct ReplayCommand {
     if (backend == "lcm" && !redrive) throw BadInput("--backend lcm applies to --redrive only");
     const replay::LogContents log = ReadTheLog();
     const std::vector<const replay::Episode*> selected = SelectEpisodes(log);
-    std::ofstream csv_file;
+    std::unique_ptr<io::AtomicFile> csv_file;
     if (!csv.empty()) OpenCsv(&csv_file);
     nlohmann::json out = json::LogJson(log, log_path);
     std::ostringstream table;
@@ -107,8 +107,9 @@ struct ReplayCommand {
     int status = 0;
     for (const replay::Episode* e : selected) {
       if (!ReportEpisode(*e, &out["episodes"], &table)) status = 1;
-      if (csv_file.is_open()) WriteCsv(*e, &csv_file);
+      if (csv_file) WriteCsv(*e, csv_file.get());
     }
+    if (csv_file) Require(csv_file->Commit());  // whole, or the old file stays
     if (selected.empty()) table << "(no episode in the log)\n";
     if (json) {
       // Channel names and texts come from the log: bytes that are not UTF-8
@@ -229,22 +230,25 @@ struct ReplayCommand {
 
   // ---- CSV
 
-  void OpenCsv(std::ofstream* file) const {
-    file->open(csv);
-    if (!*file) throw BadInput("--csv " + Quote(csv) + " cannot be written");
-    *file << std::setprecision(17) << "episode,k,t,r,y,u,n,e\n";
+  void OpenCsv(std::unique_ptr<io::AtomicFile>* file) const {
+    const Status s = io::AtomicFile::Open(csv, file);
+    if (!s.ok()) Require(Status(s.code(), "--csv " + s.message()));
+    (*file)->Write("episode,k,t,r,y,u,n,e\n");
   }
 
   // Steps 0..total_steps of an episode with a configuration (an episode
   // without one has no per-step data).
-  static void WriteCsv(const replay::Episode& e, std::ofstream* file) {
+  static void WriteCsv(const replay::Episode& e, io::AtomicFile* out) {
     const double r = e.has_config ? e.spec.reference : 1.0;
     const double dt = e.has_config ? e.spec.dt_s : std::nan("");
+    std::ostringstream rows;
+    rows << std::setprecision(17);
     for (std::size_t i = 0; i < e.y.size(); ++i) {
       const auto k = static_cast<long>(i);
-      *file << e.episode_id << "," << k << "," << static_cast<double>(k) * dt << "," << r << "," << e.y[i]
-            << "," << e.u[i] << "," << e.n[i] << "," << r - e.y[i] << "\n";
+      rows << e.episode_id << "," << k << "," << static_cast<double>(k) * dt << "," << r << "," << e.y[i]
+           << "," << e.u[i] << "," << e.n[i] << "," << r - e.y[i] << "\n";
     }
+    out->Write(rows.str());
   }
 };
 

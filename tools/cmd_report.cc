@@ -8,6 +8,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "pidlab/io/files.h"
 #include "pidlab/report/report.h"
 #include "pidlab/report/trio_episode.h"
 
@@ -47,13 +48,19 @@ struct ReportCommand {
   int Run() {
     report::ReportOptions options;
     options.paper_tables = paper_tables;
-    options.out_dir = out_dir;
     options.seed = seed;
     options.quick = quick;
     options.figures = !no_figures;
     options.trio_absent_note = no_trio ? "skipped (--no-trio)" : "skipped (--quick)";
+    // Every file of the report (report.md, the figures, the trio's log) is
+    // written into a stage inside --out and moved into place only when all
+    // are complete: a failure leaves the folder as it was.
+    PrepareOutputDir(out_dir, "--out");  // an unwritable folder is bad input (exit 2), before the work
+    std::unique_ptr<io::StagedFolder> stage;
+    Require(io::StagedFolder::Create(out_dir, &stage));
+    options.out_dir = stage->path();
     if (!no_trio && !quick) {
-      const std::string log = (std::filesystem::path(out_dir) / "trio.log").string();
+      const std::string log = (std::filesystem::path(options.out_dir) / "trio.log").string();
       options.trio_runner = [log](const Plant& plant, const PidGains& g, double dt_s, double horizon_s,
                                   report::Metrics* m, std::string* note) {
         report::TrioEpisodeOptions trio;
@@ -73,10 +80,11 @@ struct ReportCommand {
                        " (use --paper-tables FILE)");
       if (!report::ReadPaperTables(options.paper_tables, &paper, &error)) throw BadInput(error);
     }
-    PrepareOutputDir(out_dir, "--out");  // an unwritable folder is bad input (exit 2), before the work
     report::ReportData data;
-    if (!report::ComputeReport(options, paper, &data, &error)) throw std::runtime_error(error);
-    if (!report::WriteReport(&data, &error)) throw std::runtime_error(error);
+    if (!report::ComputeReport(options, paper, &data, &error))
+      throw std::runtime_error(stage->Unstaged(error));
+    if (!report::WriteReport(&data, &error)) throw std::runtime_error(stage->Unstaged(error));
+    Require(stage->Commit());
     std::cout << "wrote " << (std::filesystem::path(out_dir) / "report.md").string() << " and "
               << data.figures.size() << " figures (" << data.rows.size() << " published rows, "
               << data.tunings.size() << " tunings; computation " << data.compute_time_s

@@ -216,14 +216,14 @@ struct TuneCommand {
   }
 
   void WriteTrace(const TuneSummary& s) const {
-    std::ofstream f(trace);
-    if (!f) throw BadInput("--trace " + Quote(trace) + " cannot be written");
+    std::ostringstream f;
     f << std::setprecision(17) << "iteration,evaluations,best_objective,kp,ki,kd\n";
     for (const auto& tp : s.optimizer.trace) {
       f << tp.iteration << "," << tp.evaluations << "," << tp.best_f;
       for (int i = 0; i < 3; ++i) f << "," << (tp.best_x.size() == 3 ? tp.best_x(i) : NAN);
       f << "\n";
     }
+    WriteOutputFile(trace, f.str());
   }
 };
 

@@ -9,7 +9,11 @@ namespace {
 
 bool Fail(const Field& f, const std::string& expected, const nlohmann::json& got, std::string* error) {
   if (error) {
-    std::string text = got.dump();
+    // A long string is cut before it is printed; the rest is at most
+    // kMaxJsonDepth deep (ParseJsonText), so printing it is bounded.
+    std::string text = got.is_string() ? nlohmann::json(Truncate(got.get<std::string>(), 60))
+                                             .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
+                                       : got.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     if (text.size() > 60) text = text.substr(0, 57) + "...";
     *error = "spec key '" + std::string(f.key) + "' must be " + expected + ", not " + text;
   }
@@ -39,12 +43,42 @@ bool CheckVersion(const nlohmann::json& j, std::string* error) {
   const auto it = j.find("version");
   if (it == j.end() || (it->is_number_integer() && it->get<long long>() == kSpecVersion)) return true;
   if (error)
-    *error = "spec version " + it->dump() + " is not " + std::to_string(kSpecVersion) +
-             ", the one this pidlab reads";
+    *error = "spec version " +
+             Truncate(it->dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), 60) + " is not " +
+             std::to_string(kSpecVersion) + ", the one this pidlab reads";
   return false;
 }
 
+bool CheckJsonNesting(const std::string& text, int max_depth, std::string* error) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;  // the escaped character, whatever it is
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) {
+        if (error)
+          *error = "is nested deeper than " + std::to_string(max_depth) + " levels (at byte " +
+                   std::to_string(i) + ")";
+        return false;
+      }
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return true;
+}
+
 bool ParseJsonText(const std::string& text, nlohmann::json* out, std::string* error) {
+  // Checked before parsing: nlohmann's parser is iterative, but copying,
+  // comparing and printing a value recurse once per level.
+  if (!CheckJsonNesting(text, kMaxJsonDepth, error)) return false;
   *out = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (out->is_discarded()) {
     if (error) *error = "is not valid JSON";

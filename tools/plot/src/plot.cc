@@ -13,12 +13,17 @@
 #include <fstream>
 #include <sstream>
 
+#include "pidlab/io/files.h"
+
 extern char** environ;
 
 namespace pidlab::plot {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The largest PNG a figure may be (10000 x 10000 px is the largest size).
+constexpr std::size_t kMaxPngBytes = std::size_t{1} << 30;
 
 // Gnuplot double-quoted string: backslash and quote escaped, newline kept as \n.
 std::string Quote(const std::string& s) {
@@ -86,19 +91,24 @@ std::string FirstLines(const std::string& path, int max_lines) {
 
 // The folder for the data files and the script: figure.data_dir (created if
 // needed), or a new temporary folder that *temp removes afterwards.
+// A new folder under $TMPDIR (else /tmp) that *temp removes afterwards.
+bool MakeTempDir(TempDir* temp, std::string* error) {
+  const char* tmp = std::getenv("TMPDIR");
+  std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/pidlab-plot-XXXXXX";
+  if (!mkdtemp(pattern.data())) {
+    *error = "cannot create a temporary folder: " + std::string(std::strerror(errno));
+    return false;
+  }
+  temp->path = pattern;
+  return true;
+}
+
 bool MakeDataDir(const Figure& figure, TempDir* temp, std::string* dir, std::string* error) {
   *dir = figure.data_dir;
   std::error_code ec;
   if (dir->empty()) {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/pidlab-plot-XXXXXX";
-    std::vector<char> buf(pattern.begin(), pattern.end());
-    buf.push_back('\0');
-    if (!mkdtemp(buf.data())) {
-      *error = "cannot create a temporary folder: " + std::string(std::strerror(errno));
-      return false;
-    }
-    *dir = temp->path = buf.data();
+    if (!MakeTempDir(temp, error)) return false;
+    *dir = temp->path;
   } else if (!fs::create_directories(*dir, ec) && ec) {
     *error = "cannot create data folder " + *dir + ": " + ec.message();
     return false;
@@ -115,23 +125,20 @@ bool WriteDataFiles(const Figure& figure, const std::string& dir,
     for (std::size_t s = 0; s < figure.panels[p].series.size(); ++s) {
       const Series& se = figure.panels[p].series[s];
       const std::string name = "p" + std::to_string(p) + "_s" + std::to_string(s) + ".dat";
-      std::FILE* f = std::fopen((dir + "/" + name).c_str(), "w");
-      if (!f) {
-        *error = "cannot write " + dir + "/" + name + ": " + std::strerror(errno);
-        return false;
-      }
-      std::fprintf(f, "# %s\n", se.name.c_str());
+      std::string text = "# " + se.name + "\n";
+      char row[64];
       for (std::size_t i = 0; i < se.x.size(); ++i) {
         const double x = se.x[i], y = se.y[i];
         if (std::isfinite(x) && std::isfinite(y))
-          std::fprintf(f, "%.17g %.17g\n", x, y);
+          std::snprintf(row, sizeof row, "%.17g %.17g\n", x, y);
         else if (std::isfinite(x))
-          std::fprintf(f, "%.17g NaN\n", x);
+          std::snprintf(row, sizeof row, "%.17g NaN\n", x);
         else
-          std::fprintf(f, "NaN NaN\n");
+          std::snprintf(row, sizeof row, "NaN NaN\n");
+        text += row;
       }
-      if (std::fclose(f) != 0) {
-        *error = "cannot write " + dir + "/" + name;
+      if (const Status st = io::WriteFile(dir + "/" + name, text); !st.ok()) {
+        *error = st.message();
         return false;
       }
       (*files)[p].push_back(name);
@@ -271,21 +278,31 @@ bool DrawPng(const Figure& figure, std::string* error) {
   // Paths are absolute so gnuplot's working folder does not matter.
   const std::string abs_dir = fs::absolute(dir).string();
   const std::string abs_out = fs::absolute(figure.output_path).string();
-  std::error_code ec;
-  fs::remove(abs_out, ec);  // a stale PNG must not pass for a new one
-  const std::string script = abs_dir + "/figure.gp";
-  {
-    std::ofstream f(script);
-    f << GnuplotScript(figure, abs_dir, abs_out, files);
-    if (!f) {
-      e = "cannot write " + script;
-      return fail();
-    }
+  // The script kept beside the data draws to the figure's own path; the one
+  // run draws into a temporary folder, and the PNG is then written into
+  // place whole (io::WriteFile): an old figure stays until a new one is
+  // complete, and a full disk is named as such.
+  if (const Status st = io::WriteFile(abs_dir + "/figure.gp", GnuplotScript(figure, abs_dir, abs_out, files));
+      !st.ok()) {
+    e = st.message();
+    return fail();
   }
-  if (!RunGnuplot(script, abs_dir + "/gnuplot.log", &e)) return fail();
+  TempDir run;
+  if (!MakeTempDir(&run, &e)) return fail();
+  const std::string drawn = run.path + "/figure.png", script = run.path + "/figure.gp";
+  if (const Status st = io::WriteFile(script, GnuplotScript(figure, abs_dir, drawn, files)); !st.ok()) {
+    e = st.message();
+    return fail();
+  }
+  if (!RunGnuplot(script, run.path + "/gnuplot.log", &e)) return fail();
   int w = 0, h = 0;
-  if (!ReadPngSize(abs_out, &w, &h)) {
-    e = "gnuplot ran but wrote no PNG file at " + abs_out;
+  std::string png;
+  if (!ReadPngSize(drawn, &w, &h) || !io::ReadFile(drawn, kMaxPngBytes, &png).ok()) {
+    e = "gnuplot ran but wrote no PNG file for " + abs_out;
+    return fail();
+  }
+  if (const Status st = io::WriteFile(abs_out, png); !st.ok()) {
+    e = st.message();
     return fail();
   }
   return true;

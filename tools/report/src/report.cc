@@ -1,6 +1,7 @@
 // The paper report: see report.h. The sections live beside this file
 // (report_internal.h); here the report is put together, computed and written.
 
+#include "pidlab/io/files.h"
 #include "pidlab/report/report.h"
 
 #include <chrono>
@@ -234,10 +235,8 @@ bool WriteReport(ReportData* data, std::string* error) {
   if (data->options.figures && !DrawFigures(data, error)) return false;
   data->figure_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string path = (std::filesystem::path(data->options.out_dir) / "report.md").string();
-  std::ofstream out(path);
-  out << RenderMarkdown(*data);
-  if (!out) {
-    *error = "cannot write " + path;
+  if (const Status s = io::WriteFile(path, RenderMarkdown(*data)); !s.ok()) {
+    *error = s.message();
     return false;
   }
   return true;

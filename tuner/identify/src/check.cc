@@ -67,7 +67,52 @@ bool IdentifyOptions::IsValid(std::string* error) const {
   return e.empty();
 }
 
-Status CheckData(const IdentifyData& data, Sampling* sampling) {
+namespace {
+
+// "sample 11 (row 13)": the index, and the line of a CSV file where known.
+std::string Where(const std::vector<long>* rows, std::size_t k) {
+  std::string where = "sample " + std::to_string(k);
+  if (rows && k < rows->size()) where += " (row " + std::to_string((*rows)[k]) + ")";
+  return where;
+}
+
+double Median(std::vector<double> v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// The rules of absurd but finite data (docs/identify.md, "What a record
+// must be"): numbers no larger than any number pidlab takes, no sample
+// beyond kMaxOutlierRatio times the column's typical deviation from its
+// median.
+Status CheckColumn(const std::vector<long>* rows, const std::vector<double>& x, const char* name) {
+  for (std::size_t k = 0; k < x.size(); ++k)
+    if (std::abs(x[k]) > kMaxRecordMagnitude)
+      return Status::InvalidInput("column " + std::string(name) + ", " + Where(rows, k) + ": " +
+                                  CheckedNumber(x[k]) +
+                                  " is beyond 1e12 in magnitude, the limit of every "
+                                  "number pidlab takes (rescale the column's units)");
+  const double median = Median(x);
+  std::vector<double> deviation(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k) deviation[k] = std::abs(x[k] - median);
+  const double typical = Median(deviation);
+  if (typical > 0.0)
+    for (std::size_t k = 0; k < x.size(); ++k)
+      if (deviation[k] > kMaxOutlierRatio * typical)
+        return Status::InvalidInput("column " + std::string(name) + ", " + Where(rows, k) + ": " +
+                                    CheckedNumber(x[k]) +
+                                    " lies more than 1e12 times the column's median "
+                                    "deviation (" +
+                                    CheckedNumber(typical) +
+                                    ") from its median: an outlier "
+                                    "to remove");
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status CheckData(const IdentifyData& data, Sampling* sampling, const std::vector<long>* rows) {
   const std::size_t n = data.t.size();
   if (data.u.size() != n || data.y.size() != n)
     return Status::InvalidInput("t, u and y have different lengths (" + std::to_string(n) + ", " +
@@ -81,17 +126,24 @@ Status CheckData(const IdentifyData& data, Sampling* sampling) {
                        : !std::isfinite(data.y[k]) ? "y"
                                                    : nullptr;
     if (name)
-      return Status::InvalidInput(std::string("not finite: ") + name + " at sample " + std::to_string(k) +
-                                  " is " +
+      return Status::InvalidInput(std::string("not finite: ") + name + " at " + Where(rows, k) + " is " +
                                   CheckedNumber(std::string(name) == "t"   ? data.t[k]
                                                 : std::string(name) == "u" ? data.u[k]
                                                                            : data.y[k]));
   }
   for (std::size_t k = 1; k < n; ++k)
     if (!(data.t[k] > data.t[k - 1]))
-      return Status::InvalidInput("t is not strictly increasing: t = " + CheckedNumber(data.t[k]) +
-                                  " at sample " + std::to_string(k) + " after " +
-                                  CheckedNumber(data.t[k - 1]));
+      return Status::InvalidInput("t is not strictly increasing: t = " + CheckedNumber(data.t[k]) + " at " +
+                                  Where(rows, k) + " after " + CheckedNumber(data.t[k - 1]));
+  for (std::size_t k = 1; k < n; ++k)
+    if (data.t[k] - data.t[k - 1] < kMinRecordInterval)
+      return Status::InvalidInput("column t, " + Where(rows, k) + ": the interval " +
+                                  CheckedNumber(data.t[k] - data.t[k - 1]) +
+                                  " s is below 1e-12 s, the shortest time pidlab takes (rescale t's units)");
+  const char* const names[] = {"t", "u", "y"};
+  const std::vector<double>* const columns[] = {&data.t, &data.u, &data.y};
+  for (int c = 1; c < 3; ++c)
+    if (Status s = CheckColumn(rows, *columns[c], names[c]); !s.ok()) return s;
   Sampling found;
   found.mean_interval_s = (data.t[n - 1] - data.t[0]) / static_cast<double>(n - 1);
   found.min_interval_s = found.max_interval_s = data.t[1] - data.t[0];
@@ -106,6 +158,17 @@ Status CheckData(const IdentifyData& data, Sampling* sampling) {
     return Status::InvalidInput("constant input: u is " + CheckedNumber(data.u[0]) +
                                 " throughout, so nothing can be identified");
   *sampling = found;
+  return Status::Ok();
+}
+
+Status CheckResponse(const IdentifyData& data) {
+  // Constant to 12 digits: what is left is rounding, not a response.
+  const auto [y_min, y_max] = std::minmax_element(data.y.begin(), data.y.end());
+  const double y_scale = std::max(std::abs(*y_min), std::abs(*y_max));
+  if (*y_max - *y_min <= 1e-12 * y_scale)
+    return Status::InvalidInput("constant output: y is " + CheckedNumber(data.y[0]) +
+                                (*y_max > *y_min ? " to 12 digits" : "") +
+                                " throughout, so no response can be identified");
   return Status::Ok();
 }
 

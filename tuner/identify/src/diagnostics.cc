@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "pidlab/identify/identify.h"
+#include "pidlab/spec/field.h"
 
 namespace pidlab::identify {
 
@@ -126,7 +127,13 @@ Status IdentifyAuto(const IdentifyData& data, const IdentifyOptions& options, Au
   const int count = static_cast<int>(result->candidates.size());
   for (int i = 0; i < count; ++i)
     if (usable(i) && (lowest < 0 || aic(i) < aic(lowest))) lowest = i;
-  if (lowest < 0) return Status::RunnerFailed("no model kind could be fitted");
+  if (lowest < 0) {
+    std::string why;
+    for (const AutoCandidate& c : result->candidates)
+      if (!c.status.ok() && why.empty()) why = std::string(ToString(c.kind)) + ": " + c.status.message();
+    return Status::RunnerFailed("no model kind could be fitted (p1d, p2d, p2du, p1di and p2dz tried" +
+                                (why.empty() ? std::string(")") : "; " + spec::Truncate(why, 150) + ")"));
+  }
   const auto parameters = [&](int i) {
     return result->candidates[static_cast<std::size_t>(i)].result.names.size();
   };

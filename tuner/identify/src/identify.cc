@@ -419,6 +419,7 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
                                                               : ParameterCount(record) - 1;
   const optim::SobolSequence sobol =
       options.seed == 0 ? optim::SobolSequence(dimensions) : optim::SobolSequence(dimensions, options.seed);
+  int total = options.starts;
   const auto fit = [&](std::vector<double> theta) {
     const double cost = FitFrom(record, options, &theta);
     costs->push_back(cost);
@@ -426,10 +427,12 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
       best_cost = cost;
       best = theta;
     }
+    if (options.progress) options.progress(record.kind, static_cast<int>(costs->size()), total, best_cost);
   };
   if (options.arx_start) {
     std::vector<double> theta = ArxStartPoint(record);
     *arx_used = !theta.empty();
+    total += *arx_used ? 1 : 0;
     if (*arx_used) fit(theta);
   }
   for (int s = 0; s < options.starts; ++s) fit(StartPoint(record, sobol, s));
@@ -547,10 +550,17 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
     return Status::InvalidInput(
         "initial condition steady-state: P1DI integrates, so it has no steady state at u[0] = " +
         Number(data.u[0]) + " unless u0 is that value too (u0 = " + Number(result->u0) + ")");
+  if (Status s = CheckResponse(data); !s.ok()) return s;
   record.length_s = data.t.back() - data.t.front();
   record.max_delay_s = options.max_delay_fraction * record.length_s;
   std::vector<double> theta = MultiStart(record, options, &result->start_costs, &result->arx_start);
-  if (theta.empty()) return Status::RunnerFailed("no start of the fit converged");
+  if (theta.empty())
+    return Status::RunnerFailed(
+        "no start of the fit converged: " + std::to_string(options.starts) + " starts (seed " +
+        std::to_string(options.seed) + ") of " + ToString(kind) + ", at most " +
+        std::to_string(options.max_iterations) +
+        " iterations each, all ended at a non-finite cost; check the record's units and outliers, or try "
+        "more starts (--starts), another seed or another model");
   // P2D's time constants are interchangeable: report Tp1 >= Tp2.
   if ((kind == ProcessModelKind::kP2D || kind == ProcessModelKind::kP2DZ) && theta[2] > theta[1])
     std::swap(theta[1], theta[2]);

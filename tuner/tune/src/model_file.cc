@@ -8,6 +8,7 @@
 #include <sstream>
 #include <utility>
 
+#include "pidlab/io/files.h"
 #include "pidlab/spec/json.h"
 
 namespace pidlab::tune {
@@ -55,14 +56,14 @@ bool NumberList(const nlohmann::json& j, const std::string& where, std::vector<d
   return true;
 }
 
+// Read with the bound checked before the bytes are (io::ReadFile); the
+// message without the path, which the caller names.
 bool ReadText(const std::string& path, std::string* text, std::string* error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return FileBad(error, "cannot be read");
-  std::ostringstream os;
-  os << in.rdbuf();
-  if (os.str().size() > kMaxModelFileBytes) return FileBad(error, "is larger than 1 MiB");
-  *text = os.str();
-  return true;
+  const Status s = io::ReadFile(path, kMaxModelFileBytes, text);
+  if (s.ok()) return true;
+  const std::string quoted = spec::Quote(path) + " ";
+  const std::string& m = s.message();
+  return FileBad(error, m.compare(0, quoted.size(), quoted) == 0 ? m.substr(quoted.size()) : m);
 }
 
 // A tf's "poles" and "zeros": integers in 1..kMaxTfPoles and 0..poles-1.

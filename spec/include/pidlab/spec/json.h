@@ -42,7 +42,15 @@ bool FromJsonValue(const nlohmann::json& j, const Field& f, std::map<std::string
 int kSpecVersionForJson();
 /// True if "version" is absent or kSpecVersion; else false with *error.
 bool CheckVersion(const nlohmann::json& j, std::string* error);
-/// Parses a spec file's text; false with *error (the parser's message).
+/// The deepest nesting of arrays and objects any JSON pidlab reads may have
+/// (a spec, a model file, a result, a request to the server).
+inline constexpr int kMaxJsonDepth = 64;
+/// False with *error ("is nested deeper than 64 levels (at byte N)") if
+/// `text` opens more than `max_depth` arrays or objects at once; strings are
+/// skipped. One pass, no recursion, before any parser runs.
+bool CheckJsonNesting(const std::string& text, int max_depth, std::string* error);
+/// The one JSON reader of every file and request: the nesting checked
+/// (kMaxJsonDepth), then parsed; false with *error ("is not valid JSON").
 bool ParseJsonText(const std::string& text, nlohmann::json* out, std::string* error);
 
 /// Writes every field (Archive for Serialize).
@@ -122,7 +130,7 @@ bool FromJson(const nlohmann::json& j, Spec* spec, std::set<std::string>* given,
   }
   for (const auto& item : j.items()) {
     if (item.key() != "version" && r.known().count(item.key()) == 0) {
-      if (error) *error = "spec key '" + item.key() + "' is unknown";
+      if (error) *error = "spec key " + Quote(item.key()) + " is unknown";
       return false;
     }
   }

@@ -8,6 +8,7 @@
 // keeps the best. docs/identify.md, "Identifying a model from a CSV".
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -38,6 +39,12 @@ struct Sampling {
 
 /// The fewest samples a record may have.
 inline constexpr std::size_t kMinSamples = 20;
+/// The largest magnitude of a t, u or y sample (the limit of every number
+/// pidlab takes), the shortest interval of t, and how far beyond its column's
+/// median absolute deviation a sample may lie (CheckData).
+inline constexpr double kMaxRecordMagnitude = 1e12;
+inline constexpr double kMinRecordInterval = 1e-12;
+inline constexpr double kMaxOutlierRatio = 1e12;
 /// How far a sampling interval may be from the mean one, relative (what a CSV
 /// written with ten significant digits keeps).
 inline constexpr double kUniformSamplingTolerance = 1e-6;
@@ -91,6 +98,11 @@ struct IdentifyOptions {
   int zeros = 0;
   Intersample intersample = Intersample::kZoh;
   InitialCondition initial_condition = InitialCondition::kZero;
+  /// Called after each start of the fit (on the caller's thread): the kind
+  /// being fitted, the starts done and planned (the ARX start included), and
+  /// the best cost so far. Empty: nothing is called. A front end shows
+  /// progress with it; the library prints nothing.
+  std::function<void(ProcessModelKind kind, int done, int total, double best_cost)> progress;
 
   /// Names the field, its value and the rule on failure.
   bool IsValid(std::string* error) const;
@@ -172,8 +184,17 @@ struct AutoResult {
 
 /// Status kInvalidInput with one plain message naming the reason unless the
 /// record has at least kMinSamples samples, equal lengths, only finite
-/// values, strictly increasing t and a non-constant u. Sets *sampling.
-Status CheckData(const IdentifyData& data, Sampling* sampling);
+/// values within kMaxRecordMagnitude, t strictly increasing by at least
+/// kMinRecordInterval, no u or y sample beyond kMaxOutlierRatio times its
+/// column's median absolute deviation from the median, and a non-constant u.
+/// Names the column and the sample:
+/// its line in the file where `rows` gives each sample's (ReadCsvData), else
+/// its index. Sets *sampling.
+Status CheckData(const IdentifyData& data, Sampling* sampling, const std::vector<long>* rows = nullptr);
+/// kInvalidInput unless y varies beyond 12 digits of its magnitude: a flat
+/// record holds no response to fit (Identify checks it after CheckData and
+/// the model's own conditions, before any start).
+Status CheckResponse(const IdentifyData& data);
 
 /// yhat_k (without y0) of `model` for the input u - u0 sampled every dt_s.
 /// Throws std::invalid_argument if the model is not a valid plant.
