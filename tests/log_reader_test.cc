@@ -2,8 +2,6 @@
 // with lcm::LogFile: honest logs, retransmissions, cut-off and corrupt tails,
 // foreign and garbage events, several prefixes, an altered command.
 
-#include "pidlab/replay/replay.h"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -22,6 +20,7 @@
 #include <random>
 
 #include "pidlab/episode_client/episode_client.h"
+#include "pidlab/replay/replay.h"
 #include "pidlab/transport/episode_spec.h"
 
 using pidlab::episode_client::MakeEpisodeSpec;
@@ -136,8 +135,9 @@ struct EpisodeWriter {
 
   void Write(lcm::LogFile* log, int64_t* num) const {
     if (with_config) {
-      const auto config = transport::MakeEpisodeConfig(MakeEpisodeSpec(episode_id, ref.plant, ref.gains, ref.options,
-                                                      ref.options.disturbance, transport::RecoveryOptions{}));
+      const auto config = transport::MakeEpisodeConfig(MakeEpisodeSpec(episode_id, ref.plant, ref.gains,
+                                                                       ref.options, ref.options.disturbance,
+                                                                       transport::RecoveryOptions{}));
       WriteMsg(log, prefix + "EPISODE_CONFIG", config, num);
       WriteMsg(log, prefix + "EPISODE_CONFIG", config, num);  // republished until acknowledged
     }
@@ -302,8 +302,8 @@ TEST_F(LogReaderTest, GarbageForeignAndSelfTestEventsAreCountedAndSkipped) {
     short_output.resize(20);
     WriteRaw(&log, "PIDLAB_PLANT_OUTPUT", short_output, &num);
     // A configuration whose num_size claims two billion doubles.
-    auto config = transport::MakeEpisodeConfig(MakeEpisodeSpec(99, ref.plant, ref.gains, ref.options, ref.options.disturbance,
-                                              transport::RecoveryOptions{}));
+    auto config = transport::MakeEpisodeConfig(MakeEpisodeSpec(
+        99, ref.plant, ref.gains, ref.options, ref.options.disturbance, transport::RecoveryOptions{}));
     std::vector<uint8_t> hostile(static_cast<std::size_t>(config.getEncodedSize()));
     config.encode(hostile.data(), 0, static_cast<int>(hostile.size()));
     const std::size_t num_size_at = 8 + 24 + 4 + config.plant_name.size() + 1;
@@ -426,8 +426,34 @@ TEST_F(LogReaderTest, AFileThatIsNotALogIsRefused) {
   std::string error;
   EXPECT_FALSE(ReadLog(path_, ReadOptions{}, &contents, &error));
   EXPECT_NE(error.find("not an LCM log"), std::string::npos) << error;
+  EXPECT_TRUE(contents.opened);
   EXPECT_FALSE(ReadLog((dir_ / "missing.lcmlog").string(), ReadOptions{}, &contents, &error));
   EXPECT_NE(error.find("cannot be opened"), std::string::npos) << error;
+  EXPECT_FALSE(contents.opened);
+}
+
+TEST_F(LogReaderTest, AnEmptyFileHoldsNoLcmEventAndIsRefused) {
+  std::ofstream(path_).close();
+  LogContents contents;
+  std::string error;
+  EXPECT_FALSE(ReadLog(path_, ReadOptions{}, &contents, &error));
+  EXPECT_TRUE(contents.opened);
+  EXPECT_EQ(contents.file_bytes, 0);
+  EXPECT_EQ(contents.events, 0);
+  EXPECT_NE(error.find("no LCM event"), std::string::npos) << error;
+  EXPECT_NE(error.find(path_), std::string::npos) << error;
+}
+
+TEST_F(LogReaderTest, ALogWhoseOnlyEventIsForeignIsStillALog) {
+  {
+    lcm::LogFile log(path_, "w");
+    int64_t num = 0;
+    WriteRaw(&log, "SOMEONE_ELSE", {'h', 'e', 'l', 'l', 'o'}, &num);
+  }
+  const LogContents dut = Read();
+  EXPECT_EQ(dut.events, 1);
+  EXPECT_EQ(dut.foreign, 1);
+  EXPECT_TRUE(dut.episodes.empty());
 }
 
 }  // namespace

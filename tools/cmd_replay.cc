@@ -134,9 +134,9 @@ struct ReplayCommand {
     replay::LogContents log;
     std::string error;
     if (!replay::ReadLog(log_path, options, &log, &error)) {
-      // A file that opened but holds no LCM event is damaged content (exit 1),
-      // not a path the user mistyped (exit 2).
-      if (log.file_bytes > 0) throw std::runtime_error(error);
+      // A file that opened but holds no LCM event, an empty one included, is
+      // damaged content (exit 1), not a path the user mistyped (exit 2).
+      if (log.opened) throw std::runtime_error(error);
       throw BadInput(error);
     }
     return log;

@@ -203,6 +203,7 @@ server::Reply LogStore::Upload(const std::string& name, const std::string& body)
   if (!GoodUploadName(name))
     return Bad("upload name " + Quote(Truncate(name, 100)) +
                " must be a file name of letters, digits, '.', '_' and '-' (at most 100)");
+  if (body.empty()) return Bad("log " + Quote(name) + " holds no LCM event (an empty file)");
   std::lock_guard<std::mutex> lock(mutex_);
   const std::string id = NewId();
   const std::string file = (fs::path(upload_dir_) / (id + "-" + name)).string();

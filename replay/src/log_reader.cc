@@ -1,7 +1,6 @@
 #include "pidlab/replay/log_reader.h"
 
 #include <algorithm>
-
 #include <cstdio>
 #include <set>
 #include <sstream>
@@ -77,7 +76,8 @@ Decoded DecodeAuthenticated(const MessageType& type, const ReadOptions& options,
                             PidlabMessage* message) {
   const uint8_t* data = ev.data.data();
   const std::size_t size = ev.data.size();
-  const bool tagged = size > transport::kAuthTagBytes && type.decode(data, size - transport::kAuthTagBytes, message);
+  const bool tagged =
+      size > transport::kAuthTagBytes && type.decode(data, size - transport::kAuthTagBytes, message);
   if (!options.auth_key) {
     if (tagged) return Decoded::kUnverified;
     return type.decode(data, size, message) ? Decoded::kOk : Decoded::kFailed;
@@ -120,7 +120,8 @@ void HandleEvent(const DecoderTable& table, const ReadOptions& options, const Lo
       ++out->unauthenticated;
       return;
     case Decoded::kFailed:
-      t->decode_failed.Add(ev.channel + " (" + type->name + ", " + std::to_string(ev.data.size()) + " bytes)");
+      t->decode_failed.Add(ev.channel + " (" + type->name + ", " + std::to_string(ev.data.size()) +
+                           " bytes)");
       return;
   }
   ++out->pidlab_messages;
@@ -158,8 +159,9 @@ void RecordTallies(const Tallies& t, LogContents* out) {
   note(t.other_prefix, "pidlab events of other channel prefixes skipped");
   note(t.orphans, "episodes whose configuration is not in the log (listed, not evaluated)");
   if (out->unauthenticated)
-    out->notes.push_back(std::to_string(out->unauthenticated) +
-                         " pidlab events without a valid tag for the key given (forged or unauthenticated) dropped");
+    out->notes.push_back(
+        std::to_string(out->unauthenticated) +
+        " pidlab events without a valid tag for the key given (forged or unauthenticated) dropped");
   if (out->unverified)
     out->notes.push_back(std::to_string(out->unverified) +
                          " pidlab events carry an authentication tag that was not checked (give --auth-key)");
@@ -202,6 +204,7 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
   *out = LogContents();
   EventReader reader;
   if (!reader.Open(path, error)) return false;
+  out->opened = true;
   out->file_bytes = reader.file_bytes();
   Tallies tallies;
   reader.OnSkip([&tallies](const SkippedBytes& s) { tallies.unreadable.Add(Describe(s)); });
@@ -214,8 +217,12 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
   out->notes.insert(out->notes.end(), assembled.notes.begin(), assembled.notes.end());
   out->episodes = std::move(assembled.episodes);
   RecordTallies(tallies, out);
-  if (out->events == 0 && out->file_bytes > 0) {
-    if (error) *error = "'" + path + "' holds no LCM log event (not an LCM log?)";
+  if (out->events == 0) {
+    if (error)
+      *error = "'" + path + "' holds no LCM event (" +
+               (out->file_bytes == 0 ? std::string("an empty file")
+                                     : std::to_string(out->file_bytes) + " bytes: not an LCM log?") +
+               ")";
     return false;
   }
   return true;

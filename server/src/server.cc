@@ -8,6 +8,7 @@
 #include <boost/beast/websocket.hpp>
 #include <cctype>
 #include <chrono>
+#include <cstdint>
 #include <deque>
 #include <map>
 #include <mutex>
@@ -68,6 +69,40 @@ bool SameSecret(const std::string& a, const std::string& b) {
   return diff == 0;
 }
 
+// The deepest nesting of arrays and objects a request may have; the parser
+// never sees a deeper one.
+constexpr int kMaxJsonDepth = 64;
+
+// Whether `text` nests arrays and objects deeper than `limit`, counted
+// outside strings without recursing. A parser is only given text that passes.
+bool NestsDeeperThan(const std::string& text, int limit) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;  // the escaped character, a quote included
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit) return true;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return false;
+}
+
+// A request's body after its header: the time it may take.
+constexpr std::chrono::seconds kBodyTimeout{30};
+
+// WebSocket replies waiting beyond this many bytes: the session stops reading
+// requests until they are written (a client that sends and never reads).
+constexpr std::size_t kMaxQueuedReplyBytes = 1 << 20;
+
 Response JsonResponse(const Request& req, http::status status, const nlohmann::json& body) {
   Response res{status, req.version()};
   res.set(http::field::content_type, "application/json");
@@ -101,11 +136,74 @@ bool ServerOptions::IsValid(std::string* error) const {
     e = "the size limits must be at least 1024 bytes";
   else if (max_connections < 1)
     e = "max_connections " + std::to_string(max_connections) + " must be at least 1";
+  else if (max_connections_per_address < 1 || max_connections_per_address > max_connections)
+    e = "max_connections_per_address " + std::to_string(max_connections_per_address) + " must be in 1.." +
+        std::to_string(max_connections);
+  else if (!(header_timeout_s >= 0.1 && header_timeout_s <= 600))
+    e = "header_timeout_s " + std::to_string(header_timeout_s) + " must be in 0.1..600";
   if (error) *error = e;
   return e.empty();
 }
 
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
+  // The open connections, each with its client's address; those waiting for
+  // a request header, with the time they started waiting and how to close
+  // them. Touched on the server's thread only.
+  class Slots {
+   public:
+    using Id = std::uint64_t;
+    using Clock = std::chrono::steady_clock;
+
+    Id Open(const std::string& address) {
+      entries_[++last_].address = address;
+      return last_;
+    }
+    void Close(Id id) { entries_.erase(id); }
+    // From now on `id` waits for a request header; `close` ends it.
+    void Waiting(Id id, std::function<void()> close) {
+      const auto e = entries_.find(id);
+      if (e == entries_.end()) return;
+      e->second.since = Clock::now();
+      e->second.close = std::move(close);
+    }
+    // `id` has its header (or is a WebSocket): never evicted.
+    void Busy(Id id) {
+      const auto e = entries_.find(id);
+      if (e != entries_.end()) e->second.close = nullptr;
+    }
+    // The connections open, of `address` only if not null.
+    int Count(const std::string* address) const {
+      if (!address) return static_cast<int>(entries_.size());
+      int n = 0;
+      for (const auto& [id, e] : entries_) n += e.address == *address;
+      return n;
+    }
+    // Closes the connection (of `address` if not null) that has waited
+    // longest for its request header, and frees its slot now; false if none
+    // waits.
+    bool EvictLongestWaiting(const std::string* address) {
+      auto oldest = entries_.end();
+      for (auto e = entries_.begin(); e != entries_.end(); ++e)
+        if (e->second.close && (!address || e->second.address == *address) &&
+            (oldest == entries_.end() || e->second.since < oldest->second.since))
+          oldest = e;
+      if (oldest == entries_.end()) return false;
+      const std::function<void()> close = std::move(oldest->second.close);
+      entries_.erase(oldest);
+      close();
+      return true;
+    }
+
+   private:
+    struct Entry {
+      std::string address;
+      Clock::time_point since;
+      std::function<void()> close;  // set while waiting for a request header
+    };
+    std::map<Id, Entry> entries_;
+    Id last_ = 0;
+  };
+
   ServerOptions options;
   ConnectionHandler handler;
   UploadHandler upload_handler;
@@ -113,13 +211,25 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   net::io_context io{1};
   tcp::acceptor acceptor{io};
   int port = 0;
-  std::atomic<int> open_connections{0};
+  Slots slots;
   mutable std::mutex counters_mutex;
   ServerCounters counters;
 
   void Count(long ServerCounters::*field) {
     std::lock_guard<std::mutex> lock(counters_mutex);
     ++(counters.*field);
+  }
+
+  // Whether a new connection from `address` may open, after evicting the
+  // connection waiting longest for its header where a cap is reached.
+  bool MakeRoom(const std::string& address) {
+    const auto evict = [this](const std::string* of) {
+      if (!slots.EvictLongestWaiting(of)) return false;
+      Count(&ServerCounters::evicted);
+      return true;
+    };
+    if (slots.Count(&address) >= options.max_connections_per_address && !evict(&address)) return false;
+    return slots.Count(nullptr) < options.max_connections || evict(nullptr);
   }
 
   // Why `req` may not be served (token, host, origin), or empty.
@@ -147,6 +257,10 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
 
   // One request object through the handler: the reply's status and body.
   Reply Answer(const std::string& text, const std::shared_ptr<Connection>& connection = nullptr) {
+    if (NestsDeeperThan(text, kMaxJsonDepth)) {
+      Count(&ServerCounters::malformed);
+      return {400, {{"error", "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels"}}};
+    }
     nlohmann::json request = nlohmann::json::parse(text, nullptr, false);
     if (request.is_discarded() || !request.is_object()) {
       Count(&ServerCounters::malformed);
@@ -228,13 +342,12 @@ class SessionConnection : public Connection {
 
 class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
  public:
-  WebSocketSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
-      : ws_(std::move(socket)), server_(std::move(server)) {
-    ++server_->open_connections;
-  }
+  // Takes over the HTTP session's socket and its slot.
+  WebSocketSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server, Server::Impl::Slots::Id slot)
+      : ws_(std::move(socket)), server_(std::move(server)), slot_(slot) {}
   ~WebSocketSession() {
     if (connection_) connection_->Close();
-    --server_->open_connections;
+    server_->slots.Close(slot_);
   }
 
   void Run(Request req) {
@@ -262,18 +375,27 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
     const std::string text = beast::buffers_to_string(buffer_.data());
     buffer_.consume(buffer_.size());
     const Reply reply = server_->Answer(text, connection_);
+    // Every reply, in order: the page matches them to its requests by id.
     if (!reply.body.is_null())
-      Send(reply.body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), "reply");
-    Read();
+      Send(reply.body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), "");
+    ReadUnlessBacklogged();
+  }
+
+  // Reads the next request, unless the replies waiting exceed
+  // kMaxQueuedReplyBytes: then OnWrite reads once they are written.
+  void ReadUnlessBacklogged() {
+    reading_ = ordered_bytes_ <= kMaxQueuedReplyBytes;
+    if (reading_) Read();
   }
 
  public:
-  // At most one write in flight. Waiting: the messages without a key in
-  // order, then one per key, a newer one replacing the older (a slow client
-  // is sent the latest reply, not a growing queue).
+  // At most one write in flight. Waiting: the messages without a key (every
+  // reply) in order, then one per key, a newer one replacing the older (a
+  // slow client is sent the latest progress or frame, not a growing queue).
   void Send(std::string message, const std::string& replace_key, bool binary = false) {
     if (writing_) {
       if (replace_key.empty()) {
+        ordered_bytes_ += message.size();
         ordered_.push_back({std::move(message), binary});
       } else {
         const auto replaced = waiting_.find(replace_key);
@@ -300,6 +422,8 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
     if (!ordered_.empty()) {
       next = std::move(ordered_.front());
       ordered_.pop_front();
+      ordered_bytes_ -= next.bytes.size();
+      if (!reading_) ReadUnlessBacklogged();
     } else if (!waiting_.empty()) {
       next = std::move(waiting_.begin()->second);
       waiting_.erase(waiting_.begin());
@@ -319,9 +443,12 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
   std::shared_ptr<SessionConnection> connection_;
   beast::flat_buffer buffer_;
   std::string out_;
+  Server::Impl::Slots::Id slot_;
   std::deque<Outgoing> ordered_;
+  std::size_t ordered_bytes_ = 0;  // of ordered_
   std::map<std::string, Outgoing> waiting_;
   bool writing_ = false;
+  bool reading_ = true;  // a read is in flight (or the session is ending)
 };
 
 bool SessionConnection::Post(const nlohmann::json& message, const std::string& replace_key) {
@@ -343,21 +470,26 @@ bool SessionConnection::PostBinary(std::string bytes, const std::string& replace
 
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
-  HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
-      : stream_(std::move(socket)), server_(std::move(server)) {
-    ++server_->open_connections;
+  HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server, const std::string& address)
+      : stream_(std::move(socket)), server_(std::move(server)), slot_(server_->slots.Open(address)) {}
+  ~HttpSession() {
+    if (slot_) server_->slots.Close(slot_);
   }
-  ~HttpSession() { --server_->open_connections; }
   void Run() { Read(); }
 
  private:
   void Read() {
+    // Until the header is complete this connection may be closed for a new one.
+    server_->slots.Waiting(slot_, [weak = weak_from_this()] {
+      if (auto self = weak.lock()) self->Evict();
+    });
     parser_.emplace();
     parser_->header_limit(static_cast<std::uint32_t>(server_->options.max_header_bytes));
     // The larger limit while the headers are parsed (Beast checks a
     // Content-Length against it there); OnHeader sets the request's own.
     parser_->body_limit(std::max(server_->options.max_body_bytes, server_->options.max_upload_bytes));
-    stream_.expires_after(std::chrono::seconds(30));
+    stream_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(server_->options.header_timeout_s)));
     http::async_read_header(stream_, buffer_, *parser_,
                             beast::bind_front_handler(&HttpSession::OnHeader, shared_from_this()));
   }
@@ -365,6 +497,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   // An upload gets its own body limit, and is refused on its headers (token,
   // Host, Origin) before its body is read.
   void OnHeader(beast::error_code ec, std::size_t) {
+    if (evicted_) return;  // its slot went to a newer connection
+    server_->slots.Busy(slot_);
+    if (!ec) stream_.expires_after(kBodyTimeout);
     if (!ec && IsUpload(parser_->get())) {
       const auto [status, why] = server_->Refusal(parser_->get());
       if (status != http::status::ok) {
@@ -424,7 +559,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
         return;
       }
       stream_.expires_never();
-      std::make_shared<WebSocketSession>(stream_.release_socket(), server_)->Run(std::move(req));
+      const Server::Impl::Slots::Id slot = slot_;
+      slot_ = 0;
+      std::make_shared<WebSocketSession>(stream_.release_socket(), server_, slot)->Run(std::move(req));
       return;
     }
     Write(server_->Serve(req));
@@ -451,8 +588,17 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
   }
 
+  // Closed while waiting for its request header, to admit a new connection.
+  void Evict() {
+    evicted_ = true;
+    slot_ = 0;  // already freed
+    stream_.close();
+  }
+
   beast::tcp_stream stream_;
   std::shared_ptr<Server::Impl> server_;
+  Server::Impl::Slots::Id slot_;
+  bool evicted_ = false;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
 };
@@ -461,14 +607,18 @@ void Accept(std::shared_ptr<Server::Impl> server) {
   server->acceptor.async_accept([server](beast::error_code ec, tcp::socket socket) {
     if (ec == net::error::operation_aborted) return;
     if (!ec) {
-      if (server->open_connections >= server->options.max_connections) {
-        beast::error_code ignored;
+      beast::error_code ignored;
+      const tcp::endpoint peer = socket.remote_endpoint(ec);
+      const std::string address = peer.address().to_string();
+      if (ec) {
+        socket.close(ignored);  // gone already
+      } else if (!server->MakeRoom(address)) {
+        server->Count(&ServerCounters::turned_away);
         socket.close(ignored);
       } else {
         // Replies of 100 KB (the plot series) must not wait for delayed ACKs.
-        beast::error_code ignored;
         socket.set_option(tcp::no_delay(true), ignored);
-        std::make_shared<HttpSession>(std::move(socket), server)->Run();
+        std::make_shared<HttpSession>(std::move(socket), server, address)->Run();
       }
     }
     Accept(server);

@@ -861,7 +861,29 @@ bool IsSanitizerReport(const std::string& err) {
          err.find("UndefinedBehaviorSanitizer") != std::string::npos;
 }
 
-// What is wrong with a run that exited with `code`, empty if nothing.
+// Where the first whole LCM event of `file` starts, or -1: a sync word
+// followed by a channel of 1..256 bytes and data of 0..64 MiB that end inside
+// the file. Every sync word is tried, as the reader does after bad bytes, so
+// the reader finds no event exactly when this finds none.
+long long FirstWholeEvent(const std::string& file) {
+  const auto word = [&file](std::size_t at) {
+    uint32_t w = 0;
+    for (std::size_t i = 0; i < 4; ++i) w = (w << 8) | static_cast<uint8_t>(file[at + i]);
+    return w;
+  };
+  for (std::size_t at = 0; at + kHeaderBytes <= file.size(); ++at) {
+    if (word(at) != 0xEDA1DA01u) continue;
+    const auto channel = static_cast<int32_t>(word(at + 20)), data = static_cast<int32_t>(word(at + 24));
+    if (channel >= 1 && channel <= 256 && data >= 0 && data <= (64 << 20) &&
+        static_cast<long long>(channel) + data <= static_cast<long long>(file.size() - at - kHeaderBytes))
+      return static_cast<long long>(at);
+  }
+  return -1;
+}
+
+// What is wrong with a run that exited with `code`, empty if nothing. A
+// mutant without a whole event must exit 1 saying "no LCM event", and only
+// such a mutant may.
 std::string CheckOutput(const Options& o, const Run& r, int code) {
   const std::string err = Slurp(r.err);
   if (IsSanitizerReport(err)) return "sanitizer report: " + Printable(err);
@@ -876,8 +898,15 @@ std::string CheckOutput(const Options& o, const Run& r, int code) {
     if (line.find_first_not_of(" \t\r") == std::string::npos) return "exit 1 without a message on stderr";
     if (line.size() > o.max_line)
       return "exit 1 with a " + std::to_string(line.size()) + "-char line: " + Printable(line);
+    const long long event = FirstWholeEvent(Slurp(r.mutant));
+    if (line.find("no LCM event") != std::string::npos && event >= 0)
+      return "exit 1 with 'no LCM event', but a whole event starts at byte " + std::to_string(event) + ": " +
+             Printable(line);
+    if (line.find("no LCM event") == std::string::npos && event < 0)
+      return "exit 1 on a mutant without a whole event, not saying 'no LCM event': " + Printable(line);
     return "";
   }
+  if (FirstWholeEvent(Slurp(r.mutant)) < 0) return "exit 0 on a mutant without a whole LCM event";
   const std::string out = Slurp(r.out);
   if (!r.json) {
     if (out.compare(0, 4, "log ") != 0) return "exit 0 without the table: " + Printable(out);

@@ -95,6 +95,7 @@ struct LogContents {
   long unverified = 0;       // without a key: tagged messages used without checking their tag
   long eventnum_gaps = 0;    // jumps in the logger's event counter (events lost or corrupted)
   bool clean_end = true;     // the whole file was read
+  bool opened = false;       // the file was opened (a false ReadLog then means: no LCM event in it)
   long long bytes_read = 0, file_bytes = 0;
   /// One line per notable thing (grouped: at most a few lines per kind).
   std::vector<std::string> notes;
@@ -103,9 +104,9 @@ struct LogContents {
 };
 
 /// Reads the log at `path`. Returns false with *error only if the file
-/// cannot be opened or is not an LCM log at all (then contents->file_bytes >
-/// 0 and contents->events == 0: the file opened); anything wrong inside a
-/// readable log is reported in *contents.
+/// cannot be opened, or holds no LCM event at all, an empty file included
+/// (then contents->opened and contents->events == 0); anything wrong inside
+/// a readable log is reported in *contents.
 bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* contents, std::string* error);
 
 }  // namespace pidlab::replay

@@ -12,7 +12,15 @@
 //  - headers, bodies and WebSocket messages are bounded (431, 413, close
 //    1009); a malformed request gets 400 and its connection closes; the
 //    server keeps serving;
-//  - a slow WebSocket client is sent the latest reply, not a growing queue.
+//  - a request header must be complete within `header_timeout_s`; when the
+//    connections (all, or one address's) are at their cap, the one that has
+//    waited longest for its request header is closed to admit the new one
+//    (a slow loris loses its slot, not the next client);
+//  - request JSON nested deeper than 64 levels is refused (400) before it is
+//    parsed;
+//  - every reply to a WebSocket request is sent, in order; only the
+//    handler's progress and frames are replaced by newer ones for a slow
+//    client, and a client that does not read is not read from either.
 // One thread runs the io_context and the Handler (requests are evaluations of
 // microseconds to milliseconds); longer work (a tuning) runs on threads of the
 // handler's, which send their messages later through the request's Connection.
@@ -40,8 +48,17 @@ struct ServerOptions {
   std::size_t max_message_bytes = 64 * 1024;
   /// The body of POST /api/upload (a log); 413 above.
   std::size_t max_upload_bytes = 64 * 1024 * 1024;
-  /// Connections open at once; more are closed on accept.
+  /// Connections open at once. A new one beyond it closes the connection
+  /// that has waited longest for its request header (an established
+  /// WebSocket or a request being read or answered is never closed so); with
+  /// none to close, the new one is closed on accept.
   int max_connections = 64;
+  /// Connections open at once from one client address, 1..max_connections;
+  /// the same rule as max_connections among that address's connections.
+  int max_connections_per_address = 16;
+  /// Seconds from a connection's accept (or its previous reply) to a complete
+  /// request header, 0.1..600; the connection is closed after it.
+  double header_timeout_s = 5.0;
 
   /// Names the field, its value and the rule on failure.
   bool IsValid(std::string* error) const;
@@ -108,6 +125,8 @@ struct ServerCounters {
   long refused = 0;          // 401 and 403
   long malformed = 0;        // 400, 413, 431 and WebSocket messages that are not JSON objects
   long dropped_replies = 0;  // replaced by a newer one for a slow client
+  long evicted = 0;          // closed before their request header was complete, to admit a new connection
+  long turned_away = 0;      // closed on accept: every slot held by connections that may not be evicted
 };
 
 class Server {
