@@ -110,13 +110,18 @@ std::string UnknownFirstWord(const CLI::App& app, const std::vector<std::string>
   return pidlab::cli::Quote(word) + " is not a subcommand" + Hint(word, commands, list + "; pidlab --help");
 }
 
-/// The error for the first option `where` does not know that CLI11 left over
-/// ("pidlab tune --plnat stepper"), else "" (a stray value keeps CLI11's
-/// "not expected").
-std::string UnknownOption(const CLI::App& app, const CLI::App& where, const std::string& where_name) {
+/// The error for the first option of `args` that `where` does not know and
+/// CLI11 left over ("pidlab tune --plnat stepper"), else "": a stray value
+/// keeps CLI11's "not expected", a value that starts with '-' was taken by
+/// its option, and what follows "--" is a command's own ("launch -- CMD").
+std::string UnknownOption(const CLI::App& app, const CLI::App& where, const std::string& where_name,
+                          const std::vector<std::string>& args) {
   const std::vector<std::string> options = OptionNames(where);
-  for (const std::string& token : app.remaining(true)) {
-    if (!LooksLikeOption(token)) continue;
+  const std::vector<std::string> left_over = app.remaining(true);
+  for (std::size_t i = 1; i < args.size() && args[i] != "--"; ++i) {
+    const std::string& token = args[i];
+    if (!LooksLikeOption(token) || std::find(left_over.begin(), left_over.end(), token) == left_over.end())
+      continue;
     const std::string name = OptionName(token);
     if (std::find(options.begin(), options.end(), name) != options.end()) continue;
     return "unknown option " + pidlab::cli::Quote(name) + Hint(name, options, where_name + " --help");
@@ -186,7 +191,7 @@ int main(int argc, char** argv) {
     }
     // A mistyped option is named first: it is often why a required one is
     // missing ("--plnat stepper": "--plant is required").
-    const std::string unknown_option = UnknownOption(app, *where_app, where);
+    const std::string unknown_option = UnknownOption(app, *where_app, where, args);
     std::cerr << where << ": error: " << OneLine(unknown_option.empty() ? e.what() : unknown_option) << "\n";
     return 2;
   }

@@ -116,6 +116,8 @@ typo "the same with =VALUE" \
   "pidlab tune: error: unknown option '--plnat' (did you mean --plant?)" tune --plnat=stepper
 typo "an option with a letter changed, after good ones" \
   "pidlab evaluate: error: unknown option '--gainz' (did you mean --gains?)" evaluate --plant linear --gainz 1,1,1
+typo "an option before launch's -- COMMAND (whose own flags are not pidlab's)" \
+  "pidlab launch: error: unknown option '--drop-rat' (did you mean --drop-rate?)" launch --drop-rat 0.1 -- bash -c true
 typo "a subcommand with a letter changed" "pidlab: error: 'tunr' is not a subcommand (did you mean tune?)" tunr
 typo "a subcommand with a letter missing" \
   "pidlab: error: 'evalute' is not a subcommand (did you mean evaluate?)" evalute --plant linear
