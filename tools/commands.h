@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
 
 namespace pidlab::cli {
 
@@ -18,5 +19,10 @@ std::function<int()> RegisterBatch(CLI::App* app);
 std::function<int()> RegisterIdentify(CLI::App* app);
 std::function<int()> RegisterServe(CLI::App* app);
 std::function<int()> RegisterExport(CLI::App* app);
+std::function<int()> RegisterVersion(CLI::App* app);
+
+/// "pidlab 0.2.0 (commit 4b5211fe12ab)": what `pidlab version` and
+/// `pidlab --version` print.
+std::string VersionLine();
 
 }  // namespace pidlab::cli

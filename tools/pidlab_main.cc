@@ -5,10 +5,13 @@
 // path included), 1 for a runtime failure; either way exactly one line on
 // stderr, at most ~300 characters.
 
+#include <algorithm>
+#include <cstdlib>
 #include <iostream>
 
 #include "cli_common.h"
 #include "commands.h"
+#include "did_you_mean.h"
 
 namespace {
 
@@ -19,7 +22,8 @@ struct Command {
 };
 
 // The sanitised tree's pidlab (tools/CMakeLists.txt) holds only the
-// commands the hostile tests run on it: evaluate, launch, replay and serve.
+// commands the hostile tests run on it: evaluate, launch, replay and serve
+// (and version).
 const Command kCommands[] = {
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
     {"batch", "the AMIGO test batch: AMIGO's PID against pidlab's optimum on P1-P9",
@@ -47,19 +51,82 @@ const Command kCommands[] = {
     {"tune", "tune PID gains (Nelder-Mead, paper-nm, ZN, GA, PSO-GSA) + Ceres check",
      pidlab::cli::RegisterTune},
 #endif
+    {"version", "print the version and the git commit this pidlab was built from",
+     pidlab::cli::RegisterVersion},
 };
 
 // The message of an error as one printable line of at most 270 characters
 // (after "pidlab <command>: error: "), whatever the exception carried.
 std::string OneLine(const std::string& message) { return pidlab::cli::Truncate(message, 270); }
 
-/// The subcommand's name if args[1] names none ("pidlab frobnicate"): CLI11
-/// would only say that a subcommand is required.
-std::string UnknownSubcommand(const std::vector<std::string>& args) {
-  if (args.size() < 2 || args[1].empty() || args[1][0] == '-') return "";
-  for (const Command& command : kCommands)
-    if (args[1] == command.name) return "";
-  return args[1];
+/// Every name `app` knows its options by, as typed: "--plant", "-v".
+std::vector<std::string> OptionNames(const CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::Option* option : app.get_options()) {
+    for (const std::string& name : option->get_lnames()) names.push_back("--" + name);
+    for (const std::string& name : option->get_snames()) names.push_back("-" + name);
+  }
+  return names;
+}
+
+/// " (did you mean --plant?)" for the closest of `names` to `typed`, else
+/// " (<help>)".
+std::string Hint(const std::string& typed, const std::vector<std::string>& names, const std::string& help) {
+  const std::string closest = pidlab::cli::ClosestName(typed, names);
+  return closest.empty() ? " (" + help + ")" : " (did you mean " + closest + "?)";
+}
+
+/// An option as typed, without its "=value".
+std::string OptionName(const std::string& token) { return token.substr(0, token.find('=')); }
+
+/// Whether `token` is an option CLI11 left over ("--plnat", "-x=1"), not a
+/// value ("stepper", "-1.5", "-").
+bool LooksLikeOption(const std::string& token) {
+  if (token.size() < 2 || token[0] != '-') return false;
+  char* end = nullptr;
+  std::strtod(token.c_str(), &end);
+  return *end != '\0';
+}
+
+/// The error for args[1] when it names neither a subcommand ("pidlab tunr")
+/// nor an option of pidlab itself ("pidlab --verison"), else "": CLI11 would
+/// only say that a subcommand is required.
+std::string UnknownFirstWord(const CLI::App& app, const std::vector<std::string>& args) {
+  if (args.size() < 2 || args[1].empty() || args[1] == "--") return "";
+  const std::string& word = args[1];
+  if (LooksLikeOption(word)) {
+    const std::vector<std::string> options = OptionNames(app);
+    const std::string name = OptionName(word);
+    if (std::find(options.begin(), options.end(), name) != options.end()) return "";
+    return "unknown option " + pidlab::cli::Quote(name) + Hint(name, options, "pidlab --help");
+  }
+  std::vector<std::string> commands;
+  for (const Command& command : kCommands) {
+    if (word == command.name) return "";
+    commands.push_back(command.name);
+  }
+  std::string list;
+  for (const std::string& command : commands) list += (list.empty() ? "" : ", ") + command;
+  return pidlab::cli::Quote(word) + " is not a subcommand" + Hint(word, commands, list + "; pidlab --help");
+}
+
+/// The error for the first option of `args` that `where` does not know and
+/// CLI11 left over ("pidlab tune --plnat stepper"), else "": a stray value
+/// keeps CLI11's "not expected", a value that starts with '-' was taken by
+/// its option, and what follows "--" is a command's own ("launch -- CMD").
+std::string UnknownOption(const CLI::App& app, const CLI::App& where, const std::string& where_name,
+                          const std::vector<std::string>& args) {
+  const std::vector<std::string> options = OptionNames(where);
+  const std::vector<std::string> left_over = app.remaining(true);
+  for (std::size_t i = 1; i < args.size() && args[i] != "--"; ++i) {
+    const std::string& token = args[i];
+    if (!LooksLikeOption(token) || std::find(left_over.begin(), left_over.end(), token) == left_over.end())
+      continue;
+    const std::string name = OptionName(token);
+    if (std::find(options.begin(), options.end(), name) != options.end()) continue;
+    return "unknown option " + pidlab::cli::Quote(name) + Hint(name, options, where_name + " --help");
+  }
+  return "";
 }
 
 /// CLI11 2.1 loses the "--" that follows an option with an optional value
@@ -90,18 +157,17 @@ void JoinOptionalValues(CLI::App* sub, std::vector<std::string>* args) {
 int main(int argc, char** argv) {
   CLI::App app{"pidlab: PID tuning by Nelder-Mead, evaluated exactly and run as a distributed LCM system"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", pidlab::cli::VersionLine,
+                       "print the version and the git commit this pidlab was built from");
   std::vector<std::pair<CLI::App*, std::function<int()>>> actions;
   for (const Command& command : kCommands) {
     CLI::App* sub = app.add_subcommand(command.name, command.description);
     actions.emplace_back(sub, command.register_flags(sub));
   }
   std::vector<std::string> args(argv, argv + argc);
-  const std::string unknown = UnknownSubcommand(args);
+  const std::string unknown = UnknownFirstWord(app, args);
   if (!unknown.empty()) {
-    std::string names;
-    for (const Command& command : kCommands) names += std::string(names.empty() ? "" : ", ") + command.name;
-    std::cerr << "pidlab: error: '" << OneLine(unknown).substr(0, 80) << "' is not a subcommand (" << names
-              << "; pidlab --help)\n";
+    std::cerr << "pidlab: error: " << OneLine(unknown) << "\n";
     return 2;
   }
   for (auto& [sub, action] : actions)
@@ -114,10 +180,19 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::string where = "pidlab";
-    for (const auto* sub : app.get_subcommands()) where += " " + sub->get_name();
-    std::cerr << where << ": error: " << OneLine(e.what()) << "\n";
+    const CLI::App* where_app = &app;
+    for (const auto* sub : app.get_subcommands()) {
+      where += " " + sub->get_name();
+      where_app = sub;
+    }
+    // A mistyped option is named first: it is often why a required one is
+    // missing ("--plnat stepper": "--plant is required").
+    const std::string unknown_option = UnknownOption(app, *where_app, where, args);
+    std::cerr << where << ": error: " << OneLine(unknown_option.empty() ? e.what() : unknown_option) << "\n";
     return 2;
   }
   for (auto& [sub, action] : actions) {

@@ -45,6 +45,35 @@ function sameBits(what, got, want) {
     if (!Object.is(got[i], want[i])) throw new Error(what + '[' + i + ']: page ' + got[i] + ', log ' + want[i]);
 }
 
+// A byte offset in the middle of the payload of the lcm-logger event that
+// holds byte `target` of `log` (events: sync word 0xEDA1DA01, event number,
+// timestamp, channel and payload lengths, channel, payload; big-endian).
+function midEvent(log, target) {
+  for (let at = 0; at + 28 <= log.length;) {
+    if (log.readUInt32BE(at) !== 0xEDA1DA01) throw new Error('no event starts at byte ' + at + ' of the log');
+    const channel = log.readInt32BE(at + 20), payload = log.readInt32BE(at + 24);
+    const end = at + 28 + channel + payload;
+    if (end > target && payload >= 2) return at + 28 + channel + Math.floor(payload / 2);
+    at = end;
+  }
+  throw new Error('no event holds byte ' + target + ' of the log');
+}
+// The steps an episode of `pidlab replay --json` misses on any stream, as
+// inclusive [first, last] ranges over 0..total_steps.
+function mergedGaps(episode) {
+  const missing = new Uint8Array(episode.total_steps + 1);
+  for (const stream of [episode.plant_outputs, episode.commands, episode.disturbance_samples])
+    for (const [a, b] of stream.missing) for (let k = Math.max(0, a); k <= b && k < missing.length; ++k) missing[k] = 1;
+  const ranges = [];
+  for (let k = 0; k < missing.length; ++k) {
+    if (!missing[k]) continue;
+    const first = k;
+    while (k + 1 < missing.length && missing[k + 1]) ++k;
+    ranges.push([first, k]);
+  }
+  return ranges;
+}
+
 // Runs `pidlab launch LAUNCH_ARGS -- bash -c SCRIPT`; resolves with its
 // stdout when it exits 0; `onLine` sees each line of stdout as it comes.
 function launchTrio(launchArgs, script, onLine) {
@@ -236,6 +265,42 @@ async function main() {
     if (!/outside the log directory/.test(got.refused)) throw new Error('../../etc/passwd: ' + (got.refused || 'opened'));
     await page.evaluate(() => { document.getElementById('log-status').textContent = ''; });
     return got.name + ', refused: ' + got.refused;
+  });
+
+  await step('the log cut mid-event, uploaded: the page shows what pidlab replay --json reads of the same cut file', async () => {
+    const whole = fs.readFileSync(log25);
+    // A third in: inside the 25 s episode's steps, the log's first third and more.
+    const at = midEvent(whole, Math.floor(whole.length / 3));
+    const cutFile = path.join(args.tmp, 'cut.lcmlog');
+    fs.writeFileSync(cutFile, whole.subarray(0, at));
+    const replay = JSON.parse(pidlab(['replay', '--json', cutFile]));
+    // The cut is inside an event, wherever the run's timing put the events.
+    if (replay.clean_end !== false || replay.file_bytes !== at) throw new Error('pidlab replay --json of the cut file: clean_end ' + replay.clean_end + ', file_bytes ' + replay.file_bytes + ' (cut at ' + at + ')');
+    if (!replay.episodes.length) throw new Error('pidlab replay --json lists no episode before byte ' + at);
+    const b64 = whole.subarray(0, at).toString('base64');
+    const shown = await page.evaluate(async (b) => {
+      const raw = Uint8Array.from(atob(b), (c) => c.charCodeAt(0));
+      await window.pidlab.logs.upload(new File([raw], 'cut.lcmlog'));
+      const gaps = [];
+      for (let i = 0; i < window.pidlab.logs.log.episodes.length; ++i) {
+        await window.pidlab.logs.openEpisode(i);
+        gaps.push(JSON.parse(document.getElementById('log-marks').dataset.gaps));
+      }
+      return { log: window.pidlab.logs.log, summary: document.getElementById('log-summary').textContent, gaps };
+    }, b64);
+    for (const key of Object.keys(replay)) {
+      if (key === 'log') continue;  // the path: the page has the upload's name
+      if (JSON.stringify(shown.log[key]) !== JSON.stringify(replay[key]))
+        throw new Error('log_open ' + key + ' ' + JSON.stringify(shown.log[key]).slice(0, 200) + ', pidlab replay --json ' + JSON.stringify(replay[key]).slice(0, 200));
+    }
+    if (!shown.summary.includes('NOT read cleanly to the end')) throw new Error('#log-summary: ' + shown.summary);
+    const want = replay.episodes.map(mergedGaps);
+    shown.gaps.forEach((g, i) => {
+      if (JSON.stringify(g) !== JSON.stringify(want[i]))
+        throw new Error('episode ' + i + '\'s gaps on the page ' + JSON.stringify(g).slice(0, 200) + ', pidlab replay --json ' + JSON.stringify(want[i]).slice(0, 200));
+    });
+    return 'cut at byte ' + at + ' of ' + whole.length + ': ' + replay.events + ' events, ' +
+      replay.episodes.map((e, i) => 'episode ' + i + ' ' + (e.complete ? 'complete' : 'gaps ' + JSON.stringify(want[i]).slice(0, 80))).join(', ');
   });
 
   await step('no console error, page error or failed request during the whole run', async () => {

@@ -5,7 +5,8 @@
 # by `pidlab launch --log` is watched (final y, u, n bit for bit with the log),
 # "Run on the trio" agrees bit for bit, a --realtime episode's deadline
 # statistics equal evaluate --json's, the log is opened, uploaded and scrubbed
-# (#log-iae equals pidlab replay --json); the Live tab's screenshot goes to
+# (#log-iae equals pidlab replay --json), a copy cut mid-event is shown as
+# pidlab replay --json reads it; the Live tab's screenshot goes to
 # OUT_DIR/live.png (docs/live.png is a copy of one, made by hand: a test
 # leaves the source tree as it found it).
 #   live_test.sh PIDLAB_BINARY SOURCE_DIR OUT_DIR [logs]
@@ -87,24 +88,20 @@ timeout 200 node "$source_dir/tests/browser/live_test.js" \
   --out "$out_dir" --tmp "$tmp" --lcm-url "$lcm_url" --parts "$parts"
 status=$?
 [ $status -eq 124 ] && echo "FAIL: the browser test did not finish in 200 s"
-# Damaged logs through the upload: a log cut mid-event is read up to the cut
-# (its episode listed with its gaps), random bytes are one line of 400; the
-# server keeps serving (the reader is pidlab replay's: tests/hostile).
+# Random bytes through the upload are one line of 400 and the server keeps
+# serving (the reader is pidlab replay's: tests/hostile). A log cut mid-event
+# is the page's own step (live_test.js): what it shows of the cut equals what
+# pidlab replay --json reads of the same file.
 if ((status == 0)); then
   ask() { curl -s -w ' %{http_code}' --data-binary "$1" "$base/api/request"; }
-  head -c 1000003 "$tmp/run.lcmlog" > "$tmp/cut.lcmlog"
   head -c 4096 /dev/urandom > "$tmp/noise.lcmlog"
-  cut_id=$(curl -s --data-binary @"$tmp/cut.lcmlog" "$base/api/upload?name=cut.lcmlog" | sed -n 's/.*"log_id":"\([^"]*\)".*/\1/p')
   noise_id=$(curl -s --data-binary @"$tmp/noise.lcmlog" "$base/api/upload?name=noise.lcmlog" | sed -n 's/.*"log_id":"\([^"]*\)".*/\1/p')
-  cut=$(ask '{"type":"log_open","log_id":"'"$cut_id"'"}')
-  cut_log_id=$(sed -n 's/.*"log_id":"\([^"]*\)".*/\1/p' <<<"$cut")
-  episode=$(ask '{"type":"log_episode","log_id":"'"$cut_log_id"'","index":0,"redrive":true}')
   noise=$(ask '{"type":"log_open","log_id":"'"$noise_id"'"}')
-  if [[ $cut != *'"clean_end":false'*' 200' || $episode != *'"gaps":[['*' 200' || $noise != *' 400' ]]; then
-    echo "FAIL: damaged uploads: cut ${cut:0:200}... episode ${episode: -200} noise $noise"
+  if [[ $noise != *' 400' ]]; then
+    echo "FAIL: damaged uploads: random bytes $noise"
     status=1
   else
-    echo "ok   damaged uploads: a log cut at 1000003 bytes is read to the cut (episode 0 with gaps $(grep -o '"gaps":\[\[[0-9]*,[0-9]*\]' <<<"$episode")), random bytes: $noise"
+    echo "ok   damaged uploads: random bytes: $noise"
   fi
 fi
 kill -0 "$server" 2>/dev/null || { echo "FAIL: pidlab serve is no longer running"; status=1; }
