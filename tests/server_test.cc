@@ -222,7 +222,7 @@ TEST(Server, RefusesJsonNestedDeeperThan64LevelsBeforeParsingIt) {
   EXPECT_EQ(PostRequest(served, Nested(64)).first, 200);
   const auto [status, body] = PostRequest(served, Nested(65));
   EXPECT_EQ(status, 400);
-  EXPECT_NE(body.find("JSON nested deeper than 64 levels"), std::string::npos) << body;
+  EXPECT_NE(body.find("JSON is nested deeper than 64 levels"), std::string::npos) << body;
   EXPECT_EQ(PostRequest(served, Nested(30000)).first, 400);
   // Brackets inside a string are text, not nesting.
   EXPECT_EQ(PostRequest(served, "{\"s\":\"" + std::string(1000, '[') + "\\\"{{\"}").first, 200);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli_common.h"
+#include "pidlab/io/files.h"
 #include "pidlab/json/replay_json.h"
 #include "pidlab/json/results_json.h"
 #include "pidlab/replay/replay.h"
@@ -207,10 +208,9 @@ server::Reply LogStore::Upload(const std::string& name, const std::string& body)
   std::lock_guard<std::mutex> lock(mutex_);
   const std::string id = NewId();
   const std::string file = (fs::path(upload_dir_) / (id + "-" + name)).string();
-  std::ofstream out(file, std::ios::binary);
-  out.write(body.data(), static_cast<std::streamsize>(body.size()));
-  out.close();
-  if (!out) return {500, {{"error", "the upload could not be stored"}}};
+  // Whole or not at all: a full disk leaves no half log to be opened later.
+  if (const Status stored = io::WriteFile(file, body); !stored.ok())
+    return {500, {{"error", "the upload could not be stored: " + stored.message()}}};
   uploads_[id] = {name, file};
   upload_order_.push_back(id);
   while (upload_order_.size() > kMaxUploads) {

@@ -16,6 +16,8 @@
 #include <set>
 #include <sstream>
 
+#include "pidlab/spec/json.h"
+
 namespace pidlab::server {
 namespace {
 namespace beast = boost::beast;
@@ -67,33 +69,6 @@ bool SameSecret(const std::string& a, const std::string& b) {
   unsigned char diff = 0;
   for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
   return diff == 0;
-}
-
-// The deepest nesting of arrays and objects a request may have; the parser
-// never sees a deeper one.
-constexpr int kMaxJsonDepth = 64;
-
-// Whether `text` nests arrays and objects deeper than `limit`, counted
-// outside strings without recursing. A parser is only given text that passes.
-bool NestsDeeperThan(const std::string& text, int limit) {
-  int depth = 0;
-  bool in_string = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (in_string) {
-      if (c == '\\')
-        ++i;  // the escaped character, a quote included
-      else if (c == '"')
-        in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > limit) return true;
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  return false;
 }
 
 // A request's body after its header: the time it may take.
@@ -257,12 +232,15 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
 
   // One request object through the handler: the reply's status and body.
   Reply Answer(const std::string& text, const std::shared_ptr<Connection>& connection = nullptr) {
-    if (NestsDeeperThan(text, kMaxJsonDepth)) {
+    // The one JSON reader of every file and request: nesting beyond
+    // spec::kMaxJsonDepth is refused before any parser runs.
+    std::string why;
+    if (!spec::CheckJsonNesting(text, spec::kMaxJsonDepth, &why)) {
       Count(&ServerCounters::malformed);
-      return {400, {{"error", "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels"}}};
+      return {400, {{"error", "the request's JSON " + why}}};
     }
-    nlohmann::json request = nlohmann::json::parse(text, nullptr, false);
-    if (request.is_discarded() || !request.is_object()) {
+    nlohmann::json request;
+    if (!spec::ParseJsonText(text, &request, &why) || !request.is_object()) {
       Count(&ServerCounters::malformed);
       return {400, {{"error", "a request must be one JSON object"}}};
     }
