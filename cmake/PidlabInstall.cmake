@@ -34,7 +34,7 @@ function(pidlab_install_package)
           DESTINATION ${PIDLAB_INSTALL_CMAKEDIR})
   # The libraries in link order (each before what it links); lcmtypes is
   # headers only.
-  set(PIDLAB_PC_LIBS "-lpidlab_report -lpidlab_figures -lpidlab_replay_json -lpidlab_identify_json -lpidlab_json -lpidlab_plot -lpidlab_launcher -lpidlab_replay")
+  set(PIDLAB_PC_LIBS "-lpidlab_report -lpidlab_figures -lpidlab_replay_json -lpidlab_identify_json -lpidlab_results -lpidlab_plot -lpidlab_launcher -lpidlab_replay")
   string(APPEND PIDLAB_PC_LIBS " -lpidlab_episode_client -lpidlab_log_reader -lpidlab_tune -lpidlab_identify -lpidlab_analysis -lpidlab_evaluation -lpidlab_io -lpidlab_spec")
   string(APPEND PIDLAB_PC_LIBS " -lpidlab_optim")
   string(APPEND PIDLAB_PC_LIBS " -lpidlab_role_main -lpidlab_plant_roles -lpidlab_controller_role")

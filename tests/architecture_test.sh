@@ -9,6 +9,7 @@
 #  - the tuner's optim, evaluation, analysis and tune include no LCM,
 #    transport or episode client header, and only pidlab/<x>/ headers of
 #    their own level or below;
+#  - tools/ holds front ends only: no library's include/ folder;
 #  - nothing in the repository reads the folder beside it (the repository
 #    stands alone).
 # usage: architecture_test.sh SOURCE_DIR BUILD_DIR
@@ -28,8 +29,8 @@ level = {
     'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_analysis': 3,
     'pidlab_monitor': 3,
     'pidlab_tune': 4, 'pidlab_identify': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
-    'pidlab_tuner': 5, 'pidlab_json': 5, 'pidlab_identify_json': 6, 'pidlab_replay': 5, 'pidlab_launcher': 5,
-    'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_figures': 6, 'pidlab_cli': 7,
+    'pidlab_tuner': 5, 'pidlab_results': 5, 'pidlab_identify_json': 6, 'pidlab_replay': 5, 'pidlab_launcher': 5,
+    'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_live_json': 7, 'pidlab_figures': 6, 'pidlab_cli': 7,
     'pidlab': 8, 'pidlab_python': 8,
 }
 labels, edges = {}, []
@@ -70,10 +71,11 @@ for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
     else: print(f'ok   {exe} links only ' + ', '.join(sorted(d for d in closure(exe) if d.startswith("pidlab"))))
 # Sources: a folder includes only headers of its own level or below.
 header_level = {'io': 2, 'spec': 1, 'plant_sim': 1, 'controller': 1, 'optim': 1, 'plot': 3, 'server': 2, 'transport': 2, 'evaluation': 2, 'controller_export': 2,
-                'analysis': 3, 'monitor': 3, 'tune': 4, 'identify': 4, 'episode_client': 4, 'replay': 4, 'json': 5, 'launcher': 5, 'report': 6,
+                'analysis': 3, 'monitor': 3, 'tune': 4, 'identify': 4, 'episode_client': 4, 'replay': 4, 'results': 5, 'launcher': 5, 'report': 6,
                 'figures': 6}
 lib_dirs = {'io': 2, 'spec': 1, 'server': 2, 'transport': 2, 'tuner/optim': 1, 'tuner/evaluation': 2, 'tuner/analysis': 3, 'monitor': 3,
-            'tuner/tune': 4, 'tuner/identify': 4, 'tuner/episode_client': 4, 'replay': 5, 'launcher': 5}
+            'tuner/tune': 4, 'tuner/identify': 4, 'tuner/episode_client': 4, 'replay': 5, 'launcher': 5,
+            'plot': 3, 'results': 5, 'report': 6, 'figures': 6}
 for d, lv in lib_dirs.items():
     for root, _, files in os.walk(os.path.join(src, d)):
         for f in files:
@@ -100,14 +102,21 @@ for d in ('optim', 'evaluation', 'analysis', 'tune', 'identify'):
                     fail(f'{rel} includes {inc}, whose folder has no level in this test')
                 elif header_level[m.group(1)] > lv:
                     fail(f'{rel} (level {lv}) includes {inc} (level {header_level[m.group(1)]}) from above')
-# The live monitor watches the trio for the server: it includes no server
-# header and nothing of tools/ (the server's requests are tools/serve_live.cc's).
+# The live monitor watches the trio for the server, and holds the live
+# scope's state (LiveScope): it includes no server header and nothing of
+# tools/ (the page's requests are tools/serve_live.cc's, the JSON of its
+# status results/'s).
 for root, _, files in os.walk(os.path.join(src, 'monitor')):
     for f in files:
         path = os.path.join(root, f)
         for inc in re.findall(r'#include\s*"([^"]+)"', open(path).read()):
             if not re.match(r'pidlab/(monitor|transport)/', inc):
                 fail(f'{os.path.relpath(path, src)} includes "{inc}": the monitor includes only its own and the transport\'s headers')
+# tools/ holds the front ends only (the pidlab command, the Python module, the
+# page's request handlers): no library with headers of its own lives there.
+for root, dirs, _ in os.walk(os.path.join(src, 'tools')):
+    if 'include' in dirs:
+        fail(f'{os.path.relpath(os.path.join(root, "include"), src)}: a library in tools/, which holds only front ends')
 # plant_sim and controller models (not their roles) include no transport header.
 for d in ('plant_sim', 'controller'):
     for root, _, files in os.walk(os.path.join(src, d)):

@@ -1,5 +1,5 @@
-// The JSON builders of tools/json (pidlab/json/results_json.h,
-// pidlab/json/batch_json.h): the keys the command line and Python print,
+// The JSON builders of results/ (pidlab/results/results_json.h,
+// pidlab/results/batch_json.h): the keys the command line and Python print,
 // null for numbers JSON cannot hold, and the numbers themselves.
 
 #include <gtest/gtest.h>
@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "pidlab/evaluation/evaluation.h"
-#include "pidlab/json/batch_json.h"
-#include "pidlab/json/results_json.h"
+#include "pidlab/results/batch_json.h"
+#include "pidlab/results/results_json.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -134,4 +134,4 @@ TEST(BatchResultJson, NamesTheRuleAndTheOptimumAndNullsMissingNumbers) {
 }
 
 }  // namespace
-}  // namespace pidlab::json
+}  // namespace pidlab::results

@@ -1,8 +1,8 @@
-// The workbench's plot series (pidlab/json/plot_series.h): the step response
+// The workbench's plot series (pidlab/results/plot_series.h): the step response
 // is the evaluation's own samples, the |S| curve peaks at the analysis's Ms,
 // and the command and load response agree with the loop's steady state.
 
-#include "pidlab/json/plot_series.h"
+#include "pidlab/results/plot_series.h"
 
 #include <gtest/gtest.h>
 
@@ -11,12 +11,12 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/json/spec_run.h"
+#include "pidlab/results/spec_run.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/tune/spec_build.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 namespace {
 
 // The evaluation of `spec` by the library pieces `pidlab evaluate` uses.
@@ -142,4 +142,4 @@ TEST(PlotSeries, RefusesAGridOfFewerThanTenPoints) {
 }
 
 }  // namespace
-}  // namespace pidlab::json
+}  // namespace pidlab::results

@@ -17,8 +17,8 @@
 #include "pidlab/episode_client/episode_pool.h"
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/io/files.h"
-#include "pidlab/json/replay_json.h"
-#include "pidlab/json/results_json.h"
+#include "pidlab/results/replay_json.h"
+#include "pidlab/results/results_json.h"
 #include "pidlab/spec/field.h"
 #include "pidlab/spec/status.h"
 
@@ -128,11 +128,11 @@ analysis::LoopAnalysis AnalyzeOrThrow(const Plant& plant, const PidGains& gains,
                                       const evaluation::LoopOptions& options);
 
 // JsonNumber (null for NaN/inf), ToJson(Evaluation), ToJson(PidGains): the
-// JSON objects live in a library the Python module shares (tools/json/).
-using json::JsonNumber;
-using json::RealtimeJson;
-using json::RobustnessJson;
-using json::ToJson;
+// JSON objects live in a library the Python module shares (results/).
+using results::JsonNumber;
+using results::RealtimeJson;
+using results::RobustnessJson;
+using results::ToJson;
 std::string FormatPoles(const std::vector<std::complex<double>>& poles);
 /// Human-readable report of one evaluation.
 std::string FormatEvaluation(const evaluation::Evaluation& ev);

@@ -15,8 +15,8 @@
 
 #include "cli_common.h"
 #include "commands.h"
-#include "pidlab/json/batch_json.h"
 #include "pidlab/plot/plot.h"
+#include "pidlab/results/batch_json.h"
 #include "pidlab/tune/batch.h"
 
 using pidlab::tune::BatchOptions;
@@ -169,9 +169,9 @@ struct BatchCommand {
                         {"wall_time_s", wall},
                         {"max_ms", options.max_ms},
                         {"filter_ratio", options.filter_ratio},
-                        {"summary", json::BatchTallyJson(tune::TallyBatch(results))},
+                        {"summary", results::BatchTallyJson(tune::TallyBatch(results))},
                         {"plants", nlohmann::json::array()}};
-    for (const BatchResult& r : results) j["plants"].push_back(json::BatchResultJson(r));
+    for (const BatchResult& r : results) j["plants"].push_back(results::BatchResultJson(r));
     if (!out_dir.empty()) {
       WriteFile(out_dir + "/batch.json", j.dump(1) + "\n");
       WriteFile(out_dir + "/batch.csv", Csv(results));

@@ -153,7 +153,7 @@ struct EvaluateCommand {
       nlohmann::json j = ToJson(ev);
       j["backend"] = backend;
       j["robustness"] = RobustnessJson(analysis, loop_bounds);
-      if (s.monte_carlo > 0) j["monte_carlo"] = json::MonteCarloJson(mc, mc_summary);
+      if (s.monte_carlo > 0) j["monte_carlo"] = results::MonteCarloJson(mc, mc_summary);
       if (client) j["steps_per_second"] = JsonNumber(client->stats().StepsPerSecond());
       if (client && client->stats().realtime.paced()) j["realtime"] = RealtimeJson(client->stats().realtime);
       j["spec"] = spec::ToJson(s);

@@ -14,8 +14,8 @@
 #include "pidlab/figures/figures.h"
 #include "pidlab/identify/csv_data.h"
 #include "pidlab/identify/identify.h"
-#include "pidlab/json/identify_json.h"
 #include "pidlab/replay/log_reader.h"
+#include "pidlab/results/identify_json.h"
 
 namespace pidlab::cli {
 namespace {
@@ -320,7 +320,7 @@ struct IdentifyCommand {
       if (status.code() == StatusCode::kInvalidInput) throw BadInput(Source() + ": " + status.message());
       Require(Status(status.code(), Source() + ": " + status.message()));
       result = a.candidates[static_cast<std::size_t>(a.chosen)].result;
-      j = json::IdentifyAutoJson(a);
+      j = results::IdentifyAutoJson(a);
       std::ostringstream os;
       os << "auto: " << a.reason << "\n";
       for (const identify::AutoCandidate& c : a.candidates)
@@ -333,7 +333,7 @@ struct IdentifyCommand {
       const Status status = identify::Identify(data, kind, options, &result);
       if (status.code() == StatusCode::kInvalidInput) throw BadInput(Source() + ": " + status.message());
       Require(Status(status.code(), Source() + ": " + status.message()));
-      j = json::IdentifyResultJson(result);
+      j = results::IdentifyResultJson(result);
     }
     if (!log.empty()) {
       j["source"] = {{"log", log}, {"episode", chosen_episode}};

@@ -45,7 +45,7 @@ struct LinearizeCommand {
     if (!LinearizeStepper(o, &lin, &error)) throw BadInput(error);
     const TransferFunction eq3 = StepperMotorTransferFunction(o.motor);
     if (json) {
-      const nlohmann::json j = json::LinearizeJson(lin.tf, eq3, o.InputScale());
+      const nlohmann::json j = results::LinearizeJson(lin.tf, eq3, o.InputScale());
       std::cout << std::setprecision(std::numeric_limits<double>::max_digits10) << j.dump() << "\n";
     } else {
       std::cout << std::setprecision(10) << "linearisation  G(s) = " << lin.tf.ToString() << "\n"

@@ -15,9 +15,9 @@
 
 #include "cli_common.h"
 #include "commands.h"
-#include "pidlab/json/replay_json.h"
 #include "pidlab/replay/log_reader.h"
 #include "pidlab/replay/replay.h"
+#include "pidlab/results/replay_json.h"
 #include "pidlab/transport/episode_spec.h"
 #include "pidlab/transport/transport.h"
 
@@ -101,7 +101,7 @@ struct ReplayCommand {
     const std::vector<const replay::Episode*> selected = SelectEpisodes(log);
     std::unique_ptr<io::AtomicFile> csv_file;
     if (!csv.empty()) OpenCsv(&csv_file);
-    nlohmann::json out = json::LogJson(log, log_path);
+    nlohmann::json out = results::LogJson(log, log_path);
     std::ostringstream table;
     TableHeader(log, &table);
     int status = 0;
@@ -202,7 +202,7 @@ struct ReplayCommand {
   bool ReportEpisode(const replay::Episode& e, nlohmann::json* episodes_json, std::ostream* table) const {
     Evaluation ev;
     bool evaluated = false;
-    nlohmann::json j = json::EvaluatedEpisodeJson(e, &ev, &evaluated);
+    nlohmann::json j = results::EvaluatedEpisodeJson(e, &ev, &evaluated);
     const std::string why = evaluated ? "" : j["evaluation_error"].get<std::string>();
     TableRow(e, evaluated ? Full(ev.iae) : "-", table);
     StreamDetails("plant outputs", e.outputs, table);
@@ -223,7 +223,7 @@ struct ReplayCommand {
   // on a mismatch.
   bool RedriveEpisode(const replay::Episode& e, nlohmann::json* j, std::ostream* table) const {
     const replay::RedriveResult r = backend == "lcm" ? RedriveLive(e) : replay::Redrive(e);
-    (*j)["redrive"] = json::RedriveJson(r);
+    (*j)["redrive"] = results::RedriveJson(r);
     *table << "    redrive: " << (r.ok ? "OK, " : "FAILED, ") << FromLog(r.message) << "\n";
     return r.ok;
   }

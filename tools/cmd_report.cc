@@ -1,5 +1,5 @@
 // pidlab report: regenerates the paper's Tables II-VI and Figures 9-21 with
-// pidlab's re-evaluations and own tunings (see tools/report/include/pidlab/report/report.h, docs/report.md).
+// pidlab's re-evaluations and own tunings (see report/include/pidlab/report/report.h, docs/report.md).
 
 #include <cstdio>
 #include <filesystem>

@@ -2,6 +2,7 @@
 
 #include <sodium.h>
 
+#include <atomic>
 #include <csignal>
 #include <filesystem>
 #include <iostream>
@@ -67,11 +68,18 @@ struct ServeCommand {
     if (!options.IsValid(&error)) throw BadInput(error);
     std::unique_ptr<LogStore> logs = ServedLogs();
     std::unique_ptr<LiveService> live = StartLive();
-    server::Server s(options, server::ConnectionHandler(AnswerWorkbenchRequest), server::WorkbenchAssets());
+    std::atomic<LiveService*> live_requests{nullptr};  // the live requests' service while the server runs
+    server::Server s(
+        options,
+        [&live_requests](const nlohmann::json& request,
+                         const std::shared_ptr<server::Connection>& connection) {
+          return AnswerWorkbenchRequest(request, connection, live_requests.load());
+        },
+        server::WorkbenchAssets());
     s.SetUploadHandler(
         [&logs](const std::string& name, const std::string& body) { return logs->Upload(name, body); });
     if (!s.Start(&error)) throw BadInput(error);
-    SetLiveService(live.get());
+    live_requests = live.get();
     const std::string host =
         options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind;
     std::cout << "pidlab serve: http://" << host << ":" << s.port() << "/"
@@ -82,7 +90,7 @@ struct ServeCommand {
     s.Run();
     // The live threads post to the server's connections: they stop (and a
     // run_on_trio episode ends) while the server still exists.
-    SetLiveService(nullptr);
+    live_requests = nullptr;
     live.reset();
     g_server = nullptr;
     ServeLogs(nullptr);

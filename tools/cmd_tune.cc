@@ -118,7 +118,7 @@ struct TuneCommand {
       analysis = AnalyzeOrThrow(p, s.gains, loop);
     }
     if (json) {
-      nlohmann::json j = json::TuneJson(p, o, s, ev, backend);
+      nlohmann::json j = results::TuneJson(p, o, s, ev, backend);
       j["robustness"] = s.stable ? RobustnessJson(analysis, o.bounds) : nlohmann::json(nullptr);
       j["spec"] = spec::ToJson(ts);
       std::cout << j.dump() << "\n";

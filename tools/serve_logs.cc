@@ -10,9 +10,9 @@
 
 #include "cli_common.h"
 #include "pidlab/io/files.h"
-#include "pidlab/json/replay_json.h"
-#include "pidlab/json/results_json.h"
 #include "pidlab/replay/replay.h"
+#include "pidlab/results/replay_json.h"
+#include "pidlab/results/results_json.h"
 
 namespace pidlab::cli {
 namespace {
@@ -76,14 +76,14 @@ nlohmann::json Series(const replay::Episode& e) {
   const double dt = e.has_config ? e.spec.dt_s : std::nan("");
   const std::size_t stride = std::max<std::size_t>(1, (e.y.size() + kMaxSeriesSteps - 1) / kMaxSeriesSteps);
   for (std::size_t i = 0; i < e.y.size(); i += stride) {
-    t.push_back(json::JsonNumber(static_cast<double>(i) * dt));
-    y.push_back(json::JsonNumber(e.y[i]));
-    u.push_back(json::JsonNumber(e.u[i]));
-    n.push_back(json::JsonNumber(e.n[i]));
+    t.push_back(results::JsonNumber(static_cast<double>(i) * dt));
+    y.push_back(results::JsonNumber(e.y[i]));
+    u.push_back(results::JsonNumber(e.u[i]));
+    n.push_back(results::JsonNumber(e.n[i]));
   }
   return {{"t", t}, {"stride", stride},
           {"y", y}, {"u", u},
-          {"n", n}, {"r", e.has_config ? json::JsonNumber(e.spec.reference) : nlohmann::json(nullptr)}};
+          {"n", n}, {"r", e.has_config ? results::JsonNumber(e.spec.reference) : nlohmann::json(nullptr)}};
 }
 
 }  // namespace
@@ -120,12 +120,12 @@ server::Reply LogStore::OpenFile(const std::string& file, const std::string& nam
     return Bad("log " + Quote(name) + ": " + Truncate(error, 200));
   }
   const std::string id = NewId();
-  nlohmann::json reply = json::LogJson(log->contents, name);
+  nlohmann::json reply = results::LogJson(log->contents, name);
   reply["type"] = "log";
   reply["log_id"] = id;
   reply["name"] = name;
   for (const replay::Episode& e : log->contents.episodes)
-    reply["episodes"].push_back(json::EvaluatedEpisodeJson(e));
+    reply["episodes"].push_back(results::EvaluatedEpisodeJson(e));
   Remember(id, std::move(log));
   return {200, reply};
 }
@@ -187,9 +187,9 @@ server::Reply LogStore::Episode(const nlohmann::json& request) {
   if (redrive != request.end() && !redrive->is_boolean())
     return Bad("redrive " + Truncate(redrive->dump(), 50) + " must be true or false");
   const replay::Episode& e = log->contents.episodes[static_cast<std::size_t>(index->get<long>())];
-  nlohmann::json replayed = json::EvaluatedEpisodeJson(e);
+  nlohmann::json replayed = results::EvaluatedEpisodeJson(e);
   if (redrive != request.end() && redrive->get<bool>())
-    replayed["redrive"] = json::RedriveJson(replay::Redrive(e));
+    replayed["redrive"] = results::RedriveJson(replay::Redrive(e));
   return {200,
           {{"type", "log_episode"},
            {"log_id", request["log_id"]},

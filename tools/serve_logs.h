@@ -3,7 +3,7 @@
 // tab"): log_open (a path under --log-dir, or an uploaded log), log_episode
 // (one episode's `pidlab replay --json` object with its series, gaps and
 // repairs) and the upload route (POST /api/upload). Every reply is built with
-// the code of `pidlab replay --json` (tools/json/replay_json.h), and logs are
+// the code of `pidlab replay --json` (results/include/pidlab/results/replay_json.h), and logs are
 // read by the same reader (replay/log_reader.h), hostile logs included.
 
 #include <cstddef>

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/json/spec_run.h"
+#include "pidlab/results/spec_run.h"
 #include "serve_live.h"
 #include "serve_logs.h"
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
@@ -41,7 +41,7 @@ server::Reply Evaluate(const nlohmann::json& request) {
                            " draws pidlab serve runs (pidlab evaluate takes more)"}}};
   const auto start = std::chrono::steady_clock::now();
   nlohmann::json result, series;
-  const Status status = json::EvaluateSpecJson(request["spec"], &result, with_series ? &series : nullptr);
+  const Status status = results::EvaluateSpecJson(request["spec"], &result, with_series ? &series : nullptr);
   if (!status.ok()) return {400, {{"error", status.message()}}};
   nlohmann::json reply = {{"type", "evaluation"}, {"result", result}};
   if (with_series) reply["series"] = series;
@@ -96,14 +96,15 @@ nlohmann::json PaperDesigns() {
 }
 
 server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
-                                     const std::shared_ptr<server::Connection>& connection) {
+                                     const std::shared_ptr<server::Connection>& connection,
+                                     LiveService* live) {
   const std::string type = request.value("type", std::string());
-  if (type == "fields") return {200, {{"type", "fields"}, {"fields", json::EvaluateSpecFields()}}};
+  if (type == "fields") return {200, {{"type", "fields"}, {"fields", results::EvaluateSpecFields()}}};
   if (type == "paper_designs") return {200, {{"type", "paper_designs"}, {"designs", PaperDesigns()}}};
   if (type == "evaluate") return Evaluate(request);
   if (type == "log_open") return AnswerLogOpen(request);
   if (type == "log_episode") return AnswerLogEpisode(request);
-  if (IsLiveRequest(type)) return AnswerLive(type, request, connection);
+  if (IsLiveRequest(type)) return AnswerLive(live, type, request, connection);
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
   if (type == "export") return Export(request);
   if (type == "tune") return AnswerTune(request, connection);

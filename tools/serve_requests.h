@@ -10,10 +10,14 @@
 
 namespace pidlab::cli {
 
+class LiveService;
+
 /// One request object of the page, with the WebSocket connection it came on
-/// (null over HTTP); 400 with one line for a bad one.
+/// (null over HTTP); 400 with one line for a bad one. The live requests go
+/// to `live` (null: `pidlab serve` without --lcm-url).
 server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
-                                     const std::shared_ptr<server::Connection>& connection);
+                                     const std::shared_ptr<server::Connection>& connection,
+                                     LiveService* live);
 
 /// tune (serve_tune.cc): starts the tuning of request["spec"] on a thread;
 /// no reply now, its progress and result are posted on `connection`.

@@ -1,7 +1,7 @@
 // The page's tune and tune_cancel requests (docs/workbench.md): a tuning runs
 // on a thread of its own, one at a time per WebSocket connection, sends its
 // progress at most ten times a second and ends with the object of `pidlab
-// tune --json` (json::TuneSpecJson) or an error.
+// tune --json` (results::TuneSpecJson) or an error.
 
 #include <atomic>
 #include <chrono>
@@ -10,7 +10,7 @@
 #include <string>
 #include <thread>
 
-#include "pidlab/json/tune_run.h"
+#include "pidlab/results/tune_run.h"
 #include "serve_requests.h"
 
 namespace pidlab::cli {
@@ -52,7 +52,7 @@ void RunTuning(std::shared_ptr<TuneJob> job, std::shared_ptr<server::Connection>
   nlohmann::json reply;
   try {
     nlohmann::json result;
-    const Status status = json::TuneSpecJson(spec, ProgressPoster(job, out, id), &result);
+    const Status status = results::TuneSpecJson(spec, ProgressPoster(job, out, id), &result);
     if (status.ok())
       reply = {{"type", "tune_result"}, {"result", result}};
     else

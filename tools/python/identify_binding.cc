@@ -1,6 +1,6 @@
 // pidlab.identify(t, u, y, model=...): the fit of `pidlab identify`
 // (pidlab::identify) on arrays, returning the dict of `pidlab identify
-// --json` (the same code builds it: pidlab::json). docs/python.md.
+// --json` (the same code builds it: pidlab::results). docs/python.md.
 
 #include "identify_binding.h"
 
@@ -11,7 +11,7 @@
 #include <limits>
 
 #include "pidlab/identify/identify.h"
-#include "pidlab/json/identify_json.h"
+#include "pidlab/results/identify_json.h"
 
 namespace py = pybind11;
 
@@ -91,7 +91,7 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
       py::gil_scoped_release release;
       status = identify::IdentifyAuto(data, options, &result);
     }
-    if (status.ok()) j = json::IdentifyAutoJson(result);
+    if (status.ok()) j = results::IdentifyAutoJson(result);
   } else {
     identify::ProcessModelKind kind = identify::ProcessModelKind::kP1D;
     if (!identify::Parse(model, &kind))
@@ -102,7 +102,7 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
       py::gil_scoped_release release;
       status = identify::Identify(data, kind, options, &result);
     }
-    if (status.ok()) j = json::IdentifyResultJson(result);
+    if (status.ok()) j = results::IdentifyResultJson(result);
   }
   if (status.code() == StatusCode::kInvalidInput) throw py::value_error("identify: " + status.message());
   if (!status.ok()) throw std::runtime_error("identify: " + status.message());

@@ -1,6 +1,6 @@
 // pidlab from Python (docs/python.md): pidlab.evaluate and pidlab.tune,
 // returning the dicts of `pidlab evaluate --json` and `pidlab tune --json`
-// (the same code builds them: pidlab::json, tools/json/). The extension is
+// (the same code builds them: pidlab::results, results/). The extension is
 // pidlab._pidlab; the package pidlab (with the lcm-gen'd messages) imports
 // evaluate and tune from it.
 //
@@ -19,8 +19,8 @@
 
 #include "identify_binding.h"
 #include "pidlab/evaluation/evaluation.h"
-#include "pidlab/json/results_json.h"
-#include "pidlab/json/spec_run.h"
+#include "pidlab/results/results_json.h"
+#include "pidlab/results/spec_run.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/tune/search_box.h"
@@ -189,7 +189,7 @@ py::object EvaluatePy(const py::object& plant, const py::object& gains, py::kwar
   Status status;
   {
     py::gil_scoped_release release;
-    status = json::EvaluateSpecJson(spec::ToJson(s), &result);
+    status = results::EvaluateSpecJson(spec::ToJson(s), &result);
   }
   Require(status.ok(), status.message());
   return ToPython(result);
@@ -224,8 +224,8 @@ py::object TunePy(const py::object& plant, py::kwargs kwargs) {
     }
   }
   Require(ok, error);
-  nlohmann::json j = json::TuneJson(p, o, summary, ev, "local");
-  j["robustness"] = summary.stable ? json::RobustnessJson(analysis, o.bounds) : nlohmann::json(nullptr);
+  nlohmann::json j = results::TuneJson(p, o, summary, ev, "local");
+  j["robustness"] = summary.stable ? results::RobustnessJson(analysis, o.bounds) : nlohmann::json(nullptr);
   j["spec"] = spec::ToJson(s);
   return ToPython(j);
 }

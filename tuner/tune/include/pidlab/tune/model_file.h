@@ -1,6 +1,6 @@
 #pragma once
 // An identified model as a plant: the file `pidlab identify --out` writes
-// (tools/json/src/identify_json.cc; docs/identify.md, "The identified model
+// (results/src/identify_json.cc; docs/identify.md, "The identified model
 // as a plant"), read back. Its "transfer_function" (num, den, delay_s) is
 // the plant G(s) e^(-s Td); its "model" (the kind), "parameters" (value of
 // each, in any order) and "covariance" (ok, message, matrix p x p in the

@@ -11,7 +11,7 @@
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/tune/tune.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 /// v, or null for NaN and +-inf (JSON has no such numbers).
 nlohmann::json JsonNumber(double v);
@@ -43,4 +43,4 @@ nlohmann::json DistributionJson(const analysis::Distribution& d);
 /// The `monte_carlo` object of `pidlab evaluate --monte-carlo N --json`.
 nlohmann::json MonteCarloJson(const analysis::MonteCarloOptions& mc, const analysis::MonteCarloSummary& s);
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

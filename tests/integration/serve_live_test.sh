@@ -18,6 +18,7 @@ fi
 pidlab=$(realpath -- "$1")
 messages=$(realpath -- "$2")  # the messages as Python classes (lcm-gen), to forge one
 here=$(cd "$(dirname -- "$0")" && pwd)
+cli=$(cd "$here/../cli" && pwd)  # stderr_shape.sh and serve_client.py, shared with the CLI tests
 if [[ ${PIDLAB_TEST_IN_NAMESPACE:-} != 1 ]]; then
   PIDLAB_TEST_IN_NAMESPACE=1 exec unshare -n bash "$0" "$@"
 fi
@@ -25,7 +26,7 @@ ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev
   echo "FAIL: cannot route multicast over the private namespace's loopback"
   exit 1
 }
-source "$here/stderr_shape.sh"
+source "$cli/stderr_shape.sh"
 docs=$(cd "$here/../../docs" && pwd)/live.md
 pass=0; fail=0
 check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
@@ -51,7 +52,7 @@ start() {
 }
 
 start
-PYTHONPATH="$here" /usr/bin/python3 - "$port" > plain.out <<'PY'
+PYTHONPATH="$cli" /usr/bin/python3 - "$port" > plain.out <<'PY'
 import sys
 from serve_client import WebSocket
 ws = WebSocket(int(sys.argv[1]))
@@ -80,7 +81,7 @@ run_block() {
   for _ in $(seq 200); do grep -q '^pidlab serve: http' serve.out && break; sleep 0.05; done
   port=$(sed -nE 's#^pidlab serve: http://[^/]*:([0-9]+)/.*#\1#p' serve.out | head -1)
   eval "words=($evaluate)"
-  PYTHONPATH="$here" timeout 200 /usr/bin/python3 "$here/serve_live_client.py" "$port" "$PWD" "$mode" \
+  PYTHONPATH="$here:$cli" timeout 200 /usr/bin/python3 "$here/serve_live_client.py" "$port" "$PWD" "$mode" \
     "$messages" "$pidlab" "${words[@]:1}" > client.out 2>&1
   local status=$?
   sed "s/^/  [$mode] /" client.out
@@ -106,12 +107,12 @@ check "docs/live.md has 3 blocks of commands (found $n_blocks)" "[ $n_blocks -eq
 # health listed with its URL.
 cat > trios.sh <<'TRIOS'
 set -u
-pidlab=$1 here=$2
+pidlab=$1 cli=$2
 "$pidlab" serve --port 0 --lcm-url "$PIDLAB_LCM_URLS" > trios_serve.out 2> trios_serve.err &
 server=$!
 for _ in $(seq 200); do grep -q '^pidlab serve: http' trios_serve.out && break; sleep 0.05; done
 port=$(sed -nE 's#^pidlab serve: http://[^/]*:([0-9]+)/.*#\1#p' trios_serve.out | head -1)
-PYTHONPATH="$here" timeout 120 /usr/bin/python3 - "$port" "$pidlab" "$PIDLAB_LCM_URLS" <<'PY'
+PYTHONPATH="$cli" timeout 120 /usr/bin/python3 - "$port" "$pidlab" "$PIDLAB_LCM_URLS" <<'PY'
 import json, re, subprocess, sys, time
 from serve_client import WebSocket
 port, pidlab, urls = int(sys.argv[1]), sys.argv[2], re.split('[ ,]+', sys.argv[3].strip())
@@ -149,7 +150,7 @@ status=$?
 kill -TERM "$server"; wait "$server" || status=1
 exit $status
 TRIOS
-timeout 200 "$pidlab" launch --quiet --trios 2 -- bash trios.sh "$pidlab" "$here" > trios.out 2> trios.err
+timeout 200 "$pidlab" launch --quiet --trios 2 -- bash trios.sh "$pidlab" "$cli" > trios.out 2> trios.err
 status=$?
 sed 's/^/  [trios] /' trios.out
 check "two trios watched at once (exit $status)" "[ $status -eq 0 ] && ! grep -q '^FAIL' trios.out"
@@ -161,12 +162,12 @@ check "two trios watched at once (exit $status)" "[ $status -eq 0 ] && ! grep -q
 # kind-2 frame is never dropped.
 cat > slow.sh <<'SLOW'
 set -u
-pidlab=$1 here=$2
+pidlab=$1 cli=$2
 "$pidlab" serve --port 0 --lcm-url "$PIDLAB_LCM_URL" > slow_serve.out 2> slow_serve.err &
 server=$!
 for _ in $(seq 200); do grep -q '^pidlab serve: http' slow_serve.out && break; sleep 0.05; done
 port=$(sed -nE 's#^pidlab serve: http://[^/]*:([0-9]+)/.*#\1#p' slow_serve.out | head -1)
-PYTHONPATH="$here" timeout 120 /usr/bin/python3 - "$port" "$pidlab" <<'PY'
+PYTHONPATH="$cli" timeout 120 /usr/bin/python3 - "$port" "$pidlab" <<'PY'
 import json, socket, struct, subprocess, sys
 import serve_client
 def small_buffer_connection(address, timeout=None):
@@ -202,7 +203,7 @@ status=$?
 kill -TERM "$server"; wait "$server" || status=1
 exit $status
 SLOW
-timeout 200 "$pidlab" launch --quiet -- bash slow.sh "$pidlab" "$here" > slow.out 2> slow.err
+timeout 200 "$pidlab" launch --quiet -- bash slow.sh "$pidlab" "$cli" > slow.out 2> slow.err
 status=$?
 sed 's/^/  [slow] /' slow.out
 check "a slow client's views are dropped and counted (exit $status)" "[ $status -eq 0 ] && ! grep -q '^FAIL' slow.out"

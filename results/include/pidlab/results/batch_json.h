@@ -7,7 +7,7 @@
 
 #include "pidlab/tune/batch.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 /// One plant: family, parameter, value, label, plant_tf, delay_s, model,
 /// tau, dt_s, horizon_s, box, amigo {k, ti_s, td_s, gains, ms, load_iae,
@@ -18,4 +18,4 @@ nlohmann::json BatchResultJson(const tune::BatchResult& r);
 /// losses, best_ratio, worst_ratio, max_ms.
 nlohmann::json BatchTallyJson(const tune::BatchTally& t);
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

@@ -9,7 +9,7 @@
 
 #include "pidlab/spec/status.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 /// The object of `pidlab evaluate --json` (backend "local") for the
 /// EvaluateSpec `spec` (keys as the spec's JSON form; a --json result's
@@ -23,4 +23,4 @@ Status EvaluateSpecJson(const nlohmann::json& spec, nlohmann::json* result, nloh
 /// The fields of EvaluateSpec: [{key, flag, help, unit, default, example}].
 nlohmann::json EvaluateSpecFields();
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

@@ -1,4 +1,4 @@
-#include "pidlab/json/plot_series.h"
+#include "pidlab/results/plot_series.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "pidlab/plant_sim/matrix_exp.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 namespace {
 using analysis::LoopAnalysis;
 using analysis::LoopFrequencyPoint;
@@ -177,4 +177,4 @@ Status MonteCarloBand(const Plant& nominal, const StepperMotorParameters* steppe
   return Status::Ok();
 }
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

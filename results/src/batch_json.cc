@@ -1,8 +1,8 @@
-#include "pidlab/json/batch_json.h"
+#include "pidlab/results/batch_json.h"
 
-#include "pidlab/json/results_json.h"
+#include "pidlab/results/results_json.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 namespace {
 
 nlohmann::json GainsJson(const PidGains& g) {
@@ -61,4 +61,4 @@ nlohmann::json BatchTallyJson(const tune::BatchTally& t) {
           {"max_ms", JsonNumber(t.max_ms)}};
 }
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

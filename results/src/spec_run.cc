@@ -1,17 +1,17 @@
-#include "pidlab/json/spec_run.h"
+#include "pidlab/results/spec_run.h"
 
 #include <set>
 #include <string>
 
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/analysis/monte_carlo.h"
-#include "pidlab/json/plot_series.h"
-#include "pidlab/json/results_json.h"
+#include "pidlab/results/plot_series.h"
+#include "pidlab/results/results_json.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/tune/spec_build.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 using analysis::AnalyzeLoop;
 using analysis::LoopAnalysis;
 using analysis::LoopAnalysisOptions;
@@ -115,4 +115,4 @@ nlohmann::json EvaluateSpecFields() {
   return rows;
 }
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

@@ -4,7 +4,7 @@
 # is measured by bench/report_bench.sh, not asserted here.
 # usage: report_cli_test.sh PIDLAB PAPER_TABLES
 set -u
-source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
+source "$(dirname -- "$0")/../cli/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 pidlab=$1
 tables=$2
 out=$(mktemp -d)

@@ -10,7 +10,7 @@
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/spec/status.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 struct PlotSeriesOptions {
   /// Points of the log frequency grid (plus the frequencies of Ms, Mt and the
@@ -52,4 +52,4 @@ Status MonteCarloBand(const Plant& nominal, const StepperMotorParameters* steppe
                       const PidGains& typed_gains, const evaluation::LoopOptions& options,
                       const analysis::MonteCarloOptions& mc, nlohmann::json* band);
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

@@ -1,4 +1,4 @@
-"""The client side of tests/cli/serve_live_test.sh: watches `pidlab serve
+"""The client side of tests/integration/serve_live_test.sh: watches `pidlab serve
 --lcm-url` over its WebSocket while `pidlab evaluate --backend lcm` runs one
 episode on the trio, and checks the live scope's contract (docs/live.md).
 With auth, a forged EPISODE_CONFIG (a well-formed message with a wrong MAC)

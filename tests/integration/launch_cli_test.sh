@@ -22,7 +22,7 @@ ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev
   echo "FAIL: cannot route multicast over the private namespace's loopback"
   exit 1
 }
-source "$(dirname -- "$0")/stderr_shape.sh"
+source "$(dirname -- "$0")/../cli/stderr_shape.sh"
 export PATH="$(dirname -- "$pidlab"):$PATH"
 
 work=$(mktemp -d)

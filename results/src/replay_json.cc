@@ -1,8 +1,8 @@
-#include "pidlab/json/replay_json.h"
+#include "pidlab/results/replay_json.h"
 
-#include "pidlab/json/results_json.h"
+#include "pidlab/results/results_json.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 nlohmann::json RealtimeJson(const transport::RealtimeStats& s) {
   return {{"missed_deadlines", s.missed_deadlines},
@@ -101,4 +101,4 @@ nlohmann::json EvaluatedEpisodeJson(const replay::Episode& e, evaluation::Evalua
   return j;
 }
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

@@ -1,10 +1,10 @@
-#include "pidlab/json/tune_run.h"
+#include "pidlab/results/tune_run.h"
 
 #include <set>
 #include <string>
 
 #include "pidlab/analysis/loop_analysis.h"
-#include "pidlab/json/results_json.h"
+#include "pidlab/results/results_json.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/tune/search_box.h"
@@ -12,7 +12,7 @@
 #include "pidlab/tune/tune.h"
 #include "pidlab/tune/two_dof.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 Status TuneSpecJson(const nlohmann::json& spec_json, const optim::ProgressCallback& progress,
                     nlohmann::json* result) {
@@ -48,4 +48,4 @@ Status TuneSpecJson(const nlohmann::json& spec_json, const optim::ProgressCallba
   return Status::Ok();
 }
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

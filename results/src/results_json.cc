@@ -1,4 +1,4 @@
-#include "pidlab/json/results_json.h"
+#include "pidlab/results/results_json.h"
 
 #include <cmath>
 
@@ -18,7 +18,7 @@ using pidlab::tune::TuneOptions;
 using pidlab::tune::TuneSummary;
 using pidlab::tune::TuningRuleResult;
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 nlohmann::json JsonNumber(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
@@ -278,4 +278,4 @@ nlohmann::json MonteCarloJson(const MonteCarloOptions& mc, const MonteCarloSumma
           {"ms", DistributionJson(s.ms)}};
 }
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

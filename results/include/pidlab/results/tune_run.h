@@ -11,7 +11,7 @@
 #include "pidlab/optim/optimizer.h"
 #include "pidlab/spec/status.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 /// The object of `pidlab tune --spec FILE --json` for the TuningSpec `spec`;
 /// `progress` is called once per iteration of the search (it may throw to
@@ -21,4 +21,4 @@ namespace pidlab::json {
 Status TuneSpecJson(const nlohmann::json& spec, const optim::ProgressCallback& progress,
                     nlohmann::json* result);
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

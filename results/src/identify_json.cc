@@ -1,8 +1,8 @@
-#include "pidlab/json/identify_json.h"
+#include "pidlab/results/identify_json.h"
 
-#include "pidlab/json/results_json.h"
+#include "pidlab/results/results_json.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 nlohmann::json WhitenessJson(const identify::Whiteness& w) {
   nlohmann::json r = nlohmann::json::array();
@@ -98,4 +98,4 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
   return j;
 }
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

@@ -9,7 +9,7 @@
 #include "pidlab/replay/replay.h"
 #include "pidlab/transport/pacing.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 /// The `realtime` object of a paced episode: exactly missed_deadlines,
 /// lateness_p50_s, lateness_p99_s, lateness_max_s, rate_hz.
@@ -31,4 +31,4 @@ nlohmann::json RedriveJson(const replay::RedriveResult& r);
 nlohmann::json EvaluatedEpisodeJson(const replay::Episode& e, evaluation::Evaluation* evaluation = nullptr,
                                     bool* evaluated = nullptr);
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results

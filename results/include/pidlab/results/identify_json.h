@@ -7,7 +7,7 @@
 
 #include "pidlab/identify/identify.h"
 
-namespace pidlab::json {
+namespace pidlab::results {
 
 /// model (p1d|p2d|p2du|p1di|p2dz), parameters {name: {value, standard_error}},
 /// transfer_function {num, den, delay_s}, fit_percent, aic, aic_form, cost,
@@ -21,4 +21,4 @@ nlohmann::json WhitenessJson(const identify::Whiteness& w);
 /// candidates [{model, ok, aic, delta_aic, fit_percent | message}]}.
 nlohmann::json IdentifyAutoJson(const identify::AutoResult& a);
 
-}  // namespace pidlab::json
+}  // namespace pidlab::results
