@@ -135,6 +135,11 @@ Status CheckData(const IdentifyData& data, Sampling* sampling, const std::vector
     if (!(data.t[k] > data.t[k - 1]))
       return Status::InvalidInput("t is not strictly increasing: t = " + CheckedNumber(data.t[k]) + " at " +
                                   Where(rows, k) + " after " + CheckedNumber(data.t[k - 1]));
+  for (std::size_t k = 0; k < n; ++k)
+    if (std::abs(data.t[k]) > kMaxRecordMagnitude)
+      return Status::InvalidInput("column t, " + Where(rows, k) + ": " + CheckedNumber(data.t[k]) +
+                                  " s is beyond 1e12 in magnitude, the limit of every number pidlab takes "
+                                  "(rescale t's units)");
   for (std::size_t k = 1; k < n; ++k)
     if (data.t[k] - data.t[k - 1] < kMinRecordInterval)
       return Status::InvalidInput("column t, " + Where(rows, k) + ": the interval " +
