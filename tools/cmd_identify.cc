@@ -2,6 +2,8 @@
 // names them, or a general transfer function TF of --poles and --zeros) fitted to the t, u, y columns of a
 // CSV (docs/identify.md, "Identifying a model from a CSV").
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -163,8 +165,8 @@ struct IdentifyCommand {
         ->capture_default_str();
     app->add_flag("--json", json, "print one JSON object");
     app->add_flag("--quiet", quiet,
-                  "no progress lines (a fit that runs beyond 3 s says on stderr, once a second, the model, "
-                  "the starts done and the best cost so far)");
+                  "no progress lines (on a terminal, a fit that runs beyond 3 s says on stderr, once a "
+                  "second, the model, the starts done and the best cost so far)");
     app->add_option("--out", out,
                     "also write the JSON object to this file (a model file for --plant model:FILE)");
     app->add_option("--plot", plot_path,
@@ -310,7 +312,9 @@ struct IdentifyCommand {
       if (std::isnan(options.u0)) options.u0 = 0.0;
       if (std::isnan(options.y0)) options.y0 = 0.0;
     }
-    if (!quiet) options.progress = ProgressPrinter();
+    // On a terminal only: a log or a test's captured stderr keeps its one
+    // line (README, "Exit status and limits").
+    if (!quiet && ::isatty(STDERR_FILENO)) options.progress = ProgressPrinter();
     IdentifyResult result;
     nlohmann::json j;
     std::string header;
