@@ -350,5 +350,18 @@ TEST(CsvData, AMissingColumnOrABadCellIsNamed) {
       << status.message();
 }
 
+TEST(IdentifyOptions, RefusesStartsOutsideOneToTheLimitInOneShape) {
+  IdentifyOptions dut;
+  std::string error;
+  dut.starts = kMaxStarts;
+  EXPECT_TRUE(dut.IsValid(&error)) << error;
+  dut.starts = kMaxStarts + 1;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_EQ(error, "starts = 1001 must be in [1, 1000]");
+  dut.starts = 0;
+  EXPECT_FALSE(dut.IsValid(&error));
+  EXPECT_EQ(error, "starts = 0 must be in [1, 1000]");
+}
+
 }  // namespace
 }  // namespace pidlab::identify

@@ -18,6 +18,7 @@
 #include "pidlab/identify/identify.h"
 #include "pidlab/json/identify_json.h"
 #include "pidlab/replay/log_reader.h"
+#include "pidlab/spec/field.h"
 
 namespace pidlab::cli {
 namespace {
@@ -282,6 +283,17 @@ struct IdentifyCommand {
       throw BadInput("--u0 " + Quote(u0_text) + " must be a finite number or 'estimate'");
   }
 
+  // The library's limits (IdentifyOptions::IsValid: --starts, after --u0 and
+  // --y0 are read), its "starts = 0 must be ..." as the flag's "--starts 0 must be ...".
+  void CheckOptions() const {
+    std::string why;
+    if (options.IsValid(&why)) return;
+    const std::size_t eq = why.find(" = ");
+    if (eq != std::string::npos && why.find(' ') == eq)
+      why = spec::FlagName(why.substr(0, eq)) + " " + why.substr(eq + 3);
+    throw BadInput(why);
+  }
+
   std::string Source() const { return !csv.empty() ? "--csv " + Quote(csv) : "--log " + Quote(log); }
 
   int Run() {
@@ -293,11 +305,10 @@ struct IdentifyCommand {
       throw BadInput("--model " + Quote(model) + " must be one of " + identify::ProcessModelKindNames() +
                      "|auto");
     CheckTfShape(kind, automatic);
-    if (options.starts < 1 || options.starts > 1000)
-      throw BadInput("--starts " + std::to_string(options.starts) + " must be in [1, 1000]");
     ParseU0();
     if (!std::isnan(options.y0) && !std::isfinite(options.y0))
       throw BadInput("--y0 " + Num(options.y0) + " must be finite");
+    CheckOptions();
     if (!identify::ParseIntersample(intersample, &options.intersample))
       throw BadInput("--intersample " + Quote(intersample) + " must be zoh or foh");
     if (!identify::ParseInitialCondition(initial, &options.initial_condition))

@@ -55,8 +55,8 @@ std::string ToString(InitialCondition v) {
 
 bool IdentifyOptions::IsValid(std::string* error) const {
   std::string e;
-  if (starts < 1)
-    e = "starts = " + std::to_string(starts) + " must be at least 1";
+  if (starts < 1 || starts > kMaxStarts)
+    e = "starts = " + std::to_string(starts) + " must be in [1, " + std::to_string(kMaxStarts) + "]";
   else if (!(max_delay_fraction > 0.0 && max_delay_fraction < 1.0))
     e = "max_delay_fraction = " + CheckedNumber(max_delay_fraction) + " must be in (0, 1)";
   else if (max_iterations < 1)

@@ -66,9 +66,12 @@ bool ParseInitialCondition(const std::string& s, InitialCondition* v);
 std::string ToString(Intersample v);       // "zoh", "foh"
 std::string ToString(InitialCondition v);  // "zero", "steady-state", "estimate"
 
+/// The most starts a fit takes (IdentifyOptions::starts).
+inline constexpr int kMaxStarts = 1000;
+
 struct IdentifyOptions {
   /// Starts of the multi-start design (Sobol' points over the time constants,
-  /// Zeta and the delay, optim/sobol.h), >= 1.
+  /// Zeta and the delay, optim/sobol.h), in [1, kMaxStarts].
   int starts = 16;
   /// The design's digital shift (SobolSequence(d, seed)); 0: the unshifted
   /// sequence, whose first start is the lower corner of every range.
