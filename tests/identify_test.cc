@@ -295,6 +295,59 @@ TEST(Identify, AConstantInputIsRefused) {
   ExpectRefused(data, "constant input");
 }
 
+TEST(Identify, AConstantInputWithAGivenU0IsAStepFromRest) {
+  // A heater switched on at the first sample: u = 0.5 throughout, at rest
+  // at u0 = 0 before the record.
+  const ProcessModel truth = Truth(ProcessModelKind::kP1D);
+  IdentifyData data;
+  const std::vector<double> u(300, 0.5);
+  const std::vector<double> y = SimulateModel(truth, u, 0.0, kDt);
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    data.t.push_back(static_cast<double>(k) * kDt);
+    data.u.push_back(u[k]);
+    data.y.push_back(20.0 + y[k]);
+  }
+  IdentifyOptions options;
+  options.u0 = 0.0;
+  IdentifyResult dut;
+  const Status status = Identify(data, ProcessModelKind::kP1D, options, &dut);
+  ASSERT_TRUE(status.ok()) << status.message();
+  const std::vector<double> expected = ParameterValues(truth);
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    EXPECT_NEAR(dut.values[i], expected[i], 1e-6 * std::abs(expected[i])) << dut.names[i];
+}
+
+TEST(Identify, ADelayOfZeroIsReachedAndSaidToBeAtItsBound) {
+  ProcessModel truth = Truth(ProcessModelKind::kP2D);
+  truth.td_s = 0.0;
+  IdentifyResult dut;
+  const Status status = Identify(RecordOf(truth), ProcessModelKind::kP2D, IdentifyOptions{}, &dut);
+  ASSERT_TRUE(status.ok()) << status.message();
+  const std::vector<double> expected = ParameterValues(truth);
+  for (std::size_t i = 0; i + 1 < expected.size(); ++i)
+    EXPECT_NEAR(dut.values[i], expected[i], 1e-6 * std::abs(expected[i])) << dut.names[i];
+  EXPECT_LE(dut.values.back(), 1e-9);
+  EXPECT_EQ(dut.at_bound.back(), "lower");
+  EXPECT_TRUE(std::isnan(dut.standard_errors.back()));
+  EXPECT_TRUE(std::any_of(dut.warnings.begin(), dut.warnings.end(), [](const std::string& w) {
+    return w.find("Td = 0 s is at its lower bound") == 0;
+  }));
+}
+
+TEST(Identify, ABiggerModelStartsFromTheOptimumOfTheOneItContains) {
+  // P1D data with noise: P2D contains P1D (Tp2 -> 0) and is not worse.
+  const ProcessModel truth = Truth(ProcessModelKind::kP1D);
+  IdentifyData data = RecordOf(truth, 300);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  for (double& y : data.y) y += noise(rng);
+  IdentifyResult p1d, p2d;
+  ASSERT_TRUE(Identify(data, ProcessModelKind::kP1D, IdentifyOptions{}, &p1d).ok());
+  ASSERT_TRUE(Identify(data, ProcessModelKind::kP2D, IdentifyOptions{}, &p2d).ok());
+  EXPECT_EQ(p2d.nested_starts, 2);
+  EXPECT_LE(p2d.cost, p1d.cost * (1 + 1e-9));
+}
+
 TEST(Identify, BadOptionsAreRefusedNamingTheField) {
   IdentifyOptions options;
   options.starts = 0;
