@@ -96,7 +96,9 @@ std::string Table(const IdentifyResult& r) {
      << (r.nested_starts > 0
              ? "; " + std::to_string(r.nested_starts) + " of them from the contained model's fit"
              : "")
-     << (r.delay_profile_improved ? "; the delay's profile lowered it" : "") << "\n"
+     << (r.delay_profile_improved ? "; the delay's profile lowered it" : "")
+     << (r.bounds_refit_improved ? "; refitting with the parameters at a bound held there lowered it" : "")
+     << "\n"
      << "num " << Polynomial(tf.num) << " den " << Polynomial(tf.den) << " delay "
      << Num(r.model.delay_s(), 10) << " s\n";
   os << "poles (+- 1.96 standard errors):";

@@ -92,6 +92,7 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
       {"arx_start", r.arx_start},
       {"nested_starts", r.nested_starts},
       {"delay_profile_improved", r.delay_profile_improved},
+      {"bounds_refit_improved", r.bounds_refit_improved},
       {"whiteness", WhitenessJson(r.whiteness)},
       {"warnings", r.warnings},
       {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}, {"matrix", matrix}}}};

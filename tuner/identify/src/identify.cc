@@ -327,15 +327,13 @@ double FitFrom(const Record& record, const IdentifyOptions& options, std::vector
   return summary.final_cost;
 }
 
-// Td held at `td`, the other parameters refitted from *theta; the cost, or
-// infinity if Ceres failed.
-double FitAtDelay(const Record& record, const IdentifyOptions& options, double td,
+// The parameters `held` (indices into theta) held where *theta has them,
+// the others refitted from *theta; the cost, or infinity if Ceres failed.
+double FitHolding(const Record& record, const IdentifyOptions& options, const std::vector<int>& held,
                   std::vector<double>* theta) {
-  const int p = ParameterCount(record);
-  (*theta)[static_cast<std::size_t>(p - 1)] = td;
   ceres::Problem problem;
   BuildProblem(record, theta->data(), &problem);
-  problem.SetManifold(theta->data(), new ceres::SubsetManifold(BlockSize(record), {p - 1}));
+  problem.SetManifold(theta->data(), new ceres::SubsetManifold(BlockSize(record), held));
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
   solver.max_num_iterations = options.max_iterations;
@@ -354,9 +352,69 @@ double FitAtDelay(const Record& record, const IdentifyOptions& options, double t
   return summary.final_cost;
 }
 
+// Td held at `td`, the other parameters refitted from *theta.
+double FitAtDelay(const Record& record, const IdentifyOptions& options, double td,
+                  std::vector<double>* theta) {
+  const int p = ParameterCount(record);
+  (*theta)[static_cast<std::size_t>(p - 1)] = td;
+  return FitHolding(record, options, {p - 1}, theta);
+}
+
+// The parameters of *theta at (within 1e-6 of) a bound of the fit, put on
+// it: Td at 0 or its maximum, a time constant at dt / 1000 or 1000 times
+// the record, Zeta at either end. Not for a TF.
+std::vector<int> SnapToBounds(const Record& record, std::vector<double>* theta) {
+  std::vector<int> at;
+  if (record.kind == ProcessModelKind::kTf) return at;
+  const int p = ParameterCount(record);
+  for (int i = 1; i < p; ++i) {
+    double lo, hi, tolerance = 1e-6;
+    if (i == p - 1) {
+      lo = 0.0, hi = record.max_delay_s, tolerance = 1e-6 * record.dt_s;
+    } else if (IsLogParameter(record, i)) {
+      lo = std::log(record.dt_s / kTimeConstantRange), hi = std::log(record.length_s * kTimeConstantRange);
+    } else if (!IsZeroParameter(record.kind, i)) {
+      lo = kMinZeta, hi = kMaxZeta, tolerance = 1e-6 * kMinZeta;
+      if (hi - (*theta)[static_cast<std::size_t>(i)] <= 1e-6) {
+        (*theta)[static_cast<std::size_t>(i)] = hi;
+        at.push_back(i);
+        continue;
+      }
+    } else {
+      continue;
+    }
+    double& v = (*theta)[static_cast<std::size_t>(i)];
+    if (v - lo <= tolerance)
+      v = lo;
+    else if (hi - v <= tolerance)
+      v = hi;
+    else
+      continue;
+    at.push_back(i);
+  }
+  return at;
+}
+
+// A fit that ends with parameters at bounds may have stalled there: Ceres
+// projects its steps onto the box, and where two parameters press on their
+// bounds the projected steps can fail to lower the cost long before the
+// others are optimal. Those parameters held on their bounds, the others
+// refitted; replaces *theta and *cost if lower, true then.
+bool RefitAtBounds(const Record& record, const IdentifyOptions& options, std::vector<double>* theta,
+                   double* cost) {
+  std::vector<double> trial = *theta;
+  const std::vector<int> held = SnapToBounds(record, &trial);
+  if (held.empty()) return false;
+  const double c = FitHolding(record, options, held, &trial);
+  if (!(c < *cost)) return false;
+  *theta = trial;
+  *cost = c;
+  return true;
+}
+
 // The delay's profile around the best fit (*theta, *cost): Td held at 0, at
-// fractions of the best Td and at half samples on either side of it, the
-// rest refitted; from the lowest of those a free fit. The cost is piecewise
+// half the best Td, at the best Td and at half samples up to a sample on
+// either side of it, the rest refitted; from the lowest of those a free fit. The cost is piecewise
 // smooth in Td, with kinks where Td crosses a sample, so a start can stop at
 // a kink above the optimum, or just short of the bound Td = 0. Replaces
 // *theta and *cost if it finds a lower cost; true then.
@@ -364,9 +422,9 @@ bool ProfileDelay(const Record& record, const IdentifyOptions& options, std::vec
                   double* cost) {
   const int p = ParameterCount(record);
   const double best_td = (*theta)[static_cast<std::size_t>(p - 1)];
-  std::vector<double> grid = {best_td, 0.25 * best_td, 0.5 * best_td, 0.75 * best_td};
-  if (best_td > 0.0) grid.push_back(0.0);
-  for (int k = -4; k <= 4; ++k)
+  std::vector<double> grid = {best_td};
+  if (best_td > 0.0) grid.insert(grid.end(), {0.0, 0.5 * best_td});
+  for (int k = -2; k <= 2; ++k)
     if (k != 0) grid.push_back(best_td + 0.5 * k * record.dt_s);
   std::vector<double> lowest;
   double lowest_cost = std::numeric_limits<double>::infinity();
@@ -483,8 +541,22 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
   const optim::SobolSequence sobol =
       options.seed == 0 ? optim::SobolSequence(dimensions) : optim::SobolSequence(dimensions, options.seed);
   int total = options.starts + static_cast<int>(nested.size());
-  const auto fit = [&](std::vector<double> theta) {
-    const double cost = FitFrom(record, options, &theta);
+  // held: a nested start's delay (its contained model's) is held while the
+  // rest is refitted, then freed. A free fit from there may leave the
+  // contained optimum at once where it sits at a kink of the cost in Td (a
+  // sample crossing), and stop above the contained model's cost.
+  const auto fit = [&](std::vector<double> theta, bool held) {
+    double cost = std::numeric_limits<double>::infinity();
+    if (held) {
+      const int p = ParameterCount(record);
+      cost = FitAtDelay(record, options, theta[static_cast<std::size_t>(p - 1)], &theta);
+    }
+    std::vector<double> freed = theta;
+    const double free_cost = FitFrom(record, options, &freed);
+    if (!(cost <= free_cost)) {
+      cost = free_cost;
+      theta = freed;
+    }
     costs->push_back(cost);
     if (cost < best_cost) {
       best_cost = cost;
@@ -496,10 +568,10 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
     std::vector<double> theta = ArxStartPoint(record);
     *arx_used = !theta.empty();
     total += *arx_used ? 1 : 0;
-    if (*arx_used) fit(theta);
+    if (*arx_used) fit(theta, false);
   }
-  for (const std::vector<double>& theta : nested) fit(theta);
-  for (int s = 0; s < options.starts; ++s) fit(StartPoint(record, sobol, s));
+  for (const std::vector<double>& theta : nested) fit(theta, true);
+  for (int s = 0; s < options.starts; ++s) fit(StartPoint(record, sobol, s), false);
   return best;
 }
 
@@ -518,9 +590,10 @@ bool ContainedKind(ProcessModelKind kind, ProcessModelKind* inner) {
 
 // Starts at the optimum `inner` of the model that `record`'s kind contains,
 // in Ceres's coordinates (the offsets relative to the record's u0 and y0).
-// P2D from P1D twice: a second lag far below the sample time, and one of
-// half a sample taken out of the delay (a short lag and a short delay look
-// alike).
+// P2D from P1D twice: a second lag at its lower bound (P1D's optimum as
+// nearly as the bound allows: a free fit from a lag just above it can stall
+// there, its step projected onto the bound), and one of half a sample taken
+// out of the delay (a short lag and a short delay look alike).
 std::vector<std::vector<double>> NestedStarts(const Record& record, const IdentifyResult& inner, double u0,
                                               double y0) {
   ProcessModelKind expected;
@@ -540,7 +613,7 @@ std::vector<std::vector<double>> NestedStarts(const Record& record, const Identi
   switch (record.kind) {
     case ProcessModelKind::kP2D:  // from Kp, Tp1, Td
       theta[1] = log_lag(v[1]);
-      theta[2] = log_lag(record.dt_s / 100.0);
+      theta[2] = log_lag(record.dt_s / kTimeConstantRange);
       theta[3] = delay(v[2]);
       starts.push_back(theta);
       theta[2] = log_lag(record.dt_s / 2.0);
@@ -548,11 +621,18 @@ std::vector<std::vector<double>> NestedStarts(const Record& record, const Identi
       starts.push_back(theta);
       break;
     case ProcessModelKind::kP2DU: {  // from Kp, Tp1, Tp2, Td
-      const double tw = std::sqrt(v[1] * v[2]);
+      const double tw = std::sqrt(v[1] * v[2]), zeta = (v[1] + v[2]) / (2.0 * tw);
       theta[1] = log_lag(tw);
-      theta[2] = std::clamp((v[1] + v[2]) / (2.0 * tw), kMinZeta, kMaxZeta);
+      theta[2] = std::clamp(zeta, kMinZeta, kMaxZeta);
       theta[3] = delay(v[3]);
       starts.push_back(theta);
+      // Lags too far apart for a pair: the critically damped pair of the
+      // same sum of time constants (2 Zeta Tw = Tp1 + Tp2) too.
+      if (zeta > kMaxZeta) {
+        theta[1] = log_lag(0.5 * (v[1] + v[2]));
+        theta[2] = kMaxZeta;
+        starts.push_back(theta);
+      }
       break;
     }
     case ProcessModelKind::kP2DZ:  // from Kp, Tp1, Tp2, Td; Tz = 0
@@ -626,7 +706,9 @@ std::vector<std::string> Warnings(const Record& record, const IdentifyResult& r)
   if (r.starts >= 3 && r.starts_at_best < 3)
     w.push_back("only " + std::to_string(r.starts_at_best) + " of " + std::to_string(r.starts) +
                 " starts reached the best cost" +
-                (r.delay_profile_improved ? " (the delay's profile found it)" : "") +
+                (r.bounds_refit_improved ? " (the refit with the parameters at a bound held there found it)"
+                 : r.delay_profile_improved ? " (the delay's profile found it)"
+                                            : "") +
                 ": the optimum may not be the global one; try more --starts or another --seed");
   if (td >= max_delay_s * (1 - 1e-6))
     w.push_back("Td = " + Number(td) + " s is at its bound (" + Number(max_delay_s) +
@@ -703,8 +785,15 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
     return shape;
   if (!options.nested_starts || !ContainedKind(kind, &inner_kind))
     return Identify(data, kind, options, nullptr, result);
+  // The contained model's fit is a start only: a quarter of the starts (its
+  // optimum, of fewer parameters, is reached from fewer), the ARX start and
+  // the delay's profile as asked.
+  // Its own contained model is not fitted: one level of nesting.
+  IdentifyOptions inner_options = options;
+  inner_options.starts = std::max(1, (options.starts + 3) / 4);
+  inner_options.nested_starts = false;
   IdentifyResult inner;
-  const Status status = Identify(data, inner_kind, options, &inner);
+  const Status status = Identify(data, inner_kind, inner_options, &inner);
   if (status.code() == StatusCode::kInvalidInput) return status;
   return Identify(data, kind, options, status.ok() ? &inner : nullptr, result);
 }
@@ -770,8 +859,15 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
         " iterations each, all ended at a non-finite cost; check the record's units and outliers, or try "
         "more starts (--starts), another seed or another model");
   double best = *std::min_element(result->start_costs.begin(), result->start_costs.end());
-  if (kind != ProcessModelKind::kTf && options.delay_profile)
+  // Near Td = 0 only (within two samples): elsewhere the starts' spread
+  // finds the delay (identify_study_test), and the profile's refits would
+  // double the cost of a fit.
+  const double best_td =
+      kind == ProcessModelKind::kTf ? 0.0 : theta[static_cast<std::size_t>(ParameterCount(record) - 1)];
+  if (kind != ProcessModelKind::kTf && options.delay_profile && best_td < 2.0 * record.dt_s)
     result->delay_profile_improved = ProfileDelay(record, options, &theta, &best);
+  if (kind != ProcessModelKind::kTf && options.bounds_refit)
+    result->bounds_refit_improved = RefitAtBounds(record, options, &theta, &best);
   // P2D's time constants are interchangeable: report Tp1 >= Tp2.
   if ((kind == ProcessModelKind::kP2D || kind == ProcessModelKind::kP2DZ) && theta[2] > theta[1])
     std::swap(theta[1], theta[2]);

@@ -86,6 +86,11 @@ struct IdentifyOptions {
   /// from the lowest: the cost has kinks where Td crosses a sample, and a
   /// start may stop at one, or short of Td = 0. Process models only.
   bool delay_profile = true;
+  /// Then, if parameters end at a bound (Td at 0, Zeta at 1, a time constant
+  /// at dt / 1000, ...), hold them there and refit the others: Ceres projects
+  /// its steps onto the bounds and can stall there short of the optimum.
+  /// Process models only.
+  bool bounds_refit = true;
   /// The delay's upper bound as a fraction of the record's length, in (0, 1).
   double max_delay_fraction = 0.5;
   /// Levenberg-Marquardt iterations per start, >= 1.
@@ -171,6 +176,7 @@ struct IdentifyResult {
   std::vector<double> start_costs;      // final cost of every start, in design order
   int nested_starts = 0;                // starts from a contained model's optimum (after the ARX start)
   bool delay_profile_improved = false;  // the delay's profile found a lower cost than every start
+  bool bounds_refit_improved = false;   // holding the parameters at a bound, the rest refitted, lowered it
   /// For each parameter, "lower" or "upper" if it is at (within 1e-6 of) a
   /// bound of the fit (Td at 0, Zeta at 1, a time constant at dt / 1000),
   /// else "": its standard error is then NaN (a one-sided interval).
