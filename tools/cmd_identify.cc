@@ -73,7 +73,9 @@ std::string Table(const IdentifyResult& r) {
      << std::left << std::setw(10) << "parameter" << std::setw(18) << "value"
      << "standard error\n";
   for (std::size_t i = 0; i < r.names.size(); ++i)
-    os << std::setw(10) << r.names[i] << std::setw(18) << Num(r.values[i], 10) << Num(r.standard_errors[i], 3)
+    os << std::setw(10) << r.names[i] << std::setw(18) << Num(r.values[i], 10)
+       << (i < r.at_bound.size() && !r.at_bound[i].empty() ? "at its " + r.at_bound[i] + " bound (one-sided)"
+                                                           : Num(r.standard_errors[i], 3))
        << "\n";
   if (!r.covariance_ok) os << "(no standard errors: " << r.covariance_message << ")\n";
   const TransferFunction tf = r.model.ToTransferFunction();
@@ -93,7 +95,13 @@ std::string Table(const IdentifyResult& r) {
              ? ""
              : "input " + identify::ToString(r.intersample) + " between samples, initial condition " +
                    identify::ToString(r.initial_condition) + "\n")
-     << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)\n"
+     << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)"
+     << (r.nested_starts > 0
+             ? "; " + std::to_string(r.nested_starts) + " of them from the contained model's fit"
+             : "")
+     << (r.delay_profile_improved ? "; the delay's profile lowered it" : "")
+     << (r.bounds_refit_improved ? "; refitting with the parameters at a bound held there lowered it" : "")
+     << "\n"
      << "num " << Polynomial(tf.num) << " den " << Polynomial(tf.den) << " delay "
      << Num(r.model.delay_s(), 10) << " s\n";
   os << "poles (+- 1.96 standard errors):";
@@ -151,9 +159,11 @@ struct IdentifyCommand {
     app->add_option("--seed", options.seed,
                     "digital shift of the starts' Sobol' design (0: the unshifted sequence)")
         ->capture_default_str();
-    app->add_option("--u0", u0_text,
-                    "the input's operating point: a number, or 'estimate' (fitted with the model, from the "
-                    "default as its start); default: the first sample of u; a log's: 0");
+    app->add_option(
+        "--u0", u0_text,
+        "the input's operating point: a number, or 'estimate' (fitted with the model, from the "
+        "default as its start); default: the first sample of u; a log's: 0. A record whose u is "
+        "constant is a step from u0 and needs it (a heater switched on at the first sample: --u0 0)");
     app->add_option("--y0", options.y0,
                     "the output's operating point (default: estimated with the model; a log's: 0)");
     app->add_option("--intersample", intersample,

@@ -159,9 +159,7 @@ Status CheckData(const IdentifyData& data, Sampling* sampling, const std::vector
     if (std::abs(h - found.mean_interval_s) > kUniformSamplingTolerance * found.mean_interval_s)
       found.uniform = false;
   }
-  if (std::all_of(data.u.begin(), data.u.end(), [&](double v) { return v == data.u[0]; }))
-    return Status::InvalidInput("constant input: u is " + CheckedNumber(data.u[0]) +
-                                " throughout, so nothing can be identified");
+  // A constant u is a step when u0 is given (Identify decides): not refused here.
   *sampling = found;
   return Status::Ok();
 }
