@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "pidlab/tune/search_box.h"
-#include "pidlab/tune/spec_build.h"
 #include "pidlab/tune/tune.h"
+#include "spec_build.h"  // internal to pidlab::tune: the steps tested one by one
 
 namespace pidlab::tune {
 namespace {

@@ -12,7 +12,7 @@
 #include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/plant_sim/disturbance.h"
 #include "pidlab/spec/loop_spec.h"
-#include "pidlab/tune/spec_build.h"
+#include "spec_build.h"  // internal to pidlab::tune: the steps tested one by one
 
 namespace pidlab {
 namespace {

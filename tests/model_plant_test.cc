@@ -14,7 +14,7 @@
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/plant_sim/process_model.h"
 #include "pidlab/tune/model_file.h"
-#include "pidlab/tune/spec_build.h"
+#include "spec_build.h"  // internal to pidlab::tune: the steps tested one by one
 
 using pidlab::analysis::DrawPlants;
 using pidlab::analysis::kMaxModelRedraws;

@@ -14,7 +14,7 @@
 #include "pidlab/results/spec_run.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
-#include "pidlab/tune/spec_build.h"
+#include "spec_build.h"  // internal to pidlab::tune: the steps tested one by one
 
 namespace pidlab::results {
 namespace {

@@ -17,7 +17,7 @@
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/transport/episode_spec.h"
-#include "pidlab/tune/spec_build.h"
+#include "spec_build.h"  // internal to pidlab::tune: the steps tested one by one
 
 using pidlab::episode_client::MakeEpisodeSpec;
 using pidlab::evaluation::LoopOptions;

@@ -14,30 +14,18 @@
 #include "commands.h"
 #include "pidlab/analysis/monte_carlo.h"
 #include "pidlab/episode_client/episode_client.h"
-#include "pidlab/tune/spec_build.h"
+#include "pidlab/results/spec_run.h"
+#include "pidlab/tune/problem.h"
 
 using pidlab::analysis::Distribution;
-using pidlab::analysis::LoopAnalysis;
-using pidlab::analysis::LoopBounds;
 using pidlab::analysis::MonteCarloOptions;
 using pidlab::analysis::MonteCarloSummary;
-using pidlab::analysis::RunMonteCarlo;
 using pidlab::episode_client::EpisodeClient;
-using pidlab::evaluation::EvaluateLoop;
-using pidlab::evaluation::EvaluateOptions;
 using pidlab::evaluation::Evaluation;
 using pidlab::evaluation::LoopKind;
 using pidlab::evaluation::LoopOptions;
-using pidlab::evaluation::SampledRunner;
 using pidlab::evaluation::SampledStep;
 using pidlab::spec::NameStyle;
-using pidlab::tune::BuildBounds;
-using pidlab::tune::BuildGains;
-using pidlab::tune::BuildLoopOptions;
-using pidlab::tune::BuildMonteCarlo;
-using pidlab::tune::BuildPlant;
-using pidlab::tune::BuildStepperParameters;
-using pidlab::tune::CheckPlantInLoop;
 
 namespace pidlab::cli {
 namespace {
@@ -74,94 +62,59 @@ struct EvaluateCommand {
 
   int Run() {
     spec::EvaluateSpec s;
-    std::set<std::string> given;
-    flags.Apply(&s, &given);
-    s.plant.Normalize();
-    std::string error;
-    Plant p;
-    Require(BuildPlant(s.plant, NameStyle::kFlag, &p, &error), error);
-    StepperMotorParameters stepper;
-    Require(BuildStepperParameters(s.plant, NameStyle::kFlag, &stepper, &error), error);
-    MonteCarloOptions mc;
-    Require(BuildMonteCarlo(s, NameStyle::kFlag, &mc, &error), error);
-    if (s.gains.empty()) throw BadInput("--gains is required (or --spec FILE)");
-    PidGains g;
-    Require(BuildGains(s.gains, NameStyle::kFlag, &g, &error), error);
-    if (backend == "lcm") {
-      if (given.count("loop") > 0 && s.loop.loop != "sampled")
-        throw BadInput("--backend lcm runs the sampled loop, not --loop " + Quote(s.loop.loop));
-      s.loop.loop = "sampled";
-    }
-    LoopOptions options;
-    Require(BuildLoopOptions(s.loop, NameStyle::kFlag, &options, &error), error);
-    Require(CheckPlantInLoop(p, options, NameStyle::kFlag, &error), error);
-    LoopBounds loop_bounds;
-    Require(BuildBounds(s.bounds, NameStyle::kFlag, &loop_bounds, &error), error);
-    EvaluateOptions what;
-    what.record_trajectory = !trajectory_csv.empty();
-    if (what.record_trajectory && options.loop != LoopKind::kSampled)
+    tune::BuildOptions build;
+    build.style = NameStyle::kFlag;
+    build.backend = backend == "lcm" ? tune::Backend::kRunner : tune::Backend::kInProcess;
+    flags.Apply(&s, &build.given);
+    tune::EvaluationProblem problem;
+    Require(tune::BuildEvaluation(s, build, &problem));
+    const LoopOptions& options = problem.loop;
+    tune::EvaluationRunOptions run;
+    run.what.record_trajectory = !trajectory_csv.empty();
+    if (run.what.record_trajectory && options.loop != LoopKind::kSampled)
       throw BadInput("--trajectory-csv needs --loop sampled");
-    if (what.record_trajectory && options.TotalSteps() + 1 > kMaxRecordedPoints)
+    if (run.what.record_trajectory && options.TotalSteps() + 1 > kMaxRecordedPoints)
       throw BadInput(
           "--trajectory-csv would have horizon / dt + 1 = " + std::to_string(options.TotalSteps() + 1) +
           " rows, more than 1e7: use a coarser --dt or a shorter --horizon");
-    if (s.monte_carlo > 0 && backend == "lcm")
-      throw BadInput("--monte-carlo runs in process: use --backend local");
-    if (s.monte_carlo > 0 && p.delay_s > 0.0 && !p.model)
-      throw BadInput("--monte-carlo with --delay is not supported yet (its draws are undelayed plants)");
-    if (s.monte_carlo > 0 && p.nonlinear)
-      throw BadInput("--monte-carlo draws linear plants: it does not take --plant " + Quote(p.name));
     // Unwritable output is bad input, found before any work.
     CheckOutputFile(samples_csv, "--samples-csv");
     CheckOutputFile(trajectory_csv, "--trajectory-csv");
-    Evaluation ev;
     std::unique_ptr<EpisodeClient> client;
-    SampledRunner runner;  // null: in process
     if (backend == "lcm") {
       client = lcm.MakeClient();
-      runner = [&client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
-                         const DisturbanceOptions& d, std::vector<double>* y, std::vector<SampledStep>* tr,
-                         std::string* err) { return client->Run(pl, ga, lo, d, y, tr, err); };
+      run.runner = [&client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
+                             const DisturbanceOptions& d, std::vector<double>* y,
+                             std::vector<SampledStep>* tr,
+                             std::string* err) { return client->Run(pl, ga, lo, d, y, tr, err); };
     }
+    const bool tty = isatty(STDERR_FILENO) != 0;
+    run.monte_carlo_progress = [tty](int done, int total) {
+      if (tty && (done % 10 == 0 || done == total))
+        std::fprintf(stderr, "\r  Monte Carlo %d / %d   ", done, total);
+    };
     // A failed episode is a runtime failure (exit 1), bad input exit 2.
-    Require(EvaluateLoop(p, g, options, what, &ev, runner));
-    // Margins, peaks, noise gain and time constants of the loop evaluated.
-    const LoopAnalysis analysis = AnalyzeOrThrow(p, g, options);
-    MonteCarloSummary mc_summary;
-    if (s.monte_carlo > 0) {
-      const bool tty = isatty(STDERR_FILENO) != 0;
-      const auto progress = [tty](int done, int total) {
-        if (tty && (done % 10 == 0 || done == total))
-          std::fprintf(stderr, "\r  Monte Carlo %d / %d   ", done, total);
-      };
-      Require(RunMonteCarlo(p, p.name == "stepper_motor" ? &stepper : nullptr, g, options, mc, &mc_summary,
-                            &error, progress),
-              error);
-      if (tty) std::fprintf(stderr, "\r%40s\r", "");
-    }
-    if (!samples_csv.empty()) WriteSamplesCsv(ev, samples_csv);
-    if (!trajectory_csv.empty()) WriteTrajectoryCsv(ev, trajectory_csv);
-    Print(s, ev, analysis, loop_bounds, mc, mc_summary, client.get());
+    tune::EvaluationResult result;
+    Require(tune::RunEvaluation(problem, run, &result));
+    if (tty && result.monte_carlo_ran) std::fprintf(stderr, "\r%40s\r", "");
+    if (!samples_csv.empty()) WriteSamplesCsv(result.evaluation, samples_csv);
+    if (!trajectory_csv.empty()) WriteTrajectoryCsv(result.evaluation, trajectory_csv);
+    Print(problem, result, client.get());
     return 0;
   }
 
   // The result: one JSON object (with the spec it ran) or the table.
-  void Print(const spec::EvaluateSpec& s, const Evaluation& ev, const LoopAnalysis& analysis,
-             const LoopBounds& loop_bounds, const MonteCarloOptions& mc, const MonteCarloSummary& mc_summary,
+  void Print(const tune::EvaluationProblem& problem, const tune::EvaluationResult& result,
              const EpisodeClient* client) const {
     if (json) {
-      nlohmann::json j = ToJson(ev);
-      j["backend"] = backend;
-      j["robustness"] = RobustnessJson(analysis, loop_bounds);
-      if (s.monte_carlo > 0) j["monte_carlo"] = results::MonteCarloJson(mc, mc_summary);
+      nlohmann::json j = results::EvaluationJson(problem, result, backend);
       if (client) j["steps_per_second"] = JsonNumber(client->stats().StepsPerSecond());
       if (client && client->stats().realtime.paced()) j["realtime"] = RealtimeJson(client->stats().realtime);
-      j["spec"] = spec::ToJson(s);
       std::cout << j.dump() << "\n";
       return;
     }
-    std::cout << FormatEvaluation(ev) << FormatRobustness(analysis, loop_bounds);
-    if (s.monte_carlo > 0) std::cout << FormatMonteCarlo(mc, mc_summary);
+    std::cout << FormatEvaluation(result.evaluation) << FormatRobustness(result.analysis, problem.bounds);
+    if (result.monte_carlo_ran) std::cout << FormatMonteCarlo(problem.monte_carlo, result.monte_carlo);
     if (client) {
       std::printf("backend: lcm, %ld steps in %ld episode(s), %.0f steps/s\n", client->stats().steps,
                   client->stats().episodes, client->stats().StepsPerSecond());

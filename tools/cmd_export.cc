@@ -12,7 +12,7 @@
 #include "export_spec.h"
 #include "pidlab/controller_export/export.h"
 #include "pidlab/evaluation/closed_loop.h"
-#include "pidlab/tune/spec_build.h"
+#include "pidlab/spec/loop_spec.h"
 
 using pidlab::controller_export::Controller;
 using pidlab::controller_export::Generate;

@@ -2,6 +2,8 @@
 // names them, or a general transfer function TF of --poles and --zeros) fitted to the t, u, y columns of a
 // CSV (docs/identify.md, "Identifying a model from a CSV").
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -16,6 +18,7 @@
 #include "pidlab/identify/identify.h"
 #include "pidlab/replay/log_reader.h"
 #include "pidlab/results/identify_json.h"
+#include "pidlab/spec/field.h"
 
 namespace pidlab::cli {
 namespace {
@@ -70,7 +73,9 @@ std::string Table(const IdentifyResult& r) {
      << std::left << std::setw(10) << "parameter" << std::setw(18) << "value"
      << "standard error\n";
   for (std::size_t i = 0; i < r.names.size(); ++i)
-    os << std::setw(10) << r.names[i] << std::setw(18) << Num(r.values[i], 10) << Num(r.standard_errors[i], 3)
+    os << std::setw(10) << r.names[i] << std::setw(18) << Num(r.values[i], 10)
+       << (i < r.at_bound.size() && !r.at_bound[i].empty() ? "at its " + r.at_bound[i] + " bound (one-sided)"
+                                                           : Num(r.standard_errors[i], 3))
        << "\n";
   if (!r.covariance_ok) os << "(no standard errors: " << r.covariance_message << ")\n";
   const TransferFunction tf = r.model.ToTransferFunction();
@@ -90,7 +95,13 @@ std::string Table(const IdentifyResult& r) {
              ? ""
              : "input " + identify::ToString(r.intersample) + " between samples, initial condition " +
                    identify::ToString(r.initial_condition) + "\n")
-     << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)\n"
+     << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)"
+     << (r.nested_starts > 0
+             ? "; " + std::to_string(r.nested_starts) + " of them from the contained model's fit"
+             : "")
+     << (r.delay_profile_improved ? "; the delay's profile lowered it" : "")
+     << (r.bounds_refit_improved ? "; refitting with the parameters at a bound held there lowered it" : "")
+     << "\n"
      << "num " << Polynomial(tf.num) << " den " << Polynomial(tf.den) << " delay "
      << Num(r.model.delay_s(), 10) << " s\n";
   os << "poles (+- 1.96 standard errors):";
@@ -148,9 +159,11 @@ struct IdentifyCommand {
     app->add_option("--seed", options.seed,
                     "digital shift of the starts' Sobol' design (0: the unshifted sequence)")
         ->capture_default_str();
-    app->add_option("--u0", u0_text,
-                    "the input's operating point: a number, or 'estimate' (fitted with the model, from the "
-                    "default as its start); default: the first sample of u; a log's: 0");
+    app->add_option(
+        "--u0", u0_text,
+        "the input's operating point: a number, or 'estimate' (fitted with the model, from the "
+        "default as its start); default: the first sample of u; a log's: 0. A record whose u is "
+        "constant is a step from u0 and needs it (a heater switched on at the first sample: --u0 0)");
     app->add_option("--y0", options.y0,
                     "the output's operating point (default: estimated with the model; a log's: 0)");
     app->add_option("--intersample", intersample,
@@ -163,8 +176,8 @@ struct IdentifyCommand {
         ->capture_default_str();
     app->add_flag("--json", json, "print one JSON object");
     app->add_flag("--quiet", quiet,
-                  "no progress lines (a fit that runs beyond 3 s says on stderr, once a second, the model, "
-                  "the starts done and the best cost so far)");
+                  "no progress lines (on a terminal, a fit that runs beyond 3 s says on stderr, once a "
+                  "second, the model, the starts done and the best cost so far)");
     app->add_option("--out", out,
                     "also write the JSON object to this file (a model file for --plant model:FILE)");
     app->add_option("--plot", plot_path,
@@ -280,6 +293,17 @@ struct IdentifyCommand {
       throw BadInput("--u0 " + Quote(u0_text) + " must be a finite number or 'estimate'");
   }
 
+  // The library's limits (IdentifyOptions::IsValid: --starts, after --u0 and
+  // --y0 are read), its "starts = 0 must be ..." as the flag's "--starts 0 must be ...".
+  void CheckOptions() const {
+    std::string why;
+    if (options.IsValid(&why)) return;
+    const std::size_t eq = why.find(" = ");
+    if (eq != std::string::npos && why.find(' ') == eq)
+      why = spec::FlagName(why.substr(0, eq)) + " " + why.substr(eq + 3);
+    throw BadInput(why);
+  }
+
   std::string Source() const { return !csv.empty() ? "--csv " + Quote(csv) : "--log " + Quote(log); }
 
   int Run() {
@@ -291,11 +315,10 @@ struct IdentifyCommand {
       throw BadInput("--model " + Quote(model) + " must be one of " + identify::ProcessModelKindNames() +
                      "|auto");
     CheckTfShape(kind, automatic);
-    if (options.starts < 1 || options.starts > 1000)
-      throw BadInput("--starts " + std::to_string(options.starts) + " must be in [1, 1000]");
     ParseU0();
     if (!std::isnan(options.y0) && !std::isfinite(options.y0))
       throw BadInput("--y0 " + Num(options.y0) + " must be finite");
+    CheckOptions();
     if (!identify::ParseIntersample(intersample, &options.intersample))
       throw BadInput("--intersample " + Quote(intersample) + " must be zoh or foh");
     if (!identify::ParseInitialCondition(initial, &options.initial_condition))
@@ -310,7 +333,9 @@ struct IdentifyCommand {
       if (std::isnan(options.u0)) options.u0 = 0.0;
       if (std::isnan(options.y0)) options.y0 = 0.0;
     }
-    if (!quiet) options.progress = ProgressPrinter();
+    // On a terminal only: a log or a test's captured stderr keeps its one
+    // line (README, "Exit status and limits").
+    if (!quiet && ::isatty(STDERR_FILENO)) options.progress = ProgressPrinter();
     IdentifyResult result;
     nlohmann::json j;
     std::string header;

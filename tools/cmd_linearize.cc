@@ -9,10 +9,9 @@
 #include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
-#include "pidlab/tune/spec_build.h"
+#include "pidlab/tune/problem.h"
 
 using pidlab::spec::NameStyle;
-using pidlab::tune::BuildNonlinearOptions;
 
 namespace pidlab::cli {
 namespace {
@@ -40,7 +39,7 @@ struct LinearizeCommand {
                      " is not a nonlinear plant (expected stepper_nonlinear)");
     std::string error;
     NonlinearStepperOptions o;
-    Require(BuildNonlinearOptions(plant, NameStyle::kFlag, &o, &error), error);
+    Require(pidlab::tune::BuildNonlinearStepper(plant, NameStyle::kFlag, &o));
     StepperLinearization lin;
     if (!LinearizeStepper(o, &lin, &error)) throw BadInput(error);
     const TransferFunction eq3 = StepperMotorTransferFunction(o.motor);

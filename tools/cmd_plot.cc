@@ -11,14 +11,11 @@
 #include "commands.h"
 #include "pidlab/figures/figures.h"
 #include "pidlab/plot/loop_figure.h"
-#include "pidlab/tune/spec_build.h"
+#include "pidlab/tune/problem.h"
 
 using pidlab::evaluation::LoopKind;
 using pidlab::evaluation::LoopOptions;
 using pidlab::spec::NameStyle;
-using pidlab::tune::BuildLoopOptions;
-using pidlab::tune::BuildPlant;
-using pidlab::tune::CheckPlantInLoop;
 
 namespace pidlab::cli {
 namespace {
@@ -80,10 +77,8 @@ struct PlotCommand {
       if (!episodes.empty()) throw BadInput("--episode needs --log");
       if (gains.empty()) throw BadInput("--gains is required (or --log FILE)");
       Plant p;
-      Require(BuildPlant(ps.plant, NameStyle::kFlag, &p, &error), error);
       LoopOptions options;
-      Require(BuildLoopOptions(ps.loop, NameStyle::kFlag, &options, &error), error);
-      Require(CheckPlantInLoop(p, options, NameStyle::kFlag, &error), error);
+      Require(tune::BuildPlantInLoop(ps.plant, ps.loop, NameStyle::kFlag, &p, &options));
       std::vector<PidGains> sets;
       for (const auto& g : gains) sets.push_back(ParseGains(g));
       const long points = options.loop == LoopKind::kSampled ? options.TotalSteps() : options.NumSamples();

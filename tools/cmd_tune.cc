@@ -16,27 +16,16 @@
 #include "commands.h"
 #include "pidlab/episode_client/episode_client.h"
 #include "pidlab/episode_client/tune_progress.h"
-#include "pidlab/tune/search_box.h"
-#include "pidlab/tune/spec_build.h"
-#include "pidlab/tune/tune.h"
+#include "pidlab/results/tune_run.h"
+#include "pidlab/tune/problem.h"
 
-using pidlab::analysis::LoopAnalysis;
 using pidlab::episode_client::EpisodePool;
-using pidlab::evaluation::Evaluate;
-using pidlab::evaluation::EvaluateOptions;
 using pidlab::evaluation::Evaluation;
-using pidlab::evaluation::LoopKind;
 using pidlab::evaluation::SampledRunner;
 using pidlab::optim::ProgressCallback;
 using pidlab::optim::TracePoint;
 using pidlab::spec::NameStyle;
-using pidlab::tune::BuildPlant;
-using pidlab::tune::BuildTuneOptions;
-using pidlab::tune::CheckPlantInLoop;
-using pidlab::tune::ResolveRobustPreset;
-using pidlab::tune::ResolveSearchBox;
 using pidlab::tune::SearchBox;
-using pidlab::tune::Tune;
 using pidlab::tune::TuneOptions;
 using pidlab::tune::TuneSummary;
 
@@ -75,66 +64,47 @@ struct TuneCommand {
 
   int Run() {
     spec::TuningSpec ts;
-    std::set<std::string> given;
-    flags.Apply(&ts, &given);
-    ts.plant.Normalize();
-    ResolveRobustPreset(&ts, given);
-    const SearchBox box = ResolveSearchBox(&ts, given);
-    std::string error;
-    Plant p;
-    Require(BuildPlant(ts.plant, NameStyle::kFlag, &p, &error), error);
-    TuneOptions o;
-    Require(BuildTuneOptions(ts, NameStyle::kFlag, &o, &error), error);
-    Require(CheckPlantInLoop(p, o.loop, NameStyle::kFlag, &error), error);
-    if (p.nonlinear && o.loop.loop != LoopKind::kSampled)
-      throw BadInput("--plant " + p.name +
-                     " is nonlinear: tune it on the sampled loop (--loop sampled --dt 1e-4)");
+    tune::BuildOptions build;
+    build.style = NameStyle::kFlag;
+    build.backend = backend == "lcm" ? tune::Backend::kRunner : tune::Backend::kInProcess;
+    flags.Apply(&ts, &build.given);
+    tune::TuningProblem problem;
+    Require(tune::BuildTuning(ts, build, &problem));
     CheckOutputFile(trace, "--trace");  // before the search, not after it
-    const SampledRunner runner = MakeRunner(o);
-    if (pool) o.parallel_for = pool->AsParallelFor();  // the starts on idle trios
+    const TuneOptions& o = problem.options;
+    tune::TuningRunOptions run;
+    run.runner = MakeRunner();
+    if (pool) run.parallel_for = pool->AsParallelFor();  // the starts on idle trios
     const bool tty = isatty(STDERR_FILENO) != 0;
-    ProgressCallback progress = MakeProgress(tty);
+    run.progress = MakeProgress(tty);
     if (pool) {  // watchers of the first trio see the search as it runs (docs/live.md)
       publisher = std::make_unique<pidlab::episode_client::TuneProgressPublisher>(
           lcm.ClientOptions(lcm.Url()), pool->size(), ToString(o.method), ToString(o.objective));
-      progress = [terminal = progress, this](const TracePoint& tp) {
+      run.progress = [terminal = run.progress, this](const TracePoint& tp) {
         terminal(tp);
         publisher->Running(tp);
       };
     }
-    TuneSummary s;
-    const bool tuned = Tune(p, o, &s, &error, progress, runner);
-    if (publisher) publisher->Finished(tuned && s.stable, s.gains, s.objective);
-    Require(tuned, error);
+    tune::TuningResult result;
+    const Status tuned = tune::RunTuning(problem, run, &result);
+    const TuneSummary& s = result.summary;
+    if (publisher) publisher->Finished(tuned.ok() && s.stable, s.gains, s.objective);
+    Require(tuned);
     if (tty) std::fprintf(stderr, "\r%70s\r", "");
     if (!trace.empty()) WriteTrace(s);
-    Evaluation ev;
-    LoopAnalysis analysis;
-    if (s.stable) {
-      // With --two-dof, the loop with the setpoint weights found.
-      const pidlab::evaluation::LoopOptions loop = pidlab::tune::WithSetpointWeights(o.loop, s.two_dof);
-      EvaluateOptions what;
-      Evaluate(p, s.gains, loop, what, &ev, &error);
-      analysis = AnalyzeOrThrow(p, s.gains, loop);
-    }
     if (json) {
-      nlohmann::json j = results::TuneJson(p, o, s, ev, backend);
-      j["robustness"] = s.stable ? RobustnessJson(analysis, o.bounds) : nlohmann::json(nullptr);
-      j["spec"] = spec::ToJson(ts);
-      std::cout << j.dump() << "\n";
+      std::cout << results::TuningJson(problem, result, backend).dump() << "\n";
     } else {
-      PrintText(o, s, ev, box);
-      if (s.stable) std::cout << FormatRobustness(analysis, o.bounds);
+      PrintText(o, s, result.evaluation, problem.box);
+      if (s.stable) std::cout << FormatRobustness(result.analysis, o.bounds);
     }
     return s.stable ? 0 : 1;
   }
 
-  // The sampled-loop runner of --backend; throws BadInput.
-  SampledRunner MakeRunner(const TuneOptions& o) {
+  // The sampled-loop runner of --backend (BuildTuning checked its loop); throws BadInput.
+  SampledRunner MakeRunner() {
     if (backend == "local") return nullptr;  // in process
     if (backend != "lcm") throw BadInput("--backend " + Quote(backend) + " must be local or lcm");
-    if (o.loop.loop != LoopKind::kSampled)
-      throw BadInput("--backend lcm runs the sampled loop: add --loop sampled");
     pool = lcm.MakePool();
     return pool->AsRunner();
   }

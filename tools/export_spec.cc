@@ -2,7 +2,7 @@
 
 #include "cli_spec.h"
 #include "pidlab/evaluation/closed_loop.h"
-#include "pidlab/tune/spec_build.h"
+#include "pidlab/tune/problem.h"
 
 namespace pidlab::cli {
 
@@ -15,8 +15,10 @@ bool ExportController(const spec::EvaluateSpec& s, spec::NameStyle style, contro
   }
   PidGains g;
   evaluation::LoopOptions loop;
-  if (!(tune::BuildGains(s.gains, style, &g, error) && tune::BuildLoopOptions(s.loop, style, &loop, error)))
+  if (Status built = tune::BuildController(s, style, &g, &loop); !built.ok()) {
+    *error = built.message();
     return false;
+  }
   c->gains = evaluation::LoopGains(g, loop);
   c->pid = PidOptionsAt(loop.pid, loop.dt_s);
   // The spec's setpoint weights (c = 0 for derivative_on measurement), in the PID's options.

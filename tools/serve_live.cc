@@ -9,13 +9,14 @@
 #include <vector>
 
 #include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/results/spec_run.h"
 #include "pidlab/monitor/frames.h"
 #include "pidlab/monitor/live_scope.h"
 #include "pidlab/results/live_json.h"
 #include "pidlab/results/replay_json.h"
 #include "pidlab/results/results_json.h"
 #include "pidlab/spec/json.h"
-#include "pidlab/tune/spec_build.h"
+#include "pidlab/tune/problem.h"
 
 namespace pidlab::cli {
 namespace {
@@ -159,17 +160,6 @@ struct LiveService::Impl {
 
 namespace {
 
-// The object of `pidlab evaluate --json` for one evaluation of the spec.
-nlohmann::json ResultJson(const evaluation::Evaluation& ev, const analysis::LoopAnalysis& analysis,
-                          const analysis::LoopBounds& bounds, const spec::EvaluateSpec& s,
-                          const char* backend) {
-  nlohmann::json j = results::ToJson(ev);
-  j["backend"] = backend;
-  j["robustness"] = results::RobustnessJson(analysis, bounds);
-  j["spec"] = spec::ToJson(s);
-  return j;
-}
-
 bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
   return a.size() == b.size() &&
          (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
@@ -181,42 +171,34 @@ nlohmann::json TrioResult(const nlohmann::json& spec_json,
   spec::EvaluateSpec s;
   std::string error;
   if (!spec::FromJson(spec_json, &s, nullptr, &error)) throw std::invalid_argument(error);
-  s.plant.Normalize();
   s.loop.loop = "sampled";  // the trio runs the sampled loop
-  Plant p;
-  PidGains g;
-  evaluation::LoopOptions options;
-  analysis::LoopBounds bounds;
-  using spec::NameStyle;
-  if (!(tune::BuildPlant(s.plant, NameStyle::kKey, &p, &error) &&
-        tune::BuildGains(s.gains, NameStyle::kKey, &g, &error) &&
-        tune::BuildLoopOptions(s.loop, NameStyle::kKey, &options, &error) &&
-        tune::CheckPlantInLoop(p, options, NameStyle::kKey, &error) &&
-        tune::BuildBounds(s.bounds, NameStyle::kKey, &bounds, &error)))
-    throw std::invalid_argument(error);
-  evaluation::Evaluation local, trio;
-  analysis::LoopAnalysis analysis;
-  evaluation::EvaluateOptions what;
-  if (!evaluation::Evaluate(p, g, options, what, &local, &error) ||
-      !analysis::AnalyzeLoop(p, g, options, analysis::LoopAnalysisOptions{}, &analysis, &error))
-    throw std::invalid_argument(error);
+  tune::EvaluationProblem problem;
+  if (Status built = tune::BuildEvaluation(s, tune::BuildOptions{}, &problem); !built.ok())
+    throw std::invalid_argument(built.message());
+  tune::EvaluationRunOptions run;
+  run.monte_carlo = false;  // one loop on each side, no draws
+  tune::EvaluationResult local, trio;
+  if (Status ran = tune::RunEvaluation(problem, run, &local); !ran.ok())
+    throw std::invalid_argument(ran.message());
   episode_client::EpisodeClient runner(client);
-  if (!evaluation::Evaluate(p, g, options, what, &trio, &error, runner.AsRunner()))
-    throw std::runtime_error(error);
-  nlohmann::json result = ResultJson(trio, analysis, bounds, s, "lcm");
+  run.runner = runner.AsRunner();
+  if (Status ran = tune::RunEvaluation(problem, run, &trio); !ran.ok())
+    throw std::runtime_error(ran.message());
+  nlohmann::json result = results::EvaluationJson(problem, trio, "lcm");
   result["steps_per_second"] = JsonNumber(runner.stats().StepsPerSecond());
   if (runner.stats().realtime.paced()) result["realtime"] = results::RealtimeJson(runner.stats().realtime);
+  const std::vector<double>&ty = trio.evaluation.y, &ly = local.evaluation.y;
   double max_diff = 0.0;
-  for (std::size_t i = 0; i < std::min(trio.y.size(), local.y.size()); ++i)
-    max_diff = std::max(max_diff, std::fabs(trio.y[i] - local.y[i]));
+  for (std::size_t i = 0; i < std::min(ty.size(), ly.size()); ++i)
+    max_diff = std::max(max_diff, std::fabs(ty[i] - ly[i]));
   return {{"type", "trio_result"},
           {"loop", "sampled"},
           {"result", result},
-          {"prediction", ResultJson(local, analysis, bounds, s, "local")},
-          {"series", {{"t", trio.t}, {"y", trio.y}}},
-          {"prediction_series", {{"t", local.t}, {"y", local.y}}},
+          {"prediction", results::EvaluationJson(problem, local, "local")},
+          {"series", {{"t", trio.evaluation.t}, {"y", ty}}},
+          {"prediction_series", {{"t", local.evaluation.t}, {"y", ly}}},
           {"max_abs_difference", JsonNumber(max_diff)},
-          {"bit_identical", SameBits(trio.t, local.t) && SameBits(trio.y, local.y)}};
+          {"bit_identical", SameBits(trio.evaluation.t, local.evaluation.t) && SameBits(ty, ly)}};
 }
 
 }  // namespace

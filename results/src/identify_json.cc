@@ -39,9 +39,12 @@ nlohmann::json IdentifyAutoJson(const identify::AutoResult& a) {
 
 nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
   nlohmann::json parameters = nlohmann::json::object();
-  for (std::size_t i = 0; i < r.names.size(); ++i)
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
     parameters[r.names[i]] = {{"value", JsonNumber(r.values[i])},
                               {"standard_error", JsonNumber(r.standard_errors.at(i))}};
+    // A parameter at a bound: its interval is one-sided, so no standard error.
+    if (i < r.at_bound.size() && !r.at_bound[i].empty()) parameters[r.names[i]]["at_bound"] = r.at_bound[i];
+  }
   const TransferFunction tf = r.model.ToTransferFunction();
   nlohmann::json num = nlohmann::json::array(), den = nlohmann::json::array();
   for (double c : tf.num) num.push_back(JsonNumber(c));
@@ -87,6 +90,9 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
       {"starts_at_best", r.starts_at_best},
       {"seed", r.seed},
       {"arx_start", r.arx_start},
+      {"nested_starts", r.nested_starts},
+      {"delay_profile_improved", r.delay_profile_improved},
+      {"bounds_refit_improved", r.bounds_refit_improved},
       {"whiteness", WhitenessJson(r.whiteness)},
       {"warnings", r.warnings},
       {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}, {"matrix", matrix}}}};

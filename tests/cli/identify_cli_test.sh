@@ -70,14 +70,23 @@ with open('smooth.csv', 'w') as f:
     for k in range(n): f.write('%.17g,%.17g,%.17g\n' % (t[k], u[k] + 1, y[k * fine] + 3))
 PY
 
-# The commands of docs/identify.md's section, as written there (its ```bash block).
+# The commands of docs/identify.md's section, as written there (its ```bash block);
+# the real records of tests/data/identify beside the written ones.
+cp "$(dirname -- "$docs")"/../tests/data/identify/*.csv .
 n_docs=0
 while IFS= read -r cmd; do
   n_docs=$((n_docs + 1))
   (pidlab() { "$pidlab" "$@"; }; eval "$cmd") > docs.out 2>&1
   check "docs/identify.md: $cmd" "[ $? -eq 0 ]"
 done < <(awk '/^```bash/{on=1; next} /^```/{on=0} on && /^pidlab identify /' "$docs")
-check "docs/identify.md has 6 identify commands (found $n_docs)" "[ $n_docs -eq 6 ]"
+check "docs/identify.md has 7 identify commands (found $n_docs)" "[ $n_docs -eq 7 ]"
+pidlab() { "$pidlab" "$@"; }
+pidlab identify --csv tclab_step.csv --model p1d --u0 0 --json > tclab.json 2> tclab.err
+check "the TCLab step test is a step from --u0 0: fitted, a fit above 95 %" \
+  "[ $? -eq 0 ] && /usr/bin/python3 -c 'import json,sys; j=json.load(open(\"tclab.json\")); sys.exit(0 if j[\"fit_percent\"] > 95 else 1)'"
+"$pidlab" identify --csv tclab_step.csv --model p1d > out 2> err
+check "the TCLab step test without --u0 exits 2 with one line saying to give it" \
+  "[ $? -eq 2 ] && only_line_ok err 'give --u0'"
 pidlab() { "$pidlab" "$@"; }
 pidlab identify --csv step.csv --model p1d > table 2> err
 check "identify --csv step.csv --model p1d exits 0 with the table" \

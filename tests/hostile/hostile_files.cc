@@ -200,7 +200,7 @@ class Mutator {
     std::string s = seed;
     const bool json = ext_ == "json", csv = ext_ == "csv";
     switch (index_ % 16) {
-      case 0:  // truncation, sweeping every byte over the cases
+      case 0:  // truncation, moving over the file with the cases
         return s.substr(0, static_cast<std::size_t>(index_ / 16) % (s.size() + 1));
       case 1:
         for (int i = Uniform(1, 8); i > 0; --i) s[Position(s)] ^= static_cast<char>(1 << Uniform(0, 7));
@@ -373,8 +373,11 @@ int main(int argc, char** argv) {
       continue;
     }
     long refused = 0, accepted = 0;
-    for (long i = 0; i < count; ++i) {
-      const std::string bytes = Mutator(seed, i, r.ext).Mutate(r.seed);
+    // The seed cut at every byte, then `count` seeded mutants.
+    const long cuts = static_cast<long>(r.seed.size());
+    for (long i = 0; i < cuts + count; ++i) {
+      const std::string bytes = i < cuts ? r.seed.substr(0, static_cast<std::size_t>(i))
+                                         : Mutator(seed, i - cuts, r.ext).Mutate(r.seed);
       const std::string path = dir + "/case." + r.ext;
       if (!WriteBytes(path, bytes)) {
         std::cout << "FAIL cannot write " << path << "\n";
@@ -395,8 +398,8 @@ int main(int argc, char** argv) {
                     << "\n";
       }
     }
-    std::cout << r.name << ": " << count << " cases, " << refused << " refused, " << accepted
-              << " read, no crash\n";
+    std::cout << r.name << ": " << cuts + count << " cases (" << cuts << " cuts, one at every byte, and "
+              << count << " mutants), " << refused << " refused, " << accepted << " read, no crash\n";
   }
   std::filesystem::remove_all(dir);
   std::cout << failures << " failures\n";

@@ -104,7 +104,9 @@ kill_in_trio 1 2
 kill_in_trio 3 3
 
 # A stopped process is noted as it happens, with its trio's number. COMMAND
-# waits until its process state shows the stop (T), then continues it.
+# waits until its process state shows the stop (T), keeps it stopped for
+# 0.5 s (a stop continued before the supervisor's next waitpid is no longer
+# there to see: continued at once, it was missed under load), then continues it.
 status=0
 timeout 30 "$pidlab" launch --trios 2 -- bash -c '
   pid=$PIDLAB_TRIO2_CONTROLLER_PID
@@ -114,6 +116,7 @@ timeout 30 "$pidlab" launch --trios 2 -- bash -c '
     (($(date +%s%N) < deadline)) || exit 1
     sleep 0.01
   done
+  sleep 0.5
   kill -CONT "$pid"' >stop.out 2>stop.err || status=$?
 if ((status != 0)); then
   fail "a stop in trio 2: exit $status: $(tr '\n' '|' <stop.err)"

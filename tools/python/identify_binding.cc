@@ -81,8 +81,6 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
   if (!identify::ParseInitialCondition(initial_condition, &options.initial_condition))
     throw py::value_error("identify: initial_condition = '" + initial_condition +
                           "' must be 'zero', 'steady-state' or 'estimate'");
-  if (starts < 1 || starts > 1000)
-    throw py::value_error("identify: starts = " + std::to_string(starts) + " must be in [1, 1000]");
   Status status;
   nlohmann::json j;
   if (model == "auto") {

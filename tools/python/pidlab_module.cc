@@ -21,31 +21,10 @@
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/results/results_json.h"
 #include "pidlab/results/spec_run.h"
+#include "pidlab/results/tune_run.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
-#include "pidlab/tune/search_box.h"
-#include "pidlab/tune/spec_build.h"
-#include "pidlab/tune/tune.h"
-
-using pidlab::analysis::AnalyzeLoop;
-using pidlab::analysis::LoopAnalysis;
-using pidlab::analysis::LoopAnalysisOptions;
-using pidlab::analysis::LoopBounds;
-using pidlab::evaluation::Evaluate;
-using pidlab::evaluation::EvaluateOptions;
-using pidlab::evaluation::Evaluation;
-using pidlab::evaluation::LoopOptions;
-using pidlab::spec::NameStyle;
-using pidlab::tune::BuildBounds;
-using pidlab::tune::BuildGains;
-using pidlab::tune::BuildLoopOptions;
-using pidlab::tune::BuildPlant;
-using pidlab::tune::BuildTuneOptions;
-using pidlab::tune::CheckPlantInLoop;
-using pidlab::tune::ResolveRobustPreset;
-using pidlab::tune::Tune;
-using pidlab::tune::TuneOptions;
-using pidlab::tune::TuneSummary;
+#include "pidlab/tune/problem.h"
 
 namespace py = pybind11;
 
@@ -197,37 +176,19 @@ py::object EvaluatePy(const py::object& plant, const py::object& gains, py::kwar
 
 py::object TunePy(const py::object& plant, py::kwargs kwargs) {
   spec::TuningSpec s;
-  std::set<std::string> given;
-  ReadKwargs("tune", WithPositional(plant, nullptr, kwargs), &s, &given);
-  s.plant.Normalize();
-  ResolveRobustPreset(&s, given);
-  pidlab::tune::ResolveSearchBox(&s, given);
-  std::string error;
-  Plant p;
-  TuneOptions o;
-  Require(BuildPlant(s.plant, NameStyle::kKey, &p, &error) &&
-              BuildTuneOptions(s, NameStyle::kKey, &o, &error) &&
-              CheckPlantInLoop(p, o.loop, NameStyle::kKey, &error),
-          error);
-  TuneSummary summary;
-  Evaluation ev;
-  LoopAnalysis analysis;
-  bool ok = false;
+  tune::BuildOptions build;
+  ReadKwargs("tune", WithPositional(plant, nullptr, kwargs), &s, &build.given);
+  // The same code as `pidlab tune` and `pidlab serve` (tune/problem.h).
+  tune::TuningProblem problem;
+  Status status = tune::BuildTuning(s, build, &problem);
+  Require(status.ok(), status.message());
+  tune::TuningResult result;
   {
     py::gil_scoped_release release;
-    ok = Tune(p, o, &summary, &error);
-    if (ok && summary.stable) {
-      // With two_dof, the loop with the setpoint weights found.
-      const auto loop = pidlab::tune::WithSetpointWeights(o.loop, summary.two_dof);
-      Evaluate(p, summary.gains, loop, EvaluateOptions{}, &ev, &error);
-      ok = AnalyzeLoop(p, summary.gains, loop, LoopAnalysisOptions{}, &analysis, &error);
-    }
+    status = tune::RunTuning(problem, tune::TuningRunOptions{}, &result);
   }
-  Require(ok, error);
-  nlohmann::json j = results::TuneJson(p, o, summary, ev, "local");
-  j["robustness"] = summary.stable ? results::RobustnessJson(analysis, o.bounds) : nlohmann::json(nullptr);
-  j["spec"] = spec::ToJson(s);
-  return ToPython(j);
+  Require(status.ok(), status.message());
+  return ToPython(results::TuningJson(problem, result, "local"));
 }
 
 /// The field table of a spec: key, flag, help, unit, default, example, episode.
@@ -283,8 +244,7 @@ PYBIND11_MODULE(_pidlab, m) {
         if (which != "tune") Bad("read_spec: '" + which + "' must be evaluate or tune");
         pidlab::spec::TuningSpec s;
         ReadKwargs("read_spec", py::dict(kwargs), &s, &given);
-        pidlab::tune::ResolveRobustPreset(&s, given);
-        pidlab::tune::ResolveSearchBox(&s, given);
+        pidlab::tune::ResolveTuningSpec(&s, given);
         return ToPython(pidlab::spec::ToJson(s));
       },
       "read_spec(which, **spec): the spec evaluate or tune would read from these keywords (defaults filled "

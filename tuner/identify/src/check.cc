@@ -55,8 +55,8 @@ std::string ToString(InitialCondition v) {
 
 bool IdentifyOptions::IsValid(std::string* error) const {
   std::string e;
-  if (starts < 1)
-    e = "starts = " + std::to_string(starts) + " must be at least 1";
+  if (starts < 1 || starts > kMaxStarts)
+    e = "starts = " + std::to_string(starts) + " must be in [1, " + std::to_string(kMaxStarts) + "]";
   else if (!(max_delay_fraction > 0.0 && max_delay_fraction < 1.0))
     e = "max_delay_fraction = " + CheckedNumber(max_delay_fraction) + " must be in (0, 1)";
   else if (max_iterations < 1)
@@ -135,6 +135,11 @@ Status CheckData(const IdentifyData& data, Sampling* sampling, const std::vector
     if (!(data.t[k] > data.t[k - 1]))
       return Status::InvalidInput("t is not strictly increasing: t = " + CheckedNumber(data.t[k]) + " at " +
                                   Where(rows, k) + " after " + CheckedNumber(data.t[k - 1]));
+  for (std::size_t k = 0; k < n; ++k)
+    if (std::abs(data.t[k]) > kMaxRecordMagnitude)
+      return Status::InvalidInput("column t, " + Where(rows, k) + ": " + CheckedNumber(data.t[k]) +
+                                  " s is beyond 1e12 in magnitude, the limit of every number pidlab takes "
+                                  "(rescale t's units)");
   for (std::size_t k = 1; k < n; ++k)
     if (data.t[k] - data.t[k - 1] < kMinRecordInterval)
       return Status::InvalidInput("column t, " + Where(rows, k) + ": the interval " +
@@ -154,9 +159,7 @@ Status CheckData(const IdentifyData& data, Sampling* sampling, const std::vector
     if (std::abs(h - found.mean_interval_s) > kUniformSamplingTolerance * found.mean_interval_s)
       found.uniform = false;
   }
-  if (std::all_of(data.u.begin(), data.u.end(), [&](double v) { return v == data.u[0]; }))
-    return Status::InvalidInput("constant input: u is " + CheckedNumber(data.u[0]) +
-                                " throughout, so nothing can be identified");
+  // A constant u is a step when u0 is given (Identify decides): not refused here.
   *sampling = found;
   return Status::Ok();
 }

@@ -111,7 +111,15 @@ Status IdentifyAuto(const IdentifyData& data, const IdentifyOptions& options, Au
                                 ProcessModelKind::kP1DI, ProcessModelKind::kP2DZ}) {
     AutoCandidate c;
     c.kind = kind;
-    c.status = Identify(data, kind, options, &c.result);
+    // The model it contains, fitted before it: P1D for P2D, P2D for P2DU and P2DZ.
+    const IdentifyResult* contained = nullptr;
+    const ProcessModelKind inner =
+        kind == ProcessModelKind::kP2D ? ProcessModelKind::kP1D : ProcessModelKind::kP2D;
+    for (const AutoCandidate& before : result->candidates)
+      if (before.kind == inner && before.status.ok() && kind != ProcessModelKind::kP1D &&
+          kind != ProcessModelKind::kP1DI)
+        contained = &before.result;
+    c.status = Identify(data, kind, options, contained, &c.result);
     // Bad data or options are the same for every kind: say it once.
     if (c.status.code() == StatusCode::kInvalidInput) return c.status;
     result->candidates.push_back(std::move(c));

@@ -327,6 +327,126 @@ double FitFrom(const Record& record, const IdentifyOptions& options, std::vector
   return summary.final_cost;
 }
 
+// The parameters `held` (indices into theta) held where *theta has them,
+// the others refitted from *theta; the cost, or infinity if Ceres failed.
+double FitHolding(const Record& record, const IdentifyOptions& options, const std::vector<int>& held,
+                  std::vector<double>* theta) {
+  ceres::Problem problem;
+  BuildProblem(record, theta->data(), &problem);
+  problem.SetManifold(theta->data(), new ceres::SubsetManifold(BlockSize(record), held));
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = 1e-12;
+  solver.gradient_tolerance = 1e-20;
+  solver.parameter_tolerance = 1e-10;
+  solver.logging_type = ceres::SILENT;
+  solver.num_threads = 1;
+  ceres::Solver::Summary summary;
+  const int log_level = FLAGS_minloglevel;
+  FLAGS_minloglevel = google::GLOG_FATAL;
+  ceres::Solve(solver, &problem, &summary);
+  FLAGS_minloglevel = log_level;
+  if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost))
+    return std::numeric_limits<double>::infinity();
+  return summary.final_cost;
+}
+
+// Td held at `td`, the other parameters refitted from *theta.
+double FitAtDelay(const Record& record, const IdentifyOptions& options, double td,
+                  std::vector<double>* theta) {
+  const int p = ParameterCount(record);
+  (*theta)[static_cast<std::size_t>(p - 1)] = td;
+  return FitHolding(record, options, {p - 1}, theta);
+}
+
+// The parameters of *theta at (within 1e-6 of) a bound of the fit, put on
+// it: Td at 0 or its maximum, a time constant at dt / 1000 or 1000 times
+// the record, Zeta at either end. Not for a TF.
+std::vector<int> SnapToBounds(const Record& record, std::vector<double>* theta) {
+  std::vector<int> at;
+  if (record.kind == ProcessModelKind::kTf) return at;
+  const int p = ParameterCount(record);
+  for (int i = 1; i < p; ++i) {
+    double lo, hi, tolerance = 1e-6;
+    if (i == p - 1) {
+      lo = 0.0, hi = record.max_delay_s, tolerance = 1e-6 * record.dt_s;
+    } else if (IsLogParameter(record, i)) {
+      lo = std::log(record.dt_s / kTimeConstantRange), hi = std::log(record.length_s * kTimeConstantRange);
+    } else if (!IsZeroParameter(record.kind, i)) {
+      lo = kMinZeta, hi = kMaxZeta, tolerance = 1e-6 * kMinZeta;
+      if (hi - (*theta)[static_cast<std::size_t>(i)] <= 1e-6) {
+        (*theta)[static_cast<std::size_t>(i)] = hi;
+        at.push_back(i);
+        continue;
+      }
+    } else {
+      continue;
+    }
+    double& v = (*theta)[static_cast<std::size_t>(i)];
+    if (v - lo <= tolerance)
+      v = lo;
+    else if (hi - v <= tolerance)
+      v = hi;
+    else
+      continue;
+    at.push_back(i);
+  }
+  return at;
+}
+
+// A fit that ends with parameters at bounds may have stalled there: Ceres
+// projects its steps onto the box, and where two parameters press on their
+// bounds the projected steps can fail to lower the cost long before the
+// others are optimal. Those parameters held on their bounds, the others
+// refitted; replaces *theta and *cost if lower, true then.
+bool RefitAtBounds(const Record& record, const IdentifyOptions& options, std::vector<double>* theta,
+                   double* cost) {
+  std::vector<double> trial = *theta;
+  const std::vector<int> held = SnapToBounds(record, &trial);
+  if (held.empty()) return false;
+  const double c = FitHolding(record, options, held, &trial);
+  if (!(c < *cost)) return false;
+  *theta = trial;
+  *cost = c;
+  return true;
+}
+
+// The delay's profile around the best fit (*theta, *cost): Td held at 0, at
+// half the best Td, at the best Td and at half samples up to a sample on
+// either side of it, the rest refitted; from the lowest of those a free fit. The cost is piecewise
+// smooth in Td, with kinks where Td crosses a sample, so a start can stop at
+// a kink above the optimum, or just short of the bound Td = 0. Replaces
+// *theta and *cost if it finds a lower cost; true then.
+bool ProfileDelay(const Record& record, const IdentifyOptions& options, std::vector<double>* theta,
+                  double* cost) {
+  const int p = ParameterCount(record);
+  const double best_td = (*theta)[static_cast<std::size_t>(p - 1)];
+  std::vector<double> grid = {best_td};
+  if (best_td > 0.0) grid.insert(grid.end(), {0.0, 0.5 * best_td});
+  for (int k = -2; k <= 2; ++k)
+    if (k != 0) grid.push_back(best_td + 0.5 * k * record.dt_s);
+  std::vector<double> lowest;
+  double lowest_cost = std::numeric_limits<double>::infinity();
+  for (double td : grid) {
+    // The best Td itself too: held there, the others converge even where
+    // the free fit stopped at the bound Td = 0.
+    if (td < 0.0 || td > record.max_delay_s) continue;
+    std::vector<double> trial = *theta;
+    const double c = FitAtDelay(record, options, td, &trial);
+    if (c < lowest_cost) {
+      lowest_cost = c;
+      lowest = trial;
+    }
+  }
+  if (lowest.empty() || !(lowest_cost < *cost)) return false;
+  const double polished = FitFrom(record, options, &lowest);
+  if (!(polished < *cost)) return false;
+  *theta = lowest;
+  *cost = polished;
+  return true;
+}
+
 // The covariance of the parameters at `theta` (of the values, not of theta;
 // p x p, row-major) and their standard errors, scaled by the residual
 // variance; false with the reason if Ceres cannot invert J'J.
@@ -412,16 +532,31 @@ namespace {
 
 // The best of the starts: its theta, and every start's cost.
 std::vector<double> MultiStart(const Record& record, const IdentifyOptions& options,
-                               std::vector<double>* costs, bool* arx_used) {
+                               const std::vector<std::vector<double>>& nested, std::vector<double>* costs,
+                               bool* arx_used) {
   std::vector<double> best;
   double best_cost = std::numeric_limits<double>::infinity();
   const int dimensions = record.kind == ProcessModelKind::kTf ? internal::TfDesignDimensions(record.poles)
                                                               : ParameterCount(record) - 1;
   const optim::SobolSequence sobol =
       options.seed == 0 ? optim::SobolSequence(dimensions) : optim::SobolSequence(dimensions, options.seed);
-  int total = options.starts;
-  const auto fit = [&](std::vector<double> theta) {
-    const double cost = FitFrom(record, options, &theta);
+  int total = options.starts + static_cast<int>(nested.size());
+  // held: a nested start's delay (its contained model's) is held while the
+  // rest is refitted, then freed. A free fit from there may leave the
+  // contained optimum at once where it sits at a kink of the cost in Td (a
+  // sample crossing), and stop above the contained model's cost.
+  const auto fit = [&](std::vector<double> theta, bool held) {
+    double cost = std::numeric_limits<double>::infinity();
+    if (held) {
+      const int p = ParameterCount(record);
+      cost = FitAtDelay(record, options, theta[static_cast<std::size_t>(p - 1)], &theta);
+    }
+    std::vector<double> freed = theta;
+    const double free_cost = FitFrom(record, options, &freed);
+    if (!(cost <= free_cost)) {
+      cost = free_cost;
+      theta = freed;
+    }
     costs->push_back(cost);
     if (cost < best_cost) {
       best_cost = cost;
@@ -433,10 +568,114 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
     std::vector<double> theta = ArxStartPoint(record);
     *arx_used = !theta.empty();
     total += *arx_used ? 1 : 0;
-    if (*arx_used) fit(theta);
+    if (*arx_used) fit(theta, false);
   }
-  for (int s = 0; s < options.starts; ++s) fit(StartPoint(record, sobol, s));
+  for (const std::vector<double>& theta : nested) fit(theta, true);
+  for (int s = 0; s < options.starts; ++s) fit(StartPoint(record, sobol, s), false);
   return best;
+}
+
+// The model `kind` contains, whose optimum starts `kind`'s fit: P1D in P2D
+// (Tp2 -> 0), P2D in P2DU (as long as its lags are near enough to be a
+// pair's) and in P2DZ (Tz = 0).
+bool ContainedKind(ProcessModelKind kind, ProcessModelKind* inner) {
+  if (kind == ProcessModelKind::kP2D)
+    *inner = ProcessModelKind::kP1D;
+  else if (kind == ProcessModelKind::kP2DU || kind == ProcessModelKind::kP2DZ)
+    *inner = ProcessModelKind::kP2D;
+  else
+    return false;
+  return true;
+}
+
+// Starts at the optimum `inner` of the model that `record`'s kind contains,
+// in Ceres's coordinates (the offsets relative to the record's u0 and y0).
+// P2D from P1D twice: a second lag at its lower bound (P1D's optimum as
+// nearly as the bound allows: a free fit from a lag just above it can stall
+// there, its step projected onto the bound), and one of half a sample taken
+// out of the delay (a short lag and a short delay look alike).
+std::vector<std::vector<double>> NestedStarts(const Record& record, const IdentifyResult& inner, double u0,
+                                              double y0) {
+  ProcessModelKind expected;
+  if (!ContainedKind(record.kind, &expected) || inner.model.kind != expected) return {};
+  const int p = ParameterCount(record);
+  const std::vector<double>& v = inner.values;
+  std::vector<double> theta(static_cast<std::size_t>(BlockSize(record)), 0.0);
+  if (record.offset) theta[static_cast<std::size_t>(p)] = inner.y0 - y0;
+  if (record.input_offset) theta[static_cast<std::size_t>(InputOffsetIndex(record))] = inner.u0 - u0;
+  const auto log_lag = [&](double tau) {
+    return std::clamp(std::log(tau), std::log(record.dt_s / kTimeConstantRange),
+                      std::log(record.length_s * kTimeConstantRange));
+  };
+  const auto delay = [&](double td) { return std::clamp(td, 0.0, record.max_delay_s); };
+  theta[0] = v[0];
+  std::vector<std::vector<double>> starts;
+  switch (record.kind) {
+    case ProcessModelKind::kP2D:  // from Kp, Tp1, Td
+      theta[1] = log_lag(v[1]);
+      theta[2] = log_lag(record.dt_s / kTimeConstantRange);
+      theta[3] = delay(v[2]);
+      starts.push_back(theta);
+      theta[2] = log_lag(record.dt_s / 2.0);
+      theta[3] = delay(v[2] - record.dt_s / 2.0);
+      starts.push_back(theta);
+      break;
+    case ProcessModelKind::kP2DU: {  // from Kp, Tp1, Tp2, Td
+      const double tw = std::sqrt(v[1] * v[2]), zeta = (v[1] + v[2]) / (2.0 * tw);
+      theta[1] = log_lag(tw);
+      theta[2] = std::clamp(zeta, kMinZeta, kMaxZeta);
+      theta[3] = delay(v[3]);
+      starts.push_back(theta);
+      // Lags too far apart for a pair: the critically damped pair of the
+      // same sum of time constants (2 Zeta Tw = Tp1 + Tp2) too.
+      if (zeta > kMaxZeta) {
+        theta[1] = log_lag(0.5 * (v[1] + v[2]));
+        theta[2] = kMaxZeta;
+        starts.push_back(theta);
+      }
+      break;
+    }
+    case ProcessModelKind::kP2DZ:  // from Kp, Tp1, Tp2, Td; Tz = 0
+      theta[1] = log_lag(v[1]);
+      theta[2] = log_lag(v[2]);
+      theta[3] = 0.0;
+      theta[4] = delay(v[3]);
+      starts.push_back(theta);
+      break;
+    default:
+      break;
+  }
+  return starts;
+}
+
+// Which parameters sit at (within 1e-6, relative to the bound's scale, of)
+// a bound of the fit: "lower", "upper" or "" for each. Td at 0, Zeta at 1 (or
+// at its floor), a time constant at dt/1000 or 1000 times the record.
+std::vector<std::string> AtBound(const Record& record, const std::vector<double>& values) {
+  std::vector<std::string> at(values.size());
+  const int p = static_cast<int>(values.size());
+  if (p == 0) return at;
+  const double td = values.back();
+  if (td <= 1e-6 * record.dt_s)
+    at.back() = "lower";
+  else if (td >= record.max_delay_s * (1 - 1e-6))
+    at.back() = "upper";
+  for (int i = 1; i < p - 1 && record.kind != ProcessModelKind::kTf; ++i) {
+    const double v = values[static_cast<std::size_t>(i)];
+    std::string& a = at[static_cast<std::size_t>(i)];
+    if (IsLogParameter(record, i)) {
+      if (v <= record.dt_s / kTimeConstantRange * (1 + 1e-6))
+        a = "lower";
+      else if (v >= record.length_s * kTimeConstantRange * (1 - 1e-6))
+        a = "upper";
+    } else if (!IsZeroParameter(record.kind, i)) {  // Zeta
+      if (v >= 1.0 - 1e-6)
+        a = "upper";
+      else if (v <= kMinZeta * (1 + 1e-6))
+        a = "lower";
+    }
+  }
+  return at;
 }
 
 // The plain warnings of IdentifyResult::warnings.
@@ -446,12 +685,31 @@ std::vector<std::string> Warnings(const Record& record, const IdentifyResult& r)
   if (!r.covariance_ok) w.push_back("no intervals: " + r.covariance_message);
   for (std::size_t i = 0; i < r.names.size() && r.covariance_ok; ++i) {
     const double half = 1.96 * r.standard_errors[i];
+    if (!r.at_bound[i].empty()) continue;  // said below, with its one-sided interval
     if (half > std::abs(r.values[i]))
       w.push_back(r.names[i] + " = " + Number(r.values[i]) + " +- " + Number(half) +
                   " (95 %): the interval is wider than the value, so the data do not determine " +
                   r.names[i]);
   }
   const double td = r.model.td_s;
+  if (r.at_bound.back() == "lower")
+    w.push_back(
+        "Td = " + Number(td) +
+        " s is at its lower bound 0: the record shows no dead time the fit can resolve; its interval is "
+        "one-sided and not reported");
+  for (std::size_t i = 0; i < r.names.size(); ++i)
+    if (r.names[i] == "Zeta" && !r.at_bound[i].empty())
+      w.push_back("Zeta = " + Number(r.values[i]) + " is at its " + r.at_bound[i] + " bound (" +
+                  (r.at_bound[i] == "upper" ? "1: the poles are real or nearly so, which p2d describes"
+                                            : Number(kMinZeta) + ": an undamped oscillation") +
+                  "); its interval is one-sided and not reported");
+  if (r.starts >= 3 && r.starts_at_best < 3)
+    w.push_back("only " + std::to_string(r.starts_at_best) + " of " + std::to_string(r.starts) +
+                " starts reached the best cost" +
+                (r.bounds_refit_improved ? " (the refit with the parameters at a bound held there found it)"
+                 : r.delay_profile_improved ? " (the delay's profile found it)"
+                                            : "") +
+                ": the optimum may not be the global one; try more --starts or another --seed");
   if (td >= max_delay_s * (1 - 1e-6))
     w.push_back("Td = " + Number(td) + " s is at its bound (" + Number(max_delay_s) +
                 " s, half the record): the delay may be longer than the record can show");
@@ -461,7 +719,7 @@ std::vector<std::string> Warnings(const Record& record, const IdentifyResult& r)
     if (t <= dt_s / kTimeConstantRange * (1 + 1e-6) || t >= length_s * kTimeConstantRange * (1 - 1e-6))
       w.push_back(r.names[i] + " = " + Number(t) + " s is at its bound [" +
                   Number(dt_s / kTimeConstantRange) + ", " + Number(length_s * kTimeConstantRange) +
-                  "] s: the model's order may be wrong");
+                  "] s: the model's order may be wrong; its interval is one-sided and not reported");
   }
   // An exact fit (residual RMS below 1e-9 of the output's spread, as with
   // noise-free data) leaves rounding in its residuals: not worth a warning.
@@ -507,7 +765,14 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
       result->residuals.push_back(record.dy[k] - offset - yhat[k]);
     }
     result->whiteness = ResidualWhiteness(result->residuals);
+    // The cost of the parameters reported, from the residuals reported.
+    double resimulated = 0.0;
+    for (double r : result->residuals) resimulated += 0.5 * r * r;
+    result->cost = resimulated;
   }
+  result->at_bound = AtBound(record, result->values);
+  for (std::size_t i = 0; i < result->at_bound.size(); ++i)
+    if (!result->at_bound[i].empty() && i < result->standard_errors.size()) result->standard_errors[i] = kNaN;
   result->warnings = Warnings(record, *result);
 }
 
@@ -515,6 +780,26 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
 
 Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
                 IdentifyResult* result) {
+  ProcessModelKind inner_kind;
+  if (const Status shape = internal::CheckTfShape(kind, options.poles, options.zeros); !shape.ok())
+    return shape;
+  if (!options.nested_starts || !ContainedKind(kind, &inner_kind))
+    return Identify(data, kind, options, nullptr, result);
+  // The contained model's fit is a start only: a quarter of the starts (its
+  // optimum, of fewer parameters, is reached from fewer), the ARX start and
+  // the delay's profile as asked.
+  // Its own contained model is not fitted: one level of nesting.
+  IdentifyOptions inner_options = options;
+  inner_options.starts = std::max(1, (options.starts + 3) / 4);
+  inner_options.nested_starts = false;
+  IdentifyResult inner;
+  const Status status = Identify(data, inner_kind, inner_options, &inner);
+  if (status.code() == StatusCode::kInvalidInput) return status;
+  return Identify(data, kind, options, status.ok() ? &inner : nullptr, result);
+}
+
+Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
+                const IdentifyResult* contained, IdentifyResult* result) {
   std::string error;
   if (!options.IsValid(&error)) return Status::InvalidInput(error);
   Record record;
@@ -545,6 +830,14 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
     record.du.push_back(data.u[k] - result->u0);
     record.dy.push_back(data.y[k] - result->y0);
   }
+  // A constant input is a step from u0 when u0 is given; at its default,
+  // the first sample, there is no input to respond to.
+  if (std::all_of(data.u.begin(), data.u.end(), [&](double v) { return v == data.u[0]; }) &&
+      std::isnan(options.u0))
+    return Status::InvalidInput("constant input: u is " + Number(data.u[0]) +
+                                " throughout and u0 is its first sample, so nothing can be identified; a "
+                                "step test that starts at the "
+                                "step needs the input before it: give --u0 (e.g. --u0 0)");
   if (record.initial == InitialCondition::kSteadyState && kind == ProcessModelKind::kP1DI &&
       record.du[0] != 0.0)
     return Status::InvalidInput(
@@ -553,7 +846,11 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
   if (Status s = CheckResponse(data); !s.ok()) return s;
   record.length_s = data.t.back() - data.t.front();
   record.max_delay_s = options.max_delay_fraction * record.length_s;
-  std::vector<double> theta = MultiStart(record, options, &result->start_costs, &result->arx_start);
+  const std::vector<std::vector<double>> nested =
+      contained && options.nested_starts ? NestedStarts(record, *contained, result->u0, result->y0)
+                                         : std::vector<std::vector<double>>{};
+  result->nested_starts = static_cast<int>(nested.size());
+  std::vector<double> theta = MultiStart(record, options, nested, &result->start_costs, &result->arx_start);
   if (theta.empty())
     return Status::RunnerFailed(
         "no start of the fit converged: " + std::to_string(options.starts) + " starts (seed " +
@@ -561,10 +858,19 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
         std::to_string(options.max_iterations) +
         " iterations each, all ended at a non-finite cost; check the record's units and outliers, or try "
         "more starts (--starts), another seed or another model");
+  double best = *std::min_element(result->start_costs.begin(), result->start_costs.end());
+  // Near Td = 0 only (within two samples): elsewhere the starts' spread
+  // finds the delay (identify_study_test), and the profile's refits would
+  // double the cost of a fit.
+  const double best_td =
+      kind == ProcessModelKind::kTf ? 0.0 : theta[static_cast<std::size_t>(ParameterCount(record) - 1)];
+  if (kind != ProcessModelKind::kTf && options.delay_profile && best_td < 2.0 * record.dt_s)
+    result->delay_profile_improved = ProfileDelay(record, options, &theta, &best);
+  if (kind != ProcessModelKind::kTf && options.bounds_refit)
+    result->bounds_refit_improved = RefitAtBounds(record, options, &theta, &best);
   // P2D's time constants are interchangeable: report Tp1 >= Tp2.
   if ((kind == ProcessModelKind::kP2D || kind == ProcessModelKind::kP2DZ) && theta[2] > theta[1])
     std::swap(theta[1], theta[2]);
-  const double best = *std::min_element(result->start_costs.begin(), result->start_costs.end());
   double scale = 0.0;
   for (double v : record.dy) scale += 0.5 * v * v;
   // Within 1e-8 of the best cost, relative; a record fitted exactly (best

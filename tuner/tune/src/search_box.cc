@@ -4,9 +4,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "pidlab/tune/spec_build.h"
 #include "pidlab/tune/tune.h"
 #include "pidlab/tune/tuning_rules.h"
+#include "spec_build.h"
 
 namespace pidlab::tune {
 

@@ -1,4 +1,4 @@
-#include "pidlab/tune/spec_build.h"
+#include "spec_build.h"
 
 #include <cmath>
 #include <sstream>

@@ -9,7 +9,7 @@
 
 namespace pidlab::results {
 
-/// model (p1d|p2d|p2du|p1di|p2dz), parameters {name: {value, standard_error}},
+/// model (p1d|p2d|p2du|p1di|p2dz), parameters {name: {value, standard_error, at_bound if at one}},
 /// transfer_function {num, den, delay_s}, fit_percent, aic, aic_form, cost,
 /// samples, dt_s (the mean interval), sampling {uniform, min_interval_s,
 /// max_interval_s}, u0, y0, starts, starts_at_best, seed, whiteness {lags,

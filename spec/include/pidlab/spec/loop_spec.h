@@ -7,7 +7,7 @@
 // the keywords of pidlab.evaluate and pidlab.tune (tools/python/), the JSON
 // form (`--spec FILE`, and the "spec" every --json result echoes; json.h),
 // and the field-table test. What the values mean, and their validation, is
-// one library function per spec (tuner/spec_build.h), which names a bad field
+// one library function per job (tuner/tune/problem.h), which names a bad field
 // as the front end does (NameStyle).
 //
 // Archive: any type with

@@ -66,9 +66,12 @@ bool ParseInitialCondition(const std::string& s, InitialCondition* v);
 std::string ToString(Intersample v);       // "zoh", "foh"
 std::string ToString(InitialCondition v);  // "zero", "steady-state", "estimate"
 
+/// The most starts a fit takes (IdentifyOptions::starts).
+inline constexpr int kMaxStarts = 1000;
+
 struct IdentifyOptions {
   /// Starts of the multi-start design (Sobol' points over the time constants,
-  /// Zeta and the delay, optim/sobol.h), >= 1.
+  /// Zeta and the delay, optim/sobol.h), in [1, kMaxStarts].
   int starts = 16;
   /// The design's digital shift (SobolSequence(d, seed)); 0: the unshifted
   /// sequence, whose first start is the lower corner of every range.
@@ -77,6 +80,20 @@ struct IdentifyOptions {
   /// regression of y on its past and on u delayed by the best of a scan),
   /// before the design's starts.
   bool arx_start = true;
+  /// Also start from the optimum of the model this kind contains (P2D from
+  /// P1D's, P2DU and P2DZ from P2D's), fitted first: a bigger model is then
+  /// never worse than the smaller one it contains.
+  bool nested_starts = true;
+  /// After the starts, profile the delay (Td held at 0, at fractions of the
+  /// best Td and at half samples around it, the rest refitted) and polish
+  /// from the lowest: the cost has kinks where Td crosses a sample, and a
+  /// start may stop at one, or short of Td = 0. Process models only.
+  bool delay_profile = true;
+  /// Then, if parameters end at a bound (Td at 0, Zeta at 1, a time constant
+  /// at dt / 1000, ...), hold them there and refit the others: Ceres projects
+  /// its steps onto the bounds and can stall there short of the optimum.
+  /// Process models only.
+  bool bounds_refit = true;
   /// The delay's upper bound as a fraction of the record's length, in (0, 1).
   double max_delay_fraction = 0.5;
   /// Levenberg-Marquardt iterations per start, >= 1.
@@ -154,12 +171,19 @@ struct IdentifyResult {
   /// transfer function): fitted with kEstimate, -A^-1 B (u[0] - u0) with
   /// kSteadyState, zeros with kZero.
   std::vector<double> initial_state;
-  int samples = 0;                  // N
-  int starts = 0;                   // starts run: the design's, plus the ARX start if used
-  bool arx_start = false;           // start_costs[0] is the ARX start
-  std::uint64_t seed = 0;           // the design's shift (IdentifyOptions::seed)
-  int starts_at_best = 0;           // starts whose cost is the best's within 1e-8 relative
-  std::vector<double> start_costs;  // final cost of every start, in design order
+  int samples = 0;                      // N
+  int starts = 0;                       // starts run: the design's, plus the ARX start if used
+  bool arx_start = false;               // start_costs[0] is the ARX start
+  std::uint64_t seed = 0;               // the design's shift (IdentifyOptions::seed)
+  int starts_at_best = 0;               // starts whose cost is the best's within 1e-8 relative
+  std::vector<double> start_costs;      // final cost of every start, in design order
+  int nested_starts = 0;                // starts from a contained model's optimum (after the ARX start)
+  bool delay_profile_improved = false;  // the delay's profile found a lower cost than every start
+  bool bounds_refit_improved = false;   // holding the parameters at a bound, the rest refitted, lowered it
+  /// For each parameter, "lower" or "upper" if it is at (within 1e-6 of) a
+  /// bound of the fit (Td at 0, Zeta at 1, a time constant at dt / 1000),
+  /// else "": its standard error is then NaN (a one-sided interval).
+  std::vector<std::string> at_bound;
   /// The model's output y0 + yhat_k at every sample, and y_k - that.
   std::vector<double> simulated, residuals;
   Whiteness whiteness;
@@ -186,7 +210,8 @@ struct AutoResult {
 /// record has at least kMinSamples samples, equal lengths, only finite
 /// values within kMaxRecordMagnitude, t strictly increasing by at least
 /// kMinRecordInterval, no u or y sample beyond kMaxOutlierRatio times its
-/// column's median absolute deviation from the median, and a non-constant u.
+/// column's median absolute deviation from the median. A constant u is not
+/// refused here: with a given u0 it is a step (Identify refuses it otherwise).
 /// Names the column and the sample:
 /// its line in the file where `rows` gives each sample's (ReadCsvData), else
 /// its index. Sets *sampling.
@@ -206,6 +231,10 @@ std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<d
 /// kRunnerFailed if no start converged.
 Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
                 IdentifyResult* result);
+/// The same, with the fit of the model `kind` contains given (nullptr: none):
+/// IdentifyAuto passes the kinds it fitted before.
+Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
+                const IdentifyResult* contained, IdentifyResult* result);
 
 /// A pole of the identified model with the standard errors of its real and
 /// imaginary parts (the delta method: the parameters' covariance carried

@@ -1,9 +1,11 @@
 #pragma once
-// What a spec (pidlab/spec/loop_spec.h) means: the plant, loop, gains,
-// bounds and tuning options it describes, validated in one place for every
-// front end. Each function returns false with *error naming the field as
-// `style` names it (a flag on the command line, a key in Python and JSON),
-// its value and the rule broken.
+// Internal to pidlab::tune: the steps of what a spec (pidlab/spec/loop_spec.h)
+// means: the plant, loop, gains, bounds and tuning options it describes. Front
+// ends do not chain them: they call the one function of their job
+// (pidlab/tune/problem.h: BuildEvaluation, BuildTuning, ...), which does. Each
+// step returns false with *error naming the field as `style` names it (a flag
+// on the command line, a key in Python and JSON), its value and the rule
+// broken. Unit tests of a step include this header (tests/CMakeLists.txt).
 
 #include <set>
 #include <string>

@@ -1,0 +1,174 @@
+#include "pidlab/tune/problem.h"
+
+#include <utility>
+
+#include "pidlab/tune/two_dof.h"
+#include "spec_build.h"
+
+namespace pidlab::tune {
+
+using spec::DisplayName;
+using spec::NameStyle;
+using spec::Quote;
+
+namespace {
+
+// A step's bool + message as the edge's Status.
+Status Checked(bool ok, const std::string& error) { return ok ? Status::Ok() : Status::InvalidInput(error); }
+
+// The refusals of Monte Carlo draws for this plant on this backend.
+Status CheckMonteCarlo(const EvaluationProblem& p, const BuildOptions& options) {
+  const auto name = [&options](const char* key) { return DisplayName(key, options.style); };
+  if (!p.HasMonteCarlo()) return Status::Ok();
+  if (options.backend == Backend::kRunner)
+    return Status::InvalidInput(name("monte_carlo") + " runs in process: use " + name("backend") + " local");
+  if (p.plant.delay_s > 0.0 && !p.plant.model)
+    return Status::InvalidInput(name("monte_carlo") + " with " + name("delay") +
+                                " is not supported yet (its draws are undelayed plants)");
+  if (p.plant.nonlinear)
+    return Status::InvalidInput(name("monte_carlo") + " draws linear plants: it does not take " +
+                                name("plant") + " " + Quote(p.plant.name));
+  return Status::Ok();
+}
+
+// The loop of `s` for `plant`: the one place a plant meets its loop (its dead
+// time needs the sampled loop and a bounded delay line at its dt).
+bool BuildLoopFor(const Plant& plant, const spec::LoopSpec& s, NameStyle style, evaluation::LoopOptions* loop,
+                  std::string* error) {
+  return BuildLoopOptions(s, style, loop, error) && CheckPlantInLoop(plant, *loop, style, error);
+}
+
+// With a runner (the trio), the sampled loop: a loop given otherwise is refused.
+Status SampledForRunner(const BuildOptions& options, spec::LoopSpec* loop) {
+  if (options.backend != Backend::kRunner) return Status::Ok();
+  if (options.given.count("loop") > 0 && loop->loop != "sampled")
+    return Status::InvalidInput(DisplayName("backend", options.style) + " lcm runs the sampled loop, not " +
+                                DisplayName("loop", options.style) + " " + Quote(loop->loop));
+  loop->loop = "sampled";
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status BuildEvaluation(const spec::EvaluateSpec& s, const BuildOptions& options, EvaluationProblem* problem) {
+  const NameStyle style = options.style;
+  EvaluationProblem p;
+  p.spec = s;
+  p.spec.plant.Normalize();
+  std::string error;
+  if (!BuildPlant(p.spec.plant, style, &p.plant, &error) ||
+      !BuildStepperParameters(p.spec.plant, style, &p.stepper, &error) ||
+      !BuildMonteCarlo(p.spec, style, &p.monte_carlo, &error))
+    return Status::InvalidInput(error);
+  // The command line says where gains come from; a key names the list.
+  if (p.spec.gains.empty() && style == NameStyle::kFlag)
+    return Status::InvalidInput("--gains is required (or --spec FILE)");
+  if (!BuildGains(p.spec.gains, style, &p.gains, &error)) return Status::InvalidInput(error);
+  if (Status sampled = SampledForRunner(options, &p.spec.loop); !sampled.ok()) return sampled;
+  if (!BuildLoopFor(p.plant, p.spec.loop, style, &p.loop, &error) ||
+      !BuildBounds(p.spec.bounds, style, &p.bounds, &error))
+    return Status::InvalidInput(error);
+  if (Status mc = CheckMonteCarlo(p, options); !mc.ok()) return mc;
+  *problem = std::move(p);
+  return Status::Ok();
+}
+
+Status RunEvaluation(const EvaluationProblem& problem, const EvaluationRunOptions& options,
+                     EvaluationResult* result) {
+  EvaluationResult r;
+  const Status evaluated = evaluation::EvaluateLoop(problem.plant, problem.gains, problem.loop, options.what,
+                                                    &r.evaluation, options.runner);
+  if (!evaluated.ok()) return evaluated;
+  std::string error;
+  if (!analysis::AnalyzeLoop(problem.plant, problem.gains, problem.loop, analysis::LoopAnalysisOptions{},
+                             &r.analysis, &error))
+    return Status::InvalidInput(error);
+  if (problem.HasMonteCarlo() && options.monte_carlo) {
+    const StepperMotorParameters* motor = problem.plant.name == "stepper_motor" ? &problem.stepper : nullptr;
+    if (!analysis::RunMonteCarlo(problem.plant, motor, problem.gains, problem.loop, problem.monte_carlo,
+                                 &r.monte_carlo, &error, options.monte_carlo_progress))
+      return Status::InvalidInput(error);
+    r.monte_carlo_ran = true;
+  }
+  *result = std::move(r);
+  return Status::Ok();
+}
+
+Status BuildPlantInLoop(const spec::PlantSpec& plant, const spec::LoopSpec& loop, NameStyle style, Plant* p,
+                        evaluation::LoopOptions* options) {
+  std::string error;
+  Plant built;
+  evaluation::LoopOptions l;
+  if (!BuildPlant(plant, style, &built, &error) || !BuildLoopFor(built, loop, style, &l, &error))
+    return Status::InvalidInput(error);
+  *p = std::move(built);
+  *options = l;
+  return Status::Ok();
+}
+
+Status BuildController(const spec::EvaluateSpec& s, NameStyle style, PidGains* gains,
+                       evaluation::LoopOptions* loop) {
+  std::string error;
+  PidGains g;
+  evaluation::LoopOptions l;
+  if (!BuildGains(s.gains, style, &g, &error) || !BuildLoopOptions(s.loop, style, &l, &error))
+    return Status::InvalidInput(error);
+  *gains = g;
+  *loop = l;
+  return Status::Ok();
+}
+
+Status BuildNonlinearStepper(const spec::PlantSpec& s, NameStyle style, NonlinearStepperOptions* out) {
+  std::string error;
+  return Checked(BuildNonlinearOptions(s, style, out, &error), error);
+}
+
+SearchBox ResolveTuningSpec(spec::TuningSpec* s, const std::set<std::string>& given) {
+  ResolveRobustPreset(s, given);
+  return ResolveSearchBox(s, given);
+}
+
+Status BuildTuning(const spec::TuningSpec& s, const BuildOptions& options, TuningProblem* problem) {
+  const auto name = [&options](const char* key) { return DisplayName(key, options.style); };
+  TuningProblem p;
+  p.spec = s;
+  p.spec.plant.Normalize();
+  p.box = ResolveTuningSpec(&p.spec, options.given);
+  std::string error;
+  if (!BuildPlant(p.spec.plant, options.style, &p.plant, &error) ||
+      !BuildTuneOptions(p.spec, options.style, &p.options, &error) ||
+      !BuildLoopFor(p.plant, p.spec.loop, options.style, &p.options.loop, &error))
+    return Status::InvalidInput(error);
+  const bool sampled = p.options.loop.loop == evaluation::LoopKind::kSampled;
+  if (p.plant.nonlinear && !sampled)
+    return Status::InvalidInput(
+        name("plant") + " " + p.plant.name + " is nonlinear: tune it on the sampled loop (" + name("loop") +
+        " sampled" + (options.style == NameStyle::kFlag ? " " + name("dt") + " 1e-4" : std::string()) + ")");
+  if (options.backend == Backend::kRunner && !sampled)
+    return Status::InvalidInput(name("backend") + " lcm runs the sampled loop: add " + name("loop") +
+                                " sampled");
+  *problem = std::move(p);
+  return Status::Ok();
+}
+
+Status RunTuning(const TuningProblem& problem, const TuningRunOptions& options, TuningResult* result) {
+  TuningResult r;
+  TuneOptions o = problem.options;
+  if (options.parallel_for) o.parallel_for = options.parallel_for;
+  std::string error;
+  const bool tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
+  if (tuned && r.summary.stable) {
+    // With two_dof, the loop with the setpoint weights found.
+    r.loop = WithSetpointWeights(problem.options.loop, r.summary.two_dof);
+    const Status evaluated = evaluation::EvaluateLoop(problem.plant, r.summary.gains, r.loop,
+                                                      evaluation::EvaluateOptions{}, &r.evaluation);
+    if (!evaluated.ok()) return evaluated;
+    if (!analysis::AnalyzeLoop(problem.plant, r.summary.gains, r.loop, analysis::LoopAnalysisOptions{},
+                               &r.analysis, &error))
+      return Status::InvalidInput(error);
+  }
+  *result = std::move(r);
+  return Checked(tuned, error);
+}
+
+}  // namespace pidlab::tune
