@@ -13,6 +13,7 @@
 #include "pidlab/controller_export/export.h"
 #include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/spec/loop_spec.h"
+#include "pidlab/tune/problem.h"
 
 using pidlab::controller_export::Controller;
 using pidlab::controller_export::Generate;
@@ -67,6 +68,7 @@ struct ExportCommand {
   SpecFlags flags;
   std::string from, lang, out, scalar = "double";
   std::vector<double> input_range;
+  bool force = false;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
@@ -90,6 +92,9 @@ struct ExportCommand {
                     "fixed point: LO,HI, the range of r and y the scalings are chosen for (outside it the "
                     "inputs saturate)")
         ->delimiter(',');
+    app->add_flag("--force", force,
+                  "write the module even when the plant's sampled loop at --dt is unstable (it is refused "
+                  "otherwise, exit 2)");
     return [this] { return Run(); };
   }
 
@@ -120,6 +125,18 @@ struct ExportCommand {
     return o;
   }
 
+  // The plant's sampled loop at dt, into the header; unstable: refused
+  // unless --force, which writes it with a warning.
+  void CheckLoop(const spec::EvaluateSpec& s, Options* options) const {
+    tune::SampledControllerCheck check;
+    Require(tune::CheckSampledController(s, NameStyle::kFlag, &check));
+    options->loop_check = check.verdict;
+    if (check.stable) return;
+    if (!force) throw BadInput(check.verdict);
+    std::cerr << "pidlab export: warning: " << check.verdict << " (written: --force)\n";
+    options->loop_check = "UNSTABLE, written with --force: " + check.verdict;
+  }
+
   int Run() {
     if (lang != "c") throw BadInput("--lang " + Quote(lang) + " is not supported (c is)");
     if (!from.empty() && flags.Given("spec")) throw BadInput("--from and --spec: give one");
@@ -129,7 +146,12 @@ struct ExportCommand {
     flags.Apply(&s, &given);
     s.plant.Normalize();
     const Controller controller = BuildController(s);
-    const Options options = BuildOptions(s);
+    Options options = BuildOptions(s);
+    options.dt_source = flags.Given("dt")     ? "given (--dt)"
+                        : !from.empty()       ? "from --from " + from
+                        : flags.Given("spec") ? "from the spec"
+                                              : "pidlab's default, not chosen (give --dt)";
+    CheckLoop(s, &options);
     PrepareOutputDir(out, "--out");
     GeneratedCode code;
     try {

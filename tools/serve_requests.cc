@@ -12,6 +12,7 @@
 #include "export_spec.h"
 #include "pidlab/report/report.h"
 #include "pidlab/spec/json.h"
+#include "pidlab/tune/problem.h"
 #endif
 
 namespace pidlab::cli {
@@ -62,6 +63,14 @@ server::Reply Export(const nlohmann::json& request) {
   if (!ExportController(s, spec::NameStyle::kKey, &controller, &error)) return {400, {{"error", error}}};
   controller_export::Options options;
   options.plant = DescribePlant(s.plant);
+  // The plant's sampled loop at dt, as pidlab export checks it.
+  tune::SampledControllerCheck check;
+  if (Status checked = tune::CheckSampledController(s, spec::NameStyle::kKey, &check); !checked.ok())
+    return {400, {{"error", checked.message()}}};
+  const bool force = request.contains("force") && request["force"].is_boolean() && request["force"].get<bool>();
+  if (!check.stable && !force) return {400, {{"error", check.verdict}, {"unstable", true}}};
+  options.dt_source = "from the spec";  // as pidlab export --spec says it
+  options.loop_check = check.stable ? check.verdict : "UNSTABLE, written with force: " + check.verdict;
   options.spec_json = SpecText(spec::ToJson(s));
   options.pidlab_version = PIDLAB_VERSION;
   controller_export::GeneratedCode code;
@@ -71,7 +80,9 @@ server::Reply Export(const nlohmann::json& request) {
     return {400, {{"error", e.what()}}};
   }
   return {200,
-          {{"type", "export"}, {"files", {{"pidlab_pid.h", code.header}, {"pidlab_pid.c", code.source}}}}};
+          {{"type", "export"},
+           {"loop_check", {{"checked", check.checked}, {"stable", check.stable}, {"verdict", check.verdict}}},
+           {"files", {{"pidlab_pid.h", code.header}, {"pidlab_pid.c", code.source}}}}};
 }
 #endif
 

@@ -82,7 +82,7 @@ else
 fi
 
 # ---- --from: an evaluation's --json output (its spec and gains).
-if "$pidlab" evaluate --plant oscillator --gains 1.5,0.75,0.25 --loop sampled --dt 0.002 --derivative-on measurement \
+if "$pidlab" evaluate --plant oscillator --gains 1.5,0.75,0.5 --loop sampled --dt 0.002 --derivative-on measurement \
   --output-limits -4,4 --json >evaluation.json 2>err.txt &&
   "$pidlab" export --from evaluation.json --lang c --out from >out.txt 2>err.txt; then
   if grep -q '1.5, /\* kp \*/' from/pidlab_pid.c && grep -q '0.002, /\* dt_s' from/pidlab_pid.c &&
@@ -128,6 +128,30 @@ bad "q15 without output limits" "--output-limits" --gains 1,1,1 --input-range -1
 bad "an empty input range" "input range" --gains 1,1,1 --output-limits -1,1 --input-range 1,1 --lang c --out x \
   --scalar q31
 bad "unwritable --out" "/proc/pidlab" --gains 1,1,1 --lang c --out /proc/pidlab
+
+# ---- The loop at dt: the paper's stepper gains (Table III's Nelder-Mead row)
+# at the default dt = 1 ms make the sampled loop unstable (a pole at |z| 2.18):
+# refused with exit 2 naming dt and the pole, nothing written; --force writes
+# it with a warning and says so in the header; at dt = 0.1 ms it is stable and
+# the header says where dt came from.
+paper=(--plant stepper --gains 0.0774,14.7575,14.9913 --lang c)
+bad "the stepper's sampled loop unstable at the default dt" "--dt 0.001 s" "${paper[@]}" --out unstable
+if [[ -e unstable/pidlab_pid.c ]]; then fail "an unstable loop was written"; else pass "an unstable loop: nothing written"; fi
+grep -q 'pole z = -0.957' bad.err && grep -q -- '--force' bad.err && pass "the refusal names the pole and --force" ||
+  fail "the refusal: $(cat bad.err)"
+if "$pidlab" export "${paper[@]}" --out forced --force >out.txt 2>err.txt &&
+  grep -q 'Loop at dt: UNSTABLE, written with --force' forced/pidlab_pid.h && grep -q 'warning' err.txt; then
+  pass "--force writes the unstable loop with a warning and says so in the header"
+else
+  fail "--force: $(cat err.txt)"
+fi
+if "$pidlab" export "${paper[@]}" --out fine --dt 1e-4 >out.txt 2>err.txt &&
+  grep -q 'Sample period dt 0.0001 s: given (--dt)' fine/pidlab_pid.h &&
+  grep -q 'Loop at dt: the sampled loop of plant stepper is stable' fine/pidlab_pid.h; then
+  pass "at dt = 0.1 ms the loop is stable, and the header says dt was given"
+else
+  fail "at dt = 0.1 ms: $(cat err.txt) $(grep -n 'Sample period\|Loop at' fine/pidlab_pid.h)"
+fi
 
 # ---- docs/export.md: the sh block's commands as written (pidlab on PATH),
 # the C block compiled against each floating-point module they wrote.

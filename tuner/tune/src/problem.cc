@@ -1,6 +1,10 @@
 #include "pidlab/tune/problem.h"
 
+#include <complex>
+#include <sstream>
 #include <utility>
+
+#include "pidlab/spec/field.h"
 
 #include "pidlab/tune/two_dof.h"
 #include "spec_build.h"
@@ -115,6 +119,62 @@ Status BuildController(const spec::EvaluateSpec& s, NameStyle style, PidGains* g
     return Status::InvalidInput(error);
   *gains = g;
   *loop = l;
+  return Status::Ok();
+}
+
+namespace {
+
+// The pole of largest modulus, as text: "z = a+bj (|z| = m)".
+std::string LargestPole(const evaluation::Stability& stability, double* modulus) {
+  std::complex<double> largest = 0.0;
+  for (const std::complex<double>& p : stability.poles)
+    if (std::abs(p) > std::abs(largest)) largest = p;
+  *modulus = std::abs(largest);
+  std::ostringstream os;
+  os << "z = " << spec::FormatNumber(largest.real());
+  if (largest.imag() != 0.0)
+    os << (largest.imag() < 0.0 ? "-" : "+") << spec::FormatNumber(std::abs(largest.imag())) << "j";
+  os << " (|z| = " << spec::FormatNumber(*modulus) << ")";
+  return os.str();
+}
+
+}  // namespace
+
+Status CheckSampledController(const spec::EvaluateSpec& s, NameStyle style, SampledControllerCheck* check) {
+  *check = SampledControllerCheck();
+  spec::EvaluateSpec e = s;
+  e.plant.Normalize();
+  if (e.plant.plant.empty()) {
+    check->verdict = "not checked (no plant given)";
+    return Status::Ok();
+  }
+  e.loop.loop = "sampled";
+  e.monte_carlo = 0;
+  EvaluationProblem problem;
+  BuildOptions build;
+  build.style = style;
+  if (Status built = BuildEvaluation(e, build, &problem); !built.ok()) return built;
+  if (problem.plant.nonlinear) {
+    check->verdict = "not checked (the nonlinear plant " + problem.plant.name +
+                     " has no closed-loop poles: run pidlab evaluate --loop sampled at this dt)";
+    return Status::Ok();
+  }
+  evaluation::EvaluateOptions what;
+  what.compute_step_info = false;
+  what.compute_iae_continuous = false;
+  evaluation::Evaluation ev;
+  if (Status run = evaluation::EvaluateLoop(problem.plant, problem.gains, problem.loop, what, &ev); !run.ok())
+    return run;
+  double modulus = 0.0;
+  const std::string pole = LargestPole(ev.stability, &modulus);
+  const std::string plant = "the sampled loop of plant " + problem.spec.plant.plant;
+  check->checked = true;
+  check->stable = ev.stability.stable;
+  check->verdict = check->stable ? plant + " is stable, largest pole " + pole
+                                 : DisplayName("dt", style) + " " + spec::FormatNumber(problem.loop.dt_s) +
+                                       " s: " + plant + " under these gains is unstable, pole " + pole +
+                                       ": choose a smaller " + DisplayName("dt", style) + ", or give " +
+                                       DisplayName("force", style) + " to write it anyway";
   return Status::Ok();
 }
 

@@ -60,6 +60,10 @@ struct Options {
   std::string spec_json;
   /// The pidlab version that generated it.
   std::string pidlab_version;
+  /// Where the period dt came from (e.g. "given: --dt"), for the header comment.
+  std::string dt_source;
+  /// What pidlab found of the plant's sampled loop at dt, for the header comment.
+  std::string loop_check;
 
   /// False with *error naming the field, its value and the rule broken.
   bool IsValid(std::string* error) const;

@@ -120,6 +120,25 @@ Status BuildPlantInLoop(const spec::PlantSpec& plant, const spec::LoopSpec& loop
 Status BuildController(const spec::EvaluateSpec& s, spec::NameStyle style, PidGains* gains,
                        evaluation::LoopOptions* loop);
 
+/// What `pidlab export` (and the workbench's export) found of the loop it writes.
+struct SampledControllerCheck {
+  /// False when nothing could be checked (no plant given; a nonlinear plant,
+  /// which has no closed-loop poles).
+  bool checked = false;
+  /// The sampled loop at dt is strictly stable (true when not checked).
+  bool stable = true;
+  /// One clause: what was found, e.g. "the sampled loop of plant stepper is
+  /// stable, largest pole z = 0.99 (|z| = 0.99)"; when unstable, the refusal
+  /// naming dt, the largest pole and the way out (a smaller dt, or `force`).
+  std::string verdict;
+};
+
+/// The spec's plant under the discrete PID at the spec's dt: the sampled
+/// loop's poles. kInvalidInput only for a spec that does not build (naming
+/// the field); an unstable loop is check->stable false, for the front end to
+/// refuse or, forced, to write with a warning.
+Status CheckSampledController(const spec::EvaluateSpec& s, spec::NameStyle style, SampledControllerCheck* check);
+
 /// The nonlinear stepper a plant spec describes (pidlab linearize).
 Status BuildNonlinearStepper(const spec::PlantSpec& s, spec::NameStyle style, NonlinearStepperOptions* out);
 
