@@ -55,6 +55,14 @@ void LoadResult(const std::string& path, spec::EvaluateSpec* s) {
   } else {
     throw BadInput("--from " + Quote(path) + ": " + error);
   }
+  // A tuning's setpoint weights (--two-dof, migo) go with its gains.
+  if (j.contains("two_dof") && j["two_dof"].is_object() && j["two_dof"].value("ran", false)) {
+    const auto& w = j["two_dof"]["setpoint_weights"];
+    if (!w.is_array() || w.size() != 2 || !w[0].is_number() || !w[1].is_number())
+      throw BadInput("--from " + Quote(path) + ": two_dof.setpoint_weights is not two numbers");
+    s->loop.setpoint_weights = {w[0].get<double>(), w[1].get<double>()};
+    s->loop.derivative_on = "error";  // c carries it
+  }
   s->gains.clear();
   for (const char* key : {"kp", "ki", "kd"}) {
     const auto it = j["gains"].find(key);

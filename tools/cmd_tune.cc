@@ -97,6 +97,11 @@ struct TuneCommand {
     } else {
       PrintText(o, s, result.evaluation, problem.box);
       if (s.stable) std::cout << FormatRobustness(result.analysis, o.bounds);
+      const pidlab::tune::TimeScale& t = problem.time_scale;
+      std::cout << "time scale       n = " << t.horizon_s << " s, ts = " << t.sample_time_s << " s ("
+                << t.source << "): " << t.reason << "\n";
+      if (o.method == pidlab::tune::TuneMethod::kMigo && !t.robustness_reason.empty())
+        std::cout << "robustness       Ms <= " << o.robustness_ms << ": " << t.robustness_reason << "\n";
     }
     return s.stable ? 0 : 1;
   }
@@ -132,6 +137,8 @@ struct TuneCommand {
               << o.lower << ", " << o.upper << "]^3, seed " << o.seed << "\n";
     if (o.method == pidlab::tune::TuneMethod::kSimc || o.method == pidlab::tune::TuneMethod::kAmigo)
       std::cout << "rule             " << s.tuning_rule.message << "\n";
+    if (o.method == pidlab::tune::TuneMethod::kMigo)
+      std::cout << "design           " << s.migo.message << "\n";
     if (!s.stable) {
       std::cout << "result           " << s.message << "\n";
       return;
@@ -167,7 +174,7 @@ struct TuneCommand {
       for (std::size_t i = 0; i < s.at_bounds.size(); ++i) std::cout << (i ? ", " : "") << s.at_bounds[i];
       std::cout << "  (an optimum on the box's edge: widen it with --bounds)\n";
     }
-    if (o.two_dof) PrintTwoDof(s.two_dof);
+    if (o.two_dof || s.two_dof.ran) PrintTwoDof(s.two_dof);
     std::cout << "wall time        " << s.wall_time_s << " s\n\n";
     std::cout << FormatEvaluation(ev);
   }

@@ -67,7 +67,8 @@ server::Reply Export(const nlohmann::json& request) {
   tune::SampledControllerCheck check;
   if (Status checked = tune::CheckSampledController(s, spec::NameStyle::kKey, &check); !checked.ok())
     return {400, {{"error", checked.message()}}};
-  const bool force = request.contains("force") && request["force"].is_boolean() && request["force"].get<bool>();
+  const bool force =
+      request.contains("force") && request["force"].is_boolean() && request["force"].get<bool>();
   if (!check.stable && !force) return {400, {{"error", check.verdict}, {"unstable", true}}};
   options.dt_source = "from the spec";  // as pidlab export --spec says it
   options.loop_check = check.stable ? check.verdict : "UNSTABLE, written with force: " + check.verdict;

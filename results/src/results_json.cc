@@ -197,7 +197,16 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
         {"perturbed", s.robust_perturbed},
         {"nominal_objective", JsonNumber(s.nominal_objective)}};
   if (s.stable) AddMotor(ev, &j);
-  if (o.two_dof) j["two_dof"] = TwoDofJson(s.two_dof);
+  if (o.two_dof || s.two_dof.ran) j["two_dof"] = TwoDofJson(s.two_dof);
+  if (o.method == TuneMethod::kMigo)
+    j["migo"] = {{"robustness", o.robustness_ms},
+                 {"response_time_s", o.response_time_s},
+                 {"ms", JsonNumber(s.migo.ms)},
+                 {"mt", JsonNumber(s.migo.mt)},
+                 {"crossover_rad_s", JsonNumber(s.migo.crossover_rad_s)},
+                 {"setpoint_weight_b", s.migo.b},
+                 {"setpoint_weight_c", s.migo.c},
+                 {"message", s.migo.message}};
   return j;
 }
 

@@ -145,7 +145,8 @@ std::vector<std::string> CommentLines(const Options& o, const Controller& c) {
   l.push_back("  output limits [" + Number(c.pid.output_min) + ", " + Number(c.pid.output_max) +
               "], anti-windup " + ToString(c.pid.anti_windup) + " (back-calculation gain " +
               Number(c.pid.back_calculation_gain) + " 1/s), integral " + ToString(c.pid.integral) + ".");
-  if (!o.dt_source.empty()) l.push_back("Sample period dt " + Number(c.pid.dt_s) + " s: " + o.dt_source + ".");
+  if (!o.dt_source.empty())
+    l.push_back("Sample period dt " + Number(c.pid.dt_s) + " s: " + o.dt_source + ".");
   if (!o.loop_check.empty()) l.push_back("Loop at dt: " + o.loop_check + ".");
   if (!o.spec_json.empty()) {
     l.push_back("");

@@ -1,11 +1,12 @@
 #include "pidlab/tune/problem.h"
 
+#include <cmath>
 #include <complex>
 #include <sstream>
 #include <utility>
 
 #include "pidlab/spec/field.h"
-
+#include "pidlab/tune/tuning_rules.h"
 #include "pidlab/tune/two_dof.h"
 #include "spec_build.h"
 
@@ -183,7 +184,122 @@ Status BuildNonlinearStepper(const spec::PlantSpec& s, NameStyle style, Nonlinea
   return Checked(BuildNonlinearOptions(s, style, out, &error), error);
 }
 
-SearchBox ResolveTuningSpec(spec::TuningSpec* s, const std::set<std::string>& given) {
+bool IsPaperPlant(const spec::PlantSpec& p) {
+  for (const std::string& name : BuiltinPlantNames())
+    if (p.plant == name) return true;
+  return false;
+}
+
+namespace {
+
+// The design's closed loop (or the plant's own times) as a time scale, its
+// spacing a multiple of dt on the sampled loop.
+TimeScale DerivedTimeScale(const spec::TuningSpec& s, const Plant& plant) {
+  double fastest = 0.0, slowest = 0.0;
+  PlantTimes(plant, &fastest, &slowest);
+  MigoOptions o;
+  o.ms = s.tune.robustness > 1.0 && s.tune.robustness <= 4.0 ? s.tune.robustness : kMigoDefaultMs;
+  o.response_time_s = s.tune.response_time_s > 0.0 ? s.tune.response_time_s : 0.0;
+  MigoDesign design;
+  analysis::LoopAnalysis a;
+  std::string from = "the plant's own time constants";
+  if (!plant.nonlinear && DesignMigo(plant, o, &design).ok()) {
+    evaluation::LoopOptions loop;
+    if (analysis::AnalyzeLoop(plant, design.gains, loop, analysis::LoopAnalysisOptions{}, &a, nullptr) &&
+        a.stable && std::isfinite(a.slowest_time_constant_s) && design.crossover_rad_s > 0.0) {
+      slowest = a.slowest_time_constant_s;
+      fastest = std::min(fastest, 1.0 / design.crossover_rad_s);
+      from = "the migo design's closed loop";
+    }
+  }
+  TimeScale t = LoopTimeScale(fastest, slowest, plant.delay_s);
+  if (s.loop.loop == "sampled" && s.loop.dt_s > 0.0) {
+    const double k = std::max(1.0, std::round(t.sample_time_s / s.loop.dt_s));
+    t.sample_time_s = k * s.loop.dt_s;
+    t.horizon_s = std::ceil(t.horizon_s / t.sample_time_s - 1e-9) * t.sample_time_s;
+  }
+  t.reason = from + ": " + t.reason;
+  return t;
+}
+
+// migo's default bound: SIMC's (tau_c = L) Ms on the plant, with the
+// derivative filter migo uses, clamped to [kMigoMinDefaultMs,
+// kMigoMaxDefaultMs]; kMigoMaxDefaultMs where SIMC does not apply.
+double DefaultRobustness(const Plant& plant, std::string* why) {
+  TuningRuleResult simc;
+  analysis::LoopAnalysis a;
+  evaluation::LoopOptions loop;
+  loop.derivative_filter_ratio = kMigoFilterRatio;
+  if (plant.nonlinear || !ApplyTuningRule(plant, TuningRule::kSimc, RuleForm::kPid, &simc).ok() ||
+      !analysis::AnalyzeLoop(plant, simc.gains, loop, analysis::LoopAnalysisOptions{}, &a, nullptr) ||
+      !a.stable || !std::isfinite(a.ms)) {
+    *why = "at most " + spec::FormatNumber(kMigoMaxDefaultMs) + " (SIMC does not apply to this plant)";
+    return kMigoMaxDefaultMs;
+  }
+  const double ms = std::clamp(a.ms, kMigoMinDefaultMs, kMigoMaxDefaultMs);
+  *why = "SIMC's (tau_c = L) Ms on this plant, " + spec::FormatNumber(a.ms) + ", within [" +
+         spec::FormatNumber(kMigoMinDefaultMs) + ", " + spec::FormatNumber(kMigoMaxDefaultMs) + "]";
+  return ms;
+}
+
+// Method, filter and time scale from a plant other than the paper's.
+TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>& given) {
+  const auto kept = [&given](const char* key) { return given.count(key) > 0; };
+  TimeScale t;
+  t.horizon_s = s->loop.horizon_s;
+  t.sample_time_s = s->loop.sample_time_s;
+  const bool paper = IsPaperPlant(s->plant);
+  const bool timed = kept("horizon") || kept("sample_time");
+  if (!paper && !kept("method")) s->tune.method = "migo";
+  // A rule's or migo's PID gets a filter (migo designs with tf = Td / 10).
+  const bool rule = s->tune.method == "migo" || s->tune.method == "simc" || s->tune.method == "amigo";
+  if (rule && s->tune.rule == "pid" && !kept("derivative_filter") && !kept("derivative_filter_ratio") &&
+      !kept("robust") && (!paper || s->tune.method == "migo")) {
+    s->loop.derivative_filter_s = 0.0;
+    s->loop.derivative_filter_ratio = kMigoFilterRatio;
+  }
+  if (paper) {
+    // Given as eq. (4) has them (a result's echo): eq. (4) still.
+    const spec::LoopSpec defaults;
+    const bool eq4 =
+        s->loop.horizon_s == defaults.horizon_s && s->loop.sample_time_s == defaults.sample_time_s;
+    t.source = eq4 ? "eq. (4)" : "given";
+    t.reason = eq4 ? "the paper's eq. (4): n = 25 s, ts = 0.05 s" : "given";
+    return t;
+  }
+  Plant plant;
+  std::string error;
+  if (!BuildPlant(s->plant, NameStyle::kKey, &plant, &error)) {
+    if (timed) t.source = t.reason = "given";
+    return t;
+  }
+  if (s->tune.method == "migo" && !kept("robustness")) {
+    s->tune.robustness = DefaultRobustness(plant, &t.robustness_reason);
+  } else {
+    t.robustness_reason = "given";
+  }
+  const std::string reason = t.robustness_reason;
+  const TimeScale derived = DerivedTimeScale(*s, plant);
+  if (timed) {
+    // Given as the plant gives them (a result's echo): the plant's still.
+    const bool same =
+        s->loop.horizon_s == derived.horizon_s && s->loop.sample_time_s == derived.sample_time_s;
+    if (!same) t.source = t.reason = "given";
+    if (same) t = TimeScale(derived), t.robustness_reason = reason;
+    return t;
+  }
+  s->loop.horizon_s = derived.horizon_s;
+  s->loop.sample_time_s = derived.sample_time_s;
+  t = derived;
+  t.robustness_reason = reason;
+  return t;
+}
+
+}  // namespace
+
+SearchBox ResolveTuningSpec(spec::TuningSpec* s, const std::set<std::string>& given, TimeScale* time_scale) {
+  const TimeScale t = ResolvePlantDefaults(s, given);
+  if (time_scale) *time_scale = t;
   ResolveRobustPreset(s, given);
   return ResolveSearchBox(s, given);
 }
@@ -193,7 +309,7 @@ Status BuildTuning(const spec::TuningSpec& s, const BuildOptions& options, Tunin
   TuningProblem p;
   p.spec = s;
   p.spec.plant.Normalize();
-  p.box = ResolveTuningSpec(&p.spec, options.given);
+  p.box = ResolveTuningSpec(&p.spec, options.given, &p.time_scale);
   std::string error;
   if (!BuildPlant(p.spec.plant, options.style, &p.plant, &error) ||
       !BuildTuneOptions(p.spec, options.style, &p.options, &error) ||

@@ -380,7 +380,7 @@ bool BuildSearch(const spec::TuneSpec& t, NameStyle style, TuneOptions* o, std::
     return Bad(
         error,
         name("method") + " " + Quote(t.method) +
-            " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga, pso-gsa, simc or amigo");
+            " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga, pso-gsa, simc, amigo or migo");
   if (!evaluation::ParseObjectiveKind(t.objective, &o->objective))
     return Bad(error, name("objective") + " " + Quote(t.objective) +
                           " must be iae, ise, itae, iae-continuous, load-iae or setpoint-load");
@@ -404,6 +404,14 @@ bool BuildSearch(const spec::TuneSpec& t, NameStyle style, TuneOptions* o, std::
   o->refine_starts = t.refine_starts;
   o->adaptive = t.adaptive;
   o->two_dof = t.two_dof;
+  o->robustness_ms = t.robustness;
+  o->response_time_s = t.response_time_s;
+  if (!(t.robustness > 1.0 && t.robustness <= 4.0))
+    return Bad(error, name("robustness") + " " + spec::FormatNumber(t.robustness) +
+                          " must be an Ms bound in (1, 4]");
+  if (!(t.response_time_s >= 0.0) || !std::isfinite(t.response_time_s))
+    return Bad(error, name("response_time") + " " + spec::FormatNumber(t.response_time_s) +
+                          " must be >= 0 and finite (s)");
   o->max_overshoot_pct = t.max_overshoot_pct;
   o->max_settling_time_s = t.max_settling_s;
   o->agree_tolerance = t.agree_tolerance;

@@ -12,6 +12,7 @@
 #include "pidlab/optim/nelder_mead.h"
 #include "pidlab/optim/paper_nelder_mead.h"
 #include "pidlab/optim/pso_gsa.h"
+#include "pidlab/spec/field.h"
 #include "pidlab/tune/search_box.h"
 
 namespace pidlab::tune {
@@ -33,6 +34,8 @@ bool ParseTuneMethod(const std::string& s, TuneMethod* method) {
     *method = TuneMethod::kSimc;
   else if (s == "amigo")
     *method = TuneMethod::kAmigo;
+  else if (s == "migo")
+    *method = TuneMethod::kMigo;
   else
     return false;
   return true;
@@ -56,12 +59,15 @@ std::string ToString(TuneMethod method) {
       return "simc";
     case TuneMethod::kAmigo:
       return "amigo";
+    case TuneMethod::kMigo:
+      return "migo";
   }
   return "multi-start";
 }
 
 bool IsTuningRule(TuneMethod method) {
-  return method == TuneMethod::kZieglerNichols || method == TuneMethod::kSimc || method == TuneMethod::kAmigo;
+  return method == TuneMethod::kZieglerNichols || method == TuneMethod::kSimc ||
+         method == TuneMethod::kAmigo || method == TuneMethod::kMigo;
 }
 
 std::string ToString(RefineTermination termination) {
@@ -112,6 +118,9 @@ bool TuneOptions::IsValid(std::string* error) const {
   std::ostringstream os;
   if (!std::isfinite(lower) || !std::isfinite(upper) || lower < 0.0 || !(lower < upper) || upper > kMaxGain)
     os << "bounds [" << lower << ", " << upper << "] must be finite with 0 <= lower < upper <= " << kMaxGain;
+  else if (method == TuneMethod::kMigo && rule == RuleForm::kPid && !(loop.derivative_filter_ratio > 0.0))
+    os << "migo's PID designs its derivative filter as tf = Td / N: give a derivative filter ratio N "
+          "(--derivative-filter-ratio 10; the command line sets it when no filter is given)";
   else if (!start.empty() && (start.size() != 3 || std::any_of(start.begin(), start.end(), [this](double g) {
                                 return !(g >= lower && g <= upper);
                               })))
@@ -175,6 +184,7 @@ int TuneOptions::EvaluationBudget() const {
     case TuneMethod::kZieglerNichols:
     case TuneMethod::kSimc:
     case TuneMethod::kAmigo:
+    case TuneMethod::kMigo:
       break;
   }
   return 1;
@@ -349,6 +359,19 @@ bool RuleSearch(const Plant& plant, const TuneOptions& options,
   return true;
 }
 
+// The MIGO design (migo.h) into summary->migo, ->two_dof and ->optimizer.
+bool MigoSearch(const Plant& plant, const TuneOptions& options,
+                const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary, std::string* error) {
+  const MigoOptions o{options.robustness_ms, options.rule == RuleForm::kPi, options.response_time_s,
+                      options.migo_max_overshoot_pct,
+                      options.loop.derivative_filter_ratio > 0.0 ? options.loop.derivative_filter_ratio
+                                                                 : kMigoFilterRatio};
+  const Status status = DesignMigoForSetpoint(plant, options.loop, o, &summary->migo, &summary->two_dof);
+  if (!status.ok() && error) *error = status.message();
+  if (status.ok()) RuleResult(summary->migo.gains, evaluator, summary->migo.message, &summary->optimizer);
+  return status.ok();
+}
+
 // Runs options.method on f over the gain box into summary->optimizer
 // (Ziegler-Nichols, SIMC, AMIGO: the rule's gains, evaluated once). False
 // with *error if the rule does not apply.
@@ -415,6 +438,8 @@ bool Search(const Plant& plant, const TuneOptions& options, const optim::Objecti
     case TuneMethod::kSimc:
     case TuneMethod::kAmigo:
       return RuleSearch(plant, options, evaluator, summary, error);
+    case TuneMethod::kMigo:
+      return MigoSearch(plant, options, evaluator, summary, error);
   }
   return true;
 }

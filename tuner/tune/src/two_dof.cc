@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/evaluation/evaluation.h"
@@ -90,6 +91,43 @@ bool TuneSetpointWeights(const Plant& plant, const PidGains& gains, const evalua
   summary->b = best(0);
   summary->c = best(1);
   if (!Respond(plant, gains, loop, summary->b, summary->c, &summary->after, error)) return false;
+  summary->ran = true;
+  return true;
+}
+
+bool SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
+                                const evaluation::LoopOptions& loop, double c, double max_overshoot_pct,
+                                TwoDofSummary* summary, std::string* error) {
+  *summary = TwoDofSummary();
+  if (!Respond(plant, gains, loop, 1.0, c, &summary->before, error)) return false;
+  summary->evaluations = 1;
+  double b = 1.0;
+  if (!(summary->before.overshoot_pct <= max_overshoot_pct)) {
+    // The overshoot alone (no analysis: the weights move no pole).
+    const auto overshoot = [&](double weight) {
+      evaluation::LoopOptions o = Weighted(loop, weight, c);
+      o.disturbance = DisturbanceOptions{};
+      evaluation::EvaluateOptions what;
+      what.compute_iae_continuous = false;
+      evaluation::Evaluation ev;
+      ++summary->evaluations;
+      if (!evaluation::Evaluate(plant, gains, o, what, &ev, nullptr) || !ev.stability.stable) return kInf;
+      return ev.step.overshoot_pct;
+    };
+    double lo = 0.0, hi = 1.0;
+    for (int i = 0; i < 8; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (overshoot(mid) <= max_overshoot_pct ? lo : hi) = mid;
+    }
+    b = lo;
+  }
+  if (!Respond(plant, gains, loop, b, c, &summary->after, error)) return false;
+  summary->b = b;
+  summary->c = c;
+  summary->termination = optim::TerminationType::kConverged;
+  std::ostringstream os;
+  os << "b for a setpoint overshoot <= " << max_overshoot_pct << " % (bisection), c = " << c;
+  summary->message = os.str();
   summary->ran = true;
   return true;
 }

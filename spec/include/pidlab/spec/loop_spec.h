@@ -276,13 +276,15 @@ struct TuneSpec {
   int robust_samples = 0;
   double robust_quantile = 1.0, robust_spread = 0.1;
   bool two_dof = false;
+  double robustness = 1.4, response_time_s = 0.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(
         {"method",
          "multi-start (Sobol' design + Nelder-Mead polish) | nelder-mead | paper-nm | ziegler-nichols | ga | "
-         "pso-gsa | simc | amigo (tuning rules on a reduced model, docs/tuning.md)",
+         "pso-gsa | simc | amigo (tuning rules on a reduced model) | migo (the largest ki under an Ms "
+         "bound; the default on plants other than the paper's three, docs/tuning.md)",
          "", kNone, R"("nelder-mead")"},
         &method);
     a->Visit({"objective",
@@ -346,6 +348,17 @@ struct TuneSpec {
               "minimising the setpoint step's IAE with the gains fixed; the result reports both responses",
               "", kNone, "true"},
              &two_dof);
+    a->Visit(
+        {"robustness",
+         "migo: the bound on Ms and Mt, in (1, 4]: lower is more robust and slower (not given: SIMC's Ms "
+         "on the plant, within [1.4, 1.6]; 1.4 is a gain margin >= 3.5 and a phase margin >= 41 deg)",
+         "", kNone, "1.6"},
+        &robustness);
+    a->Visit({"response_time",
+              "migo: a slower design than --robustness allows, the loop's gain crossover at most 2/T (0 = as "
+              "fast as the bound allows)",
+              "s", kNone, "5"},
+             &response_time_s);
   }
 };
 

@@ -27,6 +27,7 @@
 #include "pidlab/optim/optimizer.h"
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/spec/status.h"
+#include "pidlab/tune/migo.h"
 #include "pidlab/tune/search_box.h"
 #include "pidlab/tune/tune.h"
 
@@ -137,21 +138,38 @@ struct SampledControllerCheck {
 /// loop's poles. kInvalidInput only for a spec that does not build (naming
 /// the field); an unstable loop is check->stable false, for the front end to
 /// refuse or, forced, to write with a warning.
-Status CheckSampledController(const spec::EvaluateSpec& s, spec::NameStyle style, SampledControllerCheck* check);
+Status CheckSampledController(const spec::EvaluateSpec& s, spec::NameStyle style,
+                              SampledControllerCheck* check);
 
 /// The nonlinear stepper a plant spec describes (pidlab linearize).
 Status BuildNonlinearStepper(const spec::PlantSpec& s, spec::NameStyle style, NonlinearStepperOptions* out);
 
 // ---- Tune: gains for a plant (pidlab tune, pidlab.tune, the workbench's tune).
 
-/// Resolves what a tuning spec leaves to the plant and the preset: with
-/// `robust`, every preset field not in `given` takes the preset's value
-/// (objective setpoint-load, load weight 1, derivative filter ratio 10, Ms <=
-/// 1.6, slowest time constant <= horizon / 10); with no `bounds` given, the
-/// box from the plant's scale (search_box.h). The spec then says what runs,
-/// so its echo runs again to the same tuning. Nothing is validated (a plant
-/// that does not build keeps the default box). Returns the box and its source.
-SearchBox ResolveTuningSpec(spec::TuningSpec* s, const std::set<std::string>& given);
+/// True for the paper's three plants (and the nonlinear stepper), whose
+/// defaults are the paper's: eq. (4)'s 25 s at 0.05 s, the multi-start on
+/// the IAE.
+bool IsPaperPlant(const spec::PlantSpec& p);
+
+/// Resolves what a tuning spec leaves to the plant and the preset, in this
+/// order (docs/tuning.md, "Any plant"):
+/// - on a plant other than the paper's, with no `method` given, the method
+///   migo; a PID of migo, simc or amigo with no derivative filter given gets
+///   derivative_filter_ratio 10;
+/// - with neither `horizon` nor `sample_time` given, on a plant other than
+///   the paper's, the time scale of the migo design's closed loop
+///   (LoopTimeScale; the plant's own times where migo does not apply); on a
+///   sampled loop the spacing is a multiple of dt;
+/// - with `robust`, every preset field not in `given` takes the preset's
+///   value (objective setpoint-load, load weight 1, derivative filter ratio
+///   10, Ms <= 1.6, slowest time constant <= horizon / 10);
+/// - with no `bounds` given, the box from the plant's scale (search_box.h).
+/// The spec then says what runs, so its echo runs again to the same tuning.
+/// Nothing is validated (a plant that does not build keeps the defaults).
+/// Returns the box and its source; *time_scale (may be null) the time scale
+/// and its source.
+SearchBox ResolveTuningSpec(spec::TuningSpec* s, const std::set<std::string>& given,
+                            TimeScale* time_scale = nullptr);
 
 /// A tuning spec resolved, built and checked.
 struct TuningProblem {
@@ -159,6 +177,8 @@ struct TuningProblem {
   spec::TuningSpec spec;
   /// The gain box and where it came from.
   SearchBox box;
+  /// The horizon and sample spacing and where they came from.
+  TimeScale time_scale;
   Plant plant;
   TuneOptions options;
 };

@@ -15,6 +15,7 @@
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/optim/multi_start.h"
 #include "pidlab/optim/optimizer.h"
+#include "pidlab/tune/migo.h"
 #include "pidlab/tune/tuning_rules.h"
 #include "pidlab/tune/two_dof.h"
 #include "pidlab/tune/ziegler_nichols.h"
@@ -36,8 +37,9 @@ enum class TuneMethod {
   kPsoGsa,
   kSimc,   // Skogestad's SIMC rule on a reduced model (tuning_rules.h)
   kAmigo,  // Astrom and Hagglund's AMIGO rule on a reduced model (tuning_rules.h)
+  kMigo,   // the largest ki under an Ms bound, on the frequency response (migo.h)
 };
-/// multi-start | nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa | simc | amigo
+/// multi-start | nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa | simc | amigo | migo
 bool ParseTuneMethod(const std::string& s, TuneMethod* method);
 std::string ToString(TuneMethod method);
 /// True for the methods that compute their gains by a rule and evaluate them
@@ -132,8 +134,13 @@ struct TuneOptions {
   double agree_tolerance = 1e-3;
   /// Ziegler-Nichols rule (ziegler-nichols only).
   ZieglerNicholsRule zn_rule = ZieglerNicholsRule::kClassic;
-  /// PI or PID (simc and amigo only).
+  /// PI or PID (simc, amigo and migo only).
   RuleForm rule = RuleForm::kPid;
+  /// migo: the bound on Ms and Mt, the response time (0: as fast as the
+  /// bound allows) and the setpoint overshoot its weight b allows.
+  double robustness_ms = kMigoDefaultMs;
+  double response_time_s = 0.0;
+  double migo_max_overshoot_pct = 20.0;
   /// Runs independent evaluations at the same time (e.g. one thread per LCM
   /// trio): the starts of multi-start Nelder-Mead, each generation of GA and
   /// PSO-GSA. Empty: one after the other. The result is the same bits either
@@ -262,6 +269,7 @@ struct TuneSummary {
   std::vector<optim::LocalMinimum> local_minima;
   ZieglerNicholsResult ziegler_nichols;  // ziegler-nichols only
   TuningRuleResult tuning_rule;          // simc and amigo only: the model and the rule's controller
+  MigoDesign migo;                       // migo only: the design's peaks and crossover
   RefineSummary refine;
   /// With a robust set (TuneOptions::robust_samples > 0): its size (nominal
   /// plus the valid draws), the draws whose parameters gave no valid plant

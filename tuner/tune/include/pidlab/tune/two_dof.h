@@ -48,6 +48,14 @@ inline constexpr int kTwoDofMaxEvaluations = 200;
 bool TuneSetpointWeights(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& loop,
                          TwoDofSummary* summary, std::string* error);
 
+/// The setpoint weight b in [0, 1] with c fixed: 1 if the setpoint step's
+/// overshoot is at most `max_overshoot_pct` there, else the largest b (by
+/// bisection, 12 steps) whose overshoot is within it (tune --method migo's
+/// second stage). Fills *summary as TuneSetpointWeights does.
+bool SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
+                                const evaluation::LoopOptions& loop, double c, double max_overshoot_pct,
+                                TwoDofSummary* summary, std::string* error);
+
 /// `loop` with the weights of `summary` when it ran.
 evaluation::LoopOptions WithSetpointWeights(evaluation::LoopOptions loop, const TwoDofSummary& summary);
 

@@ -1,0 +1,143 @@
+#!/usr/bin/env bash
+# Any plant, one command (docs/tuning.md, "Any plant: the MIGO design"): the
+# section's commands as written, and on the newcomer's plants the default tune
+# is migo, with a filter, a stable loop settled within a time scale taken from
+# the plant, Ms within its bound (SIMC's, within [1.4, 1.6]), overshoot at most
+# 30 %, a load integral below SIMC's at an Ms no higher; the knobs move the
+# design; the paper's plants keep eq. (4) and the multi-start; bad knob values
+# exit 2 with one line.
+#   any_plant_cli_test.sh PIDLAB_BINARY TUNING_MD
+set -uo pipefail
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
+pidlab=$(realpath -- "$1")
+doc=$(realpath -- "$2")
+pass=0; fail=0
+check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" || exit 1
+
+# ---- docs/tuning.md's "Any plant" commands as written (pidlab on PATH).
+mkdir bin && ln -s "$pidlab" bin/pidlab
+awk '/^## Any plant/{on=1} /^## Tuning rules/{on=0} on' "$doc" |
+  awk '/^```sh$/{on=1; next} /^```$/{on=0} on' >commands.sh
+check "the section has its five commands" "[ \$(grep -c '^pidlab tune' commands.sh) -eq 5 ]"
+i=0
+while IFS= read -r line; do
+  i=$((i + 1))
+  check "docs: $line" "PATH=\"$tmp/bin:\$PATH\" bash -c '$line' > doc$i.out 2> doc$i.err"
+done < <(grep '^pidlab ' commands.sh)
+
+# ---- The newcomer's plants with only their flags.
+verify() {  # name, json, simc json or ''
+  /usr/bin/python3 - "$2" "$3" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j['method'] == 'migo', j['method']
+assert j['stable'] is True, 'unstable'
+g = j['gains']
+assert g['kd'] > 0 and abs(g['tf'] - g['kd'] / (10 * g['kp'])) < 1e-12 * g['tf'], g
+ms = j['robustness']['ms']
+bound = j['migo']['robustness']
+assert 1.4 <= bound <= 1.6 and 1.1 <= ms <= bound * (1 + 1e-3), (ms, bound)
+assert j['overshoot_pct'] <= 30, j['overshoot_pct']
+t = j['time_scale']
+assert t['source'] == 'plant' and t['horizon_s'] == j['spec']['horizon'] and t['sample_time_s'] == j['spec']['sample_time'], t
+assert j['settling_time_s'] < t['horizon_s'] / 2, (j['settling_time_s'], t)
+b, c = j['two_dof']['setpoint_weights']
+assert c == 0 and 0 <= b <= 1 and j['migo']['setpoint_weight_b'] == b, j['two_dof']
+if sys.argv[2]:
+    s = json.load(open(sys.argv[2]))
+    s_ms = s['robustness']['ms']
+    load, s_load = j['load_iae'] * t['sample_time_s'], s['load_iae'] * s['spec']['sample_time']
+    assert ms <= s_ms + 1e-3 and load < s_load, (ms, s_ms, load, s_load)
+PY
+}
+for case in "fopdt|--num 1 --den 10,1 --delay 2" "thermal|--num 2 --den 60,1 --delay 8"; do
+  name=${case%%|*}; flags=${case#*|}
+  # shellcheck disable=SC2086
+  "$pidlab" tune $flags --json > $name.json 2>$name.err
+  check "$name: tune $flags exits 0" "[ $? -eq 0 ]"
+  n=$(/usr/bin/python3 -c "import json;s=json.load(open('$name.json'))['spec'];print(s['horizon'],s['sample_time'])")
+  # shellcheck disable=SC2086
+  "$pidlab" tune $flags --method simc --rule pi --horizon ${n% *} --sample-time ${n#* } --json > $name.simc.json
+  check "$name: migo, filtered, stable, Ms within SIMC's bound, overshoot <= 30 %, settled, load below SIMC's" \
+    "verify $name $name.json $name.simc.json"
+  # shellcheck disable=SC2086
+  "$pidlab" tune --spec $name.json --json > $name.again.json
+  check "$name: the echoed spec runs again to the same gains and time scale" "/usr/bin/python3 - <<'PY'
+import json
+a, b = json.load(open('$name.json')), json.load(open('$name.again.json'))
+assert a['gains'] == b['gains'] and a['time_scale'] == b['time_scale'], (a['gains'], b['gains'], b['time_scale'])
+PY"
+done
+
+# ---- export --from takes the design's setpoint weights with its gains, at a dt
+# where the loop is stable.
+"$pidlab" export --from fopdt.json --dt 0.01 --lang c --out fw > export.out 2> export.err
+check "export --from the design: its gains and b, c = 0 in the C, the loop checked stable at dt" "/usr/bin/python3 - <<'PY'
+import json, re
+j = json.load(open('fopdt.json'))
+c = open('fw/pidlab_pid.c').read()
+h = open('fw/pidlab_pid.h').read()
+b = j['two_dof']['setpoint_weights'][0]
+assert 'Loop at dt: the sampled loop of plant custom is stable' in h, h[:2000]
+m = re.search(r'Tuned: kp ([^,]+), ki ([^,]+), kd ([^,]+), tf ([^ ]+) s, b ([^,]+), c ([^,]+),', h)
+assert m and abs(float(m.group(5)) - b) < 1e-6 * max(1, b) and float(m.group(6)) == 0, m and m.groups()
+assert abs(float(m.group(1)) - j['gains']['kp']) < 1e-5 * j['gains']['kp'], m.groups()
+PY"
+
+# ---- The knobs: a tighter bound is slower and more robust; a response time
+# slows the crossover to 2/T.
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --robustness 1.3 --json > tight.json
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --response-time 20 --json > slow.json
+check "--robustness 1.3: Ms <= 1.3, and a smaller ki than the default" "/usr/bin/python3 - <<'PY'
+import json
+d, t = json.load(open('fopdt.json')), json.load(open('tight.json'))
+assert t['robustness']['ms'] <= 1.3 * (1 + 1e-3) and t['gains']['ki'] < d['gains']['ki'], (t['robustness']['ms'], t['gains'])
+assert t['migo']['robustness_reason'] == 'given', t['migo']
+PY"
+check "--response-time 20: the crossover at most 0.1 rad/s" "/usr/bin/python3 - <<'PY'
+import json
+s = json.load(open('slow.json'))
+assert s['migo']['crossover_rad_s'] <= 0.1 + 1e-12 and s['stable'], s['migo']
+PY"
+
+# ---- SIMC and AMIGO's PID on a first-order plant with dead time: a filter, not a refusal.
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method amigo --rule pid --json > amigo.json 2>amigo.err
+check "amigo --rule pid on 1/(10s+1) e^-2s returns its gains with tf = Td/10" "/usr/bin/python3 - <<'PY'
+import json
+j = json.load(open('amigo.json'))
+g = j['gains']
+assert j['stable'] and g['kd'] > 0 and abs(g['tf'] - g['kd'] / (10 * g['kp'])) < 1e-12, g
+PY"
+
+# ---- The paper's plants keep eq. (4) and the multi-start.
+"$pidlab" tune --plant oscillator --max-evals 300 --design-points 64 --json > paper.json
+check "the paper's oscillator: multi-start on eq. (4)'s 25 s at 0.05 s" "/usr/bin/python3 - <<'PY'
+import json
+j = json.load(open('paper.json'))
+assert j['method'] == 'multi-start' and j['spec']['horizon'] == 25 and j['spec']['sample_time'] == 0.05, j['spec']
+assert j['time_scale']['source'] == 'eq. (4)', j['time_scale']
+PY"
+
+# ---- Bad knob values: exit 2, one line naming the value.
+bad() {
+  local what=$1 needle=$2 status=0
+  shift 2
+  "$pidlab" tune "$@" >bad.out 2>bad.err || status=$?
+  if [[ $status -ne 2 ]]; then
+    check "$what: exit 2" "false"
+  elif ! why=$(only_line_ok bad.err "$needle"); then
+    check "$what: $why" "false"
+  else
+    check "$what: exit 2: $(cat bad.err)" "true"
+  fi
+}
+bad "--robustness 1" "1" --num 1 --den 10,1 --delay 2 --robustness 1
+bad "--robustness 9" "9" --num 1 --den 10,1 --delay 2 --robustness 9
+bad "--response-time -1" "-1" --num 1 --den 10,1 --delay 2 --response-time -1
+bad "--method migo without a filter" "filter" --num 1 --den 10,1 --delay 2 --method migo --horizon 100 \
+  --sample-time 0.2 --derivative-filter-ratio 0
+
+echo "passed $pass, failed $fail"
+[[ $fail -eq 0 ]]
