@@ -97,7 +97,8 @@ std::string Table(const IdentifyResult& r) {
                    identify::ToString(r.initial_condition) + "\n")
      << r.starts_at_best << " of " << r.starts << " starts reached the best cost (within 1e-8 relative)"
      << (r.nested_starts > 0
-             ? "; " + std::to_string(r.nested_starts) + " of them from the contained model's fit"
+             ? "; " + std::to_string(r.nested_starts) + " of them from the contained model's fit" +
+                   (r.loss == identify::Loss::kL2 ? "" : " or the l2 fit")
              : "")
      << (r.delay_profile_improved ? "; the delay's profile lowered it" : "")
      << (r.bounds_refit_improved ? "; refitting with the parameters at a bound held there lowered it" : "")
@@ -115,6 +116,21 @@ std::string Table(const IdentifyResult& r) {
   return os.str();
 }
 
+// The rest chosen by AIC when u0 was not given, and a robust loss with the
+// samples it down-weighted (the first 20 listed; all in the JSON).
+std::string RestAndLossLines(const IdentifyResult& r) {
+  std::ostringstream os;
+  if (!r.rest_hypotheses.empty()) os << "u0 " << Num(r.u0) << ": " << r.u0_source << "\n";
+  if (r.loss == identify::Loss::kL2) return os.str();
+  os << "loss " << identify::ToString(r.loss) << ", scale " << Num(r.loss_scale, 6) << " ("
+     << r.loss_scale_source << "); " << r.downweighted.size() << " samples down-weighted (weight < "
+     << Num(identify::kDownweightedBelow) << ")";
+  for (std::size_t i = 0; i < r.downweighted.size() && i < 20; ++i)
+    os << (i ? ", " : ": ") << r.downweighted[i];
+  os << (r.downweighted.size() > 20 ? ", ..." : "") << "\n";
+  return os.str();
+}
+
 std::string WhitenessLine(const identify::Whiteness& w) {
   std::ostringstream os;
   os << "residuals: Ljung-Box Q " << Num(w.ljung_box_q, 5) << " over " << w.lags
@@ -125,7 +141,7 @@ std::string WhitenessLine(const identify::Whiteness& w) {
 
 struct IdentifyCommand {
   std::string csv, log, model, out, plot_path;
-  std::string intersample = "zoh", initial = "zero", u0_text;
+  std::string intersample = "zoh", initial = "zero", u0_text, loss = "l2", loss_scale_text;
   CLI::Option* poles_option = nullptr;
   CLI::Option* zeros_option = nullptr;
   std::vector<long> episode;
@@ -138,7 +154,8 @@ struct IdentifyCommand {
         "(any "
         "order, other columns ignored), or one episode of an LCM log of the trio (the plant's input u + n "
         "and "
-        "the measured y of every step). By default the record starts at rest at u0 = u[0] and y0 is "
+        "the measured y of every step). By default the record starts at rest at u0 = u[0], or at u = 0 "
+        "when that fits with a lower AIC (both are fitted), and y0 is "
         "estimated with the model. Ceres "
         "fits the exact ZOH response with a continuous delay from several starts; --model auto fits every "
         "process kind (not tf) and keeps the lowest AIC; --model tf --poles N --zeros M fits a general "
@@ -162,7 +179,8 @@ struct IdentifyCommand {
     app->add_option(
         "--u0", u0_text,
         "the input's operating point: a number, or 'estimate' (fitted with the model, from the "
-        "default as its start); default: the first sample of u; a log's: 0. A record whose u is "
+        "default as its start); default: the input the record rested at, u[0] or 0, whichever fits "
+        "with the lower AIC; a log's: 0. A record whose u is "
         "constant is a step from u0 and needs it (a heater switched on at the first sample: --u0 0)");
     app->add_option("--y0", options.y0,
                     "the output's operating point (default: estimated with the model; a log's: 0)");
@@ -174,6 +192,14 @@ struct IdentifyCommand {
                     "the state at the first sample: zero (at rest at u0), steady-state (at rest with u[0] "
                     "applied) or estimate (fitted with the model, the input before the record at u[0])")
         ->capture_default_str();
+    app->add_option("--loss", loss,
+                    "the loss on each residual: l2 (least squares), huber or cauchy (Ceres's HuberLoss, "
+                    "CauchyLoss: robust to outliers such as a sensor's dropouts; the samples they "
+                    "down-weight are listed)")
+        ->capture_default_str();
+    app->add_option("--loss-scale", loss_scale_text,
+                    "with --loss huber or cauchy: the scale a in units of y, > 0 (default: 1.345 or 2.385 "
+                    "robust standard deviations, 1.4826 MAD, of the l2 fit's residuals)");
     app->add_flag("--json", json, "print one JSON object");
     app->add_flag("--quiet", quiet,
                   "no progress lines (on a terminal, a fit that runs beyond 3 s says on stderr, once a "
@@ -293,6 +319,23 @@ struct IdentifyCommand {
       throw BadInput("--u0 " + Quote(u0_text) + " must be a finite number or 'estimate'");
   }
 
+  // --loss, and --loss-scale as a number (IdentifyOptions::IsValid checks
+  // its range and that the loss is robust).
+  void ParseLoss() {
+    if (!identify::ParseLoss(loss, &options.loss))
+      throw BadInput("--loss " + Quote(loss) + " must be l2, huber or cauchy");
+    if (loss_scale_text.empty()) return;
+    std::size_t used = 0;
+    try {
+      options.loss_scale = std::stod(loss_scale_text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != loss_scale_text.size() || !(options.loss_scale > 0.0))
+      throw BadInput("--loss-scale " + Quote(loss_scale_text) +
+                     " must be a number in (0, 1e12] (units of y)");
+  }
+
   // The library's limits (IdentifyOptions::IsValid: --starts, after --u0 and
   // --y0 are read), its "starts = 0 must be ..." as the flag's "--starts 0 must be ...".
   void CheckOptions() const {
@@ -318,6 +361,7 @@ struct IdentifyCommand {
     ParseU0();
     if (!std::isnan(options.y0) && !std::isfinite(options.y0))
       throw BadInput("--y0 " + Num(options.y0) + " must be finite");
+    ParseLoss();
     CheckOptions();
     if (!identify::ParseIntersample(intersample, &options.intersample))
       throw BadInput("--intersample " + Quote(intersample) + " must be zoh or foh");
@@ -378,7 +422,8 @@ struct IdentifyCommand {
       if (!plot::DrawPng(figure, &error)) throw std::runtime_error(error);
     }
     for (const std::string& w : result.warnings) std::cerr << "warning: " << w << "\n";
-    std::cout << (json ? j.dump() + "\n" : header + Table(result) + WhitenessLine(result.whiteness));
+    std::cout << (json ? j.dump() + "\n"
+                       : header + Table(result) + RestAndLossLines(result) + WhitenessLine(result.whiteness));
     return 0;
   }
 };

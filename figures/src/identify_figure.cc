@@ -13,6 +13,7 @@ bool IdentifyFigure(const identify::IdentifyData& data, const identify::Identify
   std::ostringstream title;
   title << std::setprecision(6) << "identify: " << identify::ToString(result.model.kind) << ", fit "
         << result.fit_percent << " %, AIC " << result.aic
+        << (result.loss == identify::Loss::kL2 ? "" : ", " + identify::ToString(result.loss) + " loss")
         << "\nresiduals: Ljung-Box p = " << result.whiteness.p_value
         << (result.whiteness.white ? " (white)" : " (NOT white)");
   figure->title = title.str();
@@ -22,7 +23,21 @@ bool IdentifyFigure(const identify::IdentifyData& data, const identify::Identify
                              result.residuals,
                              result.whiteness.autocorrelation,
                              result.whiteness.band};
-  return plot::MakeFitFigure(trace, "y", figure, error);
+  if (!plot::MakeFitFigure(trace, "y", figure, error)) return false;
+  // The samples a robust loss down-weighted, marked on the measured output.
+  if (!result.downweighted.empty()) {
+    plot::Series marked;
+    marked.name = "down-weighted by the " + identify::ToString(result.loss) + " loss (" +
+                  std::to_string(result.downweighted.size()) + ")";
+    marked.style = plot::Style::kPoints;
+    marked.color = "red";
+    for (int k : result.downweighted) {
+      marked.x.push_back(data.t.at(static_cast<std::size_t>(k)));
+      marked.y.push_back(data.y.at(static_cast<std::size_t>(k)));
+    }
+    figure->panels.front().series.push_back(marked);
+  }
+  return true;
 }
 
 }  // namespace pidlab::figures

@@ -16,6 +16,33 @@ nlohmann::json WhitenessJson(const identify::Whiteness& w) {
           {"white", w.white}};
 }
 
+namespace {
+
+// The loss the fit minimised, its scale and the samples it down-weighted.
+nlohmann::json LossJson(const identify::IdentifyResult& r) {
+  return {{"name", identify::ToString(r.loss)},
+          {"scale", JsonNumber(r.loss_scale)},
+          {"scale_source", r.loss_scale_source},
+          {"downweighted",
+           {{"below_weight", identify::kDownweightedBelow},
+            {"count", r.downweighted.size()},
+            {"samples", r.downweighted}}}};
+}
+
+// u0 and how it was found: given, estimated, the first sample, or the rest
+// chosen by AIC with both hypotheses.
+nlohmann::json OperatingPointJson(const identify::IdentifyResult& r) {
+  nlohmann::json hypotheses = nlohmann::json::array();
+  for (const identify::IdentifyResult::RestHypothesis& h : r.rest_hypotheses) {
+    nlohmann::json hj = {{"u0", JsonNumber(h.u0)}, {"aic", JsonNumber(h.aic)}};
+    if (!h.message.empty()) hj["message"] = h.message;
+    hypotheses.push_back(hj);
+  }
+  return {{"u0", JsonNumber(r.u0)}, {"source", r.u0_source}, {"hypotheses", hypotheses}};
+}
+
+}  // namespace
+
 nlohmann::json IdentifyAutoJson(const identify::AutoResult& a) {
   nlohmann::json j = IdentifyResultJson(a.candidates.at(static_cast<std::size_t>(a.chosen)).result);
   nlohmann::json candidates = nlohmann::json::array();
@@ -26,6 +53,7 @@ nlohmann::json IdentifyAutoJson(const identify::AutoResult& a) {
       cj["aic"] = JsonNumber(c.result.aic);
       cj["delta_aic"] = JsonNumber(c.result.aic - best);
       cj["fit_percent"] = JsonNumber(c.result.fit_percent);
+      cj["operating_point"] = {{"u0", JsonNumber(c.result.u0)}, {"source", c.result.u0_source}};
     } else {
       cj["message"] = c.status.message();
     }
@@ -93,6 +121,8 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
       {"nested_starts", r.nested_starts},
       {"delay_profile_improved", r.delay_profile_improved},
       {"bounds_refit_improved", r.bounds_refit_improved},
+      {"operating_point", OperatingPointJson(r)},
+      {"loss", LossJson(r)},
       {"whiteness", WhitenessJson(r.whiteness)},
       {"warnings", r.warnings},
       {"covariance", {{"ok", r.covariance_ok}, {"message", r.covariance_message}, {"matrix", matrix}}}};

@@ -69,6 +69,43 @@ with open('smooth.csv', 'w') as f:
     f.write('t,u,y\n')
     for k in range(n): f.write('%.17g,%.17g,%.17g\n' % (t[k], u[k] + 1, y[k * fine] + 3))
 PY
+# The same P1D from rest at u = 1 with 2 % of y (6 samples, seeded) dropped
+# out to y + 10 (docs/identify.md, "Robust losses for dropouts"); and from
+# rest at u = 0 under a +-1 PRBS whose first level is +1 ("A record that
+# starts at rest under a nonzero input").
+/usr/bin/python3 - <<'PY'
+import math, random
+kp, tp1, td, dt, n = 2.0, 1.5, 0.25, 0.1, 300
+random.seed(3)
+u, k = [0.0] * n, 5
+while k < n:
+    level, hold = random.uniform(-1, 1), random.randint(3, 15)
+    for i in range(k, min(n, k + hold)): u[i] = level
+    k += hold
+def y(t):  # superposition of the delayed steps of u from rest at u = 0
+    total, prev = 0.0, 0.0
+    for j in range(n):
+        s = t - (j * dt + td)
+        if u[j] != prev and s > 0: total += (u[j] - prev) * kp * (1 - math.exp(-s / tp1))
+        prev = u[j]
+    return total
+random.seed(7)
+bad = sorted(random.sample(range(n), n // 50))
+with open('dropouts.csv', 'w') as f:
+    f.write('t,u,y\n')
+    for k in range(n): f.write('%.17g,%.17g,%.17g\n' % (k * dt, u[k] + 1, y(k * dt) + 3 + (10 if k in bad else 0)))
+with open('dropouts.txt', 'w') as f: f.write(' '.join(map(str, bad)))
+random.seed(11)
+k, level = 0, 1.0
+while k < n:
+    hold = random.randint(3, 12)
+    for i in range(k, min(n, k + hold)): u[i] = level
+    k += hold
+    level = -level
+with open('prbs_rest.csv', 'w') as f:
+    f.write('t,u,y\n')
+    for k in range(n): f.write('%.17g,%.17g,%.17g\n' % (k * dt, u[k], y(k * dt) + 3))
+PY
 
 # The commands of docs/identify.md's section, as written there (its ```bash block);
 # the real records of tests/data/identify beside the written ones.
@@ -79,7 +116,7 @@ while IFS= read -r cmd; do
   (pidlab() { "$pidlab" "$@"; }; eval "$cmd") > docs.out 2>&1
   check "docs/identify.md: $cmd" "[ $? -eq 0 ]"
 done < <(awk '/^```bash/{on=1; next} /^```/{on=0} on && /^pidlab identify /' "$docs")
-check "docs/identify.md has 7 identify commands (found $n_docs)" "[ $n_docs -eq 7 ]"
+check "docs/identify.md has 9 identify commands (found $n_docs)" "[ $n_docs -eq 9 ]"
 pidlab() { "$pidlab" "$@"; }
 pidlab identify --csv tclab_step.csv --model p1d --u0 0 --json > tclab.json 2> tclab.err
 check "the TCLab step test is a step from --u0 0: fitted, a fit above 95 %" \
@@ -109,6 +146,47 @@ tf = j['transfer_function']
 assert abs(tf['num'][0] - 2) < 1e-6 and abs(tf['den'][0] - 1.5) < 1e-6 and tf['den'][1] == 1, tf
 assert abs(tf['delay_s'] - 0.25) < 1e-6, tf
 PY"
+check "step.csv, at rest under its first input u = 1, keeps u0 = u[0] against u0 = 0 by AIC" "/usr/bin/python3 - p1d.json <<'PY'
+import json, sys
+o = json.load(open(sys.argv[1]))['operating_point']
+assert o['u0'] == 1 and o['source'].startswith('at rest under its first input u[0] = 1'), o
+assert [h['u0'] for h in o['hypotheses']] == [1, 0] and o['hypotheses'][0]['aic'] < o['hypotheses'][1]['aic'], o
+PY"
+pidlab identify --csv prbs_rest.csv --model p1d --json > prbs.json 2> err
+check "prbs_rest.csv without --u0: at rest at u = 0 chosen by AIC, Kp, Tp1, Td within 1e-6" "[ $? -eq 0 ] && /usr/bin/python3 - prbs.json <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j['u0'] == 0 and j['operating_point']['source'].startswith('at rest at u = 0'), j['operating_point']
+for name, want in (('Kp', 2.0), ('Tp1', 1.5), ('Td', 0.25)):
+    assert abs(j['parameters'][name]['value'] - want) <= 1e-6 * want, (name, j['parameters'][name])
+PY"
+pidlab identify --csv prbs_rest.csv --model p1d > table 2> err
+check "the table says which rest was used" "[ $? -eq 0 ] && grep -q '^u0 0: at rest at u = 0 before the record (AIC' table"
+pidlab identify --csv dropouts.csv --model p1d --json > l2.json 2> err
+pidlab identify --csv dropouts.csv --model p1d --loss cauchy --json > cauchy.json 2> err
+check "dropouts.csv: --loss cauchy within 1 % of Kp, Tp1, Td, l2 more than 5 % off one; the dropouts listed" \
+  "/usr/bin/python3 - l2.json cauchy.json dropouts.txt <<'PY'
+import json, sys
+l2, cauchy = (json.load(open(f)) for f in sys.argv[1:3])
+bad = [int(k) for k in open(sys.argv[3]).read().split()]
+truth = {'Kp': 2.0, 'Tp1': 1.5, 'Td': 0.25}
+def worst(j): return max(abs(j['parameters'][k]['value'] / v - 1) for k, v in truth.items())
+print('l2 %.3g, cauchy %.3g' % (worst(l2), worst(cauchy)))
+assert worst(cauchy) < 0.01 and worst(l2) > 0.05
+loss = cauchy['loss']
+assert loss['name'] == 'cauchy' and loss['scale'] > 0 and 'l2 fit' in loss['scale_source'], loss
+assert loss['downweighted']['samples'] == bad and loss['downweighted']['count'] == len(bad) == 6, loss
+assert l2['loss']['name'] == 'l2' and l2['loss']['scale'] is None and l2['loss']['downweighted']['count'] == 0
+PY"
+pidlab identify --csv dropouts.csv --model p1d --loss huber --loss-scale 0.05 > table 2> err
+check "--loss huber --loss-scale 0.05: the table names the loss, its given scale and the 6 samples" \
+  "[ $? -eq 0 ] && grep -q '^loss huber, scale 0.05 (given); 6 samples down-weighted' table"
+for args in "--loss tukey:--loss 'tukey'" "--loss cauchy --loss-scale 0:--loss-scale '0'" \
+            "--loss cauchy --loss-scale abc:--loss-scale 'abc'" "--loss-scale 2:--loss-scale 2 applies to"; do
+  "$pidlab" identify --csv dropouts.csv --model p1d ${args%%:*} > out 2> err
+  check "identify ${args%%:*} exits 2 with one line naming it" "[ $? -eq 2 ] && only_line_ok err \"${args#*:}\""
+done
+check "identify --help names --loss and --loss-scale" "grep -q -- '--loss ' help && grep -q -- '--loss-scale' help"
 pidlab identify --csv step.csv --model auto --json > auto.json 2> err
 check "--model auto fits every kind and chooses p1d by AIC, saying why" "[ $? -eq 0 ] && /usr/bin/python3 - auto.json <<'PY'
 import json, sys

@@ -347,6 +347,24 @@ class Identify(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "initial_condition = 'rest'"):
             pidlab.identify(self.t, self.u, self.y, initial_condition="rest")
 
+    def test_a_robust_loss_gives_the_cli_json(self):
+        y = self.y.copy()
+        y[[40, 160, 250]] += 5.0  # three dropouts
+        csv = os.path.join(self.dir, "dropouts.csv")
+        with open(csv, "w") as f:
+            f.write("t,u,y\n")
+            for row in zip(self.t, self.u, y):
+                f.write("%.17g,%.17g,%.17g\n" % row)
+        got = pidlab.identify(self.t, self.u, y, model="p1d", starts=3, loss="cauchy")
+        want = cli("identify", "--csv", csv, "--model", "p1d", "--starts", "3", "--loss", "cauchy")
+        del want["source"]
+        self.assertEqual(got, want)
+        self.assertEqual(got["loss"]["downweighted"]["samples"], [40, 160, 250])
+        with self.assertRaisesRegex(ValueError, "loss = 'tukey'"):
+            pidlab.identify(self.t, self.u, y, loss="tukey")
+        with self.assertRaisesRegex(ValueError, "loss_scale = 1 applies"):
+            pidlab.identify(self.t, self.u, y, loss_scale=1.0)
+
     def test_lists_and_options_reach_the_fit(self):
         got = pidlab.identify(list(self.t), list(self.u), list(self.y), model="p1d", starts=3, seed=7, u0=0, y0=0)
         self.assertEqual((got["starts"] - got["arx_start"], got["seed"], got["u0"], got["y0"]), (3, 7, 0, 0))

@@ -61,7 +61,8 @@ void TfShape(const std::string& model, const py::object& poles, const py::object
 py::object IdentifyPy(const py::object& t, const py::object& u, const py::object& y, const std::string& model,
                       int starts, std::uint64_t seed, const py::object& u0, const py::object& y0,
                       const py::object& poles, const py::object& zeros, const std::string& intersample,
-                      const std::string& initial_condition) {
+                      const std::string& initial_condition, const std::string& loss,
+                      const py::object& loss_scale) {
   identify::IdentifyData data{Column(t, "t"), Column(u, "u"), Column(y, "y")};
   identify::IdentifyOptions options;
   options.starts = starts;
@@ -81,6 +82,10 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
   if (!identify::ParseInitialCondition(initial_condition, &options.initial_condition))
     throw py::value_error("identify: initial_condition = '" + initial_condition +
                           "' must be 'zero', 'steady-state' or 'estimate'");
+  if (!identify::ParseLoss(loss, &options.loss))
+    throw py::value_error("identify: loss = '" + loss + "' must be 'l2', 'huber' or 'cauchy'");
+  if (!loss_scale.is_none()) options.loss_scale = loss_scale.cast<double>();
+  if (std::string error; !options.IsValid(&error)) throw py::value_error("identify: " + error);
   Status status;
   nlohmann::json j;
   if (model == "auto") {
@@ -110,22 +115,25 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
 }  // namespace
 
 void DefineIdentify(py::module_& m) {
-  m.def("identify", &IdentifyPy,
-        "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None, poles=None, zeros=None, "
-        "intersample='zoh', initial_condition='zero'): fits a "
-        "process model (p1d, p2d, p2du, p1di, p2dz, or auto to choose among them by AIC) or a general "
-        "transfer function (model='tf' with poles=N in 1..6 and zeros=M in 0..N-1, default 0) to the record "
-        "t (s, uniform or not), u, y (lists or numpy arrays) and returns the dict of `pidlab identify "
-        "--json`. u0, "
-        "y0: the operating point (None: u0 the first sample, y0 estimated with the model; u0='estimate': "
-        "fitted too). intersample: "
-        "'zoh' (held) or 'foh' (linear between samples); initial_condition: 'zero', 'steady-state' or "
-        "'estimate', as the CLI's --intersample and --initial-condition. Bad data or "
-        "arguments raise ValueError naming the reason (docs/identify.md).",
-        py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",
-        py::arg("starts") = 16, py::arg("seed") = 0, py::arg("u0") = py::none(), py::arg("y0") = py::none(),
-        py::arg("poles") = py::none(), py::arg("zeros") = py::none(), py::arg("intersample") = "zoh",
-        py::arg("initial_condition") = "zero");
+  m.def(
+      "identify", &IdentifyPy,
+      "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None, poles=None, zeros=None, "
+      "intersample='zoh', initial_condition='zero', loss='l2', loss_scale=None): fits a "
+      "process model (p1d, p2d, p2du, p1di, p2dz, or auto to choose among them by AIC) or a general "
+      "transfer function (model='tf' with poles=N in 1..6 and zeros=M in 0..N-1, default 0) to the record "
+      "t (s, uniform or not), u, y (lists or numpy arrays) and returns the dict of `pidlab identify "
+      "--json`. u0, "
+      "y0: the operating point (None: u0 the input the record rested at, u[0] or 0 by AIC, y0 estimated with "
+      "the model; u0='estimate': "
+      "fitted too). intersample: "
+      "'zoh' (held) or 'foh' (linear between samples); initial_condition: 'zero', 'steady-state' or "
+      "'estimate', as the CLI's --intersample and --initial-condition; loss: 'l2', 'huber' or 'cauchy' "
+      "with loss_scale (None: derived from the l2 fit's residuals), as --loss and --loss-scale. Bad data or "
+      "arguments raise ValueError naming the reason (docs/identify.md).",
+      py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",
+      py::arg("starts") = 16, py::arg("seed") = 0, py::arg("u0") = py::none(), py::arg("y0") = py::none(),
+      py::arg("poles") = py::none(), py::arg("zeros") = py::none(), py::arg("intersample") = "zoh",
+      py::arg("initial_condition") = "zero", py::arg("loss") = "l2", py::arg("loss_scale") = py::none());
 }
 
 }  // namespace pidlab::python

@@ -53,6 +53,30 @@ std::string ToString(InitialCondition v) {
   return "zero";
 }
 
+bool ParseLoss(const std::string& s, Loss* v) {
+  if (s == "l2")
+    *v = Loss::kL2;
+  else if (s == "huber")
+    *v = Loss::kHuber;
+  else if (s == "cauchy")
+    *v = Loss::kCauchy;
+  else
+    return false;
+  return true;
+}
+
+std::string ToString(Loss v) {
+  switch (v) {
+    case Loss::kHuber:
+      return "huber";
+    case Loss::kCauchy:
+      return "cauchy";
+    case Loss::kL2:
+      break;
+  }
+  return "l2";
+}
+
 bool IdentifyOptions::IsValid(std::string* error) const {
   std::string e;
   if (starts < 1 || starts > kMaxStarts)
@@ -63,6 +87,10 @@ bool IdentifyOptions::IsValid(std::string* error) const {
     e = "max_iterations = " + std::to_string(max_iterations) + " must be at least 1";
   else if (std::isinf(u0) || std::isinf(y0))
     e = "u0 and y0 must be finite, or NaN for the first sample";
+  else if (!std::isnan(loss_scale) && !(loss_scale > 0.0 && loss_scale <= kMaxRecordMagnitude))
+    e = "loss_scale = " + CheckedNumber(loss_scale) + " must be a number in (0, 1e12] (units of y)";
+  else if (!std::isnan(loss_scale) && loss == Loss::kL2)
+    e = "loss_scale = " + CheckedNumber(loss_scale) + " applies to the losses huber and cauchy, not l2";
   if (error) *error = e;
   return e.empty();
 }

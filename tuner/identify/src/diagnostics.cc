@@ -1,16 +1,13 @@
-// The residuals' whiteness test and the choice among the kinds by AIC
-// (identify.h; docs/identify.md, "Choosing the model" and "The output").
+// The residuals' whiteness test and the poles' standard errors (identify.h;
+// docs/identify.md, "The output").
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <boost/math/special_functions/gamma.hpp>
 #include <cmath>
 #include <complex>
-#include <iomanip>
-#include <sstream>
 
 #include "pidlab/identify/identify.h"
-#include "pidlab/spec/field.h"
 
 namespace pidlab::identify {
 
@@ -103,82 +100,6 @@ std::vector<PoleEstimate> PoleEstimates(const IdentifyResult& result) {
     out[i].im_se = std::sqrt(std::max(0.0, v_im));
   }
   return out;
-}
-
-Status IdentifyAuto(const IdentifyData& data, const IdentifyOptions& options, AutoResult* result) {
-  *result = AutoResult{};
-  for (ProcessModelKind kind : {ProcessModelKind::kP1D, ProcessModelKind::kP2D, ProcessModelKind::kP2DU,
-                                ProcessModelKind::kP1DI, ProcessModelKind::kP2DZ}) {
-    AutoCandidate c;
-    c.kind = kind;
-    // The model it contains, fitted before it: P1D for P2D, P2D for P2DU and P2DZ.
-    const IdentifyResult* contained = nullptr;
-    const ProcessModelKind inner =
-        kind == ProcessModelKind::kP2D ? ProcessModelKind::kP1D : ProcessModelKind::kP2D;
-    for (const AutoCandidate& before : result->candidates)
-      if (before.kind == inner && before.status.ok() && kind != ProcessModelKind::kP1D &&
-          kind != ProcessModelKind::kP1DI)
-        contained = &before.result;
-    c.status = Identify(data, kind, options, contained, &c.result);
-    // Bad data or options are the same for every kind: say it once.
-    if (c.status.code() == StatusCode::kInvalidInput) return c.status;
-    result->candidates.push_back(std::move(c));
-  }
-  // The lowest AIC; then, among the kinds within 2 of it (which the data
-  // hardly tell apart, Burnham & Anderson), the one of fewest parameters.
-  int lowest = -1;
-  const auto aic = [&](int i) { return result->candidates[static_cast<std::size_t>(i)].result.aic; };
-  const auto usable = [&](int i) {
-    const AutoCandidate& c = result->candidates[static_cast<std::size_t>(i)];
-    return c.status.ok() && std::isfinite(c.result.aic);
-  };
-  const int count = static_cast<int>(result->candidates.size());
-  for (int i = 0; i < count; ++i)
-    if (usable(i) && (lowest < 0 || aic(i) < aic(lowest))) lowest = i;
-  if (lowest < 0) {
-    std::string why;
-    for (const AutoCandidate& c : result->candidates)
-      if (!c.status.ok() && why.empty()) why = std::string(ToString(c.kind)) + ": " + c.status.message();
-    return Status::RunnerFailed("no model kind could be fitted (p1d, p2d, p2du, p1di and p2dz tried" +
-                                (why.empty() ? std::string(")") : "; " + spec::Truncate(why, 150) + ")"));
-  }
-  const auto parameters = [&](int i) {
-    return result->candidates[static_cast<std::size_t>(i)].result.names.size();
-  };
-  result->chosen = lowest;
-  for (int i = 0; i < count; ++i)
-    if (usable(i) && aic(i) < aic(lowest) + 2.0 &&
-        (parameters(i) < parameters(result->chosen) ||
-         (parameters(i) == parameters(result->chosen) && aic(i) < aic(result->chosen))))
-      result->chosen = i;
-  const AutoCandidate& best = result->candidates[static_cast<std::size_t>(result->chosen)];
-  std::ostringstream os;
-  os << std::setprecision(6);
-  if (result->chosen == lowest) {
-    // The runner-up: the next lowest AIC.
-    int next = -1;
-    for (int i = 0; i < count; ++i)
-      if (i != lowest && usable(i) && (next < 0 || aic(i) < aic(next))) next = i;
-    os << ToString(best.kind) << " has the lowest AIC (" << best.result.aic << ", fit "
-       << best.result.fit_percent << " %)";
-    if (next >= 0) {
-      const double delta = aic(next) - aic(lowest);
-      os << "; the next, " << ToString(result->candidates[static_cast<std::size_t>(next)].kind) << ", is "
-         << delta << " higher";
-      if (delta < 2.0)
-        os << " (less than 2, but it has more parameters)";
-      else if (delta > 10.0)
-        os << " (more than 10: the data rule it out)";
-    }
-  } else {
-    os << ToString(best.kind) << " (AIC " << best.result.aic << ", fit " << best.result.fit_percent
-       << " %) is within 2 of the lowest AIC, "
-       << ToString(result->candidates[static_cast<std::size_t>(lowest)].kind) << "'s " << aic(lowest)
-       << ", with fewer parameters (" << best.result.names.size() << " against " << parameters(lowest)
-       << "): the data hardly tell them apart, so the simpler is kept";
-  }
-  result->reason = os.str();
-  return Status::Ok();
 }
 
 }  // namespace pidlab::identify

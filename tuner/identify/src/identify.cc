@@ -9,213 +9,39 @@
 
 #include "pidlab/identify/identify.h"
 
-#include <ceres/ceres.h>
-#include <glog/logging.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <memory>
-#include <sstream>
-#include <stdexcept>
+#include <string>
 
 #include "arx_start.h"
+#include "fit_problem.h"
 #include "pidlab/optim/sobol.h"
-#include "pidlab/plant_sim/discrete_plant.h"
-#include "piecewise_response.h"
 #include "tf_start.h"
 
 namespace pidlab::identify {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// Bounds of Zeta inside (0, 1).
-constexpr double kMinZeta = 1e-3;
-constexpr double kMaxZeta = 1.0 - 1e-9;
-// How far the time constants may go from the record's scales: [dt / 1000, 1000 T_record].
-constexpr double kTimeConstantRange = 1e3;
-
-// What every start's problem shares: the record without its operating point.
-struct Record {
-  ProcessModelKind kind;
-  int poles = 0, zeros = 0;  // TF only
-  std::vector<double> du, dy;
-  double dt_s = 0.0, length_s = 0.0, max_delay_s = 0.0;
-  /// The sample times. `piecewise`: simulated interval by interval
-  /// (piecewise_response.h; non-uniform sampling, a first-order hold or an
-  /// initial condition other than zero), else DiscretePlant over dt_s.
-  std::vector<double> t;
-  bool piecewise = false;
-  Intersample hold = Intersample::kZoh;
-  InitialCondition initial = InitialCondition::kZero;
-  /// The output offset is a parameter too: theta[p] is added to y0.
-  bool offset = false;
-  /// The input offset is a parameter too (after the output offset, if any):
-  /// it is added to u0, so the model's input is du - it.
-  bool input_offset = false;
-};
-
-int ParameterCount(const Record& record) {
-  return static_cast<int>(ParameterNames(record.kind, record.poles, record.zeros).size());
-}
-// Ceres's parameter block: the model's parameters, then the offset if estimated.
-int BlockSize(const Record& record) {
-  return ParameterCount(record) + (record.offset ? 1 : 0) + (record.input_offset ? 1 : 0);
-}
-int InputOffsetIndex(const Record& record) { return ParameterCount(record) + (record.offset ? 1 : 0); }
-double InputOffsetOf(const Record& record, const double* theta) {
-  return record.input_offset ? theta[InputOffsetIndex(record)] : 0.0;
-}
-double OffsetOf(const Record& record, const double* theta) {
-  return record.offset ? theta[ParameterCount(record)] : 0.0;
-}
-
-// The initial state's entries fitted by projection (kEstimate): parameters
-// too, for the degrees of freedom and the AIC.
-int FittedStates(const Record& record, const ProcessModel& model) {
-  return record.initial == InitialCondition::kEstimate ? internal::ModelOrder(model) : 0;
-}
-
-// theta[i] is the logarithm of a time constant.
-bool IsLogParameter(const Record& record, int i) {
-  const int p = ParameterCount(record);
-  const ProcessModelKind kind = record.kind;
-  return kind != ProcessModelKind::kTf && i > 0 && i < p - 1 &&
-         !(kind == ProcessModelKind::kP2DU && i == 2) && !(kind == ProcessModelKind::kP2DZ && i == 3);
-}
-
-// theta[i] is P2DZ's Tz (any sign).
-bool IsZeroParameter(ProcessModelKind kind, int i) { return kind == ProcessModelKind::kP2DZ && i == 3; }
-
-ProcessModel ModelOf(const Record& record, const double* theta) {
-  const int p = ParameterCount(record);
-  std::vector<double> values(static_cast<std::size_t>(p));
-  for (int i = 0; i < p; ++i)
-    values[static_cast<std::size_t>(i)] = IsLogParameter(record, i) ? std::exp(theta[i]) : theta[i];
-  // A central difference at the bound Td = 0 looks just below it.
-  values.back() = std::max(0.0, values.back());
-  if (record.kind == ProcessModelKind::kTf) internal::SnapTinyCoefficients(&values);
-  return ModelFromValues(record.kind, values, record.poles, record.zeros);
-}
-
-// The response from the record's initial condition; with kEstimate and
-// `project`, the free response that best fits dy - offset added (its state
-// in *state).
-std::vector<double> Simulate(const ProcessModel& model, const Record& record, double offset,
-                             double input_shift, bool project, std::vector<double>* state) {
-  if (!record.piecewise) return SimulateModel(model, record.du, input_shift, record.dt_s);
-  std::vector<double> shifted;  // a copy only when there is a shift to take off
-  if (input_shift != 0.0) {
-    shifted = record.du;
-    for (double& v : shifted) v -= input_shift;
-  }
-  const std::vector<double>& du = input_shift != 0.0 ? shifted : record.du;
-  internal::PiecewiseStart start;
-  start.input_before = record.initial == InitialCondition::kZero ? 0.0 : du[0];
-  if (record.initial == InitialCondition::kSteadyState && !internal::SteadyState(model, du[0], &start.state))
-    throw std::invalid_argument("no steady state");
-  std::vector<double> yhat = internal::SimulatePiecewise(model, record.t, du, record.hold, start);
-  if (record.initial == InitialCondition::kEstimate && project) {
-    std::vector<double> target(record.dy);
-    for (double& v : target) v -= offset;
-    start.state = internal::FitInitialState(model, record.t, record.hold, target, &yhat);
-  }
-  if (state) *state = start.state;
-  return yhat;
-}
-
-// yhat of the model, false if it is not a valid plant or diverges (or, for
-// a TF, not admissible: tf_start.h). `offset`, `project`, `state`: Simulate's.
-bool TrySimulate(const ProcessModel& model, const Record& record, std::vector<double>* yhat,
-                 double offset = 0.0, double input_shift = 0.0, bool project = true,
-                 std::vector<double>* state = nullptr) {
-  if (model.kind == ProcessModelKind::kTf && !internal::TfDenominatorIsAdmissible(model.a, record.dt_s))
-    return false;
-  try {
-    *yhat = Simulate(model, record, offset, input_shift, project, state);
-  } catch (const std::exception&) {
-    return false;
-  }
-  for (double v : *yhat)
-    if (!std::isfinite(v)) return false;
-  return true;
-}
-
-struct OutputError {
-  const Record* record;
-  bool operator()(double const* const* parameters, double* residuals) const {
-    std::vector<double> yhat;
-    const double offset = OffsetOf(*record, parameters[0]);
-    if (!TrySimulate(ModelOf(*record, parameters[0]), *record, &yhat, offset,
-                     InputOffsetOf(*record, parameters[0])))
-      return false;
-    for (std::size_t k = 0; k < yhat.size(); ++k) residuals[k] = record->dy[k] - offset - yhat[k];
-    return true;
-  }
-};
-
-// The problem over one parameter block `theta`, with its bounds.
-void BuildProblem(const Record& record, double* theta, ceres::Problem* problem) {
-  auto* cost =
-      new ceres::DynamicNumericDiffCostFunction<OutputError, ceres::CENTRAL>(new OutputError{&record});
-  const int p = ParameterCount(record);
-  cost->AddParameterBlock(BlockSize(record));
-  cost->SetNumResiduals(static_cast<int>(record.dy.size()));
-  problem->AddResidualBlock(cost, nullptr, theta);
-  for (int i = 1; i < p - 1 && record.kind != ProcessModelKind::kTf; ++i) {
-    if (IsLogParameter(record, i)) {
-      problem->SetParameterLowerBound(theta, i, std::log(record.dt_s / kTimeConstantRange));
-      problem->SetParameterUpperBound(theta, i, std::log(record.length_s * kTimeConstantRange));
-    } else if (IsZeroParameter(record.kind, i)) {
-      problem->SetParameterLowerBound(theta, i, -record.length_s * kTimeConstantRange);
-      problem->SetParameterUpperBound(theta, i, record.length_s * kTimeConstantRange);
-    } else {
-      problem->SetParameterLowerBound(theta, i, kMinZeta);
-      problem->SetParameterUpperBound(theta, i, kMaxZeta);
-    }
-  }
-  problem->SetParameterLowerBound(theta, p - 1, 0.0);
-  problem->SetParameterUpperBound(theta, p - 1, record.max_delay_s);
-}
-
-// Kp by linear least squares at the other parameters of *theta: the model is
-// linear in it. Left at 1 if the model cannot be simulated. A TF's numerator
-// likewise (tf_start.h).
-void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
-  if (record.kind == ProcessModelKind::kTf) {
-    internal::SetNumeratorByLeastSquares(record.poles, record.zeros, record.du, record.dy, record.dt_s,
-                                         record.offset, theta);
-    return;
-  }
-  const int p = ParameterCount(record);
-  (*theta)[0] = 1.0;
-  if (record.offset) (*theta)[static_cast<std::size_t>(p)] = 0.0;
-  std::vector<double> g;
-  // Without the estimated initial state's projection, which is not linear in Kp.
-  if (!TrySimulate(ModelOf(record, theta->data()), record, &g, 0.0, InputOffsetOf(record, theta->data()),
-                   false))
-    return;
-  // dy ~ Kp g + offset: the normal equations of one or two unknowns.
-  const double n = static_cast<double>(g.size());
-  double gy = 0.0, gg = 0.0, sg = 0.0, sy = 0.0;
-  for (std::size_t k = 0; k < g.size(); ++k) {
-    gy += g[k] * record.dy[k];
-    gg += g[k] * g[k];
-    sg += g[k];
-    sy += record.dy[k];
-  }
-  if (!record.offset) {
-    if (gg > 0.0 && std::isfinite(gy / gg)) (*theta)[0] = gy / gg;
-    return;
-  }
-  const double det = gg * n - sg * sg;
-  if (!(det > 1e-12 * gg * n)) return;
-  const double kp = (gy * n - sg * sy) / det, offset = (gg * sy - sg * gy) / det;
-  if (std::isfinite(kp) && std::isfinite(offset)) {
-    (*theta)[0] = kp;
-    (*theta)[static_cast<std::size_t>(p)] = offset;
-  }
-}
+using internal::BlockSize;
+using internal::ContainedKind;
+using internal::FitAtDelay;
+using internal::FitFrom;
+using internal::FitHolding;
+using internal::InputOffsetIndex;
+using internal::InputOffsetOf;
+using internal::IsLogParameter;
+using internal::IsZeroParameter;
+using internal::kMaxZeta;
+using internal::kMinZeta;
+using internal::kTimeConstantRange;
+using internal::ModelOf;
+using internal::Number;
+using internal::OffsetOf;
+using internal::ParameterCount;
+using internal::Record;
+using internal::SetGainByLeastSquares;
+using internal::Summarise;
+using internal::TrySimulate;
 
 // Start `index` of the design: time constants log-spaced over [dt/2, T/2],
 // Zeta over [0.1, 0.9], Td over [0, min(max delay, T/4)], by the points of a
@@ -261,7 +87,7 @@ double ScreenCost(const Record& record, std::vector<double>* theta) {
     return std::numeric_limits<double>::infinity();
   double cost = 0.0;
   for (std::size_t k = 0; k < yhat.size(); ++k)
-    cost += 0.5 * (record.dy[k] - offset - yhat[k]) * (record.dy[k] - offset - yhat[k]);
+    cost += internal::SampleCost(record, record.dy[k] - offset - yhat[k]);
   return cost;
 }
 
@@ -300,64 +126,6 @@ std::vector<double> ArxStartPoint(const Record& record) {
     }
   }
   return best;
-}
-
-// One start's fit; the final cost, or infinity if Ceres failed.
-double FitFrom(const Record& record, const IdentifyOptions& options, std::vector<double>* theta) {
-  ceres::Problem problem;
-  BuildProblem(record, theta->data(), &problem);
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_QR;
-  solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = 1e-15;
-  solver.gradient_tolerance = 1e-20;
-  solver.parameter_tolerance = 1e-13;
-  solver.logging_type = ceres::SILENT;
-  solver.num_threads = 1;
-  ceres::Solver::Summary summary;
-  // A TF's start may walk to the edge of stability, where a central
-  // difference fails and Ceres stops with FAILURE, logged through glog as an
-  // error; the start's cost (infinite) says it, so keep glog quiet.
-  const int log_level = FLAGS_minloglevel;
-  FLAGS_minloglevel = google::GLOG_FATAL;
-  ceres::Solve(solver, &problem, &summary);
-  FLAGS_minloglevel = log_level;
-  if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost))
-    return std::numeric_limits<double>::infinity();
-  return summary.final_cost;
-}
-
-// The parameters `held` (indices into theta) held where *theta has them,
-// the others refitted from *theta; the cost, or infinity if Ceres failed.
-double FitHolding(const Record& record, const IdentifyOptions& options, const std::vector<int>& held,
-                  std::vector<double>* theta) {
-  ceres::Problem problem;
-  BuildProblem(record, theta->data(), &problem);
-  problem.SetManifold(theta->data(), new ceres::SubsetManifold(BlockSize(record), held));
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_QR;
-  solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = 1e-12;
-  solver.gradient_tolerance = 1e-20;
-  solver.parameter_tolerance = 1e-10;
-  solver.logging_type = ceres::SILENT;
-  solver.num_threads = 1;
-  ceres::Solver::Summary summary;
-  const int log_level = FLAGS_minloglevel;
-  FLAGS_minloglevel = google::GLOG_FATAL;
-  ceres::Solve(solver, &problem, &summary);
-  FLAGS_minloglevel = log_level;
-  if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost))
-    return std::numeric_limits<double>::infinity();
-  return summary.final_cost;
-}
-
-// Td held at `td`, the other parameters refitted from *theta.
-double FitAtDelay(const Record& record, const IdentifyOptions& options, double td,
-                  std::vector<double>* theta) {
-  const int p = ParameterCount(record);
-  (*theta)[static_cast<std::size_t>(p - 1)] = td;
-  return FitHolding(record, options, {p - 1}, theta);
 }
 
 // The parameters of *theta at (within 1e-6 of) a bound of the fit, put on
@@ -447,89 +215,6 @@ bool ProfileDelay(const Record& record, const IdentifyOptions& options, std::vec
   return true;
 }
 
-// The covariance of the parameters at `theta` (of the values, not of theta;
-// p x p, row-major) and their standard errors, scaled by the residual
-// variance; false with the reason if Ceres cannot invert J'J.
-bool Covariance(const Record& record, std::vector<double> theta, double cost, std::vector<double>* errors,
-                std::vector<double>* matrix, double* offset_error, double* input_offset_error,
-                std::string* message) {
-  const int p = ParameterCount(record);
-  const int q = BlockSize(record);
-  *offset_error = *input_offset_error = kNaN;
-  const int n = static_cast<int>(record.dy.size());
-  errors->assign(static_cast<std::size_t>(p), kNaN);
-  matrix->assign(static_cast<std::size_t>(p * p), kNaN);
-  ceres::Problem problem;
-  BuildProblem(record, theta.data(), &problem);
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::DENSE_SVD;
-  covariance_options.num_threads = 1;
-  ceres::Covariance covariance(covariance_options);
-  std::vector<std::pair<const double*, const double*>> blocks = {{theta.data(), theta.data()}};
-  // Ceres logs a rank-deficient J'J through glog as an error on stderr; the
-  // result says it in its own words (covariance_message), so keep glog quiet.
-  const int log_level = FLAGS_minloglevel;
-  FLAGS_minloglevel = google::GLOG_FATAL;
-  const bool computed = covariance.Compute(blocks, &problem);
-  FLAGS_minloglevel = log_level;
-  if (!computed) {
-    *message = "Ceres could not compute the covariance (J'J singular or ill-conditioned)";
-    return false;
-  }
-  std::vector<double> full(static_cast<std::size_t>(q * q));
-  covariance.GetCovarianceBlock(theta.data(), theta.data(), full.data());
-  // The model's block (the offset's row and column left out: the marginal
-  // covariance of the model's parameters).
-  std::vector<double> c(static_cast<std::size_t>(p * p));
-  for (int i = 0; i < p; ++i)
-    for (int j = 0; j < p; ++j)
-      c[static_cast<std::size_t>(i * p + j)] = full[static_cast<std::size_t>(i * q + j)];
-  const double variance =
-      2.0 * cost / std::max(1, n - q - FittedStates(record, ModelOf(record, theta.data())));
-  if (record.offset)
-    *offset_error = std::sqrt(std::max(0.0, full[static_cast<std::size_t>(p * q + p)] * variance));
-  if (record.input_offset) {
-    const int i = InputOffsetIndex(record);
-    *input_offset_error = std::sqrt(std::max(0.0, full[static_cast<std::size_t>(i * q + i)] * variance));
-  }
-  const ProcessModel model = ModelOf(record, theta.data());
-  const std::vector<double> values = ParameterValues(model);
-  // d value / d theta: the value for a logarithm, else 1.
-  std::vector<double> d(static_cast<std::size_t>(p));
-  for (int i = 0; i < p; ++i)
-    d[static_cast<std::size_t>(i)] = IsLogParameter(record, i) ? values[static_cast<std::size_t>(i)] : 1.0;
-  for (int i = 0; i < p; ++i)
-    for (int j = 0; j < p; ++j) {
-      const auto ij = static_cast<std::size_t>(i * p + j);
-      (*matrix)[ij] = c[ij] * variance * d[static_cast<std::size_t>(i)] * d[static_cast<std::size_t>(j)];
-    }
-  for (int i = 0; i < p; ++i)
-    (*errors)[static_cast<std::size_t>(i)] =
-        std::sqrt(std::max(0.0, (*matrix)[static_cast<std::size_t>(i * p + i)]));
-  return true;
-}
-
-std::string Number(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
-
-}  // namespace
-
-std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<double>& u, double u0,
-                                  double dt_s) {
-  DiscretePlant plant(model.ToTransferFunction(), dt_s, model.delay_s());
-  std::vector<double> yhat(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) {
-    yhat[k] = plant.Output();
-    plant.Step(u[k] - u0);
-  }
-  return yhat;
-}
-
-namespace {
-
 // The best of the starts: its theta, and every start's cost.
 std::vector<double> MultiStart(const Record& record, const IdentifyOptions& options,
                                const std::vector<std::vector<double>>& nested, std::vector<double>* costs,
@@ -573,19 +258,6 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
   for (const std::vector<double>& theta : nested) fit(theta, true);
   for (int s = 0; s < options.starts; ++s) fit(StartPoint(record, sobol, s), false);
   return best;
-}
-
-// The model `kind` contains, whose optimum starts `kind`'s fit: P1D in P2D
-// (Tp2 -> 0), P2D in P2DU (as long as its lags are near enough to be a
-// pair's) and in P2DZ (Tz = 0).
-bool ContainedKind(ProcessModelKind kind, ProcessModelKind* inner) {
-  if (kind == ProcessModelKind::kP2D)
-    *inner = ProcessModelKind::kP1D;
-  else if (kind == ProcessModelKind::kP2DU || kind == ProcessModelKind::kP2DZ)
-    *inner = ProcessModelKind::kP2D;
-  else
-    return false;
-  return true;
 }
 
 // Starts at the optimum `inner` of the model that `record`'s kind contains,
@@ -647,188 +319,80 @@ std::vector<std::vector<double>> NestedStarts(const Record& record, const Identi
   }
   return starts;
 }
-
-// Which parameters sit at (within 1e-6, relative to the bound's scale, of)
-// a bound of the fit: "lower", "upper" or "" for each. Td at 0, Zeta at 1 (or
-// at its floor), a time constant at dt/1000 or 1000 times the record.
-std::vector<std::string> AtBound(const Record& record, const std::vector<double>& values) {
-  std::vector<std::string> at(values.size());
-  const int p = static_cast<int>(values.size());
-  if (p == 0) return at;
-  const double td = values.back();
-  if (td <= 1e-6 * record.dt_s)
-    at.back() = "lower";
-  else if (td >= record.max_delay_s * (1 - 1e-6))
-    at.back() = "upper";
-  for (int i = 1; i < p - 1 && record.kind != ProcessModelKind::kTf; ++i) {
-    const double v = values[static_cast<std::size_t>(i)];
-    std::string& a = at[static_cast<std::size_t>(i)];
-    if (IsLogParameter(record, i)) {
-      if (v <= record.dt_s / kTimeConstantRange * (1 + 1e-6))
-        a = "lower";
-      else if (v >= record.length_s * kTimeConstantRange * (1 - 1e-6))
-        a = "upper";
-    } else if (!IsZeroParameter(record.kind, i)) {  // Zeta
-      if (v >= 1.0 - 1e-6)
-        a = "upper";
-      else if (v <= kMinZeta * (1 + 1e-6))
-        a = "lower";
-    }
+// The optimum of the same kind fitted with another loss (the l2 fit before
+// a robust one), in Ceres's coordinates, the offsets relative to the
+// record's u0 and y0; empty if `prior` is of another kind.
+std::vector<double> SameKindStart(const Record& record, const IdentifyResult& prior, double u0, double y0) {
+  const int p = ParameterCount(record);
+  if (prior.model.kind != record.kind || static_cast<int>(prior.values.size()) != p) return {};
+  std::vector<double> theta(static_cast<std::size_t>(BlockSize(record)), 0.0);
+  for (int i = 0; i < p; ++i) {
+    const double v = prior.values[static_cast<std::size_t>(i)];
+    double& t = theta[static_cast<std::size_t>(i)];
+    if (IsLogParameter(record, i))
+      t = std::clamp(std::log(v), std::log(record.dt_s / kTimeConstantRange),
+                     std::log(record.length_s * kTimeConstantRange));
+    else if (i == p - 1)
+      t = std::clamp(v, 0.0, record.max_delay_s);
+    else if (record.kind == ProcessModelKind::kP2DU && i == 2)
+      t = std::clamp(v, kMinZeta, kMaxZeta);
+    else
+      t = v;
   }
-  return at;
+  if (record.offset) theta[static_cast<std::size_t>(p)] = prior.y0 - y0;
+  if (record.input_offset) theta[static_cast<std::size_t>(InputOffsetIndex(record))] = prior.u0 - u0;
+  return theta;
 }
 
-// The plain warnings of IdentifyResult::warnings.
-std::vector<std::string> Warnings(const Record& record, const IdentifyResult& r) {
-  const double dt_s = record.dt_s, length_s = record.length_s, max_delay_s = record.max_delay_s;
-  std::vector<std::string> w;
-  if (!r.covariance_ok) w.push_back("no intervals: " + r.covariance_message);
-  for (std::size_t i = 0; i < r.names.size() && r.covariance_ok; ++i) {
-    const double half = 1.96 * r.standard_errors[i];
-    if (!r.at_bound[i].empty()) continue;  // said below, with its one-sided interval
-    if (half > std::abs(r.values[i]))
-      w.push_back(r.names[i] + " = " + Number(r.values[i]) + " +- " + Number(half) +
-                  " (95 %): the interval is wider than the value, so the data do not determine " +
-                  r.names[i]);
-  }
-  const double td = r.model.td_s;
-  if (r.at_bound.back() == "lower")
-    w.push_back(
-        "Td = " + Number(td) +
-        " s is at its lower bound 0: the record shows no dead time the fit can resolve; its interval is "
-        "one-sided and not reported");
-  for (std::size_t i = 0; i < r.names.size(); ++i)
-    if (r.names[i] == "Zeta" && !r.at_bound[i].empty())
-      w.push_back("Zeta = " + Number(r.values[i]) + " is at its " + r.at_bound[i] + " bound (" +
-                  (r.at_bound[i] == "upper" ? "1: the poles are real or nearly so, which p2d describes"
-                                            : Number(kMinZeta) + ": an undamped oscillation") +
-                  "); its interval is one-sided and not reported");
-  if (r.starts >= 3 && r.starts_at_best < 3)
-    w.push_back("only " + std::to_string(r.starts_at_best) + " of " + std::to_string(r.starts) +
-                " starts reached the best cost" +
-                (r.bounds_refit_improved ? " (the refit with the parameters at a bound held there found it)"
-                 : r.delay_profile_improved ? " (the delay's profile found it)"
-                                            : "") +
-                ": the optimum may not be the global one; try more --starts or another --seed");
-  if (td >= max_delay_s * (1 - 1e-6))
-    w.push_back("Td = " + Number(td) + " s is at its bound (" + Number(max_delay_s) +
-                " s, half the record): the delay may be longer than the record can show");
-  for (std::size_t i = 0; i < r.names.size(); ++i) {
-    if (!IsLogParameter(record, static_cast<int>(i))) continue;
-    const double t = r.values[i];
-    if (t <= dt_s / kTimeConstantRange * (1 + 1e-6) || t >= length_s * kTimeConstantRange * (1 - 1e-6))
-      w.push_back(r.names[i] + " = " + Number(t) + " s is at its bound [" +
-                  Number(dt_s / kTimeConstantRange) + ", " + Number(length_s * kTimeConstantRange) +
-                  "] s: the model's order may be wrong; its interval is one-sided and not reported");
-  }
-  // An exact fit (residual RMS below 1e-9 of the output's spread, as with
-  // noise-free data) leaves rounding in its residuals: not worth a warning.
-  const bool exact = r.fit_percent > 100.0 * (1.0 - 1e-9);
-  if (r.whiteness.lags > 0 && !r.whiteness.white && !exact)
-    w.push_back("the residuals are not white (Ljung-Box Q = " + Number(r.whiteness.ljung_box_q) + " over " +
-                std::to_string(r.whiteness.lags) + " lags, p = " + Number(r.whiteness.p_value) +
-                "): the model leaves dynamics unexplained, or the noise is coloured");
-  return w;
+// The loss of IdentifyOptions on the record; a robust one needs its scale
+// here (Identify and IdentifyAuto derive it first).
+Status SetLoss(const IdentifyOptions& options, Record* record, IdentifyResult* result) {
+  result->loss = options.loss;
+  if (options.loss == Loss::kL2) return Status::Ok();
+  if (std::isnan(options.loss_scale))
+    return Status::InvalidInput("loss " + ToString(options.loss) +
+                                " needs its scale: give loss_scale, or call Identify, which derives it");
+  record->loss = internal::MakeLoss(options.loss, options.loss_scale);
+  result->loss_scale = options.loss_scale;
+  result->loss_scale_source = "given";
+  return Status::Ok();
 }
 
-// Figures of merit of the fit at `theta` into *result.
-void Summarise(const Record& record, const IdentifyData& data, const std::vector<double>& theta, double cost,
-               IdentifyResult* result) {
-  const double n = static_cast<double>(data.y.size());
-  result->model = ModelOf(record, theta.data());
-  result->names = ParameterNames(record.kind, record.poles, record.zeros);
-  result->values = ParameterValues(result->model);
-  result->cost = cost;
-  double mean = 0.0;
-  for (double v : data.y) mean += v / n;
-  double spread = 0.0;
-  for (double v : data.y) spread += (v - mean) * (v - mean);
-  result->fit_percent = 100.0 * (1.0 - std::sqrt(2.0 * cost) / std::sqrt(spread));
-  result->aic =
-      n * std::log(2.0 * cost / n) + 2.0 * (BlockSize(record) + FittedStates(record, result->model));
-  const double offset = OffsetOf(record, theta.data());
-  result->y0 += offset;
-  result->y0_estimated = record.offset;
-  result->u0 += InputOffsetOf(record, theta.data());
-  result->u0_estimated = record.input_offset;
-  result->covariance_ok =
-      Covariance(record, theta, cost, &result->standard_errors, &result->covariance,
-                 &result->y0_standard_error, &result->u0_standard_error, &result->covariance_message);
-  std::vector<double> yhat;
-  result->initial_state.assign(static_cast<std::size_t>(internal::ModelOrder(result->model)), 0.0);
-  if (TrySimulate(result->model, record, &yhat, offset, InputOffsetOf(record, theta.data()), true,
-                  &result->initial_state)) {
-    if (result->initial_state.empty())
-      result->initial_state.assign(static_cast<std::size_t>(internal::ModelOrder(result->model)), 0.0);
-    for (std::size_t k = 0; k < yhat.size(); ++k) {
-      result->simulated.push_back(result->y0 + yhat[k]);
-      result->residuals.push_back(record.dy[k] - offset - yhat[k]);
-    }
-    result->whiteness = ResidualWhiteness(result->residuals);
-    // The cost of the parameters reported, from the residuals reported.
-    double resimulated = 0.0;
-    for (double r : result->residuals) resimulated += 0.5 * r * r;
-    result->cost = resimulated;
-  }
-  result->at_bound = AtBound(record, result->values);
-  for (std::size_t i = 0; i < result->at_bound.size(); ++i)
-    if (!result->at_bound[i].empty() && i < result->standard_errors.size()) result->standard_errors[i] = kNaN;
-  result->warnings = Warnings(record, *result);
-}
-
-}  // namespace
-
-Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
-                IdentifyResult* result) {
-  ProcessModelKind inner_kind;
-  if (const Status shape = internal::CheckTfShape(kind, options.poles, options.zeros); !shape.ok())
-    return shape;
-  if (!options.nested_starts || !ContainedKind(kind, &inner_kind))
-    return Identify(data, kind, options, nullptr, result);
-  // The contained model's fit is a start only: a quarter of the starts (its
-  // optimum, of fewer parameters, is reached from fewer), the ARX start and
-  // the delay's profile as asked.
-  // Its own contained model is not fitted: one level of nesting.
-  IdentifyOptions inner_options = options;
-  inner_options.starts = std::max(1, (options.starts + 3) / 4);
-  inner_options.nested_starts = false;
-  IdentifyResult inner;
-  const Status status = Identify(data, inner_kind, inner_options, &inner);
-  if (status.code() == StatusCode::kInvalidInput) return status;
-  return Identify(data, kind, options, status.ok() ? &inner : nullptr, result);
-}
-
-Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
-                const IdentifyResult* contained, IdentifyResult* result) {
+// The record of one fit with its operating point taken off, checked; the
+// result's settings (sampling, offsets, loss) into *result.
+Status MakeRecord(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
+                  Record* record, IdentifyResult* result) {
   std::string error;
   if (!options.IsValid(&error)) return Status::InvalidInput(error);
-  Record record;
-  record.kind = kind;
+  record->kind = kind;
   const Status shape = internal::CheckTfShape(kind, options.poles, options.zeros);
   if (!shape.ok()) return shape;
-  record.poles = options.poles;
-  record.zeros = options.zeros;
+  record->poles = options.poles;
+  record->zeros = options.zeros;
   Sampling sampling;
   const Status status = CheckData(data, &sampling);
   if (!status.ok()) return status;
-  record.dt_s = sampling.mean_interval_s;
-  record.t = data.t;
-  record.hold = options.intersample;
-  record.initial = options.initial_condition;
-  record.piecewise =
-      !sampling.uniform || record.hold == Intersample::kFoh || record.initial != InitialCondition::kZero;
+  record->dt_s = sampling.mean_interval_s;
+  record->t = data.t;
+  record->hold = options.intersample;
+  record->initial = options.initial_condition;
+  record->piecewise =
+      !sampling.uniform || record->hold == Intersample::kFoh || record->initial != InitialCondition::kZero;
   *result = IdentifyResult{};
   result->sampling = sampling;
   result->intersample = options.intersample;
   result->initial_condition = options.initial_condition;
   result->u0 = std::isnan(options.u0) ? data.u[0] : options.u0;
+  result->u0_source = options.estimate_u0      ? "estimated"
+                      : std::isnan(options.u0) ? "the first sample of u"
+                                               : "given";
   // Not given: estimated, from the first sample as its start.
   result->y0 = std::isnan(options.y0) ? data.y[0] : options.y0;
-  record.offset = std::isnan(options.y0);
-  record.input_offset = options.estimate_u0;
+  record->offset = std::isnan(options.y0);
+  record->input_offset = options.estimate_u0;
   for (std::size_t k = 0; k < data.u.size(); ++k) {
-    record.du.push_back(data.u[k] - result->u0);
-    record.dy.push_back(data.y[k] - result->y0);
+    record->du.push_back(data.u[k] - result->u0);
+    record->dy.push_back(data.y[k] - result->y0);
   }
   // A constant input is a step from u0 when u0 is given; at its default,
   // the first sample, there is no input to respond to.
@@ -838,17 +402,71 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
                                 " throughout and u0 is its first sample, so nothing can be identified; a "
                                 "step test that starts at the "
                                 "step needs the input before it: give --u0 (e.g. --u0 0)");
-  if (record.initial == InitialCondition::kSteadyState && kind == ProcessModelKind::kP1DI &&
-      record.du[0] != 0.0)
+  if (record->initial == InitialCondition::kSteadyState && kind == ProcessModelKind::kP1DI &&
+      record->du[0] != 0.0)
     return Status::InvalidInput(
         "initial condition steady-state: P1DI integrates, so it has no steady state at u[0] = " +
         Number(data.u[0]) + " unless u0 is that value too (u0 = " + Number(result->u0) + ")");
   if (Status s = CheckResponse(data); !s.ok()) return s;
-  record.length_s = data.t.back() - data.t.front();
-  record.max_delay_s = options.max_delay_fraction * record.length_s;
-  const std::vector<std::vector<double>> nested =
-      contained && options.nested_starts ? NestedStarts(record, *contained, result->u0, result->y0)
-                                         : std::vector<std::vector<double>>{};
+  record->length_s = data.t.back() - data.t.front();
+  record->max_delay_s = options.max_delay_fraction * record->length_s;
+  return SetLoss(options, record, result);
+}
+
+// After the starts (*theta at *best): the delay's profile, the refit at the
+// bounds, Tp1 >= Tp2, and how many starts reached the best cost.
+void Refine(const Record& record, const IdentifyOptions& options, std::vector<double>* theta, double* best,
+            IdentifyResult* result) {
+  const ProcessModelKind kind = record.kind;
+  // Near Td = 0 only (within two samples): elsewhere the starts' spread
+  // finds the delay (identify_study_test), and the profile's refits would
+  // double the cost of a fit.
+  const double best_td =
+      kind == ProcessModelKind::kTf ? 0.0 : (*theta)[static_cast<std::size_t>(ParameterCount(record) - 1)];
+  if (kind != ProcessModelKind::kTf && options.delay_profile && best_td < 2.0 * record.dt_s)
+    result->delay_profile_improved = ProfileDelay(record, options, theta, best);
+  if (kind != ProcessModelKind::kTf && options.bounds_refit)
+    result->bounds_refit_improved = RefitAtBounds(record, options, theta, best);
+  // P2D's time constants are interchangeable: report Tp1 >= Tp2.
+  if ((kind == ProcessModelKind::kP2D || kind == ProcessModelKind::kP2DZ) && (*theta)[2] > (*theta)[1])
+    std::swap((*theta)[1], (*theta)[2]);
+  double scale = 0.0;
+  for (double v : record.dy) scale += internal::SampleCost(record, v);
+  // Within 1e-8 of the best cost, relative; a record fitted exactly (best
+  // cost ~ 0) is measured against 1e-16 of the cost of the zero model.
+  const double tolerance = 1e-8 * std::max(*best, 1e-16 * scale);
+  for (double c : result->start_costs) result->starts_at_best += c - *best <= tolerance ? 1 : 0;
+  result->starts = static_cast<int>(result->start_costs.size());
+}
+
+}  // namespace
+
+namespace internal {
+
+// The model `kind` contains, whose optimum starts `kind`'s fit: P1D in P2D
+// (Tp2 -> 0), P2D in P2DU (as long as its lags are near enough to be a
+// pair's) and in P2DZ (Tz = 0).
+bool ContainedKind(ProcessModelKind kind, ProcessModelKind* inner) {
+  if (kind == ProcessModelKind::kP2D)
+    *inner = ProcessModelKind::kP1D;
+  else if (kind == ProcessModelKind::kP2DU || kind == ProcessModelKind::kP2DZ)
+    *inner = ProcessModelKind::kP2D;
+  else
+    return false;
+  return true;
+}
+
+Status FitKind(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
+               const Seeds& seeds, IdentifyResult* result) {
+  Record record;
+  if (Status s = MakeRecord(data, kind, options, &record, result); !s.ok()) return s;
+  std::vector<std::vector<double>> nested;
+  if (seeds.contained && options.nested_starts)
+    nested = NestedStarts(record, *seeds.contained, result->u0, result->y0);
+  if (seeds.same_kind) {
+    std::vector<double> theta = SameKindStart(record, *seeds.same_kind, result->u0, result->y0);
+    if (!theta.empty()) nested.push_back(theta);
+  }
   result->nested_starts = static_cast<int>(nested.size());
   std::vector<double> theta = MultiStart(record, options, nested, &result->start_costs, &result->arx_start);
   if (theta.empty())
@@ -859,30 +477,37 @@ Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyO
         " iterations each, all ended at a non-finite cost; check the record's units and outliers, or try "
         "more starts (--starts), another seed or another model");
   double best = *std::min_element(result->start_costs.begin(), result->start_costs.end());
-  // Near Td = 0 only (within two samples): elsewhere the starts' spread
-  // finds the delay (identify_study_test), and the profile's refits would
-  // double the cost of a fit.
-  const double best_td =
-      kind == ProcessModelKind::kTf ? 0.0 : theta[static_cast<std::size_t>(ParameterCount(record) - 1)];
-  if (kind != ProcessModelKind::kTf && options.delay_profile && best_td < 2.0 * record.dt_s)
-    result->delay_profile_improved = ProfileDelay(record, options, &theta, &best);
-  if (kind != ProcessModelKind::kTf && options.bounds_refit)
-    result->bounds_refit_improved = RefitAtBounds(record, options, &theta, &best);
-  // P2D's time constants are interchangeable: report Tp1 >= Tp2.
-  if ((kind == ProcessModelKind::kP2D || kind == ProcessModelKind::kP2DZ) && theta[2] > theta[1])
-    std::swap(theta[1], theta[2]);
-  double scale = 0.0;
-  for (double v : record.dy) scale += 0.5 * v * v;
-  // Within 1e-8 of the best cost, relative; a record fitted exactly (best
-  // cost ~ 0) is measured against 1e-16 of the cost of the zero model.
-  const double tolerance = 1e-8 * std::max(best, 1e-16 * scale);
-  for (double c : result->start_costs) result->starts_at_best += c - best <= tolerance ? 1 : 0;
-  result->starts = static_cast<int>(result->start_costs.size());
+  Refine(record, options, &theta, &best, result);
   result->seed = options.seed;
   result->samples = static_cast<int>(data.y.size());
   result->dt_s = record.dt_s;
   Summarise(record, data, theta, best, result);
   return Status::Ok();
+}
+
+Status FitNested(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
+                 const IdentifyResult* same_kind, IdentifyResult* result) {
+  ProcessModelKind inner_kind;
+  if (!options.nested_starts || !ContainedKind(kind, &inner_kind))
+    return FitKind(data, kind, options, Seeds{nullptr, same_kind}, result);
+  // The contained model's fit is a start only: a quarter of the starts (its
+  // optimum, of fewer parameters, is reached from fewer), the ARX start and
+  // the delay's profile as asked.
+  // Its own contained model is not fitted: one level of nesting.
+  IdentifyOptions inner_options = options;
+  inner_options.starts = std::max(1, (options.starts + 3) / 4);
+  inner_options.nested_starts = false;
+  IdentifyResult inner;
+  const Status status = FitKind(data, inner_kind, inner_options, Seeds{}, &inner);
+  if (status.code() == StatusCode::kInvalidInput) return status;
+  return FitKind(data, kind, options, Seeds{status.ok() ? &inner : nullptr, same_kind}, result);
+}
+
+}  // namespace internal
+
+Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
+                const IdentifyResult* contained, IdentifyResult* result) {
+  return internal::FitKind(data, kind, options, internal::Seeds{contained, nullptr}, result);
 }
 
 }  // namespace pidlab::identify

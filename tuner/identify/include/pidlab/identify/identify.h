@@ -66,6 +66,23 @@ bool ParseInitialCondition(const std::string& s, InitialCondition* v);
 std::string ToString(Intersample v);       // "zoh", "foh"
 std::string ToString(InitialCondition v);  // "zero", "steady-state", "estimate"
 
+/// The loss on each residual r_k: the cost is 1/2 sum rho(r_k^2), with rho
+/// Ceres's (ceres::HuberLoss, ceres::CauchyLoss of scale a): kL2 rho(s) = s
+/// (least squares); kHuber s for |r| <= a, 2 a |r| - a^2 beyond; kCauchy
+/// a^2 log(1 + s / a^2). docs/identify.md, "Robust losses for dropouts".
+enum class Loss { kL2, kHuber, kCauchy };
+bool ParseLoss(const std::string& s, Loss* v);
+std::string ToString(Loss v);  // "l2", "huber", "cauchy"
+/// The default scale a of a robust loss is this many robust standard
+/// deviations (1.4826 times the median absolute deviation) of the residuals
+/// of the l2 fit: 95 % efficiency on Gaussian noise (Huber's 1.345, Holland
+/// and Welsch's 2.385 for Cauchy).
+inline constexpr double kHuberScaleInSigmas = 1.345;
+inline constexpr double kCauchyScaleInSigmas = 2.385;
+/// A sample whose weight rho'(r_k^2) is below this is listed as
+/// down-weighted (IdentifyResult::downweighted).
+inline constexpr double kDownweightedBelow = 0.5;
+
 /// The most starts a fit takes (IdentifyOptions::starts).
 inline constexpr int kMaxStarts = 1000;
 
@@ -115,6 +132,14 @@ struct IdentifyOptions {
   int zeros = 0;
   Intersample intersample = Intersample::kZoh;
   InitialCondition initial_condition = InitialCondition::kZero;
+  /// The loss on each residual (Loss): kL2, or kHuber or kCauchy for records
+  /// with outliers (a sensor's dropouts).
+  Loss loss = Loss::kL2;
+  /// The robust loss's scale a, in units of y: finite, > 0, at most 1e12,
+  /// and only with kHuber or kCauchy. NaN: derived from the record (the l2
+  /// fit first, then kHuberScaleInSigmas or kCauchyScaleInSigmas times the
+  /// robust standard deviation of its residuals).
+  double loss_scale = std::numeric_limits<double>::quiet_NaN();
   /// Called after each start of the fit (on the caller's thread): the kind
   /// being fitted, the starts done and planned (the ARX start included), and
   /// the best cost so far. Empty: nothing is called. A front end shows
@@ -155,11 +180,34 @@ struct IdentifyResult {
   std::vector<double> covariance;
   bool covariance_ok = false;
   std::string covariance_message;  // why it failed, else empty
-  double cost = 0.0;               // 1/2 sum of squared residuals
+  double cost = 0.0;               // 1/2 sum rho(r_k^2): of squared residuals for l2
   double fit_percent = 0.0;        // 100 (1 - |y - yhat| / |y - mean y|)
   double aic = 0.0;                // N log(2 cost / N) + 2 p (p with y0 if estimated)
   double u0 = 0.0, y0 = 0.0;       // the operating point used
-  bool y0_estimated = false;       // y0 was a parameter of the fit
+  /// How u0 was found, in words: "given", "estimated", "the first sample of
+  /// u", or, when u0 was not given and the record's u[0] is not 0, the
+  /// hypothesis chosen by AIC ("at rest at u = 0 before the record (AIC ...;
+  /// at rest under u[0] = ...: AIC ...)").
+  std::string u0_source;
+  /// The hypotheses on the input the record rested at, fitted when u0 was
+  /// not given (u0 = u[0], then u0 = 0): empty otherwise.
+  struct RestHypothesis {
+    double u0 = 0.0;
+    double aic = std::numeric_limits<double>::quiet_NaN();  // NaN if it could not be fitted
+    std::string message;                                    // why not, else empty
+  };
+  std::vector<RestHypothesis> rest_hypotheses;
+  /// The loss the fit minimised, its scale a (NaN for kL2) and where that
+  /// came from ("given", or the robust standard deviation it was derived
+  /// from). `cost` is 1/2 sum rho(r_k^2) with this loss.
+  Loss loss = Loss::kL2;
+  double loss_scale = std::numeric_limits<double>::quiet_NaN();
+  std::string loss_scale_source;
+  /// rho'(r_k^2) at every sample (1 throughout for kL2), and the samples
+  /// whose weight is below kDownweightedBelow, in order.
+  std::vector<double> weights;
+  std::vector<int> downweighted;
+  bool y0_estimated = false;                                            // y0 was a parameter of the fit
   double y0_standard_error = std::numeric_limits<double>::quiet_NaN();  // if estimated
   bool u0_estimated = false;                                            // u0 was a parameter of the fit
   double u0_standard_error = std::numeric_limits<double>::quiet_NaN();  // if estimated
@@ -228,11 +276,17 @@ std::vector<double> SimulateModel(const ProcessModel& model, const std::vector<d
 
 /// Fits a model of `kind` to `data`. kInvalidInput for bad data or options
 /// (CheckData, IdentifyOptions::IsValid, poles and zeros as they say);
-/// kRunnerFailed if no start converged.
+/// kRunnerFailed if no start converged. When u0 is neither given nor
+/// estimated, the initial condition is kZero, u varies and u[0] != 0, the
+/// record is fitted at rest under u[0] and at rest at u = 0, and the lower
+/// AIC is kept (IdentifyResult::u0_source says which). A robust loss without
+/// a scale is preceded by the l2 fit that gives its scale.
 Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
                 IdentifyResult* result);
 /// The same, with the fit of the model `kind` contains given (nullptr: none):
-/// IdentifyAuto passes the kinds it fitted before.
+/// IdentifyAuto passes the kinds it fitted before. One fit: u0 as the options
+/// say (NaN: the first sample, no hypotheses), and a robust loss needs its
+/// loss_scale (kInvalidInput otherwise).
 Status Identify(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
                 const IdentifyResult* contained, IdentifyResult* result);
 
@@ -249,7 +303,10 @@ struct PoleEstimate {
 /// complex pair first), with standard errors when the covariance is ok.
 std::vector<PoleEstimate> PoleEstimates(const IdentifyResult& result);
 
-/// Fits every process kind (P1D, P2D, P2DU, P1DI, P2DZ; not TF) and chooses the lowest AIC, or,
+/// Fits every process kind (P1D, P2D, P2DU, P1DI, P2DZ; not TF), each at the
+/// rest Identify would choose (both rests fitted, the lower AIC kept per
+/// kind) and with one loss scale for all (from the l2 fit auto chooses), and
+/// chooses the lowest AIC, or,
 /// among the kinds within 2 of it (which the data hardly tell apart), the one
 /// of fewest parameters (then the lowest AIC among those).
 /// kInvalidInput as Identify; kRunnerFailed if no kind could be fitted.
