@@ -111,6 +111,16 @@ g = j['gains']
 assert j['stable'] and g['kd'] > 0 and abs(g['tf'] - g['kd'] / (10 * g['kp'])) < 1e-12, g
 PY"
 
+# ---- SIMC's knob: --tau-c 4 on K = 1, T = 10, L = 2 gives Kc = T / (K (tau_c + L)) = 10/6.
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method simc --rule pi --tau-c 4 --json > tauc.json
+check "simc --tau-c 4: Kc = 10/6, Ti = min(T, 4 (tau_c + L)) = 10" "/usr/bin/python3 - <<'PY'
+import json
+j = json.load(open('tauc.json'))
+g = j['gains']
+assert abs(g['kp'] - 10 / 6) < 1e-12 and abs(g['ki'] - 10 / 6 / 10) < 1e-12, g
+assert j['spec']['tau_c'] == 4 and 'tau_c = 4 s (given)' in j['tuning_rule']['message'], j['tuning_rule']
+PY"
+
 # ---- The paper's plants keep eq. (4) and the multi-start.
 "$pidlab" tune --plant oscillator --max-evals 300 --design-points 64 --json > paper.json
 check "the paper's oscillator: multi-start on eq. (4)'s 25 s at 0.05 s" "/usr/bin/python3 - <<'PY'
@@ -136,6 +146,7 @@ bad() {
 bad "--robustness 1" "1" --num 1 --den 10,1 --delay 2 --robustness 1
 bad "--robustness 9" "9" --num 1 --den 10,1 --delay 2 --robustness 9
 bad "--response-time -1" "-1" --num 1 --den 10,1 --delay 2 --response-time -1
+bad "--tau-c -1" "-1" --num 1 --den 10,1 --delay 2 --method simc --tau-c -1
 bad "--method migo without a filter" "filter" --num 1 --den 10,1 --delay 2 --method migo --horizon 100 \
   --sample-time 0.2 --derivative-filter-ratio 0
 

@@ -397,8 +397,8 @@ Status MigoSetpointWeights(const Plant& plant, const evaluation::LoopOptions& lo
   return Status::Ok();
 }
 
-Status DesignMigoForSetpoint(const Plant& plant, const evaluation::LoopOptions& loop, const MigoOptions& options,
-                             MigoDesign* design, TwoDofSummary* two_dof) {
+Status DesignMigoForSetpoint(const Plant& plant, const evaluation::LoopOptions& loop,
+                             const MigoOptions& options, MigoDesign* design, TwoDofSummary* two_dof) {
   MigoOptions o = options;
   Status status;
   for (;;) {

@@ -406,6 +406,9 @@ bool BuildSearch(const spec::TuneSpec& t, NameStyle style, TuneOptions* o, std::
   o->two_dof = t.two_dof;
   o->robustness_ms = t.robustness;
   o->response_time_s = t.response_time_s;
+  o->tau_c_s = t.tau_c_s;
+  if (!(t.tau_c_s >= 0.0) || !std::isfinite(t.tau_c_s))
+    return Bad(error, name("tau_c") + " " + spec::FormatNumber(t.tau_c_s) + " must be >= 0 and finite (s)");
   if (!(t.robustness > 1.0 && t.robustness <= 4.0))
     return Bad(error, name("robustness") + " " + spec::FormatNumber(t.robustness) +
                           " must be an Ms bound in (1, 4]");

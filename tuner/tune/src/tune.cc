@@ -350,7 +350,7 @@ void RuleResult(const PidGains& g, const evaluation::ObjectiveEvaluator& evaluat
 bool RuleSearch(const Plant& plant, const TuneOptions& options,
                 const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary, std::string* error) {
   const TuningRule rule = options.method == TuneMethod::kSimc ? TuningRule::kSimc : TuningRule::kAmigo;
-  const Status status = ApplyTuningRule(plant, rule, options.rule, &summary->tuning_rule);
+  const Status status = ApplyTuningRule(plant, rule, options.rule, &summary->tuning_rule, options.tau_c_s);
   if (!status.ok()) {
     if (error) *error = status.message();
     return false;
@@ -362,10 +362,10 @@ bool RuleSearch(const Plant& plant, const TuneOptions& options,
 // The MIGO design (migo.h) into summary->migo, ->two_dof and ->optimizer.
 bool MigoSearch(const Plant& plant, const TuneOptions& options,
                 const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary, std::string* error) {
-  const MigoOptions o{options.robustness_ms, options.rule == RuleForm::kPi, options.response_time_s,
-                      options.migo_max_overshoot_pct,
-                      options.loop.derivative_filter_ratio > 0.0 ? options.loop.derivative_filter_ratio
-                                                                 : kMigoFilterRatio};
+  const MigoOptions o{
+      options.robustness_ms, options.rule == RuleForm::kPi, options.response_time_s,
+      options.migo_max_overshoot_pct,
+      options.loop.derivative_filter_ratio > 0.0 ? options.loop.derivative_filter_ratio : kMigoFilterRatio};
   const Status status = DesignMigoForSetpoint(plant, options.loop, o, &summary->migo, &summary->two_dof);
   if (!status.ok() && error) *error = status.message();
   if (status.ok()) RuleResult(summary->migo.gains, evaluator, summary->migo.message, &summary->optimizer);

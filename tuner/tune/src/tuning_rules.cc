@@ -210,14 +210,15 @@ Status ReduceFactored(const FactoredPlant& plant, TuningRule rule, RuleForm form
   return Status::Ok();
 }
 
-Status SimcTune(const ProcessModel& m, RuleForm form, TuningRuleResult* r) {
+Status SimcTune(const ProcessModel& m, RuleForm form, TuningRuleResult* r, double tau_c_s) {
   r->rule = TuningRule::kSimc;
   r->form = form;
   r->model = m;
   r->controller_form = "series";
-  const Status delayed = NeedDelay(r->rule, m);
+  // tau_c given: the model may have no dead time (the closed loop's speed is given).
+  const Status delayed = tau_c_s > 0.0 ? Status::Ok() : NeedDelay(r->rule, m);
   if (!delayed.ok()) return delayed;
-  const double tau_c = m.delay_s;  // tight tuning
+  const double tau_c = tau_c_s > 0.0 ? tau_c_s : m.delay_s;  // default: tight tuning, tau_c = theta
   const double t = tau_c + m.delay_s;
   if (m.kind == ProcessModelKind::kIntegrating) {
     r->kc = 1.0 / (m.gain * t);
@@ -230,7 +231,13 @@ Status SimcTune(const ProcessModel& m, RuleForm form, TuningRuleResult* r) {
                    (m.kind == ProcessModelKind::kIntegrating && m.time_constants.size() == 1);
   r->td_s = form == RuleForm::kPid && lag ? m.time_constants.back() : 0.0;
   r->gains = SeriesToParallel(r->kc, r->ti_s, r->td_s);
-  return Finish(r);
+  const Status finished = Finish(r);
+  if (finished.ok() && tau_c_s > 0.0) {
+    std::ostringstream os;
+    os << ", tau_c = " << tau_c << " s (given)";
+    r->message += os.str();
+  }
+  return finished;
 }
 
 Status AmigoTune(const ProcessModel& m, RuleForm form, TuningRuleResult* r) {
@@ -266,12 +273,15 @@ Status AmigoTune(const ProcessModel& m, RuleForm form, TuningRuleResult* r) {
   return Finish(r);
 }
 
-Status ApplyTuningRule(const Plant& plant, TuningRule rule, RuleForm form, TuningRuleResult* result) {
+Status ApplyTuningRule(const Plant& plant, TuningRule rule, RuleForm form, TuningRuleResult* result,
+                       double tau_c_s) {
+  if (!(tau_c_s >= 0.0) || !std::isfinite(tau_c_s))
+    return Status::InvalidInput("tau_c " + std::to_string(tau_c_s) + " must be >= 0 and finite (s)");
   ProcessModel model;
   const Status reduced = ReduceModel(plant, rule, form, &model);
   if (!reduced.ok()) return reduced;
   const Status tuned =
-      rule == TuningRule::kSimc ? SimcTune(model, form, result) : AmigoTune(model, form, result);
+      rule == TuningRule::kSimc ? SimcTune(model, form, result, tau_c_s) : AmigoTune(model, form, result);
   result->plant_delay_s = plant.delay_s;
   return tuned;
 }

@@ -276,7 +276,7 @@ struct TuneSpec {
   int robust_samples = 0;
   double robust_quantile = 1.0, robust_spread = 0.1;
   bool two_dof = false;
-  double robustness = 1.4, response_time_s = 0.0;
+  double robustness = 1.4, response_time_s = 0.0, tau_c_s = 0.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -359,6 +359,11 @@ struct TuneSpec {
               "fast as the bound allows)",
               "s", kNone, "5"},
              &response_time_s);
+    a->Visit({"tau_c",
+              "simc: the closed-loop time constant tau_c (0 = theta, the tight tuning; larger is slower and "
+              "more robust; given, a plant without dead time is tuned too)",
+              "s", kNone, "4"},
+             &tau_c_s);
   }
 };
 

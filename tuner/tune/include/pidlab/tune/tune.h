@@ -141,6 +141,8 @@ struct TuneOptions {
   double robustness_ms = kMigoDefaultMs;
   double response_time_s = 0.0;
   double migo_max_overshoot_pct = 20.0;
+  /// simc: the closed-loop time constant tau_c (s); 0: tau_c = theta.
+  double tau_c_s = 0.0;
   /// Runs independent evaluations at the same time (e.g. one thread per LCM
   /// trio): the starts of multi-start Nelder-Mead, each generation of GA and
   /// PSO-GSA. Empty: one after the other. The result is the same bits either

@@ -102,11 +102,14 @@ struct FactoredPlant {
 Status ReduceFactored(const FactoredPlant& plant, TuningRule rule, RuleForm form, ProcessModel* model);
 
 /// SIMC with tight tuning (tau_c = theta) on `model`.
-Status SimcTune(const ProcessModel& model, RuleForm form, TuningRuleResult* result);
+Status SimcTune(const ProcessModel& model, RuleForm form, TuningRuleResult* result, double tau_c_s = 0.0);
 /// AMIGO on `model` (an fopdt or an ipdt without a lag).
 Status AmigoTune(const ProcessModel& model, RuleForm form, TuningRuleResult* result);
 
 /// ReduceModel, then the rule.
-Status ApplyTuningRule(const Plant& plant, TuningRule rule, RuleForm form, TuningRuleResult* result);
+/// `tau_c_s` > 0: SIMC's closed-loop time constant tau_c (`tune --tau-c`;
+/// the model may then have no dead time); 0: tau_c = theta, the tight tuning.
+Status ApplyTuningRule(const Plant& plant, TuningRule rule, RuleForm form, TuningRuleResult* result,
+                       double tau_c_s = 0.0);
 
 }  // namespace pidlab::tune
