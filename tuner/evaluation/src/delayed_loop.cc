@@ -159,11 +159,20 @@ class DelayedIntegrator {
     return tb;
   }
 
-  // The stored piece holding s (s >= 0), by a pointer that only moves forward.
+  // The stored piece holding s (s >= 0), by a pointer that only moves
+  // forward. The pieces behind it are never read again (s only grows): they
+  // are dropped once they are half the store, so memory follows the dead
+  // time's window, not the horizon (a tuner's fast candidates need millions
+  // of pieces).
   std::size_t Source(double s) {
     while (source_ + 1 < stored_.size() && stored_[source_].sb <= s + tol_) ++source_;
+    if (source_ >= kPruneAt && 2 * source_ >= stored_.size()) {
+      stored_.erase(stored_.begin(), stored_.begin() + static_cast<std::ptrdiff_t>(source_));
+      source_ = 0;
+    }
     return source_;
   }
+  static constexpr std::size_t kPruneAt = 4096;
 
   Eigen::Vector4d DelayedInput(double t) {
     const double s = t - loop_.delay_s;

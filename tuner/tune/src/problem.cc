@@ -251,10 +251,14 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
   const bool paper = IsPaperPlant(s->plant);
   const bool timed = kept("horizon") || kept("sample_time");
   if (!paper && !kept("method")) s->tune.method = "migo";
-  // A rule's or migo's PID gets a filter (migo designs with tf = Td / 10).
-  const bool rule = s->tune.method == "migo" || s->tune.method == "simc" || s->tune.method == "amigo";
-  if (rule && s->tune.rule == "pid" && !kept("derivative_filter") && !kept("derivative_filter_ratio") &&
-      !kept("robust") && (!paper || s->tune.method == "migo")) {
+  // A filtered derivative (tf = kd / (10 kp)) unless one is given: off the
+  // paper's plants for every method (an ideal derivative has an unbounded
+  // noise gain, and on relative degree 1 with dead time a neutral loop); on
+  // them for migo, which designs with it. The rules' PI has no derivative.
+  const bool pi_rule = s->tune.rule == "pi" && (s->tune.method == "migo" || s->tune.method == "simc" ||
+                                                s->tune.method == "amigo");
+  if (!pi_rule && !kept("derivative_filter") && !kept("derivative_filter_ratio") && !kept("robust") &&
+      (!paper || s->tune.method == "migo")) {
     s->loop.derivative_filter_s = 0.0;
     s->loop.derivative_filter_ratio = kMigoFilterRatio;
   }
