@@ -1,5 +1,8 @@
 #include "pidlab/results/identify_json.h"
 
+#include <Eigen/Dense>
+
+#include "pidlab/plant_sim/transfer_function.h"
 #include "pidlab/results/results_json.h"
 
 namespace pidlab::results {
@@ -77,6 +80,16 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
   nlohmann::json num = nlohmann::json::array(), den = nlohmann::json::array();
   for (double c : tf.num) num.push_back(JsonNumber(c));
   for (double c : tf.den) den.push_back(JsonNumber(c));
+  // The state's free response at t[0], C A^i x(t[0]) for i = 0 .. n-1: the
+  // initial state in terms that need no particular realisation.
+  nlohmann::json free_response = nlohmann::json::array();
+  if (!r.initial_state.empty()) {
+    const StateSpace ss = Realize(tf);
+    if (ss.order() == static_cast<int>(r.initial_state.size())) {
+      Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(r.initial_state.data(), ss.order());
+      for (int i = 0; i < ss.order(); ++i, x = ss.a * x) free_response.push_back(JsonNumber(ss.c.dot(x)));
+    }
+  }
   nlohmann::json matrix = nlohmann::json::array();
   const std::size_t p = r.names.size();
   for (std::size_t i = 0; i < p && r.covariance.size() == p * p; ++i) {
@@ -108,6 +121,7 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
       {"intersample", identify::ToString(r.intersample)},
       {"initial_condition", identify::ToString(r.initial_condition)},
       {"initial_state", r.initial_state},
+      {"initial_free_response", free_response},
       {"u0", JsonNumber(r.u0)},
       {"y0", JsonNumber(r.y0)},
       {"y0_estimated", r.y0_estimated},

@@ -14,6 +14,12 @@ Two simulators, neither pidlab's:
     grid, uniform or not: the closed-form step response of the model,
     Kp (u - u0) s(t_k - t_0 - Td).
 
+A third, for every mode of `pidlab identify` (identify_records_test.py):
+response_piecewise, any grid, the input held or linear between samples
+(zoh, foh), any input before the record and any initial state (given by its
+free response C A^i x, i < n), integrated exactly piece by piece between the
+delayed input's breakpoints by expm of [[A, B, 0], [0, 0, 1], [0, 0, 0]].
+
 The fit: variable projection. Kp and y0 enter linearly and are solved by
 least squares for every value of the nonlinear parameters (the time
 constants as logarithms, Zeta, Td), which scipy.optimize.least_squares (trf,
@@ -36,7 +42,7 @@ import os
 import sys
 
 import numpy as np
-from scipy import optimize
+from scipy import linalg, optimize
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
@@ -201,6 +207,85 @@ def cost_of(record, model, u0, values, y0):
     """1/2 sum (y - y0 - yhat)^2 of the given parameters (NAMES order)."""
     t, u, y = load(record)
     r = y - y0 - response(model, np.asarray(values, dtype=float), t, u - u0)
+    return float(0.5 * r @ r)
+
+
+def realisation(model, p):
+    """A, B, C of Kp / den(s) in controllable canonical form (this file's own,
+    not pidlab's realisation)."""
+    den = np.asarray(peer.denominator(model, p), dtype=float)
+    n = len(den) - 1
+    a = np.zeros((n, n))
+    a[0, :] = -den[1:] / den[0]
+    a[1:, :-1] += np.eye(n - 1)
+    b = np.zeros(n)
+    b[0] = 1.0
+    c = np.zeros(n)
+    c[-1] = p[0] / den[0]
+    return a, b, c
+
+
+def response_piecewise(model, p, t, du, hold="zoh", before=0.0, free=None):
+    """yhat_k (without y0) at the times t of the model with parameters p (NAMES
+    order) for the input du = u - u0, integrated exactly piece by piece on any
+    grid: the input held over [t_k, t_(k+1)) (hold "zoh") or linear from
+    (t_k, du_k) to (t_(k+1), du_(k+1)) ("foh"), held after the last sample,
+    and `before` before t[0]; all delayed by Td. The state at t[0] is the one
+    whose free response C A^i x, i = 0 .. n-1, is `free` (zeros if None).
+    Each piece between the delayed input's breakpoints t_j + Td advances
+    [x, w, w'] by expm of [[A, B, 0], [0, 0, 1], [0, 0, 0]] times its length."""
+    t = np.asarray(t, dtype=float)
+    du = np.asarray(du, dtype=float)
+    a, b, c = realisation(model, p)
+    n = len(b)
+    td = float(p[-1])
+    m = np.zeros((n + 2, n + 2))
+    m[:n, :n], m[:n, n], m[n, n + 1] = a, b, 1.0
+    x = np.zeros(n)
+    if free is not None:
+        obs = np.array([c @ np.linalg.matrix_power(a, i) for i in range(n)])
+        x = np.linalg.solve(obs, np.asarray(free, dtype=float))
+    cache = {}
+
+    def advance(x, h, w, slope):
+        key = round(h, 12)
+        if key not in cache:
+            cache[key] = linalg.expm(m * h)
+        return (cache[key] @ np.concatenate([x, [w, slope]]))[:n]
+
+    def piece(s):
+        """The undelayed input's value and slope on the piece starting at s."""
+        if s < t[0]:
+            return before, 0.0
+        j = min(int(np.searchsorted(t, s, side="right")) - 1, len(t) - 1)
+        if hold == "zoh" or j == len(t) - 1:
+            return du[j], 0.0
+        slope = (du[j + 1] - du[j]) / (t[j + 1] - t[j])
+        return du[j] + slope * (s - t[j]), slope
+
+    y = np.zeros(len(t))
+    y[0] = c @ x
+    shifted = t + td
+    for k in range(len(t) - 1):
+        cuts = shifted[(shifted > t[k]) & (shifted < t[k + 1])]
+        edges = np.concatenate([[t[k]], cuts, [t[k + 1]]])
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            # The piece's delayed input from its midpoint's sample: no
+            # rounding at the breakpoints.
+            mid = 0.5 * (lo + hi) - td
+            w, slope = piece(mid)
+            x = advance(x, hi - lo, w - slope * (mid - (lo - td)), slope)
+        y[k + 1] = c @ x
+    return y
+
+
+def cost_of_mode(record, model, values, u0, y0, hold="zoh", before=None, free=None):
+    """1/2 sum (y - y0 - yhat)^2 of the given parameters (NAMES order) in any
+    mode: the intersample behaviour `hold`, the input before the record
+    `before` (u0 if None), the initial state by its free response `free`."""
+    t, u, y = load(record)
+    before = u0 if before is None else before
+    r = y - y0 - response_piecewise(model, np.asarray(values, dtype=float), t, u - u0, hold, before - u0, free)
     return float(0.5 * r @ r)
 
 
