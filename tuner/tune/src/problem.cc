@@ -242,6 +242,20 @@ double DefaultRobustness(const Plant& plant, std::string* why) {
   return ms;
 }
 
+// A spec that says how to search (an objective, a box, budgets, step or
+// robustness bounds, the robust preset or set) or runs the sampled loop
+// asks for the search, not for migo's frequency-domain design.
+bool AsksForASearch(const spec::TuningSpec& s, const std::set<std::string>& given) {
+  for (const char* key :
+       {"robust",           "robust_samples", "objective",      "load_weight",      "bounds",
+        "max_evals",        "max_iter",       "starts",         "design_points",    "refine_starts",
+        "adaptive",         "refine",         "two_dof",        "max_overshoot",    "max_settling",
+        "max_ms",           "max_mt",         "max_noise_gain", "min_phase_margin", "min_gain_margin",
+        "max_time_constant"})
+    if (given.count(key) > 0) return true;
+  return s.loop.loop == "sampled";
+}
+
 // Method, filter and time scale from a plant other than the paper's.
 TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>& given) {
   const auto kept = [&given](const char* key) { return given.count(key) > 0; };
@@ -250,13 +264,13 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
   t.sample_time_s = s->loop.sample_time_s;
   const bool paper = IsPaperPlant(s->plant);
   const bool timed = kept("horizon") || kept("sample_time");
-  if (!paper && !kept("method")) s->tune.method = "migo";
+  if (!paper && !kept("method") && !AsksForASearch(*s, given)) s->tune.method = "migo";
   // A filtered derivative (tf = kd / (10 kp)) unless one is given: off the
   // paper's plants for every method (an ideal derivative has an unbounded
   // noise gain, and on relative degree 1 with dead time a neutral loop); on
   // them for migo, which designs with it. The rules' PI has no derivative.
-  const bool pi_rule = s->tune.rule == "pi" && (s->tune.method == "migo" || s->tune.method == "simc" ||
-                                                s->tune.method == "amigo");
+  const bool pi_rule = s->tune.rule == "pi" &&
+                       (s->tune.method == "migo" || s->tune.method == "simc" || s->tune.method == "amigo");
   if (!pi_rule && !kept("derivative_filter") && !kept("derivative_filter_ratio") && !kept("robust") &&
       (!paper || s->tune.method == "migo")) {
     s->loop.derivative_filter_s = 0.0;
@@ -283,6 +297,13 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
     t.robustness_reason = "given";
   }
   const std::string reason = t.robustness_reason;
+  if (s->tune.robust && !timed) {
+    // The robust preset bounds the slowest time constant by a tenth of the
+    // horizon, tuned on eq. (4)'s 25 s: it keeps that horizon (for now).
+    t.reason = "the robust preset's: eq. (4)'s n = 25 s, ts = 0.05 s (its time-constant bound is n / 10)";
+    t.robustness_reason = reason;
+    return t;
+  }
   const TimeScale derived = DerivedTimeScale(*s, plant);
   if (timed) {
     // Given as the plant gives them (a result's echo): the plant's still.

@@ -153,8 +153,10 @@ bool IsPaperPlant(const spec::PlantSpec& p);
 
 /// Resolves what a tuning spec leaves to the plant and the preset, in this
 /// order (docs/tuning.md, "Any plant"):
-/// - on a plant other than the paper's, with no `method` given, the method
-///   migo; with no derivative filter given (nor `robust`), a PID of any
+/// - on a plant other than the paper's, with no `method` given and nothing
+///   that asks for a search (an objective, a box, budgets, step or
+///   robustness bounds, `robust`, a robust set, the sampled loop), the
+///   method migo; with no derivative filter given (nor `robust`), a PID of any
 ///   method gets derivative_filter_ratio 10 (on the paper's plants, migo's);
 /// - with neither `horizon` nor `sample_time` given, on a plant other than
 ///   the paper's, the time scale of the migo design's closed loop
