@@ -50,9 +50,9 @@ plants=(
   "lag (s+1)^-2 e^-0.2s, 1e-4 s|lag|--num 1 --den 1e-8,2e-4,1 --delay 0.00002"
   "sopdt T 100,10 L 5|sopdt|--num 1 --den 1000,110,1 --delay 5"
   "double integrator (custom)|other|--num 1 --den 1,0,0"
-  "paper: double_integrator|paper|--plant double_integrator --method migo"
-  "paper: oscillator|paper|--plant oscillator --method migo"
-  "paper: stepper|paper|--plant stepper --method migo"
+  "paper: double_integrator|paper|--plant double_integrator"
+  "paper: oscillator|paper|--plant oscillator"
+  "paper: stepper|paper|--plant stepper"
 )
 
 fail=0

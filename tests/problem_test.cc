@@ -177,14 +177,16 @@ TEST(RunTuning, GivesTheBitsOfTheStepsChainedByHand) {
   s.tune.method = "nelder-mead";
   s.tune.max_evals = 300;
   s.tune.refine = "none";
+  BuildOptions given;  // what a front end passes: the keys the user gave
+  given.given = {"method", "max_evals", "refine"};
   TuningProblem problem;
-  ASSERT_TRUE(BuildTuning(s, BuildOptions{}, &problem).ok());
+  ASSERT_TRUE(BuildTuning(s, given, &problem).ok());
   TuningResult dut;
   ASSERT_TRUE(RunTuning(problem, TuningRunOptions{}, &dut).ok());
 
   spec::TuningSpec ts = s;
-  ResolveRobustPreset(&ts, {});
-  ResolveSearchBox(&ts, {});
+  ResolveRobustPreset(&ts, given.given);
+  ResolveSearchBox(&ts, given.given);
   std::string error;
   Plant p;
   TuneOptions o;

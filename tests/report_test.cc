@@ -116,7 +116,7 @@ TEST(Report, TheMotorItselfRunsEveryMoveWithAndWithoutTheVoltageLimitNextToEquat
   ASSERT_EQ(m.moves.size(), 4u);
   EXPECT_EQ(m.moves[2], StepperMotorParameters{}.tooth_pitch_rad);
   EXPECT_EQ(m.voltage_limit_v, 24.0);
-  ASSERT_EQ(m.sets.size(), 4u);  // paper's NM, pidlab's default tune, its robust preset, tuned on the motor
+  ASSERT_EQ(m.sets.size(), 4u);  // paper's NM, pidlab's multi-start, its robust preset, tuned on the motor
   EXPECT_EQ(m.sets[0].gains.kp, 20.8836);
   // The robust preset: its filtered derivative is carried into the sampled loop.
   EXPECT_TRUE(m.robust_available);

@@ -114,6 +114,9 @@ struct EvaluateCommand {
       return;
     }
     std::cout << FormatEvaluation(result.evaluation) << FormatRobustness(result.analysis, problem.bounds);
+    const tune::TimeScale& t = problem.time_scale;
+    std::cout << "time scale     n = " << t.horizon_s << " s, ts = " << t.sample_time_s << " s (" << t.source
+              << "): " << t.reason << "\n";
     if (result.monte_carlo_ran) std::cout << FormatMonteCarlo(problem.monte_carlo, result.monte_carlo);
     if (client) {
       std::printf("backend: lcm, %ld steps in %ld episode(s), %.0f steps/s\n", client->stats().steps,

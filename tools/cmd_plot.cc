@@ -12,6 +12,7 @@
 #include "pidlab/figures/figures.h"
 #include "pidlab/plot/loop_figure.h"
 #include "pidlab/tune/problem.h"
+#include "pidlab/tune/time_scale.h"
 
 using pidlab::evaluation::LoopKind;
 using pidlab::evaluation::LoopOptions;
@@ -64,7 +65,8 @@ struct PlotCommand {
     figure.height_px = height_px;
     std::string error;
     PlotSpec ps;
-    flags.Apply(&ps, nullptr);
+    std::set<std::string> given;
+    flags.Apply(&ps, &given);
     if (!log_path.empty()) {
       if (!gains.empty() || flags.Given("plant") || flags.Given("num"))
         throw BadInput("--log cannot be combined with --plant/--gains (the log carries its own)");
@@ -81,6 +83,10 @@ struct PlotCommand {
       Require(tune::BuildPlantInLoop(ps.plant, ps.loop, NameStyle::kFlag, &p, &options));
       std::vector<PidGains> sets;
       for (const auto& g : gains) sets.push_back(ParseGains(g));
+      // Framed for the loop: with neither --horizon nor --sample-time, the
+      // closed loops' time scale, on every plant (tune/time_scale.h).
+      tune::ResolveGainsTimeScale(ps.plant, p, sets, given, tune::TimeScaleScope::kFigure, &ps.loop);
+      Require(tune::BuildPlantInLoop(ps.plant, ps.loop, NameStyle::kFlag, &p, &options));
       const long points = options.loop == LoopKind::kSampled ? options.TotalSteps() : options.NumSamples();
       if (static_cast<double>(points) * static_cast<double>(sets.size()) > kMaxRecordedPoints)
         throw BadInput(

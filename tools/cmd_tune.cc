@@ -95,12 +95,15 @@ struct TuneCommand {
     if (json) {
       std::cout << results::TuningJson(problem, result, backend).dump() << "\n";
     } else {
-      PrintText(o, s, result.evaluation, problem.box);
+      PrintText(o, s, result.evaluation, problem.box, result.widened_from, result.box_upper);
       if (s.stable) std::cout << FormatRobustness(result.analysis, o.bounds);
       const pidlab::tune::TimeScale& t = problem.time_scale;
       std::cout << "time scale       n = " << t.horizon_s << " s, ts = " << t.sample_time_s << " s ("
                 << t.source << "): " << t.reason << "\n";
-      if (o.method == pidlab::tune::TuneMethod::kMigo && !t.robustness_reason.empty())
+      if (o.method == pidlab::tune::TuneMethod::kMigo && o.robustness_phase_margin_deg > 0.0)
+        std::cout << "robustness       phase margin >= " << o.robustness_phase_margin_deg
+                  << " deg (given): the largest Ms bound whose design keeps it, " << s.migo.ms_bound << "\n";
+      else if (o.method == pidlab::tune::TuneMethod::kMigo && !t.robustness_reason.empty())
         std::cout << "robustness       Ms <= " << o.robustness_ms << ": " << t.robustness_reason << "\n";
     }
     return s.stable ? 0 : 1;
@@ -131,10 +134,10 @@ struct TuneCommand {
 
   // The human-readable result; `ev` as for ToJson.
   static void PrintText(const TuneOptions& o, const TuneSummary& s, const Evaluation& ev,
-                        const SearchBox& box) {
+                        const SearchBox& box, const std::vector<double>& widened_from, double box_upper) {
     std::cout << std::setprecision(6);
     std::cout << "method           " << ToString(o.method) << " on " << ToString(o.objective) << ", box ["
-              << o.lower << ", " << o.upper << "]^3, seed " << o.seed << "\n";
+              << o.lower << ", " << box_upper << "]^3, seed " << o.seed << "\n";
     if (o.method == pidlab::tune::TuneMethod::kSimc || o.method == pidlab::tune::TuneMethod::kAmigo)
       std::cout << "rule             " << s.tuning_rule.message << "\n";
     if (o.method == pidlab::tune::TuneMethod::kMigo)
@@ -169,6 +172,11 @@ struct TuneCommand {
                 << "): objective = quantile " << o.robust_quantile << "; nominal plant's "
                 << s.nominal_objective << "\n";
     if (box.source == "plant") std::cout << "box              " << box.message << "\n";
+    if (!widened_from.empty()) {
+      std::cout << "box widened      ";
+      for (double u : widened_from) std::cout << "[0, " << u << "] -> ";
+      std::cout << "[0, " << box_upper << "]  (the optimum was on the upper edge of a box not given: docs/tuning.md)\n";
+    }
     if (!s.at_bounds.empty()) {
       std::cout << "at bounds        ";
       for (std::size_t i = 0; i < s.at_bounds.size(); ++i) std::cout << (i ? ", " : "") << s.at_bounds[i];

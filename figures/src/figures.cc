@@ -64,7 +64,9 @@ bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, co
     traces.push_back(std::move(tr));
   }
   std::ostringstream title;
-  title << std::setprecision(6) << plant.name << ", G(s) = " << plant.tf.ToString() << "\n";
+  title << std::setprecision(6) << plant.name << ", G(s) = " << plant.tf.ToString();
+  if (plant.delay_s > 0.0) title << " e^(-" << plant.delay_s << " s)";
+  title << "\n";
   if (options.loop == LoopKind::kSampled)
     title << "sampled loop, dt = " << options.dt_s << " s, every step";
   else

@@ -121,7 +121,7 @@ bool ComputeRobustSection(const std::vector<RobustInput>& inputs, bool quick, st
     paper.name = "paper Nelder-Mead";
     paper.gains = in.paper;
     p.sets.push_back(paper);
-    TuneOptions d;  // `pidlab tune --plant P --seed S`
+    TuneOptions d;  // `pidlab tune --plant P --method multi-start --seed S`
     d.seed = seed;
     TuneSummary optimum;
     if (!Tune(plant, d, &optimum, error)) return false;

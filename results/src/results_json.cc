@@ -200,6 +200,8 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
   if (o.two_dof || s.two_dof.ran) j["two_dof"] = TwoDofJson(s.two_dof);
   if (o.method == TuneMethod::kMigo)
     j["migo"] = {{"robustness", o.robustness_ms},
+                 {"phase_margin_deg", o.robustness_phase_margin_deg},
+                 {"ms_bound", JsonNumber(s.migo.ms_bound)},
                  {"response_time_s", o.response_time_s},
                  {"ms", JsonNumber(s.migo.ms)},
                  {"mt", JsonNumber(s.migo.mt)},
@@ -208,6 +210,10 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
                  {"setpoint_weight_c", s.migo.c},
                  {"message", s.migo.message}};
   return j;
+}
+
+nlohmann::json TimeScaleJson(const tune::TimeScale& t) {
+  return {{"horizon_s", t.horizon_s}, {"sample_time_s", t.sample_time_s}, {"source", t.source}, {"reason", t.reason}};
 }
 
 nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds) {

@@ -44,15 +44,19 @@ nlohmann::json EvaluationJson(const tune::EvaluationProblem& problem, const tune
   j["robustness"] = RobustnessJson(result.analysis, problem.bounds);
   if (result.monte_carlo_ran) j["monte_carlo"] = MonteCarloJson(problem.monte_carlo, result.monte_carlo);
   j["spec"] = spec::ToJson(problem.spec);
+  j["time_scale"] = TimeScaleJson(problem.time_scale);
   return j;
 }
 
-Status EvaluateSpecJson(const nlohmann::json& spec_json, nlohmann::json* result, nlohmann::json* series) {
+Status EvaluateSpecJson(const nlohmann::json& spec_json, nlohmann::json* result, nlohmann::json* series,
+                        const std::set<std::string>* given) {
   spec::EvaluateSpec s;
+  tune::BuildOptions build;
   std::string error;
-  if (!spec::FromJson(spec_json, &s, nullptr, &error)) return Status::InvalidInput(error);
+  if (!spec::FromJson(spec_json, &s, &build.given, &error)) return Status::InvalidInput(error);
+  if (given) build.given = *given;
   tune::EvaluationProblem problem;
-  const Status built = tune::BuildEvaluation(s, tune::BuildOptions{}, &problem);
+  const Status built = tune::BuildEvaluation(s, build, &problem);
   if (!built.ok()) return built;
   tune::EvaluationRunOptions run;
   run.what.record_trajectory = series != nullptr && problem.loop.loop == evaluation::LoopKind::kSampled;

@@ -17,10 +17,11 @@ nlohmann::json TuningJson(const tune::TuningProblem& problem, const tune::Tuning
       s.stable ? RobustnessJson(result.analysis, problem.options.bounds) : nlohmann::json(nullptr);
   j["spec"] = spec::ToJson(problem.spec);
   const tune::TimeScale& t = problem.time_scale;
-  j["time_scale"] = {{"horizon_s", t.horizon_s},
-                     {"sample_time_s", t.sample_time_s},
-                     {"source", t.source},
-                     {"reason", t.reason}};
+  j["time_scale"] = TimeScaleJson(t);
+  if (!result.widened_from.empty()) {
+    j["box"]["upper"] = result.box_upper;
+    j["box"]["widened_from"] = result.widened_from;
+  }
   if (j.contains("migo")) j["migo"]["robustness_reason"] = t.robustness_reason;
   return j;
 }

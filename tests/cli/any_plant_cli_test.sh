@@ -20,7 +20,7 @@ cd "$tmp" || exit 1
 mkdir bin && ln -s "$pidlab" bin/pidlab
 awk '/^## Any plant/{on=1} /^## Tuning rules/{on=0} on' "$doc" |
   awk '/^```sh$/{on=1; next} /^```$/{on=0} on' >commands.sh
-check "the section has its five commands" "[ \$(grep -c '^pidlab tune' commands.sh) -eq 5 ]"
+check "the section has its eight commands" "[ \$(grep -c '^pidlab tune' commands.sh) -eq 8 ]"
 i=0
 while IFS= read -r line; do
   i=$((i + 1))
@@ -121,14 +121,100 @@ assert abs(g['kp'] - 10 / 6) < 1e-12 and abs(g['ki'] - 10 / 6 / 10) < 1e-12, g
 assert j['spec']['tau_c'] == 4 and 'tau_c = 4 s (given)' in j['tuning_rule']['message'], j['tuning_rule']
 PY"
 
-# ---- The paper's plants keep eq. (4) and the multi-start.
+# ---- The paper's plants keep eq. (4); a budget asks for the multi-start.
 "$pidlab" tune --plant oscillator --max-evals 300 --design-points 64 --json > paper.json
-check "the paper's oscillator: multi-start on eq. (4)'s 25 s at 0.05 s" "/usr/bin/python3 - <<'PY'
+check "the paper's oscillator with a budget: multi-start on eq. (4)'s 25 s at 0.05 s" "/usr/bin/python3 - <<'PY'
 import json
 j = json.load(open('paper.json'))
 assert j['method'] == 'multi-start' and j['spec']['horizon'] == 25 and j['spec']['sample_time'] == 0.05, j['spec']
 assert j['time_scale']['source'] == 'eq. (4)', j['time_scale']
 PY"
+# The newcomer's `tune --plant stepper`: migo on eq. (4), off the box's edge,
+# and its load IAE far below the multi-start's on the paper's objective.
+"$pidlab" tune --plant stepper --json > stepper.json
+"$pidlab" tune --plant stepper --method multi-start --json > stepper_ms.json
+check "tune --plant stepper: migo, not on the box's edge, Ms <= 1.4, overshoot <= 30 %" "/usr/bin/python3 - <<'PY'
+import json
+j = json.load(open('stepper.json'))
+m = json.load(open('stepper_ms.json'))
+assert j['method'] == 'migo' and j['time_scale']['source'] == 'eq. (4)', (j['method'], j['time_scale'])
+assert j['migo']['robustness_reason'].startswith('the default'), j['migo']
+assert not j.get('at_bounds'), j.get('at_bounds')
+assert m['at_bounds'], m.get('at_bounds')  # the paper's objective ends on ki = 30
+assert j['robustness']['ms'] <= 1.4 + 1e-3, j['robustness']
+assert j['overshoot_pct'] <= 30, j['overshoot_pct']
+assert j['load_iae'] < m['load_iae'] / 10, (j['load_iae'], m['load_iae'])
+PY"
+
+# ---- One knob, two words: a phase margin; a crossover is a response time.
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --robustness 60 --json > pm60.json
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --robustness 45 --json > pm45.json
+check "--robustness 60: a phase margin of at least 60 deg, less robust at 45" "/usr/bin/python3 - <<'PY'
+import json
+a, b = json.load(open('pm60.json')), json.load(open('pm45.json'))
+assert a['migo']['phase_margin_deg'] == 60 and a['robustness']['phase_margin_deg'] >= 60 - 0.5, a['robustness']['phase_margin_deg']
+assert 1.05 <= a['migo']['ms_bound'] < b['migo']['ms_bound'] <= 4, (a['migo'], b['migo'])
+assert b['robustness']['phase_margin_deg'] >= 45 - 0.5 and a['gains']['ki'] < b['gains']['ki'], (a['gains'], b['gains'])
+PY"
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --crossover 0.1 --json > w.json
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --response-time 20 --json > t.json
+check "--crossover 0.1 is --response-time 20" "/usr/bin/python3 - <<'PY'
+import json
+w, t = json.load(open('w.json')), json.load(open('t.json'))
+assert w['gains'] == t['gains'] and w['migo']['response_time_s'] == 20, (w['gains'], t['gains'], w['migo'])
+assert w['migo']['crossover_rad_s'] <= 0.1 * (1 + 1e-6), w['migo']
+PY"
+
+# ---- evaluate and plot take the loop's time scale.
+"$pidlab" evaluate --num 2 --den 60,1 --delay 8 --gains 3,0.05,10 --derivative-filter-ratio 10 --json > ev.json
+check "evaluate on the thermal plant: the closed loop's time scale, said so" "/usr/bin/python3 - <<'PY'
+import json
+j = json.load(open('ev.json'))
+t = j['time_scale']
+assert t['source'] == 'plant' and t['reason'].startswith('the closed loop of the gains'), t
+assert t['horizon_s'] == j['spec']['horizon'] and t['horizon_s'] >= 10 * j['robustness']['slowest_time_constant_s'], (t, j['robustness']['slowest_time_constant_s'])
+PY"
+"$pidlab" evaluate --spec ev.json --json > ev2.json
+check "its spec echo runs again to the same numbers and time scale" "/usr/bin/python3 - <<'PY'
+import json
+a, b = json.load(open('ev.json')), json.load(open('ev2.json'))
+assert a['iae'] == b['iae'] and a['time_scale'] == b['time_scale'], (a['time_scale'], b['time_scale'])
+PY"
+"$pidlab" evaluate --plant stepper --gains 20.8836,26.607,12.4866 > paper_ev.txt
+check "evaluate on the paper's stepper keeps eq. (4) and its IAE" \
+  "grep -q '^time scale .*(eq. (4))' paper_ev.txt && grep -q '^IAE (eq. 4)  *1.97506' paper_ev.txt"
+"$pidlab" plot --plant stepper --gains 2.18522,97.6195,0.135618 --derivative-filter 0.00620615 --out fig >/dev/null
+check "plot frames the stepper's 0.4 s transient: a horizon of at most 2 s" "/usr/bin/python3 - <<'PY'
+import glob
+rows = []
+for f in sorted(glob.glob('fig/evaluation_data/*')):
+    for line in open(f):
+        p = line.replace(',', ' ').split()
+        try: rows.append(float(p[0]))
+        except (ValueError, IndexError): pass
+assert rows and 0.5 <= max(rows) <= 2, max(rows) if rows else 'no data'
+PY"
+
+# ---- A box nobody gave is widened when the optimum is on its upper edge.
+"$pidlab" tune --num 1 --den 1,2,1 --method multi-start --max-evals 300 --json > wide.json
+"$pidlab" tune --num 1 --den 1,2,1 --method multi-start --max-evals 300 > wide.txt
+"$pidlab" tune --num 1 --den 1,2,1 --method multi-start --max-evals 300 --bounds 0,15.5 --json > given_box.json
+check "a search on the edge of the plant's box widens it tenfold, and says so; a given box is kept" "/usr/bin/python3 - <<'PY'
+import json
+j, g = json.load(open('wide.json')), json.load(open('given_box.json'))
+w = j['box']['widened_from']
+assert len(w) >= 1 and abs(w[0] - 15.5) < 0.01 and abs(j['box']['upper'] - 10 * w[-1]) < 1e-9 * j['box']['upper'], j['box']
+assert 'widened_from' not in g['box'] and g['box']['upper'] == 15.5 and 'kp_hi' in g['at_bounds'], (g['box'], g['at_bounds'])
+PY"
+check "the text says so too" "grep -q '^box widened  *\[0, 15.5' wide.txt"
+
+# ---- A search that finds no stable loop names the rule and the flag.
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method multi-start --derivative-filter-ratio 0 >neutral.txt 2>&1
+check "no stable loop: the ideal derivative's neutral loop is named, with --derivative-filter-ratio" \
+  "grep -q 'probe points of the box are not strictly stable (an ideal derivative on a plant of relative degree 1 with dead time makes the loop neutral); what helps: filter the derivative: --derivative-filter-ratio 10' neutral.txt"
+"$pidlab" tune --num 1 --den 1,1 --max-time-constant 0.001 --max-evals 300 >slow.txt 2>&1
+check "no loop fast enough: --max-time-constant is named" \
+  "grep -q 'probe points of the box are slower than --max-time-constant; what helps: raise --max-time-constant' slow.txt"
 
 # ---- Bad knob values: exit 2, one line naming the value.
 bad() {
@@ -145,6 +231,9 @@ bad() {
 }
 bad "--robustness 1" "1" --num 1 --den 10,1 --delay 2 --robustness 1
 bad "--robustness 9" "9" --num 1 --den 10,1 --delay 2 --robustness 9
+bad "--robustness 85 (deg)" "85" --num 1 --den 10,1 --delay 2 --robustness 85
+bad "--crossover -1" "-1" --num 1 --den 10,1 --delay 2 --crossover -1
+bad "--crossover with --response-time" "say the same thing twice" --num 1 --den 10,1 --delay 2 --crossover 1 --response-time 2
 bad "--response-time -1" "-1" --num 1 --den 10,1 --delay 2 --response-time -1
 bad "--tau-c -1" "-1" --num 1 --den 10,1 --delay 2 --method simc --tau-c -1
 bad "--method migo without a filter" "filter" --num 1 --den 10,1 --delay 2 --method migo --horizon 100 \

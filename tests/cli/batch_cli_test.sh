@@ -80,7 +80,7 @@ PY"
 check "the text says where the box came from" "grep -q '^box  *\[0, 6.5' $tmp/box.txt"
 "$pidlab" tune --num 1 --den 1,3,3,1 --method multi-start --max-evals 200 --bounds 0,2 --json > "$tmp/given.json"
 check "--bounds overrides the plant's box" "python3 -c \"import json; j = json.load(open('$tmp/given.json')); assert j['box']['upper'] == 2, j['box']\""
-"$pidlab" tune --plant linear --json > "$tmp/paper.json"
+"$pidlab" tune --plant linear --method multi-start --json > "$tmp/paper.json"
 check "the paper's 1/s^2 keeps [0, 30]" "python3 -c \"import json; j = json.load(open('$tmp/paper.json')); assert j['box'] == {'lower': 0, 'upper': 30}, j['box']\""
 
 # tune --robust on 1/s^2 ends on the box's edge, and says so.

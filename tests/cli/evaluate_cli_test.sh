@@ -163,7 +163,7 @@ bad "delay with Monte Carlo" "--monte-carlo with --delay" evaluate --loop sample
 bad "tune ziegler-nichols with a delay" "ziegler-nichols with a plant dead time" tune --loop sampled \
   --plant custom --num 1 --den 1,1 --delay 0.3 --method ziegler-nichols
 status=0
-"$pidlab" evaluate --loop sampled "${F[@]}" --delay 0.3 --json --samples-csv delay.csv >delay.json 2>delay.err ||
+"$pidlab" evaluate --loop sampled "${F[@]}" --delay 0.3 --horizon 25 --sample-time 0.05 --json --samples-csv delay.csv >delay.json 2>delay.err ||
   status=$?
 if [[ $status -eq 0 ]] && /usr/bin/python3 - delay.json delay.csv <<'PY'
 import csv, json, sys

@@ -152,9 +152,9 @@ bad "measurement noise in tune" "--measurement-noise 0.01: tune does not take me
 bad "tune sampled --dt 1e-5 (5000 x 2.5e6 steps)" "5e9" tune --plant stepper --loop sampled --dt 1e-5
 bad "tune --max-evals 1e8 (1e8 x 501 samples)" "5e9" tune --plant linear --max-evals 100000000
 bad "tune square period 1e-3 (5000 x 5e4 switches)" "5e9" \
-  tune --plant stepper --disturbance-amplitude 1 --disturbance-period 1e-3
+  tune --plant stepper --method multi-start --disturbance-amplitude 1 --disturbance-period 1e-3
 bad "plot of 2.5e7 points" "more than 1e7 points" \
-  plot --plant stepper --gains 20.8836,26.607,12.4866 --loop sampled --dt 1e-6 --out plots
+  plot --plant stepper --gains 20.8836,26.607,12.4866 --loop sampled --dt 1e-6 --horizon 25 --out plots
 bad "--trajectory-csv of 2.5e7 rows" "more than 1e7" \
   evaluate --plant stepper --gains 20.8836,26.607,12.4866 --loop sampled --dt 1e-6 --trajectory-csv t.csv
 bad "20,000-coefficient --den" "more than 64" evaluate --num 1 --den "$(list 20000 1)" --gains 1,1,1

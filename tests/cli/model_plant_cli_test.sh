@@ -70,10 +70,12 @@ assert a['spec']['model'] == '' and a['spec']['delay'] == 0 and a['spec']['num']
 PY"
 pidlab evaluate --spec by_model.json --json > rerun.json
 check "the echoed spec runs again to the same JSON" "cmp -s by_model.json rerun.json"
-# docs/spec.md: another result's spec, run on the model.
+# docs/spec.md: another result's spec, run on the model (its loop: eq. (4)'s
+# time scale, which the double integrator's result echoes).
 pidlab evaluate --plant double_integrator "${G[@]}" --json > other.json
 pidlab evaluate --spec other.json --model model.json --json > other_on_model.json 2> err
-check "--spec result.json --model model.json runs the result's loop on the model" "cmp -s by_model.json other_on_model.json"
+pidlab evaluate --model model.json "${G[@]}" --horizon 25 --sample-time 0.05 --json > by_model_eq4.json
+check "--spec result.json --model model.json runs the result's loop on the model" "cmp -s by_model_eq4.json other_on_model.json"
 
 # Draws from the covariance: evaluate --monte-carlo and tune --robust-samples.
 pidlab evaluate --model model.json "${G[@]}" --monte-carlo 20 --seed 3 --json > mc.json 2> err

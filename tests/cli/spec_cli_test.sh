@@ -89,13 +89,15 @@ else fail "a flag given with --spec does not override the file"; fi
 
 # A plant named on the command line replaces the file's, whatever form each
 # was given in: a custom num/den file under --plant, a built-in under --num/--den.
-"$pidlab" evaluate --plant custom --num 1 --den 1,1 --gains 1,1,0 --json >custom.json 2>/dev/null
+# (The file's time scale, eq. (4)'s, is given, as a result's echo gives the
+# one it ran.)
+"$pidlab" evaluate --plant custom --num 1 --den 1,1 --gains 1,1,0 --horizon 25 --sample-time 0.05 --json >custom.json 2>/dev/null
 "$pidlab" evaluate --spec custom.json --plant oscillator --json >replaced.json 2>err.txt &&
   "$pidlab" evaluate --plant oscillator --gains 1,1,0 --json >direct2.json 2>/dev/null &&
   same replaced.json direct2.json && pass "--plant replaces a spec file's custom num/den" ||
   fail "--plant over a spec file's custom plant: $(head -c 300 err.txt)"
 "$pidlab" evaluate --spec continuous.json --num 1 --den 1,2,1 --json >replaced2.json 2>err.txt &&
-  "$pidlab" evaluate --num 1 --den 1,2,1 --gains 2,1,1.5 --json >direct3.json 2>/dev/null &&
+  "$pidlab" evaluate --num 1 --den 1,2,1 --gains 2,1,1.5 --horizon 25 --sample-time 0.05 --json >direct3.json 2>/dev/null &&
   same replaced2.json direct3.json && pass "--num/--den replace a spec file's built-in plant" ||
   fail "--num/--den over a spec file's plant: $(head -c 300 err.txt)"
 

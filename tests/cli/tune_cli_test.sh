@@ -7,7 +7,7 @@ pass=0; fail=0
 check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 
-"$pidlab" tune --plant linear --json --trace "$tmp/trace.csv" > "$tmp/out.json" 2>"$tmp/err"
+"$pidlab" tune --plant linear --method multi-start --json --trace "$tmp/trace.csv" > "$tmp/out.json" 2>"$tmp/err"
 check "tune --json exits 0" "[ $? -eq 0 ]"
 check "tune --json has the documented keys" "python3 - \"$tmp/out.json\" <<'PY'
 import json, sys

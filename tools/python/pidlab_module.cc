@@ -168,7 +168,7 @@ py::object EvaluatePy(const py::object& plant, const py::object& gains, py::kwar
   Status status;
   {
     py::gil_scoped_release release;
-    status = results::EvaluateSpecJson(spec::ToJson(s), &result);
+    status = results::EvaluateSpecJson(spec::ToJson(s), &result, nullptr, &given);
   }
   Require(status.ok(), status.message());
   return ToPython(result);

@@ -208,14 +208,6 @@ class Designer {
   std::vector<double> num_, den_;
 };
 
-// 1, 2 or 5 times a power of ten, at least v.
-double NiceUp(double v) {
-  const double e = std::pow(10.0, std::floor(std::log10(v)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * e >= v * (1.0 - 1e-12)) return m * e;
-  return 10.0 * e;
-}
-
 }  // namespace
 
 bool MigoOptions::IsValid(std::string* error) const {
@@ -250,6 +242,43 @@ void PlantTimes(const Plant& plant, double* fastest_s, double* slowest_s) {
   }
   *fastest_s = *std::min_element(times.begin(), times.end());
   *slowest_s = *std::max_element(times.begin(), times.end());
+}
+
+Status MigoMsForPhaseMargin(const Plant& plant, double phase_margin_deg, MigoOptions* options) {
+  const auto margin = [&plant, options](double ms, double* pm) {
+    MigoOptions o = *options;
+    o.ms = ms;
+    MigoDesign d;
+    analysis::LoopAnalysis a;
+    if (!DesignMigo(plant, o, &d).ok() ||
+        !analysis::AnalyzeLoop(plant, d.gains, evaluation::LoopOptions{}, analysis::LoopAnalysisOptions{}, &a,
+                               nullptr) ||
+        !a.stable)
+      return false;
+    *pm = std::isfinite(a.phase_margin_deg) ? a.phase_margin_deg : 180.0;
+    return true;
+  };
+  double lo = 1.05, hi = 4.0, pm = 0.0;
+  if (!margin(lo, &pm) || pm < phase_margin_deg) {
+    std::ostringstream os;
+    os << "migo: no design keeps a phase margin of " << spec::FormatNumber(phase_margin_deg) << " deg on plant "
+       << plant.name << " (at Ms 1.05 it is " << spec::FormatNumber(pm) << " deg): lower --robustness";
+    return Status::InvalidInput(os.str());
+  }
+  if (margin(hi, &pm) && pm >= phase_margin_deg) lo = hi;
+  for (int i = 0; i < 10 && lo < hi; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    (margin(mid, &pm) && pm >= phase_margin_deg ? lo : hi) = mid;
+  }
+  options->ms = lo;
+  return Status::Ok();
+}
+
+double NiceUp(double v) {
+  const double e = std::pow(10.0, std::floor(std::log10(v)));
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * e >= v * (1.0 - 1e-12)) return m * e;
+  return 10.0 * e;
 }
 
 TimeScale LoopTimeScale(double fastest_s, double slowest_s, double delay_s) {
@@ -366,6 +395,7 @@ Status DesignMigoUncached(const Plant& plant, const MigoOptions& options, MigoDe
   r.ms = p.ms;
   r.mt = p.mt;
   r.crossover_rad_s = p.crossover;
+  r.ms_bound = options.ms;
   r.plant_time_s = slowest;
   std::ostringstream os;
   os << "migo: the largest ki with Ms, Mt <= " << spec::FormatNumber(options.ms)

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "pidlab/spec/field.h"
+#include "pidlab/tune/time_scale.h"
 #include "pidlab/tune/tuning_rules.h"
 #include "pidlab/tune/two_dof.h"
 #include "spec_build.h"
@@ -70,6 +71,8 @@ Status BuildEvaluation(const spec::EvaluateSpec& s, const BuildOptions& options,
     return Status::InvalidInput("--gains is required (or --spec FILE)");
   if (!BuildGains(p.spec.gains, style, &p.gains, &error)) return Status::InvalidInput(error);
   if (Status sampled = SampledForRunner(options, &p.spec.loop); !sampled.ok()) return sampled;
+  p.time_scale = ResolveGainsTimeScale(p.spec.plant, p.plant, {p.gains}, options.given,
+                                       TimeScaleScope::kNotPaper, &p.spec.loop);
   if (!BuildLoopFor(p.plant, p.spec.loop, style, &p.loop, &error) ||
       !BuildBounds(p.spec.bounds, style, &p.bounds, &error))
     return Status::InvalidInput(error);
@@ -200,6 +203,8 @@ TimeScale DerivedTimeScale(const spec::TuningSpec& s, const Plant& plant) {
   MigoOptions o;
   o.ms = s.tune.robustness > 1.0 && s.tune.robustness <= 4.0 ? s.tune.robustness : kMigoDefaultMs;
   o.response_time_s = s.tune.response_time_s > 0.0 ? s.tune.response_time_s : 0.0;
+  if (s.tune.crossover_rad_s > 0.0 && std::isfinite(s.tune.crossover_rad_s))
+    o.response_time_s = 2.0 / s.tune.crossover_rad_s;
   MigoDesign design;
   analysis::LoopAnalysis a;
   std::string from = "the plant's own time constants";
@@ -256,7 +261,7 @@ bool AsksForASearch(const spec::TuningSpec& s, const std::set<std::string>& give
   return s.loop.loop == "sampled";
 }
 
-// Method, filter and time scale from a plant other than the paper's.
+// Method, filter and time scale from the plant.
 TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>& given) {
   const auto kept = [&given](const char* key) { return given.count(key) > 0; };
   TimeScale t;
@@ -264,7 +269,10 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
   t.sample_time_s = s->loop.sample_time_s;
   const bool paper = IsPaperPlant(s->plant);
   const bool timed = kept("horizon") || kept("sample_time");
-  if (!paper && !kept("method") && !AsksForASearch(*s, given)) s->tune.method = "migo";
+  // migo designs on a transfer function: the nonlinear stepper keeps the
+  // multi-start.
+  if (!kept("method") && !AsksForASearch(*s, given) && s->plant.plant != "stepper_nonlinear")
+    s->tune.method = "migo";
   // A filtered derivative (tf = kd / (10 kp)) unless one is given: off the
   // paper's plants for every method (an ideal derivative has an unbounded
   // noise gain, and on relative degree 1 with dead time a neutral loop); on
@@ -283,6 +291,7 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
         s->loop.horizon_s == defaults.horizon_s && s->loop.sample_time_s == defaults.sample_time_s;
     t.source = eq4 ? "eq. (4)" : "given";
     t.reason = eq4 ? "the paper's eq. (4): n = 25 s, ts = 0.05 s" : "given";
+    t.robustness_reason = kept("robustness") ? "given" : "the default, " + spec::FormatNumber(s->tune.robustness);
     return t;
   }
   Plant plant;
@@ -352,12 +361,33 @@ Status BuildTuning(const spec::TuningSpec& s, const BuildOptions& options, Tunin
   return Status::Ok();
 }
 
+namespace {
+
+bool AtAnUpperEdge(const TuneSummary& s) {
+  for (const std::string& b : s.at_bounds)
+    if (b.size() > 3 && b.compare(b.size() - 3, 3, "_hi") == 0) return true;
+  return false;
+}
+
+}  // namespace
+
 Status RunTuning(const TuningProblem& problem, const TuningRunOptions& options, TuningResult* result) {
   TuningResult r;
   TuneOptions o = problem.options;
   if (options.parallel_for) o.parallel_for = options.parallel_for;
   std::string error;
-  const bool tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
+  bool tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
+  // An optimum on the edge of a box nobody gave is the box's, not the
+  // plant's: tenfold wider, at most twice (in process; over the trio, and on
+  // the paper's plants, whose box is the paper's, the edge is reported).
+  while (tuned && r.summary.stable && problem.box.source != "given" && !IsPaperPlant(problem.spec.plant) &&
+         !IsTuningRule(o.method) &&
+         !options.runner && AtAnUpperEdge(r.summary) && r.widened_from.size() < 2 && o.upper < kMaxGain) {
+    r.widened_from.push_back(o.upper);
+    o.upper = std::min(10.0 * o.upper, kMaxGain);
+    tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
+  }
+  r.box_upper = o.upper;
   if (tuned && r.summary.stable) {
     // With two_dof, the loop with the setpoint weights found.
     r.loop = WithSetpointWeights(problem.options.loop, r.summary.two_dof);

@@ -407,11 +407,21 @@ bool BuildSearch(const spec::TuneSpec& t, NameStyle style, TuneOptions* o, std::
   o->robustness_ms = t.robustness;
   o->response_time_s = t.response_time_s;
   o->tau_c_s = t.tau_c_s;
+  if (!(t.crossover_rad_s >= 0.0) || !std::isfinite(t.crossover_rad_s))
+    return Bad(error, name("crossover") + " " + spec::FormatNumber(t.crossover_rad_s) +
+                          " must be >= 0 and finite (rad/s)");
+  if (t.crossover_rad_s > 0.0 && t.response_time_s > 0.0)
+    return Bad(error, name("crossover") + " " + spec::FormatNumber(t.crossover_rad_s) + " and " +
+                          name("response_time") + " " + spec::FormatNumber(t.response_time_s) +
+                          " say the same thing twice: give one");
+  if (t.crossover_rad_s > 0.0) o->response_time_s = 2.0 / t.crossover_rad_s;
   if (!(t.tau_c_s >= 0.0) || !std::isfinite(t.tau_c_s))
     return Bad(error, name("tau_c") + " " + spec::FormatNumber(t.tau_c_s) + " must be >= 0 and finite (s)");
-  if (!(t.robustness > 1.0 && t.robustness <= 4.0))
+  const bool phase_margin = t.robustness >= kMigoMinPhaseMarginDeg && t.robustness <= kMigoMaxPhaseMarginDeg;
+  if (!(t.robustness > 1.0 && t.robustness <= 4.0) && !phase_margin)
     return Bad(error, name("robustness") + " " + spec::FormatNumber(t.robustness) +
-                          " must be an Ms bound in (1, 4]");
+                          " must be an Ms bound in (1, 4] or a phase margin in [20, 80] deg");
+  if (phase_margin) o->robustness_ms = kMigoDefaultMs, o->robustness_phase_margin_deg = t.robustness;
   if (!(t.response_time_s >= 0.0) || !std::isfinite(t.response_time_s))
     return Bad(error, name("response_time") + " " + spec::FormatNumber(t.response_time_s) +
                           " must be >= 0 and finite (s)");

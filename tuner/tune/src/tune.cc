@@ -14,6 +14,7 @@
 #include "pidlab/optim/pso_gsa.h"
 #include "pidlab/spec/field.h"
 #include "pidlab/tune/search_box.h"
+#include "rejections.h"
 
 namespace pidlab::tune {
 
@@ -362,11 +363,14 @@ bool RuleSearch(const Plant& plant, const TuneOptions& options,
 // The MIGO design (migo.h) into summary->migo, ->two_dof and ->optimizer.
 bool MigoSearch(const Plant& plant, const TuneOptions& options,
                 const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary, std::string* error) {
-  const MigoOptions o{
+  MigoOptions o{
       options.robustness_ms, options.rule == RuleForm::kPi, options.response_time_s,
       options.migo_max_overshoot_pct,
       options.loop.derivative_filter_ratio > 0.0 ? options.loop.derivative_filter_ratio : kMigoFilterRatio};
-  const Status status = DesignMigoForSetpoint(plant, options.loop, o, &summary->migo, &summary->two_dof);
+  Status status = options.robustness_phase_margin_deg > 0.0
+                      ? MigoMsForPhaseMargin(plant, options.robustness_phase_margin_deg, &o)
+                      : Status::Ok();
+  if (status.ok()) status = DesignMigoForSetpoint(plant, options.loop, o, &summary->migo, &summary->two_dof);
   if (!status.ok() && error) *error = status.message();
   if (status.ok()) RuleResult(summary->migo.gains, evaluator, summary->migo.message, &summary->optimizer);
   return status.ok();
@@ -571,7 +575,7 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
     return false;
   }
   if (!opt.IsUsable()) {
-    summary->message = "no strictly stable loop found in the box: " + opt.message;
+    summary->message = "no strictly stable loop found in the box: " + opt.message + ExplainRejections(plant, options, evaluator);
     summary->wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     return true;

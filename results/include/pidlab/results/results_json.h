@@ -24,6 +24,10 @@ nlohmann::json ToJson(const evaluation::Evaluation& ev);
 /// phase_margin_deg, delay_margin_s, noise_gain, slowest_time_constant_s
 /// (null where infinite or undefined, with a note in `notes`), crossover and
 /// peak frequencies, cancellations, and the `violations` of `bounds`.
+/// A time scale: horizon_s, sample_time_s, source ("given", "eq. (4)",
+/// "plant") and reason.
+nlohmann::json TimeScaleJson(const tune::TimeScale& t);
+
 nlohmann::json RobustnessJson(const analysis::LoopAnalysis& a, const analysis::LoopBounds& bounds);
 /// The object of `pidlab tune --json`: plant `p`, options `o`, summary `s`,
 /// and `ev`, the evaluation of s.gains on o.loop (unused unless s.stable);

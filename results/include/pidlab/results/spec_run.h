@@ -6,6 +6,7 @@
 // "spec" echo).
 
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 
 #include "pidlab/spec/status.h"
@@ -25,8 +26,12 @@ nlohmann::json EvaluationJson(const tune::EvaluationProblem& problem, const tune
 /// value for a spec that does not validate (tune::BuildEvaluation) or a loop
 /// the analysis or the draws refuse; kRunnerFailed if the evaluation fails. With `series`, also the plot data
 /// of that loop there (plot_series.h: PlotSeries), for the workbench's plots; for the nonlinear stepper also
-/// "linear_y", the linear model of eq. (3) on the same loop.
-Status EvaluateSpecJson(const nlohmann::json& spec, nlohmann::json* result, nlohmann::json* series = nullptr);
+/// "linear_y", the linear model of eq. (3) on the same loop. The keys given
+/// are those of `spec` (or *given, a caller's own list): off the paper's
+/// plants, with neither horizon nor sample_time given, the time scale comes
+/// from the closed loop (tune/time_scale.h).
+Status EvaluateSpecJson(const nlohmann::json& spec, nlohmann::json* result, nlohmann::json* series = nullptr,
+                        const std::set<std::string>* given = nullptr);
 
 /// The fields of EvaluateSpec: [{key, flag, help, unit, default, example}].
 nlohmann::json EvaluateSpecFields();

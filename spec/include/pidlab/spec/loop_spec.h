@@ -276,7 +276,7 @@ struct TuneSpec {
   int robust_samples = 0;
   double robust_quantile = 1.0, robust_spread = 0.1;
   bool two_dof = false;
-  double robustness = 1.4, response_time_s = 0.0, tau_c_s = 0.0;
+  double robustness = 1.4, response_time_s = 0.0, crossover_rad_s = 0.0, tau_c_s = 0.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -284,7 +284,9 @@ struct TuneSpec {
         {"method",
          "multi-start (Sobol' design + Nelder-Mead polish) | nelder-mead | paper-nm | ziegler-nichols | ga | "
          "pso-gsa | simc | amigo (tuning rules on a reduced model) | migo (the largest ki under an Ms "
-         "bound; the default on plants other than the paper's three, docs/tuning.md)",
+         "bound). Not given: migo, unless a flag asks for a search (an objective, a box, a budget, a step "
+         "or robustness bound, robust, the sampled loop) or the plant is the nonlinear stepper: then "
+         "multi-start (docs/tuning.md, \"Any plant\")",
          "", kNone, R"("nelder-mead")"},
         &method);
     a->Visit({"objective",
@@ -351,7 +353,9 @@ struct TuneSpec {
     a->Visit(
         {"robustness",
          "migo: the bound on Ms and Mt, in (1, 4]: lower is more robust and slower (not given: SIMC's Ms "
-         "on the plant, within [1.4, 1.6]; 1.4 is a gain margin >= 3.5 and a phase margin >= 41 deg)",
+         "on the plant, within [1.4, 1.6]; 1.4 is a gain margin >= 3.5 and a phase margin >= 41 deg); or "
+         "a phase margin in [20, 80] deg, e.g. 60 as MATLAB's pidtune: the largest Ms bound whose design "
+         "keeps it",
          "", kNone, "1.6"},
         &robustness);
     a->Visit({"response_time",
@@ -359,6 +363,11 @@ struct TuneSpec {
               "fast as the bound allows)",
               "s", kNone, "5"},
              &response_time_s);
+    a->Visit({"crossover",
+              "migo: the response time as a gain crossover W, the same as --response-time 2/W (0 = as fast as "
+              "the bound allows; not with --response-time)",
+              "rad/s", kNone, "0.1"},
+             &crossover_rad_s);
     a->Visit({"tau_c",
               "simc: the closed-loop time constant tau_c (0 = theta, the tight tuning; larger is slower and "
               "more robust; given, a plant without dead time is tuned too)",

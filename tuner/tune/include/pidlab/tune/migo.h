@@ -72,6 +72,8 @@ struct MigoDesign {
   double b = 1.0, c = 0.0;
   /// The peaks reached on the design grid and the gain crossover (rad/s).
   double ms = 0.0, mt = 0.0, crossover_rad_s = 0.0;
+  /// The bound designed for (MigoOptions::ms, or the tightened one).
+  double ms_bound = 0.0;
   /// The plant's characteristic time (s): its slowest and fastest features
   /// and its dead time, as the design grid saw them.
   double plant_time_s = 0.0;
@@ -97,6 +99,17 @@ Status MigoSetpointWeights(const Plant& plant, const evaluation::LoopOptions& lo
 Status DesignMigoForSetpoint(const Plant& plant, const evaluation::LoopOptions& loop, const MigoOptions& options,
                              MigoDesign* design, TwoDofSummary* two_dof);
 
+/// `--robustness` as a phase margin: the range it takes (deg); an Ms bound is
+/// in (1, 4], so the two never meet.
+inline constexpr double kMigoMinPhaseMarginDeg = 20.0;
+inline constexpr double kMigoMaxPhaseMarginDeg = 80.0;
+
+/// The largest Ms bound in [1.05, 4] whose design (DesignMigo with *options
+/// otherwise) keeps a phase margin of at least `phase_margin_deg` (bisection
+/// on log Ms, 10 designs), into options->ms. kInvalidInput naming the margin
+/// when even Ms 1.05 does not keep it.
+Status MigoMsForPhaseMargin(const Plant& plant, double phase_margin_deg, MigoOptions* options);
+
 /// A time scale for evaluating a loop: the horizon and the sample spacing.
 struct TimeScale {
   double horizon_s = 25.0, sample_time_s = 0.05;
@@ -114,6 +127,9 @@ struct TimeScale {
 /// 2 or 5 times a power of ten; the spacing a 500th of it, or a fifth of the
 /// fastest time constant where that is shorter (at most 20000 samples).
 TimeScale LoopTimeScale(double fastest_s, double slowest_s, double delay_s);
+
+/// 1, 2 or 5 times a power of ten, at least v > 0.
+double NiceUp(double v);
 
 /// The plant's characteristic times (s), slowest and fastest, from its poles,
 /// zeros, dead time and gain crossover (never 0 or infinite).

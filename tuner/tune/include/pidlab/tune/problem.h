@@ -72,6 +72,9 @@ struct EvaluationProblem {
   analysis::MonteCarloOptions monte_carlo;
   /// Table I with the spec's stepper overrides (the draws of stepper_motor).
   StepperMotorParameters stepper;
+  /// The horizon and sample spacing used, and why: off the paper's plants,
+  /// with neither given, from the closed loop of the gains (time_scale.h).
+  TimeScale time_scale;
 
   /// The spec asks for Monte Carlo draws (monte_carlo > 0).
   bool HasMonteCarlo() const { return spec.monte_carlo > 0; }
@@ -147,16 +150,15 @@ Status BuildNonlinearStepper(const spec::PlantSpec& s, spec::NameStyle style, No
 // ---- Tune: gains for a plant (pidlab tune, pidlab.tune, the workbench's tune).
 
 /// True for the paper's three plants (and the nonlinear stepper), whose
-/// defaults are the paper's: eq. (4)'s 25 s at 0.05 s, the multi-start on
-/// the IAE.
+/// time scale is the paper's: eq. (4)'s 25 s at 0.05 s.
 bool IsPaperPlant(const spec::PlantSpec& p);
 
 /// Resolves what a tuning spec leaves to the plant and the preset, in this
 /// order (docs/tuning.md, "Any plant"):
-/// - on a plant other than the paper's, with no `method` given and nothing
+/// - with no `method` given and nothing
 ///   that asks for a search (an objective, a box, budgets, step or
 ///   robustness bounds, `robust`, a robust set, the sampled loop), the
-///   method migo; with no derivative filter given (nor `robust`), a PID of any
+///   method migo (the nonlinear stepper: multi-start); with no derivative filter given (nor `robust`), a PID of any
 ///   method gets derivative_filter_ratio 10 (on the paper's plants, migo's);
 /// - with neither `horizon` nor `sample_time` given, on a plant other than
 ///   the paper's, the time scale of the migo design's closed loop
@@ -211,6 +213,13 @@ struct TuningResult {
   evaluation::LoopOptions loop;
   evaluation::Evaluation evaluation;
   analysis::LoopAnalysis analysis;
+  /// A search in process on a box not given, off the paper's plants (whose
+  /// box is the paper's [0, 30]), that ended on an upper edge
+  /// ran again on a box ten times wider (up to twice): the upper bounds it
+  /// had before, in order ([] when it did not widen), and the upper bound the
+  /// summary's gains were found in.
+  std::vector<double> widened_from;
+  double box_upper = 0.0;
 };
 
 /// Tunes (Tune()), then evaluates and analyses the gains found in process

@@ -139,6 +139,10 @@ struct TuneOptions {
   /// migo: the bound on Ms and Mt, the response time (0: as fast as the
   /// bound allows) and the setpoint overshoot its weight b allows.
   double robustness_ms = kMigoDefaultMs;
+  /// migo: 0, or a phase margin (deg, in [kMigoMinPhaseMarginDeg,
+  /// kMigoMaxPhaseMarginDeg]) the design keeps instead of robustness_ms
+  /// (MigoMsForPhaseMargin: the largest Ms bound whose design keeps it).
+  double robustness_phase_margin_deg = 0.0;
   double response_time_s = 0.0;
   double migo_max_overshoot_pct = 20.0;
   /// simc: the closed-loop time constant tau_c (s); 0: tau_c = theta.

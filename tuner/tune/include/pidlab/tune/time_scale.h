@@ -1,0 +1,45 @@
+// Time scales from the closed loop of given gains (issue 40, "Time scales
+// from the plant"): what `pidlab evaluate` and `pidlab plot` sample when
+// neither --horizon nor --sample-time is given.
+#pragma once
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include "pidlab/evaluation/evaluation.h"
+#include "pidlab/plant_sim/plants.h"
+#include "pidlab/spec/loop_spec.h"
+#include "pidlab/tune/migo.h"
+
+namespace pidlab::tune {
+
+/// LoopTimeScale of the closed loops of `gains` on `plant`: the slowest
+/// closed-loop time constant over the sets, the fastest of the plant's times
+/// and 1/gain crossover. Where no set gives a stable, analysed loop, the
+/// plant's own times (PlantTimes). source "plant"; reason says which.
+TimeScale GainsTimeScale(const Plant& plant, const std::vector<PidGains>& gains,
+                         const evaluation::LoopOptions& loop);
+
+/// Which loops take a derived time scale.
+enum class TimeScaleScope {
+  kNotPaper,  ///< every plant but the paper's (evaluate: eq. 4's numbers stay)
+  /// Every plant, framed for a figure (plot: not a published number): the
+  /// horizon cut to 3 x the slowest 2 % settling time of the sets' step
+  /// responses plus the dead time, rounded up, the spacing at most a 500th
+  /// of it, so that the transient fills the frame.
+  kFigure,
+};
+
+/// With neither `horizon` nor `sample_time` in `given` and the plant in
+/// `scope`, sets loop->horizon_s and loop->sample_time_s to GainsTimeScale
+/// (the spacing a multiple of dt on the sampled loop) and returns it. Else
+/// the loop's own: "eq. (4)" when it is eq. (4)'s on a paper plant, "given"
+/// otherwise (or the derived one, when the given loop has its numbers: a
+/// result's echo). A loop that does not build keeps its own (its caller
+/// reports it).
+TimeScale ResolveGainsTimeScale(const spec::PlantSpec& plant_spec, const Plant& plant,
+                                const std::vector<PidGains>& gains, const std::set<std::string>& given,
+                                TimeScaleScope scope, spec::LoopSpec* loop);
+
+}  // namespace pidlab::tune

@@ -1,0 +1,102 @@
+// See time_scale.h.
+#include "pidlab/tune/time_scale.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/spec/field.h"
+#include "pidlab/tune/problem.h"
+#include "spec_build.h"
+
+namespace pidlab::tune {
+
+namespace {
+
+// TimeScaleScope::kFigure's frame of `t` (see there).
+TimeScale Framed(const Plant& plant, const std::vector<PidGains>& gains, evaluation::LoopOptions loop,
+                 const TimeScale& t) {
+  loop.horizon_s = t.horizon_s;
+  loop.sample_time_s = t.sample_time_s;
+  double settling = 0.0;
+  for (const PidGains& g : gains) {
+    evaluation::Evaluation ev;
+    evaluation::EvaluateOptions what;
+    what.compute_iae_continuous = false;
+    if (!evaluation::Evaluate(plant, g, loop, what, &ev, nullptr) || !ev.step.valid ||
+        !std::isfinite(ev.step.settling_time_s))
+      return t;
+    settling = std::max(settling, ev.step.settling_time_s);
+  }
+  const double horizon = NiceUp(3.0 * settling + plant.delay_s);
+  if (!(settling > 0.0) || !(horizon < t.horizon_s)) return t;
+  TimeScale f = t;
+  f.horizon_s = horizon;
+  while (f.sample_time_s > horizon / 500.0 && horizon / f.sample_time_s < 20000.0) f.sample_time_s /= 2.0;
+  f.reason = "framed for the figure: 3 x the 2 % settling time " + spec::FormatNumber(settling) +
+             " s, rounded up, of " + t.reason;
+  return f;
+}
+
+}  // namespace
+
+TimeScale GainsTimeScale(const Plant& plant, const std::vector<PidGains>& gains,
+                         const evaluation::LoopOptions& loop) {
+  double fastest = 0.0, slowest = 0.0;
+  PlantTimes(plant, &fastest, &slowest);
+  double loop_slowest = 0.0, loop_fastest = fastest;
+  bool analysed = false;
+  for (const PidGains& g : gains) {
+    analysis::LoopAnalysis a;
+    if (plant.nonlinear ||
+        !analysis::AnalyzeLoop(plant, g, loop, analysis::LoopAnalysisOptions{}, &a, nullptr) || !a.stable ||
+        !std::isfinite(a.slowest_time_constant_s) || !(a.slowest_time_constant_s > 0.0))
+      continue;
+    analysed = true;
+    loop_slowest = std::max(loop_slowest, a.slowest_time_constant_s);
+    if (a.gain_crossover_rad_s > 0.0 && std::isfinite(a.gain_crossover_rad_s))
+      loop_fastest = std::min(loop_fastest, 1.0 / a.gain_crossover_rad_s);
+  }
+  TimeScale t = analysed ? LoopTimeScale(loop_fastest, loop_slowest, plant.delay_s)
+                         : LoopTimeScale(fastest, slowest, plant.delay_s);
+  t.reason = (analysed ? std::string("the closed loop of the gains: ") : "the plant's own time constants: ") +
+             t.reason;
+  return t;
+}
+
+TimeScale ResolveGainsTimeScale(const spec::PlantSpec& plant_spec, const Plant& plant,
+                                const std::vector<PidGains>& gains, const std::set<std::string>& given,
+                                TimeScaleScope scope, spec::LoopSpec* loop) {
+  const bool paper = IsPaperPlant(plant_spec);
+  TimeScale t;
+  t.horizon_s = loop->horizon_s;
+  t.sample_time_s = loop->sample_time_s;
+  const spec::LoopSpec defaults;
+  const bool eq4 = loop->horizon_s == defaults.horizon_s && loop->sample_time_s == defaults.sample_time_s;
+  t.source = paper && eq4 ? "eq. (4)" : "given";
+  t.reason = paper && eq4 ? "the paper's eq. (4): n = 25 s, ts = 0.05 s" : "given";
+  evaluation::LoopOptions options;
+  std::string error;
+  const bool timed = given.count("horizon") > 0 || given.count("sample_time") > 0;
+  if ((paper && scope == TimeScaleScope::kNotPaper) || (timed && scope == TimeScaleScope::kFigure) ||
+      plant.nonlinear ||
+      !BuildLoopOptions(*loop, spec::NameStyle::kKey, &options, &error))
+    return t;  // (a loop that does not build is reported by its caller)
+  TimeScale derived = GainsTimeScale(plant, gains, options);
+  if (loop->loop == "sampled" && loop->dt_s > 0.0) {
+    const double k = std::max(1.0, std::round(derived.sample_time_s / loop->dt_s));
+    derived.sample_time_s = k * loop->dt_s;
+    derived.horizon_s = std::ceil(derived.horizon_s / derived.sample_time_s - 1e-9) * derived.sample_time_s;
+  }
+  if (scope == TimeScaleScope::kFigure) derived = Framed(plant, gains, options, derived);
+  if (timed) {
+    // Given as the loop gives them (a result's echo): the loop's still.
+    const bool same = loop->horizon_s == derived.horizon_s && loop->sample_time_s == derived.sample_time_s;
+    return same ? derived : t;
+  }
+  loop->horizon_s = derived.horizon_s;
+  loop->sample_time_s = derived.sample_time_s;
+  return derived;
+}
+
+}  // namespace pidlab::tune
