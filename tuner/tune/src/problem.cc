@@ -306,13 +306,8 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
     t.robustness_reason = "given";
   }
   const std::string reason = t.robustness_reason;
-  if (s->tune.robust && !timed) {
-    // The robust preset bounds the slowest time constant by a tenth of the
-    // horizon, tuned on eq. (4)'s 25 s: it keeps that horizon (for now).
-    t.reason = "the robust preset's: eq. (4)'s n = 25 s, ts = 0.05 s (its time-constant bound is n / 10)";
-    t.robustness_reason = reason;
-    return t;
-  }
+  // (The robust preset's bound on the slowest time constant is a tenth of
+  // this horizon: at least the migo design's own.)
   const TimeScale derived = DerivedTimeScale(*s, plant);
   if (timed) {
     // Given as the plant gives them (a result's echo): the plant's still.
