@@ -120,7 +120,13 @@ class UniformRun {
     auto& ring = Ring(static_cast<std::size_t>(m_));
     Vec w = loop_.w0;
     (*y)[0] = c_.dot(w);
-    if (record) trace->t.assign(1, 0.0), trace->y.assign(1, (*y)[0]);
+    if (record) {
+      // Every node, reserved once: a stiff loop's are millions.
+      const std::size_t nodes = static_cast<std::size_t>(std::ceil(t_end / h_ - 1e-9)) + 2;
+      trace->t.clear(), trace->y.clear();
+      trace->t.reserve(nodes), trace->y.reserve(nodes);
+      trace->t.push_back(0.0), trace->y.push_back((*y)[0]);
+    }
     Eigen::Vector2d kw = k_ * w;  // (q, kq m w) at the current node
     int k = 1;
     long j = 0, pieces = 0;

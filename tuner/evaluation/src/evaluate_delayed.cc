@@ -82,18 +82,24 @@ Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& gains, cons
   const Disturbance disturbance(options.disturbance), none(DisturbanceOptions{});
   const double a = options.reference;
   const DelayedPath fast = DelayedPath::kFast;
+  const bool disturbed = options.disturbance.kind != DisturbanceKind::kNone;
   std::string error;
   DelayedTrace trace, clean;
-  trace.record = what.compute_iae_continuous;
+  // Without a disturbance one run records the nodes for both (a stiff
+  // loop's Hermite nodes are millions).
+  trace.record = what.compute_iae_continuous || (!disturbed && what.compute_step_info);
   clean.record = what.compute_step_info;
   if (!Sample(plant, gains, options, disturbance, a, fast, &ev->y, &trace, &error))
     return Status::InvalidInput(error);
-  std::vector<double> y1;
-  if (options.disturbance.kind != DisturbanceKind::kNone || clean.record) {
+  if (disturbed) {
+    std::vector<double> y1;
     if (!Sample(plant, gains, options, none, a, fast, &y1, &clean, &error)) return Status::InvalidInput(error);
     ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1, options.sample_time_s, a);
+  } else if (clean.record) {
+    clean = std::move(trace);
+    ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, ev->y, options.sample_time_s, a);
   }
-  if (what.compute_iae_continuous) ev->iae_continuous = NodeIntegralAbsError(trace, a);
+  if (what.compute_iae_continuous) ev->iae_continuous = NodeIntegralAbsError(!disturbed && clean.record ? clean : trace, a);
   if (what.compute_step_info) {
     // e^(-sL) = 1 at s = 0: the undelayed loop's steady state.
     ContinuousClosedLoop<double> undelayed;
