@@ -35,8 +35,8 @@ struct Case {
   std::vector<double> num, den;
   double delay_s;
   pidlab::PidGains gains;
-  double filter_s;        // tf, or 0 for the ratio
-  double filter_ratio;    // N: tf = Td / N (migo's)
+  double filter_s;      // tf, or 0 for the ratio
+  double filter_ratio;  // N: tf = Td / N (migo's)
   double horizon_s, sample_time_s;
 };
 const Case kCases[] = {
@@ -79,10 +79,7 @@ void BM_DelayedObjective(benchmark::State& state) {
   std::snprintf(label, sizeof label, "%s %s iae=%.15g", c.name, reference ? "reference" : "fast", iae);
   state.SetLabel(label);
 }
-BENCHMARK(BM_DelayedObjective)
-    ->ArgsProduct({{0, 1, 2}, {0, 1}})
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(0.5);
+BENCHMARK(BM_DelayedObjective)->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond)->MinTime(0.5);
 
 // The console's lines, then per case the two paths' evaluations/s, their
 // ratio and the objectives' relative difference.

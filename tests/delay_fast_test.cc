@@ -154,8 +154,9 @@ TEST(CrossingCount, AgreesWithTheNyquistCountNearTheBoundaryOnThousandsOfRandomL
       ++compared;
       stable += dut.verdict == CrossingVerdict::kStable ? 1 : 0;
       EXPECT_EQ(dut.verdict == CrossingVerdict::kStable, ref.stable)
-          << "loop " << loop << " d " << d << " kp " << g.kp << " ki " << g.ki << " kd " << g.kd << " tf " << g.tf
-          << " L " << delay << ": Z " << dut.roots_right << ", gap " << dut.phase_gap << "; " << ref.note;
+          << "loop " << loop << " d " << d << " kp " << g.kp << " ki " << g.ki << " kd " << g.kd << " tf "
+          << g.tf << " L " << delay << ": Z " << dut.roots_right << ", gap " << dut.phase_gap << "; "
+          << ref.note;
     }
   }
   std::cout << "crossing test vs Nyquist count: " << compared << " compared (" << stable << " stable), "
@@ -205,8 +206,8 @@ TEST(DelayedContinuous, UniformHermiteGridEqualsTheNodeByNodeIntegratorToRoundin
     const double delay = std::sqrt(2.0);
     DelayedClosedLoop loop;
     std::string error;
-    ASSERT_TRUE(BuildDelayedClosedLoop(tf, Realize(tf), g, Disturbance(DisturbanceOptions{}), delay, 1.0, &loop,
-                                       &error))
+    ASSERT_TRUE(BuildDelayedClosedLoop(tf, Realize(tf), g, Disturbance(DisturbanceOptions{}), delay, 1.0,
+                                       &loop, &error))
         << error;
     DelayedTrace reference;
     reference.node_by_node = true;

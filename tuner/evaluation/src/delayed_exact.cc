@@ -65,7 +65,8 @@ Blocks<N> ToeplitzProduct(const Blocks<N>& a, const Blocks<N>& b) {
 template <int N>
 Blocks<N> BlockExp(const Mat<N>& m, const Mat<N>& c, double h, int blocks) {
   const Eigen::Index n = m.rows();
-  const double norm = (m * h).cwiseAbs().rowwise().sum().maxCoeff() + (c * h).cwiseAbs().rowwise().sum().maxCoeff();
+  const double norm =
+      (m * h).cwiseAbs().rowwise().sum().maxCoeff() + (c * h).cwiseAbs().rowwise().sum().maxCoeff();
   int squarings = 0;
   if (norm > 0.5) squarings = static_cast<int>(std::min(1100.0, std::ceil(std::log2(norm / 0.5))));
   const double scale = std::ldexp(h, -squarings);
@@ -124,8 +125,10 @@ bool Run(const DelayedClosedLoop& loop, double ts, int num_samples, long p, long
   const bool truncated = std::floor(t_end / loop.delay_s + 1e-9) > kMaxBlocks;
   Blocks<N> psi;
   for (int halving = 0;; ++halving, p *= 2, m *= 2) {
-    if (halving > kMaxHalvings || static_cast<double>(depth * m + 1) * static_cast<double>(n) > kMaxRingDoubles ||
-        static_cast<double>(num_samples - 1) * static_cast<double>(p) > static_cast<double>(kMaxDelayedPieces))
+    if (halving > kMaxHalvings ||
+        static_cast<double>(depth * m + 1) * static_cast<double>(n) > kMaxRingDoubles ||
+        static_cast<double>(num_samples - 1) * static_cast<double>(p) >
+            static_cast<double>(kMaxDelayedPieces))
       return false;
     psi = BlockExp<N>(a, c, ts / static_cast<double>(p), depth);
     if (BlocksUsable<N>(psi, truncated)) break;
@@ -158,12 +161,6 @@ bool Run(const DelayedClosedLoop& loop, double ts, int num_samples, long p, long
   return true;
 }
 
-template <int N>
-bool RunOfSize(const DelayedClosedLoop& loop, double ts, int num_samples, long p, long m, std::vector<double>* y,
-               DelayedTrace* trace) {
-  return Run<N>(loop, ts, num_samples, p, m, y, trace);
-}
-
 }  // namespace
 
 bool SampleExactDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturbance, double ts,
@@ -184,17 +181,17 @@ bool SampleExactDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& di
   const long p = b * static_cast<long>(least), m = a * static_cast<long>(least);
   switch (loop.m.rows()) {
     case 3:
-      return RunOfSize<3>(loop, ts, num_samples, p, m, y, trace);
+      return Run<3>(loop, ts, num_samples, p, m, y, trace);
     case 4:
-      return RunOfSize<4>(loop, ts, num_samples, p, m, y, trace);
+      return Run<4>(loop, ts, num_samples, p, m, y, trace);
     case 5:
-      return RunOfSize<5>(loop, ts, num_samples, p, m, y, trace);
+      return Run<5>(loop, ts, num_samples, p, m, y, trace);
     case 6:
-      return RunOfSize<6>(loop, ts, num_samples, p, m, y, trace);
+      return Run<6>(loop, ts, num_samples, p, m, y, trace);
     case 7:
-      return RunOfSize<7>(loop, ts, num_samples, p, m, y, trace);
+      return Run<7>(loop, ts, num_samples, p, m, y, trace);
     default:
-      return RunOfSize<Eigen::Dynamic>(loop, ts, num_samples, p, m, y, trace);
+      return Run<Eigen::Dynamic>(loop, ts, num_samples, p, m, y, trace);
   }
 }
 

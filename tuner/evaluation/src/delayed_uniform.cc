@@ -22,10 +22,10 @@ constexpr std::size_t kKeptRing = 1 << 16;
 Eigen::Matrix4d HermiteToGenerator(double h) {
   const double h2 = h * h, h3 = h2 * h;
   Eigen::Matrix4d t;
-  t << 1.0, 0.0, 0.0, 0.0,                                  //
-      0.0, 1.0, 0.0, 0.0,                                   //
-      -6.0 / h2, -4.0 / h, 6.0 / h2, -2.0 / h,              // 2 a2
-      12.0 / h3, 6.0 / h2, -12.0 / h3, 6.0 / h2;            // 6 a3
+  t << 1.0, 0.0, 0.0, 0.0,                        //
+      0.0, 1.0, 0.0, 0.0,                         //
+      -6.0 / h2, -4.0 / h, 6.0 / h2, -2.0 / h,    // 2 a2
+      12.0 / h3, 6.0 / h2, -12.0 / h3, 6.0 / h2;  // 6 a3
   return t;
 }
 

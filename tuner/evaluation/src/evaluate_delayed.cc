@@ -93,13 +93,15 @@ Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& gains, cons
     return Status::InvalidInput(error);
   if (disturbed) {
     std::vector<double> y1;
-    if (!Sample(plant, gains, options, none, a, fast, &y1, &clean, &error)) return Status::InvalidInput(error);
+    if (!Sample(plant, gains, options, none, a, fast, &y1, &clean, &error))
+      return Status::InvalidInput(error);
     ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1, options.sample_time_s, a);
   } else if (clean.record) {
     clean = std::move(trace);
     ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, ev->y, options.sample_time_s, a);
   }
-  if (what.compute_iae_continuous) ev->iae_continuous = NodeIntegralAbsError(!disturbed && clean.record ? clean : trace, a);
+  if (what.compute_iae_continuous)
+    ev->iae_continuous = NodeIntegralAbsError(!disturbed && clean.record ? clean : trace, a);
   if (what.compute_step_info) {
     // e^(-sL) = 1 at s = 0: the undelayed loop's steady state.
     ContinuousClosedLoop<double> undelayed;
@@ -111,9 +113,11 @@ Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& gains, cons
   return Status::Ok();
 }
 
-double DelayedLoadIae(const Plant& plant, const PidGains& gains, const LoopOptions& options, DelayedPath path) {
+double DelayedLoadIae(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                      DelayedPath path) {
   thread_local std::vector<double> y;
-  if (!Sample(plant, gains, options, Disturbance(UnitLoadStep()), 0.0, path, &y, nullptr, nullptr)) return kInf;
+  if (!Sample(plant, gains, options, Disturbance(UnitLoadStep()), 0.0, path, &y, nullptr, nullptr))
+    return kInf;
   double sum = 0.0;
   for (double v : y) sum += std::abs(v);
   return std::isfinite(sum) ? sum : kInf;

@@ -72,9 +72,9 @@ struct DelayedTrace {
   // disturbance breakpoint inside the horizon), the reference of the
   // equivalence test and the bench; the two agree to rounding.
   bool node_by_node = false;
-  std::vector<double> t, y;   // the nodes (t = 0 first) and y there
-  long pieces = 0;            // integration pieces taken
-  double step_s = 0.0;        // h
+  std::vector<double> t, y;  // the nodes (t = 0 first) and y there
+  long pieces = 0;           // integration pieces taken
+  double step_s = 0.0;       // h
 };
 
 /// y at t = 0, ts, ..., (num_samples - 1) ts of the delayed loop, on the
