@@ -389,7 +389,7 @@ std::string FormatEvaluation(const Evaluation& ev) {
   os << "stable           " << (ev.stability.stable ? "yes" : "NO (objectives are +inf)") << "\n";
   if (ev.options.loop == LoopKind::kContinuous && ev.plant.delay_s > 0.0)
     os << "closed-loop poles (s) infinitely many (dead time " << ev.plant.delay_s
-       << " s): stability by the Nyquist count, the response by the method of steps\n";
+       << " s): stability by the crossing frequencies, the response by the method of steps\n";
   else
     os << "closed-loop poles " << (ev.options.loop == LoopKind::kSampled ? "(z) " : "(s) ")
        << FormatPoles(ev.stability.poles) << "\n";

@@ -11,6 +11,8 @@
 #include <map>
 #include <sstream>
 
+#include "delayed_exact.h"
+#include "delayed_uniform.h"
 #include "evaluation_internal.h"
 #include "pidlab/plant_sim/matrix_exp.h"
 
@@ -281,6 +283,23 @@ double DelayedStepSize(const DelayedClosedLoop& loop) {
   return loop.delay_s / std::max(1.0, m);
 }
 
+namespace {
+
+// The samples (and the trace) by the Hermite store of step h: on the
+// uniform grid where it applies, else node by node.
+bool SampleByHermiteStore(const DelayedClosedLoop& loop, const Disturbance& disturbance, double h, double ts,
+                          int num_samples, std::vector<double>* y, DelayedTrace* trace, std::string* error) {
+  const double t_end = (num_samples - 1) * ts;
+  if (!(trace && trace->node_by_node) && internal::UniformGridApplies(loop, disturbance, h, t_end)) {
+    internal::SampleUniformDelayedLoop(loop, h, ts, num_samples, y, trace);
+    return true;
+  }
+  DelayedIntegrator integrator(loop, disturbance, h);
+  return integrator.Run(ts, num_samples, y, trace, error);
+}
+
+}  // namespace
+
 bool SampleDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturbance, double ts,
                        int num_samples, std::vector<double>* y, DelayedTrace* trace, std::string* error) {
   const double h = trace && trace->force_step_s > 0.0 ? trace->force_step_s : DelayedStepSize(loop);
@@ -292,8 +311,20 @@ bool SampleDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturb
     if (error) *error = os.str();
     return false;
   }
-  DelayedIntegrator integrator(loop, disturbance, h);
-  return integrator.Run(ts, num_samples, y, trace, error);
+  const bool hermite_only = trace && (trace->node_by_node || trace->force_step_s > 0.0);
+  DelayedTrace exact;
+  if (hermite_only || !internal::SampleExactDelayedLoop(loop, disturbance, ts, num_samples, y, &exact))
+    return SampleByHermiteStore(loop, disturbance, h, ts, num_samples, y, trace, error);
+  if (!trace) return true;
+  if (!trace->record) {
+    trace->pieces = exact.pieces;
+    trace->step_s = exact.step_s;
+    return true;
+  }
+  // The nodes of the trace are the Hermite store's (its integral over them,
+  // its stepinfo); the samples stay the exact ones.
+  thread_local std::vector<double> hermite;
+  return SampleByHermiteStore(loop, disturbance, h, ts, num_samples, &hermite, trace, error);
 }
 
 }  // namespace pidlab::evaluation

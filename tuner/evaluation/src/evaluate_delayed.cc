@@ -1,11 +1,16 @@
 // The continuous loop with dead time in Evaluate and the tuner's objective
-// (evaluation_internal.h): stability by the Nyquist count, the responses by
-// the method of steps (delayed_loop.h).
+// (evaluation_internal.h): stability by the crossing frequencies
+// (delay_crossings.h; the Nyquist count where they leave it undecided), the
+// responses by the method of steps (delayed_loop.h). The reference path,
+// the Nyquist count always and the method of steps node by node, is the
+// same loop computed as before both: the equivalence tests and
+// bench/delay_bench.cc measure the fast path against it.
 
 #include <cmath>
 #include <limits>
 
 #include "evaluation_internal.h"
+#include "pidlab/evaluation/delay_crossings.h"
 #include "pidlab/evaluation/delayed_loop.h"
 #include "pidlab/evaluation/loop_frequency.h"
 
@@ -19,11 +24,14 @@ constexpr double kPointsPerDecade = 100.0;
 // y at the samples of the delayed loop with `disturbance` and reference a;
 // false (with *error) when the run is refused.
 bool Sample(const Plant& plant, const PidGains& gains, const LoopOptions& options, const Disturbance& d,
-            double a, std::vector<double>* y, DelayedTrace* trace, std::string* error) {
+            double a, DelayedPath path, std::vector<double>* y, DelayedTrace* trace, std::string* error) {
   DelayedClosedLoop loop;
   if (!BuildDelayedClosedLoop(plant.tf, Realize(plant.tf), gains, d, plant.delay_s, a, &loop, error,
                               SetpointWeightsOf(options.pid)))
     return false;
+  DelayedTrace untraced;
+  if (!trace) trace = &untraced;
+  trace->node_by_node = path == DelayedPath::kReference;
   return SampleDelayedLoop(loop, d, options.sample_time_s, options.NumSamples(), y, trace, error);
 }
 
@@ -46,8 +54,19 @@ double NodeIntegralAbsError(const DelayedTrace& trace, double a) {
 
 }  // namespace
 
-Status DelayedStability(const Plant& plant, const PidGains& gains, Stability* s) {
+Status DelayedStability(const Plant& plant, const PidGains& gains, Stability* s, DelayedPath path) {
   *s = Stability();
+  if (path == DelayedPath::kFast) {
+    std::vector<double> num, den;
+    ContinuousPidPolynomials(gains, &num, &den);
+    const CrossingCount crossings =
+        CountRootsByCrossings(frequency::Mul(num, frequency::Trim(plant.tf.num)),
+                              frequency::Mul(den, frequency::Trim(plant.tf.den)), plant.delay_s);
+    if (crossings.verdict != CrossingVerdict::kUndecided) {
+      s->stable = crossings.verdict == CrossingVerdict::kStable;
+      return Status::Ok();
+    }
+  }
   NyquistCount count;
   std::string error;
   if (!CountContinuousNyquist(plant.tf, gains, plant.delay_s, kPointsPerDecade, &count, &error))
@@ -62,18 +81,27 @@ Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& gains, cons
   if (!st.ok() || !ev->stability.stable) return st;
   const Disturbance disturbance(options.disturbance), none(DisturbanceOptions{});
   const double a = options.reference;
+  const DelayedPath fast = DelayedPath::kFast;
+  const bool disturbed = options.disturbance.kind != DisturbanceKind::kNone;
   std::string error;
   DelayedTrace trace, clean;
-  trace.record = what.compute_iae_continuous;
+  // Without a disturbance one run records the nodes for both (a stiff
+  // loop's Hermite nodes are millions).
+  trace.record = what.compute_iae_continuous || (!disturbed && what.compute_step_info);
   clean.record = what.compute_step_info;
-  if (!Sample(plant, gains, options, disturbance, a, &ev->y, &trace, &error))
+  if (!Sample(plant, gains, options, disturbance, a, fast, &ev->y, &trace, &error))
     return Status::InvalidInput(error);
-  std::vector<double> y1;
-  if (options.disturbance.kind != DisturbanceKind::kNone || clean.record) {
-    if (!Sample(plant, gains, options, none, a, &y1, &clean, &error)) return Status::InvalidInput(error);
+  if (disturbed) {
+    std::vector<double> y1;
+    if (!Sample(plant, gains, options, none, a, fast, &y1, &clean, &error))
+      return Status::InvalidInput(error);
     ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1, options.sample_time_s, a);
+  } else if (clean.record) {
+    clean = std::move(trace);
+    ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, ev->y, options.sample_time_s, a);
   }
-  if (what.compute_iae_continuous) ev->iae_continuous = NodeIntegralAbsError(trace, a);
+  if (what.compute_iae_continuous)
+    ev->iae_continuous = NodeIntegralAbsError(!disturbed && clean.record ? clean : trace, a);
   if (what.compute_step_info) {
     // e^(-sL) = 1 at s = 0: the undelayed loop's steady state.
     ContinuousClosedLoop<double> undelayed;
@@ -85,31 +113,46 @@ Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& gains, cons
   return Status::Ok();
 }
 
-double DelayedLoadIae(const Plant& plant, const PidGains& gains, const LoopOptions& options) {
+double DelayedLoadIae(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                      DelayedPath path) {
   thread_local std::vector<double> y;
-  if (!Sample(plant, gains, options, Disturbance(UnitLoadStep()), 0.0, &y, nullptr, nullptr)) return kInf;
+  if (!Sample(plant, gains, options, Disturbance(UnitLoadStep()), 0.0, path, &y, nullptr, nullptr))
+    return kInf;
   double sum = 0.0;
   for (double v : y) sum += std::abs(v);
   return std::isfinite(sum) ? sum : kInf;
 }
 
 double DelayedContinuousObjective(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
-                                  double load_weight, const PidGains& gains) {
+                                  double load_weight, const PidGains& gains, DelayedPath path) {
   if (!DelayedLoopIsRetarded(plant.tf, gains, nullptr)) return kInf;
   Stability s;
-  if (!DelayedStability(plant, gains, &s).ok() || !s.stable) return kInf;
-  if (kind == ObjectiveKind::kLoadIae) return DelayedLoadIae(plant, gains, options);
+  if (!DelayedStability(plant, gains, &s, path).ok() || !s.stable) return kInf;
+  if (kind == ObjectiveKind::kLoadIae) return DelayedLoadIae(plant, gains, options, path);
   thread_local std::vector<double> y;
   DelayedTrace trace;
   trace.record = kind == ObjectiveKind::kIaeContinuous;
   const double a = options.reference;
-  if (!Sample(plant, gains, options, Disturbance(options.disturbance), a, &y, &trace, nullptr)) return kInf;
+  if (!Sample(plant, gains, options, Disturbance(options.disturbance), a, path, &y, &trace, nullptr))
+    return kInf;
   if (kind == ObjectiveKind::kIaeContinuous) return NodeIntegralAbsError(trace, a);
   if (kind != ObjectiveKind::kSetpointLoad) return ObjectiveFromSamples(kind, y, options.sample_time_s, a);
   const double setpoint = ObjectiveFromSamples(ObjectiveKind::kIae, y, options.sample_time_s, a);
   const double sum =
-      load_weight == 0.0 ? setpoint : setpoint + load_weight * DelayedLoadIae(plant, gains, options);
+      load_weight == 0.0 ? setpoint : setpoint + load_weight * DelayedLoadIae(plant, gains, options, path);
   return std::isfinite(sum) ? sum : kInf;
 }
 
 }  // namespace pidlab::evaluation::internal
+
+namespace pidlab::evaluation {
+
+double ReferenceDelayedObjective(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
+                                 const PidGains& typed_gains, double load_weight) {
+  const PidGains gains = LoopGains(typed_gains, options);
+  if (!GainsAreValid(gains, nullptr)) return internal::kInf;
+  return internal::DelayedContinuousObjective(plant, options, kind, load_weight, gains,
+                                              internal::DelayedPath::kReference);
+}
+
+}  // namespace pidlab::evaluation

@@ -21,10 +21,17 @@ double LoadIaeOfStableLoop(const StateSpace& realization, const DiscretePlant* d
 
 namespace pidlab::evaluation::internal {
 
-/// The continuous loop with dead time (evaluate_delayed.cc): its stability by
-/// the Nyquist count (no poles, abscissa NaN; kInvalidInput when e^(-jwL)
-/// cannot be resolved),
-Status DelayedStability(const Plant& plant, const PidGains& loop_gains, Stability* s);
+/// How the continuous loop with dead time is computed: kFast by the crossing
+/// frequencies (the Nyquist count where they do not decide) and the uniform
+/// grid where it applies; kReference by the Nyquist count and node by node,
+/// as before both (ReferenceDelayedObjective).
+enum class DelayedPath { kFast, kReference };
+
+/// The continuous loop with dead time (evaluate_delayed.cc): its stability
+/// (no poles, abscissa NaN; kInvalidInput when the Nyquist count is needed and
+/// e^(-jwL) cannot be resolved),
+Status DelayedStability(const Plant& plant, const PidGains& loop_gains, Stability* s,
+                        DelayedPath path = DelayedPath::kFast);
 /// y at the samples, the undisturbed IAE, the integral of |e| over the nodes
 /// and stepinfo of the undisturbed response on the nodes, into *ev (a stable
 /// loop; +inf scores are FinishScores' for an unstable one),
@@ -32,9 +39,11 @@ Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& loop_gains,
                                  const EvaluateOptions& what, Evaluation* ev);
 /// sum_m |y_L(m ts)| of its load response (r = 0, a unit step at the plant
 /// input, delayed with the control),
-double DelayedLoadIae(const Plant& plant, const PidGains& loop_gains, const LoopOptions& options);
+double DelayedLoadIae(const Plant& plant, const PidGains& loop_gains, const LoopOptions& options,
+                      DelayedPath path = DelayedPath::kFast);
 /// and the tuner's objective: +inf for an unstable or neutral loop.
 double DelayedContinuousObjective(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
-                                  double load_weight, const PidGains& loop_gains);
+                                  double load_weight, const PidGains& loop_gains,
+                                  DelayedPath path = DelayedPath::kFast);
 
 }  // namespace pidlab::evaluation::internal

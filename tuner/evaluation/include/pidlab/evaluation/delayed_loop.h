@@ -68,13 +68,19 @@ double DelayedStepSize(const DelayedClosedLoop& loop);
 struct DelayedTrace {
   bool record = false;        // fill t and y at every node
   double force_step_s = 0.0;  // > 0: this h instead of DelayedStepSize (tests)
-  std::vector<double> t, y;   // the nodes (t = 0 first) and y there
-  long pieces = 0;            // integration pieces taken
-  double step_s = 0.0;        // h
+  // true: node by node even where the uniform grid applies (h divides L, no
+  // disturbance breakpoint inside the horizon), the reference of the
+  // equivalence test and the bench; the two agree to rounding.
+  bool node_by_node = false;
+  std::vector<double> t, y;  // the nodes (t = 0 first) and y there
+  long pieces = 0;           // integration pieces taken
+  double step_s = 0.0;       // h
 };
 
-/// y at t = 0, ts, ..., (num_samples - 1) ts of the delayed loop. False
-/// with *error when the run needs more than kMaxDelayedPieces pieces.
+/// y at t = 0, ts, ..., (num_samples - 1) ts of the delayed loop, on the
+/// uniform grid t_j = j h where it applies (one map per piece, a ring of the
+/// m = L / h stored pieces), else node by node. False with *error when the
+/// run needs more than kMaxDelayedPieces pieces.
 bool SampleDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturbance, double ts,
                        int num_samples, std::vector<double>* y, DelayedTrace* trace, std::string* error);
 

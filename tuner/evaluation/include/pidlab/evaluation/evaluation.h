@@ -191,6 +191,15 @@ class ObjectiveEvaluator {
   mutable std::atomic<long> evaluations_{0};
 };
 
+/// ObjectiveEvaluator's objective on the continuous loop with dead time
+/// (plant.delay_s > 0) by the reference path: the Nyquist count on the
+/// analysis grid for every candidate and the method of steps node by node,
+/// the loop computed as before the crossing test (delay_crossings.h) and the
+/// uniform grid (delayed_loop.h). The same objective to rounding, many times
+/// slower: only for the equivalence tests and bench/delay_bench.cc.
+double ReferenceDelayedObjective(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
+                                 const PidGains& typed_gains, double load_weight = 1.0);
+
 /// Objective from output samples y_m at t_m = m ts (iae, ise, itae only;
 /// throws std::logic_error for the others), with e_m = reference - y_m.
 double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, double ts,
