@@ -10,7 +10,8 @@ check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 
 start=$(date +%s)
-"$pidlab" tune --robust --plant custom --num 1 --den 1,1 --delay 0.5 --bounds 0,3 --max-evals 80 --json \
+"$pidlab" tune --robust --plant custom --num 1 --den 1,1 --delay 0.5 --bounds 0,3 --max-evals 80 \
+  --horizon 25 --sample-time 0.05 --json \
   > "$tmp/out.json" 2>"$tmp/err"
 rc=$?
 took=$(( $(date +%s) - start ))

@@ -71,8 +71,7 @@ struct LoopOptions {
   /// gains that carry none (LoopGains).
   PidOptions pid;
   /// Derivative filter by a ratio N > 0: tf = kd / (N kp) for gains that
-  /// carry none (LoopGains), on the sampled loop at least dt_s; 0 = not
-  /// used. Excludes pid.derivative_filter_s.
+  /// carry none (LoopGains); 0 = not used. Excludes pid.derivative_filter_s.
   double derivative_filter_ratio = 0.0;
   DisturbanceOptions disturbance;
   /// A loop is strictly stable when every closed-loop pole p has
@@ -151,10 +150,6 @@ PidGainsT<T> LoopGains(const PidGainsT<T>& g, const LoopOptions& o) {
       out.tf = T(std::numeric_limits<double>::infinity());
     else
       out.tf = g.kd / (T(o.derivative_filter_ratio) * g.kp);
-    // On the sampled loop at least one period: a faster filter filters
-    // nothing the sampling lets through, and leaves the noise gain at pi/dt
-    // to kd/dt.
-    if (o.loop == LoopKind::kSampled && out.tf < T(o.dt_s)) out.tf = T(o.dt_s);
   } else {
     out.tf = T(o.pid.derivative_filter_s);
   }
