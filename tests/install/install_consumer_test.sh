@@ -33,12 +33,13 @@ check "the installed Python messages encode and decode with /usr/bin/python3" \
 
 # The CLI of the install gives the reference numbers. examples/consumer calls
 # Tune() with TuneOptions' defaults (eq. (4)'s 25 s at 0.05 s, an ideal
-# derivative); on a custom plant the command line derives both from the
-# plant (docs/tuning.md, "Any plant"), so the tune asks for them explicitly.
+# derivative, the box [0, 30]); on a custom plant the command line derives
+# the time scale and widens a box it was not given whose optimum is on the
+# edge (docs/tuning.md), so the tune asks for all of them explicitly.
 "$prefix/bin/pidlab" evaluate --plant double_integrator --gains 29.6558,0.4977,28.3216 --json >"$tmp/eval.json"
 check "installed pidlab evaluate --json exits 0" "[ $? -eq 0 ]"
 "$prefix/bin/pidlab" tune --num 1 --den 1,0,1 --max-evals 400 --horizon 25 --sample-time 0.05 \
-  --derivative-filter-ratio 0 --json >"$tmp/tune.json" 2>/dev/null
+  --derivative-filter-ratio 0 --bounds 0,30 --json >"$tmp/tune.json" 2>/dev/null
 check "installed pidlab tune --json exits 0" "[ $? -eq 0 ]"
 PYTHONPATH="$prefix/lib/python3/dist-packages" /usr/bin/python3 -c '
 import json, sys, pidlab
