@@ -636,6 +636,20 @@ TEST(FilteredPid, OptionsFilterReachesBothLoopsAndTheGainsFilterWins) {
   EXPECT_EQ(EvaluateOrFail(di, g, o).gains.tf, 0.05);
 }
 
+TEST(FilteredPid, ARatiosFilterIsAtLeastItsFloorAndAGivenTfIsKept) {
+  LoopOptions o;
+  o.derivative_filter_ratio = 10.0;
+  o.derivative_filter_min_s = 0.5;
+  EXPECT_DOUBLE_EQ(LoopGains(PidGains{2.0, 1.0, 4.0}, o).tf, 0.5) << "Td / N = 0.2 < 0.5";
+  EXPECT_DOUBLE_EQ(LoopGains(PidGains{2.0, 1.0, 40.0}, o).tf, 2.0) << "Td / N = 2 above the floor";
+  EXPECT_EQ(LoopGains(PidGains{2.0, 1.0, 0.0}, o).tf, 0.0) << "no derivative: no filter";
+  EXPECT_EQ(LoopGains(PidGains{2.0, 1.0, 4.0, 0.1}, o).tf, 0.1) << "the gains' own tf";
+  std::string error;
+  o.derivative_filter_min_s = -1.0;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("floor -1"), std::string::npos) << error;
+}
+
 TEST(FilteredPid, RatioSetsTfToKdOverNKp) {
   LoopOptions o;
   o.derivative_filter_ratio = 10.0;

@@ -45,13 +45,18 @@ nlohmann::json SeriesOf(const nlohmann::json& spec, nlohmann::json* result = nul
   return series;
 }
 
-TEST(PlotSeries, StepResponseIsTheEvaluationsSamplesBitForBit) {
+TEST(PlotSeries, StepResponseIsTheEvaluationsSamplesOnTheFiguresFrameBitForBit) {
   for (const nlohmann::json& spec :
        {nlohmann::json{{"plant", "double_integrator"}, {"gains", {3.9, 0.06, 4.9}}},
         nlohmann::json{{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"loop", "sampled"}},
         nlohmann::json{{"plant", "stepper_motor"}, {"gains", {20.8836, 26.607, 12.4866}}}}) {
     const nlohmann::json series = SeriesOf(spec);
-    const evaluation::Evaluation ev = EvaluateDirectly(spec);
+    const nlohmann::json& frame = series["time_scale"];
+    ASSERT_EQ(frame["source"], "plant") << spec << ": no horizon given, the figure's frame";
+    nlohmann::json on_frame = spec;
+    on_frame["horizon"] = frame["horizon_s"];
+    on_frame["sample_time"] = frame["sample_time_s"];
+    const evaluation::Evaluation ev = EvaluateDirectly(on_frame);
     ASSERT_EQ(series["y"].size(), ev.y.size()) << spec;
     for (std::size_t m = 0; m < ev.y.size(); ++m) {
       ASSERT_EQ(series["t"][m].get<double>(), ev.t[m]) << spec << " sample " << m;
@@ -60,6 +65,25 @@ TEST(PlotSeries, StepResponseIsTheEvaluationsSamplesBitForBit) {
     EXPECT_EQ(series["u"].size(), ev.y.size()) << spec;
     EXPECT_EQ(series["load_y"].size(), ev.y.size()) << spec;
   }
+}
+
+TEST(PlotSeries, TheFrameFitsTheTransientAndAGivenHorizonIsKept) {
+  nlohmann::json result;
+  const nlohmann::json stepper =
+      SeriesOf({{"plant", "stepper_motor"}, {"gains", {2.185, 97.62, 0.1356}}}, &result);
+  EXPECT_LE(stepper["time_scale"]["horizon_s"].get<double>(), 2.0) << stepper["time_scale"];
+  EXPECT_EQ(result["time_scale"]["source"], "eq. (4)") << "the numbers keep eq. (4)";
+  const nlohmann::json thermal = SeriesOf({{"plant", "custom"},
+                                           {"num", {2}},
+                                           {"den", {60, 1}},
+                                           {"delay", 8},
+                                           {"gains", {1.9, 0.07, 5.6}},
+                                           {"derivative_filter_ratio", 10}});
+  EXPECT_GE(thermal["time_scale"]["horizon_s"].get<double>(), 100.0) << thermal["time_scale"];
+  const nlohmann::json given =
+      SeriesOf({{"plant", "double_integrator"}, {"gains", {3.9, 0.06, 4.9}}, {"horizon", 25}});
+  EXPECT_EQ(given["t"].size(), 501u);
+  EXPECT_EQ(given["time_scale"]["horizon_s"], 25.0);
 }
 
 TEST(PlotSeries, SensitivityPeakOnTheGridIsTheReportedMs) {

@@ -210,5 +210,37 @@ TEST(RunTuning, GivesTheBitsOfTheStepsChainedByHand) {
   EXPECT_TRUE(SameBits(dut.evaluation.y, ev.y));
 }
 
+TEST(RunTuning, GivesTheBestFilteredPidWhereAnIdealDerivativeMakesEveryLoopNeutral) {
+  spec::TuningSpec s;
+  s.plant.plant = "custom";
+  s.plant.num = {1.0};
+  s.plant.den = {10.0, 1.0};
+  s.plant.delay_s = 2.0;
+  s.tune.method = "nelder-mead";
+  s.tune.max_evals = 200;
+  s.loop.derivative_filter_ratio = 0.0;
+  BuildOptions given;
+  given.given = {"num", "den", "delay", "method", "max_evals", "derivative_filter_ratio"};
+  TuningProblem problem;
+  ASSERT_TRUE(BuildTuning(s, given, &problem).ok());
+  ASSERT_EQ(problem.options.loop.derivative_filter_ratio, 0.0) << "the ideal derivative asked for";
+  TuningResult dut;
+  ASSERT_TRUE(RunTuning(problem, TuningRunOptions{}, &dut).ok());
+  ASSERT_TRUE(dut.summary.stable);
+  EXPECT_EQ(dut.options.loop.derivative_filter_ratio, kMigoFilterRatio);
+  EXPECT_EQ(dut.loop.derivative_filter_ratio, kMigoFilterRatio);
+  EXPECT_NE(dut.fallback.find("tuned the best filtered PID instead"), std::string::npos) << dut.fallback;
+  EXPECT_DOUBLE_EQ(dut.summary.gains.tf, dut.summary.gains.kd / (kMigoFilterRatio * dut.summary.gains.kp));
+
+  // Tune() itself (a library caller) still says why, and which flag helps.
+  TuneSummary alone;
+  std::string error;
+  ASSERT_TRUE(Tune(problem.plant, problem.options, &alone, &error)) << error;
+  EXPECT_FALSE(alone.stable);
+  EXPECT_NE(alone.message.find("makes the loop neutral); what helps: filter the derivative"),
+            std::string::npos)
+      << alone.message;
+}
+
 }  // namespace
 }  // namespace pidlab::tune

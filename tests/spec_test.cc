@@ -294,6 +294,21 @@ TEST(SpecBuild, ThePidRunsAtTheLoopsPeriod) {
   EXPECT_EQ(o.pid.dt_s, 2.5e-4);
 }
 
+TEST(SpecBuild, ARatiosFilterOnTheSampledLoopIsAtLeastOnePeriod) {
+  spec::LoopSpec s;
+  s.derivative_filter_ratio = 10.0;
+  LoopOptions o;
+  std::string error;
+  ASSERT_TRUE(BuildLoopOptions(s, NameStyle::kKey, &o, &error)) << error;
+  EXPECT_EQ(o.derivative_filter_min_s, 0.0) << "the continuous loop has no period";
+  s.loop = "sampled";
+  s.dt_s = 1.0;
+  s.sample_time_s = 1.0;
+  ASSERT_TRUE(BuildLoopOptions(s, NameStyle::kKey, &o, &error)) << error;
+  EXPECT_EQ(o.derivative_filter_min_s, 1.0);
+  EXPECT_EQ(pidlab::evaluation::LoopGains(PidGains{4.0, 0.1, 12.0}, o).tf, 1.0) << "Td / N = 0.3 s < dt";
+}
+
 TEST(SpecBuild, TheRobustPresetFillsWhatTheUserDidNotGiveAndKeepsWhatTheyDid) {
   spec::TuningSpec s;
   s.tune.robust = true;

@@ -95,6 +95,7 @@ struct TuneCommand {
     if (json) {
       std::cout << results::TuningJson(problem, result, backend).dump() << "\n";
     } else {
+      if (!result.fallback.empty()) std::cout << "fallback         " << result.fallback << "\n";
       PrintText(o, s, result.evaluation, problem.box, result.widened_from, result.box_upper);
       if (s.stable) std::cout << FormatRobustness(result.analysis, o.bounds);
       const pidlab::tune::TimeScale& t = problem.time_scale;

@@ -9,6 +9,7 @@
 #include "pidlab/results/results_json.h"
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
+#include "pidlab/tune/time_scale.h"
 
 namespace pidlab::results {
 using analysis::AnalyzeLoop;
@@ -23,7 +24,8 @@ namespace {
 // The nonlinear motor's plot: the linear model of eq. (3) (plant
 // stepper_motor with the same Table I) run on the same loop, its y in
 // (*series)["linear_y"] (null if it does not run).
-void AddLinearMotor(const tune::EvaluationProblem& problem, nlohmann::json* series) {
+void AddLinearMotor(const tune::EvaluationProblem& problem, const evaluation::LoopOptions& loop,
+                    nlohmann::json* series) {
   Plant p;
   Evaluation ev;
   std::string error;
@@ -31,8 +33,33 @@ void AddLinearMotor(const tune::EvaluationProblem& problem, nlohmann::json* seri
   what.compute_step_info = false;
   what.compute_iae_continuous = false;
   const bool ran = MakePlant("stepper_motor", problem.stepper, &p, &error) &&
-                   Evaluate(p, problem.gains, problem.loop, what, &ev, &error);
+                   Evaluate(p, problem.gains, loop, what, &ev, &error);
   (*series)["linear_y"] = ran ? nlohmann::json(ev.y) : nlohmann::json(nullptr);
+}
+
+// The figures' frame, as `pidlab plot` draws them (tune/time_scale.h,
+// kFigure): with neither horizon nor sample_time given, on every plant the
+// closed loop's transient fills it. The result's numbers keep the
+// evaluation's own time scale; only the series moves. *loop and *figure
+// are the evaluation's when the frame is its own.
+Status FigureFrame(const tune::EvaluationProblem& problem, const std::set<std::string>& given,
+                   const Evaluation& evaluated, evaluation::LoopOptions* loop, Evaluation* figure,
+                   tune::TimeScale* frame) {
+  spec::LoopSpec framed = problem.spec.loop;
+  *frame = tune::ResolveGainsTimeScale(problem.spec.plant, problem.plant, {problem.gains}, given,
+                                       tune::TimeScaleScope::kFigure, &framed);
+  *loop = problem.loop;
+  *figure = evaluated;
+  if (framed.horizon_s == problem.spec.loop.horizon_s &&
+      framed.sample_time_s == problem.spec.loop.sample_time_s)
+    return Status::Ok();
+  Plant plant;
+  const Status built =
+      tune::BuildPlantInLoop(problem.spec.plant, framed, spec::NameStyle::kKey, &plant, loop);
+  if (!built.ok()) return built;
+  evaluation::EvaluateOptions what;
+  what.record_trajectory = loop->loop == evaluation::LoopKind::kSampled;
+  return evaluation::EvaluateLoop(problem.plant, problem.gains, *loop, what, figure);
 }
 
 }  // namespace
@@ -65,13 +92,19 @@ Status EvaluateSpecJson(const nlohmann::json& spec_json, nlohmann::json* result,
   if (!ran.ok()) return ran;
   *result = EvaluationJson(problem, r, "local");
   if (!series) return Status::Ok();
-  const Status plotted = PlotSeries(problem.plant, problem.gains, problem.loop, r.evaluation, r.analysis,
-                                    PlotSeriesOptions{}, series);
+  evaluation::LoopOptions loop;
+  Evaluation figure;
+  tune::TimeScale frame;
+  const Status framed = FigureFrame(problem, build.given, r.evaluation, &loop, &figure, &frame);
+  if (!framed.ok()) return framed;
+  const Status plotted =
+      PlotSeries(problem.plant, problem.gains, loop, figure, r.analysis, PlotSeriesOptions{}, series);
   if (!plotted.ok()) return plotted;
-  if (problem.plant.nonlinear) AddLinearMotor(problem, series);
+  (*series)["time_scale"] = TimeScaleJson(frame);
+  if (problem.plant.nonlinear) AddLinearMotor(problem, loop, series);
   if (!r.monte_carlo_ran) return Status::Ok();
   const StepperMotorParameters* motor = problem.plant.name == "stepper_motor" ? &problem.stepper : nullptr;
-  return MonteCarloBand(problem.plant, motor, problem.gains, problem.loop, problem.monte_carlo,
+  return MonteCarloBand(problem.plant, motor, problem.gains, loop, problem.monte_carlo,
                         &(*series)["monte_carlo"]);
 }
 

@@ -12,7 +12,8 @@ namespace pidlab::results {
 nlohmann::json TuningJson(const tune::TuningProblem& problem, const tune::TuningResult& result,
                           const std::string& backend) {
   const tune::TuneSummary& s = result.summary;
-  nlohmann::json j = TuneJson(problem.plant, problem.options, s, result.evaluation, backend);
+  nlohmann::json j = TuneJson(problem.plant, result.options, s, result.evaluation, backend);
+  if (!result.fallback.empty()) j["fallback"] = result.fallback;
   j["robustness"] =
       s.stable ? RobustnessJson(result.analysis, problem.options.bounds) : nlohmann::json(nullptr);
   j["spec"] = spec::ToJson(problem.spec);

@@ -122,6 +122,22 @@ function resample(w, v, at) {
 
 const orEmpty = (v, n) => (Array.isArray(v) ? v : new Array(n).fill(null));
 
+// The trio's y at the times `t` that are its own sample times (within 1e-9
+// relative: the plots' frame has its own grid, docs/workbench.md); null elsewhere.
+function atSampleTimes(trio, t) {
+  return t.map((x) => {
+    let lo = 0, hi = trio.t.length - 1;
+    if (hi < 0) return null;
+    while (lo < hi) {  // the first trio time >= x
+      const mid = (lo + hi) >> 1;
+      if (trio.t[mid] < x) lo = mid + 1; else hi = mid;
+    }
+    for (const k of [lo - 1, lo])
+      if (k >= 0 && Math.abs(trio.t[k] - x) <= 1e-9 * Math.max(1, Math.abs(x))) return trio.y[k];
+    return null;
+  });
+}
+
 // Builds the five charts in `elements` ({step, effort, load, freq, nyquist})
 // with a dashed series per pinned design.
 export function createPlots(elements, pinned) {
@@ -143,8 +159,7 @@ export function destroyPlots(plots) {
 // its sample times are the series' own.
 export function drawPlots(plots, series, pinned, trio) {
   const n = series.t.length;
-  const atT = trio ? new Map(trio.t.map((t, i) => [t, trio.y[i]])) : null;
-  const trioY = series.t.map((t) => (atT && atT.has(t) ? atT.get(t) : null));
+  const trioY = trio ? atSampleTimes(trio, series.t) : new Array(n).fill(null);
   const pin = (key) => pinned.map((p) => orEmpty(p.series && p.series[key], n));
   const mc = series.monte_carlo || {};
   plots.step.setData([series.t, series.y, ...pin('y'), orEmpty(series.linear_y, n), orEmpty(mc.y_max, n), orEmpty(mc.y_min, n), trioY]);

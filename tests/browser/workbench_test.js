@@ -83,11 +83,16 @@ async function main() {
         spec: window.pidlab.spec(), result: window.pidlab.lastResult,
         iae: document.getElementById('metric-iae').dataset.value,
         t: Array.from(window.pidlab.plots.step.data[0]), y: Array.from(window.pidlab.plots.step.data[1]),
+        frame: window.pidlab.lastSeries.time_scale,
       }));
       if (shown.spec.gains[0] !== gain) throw new Error('pidlab.spec() has kp ' + shown.spec.gains[0] + ', the slider set ' + gain);
       if (shown.iae === before) throw new Error('the IAE cell did not change (' + before + ')');
       const csv = path.join(args.tmp, plant + '.csv');
-      const cli = JSON.parse(pidlab(['evaluate', '--spec', specFile(shown.spec), '--json', '--samples-csv', csv]));
+      const cli = JSON.parse(pidlab(['evaluate', '--spec', specFile(shown.spec), '--json']));
+      // The plots' frame is `pidlab plot`'s (the transient fills it): the samples of evaluate on it.
+      if (!shown.frame || !(shown.frame.horizon_s > 0)) throw new Error('the series has no time_scale: ' + JSON.stringify(shown.frame));
+      pidlab(['evaluate', '--spec', specFile(shown.spec), '--horizon', String(shown.frame.horizon_s),
+              '--sample-time', String(shown.frame.sample_time_s), '--json', '--samples-csv', csv]);
       if (canonical(cli.spec) !== canonical(shown.result.spec))
         throw new Error('pidlab.lastResult.spec differs from the spec evaluate --spec echoes: ' +
                         JSON.stringify(shown.result.spec) + ' vs ' + JSON.stringify(cli.spec));
@@ -97,7 +102,8 @@ async function main() {
       expectSeries('plots.step.data[0] (t)', shown.t, samples.t, 1e-12);
       expectSeries('plots.step.data[1] (y)', shown.y, samples.y, 1e-12);
       await shot(plant);
-      return 'kp ' + gain + ', IAE ' + before + ' -> ' + shown.iae + ', ' + shown.y.length + ' samples';
+      return 'kp ' + gain + ', IAE ' + before + ' -> ' + shown.iae + ', ' + shown.y.length + ' samples on ' +
+             shown.frame.horizon_s + ' s (' + shown.frame.source + ')';
     });
   }
 

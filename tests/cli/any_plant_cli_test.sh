@@ -208,10 +208,31 @@ assert 'widened_from' not in g['box'] and g['box']['upper'] == 15.5 and 'kp_hi' 
 PY"
 check "the text says so too" "grep -q '^box widened  *\[0, 15.5' wide.txt"
 
-# ---- A search that finds no stable loop names the rule and the flag.
+# ---- A PID that cannot be evaluated (an ideal derivative on relative degree
+# 1 with dead time: every loop neutral) gets the best filtered PID, said in one line.
 "$pidlab" tune --num 1 --den 10,1 --delay 2 --method multi-start --derivative-filter-ratio 0 >neutral.txt 2>&1
-check "no stable loop: the ideal derivative's neutral loop is named, with --derivative-filter-ratio" \
-  "grep -q 'probe points of the box are not strictly stable (an ideal derivative on a plant of relative degree 1 with dead time makes the loop neutral); what helps: filter the derivative: --derivative-filter-ratio 10' neutral.txt"
+check "an ideal derivative's neutral loop: exit 0 with the best filtered PID" "[ $? -eq 0 ]"
+check "... and one line says so, with the flag" \
+  "[ \$(grep -c '^fallback  *an ideal derivative makes every loop on this plant neutral (relative degree 1 with dead time): tuned the best filtered PID instead, tf = Td / 10 (--derivative-filter-ratio 10)' neutral.txt) -eq 1 ]"
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method multi-start --derivative-filter-ratio 0 --max-evals 400 --json >neutral.json
+"$pidlab" tune --spec neutral.json --json >neutral.again.json
+check "its JSON: the fallback, a stable filtered loop, and an echo that reruns to the same gains" "/usr/bin/python3 - <<'PY'
+import json
+j, e = json.load(open('neutral.json')), json.load(open('neutral.again.json'))
+assert j['fallback'].startswith('an ideal derivative makes every loop'), j.get('fallback')
+assert j['stable'] and abs(j['gains']['tf'] - j['gains']['kd'] / (10 * j['gains']['kp'])) < 1e-12, j['gains']
+assert e['gains'] == j['gains'] and e['fallback'] == j['fallback'], (e['gains'], j['gains'])
+PY"
+
+# ---- The sampled loop's filter is relative to its period: at least dt.
+"$pidlab" tune --num 2 --den 60,1 --delay 8 --robust --loop sampled --dt 1 --json >robust_dt.json
+check "--robust at dt = 1 s on the thermal model: tf = 1 s (Td/10 would be below dt), noise gain below 7" "/usr/bin/python3 - <<'PY'
+import json
+j = json.load(open('robust_dt.json'))
+g = j['gains']
+assert g['kd'] / (10 * g['kp']) < 1.0 and g['tf'] == 1.0, g
+assert j['robustness']['noise_gain'] < 7, j['robustness']['noise_gain']
+PY"
 "$pidlab" tune --num 1 --den 1,1 --max-time-constant 0.001 --max-evals 300 >slow.txt 2>&1
 check "no loop fast enough: --max-time-constant is named" \
   "grep -q 'probe points of the box are slower than --max-time-constant; what helps: raise --max-time-constant' slow.txt"

@@ -47,13 +47,12 @@ start --port 0
 check "serve --port 0 prints its URL on 127.0.0.1 without a token" "[[ $url =~ ^http://127\.0\.0\.1:[0-9]+/$ ]]"
 "$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --json > want.json
 "$pidlab" evaluate --plant stepper_motor --gains 30,0.5,1 --loop sampled --dt 0.001 --json > want_sampled.json
-"$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --samples-csv samples.csv > /dev/null
 "$pidlab" tune --plant double_integrator --robust --json > want_tune.json
 "$pidlab" evaluate --plant oscillator --gains 2,1,1.5 --monte-carlo 20 --spread 0.2 --json > want_mc.json
 echo '{"plant": "oscillator", "gains": [2, 1, 1.5], "loop": "sampled", "output_limits": [-5, 5]}' > export_spec.json
 "$pidlab" export --spec export_spec.json --lang c --out exported > /dev/null
-PYTHONPATH="$here" /usr/bin/python3 - "$port" <<'PY'
-import json, sys
+PYTHONPATH="$here" /usr/bin/python3 - "$port" "$pidlab" <<'PY'
+import json, subprocess, sys
 from serve_client import http, WebSocket
 port = int(sys.argv[1])
 def check(name, ok):
@@ -70,9 +69,16 @@ got = json.loads(body)
 check('POST evaluate gives evaluate --json\'s object, key for key', status == 200 and got['result'] == want)
 json.dump(got['result'], open('served.json', 'w'))
 import csv
-rows = list(csv.DictReader(open('samples.csv')))
 series = got.get('series', {})
-check('the reply\'s series y is --samples-csv\'s y, bit for bit',
+frame = series.get('time_scale', {})
+# The plots' frame is `pidlab plot`'s: the transient fills it (eq. (4)'s numbers stay in the result).
+check('the series has its own frame, the figure\'s, shorter than eq. (4)\'s 25 s',
+      frame.get('source') == 'plant' and 0 < frame.get('horizon_s', 0) < 25)
+subprocess.run([sys.argv[2], 'evaluate', '--plant', 'double_integrator', '--gains', '3.9,0.06,4.9',
+                '--horizon', repr(frame['horizon_s']), '--sample-time', repr(frame['sample_time_s']),
+                '--samples-csv', 'samples.csv'], check=True, stdout=subprocess.DEVNULL)
+rows = list(csv.DictReader(open('samples.csv')))
+check('the reply\'s series y is --samples-csv\'s y on that frame, bit for bit',
       [float(r['y']) for r in rows] == series.get('y') and [float(r['t']) for r in rows] == series.get('t'))
 ms = got['result']['robustness']['ms']  # at w = inf here: the grid's end comes within 1e-6
 check('the reply\'s series has |S| peaking at the reported Ms and the Nyquist curve',

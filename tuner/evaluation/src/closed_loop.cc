@@ -51,6 +51,8 @@ bool LoopOptions::IsValid(std::string* error) const {
     os << "dt " << dt_s << " s must be positive and finite";
   else if (!(derivative_filter_ratio >= 0.0) || !std::isfinite(derivative_filter_ratio))
     os << "derivative filter ratio " << derivative_filter_ratio << " must be >= 0 and finite";
+  else if (!(derivative_filter_min_s >= 0.0) || !std::isfinite(derivative_filter_min_s))
+    os << "derivative filter floor " << derivative_filter_min_s << " s must be >= 0 and finite";
   else if (derivative_filter_ratio > 0.0 && pid.derivative_filter_s != 0.0)
     os << "give the derivative filter once: a time constant " << pid.derivative_filter_s << " s or a ratio "
        << derivative_filter_ratio << ", not both";

@@ -9,6 +9,7 @@
 #include "pidlab/tune/time_scale.h"
 #include "pidlab/tune/tuning_rules.h"
 #include "pidlab/tune/two_dof.h"
+#include "rejections.h"
 #include "spec_build.h"
 
 namespace pidlab::tune {
@@ -372,6 +373,19 @@ Status RunTuning(const TuningProblem& problem, const TuningRunOptions& options, 
   if (options.parallel_for) o.parallel_for = options.parallel_for;
   std::string error;
   bool tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
+  // A PID that cannot be evaluated (an ideal derivative on relative degree 1
+  // with dead time: every loop neutral) gets the best filtered PID instead.
+  if (tuned && !r.summary.stable && !IsTuningRule(o.method) && o.method != TuneMethod::kMigo &&
+      IdealDerivativeMakesLoopNeutral(problem.plant, o)) {
+    o.loop.pid.derivative_filter_s = 0.0;
+    o.loop.derivative_filter_ratio = kMigoFilterRatio;
+    r.fallback =
+        "an ideal derivative makes every loop on this plant neutral (relative degree 1 with dead "
+        "time): tuned the best filtered PID instead, tf = Td / " +
+        spec::FormatNumber(kMigoFilterRatio) + " (--derivative-filter-ratio " +
+        spec::FormatNumber(kMigoFilterRatio) + ")";
+    tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
+  }
   // An optimum on the edge of a box nobody gave is the box's, not the
   // plant's: tenfold wider, at most twice (in process; over the trio, and on
   // the paper's plants, whose box is the paper's, the edge is reported).
@@ -383,9 +397,10 @@ Status RunTuning(const TuningProblem& problem, const TuningRunOptions& options, 
     tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
   }
   r.box_upper = o.upper;
+  r.options = o;
   if (tuned && r.summary.stable) {
     // With two_dof, the loop with the setpoint weights found.
-    r.loop = WithSetpointWeights(problem.options.loop, r.summary.two_dof);
+    r.loop = WithSetpointWeights(o.loop, r.summary.two_dof);
     const Status evaluated = evaluation::EvaluateLoop(problem.plant, r.summary.gains, r.loop,
                                                       evaluation::EvaluateOptions{}, &r.evaluation);
     if (!evaluated.ok()) return evaluated;

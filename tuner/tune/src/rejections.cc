@@ -10,6 +10,14 @@
 #include "pidlab/evaluation/evaluation.h"
 
 namespace pidlab::tune {
+
+bool IdealDerivativeMakesLoopNeutral(const Plant& plant, const TuneOptions& options) {
+  const bool ideal =
+      !(options.loop.pid.derivative_filter_s > 0.0) && !(options.loop.derivative_filter_ratio > 0.0);
+  return options.loop.loop == evaluation::LoopKind::kContinuous && ideal && plant.delay_s > 0.0 &&
+         plant.tf.RelativeDegree() == 1;
+}
+
 namespace {
 
 // A rule of the search and the flag that relaxes it.
@@ -31,9 +39,7 @@ constexpr std::array<Rule, 6> kBoundRules = {{
 // Why an unstable loop: the ideal derivative's neutral loop on relative
 // degree 1 with dead time, or the box.
 std::pair<std::string, std::string> Unstable(const Plant& plant, const TuneOptions& options) {
-  const bool ideal = !(options.loop.pid.derivative_filter_s > 0.0) && !(options.loop.derivative_filter_ratio > 0.0);
-  if (options.loop.loop == evaluation::LoopKind::kContinuous && ideal && plant.delay_s > 0.0 &&
-      plant.tf.RelativeDegree() == 1 && options.upper > 0.0)
+  if (IdealDerivativeMakesLoopNeutral(plant, options) && options.upper > 0.0)
     return {"not strictly stable (an ideal derivative on a plant of relative degree 1 with dead time makes the "
             "loop neutral)",
             "filter the derivative: --derivative-filter-ratio 10, or --method migo"};

@@ -16,6 +16,11 @@ namespace pidlab::tune {
 /// bounds. Returns "; K of 27 probe points of the box are <rule>; what
 /// helps: <flags>" for the rule that rejects most of them, or "" when a probe point
 /// passes every rule (the search then ran out of budget, not of loops).
+/// True when every loop of `options` on `plant` is neutral, never strictly
+/// stable: an ideal derivative (no filter) on the continuous loop of a plant
+/// of relative degree 1 with dead time.
+bool IdealDerivativeMakesLoopNeutral(const Plant& plant, const TuneOptions& options);
+
 std::string ExplainRejections(const Plant& plant, const TuneOptions& options,
                               const evaluation::ObjectiveEvaluator& evaluator);
 

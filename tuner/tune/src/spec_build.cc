@@ -297,6 +297,8 @@ bool BuildLoopOptions(const spec::LoopSpec& s, NameStyle style, evaluation::Loop
       !BuildMeasurementNoise(s, style, &o.measurement_noise, error))
     return false;
   o.pid = PidOptionsAt(o.pid, o.dt_s);
+  // A ratio's filter relative to the sample period (issue 40): at least dt.
+  if (o.loop == evaluation::LoopKind::kSampled) o.derivative_filter_min_s = o.dt_s;
   if (!o.IsValid(error)) return false;
   *out = o;
   return true;

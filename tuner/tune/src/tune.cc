@@ -109,6 +109,7 @@ void ApplyRobustPreset(TuneOptions* o, const RobustPresetKeep& keep) {
   if (!keep.derivative_filter) {
     o->loop.pid.derivative_filter_s = 0.0;
     o->loop.derivative_filter_ratio = RobustPreset::kFilterRatio;
+    if (o->loop.loop == evaluation::LoopKind::kSampled) o->loop.derivative_filter_min_s = o->loop.dt_s;
   }
   if (!keep.max_ms) o->bounds.max_ms = RobustPreset::kMaxMs;
   if (!keep.max_time_constant)

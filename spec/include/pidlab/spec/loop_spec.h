@@ -214,8 +214,8 @@ struct LoopSpec {
               "s", kEpisode, "0.01"},
              &derivative_filter_s);
     a->Visit({"derivative_filter_ratio",
-              "derivative filter by a ratio N: Tf = kd / (N kp) (Td / N), both loops; 0 = not used; excludes "
-              "--derivative-filter",
+              "derivative filter by a ratio N: Tf = kd / (N kp) (Td / N), both loops, on the sampled loop at "
+              "least dt; 0 = not used; excludes --derivative-filter",
               "", kEpisode, "10"},
              &derivative_filter_ratio);
     a->Visit({"output_limits", "sampled PID: output limits LO,HI", "", kEpisode | kInfinite, "[-5, 5]"},

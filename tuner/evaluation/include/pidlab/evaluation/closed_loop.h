@@ -73,6 +73,12 @@ struct LoopOptions {
   /// Derivative filter by a ratio N > 0: tf = kd / (N kp) for gains that
   /// carry none (LoopGains); 0 = not used. Excludes pid.derivative_filter_s.
   double derivative_filter_ratio = 0.0;
+  /// A ratio's tf is at least this, s (0 = no floor). The run assembly
+  /// (BuildLoopOptions) and the robust preset set it to dt_s on the sampled
+  /// loop: a faster filter filters nothing the sampling lets through and
+  /// leaves the noise gain at pi/dt near kd/dt. The resolved tf travels
+  /// with the gains (the trio, export, the echo), so nothing else needs it.
+  double derivative_filter_min_s = 0.0;
   DisturbanceOptions disturbance;
   /// A loop is strictly stable when every closed-loop pole p has
   /// Re p < -stability_margin * max(1, |p|), for the s-plane poles p of the
@@ -135,8 +141,8 @@ struct Stability {
 
 /// The gains the loop runs with: `g`, its derivative filter tf filled in
 /// from `o` when g.tf = 0: tf = kd / (N kp) for o.derivative_filter_ratio
-/// N > 0 (0 when kd = 0; +inf, which no loop accepts, when kp = 0 < kd),
-/// else o.pid.derivative_filter_s. Evaluate, the tuner's objective, the
+/// N > 0 (0 when kd = 0; +inf, which no loop accepts, when kp = 0 < kd;
+/// at least o.derivative_filter_min_s), else o.pid.derivative_filter_s. Evaluate, the tuner's objective, the
 /// Ceres cross-check and the LCM episode all run these gains, so both loops
 /// see the same tf.
 template <typename T>
@@ -148,6 +154,8 @@ PidGainsT<T> LoopGains(const PidGainsT<T>& g, const LoopOptions& o) {
       out.tf = T(0.0);
     else if (!(g.kp > T(0.0)))
       out.tf = T(std::numeric_limits<double>::infinity());
+    else if (g.kd / (T(o.derivative_filter_ratio) * g.kp) < T(o.derivative_filter_min_s))
+      out.tf = T(o.derivative_filter_min_s);
     else
       out.tf = g.kd / (T(o.derivative_filter_ratio) * g.kp);
   } else {

@@ -220,6 +220,14 @@ struct TuningResult {
   /// summary's gains were found in.
   std::vector<double> widened_from;
   double box_upper = 0.0;
+  /// A search whose every loop was neutral (an ideal derivative on relative
+  /// degree 1 with dead time: IdealDerivativeMakesLoopNeutral) ran again
+  /// with a filtered derivative, tf = Td / kMigoFilterRatio: that, in one
+  /// line ("" when it did not).
+  std::string fallback;
+  /// The options the summary's gains were tuned with: problem.options with
+  /// the box widened and the fallback's filter.
+  TuneOptions options;
 };
 
 /// Tunes (Tune()), then evaluates and analyses the gains found in process
