@@ -210,6 +210,34 @@ TEST(RunTuning, GivesTheBitsOfTheStepsChainedByHand) {
   EXPECT_TRUE(SameBits(dut.evaluation.y, ev.y));
 }
 
+TEST(BuildTuning, EveryFieldTaggedSearchAsksForASearchAndNoneGivenIsMigo) {
+  const nlohmann::json plant = {{"plant", "custom"}, {"num", {1}}, {"den", {10, 1}}, {"delay", 2}};
+  const auto method_of = [](const nlohmann::json& j, std::string* method) {
+    spec::TuningSpec s;
+    BuildOptions o;
+    std::string error;
+    if (!spec::FromJson(j, &s, &o.given, &error)) return Status::InvalidInput(error);
+    TuningProblem problem;
+    const Status built = BuildTuning(s, o, &problem);
+    *method = ToString(problem.options.method);
+    return built;
+  };
+  std::string method;
+  ASSERT_TRUE(method_of(plant, &method).ok());
+  EXPECT_EQ(method, "migo");
+  int tagged = 0;
+  for (const spec::FieldEntry& e : spec::Fields<spec::TuningSpec>()) {
+    if (!e.field.Has(spec::kSearch)) continue;
+    ++tagged;
+    nlohmann::json j = plant;
+    j[e.field.key] = nlohmann::json::parse(e.field.example);
+    const Status built = method_of(j, &method);
+    ASSERT_TRUE(built.ok()) << e.field.key << ": " << built.message();
+    EXPECT_NE(method, "migo") << e.field.key << " given: a search";
+  }
+  EXPECT_EQ(tagged, 21);
+}
+
 TEST(RunTuning, GivesTheBestFilteredPidWhereAnIdealDerivativeMakesEveryLoopNeutral) {
   spec::TuningSpec s;
   s.plant.plant = "custom";

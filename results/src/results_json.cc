@@ -125,6 +125,54 @@ nlohmann::json TwoDofJson(const tune::TwoDofSummary& s) {
           {"message", s.message}};
 }
 
+namespace {
+
+// TuneJson's "refine": the Ceres cross-check.
+nlohmann::json RefineJson(const TuneOptions& o, const TuneSummary& s) {
+  return {{"ran", s.refine.ran},
+          {"gains", ToJson(s.refine.gains)},
+          {"objective", JsonNumber(s.refine.objective)},
+          {"iae", JsonNumber(o.objective == ObjectiveKind::kIae ? s.refine.objective : NAN)},
+          {"verdict", ToString(s.refine.verdict, s.method)},
+          {"termination", ToString(s.refine.termination)},
+          {"iterations", s.refine.iterations},
+          {"relative_improvement", JsonNumber(s.refine.relative_improvement)},
+          {"runs", s.refine.runs},
+          {"start_index", s.refine.start_index},
+          {"message", s.refine.message}};
+}
+
+// TuneJson's "constraints": the bounds the search obeyed, and the filter.
+nlohmann::json ConstraintsJson(const TuneOptions& o) {
+  const LoopBounds& b = o.bounds;
+  return {{"max_ms", JsonNumber(b.max_ms)},
+          {"max_mt", JsonNumber(b.max_mt)},
+          {"max_noise_gain", JsonNumber(b.max_noise_gain)},
+          {"min_phase_margin_deg", b.min_phase_margin_deg},
+          {"min_gain_margin", b.min_gain_margin},
+          {"max_time_constant_s", JsonNumber(b.max_time_constant_s)},
+          {"max_overshoot_pct", JsonNumber(o.max_overshoot_pct)},
+          {"max_settling_time_s", JsonNumber(o.max_settling_time_s)},
+          {"derivative_filter_s", o.loop.pid.derivative_filter_s},
+          {"derivative_filter_ratio", o.loop.derivative_filter_ratio}};
+}
+
+// TuneJson's "robust_set" (robust_samples > 0).
+nlohmann::json RobustSetJson(const TuneOptions& o, const TuneSummary& s) {
+  return {{"samples", o.robust_samples},
+          // null where the draws come from a model's covariance (no spread)
+          {"spread", s.robust_perturbed == analysis::kCovariancePerturbed ? nlohmann::json(nullptr)
+                                                                          : nlohmann::json(o.robust_spread)},
+          {"quantile", o.robust_quantile},
+          {"size", s.robust_set_size},
+          {"invalid_draws", s.robust_invalid_draws},
+          {"redrawn", s.robust_redrawn},
+          {"perturbed", s.robust_perturbed},
+          {"nominal_objective", JsonNumber(s.nominal_objective)}};
+}
+
+}  // namespace
+
 nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary& s, const Evaluation& ev,
                         const std::string& backend) {
   nlohmann::json j;
@@ -157,45 +205,14 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
   j["iterations"] = s.iterations;
   j["seed"] = o.seed;
   j["wall_time_s"] = s.wall_time_s;
-  j["refine"] = {{"ran", s.refine.ran},
-                 {"gains", ToJson(s.refine.gains)},
-                 {"objective", JsonNumber(s.refine.objective)},
-                 {"iae", JsonNumber(o.objective == ObjectiveKind::kIae ? s.refine.objective : NAN)},
-                 {"verdict", ToString(s.refine.verdict, s.method)},
-                 {"termination", ToString(s.refine.termination)},
-                 {"iterations", s.refine.iterations},
-                 {"relative_improvement", JsonNumber(s.refine.relative_improvement)},
-                 {"runs", s.refine.runs},
-                 {"start_index", s.refine.start_index},
-                 {"message", s.refine.message}};
+  j["refine"] = RefineJson(o, s);
   if (o.method == TuneMethod::kZieglerNichols)
     j["ziegler_nichols"] = {{"ultimate_gain", s.ziegler_nichols.ultimate_gain},
                             {"ultimate_period_s", s.ziegler_nichols.ultimate_period_s},
                             {"rule", ToString(o.zn_rule)}};
   if (o.method == TuneMethod::kSimc || o.method == TuneMethod::kAmigo) AddTuningRule(o, s.tuning_rule, &j);
-  const LoopBounds& b = o.bounds;
-  j["constraints"] = {{"max_ms", JsonNumber(b.max_ms)},
-                      {"max_mt", JsonNumber(b.max_mt)},
-                      {"max_noise_gain", JsonNumber(b.max_noise_gain)},
-                      {"min_phase_margin_deg", b.min_phase_margin_deg},
-                      {"min_gain_margin", b.min_gain_margin},
-                      {"max_time_constant_s", JsonNumber(b.max_time_constant_s)},
-                      {"max_overshoot_pct", JsonNumber(o.max_overshoot_pct)},
-                      {"max_settling_time_s", JsonNumber(o.max_settling_time_s)},
-                      {"derivative_filter_s", o.loop.pid.derivative_filter_s},
-                      {"derivative_filter_ratio", o.loop.derivative_filter_ratio}};
-  if (o.robust_samples > 0)
-    j["robust_set"] = {
-        {"samples", o.robust_samples},
-        // null where the draws come from a model's covariance (no spread)
-        {"spread", s.robust_perturbed == analysis::kCovariancePerturbed ? nlohmann::json(nullptr)
-                                                                        : nlohmann::json(o.robust_spread)},
-        {"quantile", o.robust_quantile},
-        {"size", s.robust_set_size},
-        {"invalid_draws", s.robust_invalid_draws},
-        {"redrawn", s.robust_redrawn},
-        {"perturbed", s.robust_perturbed},
-        {"nominal_objective", JsonNumber(s.nominal_objective)}};
+  j["constraints"] = ConstraintsJson(o);
+  if (o.robust_samples > 0) j["robust_set"] = RobustSetJson(o, s);
   if (s.stable) AddMotor(ev, &j);
   if (o.two_dof || s.two_dof.ran) j["two_dof"] = TwoDofJson(s.two_dof);
   if (o.method == TuneMethod::kMigo)

@@ -178,7 +178,8 @@ void ScoreSampled(const Plant& plant, const PidGains& gains, const LoopOptions& 
 
 // The sums of a stable loop from its samples, and its load response; +inf
 // for an unstable one.
-void FinishScores(const Plant& plant, const PidGains& gains, const LoopOptions& options, Evaluation* ev) {
+void FinishScores(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                  const EvaluateOptions& what, Evaluation* ev) {
   if (!ev->stability.stable) {
     ev->iae = ev->ise = ev->itae = ev->iae_continuous = ev->iae_undisturbed = ev->iae_per_unit =
         ev->load_iae = kInf;
@@ -191,6 +192,10 @@ void FinishScores(const Plant& plant, const PidGains& gains, const LoopOptions& 
   ev->itae = ObjectiveFromSamples(ObjectiveKind::kItae, ev->y, ts, a);
   ev->iae_per_unit = ev->iae / std::abs(a);
   if (options.disturbance.kind == DisturbanceKind::kNone) ev->iae_undisturbed = ev->iae;
+  if (!what.compute_load_iae) {
+    ev->load_iae = std::numeric_limits<double>::quiet_NaN();
+    return;
+  }
   const std::unique_ptr<DiscretePlant> discrete =
       options.loop == LoopKind::kSampled ? std::make_unique<DiscretePlant>(SampledPlant(plant, options.dt_s))
                                          : nullptr;
@@ -278,7 +283,7 @@ Status EvaluateSampledRun(const Plant& plant, const PidGains& typed_gains, const
                                 std::to_string(steps) +
                                 " of the loop (and one undisturbed run with a disturbance)");
   if (ev->stability.stable) ScoreSampled(plant, gains, options, what, run, ev);
-  FinishScores(plant, gains, options, ev);
+  FinishScores(plant, gains, options, what, ev);
   return Status::Ok();
 }
 
@@ -291,7 +296,7 @@ Status EvaluateLoop(const Plant& plant, const PidGains& typed_gains, const LoopO
     StartEvaluation(plant, gains, options, ev);
     const Status evaluated = EvaluateContinuous(plant, gains, options, what, ev);
     if (!evaluated.ok()) return evaluated;
-    FinishScores(plant, gains, options, ev);
+    FinishScores(plant, gains, options, what, ev);
     return Status::Ok();
   }
   const Status started = StartSampled(plant, typed_gains, options, &gains, ev);
@@ -302,7 +307,7 @@ Status EvaluateLoop(const Plant& plant, const PidGains& typed_gains, const LoopO
     if (!ran.ok()) return ran;
     ScoreSampled(plant, gains, options, what, run, ev);
   }
-  FinishScores(plant, gains, options, ev);
+  FinishScores(plant, gains, options, what, ev);
   return Status::Ok();
 }
 

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "pidlab/spec/field.h"
+#include "pidlab/spec/json.h"
 #include "pidlab/tune/time_scale.h"
 #include "pidlab/tune/tuning_rules.h"
 #include "pidlab/tune/two_dof.h"
@@ -248,17 +249,13 @@ double DefaultRobustness(const Plant& plant, std::string* why) {
   return ms;
 }
 
-// A spec that says how to search (an objective, a box, budgets, step or
-// robustness bounds, the robust preset or set) or runs the sampled loop
-// asks for the search, not for migo's frequency-domain design.
+// A spec that says how to search (a field tagged kSearch: an objective, a
+// box, budgets, step or robustness bounds, the robust preset or set) or runs
+// the sampled loop asks for the search, not for migo's frequency-domain design.
 bool AsksForASearch(const spec::TuningSpec& s, const std::set<std::string>& given) {
-  for (const char* key :
-       {"robust",           "robust_samples", "objective",      "load_weight",      "bounds",
-        "max_evals",        "max_iter",       "starts",         "design_points",    "refine_starts",
-        "adaptive",         "refine",         "two_dof",        "max_overshoot",    "max_settling",
-        "max_ms",           "max_mt",         "max_noise_gain", "min_phase_margin", "min_gain_margin",
-        "max_time_constant"})
-    if (given.count(key) > 0) return true;
+  static const std::vector<spec::FieldEntry> fields = spec::Fields<spec::TuningSpec>();
+  for (const spec::FieldEntry& e : fields)
+    if (e.field.Has(spec::kSearch) && given.count(e.field.key) > 0) return true;
   return s.loop.loop == "sampled";
 }
 

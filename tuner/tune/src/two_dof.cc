@@ -28,6 +28,7 @@ double SetpointIae(const Plant& plant, const PidGains& gains, const evaluation::
   evaluation::EvaluateOptions what;
   what.compute_step_info = false;
   what.compute_iae_continuous = false;
+  what.compute_load_iae = false;
   evaluation::Evaluation ev;
   if (!evaluation::Evaluate(plant, gains, o, what, &ev, nullptr) || !ev.stability.stable) return kInf;
   return std::isfinite(ev.iae) ? ev.iae : kInf;
@@ -109,6 +110,7 @@ bool SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
       o.disturbance = DisturbanceOptions{};
       evaluation::EvaluateOptions what;
       what.compute_iae_continuous = false;
+      what.compute_load_iae = false;
       evaluation::Evaluation ev;
       ++summary->evaluations;
       if (!evaluation::Evaluate(plant, gains, o, what, &ev, nullptr) || !ev.stability.stable) return kInf;

@@ -20,6 +20,10 @@ enum FieldFlag : unsigned {
   kInfinite = 1u << 1,
   /// A relative spread typed as "10%" or 0.1 (the JSON holds the number).
   kPercent = 1u << 2,
+  /// Given to `tune`, it asks for a search over the box (an objective, a
+  /// box, a budget, a step or robustness bound, the robust preset or set),
+  /// not migo's design (docs/tuning.md, "Any plant").
+  kSearch = 1u << 3,
 };
 
 struct Field {

@@ -245,16 +245,17 @@ struct BoundsSpec {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit({"max_ms", "bound on Ms = ||S||inf (e.g. 1.6)", "", kInfinite, "1.6"}, &max_ms);
-    a->Visit({"max_mt", "bound on Mt = ||T||inf (e.g. 1.3)", "", kInfinite, "1.3"}, &max_mt);
+    a->Visit({"max_ms", "bound on Ms = ||S||inf (e.g. 1.6)", "", kInfinite | kSearch, "1.6"}, &max_ms);
+    a->Visit({"max_mt", "bound on Mt = ||T||inf (e.g. 1.3)", "", kInfinite | kSearch, "1.3"}, &max_mt);
     a->Visit({"max_noise_gain", "bound on the noise gain ||C S||inf (the ideal derivative's is unbounded)",
-              "", kInfinite, "500"},
+              "", kInfinite | kSearch, "500"},
              &max_noise_gain);
-    a->Visit({"min_phase_margin", "least phase margin", "deg", kNone, "30"}, &min_phase_margin_deg);
-    a->Visit({"min_gain_margin", "least gain margin, a factor > 1 (e.g. 2 = 6 dB; 0 = none)", "", kNone, "2"},
-             &min_gain_margin);
+    a->Visit({"min_phase_margin", "least phase margin", "deg", kSearch, "30"}, &min_phase_margin_deg);
+    a->Visit(
+        {"min_gain_margin", "least gain margin, a factor > 1 (e.g. 2 = 6 dB; 0 = none)", "", kSearch, "2"},
+        &min_gain_margin);
     a->Visit({"max_time_constant", "bound on the slowest closed-loop time constant 1/min|Re p|", "s",
-              kInfinite, "2.5"},
+              kInfinite | kSearch, "2.5"},
              &max_time_constant_s);
   }
 };
@@ -292,37 +293,38 @@ struct TuneSpec {
     a->Visit({"objective",
               "iae | ise | itae | iae-continuous | load-iae (IAE of a unit step at the plant input, r = 0) | "
               "setpoint-load (iae + W load-iae)",
-              "", kNone, R"("ise")"},
+              "", kSearch, R"("ise")"},
              &objective);
-    a->Visit({"load_weight", "W of --objective setpoint-load (>= 0)", "", kNone, "2"}, &load_weight);
+    a->Visit({"load_weight", "W of --objective setpoint-load (>= 0)", "", kSearch, "2"}, &load_weight);
     a->Visit({"bounds",
               "gain box LO,HI for each of kp, ki, kd (not given: 0 to 10 x the largest AMIGO PID gain on the "
               "plant's half-rule model, or 0,30 where the rule does not apply; docs/tuning.md)",
-              "", kNone, "[0, 20]"},
+              "", kSearch, "[0, 20]"},
              &bounds);
-    a->Visit({"max_iter", "iteration budget (0 = method default; paper-nm: 100)", "", kNone, "50"},
+    a->Visit({"max_iter", "iteration budget (0 = method default; paper-nm: 100)", "", kSearch, "50"},
              &max_iter);
-    a->Visit({"max_evals", "evaluation budget over all starts (0 = method default)", "", kNone, "300"},
+    a->Visit({"max_evals", "evaluation budget over all starts (0 = method default)", "", kSearch, "300"},
              &max_evals);
     a->Visit(
         {"starts", "seeded starts (nelder-mead, paper-nm; 0 = 4) or polished starts (multi-start; 0 = 16)",
-         "", kNone, "3"},
+         "", kSearch, "3"},
         &starts);
     a->Visit(
         {"design_points", "multi-start: Sobol' points of the design (at most half of --max-evals when given)",
-         "", kNone, "64"},
+         "", kSearch, "64"},
         &design_points);
     a->Visit({"refine_starts", "multi-start: Ceres from this many distinct polished minima, best first", "",
-              kNone, "1"},
+              kSearch, "1"},
              &refine_starts);
-    a->Visit({"adaptive", "nelder-mead, multi-start: Gao & Han's adaptive coefficients", "", kNone, "true"},
+    a->Visit({"adaptive", "nelder-mead, multi-start: Gao & Han's adaptive coefficients", "", kSearch, "true"},
              &adaptive);
-    a->Visit({"refine", "ceres | none: the least-squares cross-check", "", kNone, R"("none")"}, &refine);
+    a->Visit({"refine", "ceres | none: the least-squares cross-check", "", kSearch, R"("none")"}, &refine);
     a->Visit({"agree_tolerance", "relative objective difference for the 'agree' verdict", "", kNone, "0.01"},
              &agree_tolerance);
-    a->Visit({"max_overshoot", "reject candidates overshooting more", "%", kInfinite, "20"},
+    a->Visit({"max_overshoot", "reject candidates overshooting more", "%", kInfinite | kSearch, "20"},
              &max_overshoot_pct);
-    a->Visit({"max_settling", "reject candidates settling later", "s", kInfinite, "10"}, &max_settling_s);
+    a->Visit({"max_settling", "reject candidates settling later", "s", kInfinite | kSearch, "10"},
+             &max_settling_s);
     a->Visit({"zn_rule", "classic | pessen | some-overshoot | no-overshoot", "", kNone, R"("pessen")"},
              &zn_rule);
     a->Visit({"rule", "simc, amigo: pi | pid, the controller the rule gives", "", kNone, R"("pi")"}, &rule);
@@ -330,13 +332,13 @@ struct TuneSpec {
               "the robust preset (docs/robustness.md): --objective setpoint-load --load-weight 1 "
               "--derivative-filter-ratio 10 --max-ms 1.6 --max-time-constant <horizon/10>; a field given "
               "explicitly overrides its part",
-              "", kNone, "true"},
+              "", kSearch, "true"},
              &robust);
     a->Visit(
         {"robust_samples",
          "optimise over the nominal plant and N plants drawn as evaluate --monte-carlo draws them (seeded by "
          "--seed): the --robust-quantile of the objective over the set",
-         "", kNone, "5"},
+         "", kSearch, "5"},
         &robust_samples);
     a->Visit(
         {"robust_quantile", "quantile of the robust set's objective to minimise, (0, 1]; 1 = the worst case",
@@ -348,7 +350,7 @@ struct TuneSpec {
     a->Visit({"two_dof",
               "2-DOF PID (docs/two_dof.md): after the feedback gains, the setpoint weights b, c in [0, 1] "
               "minimising the setpoint step's IAE with the gains fixed; the result reports both responses",
-              "", kNone, "true"},
+              "", kSearch, "true"},
              &two_dof);
     a->Visit(
         {"robustness",

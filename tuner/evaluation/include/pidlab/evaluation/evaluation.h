@@ -78,6 +78,9 @@ struct EvaluateOptions {
   bool compute_step_info = true;
   bool compute_iae_continuous = true;
   bool record_trajectory = false;
+  /// The load response (load_iae); off, load_iae is NaN. A search over the
+  /// setpoint weights, which move no pole and no load response, skips it.
+  bool compute_load_iae = true;
 };
 
 /// Runs the sampled loop of `options` with the disturbance `disturbance`
