@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "pidlab/spec/json.h"
+#include "url.h"
 
 namespace pidlab::server {
 namespace {
@@ -27,48 +28,13 @@ namespace net = boost::asio;
 using tcp = net::ip::tcp;
 using Request = http::request<http::string_body>;
 using Response = http::response<http::string_body>;
-
-// The value of `name` in a URL's query ("a=1&token=x"), empty if absent.
-std::string QueryValue(const std::string& target, const std::string& name) {
-  const std::size_t q = target.find('?');
-  if (q == std::string::npos) return "";
-  std::istringstream in(target.substr(q + 1));
-  std::string pair;
-  while (std::getline(in, pair, '&'))
-    if (pair.compare(0, name.size() + 1, name + "=") == 0) return pair.substr(name.size() + 1);
-  return "";
-}
-
-std::string PathOf(const std::string& target) { return target.substr(0, target.find('?')); }
-
-// "%41+b" -> "A b"; a malformed escape is kept as it is.
-std::string PercentDecoded(const std::string& text) {
-  std::string out;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    if (text[i] == '+') {
-      out += ' ';
-    } else if (text[i] == '%' && i + 2 < text.size() &&
-               std::isxdigit(static_cast<unsigned char>(text[i + 1])) &&
-               std::isxdigit(static_cast<unsigned char>(text[i + 2]))) {
-      out += static_cast<char>(std::stoi(text.substr(i + 1, 2), nullptr, 16));
-      i += 2;
-    } else {
-      out += text[i];
-    }
-  }
-  return out;
-}
+using internal::PathOf;
+using internal::PercentDecoded;
+using internal::QueryValue;
+using internal::SameSecret;
 
 bool IsUpload(const Request& req) {
   return req.method() == http::verb::post && PathOf(std::string(req.target())) == "/api/upload";
-}
-
-// Compares without an early exit, so that timing does not tell a prefix.
-bool SameSecret(const std::string& a, const std::string& b) {
-  if (a.size() != b.size()) return false;
-  unsigned char diff = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
-  return diff == 0;
 }
 
 // A request's body after its header: the time it may take.
@@ -89,36 +55,6 @@ Response JsonResponse(const Request& req, http::status status, const nlohmann::j
 }
 
 }  // namespace
-
-bool IsLoopback(const std::string& address) {
-  boost::system::error_code ec;
-  const net::ip::address a = net::ip::make_address(address, ec);
-  return !ec && a.is_loopback();
-}
-
-bool ServerOptions::IsValid(std::string* error) const {
-  std::string e;
-  boost::system::error_code ec;
-  net::ip::make_address(bind, ec);
-  if (ec)
-    e = "bind address '" + bind + "' is not an IPv4 or IPv6 address";
-  else if (port < 0 || port > 65535)
-    e = "port " + std::to_string(port) + " must be in 0..65535";
-  else if (!IsLoopback(bind) && token.size() < 16)
-    e = "bind address '" + bind + "' is not loopback: a token of at least 16 characters is required";
-  else if (max_body_bytes < 1024 || max_message_bytes < 1024 || max_header_bytes < 1024 ||
-           max_upload_bytes < 1024)
-    e = "the size limits must be at least 1024 bytes";
-  else if (max_connections < 1)
-    e = "max_connections " + std::to_string(max_connections) + " must be at least 1";
-  else if (max_connections_per_address < 1 || max_connections_per_address > max_connections)
-    e = "max_connections_per_address " + std::to_string(max_connections_per_address) + " must be in 1.." +
-        std::to_string(max_connections);
-  else if (!(header_timeout_s >= 0.1 && header_timeout_s <= 600))
-    e = "header_timeout_s " + std::to_string(header_timeout_s) + " must be in 0.1..600";
-  if (error) *error = e;
-  return e.empty();
-}
 
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   // The open connections, each with its client's address; those waiting for
