@@ -49,10 +49,18 @@ TEST(PlotSeries, StepResponseIsTheEvaluationsSamplesOnTheFiguresFrameBitForBit) 
   for (const nlohmann::json& spec :
        {nlohmann::json{{"plant", "double_integrator"}, {"gains", {3.9, 0.06, 4.9}}},
         nlohmann::json{{"plant", "oscillator"}, {"gains", {2, 1, 1.5}}, {"loop", "sampled"}},
-        nlohmann::json{{"plant", "stepper_motor"}, {"gains", {20.8836, 26.607, 12.4866}}}}) {
+        nlohmann::json{{"plant", "stepper_motor"}, {"gains", {20.8836, 26.607, 12.4866}}},
+        // A fast rise and a slow integral tail: the frame's spacing is widened to 4000 intervals.
+        nlohmann::json{{"plant", "custom"}, {"num", {1}}, {"den", {1, 1}}, {"gains", {1, 0.001, 0}}}}) {
     const nlohmann::json series = SeriesOf(spec);
     const nlohmann::json& frame = series["time_scale"];
     ASSERT_EQ(frame["source"], "plant") << spec << ": no horizon given, the figure's frame";
+    EXPECT_LE(series["t"].size(), 4001u) << spec << frame;
+    if (spec["plant"] == "custom") {
+      EXPECT_NE(frame["reason"].get<std::string>().find("spaced for at most 4000 intervals"),
+                std::string::npos)
+          << frame;
+    }
     nlohmann::json on_frame = spec;
     on_frame["horizon"] = frame["horizon_s"];
     on_frame["sample_time"] = frame["sample_time_s"];

@@ -1,5 +1,6 @@
 #include "pidlab/results/spec_run.h"
 
+#include <cmath>
 #include <set>
 #include <string>
 
@@ -37,6 +38,9 @@ void AddLinearMotor(const tune::EvaluationProblem& problem, const evaluation::Lo
   (*series)["linear_y"] = ran ? nlohmann::json(ev.y) : nlohmann::json(nullptr);
 }
 
+// The most sample intervals of a derived figure frame (FigureFrame).
+constexpr double kMaxFigureIntervals = 4000.0;
+
 // The figures' frame, as `pidlab plot` draws them (tune/time_scale.h,
 // kFigure): with neither horizon nor sample_time given, on every plant the
 // closed loop's transient fills it. The result's numbers keep the
@@ -48,6 +52,18 @@ Status FigureFrame(const tune::EvaluationProblem& problem, const std::set<std::s
   spec::LoopSpec framed = problem.spec.loop;
   *frame = tune::ResolveGainsTimeScale(problem.spec.plant, problem.plant, {problem.gains}, given,
                                        tune::TimeScaleScope::kFigure, &framed);
+  // A derived frame is drawn with at most kMaxFigureIntervals + 1 points a
+  // curve (a loop whose fast rise and slow tail both stay in it would send
+  // the page tens of thousands): its spacing doubled (a multiple of dt still),
+  // the horizon rounded up to a multiple of it.
+  if (frame->source == "plant" && framed.horizon_s / framed.sample_time_s > kMaxFigureIntervals + 0.5) {
+    while (framed.horizon_s / framed.sample_time_s > kMaxFigureIntervals + 0.5) framed.sample_time_s *= 2.0;
+    framed.horizon_s = std::ceil(framed.horizon_s / framed.sample_time_s - 1e-9) * framed.sample_time_s;
+    frame->horizon_s = framed.horizon_s;
+    frame->sample_time_s = framed.sample_time_s;
+    frame->reason += "; spaced for at most " + std::to_string(static_cast<int>(kMaxFigureIntervals)) +
+                     " intervals a curve";
+  }
   *loop = problem.loop;
   *figure = evaluated;
   if (framed.horizon_s == problem.spec.loop.horizon_s &&
