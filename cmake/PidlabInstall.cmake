@@ -6,6 +6,22 @@ include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 set(PIDLAB_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/pidlab)
 
+# pidlab_library(<target> <name> [HEADERS_INSTALLED | NOT_INSTALLED]): a
+# folder's library as every folder exports it: its include/ folder public
+# (in the build and installed), the alias pidlab::<name>, and its
+# installation with that include/ tree (HEADERS_INSTALLED: the folder's other
+# library installs the headers; NOT_INSTALLED: used in this build only).
+function(pidlab_library target name)
+  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+                             $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  add_library(pidlab::${name} ALIAS ${target})
+  if("HEADERS_INSTALLED" IN_LIST ARGN)
+    pidlab_install_library(${target} ${name})
+  elseif(NOT "NOT_INSTALLED" IN_LIST ARGN)
+    pidlab_install_library(${target} ${name} ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  endif()
+endfunction()
+
 # pidlab_install_library(<target> <export name> [<include dir>])
 function(pidlab_install_library target export_name)
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${export_name})
