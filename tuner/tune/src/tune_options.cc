@@ -4,7 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
 
+#include "pidlab/optim/genetic_algorithm.h"
+#include "pidlab/optim/nelder_mead.h"
+#include "pidlab/optim/paper_nelder_mead.h"
+#include "pidlab/optim/pso_gsa.h"
 #include "pidlab/spec/field.h"
 #include "pidlab/tune/tune.h"
 
