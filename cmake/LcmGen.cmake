@@ -14,7 +14,8 @@ function(pidlab_lcm_cpp)
   endforeach()
   set(abs_files)
   foreach(f ${ARG_FILES})
-    list(APPEND abs_files ${CMAKE_CURRENT_SOURCE_DIR}/${f})
+    get_filename_component(abs ${f} ABSOLUTE BASE_DIR ${CMAKE_CURRENT_SOURCE_DIR})
+    list(APPEND abs_files ${abs})
   endforeach()
   add_custom_command(
     OUTPUT ${headers}
@@ -44,7 +45,8 @@ function(pidlab_lcm_python)
   foreach(f ${ARG_FILES})
     get_filename_component(stem ${f} NAME_WE)
     list(APPEND outputs ${ARG_OUT_DIR}/${ARG_PACKAGE}/${stem}.py)
-    list(APPEND abs_files ${CMAKE_CURRENT_SOURCE_DIR}/${f})
+    get_filename_component(abs ${f} ABSOLUTE BASE_DIR ${CMAKE_CURRENT_SOURCE_DIR})
+    list(APPEND abs_files ${abs})
   endforeach()
   add_custom_command(
     OUTPUT ${outputs}
@@ -56,4 +58,47 @@ function(pidlab_lcm_python)
     COMMENT "lcm-gen --python ${ARG_PACKAGE}"
     VERBATIM)
   add_custom_target(${ARG_TARGET} ALL DEPENDS ${outputs})
+endfunction()
+
+# pidlab_lcm_frozen_versions(FILE <type.lcm> OUT_VAR <var>)
+#
+# A type that only ever gains fields at its end marks each place it once
+# ended with a line "//@frozen <name>" (<name>: the frozen copy's type name).
+# For each marker this writes <build>/lcm_frozen/<name>.lcm at configure
+# time: the package line and the fields above the marker, as struct <name>.
+# Such a copy has the old type's fingerprint (lcm-gen's hash covers the
+# fields' names and types, not the type's name), so logs written before an
+# append still decode. <var> receives the generated files' paths.
+function(pidlab_lcm_frozen_versions)
+  cmake_parse_arguments(ARG "" "FILE;OUT_VAR" "" ${ARGN})
+  set(src ${CMAKE_CURRENT_SOURCE_DIR}/${ARG_FILE})
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${src})
+  get_filename_component(stem ${ARG_FILE} NAME_WE)
+  # Lines as a list: the ';' that ends every field is kept as @SEMI@.
+  file(READ ${src} content)
+  string(REPLACE ";" "@SEMI@" content "${content}")
+  string(REPLACE "\n" ";" lines "${content}")
+  set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/lcm_frozen)
+  set(head "")       # the package line
+  set(body "")       # the fields so far
+  set(in_struct OFF)
+  set(outputs)
+  foreach(line IN LISTS lines)
+    if(line MATCHES "^package ")
+      string(REPLACE "@SEMI@" ";" head "${line}")
+    elseif(line MATCHES "^struct ${stem}")
+      set(in_struct ON)
+    elseif(in_struct AND line MATCHES "^[ \t]*//@frozen ([A-Za-z0-9_]+)")
+      set(name ${CMAKE_MATCH_1})
+      set(text "${head}\n\n// Generated from lcmtypes/${ARG_FILE} (the fields above its line\n// \"//@frozen ${name}\") by pidlab_lcm_frozen_versions: do not edit.\nstruct ${name}\n{${body}}\n")
+      # Written only when it changes, so that a reconfigure rebuilds nothing.
+      file(CONFIGURE OUTPUT ${out_dir}/${name}.lcm CONTENT "${text}" @ONLY)
+      list(APPEND outputs ${out_dir}/${name}.lcm)
+    elseif(in_struct AND line MATCHES "^[ \t]*[a-z]")
+      string(REGEX REPLACE "[ \t]*//.*$" "" field "${line}")
+      string(REPLACE "@SEMI@" ";" field "${field}")
+      string(APPEND body "\n${field}")
+    endif()
+  endforeach()
+  set(${ARG_OUT_VAR} ${outputs} PARENT_SCOPE)
 endfunction()

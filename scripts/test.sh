@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs the tests.
 #   scripts/test.sh          every test (unit, cli, integration, install,
-#                            hostile, browser): what .ci/run runs
+#                            hostile, browser, study): what .ci/run runs
 #   scripts/test.sh --fast   the fast lane: build/ only, then the `unit` and
 #                            `cli` labels (ctest -L 'unit|cli'), in parallel
 # Every test's label is the first word of its name (tests/CMakeLists.txt).

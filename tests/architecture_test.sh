@@ -22,8 +22,8 @@ import os, re, subprocess, sys
 dot, src = sys.argv[1], sys.argv[2]
 # Levels of the house, bottom (0) to top. A library may link only lower levels.
 level = {
-    'pidlab_lcmtypes': 0,
-    'pidlab_spec': 1, 'pidlab_plant_sim': 1, 'pidlab_controller': 1, 'pidlab_optim': 1, 'pidlab_plot': 3,
+    'pidlab_lcmtypes': 0, 'pidlab_controller': 0,
+    'pidlab_spec': 1, 'pidlab_plant_sim': 1, 'pidlab_optim': 1, 'pidlab_plot': 3,
     'pidlab_server': 2,
     'pidlab_io': 2, 'pidlab_transport': 2, 'pidlab_evaluation': 2, 'pidlab_controller_export': 2,
     'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_analysis': 3,
@@ -70,7 +70,7 @@ for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
     if bad: fail(f'{exe} links {", ".join(bad)}')
     else: print(f'ok   {exe} links only ' + ', '.join(sorted(d for d in closure(exe) if d.startswith("pidlab"))))
 # Sources: a folder includes only headers of its own level or below.
-header_level = {'io': 2, 'spec': 1, 'plant_sim': 1, 'controller': 1, 'optim': 1, 'plot': 3, 'server': 2, 'transport': 2, 'evaluation': 2, 'controller_export': 2,
+header_level = {'io': 2, 'spec': 1, 'plant_sim': 1, 'controller': 0, 'optim': 1, 'plot': 3, 'server': 2, 'transport': 2, 'evaluation': 2, 'controller_export': 2,
                 'analysis': 3, 'monitor': 3, 'tune': 4, 'identify': 4, 'episode_client': 4, 'replay': 4, 'results': 5, 'launcher': 5, 'report': 6,
                 'figures': 6}
 lib_dirs = {'io': 2, 'spec': 1, 'server': 2, 'transport': 2, 'tuner/optim': 1, 'tuner/evaluation': 2, 'tuner/analysis': 3, 'monitor': 3,
@@ -125,6 +125,19 @@ for d in ('plant_sim', 'controller'):
             text = open(os.path.join(root, f)).read()
             if re.search(r'#include "pidlab/(transport|optim|evaluation|analysis|tune|episode_client|replay|launcher)/', text) or 'lcm' in re.findall(r'#include <(\w+)', text):
                 fail(f'{os.path.relpath(os.path.join(root, f), src)} is a model but includes LCM or a higher layer')
+# One episode shape: the evaluation's loop and the trio's episode embed
+# EpisodeShape (plant_sim/episode_shape.h) instead of copying its fields, and
+# the episode configuration's frozen copies are generated from its
+# "//@frozen" lines (cmake/LcmGen.cmake), never kept by hand in lcmtypes/.
+for header, shape in (('tuner/evaluation/include/pidlab/evaluation/closed_loop.h', 'struct LoopOptions : EpisodeShape'),
+                      ('transport/include/pidlab/transport/episode_spec.h', 'struct EpisodeSpec : EpisodeShape')):
+    if shape not in open(os.path.join(src, header)).read():
+        fail(f'{header}: no "{shape}"')
+for f in os.listdir(os.path.join(src, 'lcmtypes')):
+    if re.match(r'lcmt_.*_v\d+\.lcm$', f):
+        fail(f'lcmtypes/{f}: a frozen copy kept by hand (mark "//@frozen" in the type instead)')
+if len(re.findall(r'//@frozen lcmt_episode_config_v\d', open(os.path.join(src, 'lcmtypes/lcmt_episode_config.lcm')).read())) != 4:
+    fail('lcmtypes/lcmt_episode_config.lcm: expected the four //@frozen lines of v1..v4')
 # Nothing in the repository names the folder beside it.
 beside = '..' + '/' + 'shared'
 hits = subprocess.run(['git', '-C', src, 'grep', '-l', '-F', beside, '--', '.'],

@@ -113,8 +113,8 @@ TEST(EpisodeClient, SampledLoopOptionsRoundTripsDtHorizonPidAndDisturbance) {
   l.options.pid.output_max = 6.0;
   l.options.pid.anti_windup = AntiWindup::kBackCalculation;
   l.options.pid.back_calculation_gain = 2.5;
-  l.options.pid.setpoint_weight_p = 0.75;
-  l.options.pid.setpoint_weight_d = 0.0;  // derivative on measurement
+  l.options.pid.setpoint_weight_b = 0.75;
+  l.options.pid.setpoint_weight_c = 0.0;  // derivative on measurement
   l.options.pid.integral = IntegralMethod::kTrapezoidal;
   DisturbanceOptions d;  // differs from options.disturbance: the spec takes this one
   d.kind = DisturbanceKind::kSine;
@@ -142,8 +142,8 @@ TEST(EpisodeClient, SampledLoopOptionsRoundTripsDtHorizonPidAndDisturbance) {
   EXPECT_EQ(back.pid.output_max, 6.0);
   EXPECT_EQ(back.pid.anti_windup, AntiWindup::kBackCalculation);
   EXPECT_EQ(back.pid.back_calculation_gain, 2.5);
-  EXPECT_EQ(back.pid.setpoint_weight_p, 0.75);
-  EXPECT_EQ(back.pid.setpoint_weight_d, 0.0);
+  EXPECT_EQ(back.pid.setpoint_weight_b, 0.75);
+  EXPECT_EQ(back.pid.setpoint_weight_c, 0.0);
   EXPECT_EQ(back.pid.integral, IntegralMethod::kTrapezoidal);
   EXPECT_EQ(back.disturbance.kind, DisturbanceKind::kSine);
   EXPECT_EQ(back.disturbance.amplitude, 0.7);

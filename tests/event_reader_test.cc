@@ -20,10 +20,12 @@
 #include <pidlab/lcmt_episode_config_v2.hpp>
 #include <pidlab/lcmt_episode_config_v3.hpp>
 #include <pidlab/lcmt_episode_config_v4.hpp>
+#include <pidlab/lcmt_ready.hpp>
 
 #include "pidlab/replay/decoder_table.h"
 #include "pidlab/replay/episode_assembler.h"
 #include "pidlab/transport/episode_spec.h"
+#include "pidlab/transport/wire.h"
 
 namespace {
 std::atomic<bool> g_watching{false};
@@ -555,6 +557,110 @@ TEST(DecoderTable, AConfigurationWrittenBeforeTheSetpointWeightsIsReadAsTheOneDo
     const std::vector<uint8_t> cut(bytes.begin(), bytes.end() - 4);
     EXPECT_FALSE(type->decode(cut.data(), cut.size(), &message));
   }
+}
+
+TEST(DecoderTable, EachGeneratedFrozenConfigurationKeepsTheFingerprintItsLogsCarry) {
+  // The frozen copies are generated from lcmt_episode_config.lcm's
+  // "//@frozen" lines; these are the fingerprints of the hand-written copies
+  // they replaced, which every log written before an append carries.
+  EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v1::getHash()), 0xfe4e3ce8f5a0287bULL);
+  EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v2::getHash()), 0xdaafa1e58acc7835ULL);
+  EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v3::getHash()), 0x7996f8fa958b6b63ULL);
+  EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v4::getHash()), 0xab82a939990368c8ULL);
+  EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_episode_config_v1::getHash()), 1);
+  EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_episode_config_v4::getHash()), 4);
+  EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_episode_config::getHash()),
+            transport::kEpisodeConfigVersion);
+  EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_ready::getHash()), 0);
+}
+
+TEST(DecoderTable, AnOlderConfigurationReadsAsTheCurrentOneWithOnlyTheAppendedFieldsAtTheirDefaults) {
+  // Every field of the frozen copy keeps its value, whatever its version;
+  // everything appended after it is 0 or "" (b = c = 1 for the 1-DOF PID).
+  pidlab::lcmt_episode_config_v2 old{};
+  old.utime = 11;
+  old.episode_id = 7;
+  old.plant_name = "stepper_nonlinear";
+  old.num = {2.0};
+  old.num_size = 1;
+  old.den = {1.0, 3.0, 0.0};
+  old.den_size = 3;
+  old.kp = 1.5;
+  old.ki = 0.25;
+  old.kd = 0.125;
+  old.reference = -2.0;
+  old.derivative_filter_s = 0.01;
+  old.output_min = -3.0;
+  old.output_max = 4.0;
+  old.anti_windup = "back-calculation";
+  old.back_calculation_gain = 2.5;
+  old.derivative_on = "measurement";
+  old.integral = "trapezoidal";
+  old.dt_s = 0.001;
+  old.sample_time_s = 0.05;
+  old.horizon_s = 1.0;
+  old.total_steps = 1000;
+  old.disturbance_kind = "square";
+  old.disturbance_amplitude = 0.5;
+  old.disturbance_period_s = 0.2;
+  old.disturbance_phase_s = 0.05;
+  old.disturbance_step_time_s = 0.3;
+  old.noise_hold_s = 0.01;
+  old.seed = 99;
+  old.retransmit_interval_s = 0.004;
+  old.silence_deadline_s = 6.0;
+  old.motor_resistance_ohm = 1.1;
+  old.motor_flux_linkage = 0.02;
+  old.motor_rel_tolerance = 1e-9;
+  old.motor_drive = "microstep";
+  std::vector<uint8_t> bytes = Encode(old);
+  const DecoderTable table;
+  const MessageType* type = table.Find(pidlab::lcmt_episode_config_v2::getHash());
+  ASSERT_NE(type, nullptr);
+  PidlabMessage message;
+  ASSERT_TRUE(type->decode(bytes.data(), bytes.size(), &message));
+  const auto* c = std::get_if<pidlab::lcmt_episode_config>(&message);
+  ASSERT_NE(c, nullptr);
+  pidlab::lcmt_episode_config want{};
+  want.utime = 11;
+  want.episode_id = 7;
+  want.plant_name = old.plant_name;
+  want.num_size = 1;
+  want.num = old.num;
+  want.den_size = 3;
+  want.den = old.den;
+  want.kp = 1.5;
+  want.ki = 0.25;
+  want.kd = 0.125;
+  want.reference = -2.0;
+  want.derivative_filter_s = 0.01;
+  want.output_min = -3.0;
+  want.output_max = 4.0;
+  want.anti_windup = old.anti_windup;
+  want.back_calculation_gain = 2.5;
+  want.derivative_on = old.derivative_on;
+  want.integral = old.integral;
+  want.dt_s = 0.001;
+  want.sample_time_s = 0.05;
+  want.horizon_s = 1.0;
+  want.total_steps = 1000;
+  want.disturbance_kind = old.disturbance_kind;
+  want.disturbance_amplitude = 0.5;
+  want.disturbance_period_s = 0.2;
+  want.disturbance_phase_s = 0.05;
+  want.disturbance_step_time_s = 0.3;
+  want.noise_hold_s = 0.01;
+  want.seed = 99;
+  want.retransmit_interval_s = 0.004;
+  want.silence_deadline_s = 6.0;
+  want.motor_resistance_ohm = 1.1;
+  want.motor_flux_linkage = 0.02;
+  want.motor_rel_tolerance = 1e-9;
+  want.motor_drive = old.motor_drive;
+  want.setpoint_weight_b = 1.0;
+  want.setpoint_weight_c = 0.0;  // derivative on the measurement
+  // The same message, byte for byte.
+  EXPECT_EQ(Encode(*c), Encode(want));
 }
 
 TEST(DecoderTable, RefusesAnArrayLongerThanThePayloadBeforeTheDecoderAllocatesIt) {

@@ -62,7 +62,7 @@ double& PrevError(DiscretePid<double>* p) { return p->*Get(PrevErrorTag{}); }
 double& PrevSignal(DiscretePid<double>* p) { return p->*Get(PrevSignalTag{}); }
 
 // The derivative's setpoint weight c (1 on the error, 0 on the measurement)
-// in DiscretePid's options: derivative_on today, setpoint_weight_d once the
+// in DiscretePid's options: derivative_on today, setpoint_weight_c once the
 // 2-DOF PID replaces it; each is set where it exists (overload resolution
 // takes the int overload where it compiles), so the test runs on both.
 template <typename O>
@@ -72,8 +72,8 @@ auto SetDerivativeOnField(O* o, double c, int) -> decltype(o->derivative_on = De
 template <typename O>
 void SetDerivativeOnField(O*, double, long) {}
 template <typename O>
-auto SetWeightDField(O* o, double c, int) -> decltype(o->setpoint_weight_d = c, void()) {
-  o->setpoint_weight_d = c;
+auto SetWeightDField(O* o, double c, int) -> decltype(o->setpoint_weight_c = c, void()) {
+  o->setpoint_weight_c = c;
 }
 template <typename O>
 void SetWeightDField(O*, double, long) {}

@@ -82,7 +82,7 @@ TEST(DiscretePid, DerivativeOnErrorGivesAKickOfAreaKdOnTheFirstStep) {
 TEST(DiscretePid, DerivativeOnMeasurementGivesNoKick) {
   const double kd = 0.5, dt = 1e-3;
   PidOptions o = Options(dt);
-  o.setpoint_weight_d = SetpointWeightD(DerivativeOn::kMeasurement);  // c = 0
+  o.setpoint_weight_c = SetpointWeightC(DerivativeOn::kMeasurement);  // c = 0
   DiscretePid<double> dut({0.0, 0.0, kd}, o);
   double u = 1.0;
   EXPECT_EQ(dut.Step(1.0, 0.0, &u), PidStatus::kOk);
@@ -174,7 +174,7 @@ TEST(DiscretePid, ClampingKeepsIntegratingWhenTheErrorPullsBackInside) {
   o.output_min = -1.0;
   o.output_max = 1.0;
   o.anti_windup = AntiWindup::kClamping;
-  o.setpoint_weight_d = SetpointWeightD(DerivativeOn::kMeasurement);  // c = 0
+  o.setpoint_weight_c = SetpointWeightC(DerivativeOn::kMeasurement);  // c = 0
   DiscretePid<double> dut({0.0, 2.0, 5.0}, o);
   double u = 0.0;
   dut.Step(0.0, 0.0, &u);

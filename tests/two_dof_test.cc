@@ -75,8 +75,8 @@ Plant Custom(std::vector<double> num, std::vector<double> den, double delay_s = 
 }
 
 Evaluation EvaluateWith(const Plant& plant, const PidGains& g, LoopOptions o, double b, double c) {
-  o.pid.setpoint_weight_p = b;
-  o.pid.setpoint_weight_d = c;
+  o.pid.setpoint_weight_b = b;
+  o.pid.setpoint_weight_c = c;
   Evaluation ev;
   std::string error;
   EXPECT_TRUE(Evaluate(plant, g, o, EvaluateOptions{}, &ev, &error)) << error;
@@ -135,8 +135,8 @@ TEST(TwoDofPid, WithCZeroTheFirstSampleOfAUnitStepAtRestIsKpB) {
     PidOptions o;
     o.dt_s = 0.01;
     o.integral = IntegralMethod::kForwardEuler;  // no integral at k = 0
-    o.setpoint_weight_p = b;
-    o.setpoint_weight_d = 0.0;
+    o.setpoint_weight_b = b;
+    o.setpoint_weight_c = 0.0;
     DiscretePid<double> dut({1.12, 0.23, 1.3, 0.122}, o);
     double u = -1.0;
     ASSERT_EQ(dut.Step(1.0, 0.0, &u), PidStatus::kOk);
@@ -154,19 +154,19 @@ TEST(TwoDofPid, WithCZeroTheIdealDerivativeGivesTheContinuousLoopNoKick) {
 }
 
 TEST(TwoDofPid, DerivativeOnMeasurementIsTheSetpointWeightCZero) {
-  EXPECT_EQ(SetpointWeightD(DerivativeOn::kMeasurement), 0.0);
-  EXPECT_EQ(SetpointWeightD(DerivativeOn::kError), 1.0);
+  EXPECT_EQ(SetpointWeightC(DerivativeOn::kMeasurement), 0.0);
+  EXPECT_EQ(SetpointWeightC(DerivativeOn::kError), 1.0);
 }
 
 TEST(TwoDofPid, WeightsOutsideTheUnitIntervalOrNotFiniteAreRefused) {
   for (const double w : {-0.1, 1.5, std::nan(""), static_cast<double>(INFINITY)}) {
     PidOptions o;
-    o.setpoint_weight_p = w;
+    o.setpoint_weight_b = w;
     std::string error;
     EXPECT_FALSE(o.IsValid(&error));
     EXPECT_NE(error.find("setpoint weight b"), std::string::npos) << error;
-    o.setpoint_weight_p = 1.0;
-    o.setpoint_weight_d = w;
+    o.setpoint_weight_b = 1.0;
+    o.setpoint_weight_c = w;
     EXPECT_FALSE(o.IsValid(&error));
     EXPECT_NE(error.find("setpoint weight c"), std::string::npos) << error;
   }
@@ -203,8 +203,8 @@ void ExpectOnlyTheSetpointResponseMoves(const Plant& plant, const PidGains& g, c
   for (const auto& [b, c] : std::vector<std::pair<double, double>>{{0.5, 0.0}, {0.0, 0.3}, {0.664, 0.0136}}) {
     const Evaluation two = EvaluateWith(plant, g, o, b, c);
     LoopOptions ow = o;
-    ow.pid.setpoint_weight_p = b;
-    ow.pid.setpoint_weight_d = c;
+    ow.pid.setpoint_weight_b = b;
+    ow.pid.setpoint_weight_c = c;
     LoopAnalysis a2;
     ASSERT_TRUE(AnalyzeLoop(plant, g, ow, LoopAnalysisOptions{}, &a2, &error)) << error;
     EXPECT_EQ(two.load_iae, one.load_iae) << b << "," << c;

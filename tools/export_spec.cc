@@ -22,8 +22,8 @@ bool ExportController(const spec::EvaluateSpec& s, spec::NameStyle style, contro
   c->gains = evaluation::LoopGains(g, loop);
   c->pid = PidOptionsAt(loop.pid, loop.dt_s);
   // The spec's setpoint weights (c = 0 for derivative_on measurement), in the PID's options.
-  c->setpoint_weight_b = c->pid.setpoint_weight_p;
-  c->setpoint_weight_c = c->pid.setpoint_weight_d;
+  c->setpoint_weight_b = c->pid.setpoint_weight_b;
+  c->setpoint_weight_c = c->pid.setpoint_weight_c;
   return controller_export::ControllerIsValid(*c, error);
 }
 

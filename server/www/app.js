@@ -10,11 +10,11 @@ const plants = ['double_integrator', 'oscillator', 'stepper_motor', 'custom', 's
 // The design: what the form shows. Empty strings are fields left to the spec's defaults.
 const state = {
   plant: 'double_integrator', num: '1', den: '1,0,0', model: '', delay: '', stepper: '',
-  kp: 3.9, ki: 0.06, kd: 4.9, derivative_filter: '', weight_b: '', weight_c: '', limit_lo: '', limit_hi: '',
+  kp: 3.9, ki: 0.06, kd: 4.9, derivative_filter: '', setpoint_weight_b: '', setpoint_weight_c: '', limit_lo: '', limit_hi: '',
   loop: 'continuous', dt: '', max_ms: '', max_mt: '', max_noise_gain: '', min_phase_margin: '',
   monte_carlo: '', spread: '',
 };
-const textFields = ['num', 'den', 'model', 'delay', 'stepper', 'derivative_filter', 'weight_b', 'weight_c',
+const textFields = ['num', 'den', 'model', 'delay', 'stepper', 'derivative_filter', 'setpoint_weight_b', 'setpoint_weight_c',
   'limit_lo', 'limit_hi', 'dt', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin', 'monte_carlo', 'spread'];
 const pidlab = window.pidlab = {
   state, lastResult: null, lastSeries: null, plots: {}, rendered: 0, timings: [], pinned: [],
@@ -42,8 +42,8 @@ function spec() {
   if (state.loop === 'sampled') s.loop = 'sampled';
   if (state.loop === 'sampled' && given(state.dt)) s.dt = Number(state.dt);
   if (given(state.derivative_filter)) s.derivative_filter = Number(state.derivative_filter);
-  if (given(state.weight_b) || given(state.weight_c))
-    s.setpoint_weights = [given(state.weight_b) ? Number(state.weight_b) : 1, given(state.weight_c) ? Number(state.weight_c) : 1];
+  if (given(state.setpoint_weight_b) || given(state.setpoint_weight_c))
+    s.setpoint_weights = [given(state.setpoint_weight_b) ? Number(state.setpoint_weight_b) : 1, given(state.setpoint_weight_c) ? Number(state.setpoint_weight_c) : 1];
   if (given(state.limit_lo) || given(state.limit_hi))
     s.output_limits = [given(state.limit_lo) ? Number(state.limit_lo) : '-inf', given(state.limit_hi) ? Number(state.limit_hi) : 'inf'];
   for (const k of ['max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin']) if (given(state[k])) s[k] = Number(state[k]);

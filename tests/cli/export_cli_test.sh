@@ -86,7 +86,7 @@ if "$pidlab" evaluate --plant oscillator --gains 1.5,0.75,0.5 --loop sampled --d
   --output-limits -4,4 --json >evaluation.json 2>err.txt &&
   "$pidlab" export --from evaluation.json --lang c --out from >out.txt 2>err.txt; then
   if grep -q '1.5, /\* kp \*/' from/pidlab_pid.c && grep -q '0.002, /\* dt_s' from/pidlab_pid.c &&
-    grep -q '0.0, /\* c \*/' from/pidlab_pid.c; then
+    grep -q '0.0, /\* setpoint_weight_c \*/' from/pidlab_pid.c; then
     pass "--from evaluation.json: its gains, dt and derivative on measurement (c = 0)"
     grep -q 'Plant: oscillator' from/pidlab_pid.h && pass "--from: the plant in the comment" ||
       fail "--from: no plant in the comment"

@@ -51,8 +51,8 @@ void *shim_new(const shim_config *s) {
   c.ki = s->ki;
   c.kd = s->kd;
   c.tf = s->tf;
-  c.b = s->b;
-  c.c = s->c;
+  c.setpoint_weight_b = s->b;
+  c.setpoint_weight_c = s->c;
   c.dt_s = s->dt_s;
   c.output_min = s->output_min;
   c.output_max = s->output_max;

@@ -24,8 +24,8 @@ void *shim_new(const shim_config *s) {
   c.ki = (pidlab_real)s->ki;
   c.kd = (pidlab_real)s->kd;
   c.tf = (pidlab_real)s->tf;
-  c.b = (pidlab_real)s->b;
-  c.c = (pidlab_real)s->c;
+  c.setpoint_weight_b = (pidlab_real)s->b;
+  c.setpoint_weight_c = (pidlab_real)s->c;
   c.dt_s = (pidlab_real)s->dt_s;
   c.has_output_min = s->has_output_min;
   c.output_min = (pidlab_real)s->output_min;

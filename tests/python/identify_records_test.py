@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""cli.identify_records_RECORD: `pidlab identify` on a real record of
+"""study.identify_records_RECORD: `pidlab identify` on a real record of
 tests/data/identify (README.md there names the sources) against the reference
 fits of tests/python/identify_reference.py (scipy, many starts, a delay
 profile; no pidlab code), stored in tests/data/identify/reference_fits.json.

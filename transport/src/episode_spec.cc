@@ -111,9 +111,9 @@ pidlab::lcmt_episode_config MakeEpisodeConfig(const EpisodeSpec& spec) {
   m.back_calculation_gain = pid.back_calculation_gain;
   // derivative_on "measurement" is c = 0, kept for older readers of the log.
   m.derivative_on =
-      ToString(pid.setpoint_weight_d == 0.0 ? DerivativeOn::kMeasurement : DerivativeOn::kError);
-  m.setpoint_weight_b = pid.setpoint_weight_p;
-  m.setpoint_weight_c = pid.setpoint_weight_d;
+      ToString(pid.setpoint_weight_c == 0.0 ? DerivativeOn::kMeasurement : DerivativeOn::kError);
+  m.setpoint_weight_b = pid.setpoint_weight_b;
+  m.setpoint_weight_c = pid.setpoint_weight_c;
   m.integral = ToString(pid.integral);
   m.dt_s = spec.dt_s;
   m.sample_time_s = spec.sample_time_s;
@@ -238,8 +238,8 @@ bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec,
   DerivativeOn derivative_on = DerivativeOn::kError;
   if (!ParseDerivativeOn(m.derivative_on, &derivative_on))
     return Fail("derivative-on '" + m.derivative_on + "' unknown", error);
-  pid.setpoint_weight_p = m.setpoint_weight_b;
-  pid.setpoint_weight_d = m.setpoint_weight_c;
+  pid.setpoint_weight_b = m.setpoint_weight_b;
+  pid.setpoint_weight_c = m.setpoint_weight_c;
   if (derivative_on == DerivativeOn::kMeasurement && m.setpoint_weight_c != 0.0)
     return Fail("derivative-on measurement with setpoint weight c = " + std::to_string(m.setpoint_weight_c) +
                     " (measurement is c = 0)",

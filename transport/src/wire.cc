@@ -75,16 +75,23 @@ constexpr int kHeader = 24;  // utime, episode_id, step
 
 }  // namespace
 
+int EpisodeConfigVersion(int64_t fingerprint) {
+  const int64_t versions[kEpisodeConfigVersion] = {
+      pidlab::lcmt_episode_config_v1::getHash(), pidlab::lcmt_episode_config_v2::getHash(),
+      pidlab::lcmt_episode_config_v3::getHash(), pidlab::lcmt_episode_config_v4::getHash(),
+      pidlab::lcmt_episode_config::getHash()};
+  for (int v = 0; v < kEpisodeConfigVersion; ++v)
+    if (versions[v] == fingerprint) return v + 1;
+  return 0;
+}
+
 bool WireLayoutOk(int64_t fingerprint, const void* data, int size) {
   if (size < 8 + kHeader) return false;
   LayoutCheck c(static_cast<const uint8_t*>(data), size);
   c.Fixed(kHeader);
-  const bool config = fingerprint == pidlab::lcmt_episode_config::getHash();
-  const bool config_v4 = fingerprint == pidlab::lcmt_episode_config_v4::getHash();
-  const bool config_v3 = fingerprint == pidlab::lcmt_episode_config_v3::getHash();
-  const bool config_v2 = fingerprint == pidlab::lcmt_episode_config_v2::getHash();
-  if (config || config_v4 || config_v3 || config_v2 ||
-      fingerprint == pidlab::lcmt_episode_config_v1::getHash()) {
+  // An episode configuration of any version: the current layout, cut where
+  // that version ended.
+  if (const int version = EpisodeConfigVersion(fingerprint); version > 0) {
     c.String()
         .Array(8, kMaxPolynomialCoefficients)
         .Array(8, kMaxPolynomialCoefficients)
@@ -97,11 +104,10 @@ bool WireLayoutOk(int64_t fingerprint, const void* data, int size) {
         .String()
         .Fixed(6 * 8)
         .Fixed(2 * 8);
-    const bool motor = config || config_v4 || config_v3 || config_v2;
-    if (motor) c.Fixed(17 * 8).String();               // the motor's fields, then motor_drive
-    if (config || config_v4 || config_v3) c.Fixed(8);  // delay_s
-    if (config || config_v4) c.Fixed(5 * 8);  // the chirp's band and duration, measurement noise and its seed
-    if (config) c.Fixed(2 * 8);               // the setpoint weights b, c
+    if (version >= 2) c.Fixed(17 * 8).String();  // the motor's fields, then motor_drive
+    if (version >= 3) c.Fixed(8);                // delay_s
+    if (version >= 4) c.Fixed(5 * 8);  // the chirp's band and duration, measurement noise and its seed
+    if (version >= 5) c.Fixed(2 * 8);  // the setpoint weights b, c
   } else if (fingerprint == pidlab::lcmt_ready::getHash()) {
     c.Fixed(1).String().Fixed(4).String();
   } else if (fingerprint == pidlab::lcmt_episode_summary::getHash()) {

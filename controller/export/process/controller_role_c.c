@@ -116,8 +116,8 @@ static void to_config(const pidlab_lcmt_episode_config *m, pidlab_pid_config *p)
   p->ki = m->ki;
   p->kd = m->kd;
   p->tf = m->derivative_filter_s;
-  p->b = m->setpoint_weight_b;
-  p->c = m->setpoint_weight_c;
+  p->setpoint_weight_b = m->setpoint_weight_b;
+  p->setpoint_weight_c = m->setpoint_weight_c;
   p->dt_s = m->dt_s;
   p->has_output_min = finite(m->output_min);
   p->output_min = p->has_output_min ? m->output_min : 0.0;

@@ -54,7 +54,7 @@ typedef enum {
  * setters, which turn it into integer coefficients; the step uses no
  * floating point). */
 typedef struct {
-  double kp, ki, kd, tf, b, c, dt_s;
+  double kp, ki, kd, tf, setpoint_weight_b, setpoint_weight_c, dt_s;
   double output_min, output_max; /* finite, inside +-PIDLAB_OUTPUT_FULL_SCALE */
   pidlab_anti_windup anti_windup;
   double back_calculation_gain;
@@ -196,7 +196,7 @@ static int pidlab_finite(double x) { return x - x == 0.0; }
  * units: what the range analysis bounds. */
 static double pidlab_worst_case(const pidlab_pid_config *c) {
   const double limit = c->output_max > -c->output_min ? c->output_max : -c->output_min;
-  return c->kp * (c->b + 1.0) * PIDLAB_INPUT_RANGE_REAL + c->kd * (1.0 + c->c) * PIDLAB_INPUT_SPAN_REAL / c->dt_s +
+  return c->kp * (c->setpoint_weight_b + 1.0) * PIDLAB_INPUT_RANGE_REAL + c->kd * (1.0 + c->setpoint_weight_c) * PIDLAB_INPUT_SPAN_REAL / c->dt_s +
          limit;
 }
 
@@ -206,7 +206,7 @@ static int pidlab_config_valid(const pidlab_pid_config *c) {
   if (!(pidlab_finite(c->kp) && c->kp >= 0.0 && pidlab_finite(c->ki) && c->ki >= 0.0 && pidlab_finite(c->kd) &&
         c->kd >= 0.0 && pidlab_finite(c->tf) && c->tf >= 0.0))
     return 0;
-  if (!pidlab_unit(c->b) || !pidlab_unit(c->c) || !pidlab_finite(c->dt_s) || !(c->dt_s > 0.0)) return 0;
+  if (!pidlab_unit(c->setpoint_weight_b) || !pidlab_unit(c->setpoint_weight_c) || !pidlab_finite(c->dt_s) || !(c->dt_s > 0.0)) return 0;
   if (!pidlab_finite(c->output_min) || !pidlab_finite(c->output_max) || !(c->output_min < c->output_max)) return 0;
   if (c->output_max > PIDLAB_OUTPUT_FULL_SCALE || c->output_min < -PIDLAB_OUTPUT_FULL_SCALE) return 0;
   if (!pidlab_finite(c->back_calculation_gain) || !(c->back_calculation_gain > 0.0)) return 0;
@@ -223,8 +223,8 @@ static int pidlab_coefficients(const pidlab_pid_config *c, pidlab_pid *pid) {
          pidlab_encode(c->ki * (c->dt_s * 0.5) * a, &pid->ki_half_dt) &&
          pidlab_encode(c->kd / (c->tf + c->dt_s) * a, &pid->kd_k) &&
          pidlab_encode(c->dt_s / (c->tf + c->dt_s), &pid->pole_g) &&
-         pidlab_encode(c->back_calculation_gain * c->dt_s, &pid->aw) && pidlab_encode(c->b, &pid->b) &&
-         pidlab_encode(c->c, &pid->c);
+         pidlab_encode(c->back_calculation_gain * c->dt_s, &pid->aw) && pidlab_encode(c->setpoint_weight_b, &pid->b) &&
+         pidlab_encode(c->setpoint_weight_c, &pid->c);
 }
 
 /* A configuration in place of the current one, or nothing changed. */
@@ -366,8 +366,8 @@ pidlab_pid_status pidlab_pid_set_gains(pidlab_pid *pid, double kp, double ki, do
 
 pidlab_pid_status pidlab_pid_set_setpoint_weights(pidlab_pid *pid, double b, double c) {
   pidlab_pid_config config = pid->config;
-  config.b = b;
-  config.c = c;
+  config.setpoint_weight_b = b;
+  config.setpoint_weight_c = c;
   return pidlab_change(pid, &config);
 }
 

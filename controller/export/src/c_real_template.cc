@@ -47,8 +47,8 @@ typedef struct {
   pidlab_real ki;   /* integral gain, 1/s */
   pidlab_real kd;   /* derivative gain, s */
   pidlab_real tf;   /* derivative filter time constant, s; 0 = unfiltered */
-  pidlab_real b;    /* setpoint weight of P, [0, 1] */
-  pidlab_real c;    /* setpoint weight of D, [0, 1]; 0 = on measurement */
+  pidlab_real setpoint_weight_b; /* b: setpoint weight of P, [0, 1] */
+  pidlab_real setpoint_weight_c; /* c: setpoint weight of D, [0, 1]; 0 = on measurement */
   pidlab_real dt_s; /* sample period, s, > 0: call pidlab_pid_step this often */
   int has_output_min; /* 0: no lower limit */
   pidlab_real output_min;
@@ -133,7 +133,7 @@ static int pidlab_gains_valid(pidlab_real kp, pidlab_real ki, pidlab_real kd, pi
 
 static int pidlab_config_valid(const pidlab_pid_config *c) {
   if (!pidlab_gains_valid(c->kp, c->ki, c->kd, c->tf)) return 0;
-  if (!pidlab_in_unit(c->b) || !pidlab_in_unit(c->c)) return 0;
+  if (!pidlab_in_unit(c->setpoint_weight_b) || !pidlab_in_unit(c->setpoint_weight_c)) return 0;
   if (!pidlab_is_finite(c->dt_s) || !(c->dt_s > PIDLAB_ZERO)) return 0;
   if (c->has_output_min && !pidlab_is_finite(c->output_min)) return 0;
   if (c->has_output_max && !pidlab_is_finite(c->output_max)) return 0;
@@ -163,7 +163,7 @@ static pidlab_real pidlab_clip(const pidlab_pid_config *c, pidlab_real u) {
 /* The proportional term at the last sample: what a change of kp or b must
  * not change. */
 static pidlab_real pidlab_last_p(const pidlab_pid *pid) {
-  return pid->config.kp * (pid->config.b * pid->prev_r - pid->prev_y);
+  return pid->config.kp * (pid->config.setpoint_weight_b * pid->prev_r - pid->prev_y);
 }
 
 pidlab_pid_status pidlab_pid_init(pidlab_pid *pid, const pidlab_pid_config *config) {
@@ -192,7 +192,7 @@ pidlab_pid_status pidlab_pid_step(pidlab_pid *pid, pidlab_real r, pidlab_real y,
   int saturated = 0;
   if (!pidlab_is_finite(r) || !pidlab_is_finite(y)) return PIDLAB_PID_INVALID_INPUT;
   e = r - y;
-  p = c->kp * (c->b * r - y);
+  p = c->kp * (c->setpoint_weight_b * r - y);
   integral = pid->integral;
   integral_lo = pid->integral_lo;
   switch (c->integral) {
@@ -207,7 +207,7 @@ pidlab_pid_status pidlab_pid_step(pidlab_pid *pid, pidlab_real r, pidlab_real y,
       pidlab_accumulate(&integral, &integral_lo, c->ki * c->dt_s * e);
       break;
   }
-  signal = c->c * r - y;
+  signal = c->setpoint_weight_c * r - y;
   tf = c->tf;
   /* @DERIVATIVE_WHY@ */
   d = @DERIVATIVE@;
@@ -281,8 +281,8 @@ pidlab_pid_status pidlab_pid_set_setpoint_weights(pidlab_pid *pid, pidlab_real b
   pidlab_real p_before;
   if (!pidlab_in_unit(b) || !pidlab_in_unit(c)) return PIDLAB_PID_INVALID_CONFIG;
   p_before = pidlab_last_p(pid);
-  pid->config.b = b;
-  pid->config.c = c;
+  pid->config.setpoint_weight_b = b;
+  pid->config.setpoint_weight_c = c;
   pidlab_accumulate(&pid->integral, &pid->integral_lo, p_before - pidlab_last_p(pid));
   pid->prev_signal = c * pid->prev_r - pid->prev_y;
   return PIDLAB_PID_OK;

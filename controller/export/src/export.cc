@@ -100,8 +100,8 @@ std::string RealConfig(const Controller& c, Scalar scalar) {
   s += line(Literal(c.gains.ki, scalar), "ki, 1/s");
   s += line(Literal(c.gains.kd, scalar), "kd, s");
   s += line(Literal(tf, scalar), "tf, s");
-  s += line(Literal(c.setpoint_weight_b, scalar), "b");
-  s += line(Literal(c.setpoint_weight_c, scalar), "c");
+  s += line(Literal(c.setpoint_weight_b, scalar), "setpoint_weight_b");
+  s += line(Literal(c.setpoint_weight_c, scalar), "setpoint_weight_c");
   s += line(Literal(c.pid.dt_s, scalar), "dt_s, s");
   s += line(has_min ? "1" : "0", "has_output_min");
   s += line(Literal(has_min ? c.pid.output_min : 0.0, scalar), "output_min");
@@ -243,9 +243,8 @@ GeneratedCode Generate(const Options& options, const Controller& controller) {
             "   * c (r_k - r_{k-1}) - (y_k - y_{k-1}), differences of the inputs, where c r - y would round\n"
             "   * at the size of r, which kd/dt amplifies.");
     Replace(&code.source, "DERIVATIVE",
-            "pid->derivative + (c->kd * (c->c * (r - pid->prev_r) - (y - pid->prev_y)) - c->dt_s * "
-            "pid->derivative) "
-            "*\n      (PIDLAB_ONE / (tf + c->dt_s))");
+            "pid->derivative + (c->kd * (c->setpoint_weight_c * (r - pid->prev_r) - (y - pid->prev_y)) - "
+            "c->dt_s * pid->derivative) *\n      (PIDLAB_ONE / (tf + c->dt_s))");
   } else {
     Replace(&code.source, "ACCUMULATE_WHY", "Double: plain addition, as DiscretePid.");
     Replace(&code.source, "ACCUMULATE_BODY", "  (void)lo;\n  *sum += x;\n");

@@ -26,15 +26,10 @@ transport::EpisodeSpec MakeEpisodeSpec(int64_t episode_id, const Plant& plant, c
   spec.plant = plant;
   // The loop's gains, whose tf travels as the wire's derivative_filter_s.
   spec.gains = evaluation::LoopGains(gains, options);
-  spec.pid = options.pid;
+  static_cast<EpisodeShape&>(spec) = options;  // dt, ts, horizon, reference, PID, noise on y
   spec.pid = PidOptionsAt(spec.pid, options.dt_s);
   spec.pid.derivative_filter_s = spec.gains.tf;
   spec.disturbance = disturbance;
-  spec.measurement_noise = options.measurement_noise;
-  spec.dt_s = options.dt_s;
-  spec.sample_time_s = options.sample_time_s;
-  spec.horizon_s = options.horizon_s;
-  spec.reference = options.reference;
   spec.total_steps = options.TotalSteps();
   spec.recovery = recovery;
   std::string error;
@@ -45,13 +40,7 @@ transport::EpisodeSpec MakeEpisodeSpec(int64_t episode_id, const Plant& plant, c
 evaluation::LoopOptions SampledLoopOptions(const transport::EpisodeSpec& spec) {
   evaluation::LoopOptions o;
   o.loop = evaluation::LoopKind::kSampled;
-  o.dt_s = spec.dt_s;
-  o.sample_time_s = spec.sample_time_s;
-  o.horizon_s = spec.horizon_s;
-  o.pid = spec.pid;
-  o.disturbance = spec.disturbance;
-  o.measurement_noise = spec.measurement_noise;
-  o.reference = spec.reference;
+  static_cast<EpisodeShape&>(o) = spec;
   return o;
 }
 

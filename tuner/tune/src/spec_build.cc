@@ -249,13 +249,13 @@ bool BuildSetpointWeights(const spec::LoopSpec& s, DerivativeOn derivative_on, N
   const std::string value = name + " " + spec::FormatNumber(b) + "," + spec::FormatNumber(c);
   if (!PidOptions::SetpointWeightIsValid(b) || !PidOptions::SetpointWeightIsValid(c))
     return Bad(error, value + ": each weight must be finite and in [0, 1]");
-  pid->setpoint_weight_p = b;
-  pid->setpoint_weight_d = c;
+  pid->setpoint_weight_b = b;
+  pid->setpoint_weight_c = c;
   if (derivative_on == DerivativeOn::kMeasurement) {
     if (c != 0.0 && c != 1.0)
       return Bad(error, value + ": " + spec::DisplayName("derivative_on", style) +
                             " measurement is c = 0; give one of the two");
-    pid->setpoint_weight_d = 0.0;
+    pid->setpoint_weight_c = 0.0;
   }
   return true;
 }

@@ -14,8 +14,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 evaluation::LoopOptions Weighted(evaluation::LoopOptions loop, double b, double c) {
-  loop.pid.setpoint_weight_p = b;
-  loop.pid.setpoint_weight_d = c;
+  loop.pid.setpoint_weight_b = b;
+  loop.pid.setpoint_weight_c = c;
   return loop;
 }
 
@@ -69,7 +69,7 @@ bool Respond(const Plant& plant, const PidGains& gains, const evaluation::LoopOp
 bool TuneSetpointWeights(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& loop,
                          TwoDofSummary* summary, std::string* error) {
   *summary = TwoDofSummary();
-  const double b0 = loop.pid.setpoint_weight_p, c0 = loop.pid.setpoint_weight_d;
+  const double b0 = loop.pid.setpoint_weight_b, c0 = loop.pid.setpoint_weight_c;
   if (!Respond(plant, gains, loop, b0, c0, &summary->before, error)) return false;
   const auto f = [&](const Eigen::VectorXd& x) { return SetpointIae(plant, gains, loop, x(0), x(1)); };
   // A grid first (the IAE of a weighted loop can have several minima), then

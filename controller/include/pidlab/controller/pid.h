@@ -6,7 +6,7 @@
 // or with a first-order derivative filter of time constant tf > 0:
 //   C(s) = kp + ki / s + kd s / (tf s + 1)           (tf = 0: the ideal PID).
 // Two degrees of freedom (docs/two_dof.md): setpoint weights b, c in [0, 1]
-// (PidOptions::setpoint_weight_p, setpoint_weight_d) weight r in the
+// (PidOptions::setpoint_weight_b, setpoint_weight_c) weight r in the
 // proportional and derivative terms,
 //   u = kp (b r - y) + ki/s (r - y) + kd s / (tf s + 1) (c r - y);
 // b = c = 1 is the 1-DOF PID above, c = 0 the derivative on measurement.
@@ -76,7 +76,7 @@ inline bool GainsAreValid(const PidGains& g, std::string* error) {
 }
 
 /// The spec's derivative_on (kept for the flag and for logs): kError is
-/// setpoint weight c = 1, kMeasurement c = 0 (SetpointWeightD).
+/// setpoint weight c = 1, kMeasurement c = 0 (SetpointWeightC).
 enum class DerivativeOn { kError, kMeasurement };
 enum class IntegralMethod { kBackwardEuler, kForwardEuler, kTrapezoidal };
 enum class AntiWindup { kNone, kClamping, kBackCalculation };
@@ -102,8 +102,8 @@ struct PidOptions {
   /// on measurement). The weights live here, not in the gains: they do not
   /// change the feedback loop (Ms, margins, load rejection), only how r
   /// enters. 1, 1: the 1-DOF PID, bit for bit.
-  double setpoint_weight_p = 1.0;  // b
-  double setpoint_weight_d = 1.0;  // c
+  double setpoint_weight_b = 1.0;  // b
+  double setpoint_weight_c = 1.0;  // c
 
   bool IsValid(std::string* error) const {
     std::ostringstream os;
@@ -113,10 +113,10 @@ struct PidOptions {
       os << "derivative filter " << derivative_filter_s << " s must be >= 0 and finite";
     else if (std::isnan(output_min) || std::isnan(output_max) || !(output_min < output_max))
       os << "output limits [" << output_min << ", " << output_max << "] must satisfy min < max";
-    else if (!SetpointWeightIsValid(setpoint_weight_p))
-      os << "setpoint weight b = " << setpoint_weight_p << " must be finite and in [0, 1]";
-    else if (!SetpointWeightIsValid(setpoint_weight_d))
-      os << "setpoint weight c = " << setpoint_weight_d << " must be finite and in [0, 1]";
+    else if (!SetpointWeightIsValid(setpoint_weight_b))
+      os << "setpoint weight b = " << setpoint_weight_b << " must be finite and in [0, 1]";
+    else if (!SetpointWeightIsValid(setpoint_weight_c))
+      os << "setpoint weight c = " << setpoint_weight_c << " must be finite and in [0, 1]";
     else if (anti_windup == AntiWindup::kBackCalculation &&
              (!(back_calculation_gain > 0.0) || !std::isfinite(back_calculation_gain)))
       os << "back-calculation gain " << back_calculation_gain << " must be positive";
@@ -131,7 +131,7 @@ struct PidOptions {
 
 /// The derivative's setpoint weight c that derivative_on stands for: 1 on
 /// the error, 0 on the measurement.
-inline double SetpointWeightD(DerivativeOn v) { return v == DerivativeOn::kError ? 1.0 : 0.0; }
+inline double SetpointWeightC(DerivativeOn v) { return v == DerivativeOn::kError ? 1.0 : 0.0; }
 
 /// The PID's options for a loop of period `loop_dt_s`: `options` with its
 /// sample time set to the loop's. The one place the PID's dt is derived from
@@ -171,7 +171,7 @@ class DiscretePid {
     const double dt = options_.dt_s;
     const T e = r - y;
     // The operation order is the exported C's (pidlab export): keep it.
-    const T p = gains_.kp * (T(options_.setpoint_weight_p) * r - y);
+    const T p = gains_.kp * (T(options_.setpoint_weight_b) * r - y);
     T integral = integral_;
     switch (options_.integral) {
       case IntegralMethod::kBackwardEuler:
@@ -184,7 +184,7 @@ class DiscretePid {
         integral += gains_.ki * T(dt * 0.5) * (e + prev_error_);
         break;
     }
-    const T signal = T(options_.setpoint_weight_d) * r - y;
+    const T signal = T(options_.setpoint_weight_c) * r - y;
     const T tf = EffectiveDerivativeFilter(gains_, options_);
     const T d =
         tf / (tf + T(dt)) * derivative_ + gains_.kd * (signal - prev_signal_) * (T(1.0) / (tf + T(dt)));

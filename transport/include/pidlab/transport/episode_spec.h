@@ -11,6 +11,7 @@
 
 #include "pidlab/controller/pid.h"
 #include "pidlab/plant_sim/disturbance.h"
+#include "pidlab/plant_sim/episode_shape.h"
 #include "pidlab/plant_sim/plants.h"
 
 namespace pidlab::transport {
@@ -36,19 +37,11 @@ inline constexpr int64_t kMaxEpisodeSteps = 50000000;
 /// u_k = PID(reference, y_k), n_k = n(k dt_s), for k = 0..total_steps-1; with
 /// a plant dead time (plant.delay_s: finite, >= 0, ceil(delay / dt) at most
 /// kMaxDelaySteps, linear plants only) the delayed step of docs/deadtime.md.
-struct EpisodeSpec {
+struct EpisodeSpec : EpisodeShape {
   int64_t episode_id = 0;
   Plant plant;
   PidGains gains;
-  /// Discrete PID options; pid.dt_s equals dt_s.
-  PidOptions pid;
-  DisturbanceOptions disturbance;
-  /// Noise on the measured y: the plant publishes y_k + v_k (sampled loop).
-  MeasurementNoise measurement_noise;
-  double dt_s = 1e-3;           // lockstep period, s
-  double sample_time_s = 0.05;  // spacing of the objective's samples, s (a multiple of dt_s)
-  double horizon_s = 25.0;      // last sample time, s
-  double reference = 1.0;
+  /// The EpisodeShape's pid.dt_s equals dt_s here.
   long total_steps = 0;  // horizon_s / dt_s
   RecoveryOptions recovery;
 

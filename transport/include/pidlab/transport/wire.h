@@ -16,6 +16,14 @@ inline constexpr int kMaxPolynomialCoefficients = 64;
 /// Longest string field, bytes (plant names, options, roles, messages).
 inline constexpr int kMaxStringBytes = 4096;
 
+/// Which version of lcmt_episode_config a fingerprint names: kEpisodeConfigVersion
+/// for the current type, 1..kEpisodeConfigVersion - 1 for its frozen copies
+/// lcmt_episode_config_v1.. (generated from the "//@frozen" lines of
+/// lcmtypes/lcmt_episode_config.lcm: each holds the fields before an append),
+/// 0 for any other fingerprint.
+inline constexpr int kEpisodeConfigVersion = 5;
+int EpisodeConfigVersion(int64_t fingerprint);
+
 /// True if `data` (size bytes, fingerprint first) has the layout of the
 /// pidlab message whose fingerprint is `fingerprint`, with every string and
 /// array length within the payload and the protocol's limits. Messages

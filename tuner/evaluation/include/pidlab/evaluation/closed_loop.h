@@ -30,6 +30,7 @@
 #include "pidlab/controller/pid.h"
 #include "pidlab/plant_sim/discrete_plant.h"
 #include "pidlab/plant_sim/disturbance.h"
+#include "pidlab/plant_sim/episode_shape.h"
 #include "pidlab/plant_sim/matrix_exp.h"
 #include "pidlab/plant_sim/plants.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
@@ -58,18 +59,14 @@ enum class LoopKind { kContinuous, kSampled };
 bool ParseLoopKind(const std::string& s, LoopKind* kind);
 std::string ToString(LoopKind kind);
 
-struct LoopOptions {
+/// The loop an evaluation runs: the episode's description (EpisodeShape: dt,
+/// ts, horizon, reference, the PID's options, the disturbance, the noise on
+/// y), which the trio's episode (transport::EpisodeSpec) embeds too, and what
+/// only the evaluation needs: the loop kind, the derivative filter's rules
+/// and the stability margin. pid.derivative_filter_s is the derivative
+/// filter tf of BOTH loops for gains that carry none (LoopGains).
+struct LoopOptions : EpisodeShape {
   LoopKind loop = LoopKind::kContinuous;
-  /// ts of eq. (4): spacing of the error samples, s.
-  double sample_time_s = 0.05;
-  /// n of eq. (4): last sample time, s; a multiple of sample_time_s.
-  double horizon_s = 25.0;
-  /// Period of the sampled loop, s; sample_time_s must be a multiple of it.
-  double dt_s = 1e-3;
-  /// Discrete PID options (sampled loop only; its dt_s is taken from dt_s).
-  /// pid.derivative_filter_s is the derivative filter tf of BOTH loops for
-  /// gains that carry none (LoopGains).
-  PidOptions pid;
   /// Derivative filter by a ratio N > 0: tf = kd / (N kp) for gains that
   /// carry none (LoopGains); 0 = not used. Excludes pid.derivative_filter_s.
   double derivative_filter_ratio = 0.0;
@@ -79,21 +76,11 @@ struct LoopOptions {
   /// leaves the noise gain at pi/dt near kd/dt. The resolved tf travels
   /// with the gains (the trio, export, the echo), so nothing else needs it.
   double derivative_filter_min_s = 0.0;
-  DisturbanceOptions disturbance;
   /// A loop is strictly stable when every closed-loop pole p has
   /// Re p < -stability_margin * max(1, |p|), for the s-plane poles p of the
   /// continuous loop or p = log(z) / dt of the sampled loop's eigenvalues z. Guards against loops that game
   /// the sampled objective with poles on the imaginary axis.
   double stability_margin = 1e-9;
-  /// A: size of the reference step r(t) = A for t >= 0 (the paper's unit step
-  /// is 1). Every error is e = A - y; step metrics stay relative to the final
-  /// value. Finite, nonzero, |A| <= kMaxCoefficientMagnitude.
-  double reference = 1.0;
-  /// Seeded Gaussian noise on the measured y (sampled loop only): the PID,
-  /// the run record and every score see y_k + v_k (docs/spec.md). Its seed
-  /// is the spec's seed, kept here apart from disturbance.seed because a run
-  /// without the disturbance (the undisturbed response) keeps the noise.
-  MeasurementNoise measurement_noise;
 
   /// The discrete PID's options at this loop's period (PidOptionsAt).
   PidOptions Pid() const { return PidOptionsAt(pid, dt_s); }
@@ -165,7 +152,7 @@ PidGainsT<T> LoopGains(const PidGainsT<T>& g, const LoopOptions& o) {
 }
 
 /// The 2-DOF PID's setpoint weights as the continuous loops take them
-/// (PidOptions::setpoint_weight_p, setpoint_weight_d): r enters the
+/// (PidOptions::setpoint_weight_b, setpoint_weight_c): r enters the
 /// proportional term as b r and the derivative's as c r. They change the loop
 /// from r only, never its poles or the loop from the disturbance.
 struct SetpointWeights {
@@ -173,7 +160,7 @@ struct SetpointWeights {
   double c = 1.0;
 };
 inline SetpointWeights SetpointWeightsOf(const PidOptions& o) {
-  return {o.setpoint_weight_p, o.setpoint_weight_d};
+  return {o.setpoint_weight_b, o.setpoint_weight_c};
 }
 
 /// The continuous closed loop as one linear system w' = M w with
