@@ -132,7 +132,8 @@ void BM_TuneDefault(benchmark::State& state) {
   for (auto _ : state) {
     pidlab::tune::TuneSummary summary;
     std::string error;
-    if (!pidlab::tune::Tune(plant, options, &summary, &error)) state.SkipWithError(error.c_str());
+    if (const pidlab::Status st = pidlab::tune::Tune(plant, options, &summary); !st.ok())
+      state.SkipWithError(st.message().c_str());
     // Tune() cannot be optimised away (it allocates and runs Ceres); no
     // DoNotOptimize on a double here: GCC 12 with benchmark 1.7's "+m,r"
     // constraint garbles the value read back.

@@ -159,9 +159,10 @@ int main(int argc, char** argv) {
   pidlab::episode_client::EpisodeClient client(co);
   std::vector<double> y;
   for (int episode = 0; episode < 3; ++episode) {
-    if (!client.Run(plant, pidlab::PidGains{2.0, 1.0, 1.5}, options, options.disturbance, &y, nullptr,
-                    &error)) {
-      std::fprintf(stderr, "trio_bench: %s\n", error.c_str());
+    if (const pidlab::Status st =
+            client.Run(plant, pidlab::PidGains{2.0, 1.0, 1.5}, options, options.disturbance, &y, nullptr);
+        !st.ok()) {
+      std::fprintf(stderr, "trio_bench: %s\n", st.message().c_str());
       return 1;
     }
   }

@@ -30,7 +30,8 @@ void RunTunes(benchmark::State& state, const pidlab::tune::TuneOptions& base) {
     seed = seed % 5 + 1;
     pidlab::tune::TuneSummary summary;
     std::string error;
-    if (!pidlab::tune::Tune(plant, options, &summary, &error)) state.SkipWithError(error.c_str());
+    if (const pidlab::Status st = pidlab::tune::Tune(plant, options, &summary); !st.ok())
+      state.SkipWithError(st.message().c_str());
     iae_sum += summary.objective;
     evaluations += summary.evaluations;
     ++tunes;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "pidlab/evaluation/evaluation.h"
+#include "test_status.h"
 
 using pidlab::evaluation::BuildContinuousClosedLoop;
 using pidlab::evaluation::ContinuousClosedLoop;
@@ -39,7 +40,7 @@ namespace {
 Evaluation EvaluateOrFail(const TransferFunction& tf, const PidGains& gains, const LoopOptions& options) {
   Evaluation ev;
   std::string error;
-  EXPECT_TRUE(Evaluate(Plant{"custom", tf}, gains, options, EvaluateOptions{}, &ev, &error)) << error;
+  EXPECT_TRUE(IsOk(Evaluate(Plant{"custom", tf}, gains, options, EvaluateOptions{}, &ev)));
   return ev;
 }
 
@@ -163,8 +164,8 @@ TEST(SampledStability, StepperMotorWithNelderMeadGainsIsUnstableAtOneMillisecond
   o.dt_s = 1e-3;
   Evaluation dut;
   std::string error;
-  ASSERT_TRUE(
-      Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut, &error))
+  ASSERT_TRUE(OkInto(
+      Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut), &error))
       << error;
   EXPECT_FALSE(dut.stability.stable);
   EXPECT_GT(dut.stability.abscissa, 1.0);
@@ -177,8 +178,8 @@ TEST(SampledStability, StepperMotorWithNelderMeadGainsIsStableAtATenthOfAMillise
   o.dt_s = 1e-4;
   Evaluation dut;
   std::string error;
-  ASSERT_TRUE(
-      Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut, &error))
+  ASSERT_TRUE(OkInto(
+      Evaluate(Builtin("stepper_motor"), {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &dut), &error))
       << error;
   EXPECT_TRUE(dut.stability.stable);
   EXPECT_LT(dut.stability.abscissa, 1.0);
@@ -275,7 +276,7 @@ void ExpectSampledConvergesToContinuous(const std::string& plant_name, const Pid
   const Plant plant = Builtin(plant_name);
   Evaluation continuous;
   std::string error;
-  ASSERT_TRUE(Evaluate(plant, gains, LoopOptions{}, EvaluateOptions{}, &continuous, &error)) << error;
+  ASSERT_TRUE(IsOk(Evaluate(plant, gains, LoopOptions{}, EvaluateOptions{}, &continuous)));
   ASSERT_TRUE(continuous.stability.stable);
   double previous = std::numeric_limits<double>::infinity();
   for (double dt : {1e-2, 1e-3, 1e-4}) {
@@ -285,7 +286,7 @@ void ExpectSampledConvergesToContinuous(const std::string& plant_name, const Pid
     Evaluation dut;
     EvaluateOptions what;
     what.compute_step_info = false;
-    ASSERT_TRUE(Evaluate(plant, gains, o, what, &dut, &error)) << error;
+    ASSERT_TRUE(IsOk(Evaluate(plant, gains, o, what, &dut)));
     const double rel = std::abs(dut.iae - continuous.iae) / continuous.iae;
     EXPECT_LT(rel, previous) << "dt = " << dt;
     if (dt == 1e-3) {
@@ -534,15 +535,17 @@ TEST(SampleContinuousLoop, EndsOnABreakpointThatDoesNotAdvance) {
 TEST(Evaluate, RejectsANegativeGainAsBadInput) {
   Evaluation ev;
   std::string error;
-  EXPECT_FALSE(Evaluate(Builtin("linear"), {1.0, -2.0, 0.0}, LoopOptions{}, EvaluateOptions{}, &ev, &error));
+  EXPECT_FALSE(
+      OkInto(Evaluate(Builtin("linear"), {1.0, -2.0, 0.0}, LoopOptions{}, EvaluateOptions{}, &ev), &error));
   EXPECT_NE(error.find("ki = -2"), std::string::npos) << error;
 }
 
 TEST(Evaluate, RejectsABiproperPlantAsBadInput) {
   Evaluation ev;
   std::string error;
-  EXPECT_FALSE(Evaluate(Plant{"custom", {{1.0, 0.0}, {1.0, 1.0}}}, {1.0, 0.0, 0.0}, LoopOptions{},
-                        EvaluateOptions{}, &ev, &error));
+  EXPECT_FALSE(OkInto(Evaluate(Plant{"custom", {{1.0, 0.0}, {1.0, 1.0}}}, {1.0, 0.0, 0.0}, LoopOptions{},
+                               EvaluateOptions{}, &ev),
+                      &error));
   EXPECT_NE(error.find("strictly proper"), std::string::npos) << error;
 }
 
@@ -658,8 +661,9 @@ TEST(FilteredPid, RatioSetsTfToKdOverNKp) {
   EXPECT_TRUE(std::isinf(LoopGains(PidGains{0.0, 1.0, 4.0}, o).tf));
   Evaluation ev;
   std::string error;
-  EXPECT_FALSE(Evaluate(Plant{"custom", {{1.0}, {1.0, 0.0, 0.0}}}, PidGains{0.0, 1.0, 4.0}, o,
-                        EvaluateOptions{}, &ev, &error));
+  EXPECT_FALSE(OkInto(
+      Evaluate(Plant{"custom", {{1.0}, {1.0, 0.0, 0.0}}}, PidGains{0.0, 1.0, 4.0}, o, EvaluateOptions{}, &ev),
+      &error));
   EXPECT_NE(error.find("kp > 0"), std::string::npos) << error;
   o.pid.derivative_filter_s = 0.1;
   EXPECT_FALSE(o.IsValid(&error)) << "a time constant and a ratio at once";

@@ -16,12 +16,13 @@
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/evaluation/evaluation.h"
+#include "test_status.h"
 
 using pidlab::analysis::AnalyzeLoop;
 using pidlab::analysis::LoopAnalysis;
 using pidlab::analysis::LoopAnalysisOptions;
 using pidlab::evaluation::DelayIsValid;
-using pidlab::evaluation::EvaluateLoop;
+using pidlab::evaluation::Evaluate;
 using pidlab::evaluation::EvaluateOptions;
 using pidlab::evaluation::Evaluation;
 using pidlab::evaluation::kMaxAnalysedDelaySteps;
@@ -210,7 +211,7 @@ TEST(DelayedSampledLoop, RunsThePlantsOwnDelayedStepBitForBit) {
 TEST(DelayedSampledLoop, OutputStaysAtRestForTheDeadTime) {
   LoopOptions o = Sampled(0.01);
   Evaluation dut;
-  ASSERT_TRUE(EvaluateLoop(Fopdt(0.3), {1.0, 1.0, 0.0}, o, EvaluateOptions{}, &dut).ok());
+  ASSERT_TRUE(Evaluate(Fopdt(0.3), {1.0, 1.0, 0.0}, o, EvaluateOptions{}, &dut).ok());
   ASSERT_TRUE(dut.stability.stable);
   for (std::size_t m = 0; m <= 6; ++m) EXPECT_EQ(dut.y[m], 0.0) << "t = " << dut.t[m];
   EXPECT_GT(dut.y[7], 0.0) << "t = 0.35 s, after the dead time";
@@ -220,8 +221,8 @@ TEST(DelayedSampledLoop, OutputStaysAtRestForTheDeadTime) {
 TEST(DelayedSampledLoop, UnstableDelayedLoopIsFlaggedLikeAnUnstableUndelayedOne) {
   const LoopOptions o = Sampled(0.01);
   Evaluation delayed, undelayed;
-  ASSERT_TRUE(EvaluateLoop(Fopdt(1.0), {3.0, 0.0, 0.0}, o, EvaluateOptions{}, &delayed).ok());
-  ASSERT_TRUE(EvaluateLoop(Fopdt(0.0), {3.0, 0.0, 0.0}, o, EvaluateOptions{}, &undelayed).ok());
+  ASSERT_TRUE(Evaluate(Fopdt(1.0), {3.0, 0.0, 0.0}, o, EvaluateOptions{}, &delayed).ok());
+  ASSERT_TRUE(Evaluate(Fopdt(0.0), {3.0, 0.0, 0.0}, o, EvaluateOptions{}, &undelayed).ok());
   EXPECT_TRUE(undelayed.stability.stable);
   EXPECT_FALSE(delayed.stability.stable) << "kp = 3 is above Ku = 2.26 of e^(-s)/(s+1)";
   EXPECT_GT(delayed.stability.abscissa, 1.0);
@@ -236,7 +237,7 @@ TEST(DelayedSampledLoop, GainMarginOfTheSampledLoopIsItsUltimateGain) {
   const double ku = SampledUltimateGain(plant, 0.01, 2.0, 2.5);
   LoopAnalysis dut;
   std::string error;
-  ASSERT_TRUE(AnalyzeLoop(plant, {1.0, 0.0, 0.0}, Sampled(0.01), LoopAnalysisOptions{}, &dut, &error))
+  ASSERT_TRUE(OkInto(AnalyzeLoop(plant, {1.0, 0.0, 0.0}, Sampled(0.01), LoopAnalysisOptions{}, &dut), &error))
       << error;
   EXPECT_NEAR(dut.gain_margin, ku, 1e-4 * ku);
 }
@@ -244,24 +245,24 @@ TEST(DelayedSampledLoop, GainMarginOfTheSampledLoopIsItsUltimateGain) {
 TEST(DelayedLoop, ContinuousLoopWithDeadTimeIsEvaluatedAndItsNeutralCaseRefused) {
   LoopOptions o;  // continuous: the method of steps (delayed_loop.h)
   Evaluation ev;
-  ASSERT_TRUE(EvaluateLoop(Fopdt(0.3), {1.0, 1.0, 0.0}, o, EvaluateOptions{}, &ev).ok());
+  ASSERT_TRUE(Evaluate(Fopdt(0.3), {1.0, 1.0, 0.0}, o, EvaluateOptions{}, &ev).ok());
   EXPECT_TRUE(ev.stability.stable);
   EXPECT_TRUE(std::isfinite(ev.iae));
   const ObjectiveEvaluator objective(Fopdt(0.3), o, ObjectiveKind::kIae);
   EXPECT_NEAR(objective({1.0, 1.0, 0.0}), ev.iae, 1e-12 * ev.iae);
   EXPECT_NEAR(LoadIntegralAbsError(Fopdt(0.3), {1.0, 1.0, 0.0}, o), ev.load_iae, 1e-12 * ev.load_iae);
   // An ideal derivative on a plant of relative degree 1: a neutral loop.
-  const auto status = EvaluateLoop(Fopdt(0.3), {1.0, 1.0, 0.1}, o, EvaluateOptions{}, &ev);
+  const auto status = Evaluate(Fopdt(0.3), {1.0, 1.0, 0.1}, o, EvaluateOptions{}, &ev);
   EXPECT_EQ(status.code(), StatusCode::kInvalidInput);
   EXPECT_NE(status.message().find("derivative filter"), std::string::npos) << status.message();
   EXPECT_TRUE(std::isinf(objective({1.0, 1.0, 0.1})));
   // Past the ultimate gain the Nyquist count says unstable: +inf, not a number.
-  ASSERT_TRUE(EvaluateLoop(Fopdt(1.0), {2.3, 0.0, 0.0}, o, EvaluateOptions{}, &ev).ok());
+  ASSERT_TRUE(Evaluate(Fopdt(1.0), {2.3, 0.0, 0.0}, o, EvaluateOptions{}, &ev).ok());
   EXPECT_FALSE(ev.stability.stable);
   EXPECT_TRUE(std::isinf(ev.iae));
   LoopAnalysis analysis;
   std::string error;
-  EXPECT_TRUE(AnalyzeLoop(Fopdt(0.3), {1.0, 1.0, 0.0}, o, LoopAnalysisOptions{}, &analysis, &error)) << error;
+  EXPECT_TRUE(IsOk(AnalyzeLoop(Fopdt(0.3), {1.0, 1.0, 0.0}, o, LoopAnalysisOptions{}, &analysis)));
 }
 
 TEST(DelayedLoop, DelayOutOfRangeIsRefusedNamingTheField) {

@@ -24,6 +24,7 @@
 #include "pidlab/plant_sim/plant_role.h"
 #include "pidlab/transport/episode_spec.h"
 #include "pidlab/transport/transport.h"
+#include "test_status.h"
 
 using pidlab::episode_client::EpisodeClient;
 using pidlab::episode_client::EpisodeClientOptions;
@@ -179,14 +180,16 @@ TEST(EpisodeClient, RunEqualsTheInProcessSampledLoopBitForBit) {
   std::vector<double> expected_y;
   std::vector<SampledStep> expected;
   std::string error;
-  ASSERT_TRUE(RunSampledLoopInProcess(l.plant, l.gains, l.options, l.options.disturbance, &expected_y,
-                                      &expected, &error))
+  ASSERT_TRUE(OkInto(
+      RunSampledLoopInProcess(l.plant, l.gains, l.options, l.options.disturbance, &expected_y, &expected),
+      &error))
       << error;
 
   InProcessTrio trio;
   std::vector<double> y;
   std::vector<SampledStep> trajectory;
-  ASSERT_TRUE(trio.client->Run(l.plant, l.gains, l.options, l.options.disturbance, &y, &trajectory, &error))
+  ASSERT_TRUE(
+      OkInto(trio.client->Run(l.plant, l.gains, l.options, l.options.disturbance, &y, &trajectory), &error))
       << error;
   ASSERT_EQ(y.size(), static_cast<std::size_t>(l.options.TotalSteps() + 1));
   ASSERT_EQ(y.size(), expected_y.size());
@@ -206,10 +209,10 @@ TEST(EpisodeClient, EvaluateThroughTheClientEqualsEvaluateInProcess) {
   const Loop l = DoubleIntegrator();
   Evaluation local, remote;
   std::string error;
-  ASSERT_TRUE(Evaluate(l.plant, l.gains, l.options, EvaluateOptions{}, &local, &error)) << error;
+  ASSERT_TRUE(IsOk(Evaluate(l.plant, l.gains, l.options, EvaluateOptions{}, &local)));
   InProcessTrio trio;
-  ASSERT_TRUE(
-      Evaluate(l.plant, l.gains, l.options, EvaluateOptions{}, &remote, &error, trio.client->AsRunner()))
+  ASSERT_TRUE(OkInto(
+      Evaluate(l.plant, l.gains, l.options, EvaluateOptions{}, &remote, trio.client->AsRunner()), &error))
       << error;
   EXPECT_EQ(remote.iae, local.iae);
   EXPECT_EQ(remote.ise, local.ise);
@@ -227,7 +230,8 @@ TEST(EpisodeClient, RunReturnsFalseNamingTheSilentControllerWithinTheStartTimeou
   std::vector<double> y;
   std::string error;
   const auto t0 = std::chrono::steady_clock::now();
-  EXPECT_FALSE(trio.client->Run(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr, &error));
+  EXPECT_FALSE(
+      OkInto(trio.client->Run(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr), &error));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_NE(error.find("no answer from pidlab-controller within 0.3 s"), std::string::npos) << error;
   EXPECT_EQ(error.find("pidlab-plant"), std::string::npos) << error;  // the others answered
@@ -249,7 +253,8 @@ TEST(EpisodeClient, RunsAnEpisodeThatFailedOnSilenceAgainAndNotesIt) {
   const Loop l = DoubleIntegrator();
   std::vector<double> y;
   std::string error;
-  EXPECT_FALSE(trio.client->Run(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr, &error));
+  EXPECT_FALSE(
+      OkInto(trio.client->Run(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr), &error));
   EXPECT_NE(error.find("pidlab-controller"), std::string::npos) << error;
   EXPECT_NE(error.find("(after 2 attempts)"), std::string::npos) << error;
   ASSERT_EQ(notes.size(), 1u);
@@ -263,9 +268,11 @@ TEST(EpisodeClient, StatsCountEpisodesAndSteps) {
   std::vector<double> y;
   std::string error;
   EXPECT_EQ(trio.client->stats().episodes, 0);
-  ASSERT_TRUE(trio.client->Run(a.plant, a.gains, a.options, a.options.disturbance, &y, nullptr, &error))
+  ASSERT_TRUE(
+      OkInto(trio.client->Run(a.plant, a.gains, a.options, a.options.disturbance, &y, nullptr), &error))
       << error;
-  ASSERT_TRUE(trio.client->Run(b.plant, b.gains, b.options, b.options.disturbance, &y, nullptr, &error))
+  ASSERT_TRUE(
+      OkInto(trio.client->Run(b.plant, b.gains, b.options, b.options.disturbance, &y, nullptr), &error))
       << error;
   const EpisodeClientStats& stats = trio.client->stats();
   EXPECT_EQ(stats.episodes, 2);
@@ -285,7 +292,8 @@ TEST(EpisodeClient, RunOfAnInvalidLoopReturnsFalseWithoutStartingAnEpisode) {
   l.options.horizon_s = 1.01;
   std::vector<double> y;
   std::string error;
-  EXPECT_FALSE(trio.client->Run(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr, &error));
+  EXPECT_FALSE(
+      OkInto(trio.client->Run(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr), &error));
   EXPECT_NE(error.find("invalid episode: horizon 1.01"), std::string::npos) << error;
   EXPECT_EQ(trio.plant.counters().episodes, 0);
   EXPECT_EQ(trio.client->stats().episodes, 0);

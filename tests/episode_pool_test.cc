@@ -17,6 +17,8 @@
 #include <thread>
 #include <vector>
 
+#include "test_status.h"
+
 using pidlab::episode_client::EpisodeClientOptions;
 using pidlab::episode_client::EpisodePool;
 using pidlab::episode_client::SplitUrlList;
@@ -119,7 +121,7 @@ TEST(EpisodePool, LeavesOutEachSilentTrioNamingItAndFailsWhenNoneIsLeft) {
   const Loop l = ShortLoop();
   std::vector<double> y;
   std::string error;
-  EXPECT_FALSE(runner(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr, &error));
+  EXPECT_FALSE(OkInto(runner(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr), &error));
   EXPECT_NE(error.find("every trio failed; the last: "), std::string::npos) << error;
   EXPECT_NE(error.find("no answer from"), std::string::npos) << error;
   const std::vector<std::string> lost = dut.lost();
@@ -132,7 +134,7 @@ TEST(EpisodePool, LeavesOutEachSilentTrioNamingItAndFailsWhenNoneIsLeft) {
 
   // Nothing is left to try: the next episode fails at once.
   error.clear();
-  EXPECT_FALSE(runner(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr, &error));
+  EXPECT_FALSE(OkInto(runner(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr), &error));
   EXPECT_NE(error.find("every trio failed"), std::string::npos) << error;
   EXPECT_EQ(dut.lost().size(), 2u);
 }
@@ -143,7 +145,8 @@ TEST(EpisodePool, AnEpisodeThatFailsByItselfLeavesNoTrioOut) {
   l.options.horizon_s = 1.01;  // not a multiple of the sample time: invalid anywhere
   std::vector<double> y;
   std::string error;
-  EXPECT_FALSE(dut.AsRunner()(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr, &error));
+  EXPECT_FALSE(
+      OkInto(dut.AsRunner()(l.plant, l.gains, l.options, l.options.disturbance, &y, nullptr), &error));
   EXPECT_NE(error.find("horizon 1.01"), std::string::npos) << error;
   EXPECT_TRUE(dut.lost().empty());
 }

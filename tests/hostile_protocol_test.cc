@@ -25,6 +25,7 @@
 #include "pidlab/plant_sim/plant_role.h"
 #include "pidlab/transport/transport.h"
 #include "pidlab/transport/wire.h"
+#include "test_status.h"
 
 using pidlab::controller::ControllerRole;
 using pidlab::evaluation::LoopKind;
@@ -126,8 +127,9 @@ struct Arena {
   std::vector<double> Reference() const {
     std::vector<double> ref;
     std::string error;
-    EXPECT_TRUE(RunSampledLoopInProcess(model, PidGains{2.0, 1.0, 1.5}, options, options.disturbance, &ref,
-                                        nullptr, &error));
+    EXPECT_TRUE(OkInto(
+        RunSampledLoopInProcess(model, PidGains{2.0, 1.0, 1.5}, options, options.disturbance, &ref, nullptr),
+        &error));
     return ref;
   }
 };

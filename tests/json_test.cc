@@ -41,7 +41,7 @@ TEST(EvaluationJson, CarriesTheEvaluationsNumbersAndNullsAnUnstableLoopsObjectiv
   plant.tf = TransferFunction{{1.0}, {1.0, 0.0, 0.0}};  // 1/s^2
   evaluation::LoopOptions o;
   evaluation::Evaluation ev;
-  ASSERT_TRUE(evaluation::EvaluateLoop(plant, PidGains{2.0, 1.0, 1.5}, o, {}, &ev).ok());
+  ASSERT_TRUE(evaluation::Evaluate(plant, PidGains{2.0, 1.0, 1.5}, o, {}, &ev).ok());
   nlohmann::json j = ToJson(ev);
   for (const char* key : {"plant",
                           "plant_tf",
@@ -74,7 +74,7 @@ TEST(EvaluationJson, CarriesTheEvaluationsNumbersAndNullsAnUnstableLoopsObjectiv
   EXPECT_EQ(j.at("samples").get<long>(), 501);
   EXPECT_EQ(j.at("closed_loop_poles").size(), ev.stability.poles.size());
   ASSERT_TRUE(
-      evaluation::EvaluateLoop(plant, PidGains{2.0, 1.0, 0.0}, o, {}, &ev).ok());  // PI on 1/s^2: unstable
+      evaluation::Evaluate(plant, PidGains{2.0, 1.0, 0.0}, o, {}, &ev).ok());  // PI on 1/s^2: unstable
   j = ToJson(ev);
   EXPECT_FALSE(j.at("stable").get<bool>());
   EXPECT_TRUE(j.at("iae").is_null()) << "an unstable loop's +inf IAE is null, not a number";

@@ -646,7 +646,9 @@ class Launcher : public ::testing::Test {
     options.horizon_s = horizon_s;
     options.disturbance.kind = DisturbanceKind::kSquare;
     options.disturbance.amplitude = 0.3;
-    return client.Run(plant, PidGains{2.0, 1.0, 1.5}, options, options.disturbance, y, nullptr, error);
+    const Status ran = client.Run(plant, PidGains{2.0, 1.0, 1.5}, options, options.disturbance, y, nullptr);
+    if (error) *error = ran.message();
+    return ran.ok();
   }
   /// The episodes of `prefix` in the log, which must be readable.
   std::vector<replay::Episode> ReadEpisodes(const std::string& path, const std::string& prefix) {

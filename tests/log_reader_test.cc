@@ -22,6 +22,7 @@
 #include "pidlab/episode_client/episode_client.h"
 #include "pidlab/replay/replay.h"
 #include "pidlab/transport/episode_spec.h"
+#include "test_status.h"
 
 using pidlab::episode_client::MakeEpisodeSpec;
 using pidlab::evaluation::Evaluate;
@@ -57,10 +58,10 @@ struct Reference {
     options.disturbance.kind = kind;
     options.disturbance.amplitude = kind == DisturbanceKind::kNone ? 0.0 : 0.2;
     options.disturbance.period_s = 0.4;
-    EXPECT_TRUE(
-        RunSampledLoopInProcess(plant, gains, options, options.disturbance, &y_all, &trajectory, &error));
+    EXPECT_TRUE(OkInto(
+        RunSampledLoopInProcess(plant, gains, options, options.disturbance, &y_all, &trajectory), &error));
     EvaluateOptions what;
-    EXPECT_TRUE(Evaluate(plant, gains, options, what, &evaluation, &error)) << error;
+    EXPECT_TRUE(IsOk(Evaluate(plant, gains, options, what, &evaluation)));
   }
   long total_steps() const { return options.TotalSteps(); }
 };

@@ -10,6 +10,8 @@
 #include <random>
 #include <string>
 
+#include "test_status.h"
+
 using pidlab::analysis::AnalyzeLoop;
 using pidlab::analysis::ContinuousLoopMeetsBounds;
 using pidlab::analysis::HinfNormBruinsmaSteinbuch;
@@ -36,7 +38,7 @@ LoopAnalysis AnalyzeOrFail(const TransferFunction& tf, const PidGains& g,
                            const LoopAnalysisOptions& ao = LoopAnalysisOptions{}) {
   LoopAnalysis a;
   std::string error;
-  EXPECT_TRUE(AnalyzeLoop(Plant{"custom", tf}, g, o, ao, &a, &error)) << error;
+  EXPECT_TRUE(IsOk(AnalyzeLoop(Plant{"custom", tf}, g, o, ao, &a)));
   return a;
 }
 
@@ -241,8 +243,9 @@ TEST(LoopFrequencyResponse, IntegratorUnderPControlMatchesTheClosedForm) {
   const std::vector<double> w = {1e-3, 0.1, 1.0, 2.5, 10.0, 1e3};
   std::vector<LoopFrequencyPoint> r;
   std::string error;
-  ASSERT_TRUE(LoopFrequencyResponse(Plant{"custom", TransferFunction{{1.0}, {1.0, 0.0}}},
-                                    PidGains{kp, 0.0, 0.0}, LoopOptions{}, w, &r, &error))
+  ASSERT_TRUE(OkInto(LoopFrequencyResponse(Plant{"custom", TransferFunction{{1.0}, {1.0, 0.0}}},
+                                           PidGains{kp, 0.0, 0.0}, LoopOptions{}, w, &r),
+                     &error))
       << error;
   ASSERT_EQ(r.size(), w.size());
   for (std::size_t i = 0; i < w.size(); ++i) {
@@ -266,8 +269,8 @@ TEST(LoopFrequencyResponse, FilteredPidOnTheOscillatorMatchesTheDirectProduct) {
   std::vector<LoopFrequencyPoint> r;
   std::string error;
   const std::vector<double> w = {0.01, 0.5, 0.999, 1.001, 7.0, 300.0};
-  ASSERT_TRUE(
-      LoopFrequencyResponse(Plant{"custom", TransferFunction{{1.0}, {1.0, 0.0, 1.0}}}, g, o, w, &r, &error))
+  ASSERT_TRUE(OkInto(
+      LoopFrequencyResponse(Plant{"custom", TransferFunction{{1.0}, {1.0, 0.0, 1.0}}}, g, o, w, &r), &error))
       << error;
   for (std::size_t i = 0; i < w.size(); ++i) {
     const std::complex<double> s(0.0, w[i]);
@@ -277,8 +280,8 @@ TEST(LoopFrequencyResponse, FilteredPidOnTheOscillatorMatchesTheDirectProduct) {
     EXPECT_LT(std::abs(r[i].s + r[i].t - 1.0), 1e-12) << w[i];
   }
   // On the plant's pole (w = 1) L is infinite: S = 0, T = 1, no NaN.
-  ASSERT_TRUE(LoopFrequencyResponse(Plant{"custom", TransferFunction{{1.0}, {1.0, 0.0, 1.0}}}, g, o, {1.0},
-                                    &r, &error));
+  ASSERT_TRUE(IsOk(
+      LoopFrequencyResponse(Plant{"custom", TransferFunction{{1.0}, {1.0, 0.0, 1.0}}}, g, o, {1.0}, &r)));
   EXPECT_TRUE(std::isinf(std::abs(r[0].l)));
   EXPECT_EQ(std::abs(r[0].s), 0.0);
   EXPECT_EQ(r[0].t, std::complex<double>(1.0, 0.0));
@@ -290,10 +293,10 @@ TEST(LoopFrequencyResponse, RejectsFrequenciesOutsideTheLoopsRange) {
   const Plant p{"custom", TransferFunction{{1.0}, {1.0, 0.0}}};
   LoopOptions sampled;
   sampled.loop = LoopKind::kSampled;
-  EXPECT_FALSE(
-      LoopFrequencyResponse(p, PidGains{1.0, 0.0, 0.0}, sampled, {1.1 * M_PI / sampled.dt_s}, &r, &error));
+  EXPECT_FALSE(OkInto(
+      LoopFrequencyResponse(p, PidGains{1.0, 0.0, 0.0}, sampled, {1.1 * M_PI / sampled.dt_s}, &r), &error));
   EXPECT_NE(error.find("pi/dt"), std::string::npos) << error;
-  EXPECT_FALSE(LoopFrequencyResponse(p, PidGains{1.0, 0.0, 0.0}, LoopOptions{}, {0.0}, &r, &error));
+  EXPECT_FALSE(OkInto(LoopFrequencyResponse(p, PidGains{1.0, 0.0, 0.0}, LoopOptions{}, {0.0}, &r), &error));
   EXPECT_NE(error.find("frequency"), std::string::npos) << error;
 }
 
@@ -305,9 +308,10 @@ TEST(LoopFrequencyResponse, SampledLoopPeaksAtTheAnalysisMsMtAndNoiseGain) {
   const PidGains g{2.0, 1.0, 1.5, 0.1};
   pidlab::analysis::LoopAnalysis a;
   std::string error;
-  ASSERT_TRUE(pidlab::analysis::AnalyzeLoop(p, g, sampled, {}, &a, &error)) << error;
+  ASSERT_TRUE(IsOk(pidlab::analysis::AnalyzeLoop(p, g, sampled, {}, &a)));
   std::vector<LoopFrequencyPoint> r;
-  ASSERT_TRUE(LoopFrequencyResponse(p, g, sampled, {a.ms_rad_s, a.mt_rad_s, a.noise_gain_rad_s}, &r, &error))
+  ASSERT_TRUE(
+      OkInto(LoopFrequencyResponse(p, g, sampled, {a.ms_rad_s, a.mt_rad_s, a.noise_gain_rad_s}, &r), &error))
       << error;
   EXPECT_NEAR(std::abs(r[0].s), a.ms, 1e-9 * a.ms);
   EXPECT_NEAR(std::abs(r[1].t), a.mt, 1e-9 * a.mt);

@@ -13,6 +13,7 @@
 
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/analysis/monte_carlo.h"
+#include "test_status.h"
 
 using pidlab::analysis::AnalyzeLoop;
 using pidlab::analysis::CountNyquist;
@@ -44,14 +45,14 @@ Plant Delayed(const TransferFunction& tf, double delay_s) {
 LoopAnalysis AnalyzeOrFail(const Plant& plant, const PidGains& g) {
   LoopAnalysis a;
   std::string error;
-  EXPECT_TRUE(AnalyzeLoop(plant, g, LoopOptions{}, LoopAnalysisOptions{}, &a, &error)) << error;
+  EXPECT_TRUE(IsOk(AnalyzeLoop(plant, g, LoopOptions{}, LoopAnalysisOptions{}, &a)));
   return a;
 }
 
 NyquistCount CountOrFail(const Plant& plant, const PidGains& g) {
   NyquistCount n;
   std::string error;
-  EXPECT_TRUE(CountNyquist(plant, g, LoopOptions{}, &n, &error)) << error;
+  EXPECT_TRUE(IsOk(CountNyquist(plant, g, LoopOptions{}, &n)));
   return n;
 }
 
@@ -218,7 +219,7 @@ TEST(LoopDelay, SteppersLoopWithSeveralCrossoversReportsTheSmallestDistanceToThe
     g.kd = std::pow(10.0, exponent(rng) - 2.0);
     g.tf = std::pow(10.0, exponent(rng) - 3.0);
     LoopAnalysis a;
-    if (AnalyzeLoop(plant, g, LoopOptions{}, LoopAnalysisOptions{}, &a, nullptr) && a.stable &&
+    if (OkInto(AnalyzeLoop(plant, g, LoopOptions{}, LoopAnalysisOptions{}, &a), nullptr) && a.stable &&
         std::any_of(a.phase_margins_deg.begin(), a.phase_margins_deg.end(), [](double m) { return m < 0.0; }))
       found = a;
   }
@@ -242,24 +243,28 @@ TEST(LoopDelay, SampledLoopAnalysisTakesTheDelayItsStoredInputsAllowAndRefusesTh
   o.dt_s = 0.01;
   LoopAnalysis a;
   std::string error;
-  EXPECT_TRUE(AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, 0.25), P(1.0), o, LoopAnalysisOptions{}, &a,
-                          &error))
+  EXPECT_TRUE(OkInto(
+      AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, 0.25), P(1.0), o, LoopAnalysisOptions{}, &a),
+      &error))
       << error;
   EXPECT_TRUE(a.stable);
   // 100 s at dt 0.01 s: ten thousand stored inputs, more than the analysis takes.
-  EXPECT_FALSE(AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, 100.0), P(1.0), o, LoopAnalysisOptions{},
-                           &a, &error));
+  EXPECT_FALSE(OkInto(
+      AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, 100.0), P(1.0), o, LoopAnalysisOptions{}, &a),
+      &error));
   EXPECT_NE(error.find("delay 100 s"), std::string::npos) << error;
-  EXPECT_FALSE(AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, -1.0), P(1.0), LoopOptions{},
-                           LoopAnalysisOptions{}, &a, &error));
+  EXPECT_FALSE(OkInto(AnalyzeLoop(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, -1.0), P(1.0), LoopOptions{},
+                                  LoopAnalysisOptions{}, &a),
+                      &error));
   EXPECT_NE(error.find("dead time -1 s"), std::string::npos) << error;
 }
 
 TEST(LoopDelay, MonteCarloWithDelayIsRefusedNamingTheDelay) {
   MonteCarloSummary summary;
   std::string error;
-  EXPECT_FALSE(RunMonteCarlo(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, 0.5), nullptr, P(1.0),
-                             LoopOptions{}, MonteCarloOptions{}, &summary, &error));
+  EXPECT_FALSE(OkInto(RunMonteCarlo(Delayed(TransferFunction{{1.0}, {1.0, 1.0}}, 0.5), nullptr, P(1.0),
+                                    LoopOptions{}, MonteCarloOptions{}, &summary),
+                      &error));
   EXPECT_NE(error.find("dead time 0.5 s"), std::string::npos) << error;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pidlab/evaluation/evaluation.h"
+#include "test_status.h"
 
 using pidlab::evaluation::Evaluate;
 using pidlab::evaluation::EvaluateOptions;
@@ -26,7 +27,7 @@ Evaluation EvaluateOrFail(const TransferFunction& tf, const PidGains& gains,
                           const LoopOptions& options = {}) {
   Evaluation ev;
   std::string error;
-  EXPECT_TRUE(Evaluate(Plant{"custom", tf}, gains, options, EvaluateOptions{}, &ev, &error)) << error;
+  EXPECT_TRUE(IsOk(Evaluate(Plant{"custom", tf}, gains, options, EvaluateOptions{}, &ev)));
   return ev;
 }
 

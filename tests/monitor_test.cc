@@ -19,6 +19,7 @@
 #include "pidlab/monitor/live_monitor.h"
 #include "pidlab/plant_sim/disturbance_role.h"
 #include "pidlab/plant_sim/plant_role.h"
+#include "test_status.h"
 
 namespace pidlab::monitor {
 namespace {
@@ -143,7 +144,7 @@ TEST(LiveMonitor, AssemblesAnEpisodeOfTheInProcessTrioBitForBitWithItsHealth) {
   options.disturbance.amplitude = 0.3;
   std::vector<double> y;
   std::vector<evaluation::SampledStep> trajectory;
-  ASSERT_TRUE(client.Run(p, {2.0, 1.0, 1.5}, options, options.disturbance, &y, &trajectory, &error)) << error;
+  ASSERT_TRUE(IsOk(client.Run(p, {2.0, 1.0, 1.5}, options, options.disturbance, &y, &trajectory)));
   Drain(&dut);
 
   const MonitorSnapshot s = dut.Snapshot();

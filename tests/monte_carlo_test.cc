@@ -8,6 +8,8 @@
 #include <cmath>
 #include <string>
 
+#include "test_status.h"
+
 using pidlab::analysis::AnalyzeLoop;
 using pidlab::analysis::Distribution;
 using pidlab::analysis::DrawPlants;
@@ -31,7 +33,7 @@ MonteCarloSummary RunOrFail(const Plant& plant, const PidGains& g, const MonteCa
                             const StepperMotorParameters* stepper = nullptr) {
   MonteCarloSummary s;
   std::string error;
-  EXPECT_TRUE(RunMonteCarlo(plant, stepper, g, LoopOptions{}, mc, &s, &error)) << error;
+  EXPECT_TRUE(IsOk(RunMonteCarlo(plant, stepper, g, LoopOptions{}, mc, &s)));
   return s;
 }
 
@@ -54,7 +56,7 @@ TEST(MonteCarlo, TinySpreadGivesNearlyTheNominalValues) {
   const PidGains g{29.6558, 0.4977, 28.3216};
   Evaluation nominal;
   std::string error;
-  ASSERT_TRUE(Evaluate(kDoubleIntegrator, g, LoopOptions{}, EvaluateOptions{}, &nominal, &error));
+  ASSERT_TRUE(IsOk(Evaluate(kDoubleIntegrator, g, LoopOptions{}, EvaluateOptions{}, &nominal)));
   MonteCarloOptions mc;
   mc.samples = 10;
   mc.spread = 1e-7;
@@ -64,7 +66,7 @@ TEST(MonteCarlo, TinySpreadGivesNearlyTheNominalValues) {
   EXPECT_NEAR(s.iae.max, nominal.iae, 1e-5 * nominal.iae);
   EXPECT_NEAR(s.overshoot_pct.median, nominal.step.overshoot_pct, 1e-4);
   LoopAnalysis a;
-  ASSERT_TRUE(AnalyzeLoop(kDoubleIntegrator, g, LoopOptions{}, LoopAnalysisOptions{}, &a, &error));
+  ASSERT_TRUE(IsOk(AnalyzeLoop(kDoubleIntegrator, g, LoopOptions{}, LoopAnalysisOptions{}, &a)));
   EXPECT_NEAR(s.ms.median, a.ms, 1e-4 * a.ms);
 }
 

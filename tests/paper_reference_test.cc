@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pidlab/evaluation/evaluation.h"
+#include "test_status.h"
 
 using pidlab::evaluation::Evaluate;
 using pidlab::evaluation::EvaluateOptions;
@@ -105,7 +106,7 @@ const std::vector<Evaluated>& EvaluatedRows() {
         o.disturbance.amplitude = r.amplitude;
       }
       Evaluated e{r, {}};
-      if (!Evaluate(plant, r.gains, o, EvaluateOptions{}, &e.ev, &error)) break;
+      if (!OkInto(Evaluate(plant, r.gains, o, EvaluateOptions{}, &e.ev), &error)) break;
       out.push_back(e);
     }
     return out;

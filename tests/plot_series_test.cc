@@ -15,6 +15,7 @@
 #include "pidlab/spec/json.h"
 #include "pidlab/spec/loop_spec.h"
 #include "spec_build.h"  // internal to pidlab::tune: the steps tested one by one
+#include "test_status.h"
 
 namespace pidlab::results {
 namespace {
@@ -33,7 +34,7 @@ evaluation::Evaluation EvaluateDirectly(const nlohmann::json& spec_json) {
               tune::BuildLoopOptions(s.loop, spec::NameStyle::kKey, &options, &error))
       << error;
   evaluation::Evaluation ev;
-  EXPECT_TRUE(evaluation::Evaluate(p, g, options, evaluation::EvaluateOptions{}, &ev, &error)) << error;
+  EXPECT_TRUE(IsOk(evaluation::Evaluate(p, g, options, evaluation::EvaluateOptions{}, &ev)));
   return ev;
 }
 

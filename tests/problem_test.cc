@@ -14,6 +14,7 @@
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/tune/two_dof.h"
 #include "spec_build.h"  // internal to pidlab::tune: the old chain, for comparison
+#include "test_status.h"
 
 namespace pidlab::tune {
 namespace {
@@ -158,9 +159,9 @@ TEST(RunEvaluation, GivesTheBitsOfTheStepsChainedByHand) {
     evaluation::Evaluation ev;
     analysis::LoopAnalysis a;
     analysis::MonteCarloSummary draws;
-    ASSERT_TRUE(evaluation::Evaluate(p, g, options, evaluation::EvaluateOptions{}, &ev, &error) &&
-                analysis::AnalyzeLoop(p, g, options, analysis::LoopAnalysisOptions{}, &a, &error) &&
-                analysis::RunMonteCarlo(p, nullptr, g, options, mc, &draws, &error))
+    ASSERT_TRUE(OkInto(evaluation::Evaluate(p, g, options, evaluation::EvaluateOptions{}, &ev), &error) &&
+                OkInto(analysis::AnalyzeLoop(p, g, options, analysis::LoopAnalysisOptions{}, &a), &error) &&
+                OkInto(analysis::RunMonteCarlo(p, nullptr, g, options, mc, &draws), &error))
         << error;
     EXPECT_TRUE(SameBits(dut.evaluation.y, ev.y)) << loop;
     EXPECT_TRUE(SameBits(dut.evaluation.iae, ev.iae)) << loop;
@@ -195,11 +196,12 @@ TEST(RunTuning, GivesTheBitsOfTheStepsChainedByHand) {
               CheckPlantInLoop(p, o.loop, NameStyle::kKey, &error))
       << error;
   TuneSummary summary;
-  ASSERT_TRUE(Tune(p, o, &summary, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(p, o, &summary)));
   ASSERT_TRUE(summary.stable);
   evaluation::Evaluation ev;
   const evaluation::LoopOptions loop = WithSetpointWeights(o.loop, summary.two_dof);
-  ASSERT_TRUE(evaluation::Evaluate(p, summary.gains, loop, evaluation::EvaluateOptions{}, &ev, &error))
+  ASSERT_TRUE(
+      OkInto(evaluation::Evaluate(p, summary.gains, loop, evaluation::EvaluateOptions{}, &ev), &error))
       << error;
 
   ASSERT_TRUE(dut.summary.stable);
@@ -263,7 +265,7 @@ TEST(RunTuning, GivesTheBestFilteredPidWhereAnIdealDerivativeMakesEveryLoopNeutr
   // Tune() itself (a library caller) still says why, and which flag helps.
   TuneSummary alone;
   std::string error;
-  ASSERT_TRUE(Tune(problem.plant, problem.options, &alone, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(problem.plant, problem.options, &alone)));
   EXPECT_FALSE(alone.stable);
   EXPECT_NE(alone.message.find("makes the loop neutral); what helps: filter the derivative"),
             std::string::npos)

@@ -8,6 +8,7 @@
 
 #include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/evaluation/evaluation.h"
+#include "test_status.h"
 
 using pidlab::evaluation::Evaluate;
 using pidlab::evaluation::EvaluateOptions;
@@ -32,7 +33,7 @@ Evaluation EvaluateAt(const Plant& plant, const PidGains& gains, LoopOptions o, 
   o.reference = reference;
   Evaluation ev;
   std::string error;
-  EXPECT_TRUE(Evaluate(plant, gains, o, EvaluateOptions{}, &ev, &error)) << error;
+  EXPECT_TRUE(IsOk(Evaluate(plant, gains, o, EvaluateOptions{}, &ev)));
   return ev;
 }
 
@@ -119,7 +120,7 @@ TEST(Reference, SampledTrajectoryCarriesTheReference) {
   std::string error;
   EvaluateOptions what;
   what.record_trajectory = true;
-  ASSERT_TRUE(Evaluate(Stepper(), kPaperNelderMead, o, what, &ev, &error)) << error;
+  ASSERT_TRUE(IsOk(Evaluate(Stepper(), kPaperNelderMead, o, what, &ev)));
   ASSERT_FALSE(ev.trajectory.empty());
   for (const SampledStep& s : ev.trajectory) ASSERT_EQ(s.r, 0.01);
 }

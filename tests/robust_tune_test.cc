@@ -6,6 +6,7 @@
 
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/tune/tune.h"
+#include "test_status.h"
 
 using pidlab::analysis::AnalyzeLoop;
 using pidlab::analysis::DrawPlants;
@@ -74,12 +75,12 @@ TEST_P(RobustPresetOnPlant, ReturnsALoopThatMeetsEveryBoundWithAFiniteNoiseGain)
   ApplyRobustPreset(&o);
   TuneSummary s;
   std::string error;
-  ASSERT_TRUE(Tune(plant, o, &s, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(plant, o, &s)));
   ASSERT_TRUE(s.stable) << s.message;
   EXPECT_GT(s.gains.tf, 0.0);
   EXPECT_NEAR(s.gains.tf, s.gains.kd / (10.0 * s.gains.kp), 1e-12 * s.gains.tf);
   LoopAnalysis a;
-  ASSERT_TRUE(AnalyzeLoop(plant, s.gains, o.loop, LoopAnalysisOptions{}, &a, &error)) << error;
+  ASSERT_TRUE(IsOk(AnalyzeLoop(plant, s.gains, o.loop, LoopAnalysisOptions{}, &a)));
   EXPECT_TRUE(a.stable);
   EXPECT_LE(a.ms, 1.6 * (1.0 + 1e-6));
   EXPECT_LE(a.slowest_time_constant_s, 2.5);
@@ -88,7 +89,7 @@ TEST_P(RobustPresetOnPlant, ReturnsALoopThatMeetsEveryBoundWithAFiniteNoiseGain)
   // The paper's objective optimum of the same plant has an unbounded noise
   // gain (ideal derivative): the preset trades IAE for it.
   Evaluation ev;
-  ASSERT_TRUE(Evaluate(plant, s.gains, o.loop, EvaluateOptions{}, &ev, &error)) << error;
+  ASSERT_TRUE(IsOk(Evaluate(plant, s.gains, o.loop, EvaluateOptions{}, &ev)));
   EXPECT_NEAR(s.objective, ev.iae + ev.load_iae, 1e-9 * s.objective);
 }
 
@@ -105,7 +106,7 @@ TEST(RobustSet, WorstCaseObjectiveIsAtLeastTheNominalOneAndEveryDrawIsStable) {
   o.design_points = 256;
   TuneSummary s;
   std::string error;
-  ASSERT_TRUE(Tune(plant, o, &s, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(plant, o, &s)));
   ASSERT_TRUE(s.stable) << s.message;
   EXPECT_EQ(s.robust_set_size, 9);
   EXPECT_FALSE(s.refine.ran);
@@ -134,9 +135,9 @@ TEST(RobustSet, ALowerQuantileNeverScoresAboveTheWorstCase) {
   o.design_points = 256;
   TuneSummary worst, median;
   std::string error;
-  ASSERT_TRUE(Tune(plant, o, &worst, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(plant, o, &worst)));
   o.robust_quantile = 0.5;
-  ASSERT_TRUE(Tune(plant, o, &median, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(plant, o, &median)));
   ASSERT_TRUE(worst.stable && median.stable);
   EXPECT_LE(median.objective, worst.objective);
 }
@@ -173,11 +174,11 @@ TEST(RobustPreset, FindsGainsMeetingEveryBoundOnTheContinuousLoopOfAPlantWithDea
   o.design_points = 16;
   TuneSummary s;
   std::string error;
-  ASSERT_TRUE(Tune(plant, o, &s, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(plant, o, &s)));
   ASSERT_TRUE(s.stable) << s.message;
   EXPECT_LT(s.optimizer.rejected_evaluations, s.evaluations);
   LoopAnalysis a;
-  ASSERT_TRUE(AnalyzeLoop(plant, s.gains, o.loop, LoopAnalysisOptions{}, &a, &error)) << error;
+  ASSERT_TRUE(IsOk(AnalyzeLoop(plant, s.gains, o.loop, LoopAnalysisOptions{}, &a)));
   EXPECT_TRUE(a.stable) << a.stability_note;
   EXPECT_TRUE(a.time_constant_note.empty()) << a.time_constant_note;
   EXPECT_GT(a.slowest_time_constant_s, 0.0);

@@ -16,6 +16,7 @@
 
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/evaluation/fast_objective.h"
+#include "test_status.h"
 
 using pidlab::evaluation::Evaluate;
 using pidlab::evaluation::EvaluateOptions;
@@ -198,8 +199,8 @@ TEST(NonlinearStepperLoop, PapersGainsAgreeWithEquationThreeWithinOnePercentForA
   ASSERT_TRUE(MakePlant("stepper_motor", StepperMotorParameters{}, &linear, &error)) << error;
   ASSERT_TRUE(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor, &error)) << error;
   Evaluation lin, dut;
-  ASSERT_TRUE(Evaluate(linear, nm, o, EvaluateOptions{}, &lin, &error)) << error;
-  ASSERT_TRUE(Evaluate(motor, nm, o, EvaluateOptions{}, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(Evaluate(linear, nm, o, EvaluateOptions{}, &lin)));
+  ASSERT_TRUE(IsOk(Evaluate(motor, nm, o, EvaluateOptions{}, &dut)));
   ASSERT_TRUE(dut.stability.stable);
   EXPECT_NEAR(dut.iae_per_unit, lin.iae_per_unit, 0.01 * lin.iae_per_unit)
       << "nonlinear " << dut.iae_per_unit << " vs eq. (3) " << lin.iae_per_unit;
@@ -213,7 +214,7 @@ TEST(NonlinearStepperLoop, ContinuousLoopIsRefusedForTheNonlinearMotor) {
   std::string error;
   ASSERT_TRUE(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor, &error)) << error;
   Evaluation ev;
-  EXPECT_FALSE(Evaluate(motor, {1.0, 1.0, 0.1}, LoopOptions{}, EvaluateOptions{}, &ev, &error));
+  EXPECT_FALSE(OkInto(Evaluate(motor, {1.0, 1.0, 0.1}, LoopOptions{}, EvaluateOptions{}, &ev), &error));
   EXPECT_NE(error.find("--loop sampled"), std::string::npos) << error;
 }
 
@@ -245,7 +246,7 @@ TEST(NonlinearStepperLoop, ObjectiveEvaluatorRunsTheNonlinearMotor) {
   ASSERT_TRUE(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor, &error)) << error;
   const ObjectiveEvaluator dut(motor, o, ObjectiveKind::kIae);
   Evaluation ev;
-  ASSERT_TRUE(Evaluate(motor, {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &ev, &error)) << error;
+  ASSERT_TRUE(IsOk(Evaluate(motor, {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &ev)));
   EXPECT_EQ(dut({20.8836, 26.607, 12.4866}), ev.iae);
 }
 

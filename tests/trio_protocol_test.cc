@@ -27,6 +27,7 @@
 #include "pidlab/transport/pacing.h"
 #include "pidlab/transport/rtt.h"
 #include "pidlab/transport/transport.h"
+#include "test_status.h"
 
 using pidlab::controller::ControllerRole;
 using pidlab::evaluation::LoopKind;
@@ -124,8 +125,8 @@ bool RunOnMemq(const Episode& e, double drop_rate, Recorder* rec, RoleCounters* 
 std::vector<double> Reference(const Episode& e) {
   std::vector<double> y;
   std::string error;
-  EXPECT_TRUE(
-      RunSampledLoopInProcess(e.plant, e.gains, e.options, e.options.disturbance, &y, nullptr, &error));
+  EXPECT_TRUE(OkInto(RunSampledLoopInProcess(e.plant, e.gains, e.options, e.options.disturbance, &y, nullptr),
+                     &error));
   return y;
 }
 

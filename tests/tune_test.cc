@@ -10,6 +10,8 @@
 #include <thread>
 #include <vector>
 
+#include "test_status.h"
+
 using pidlab::evaluation::Evaluate;
 using pidlab::evaluation::EvaluateOptions;
 using pidlab::evaluation::Evaluation;
@@ -51,12 +53,12 @@ TEST_P(TuneBeatsPaper, DefaultTuneBeatsThePapersIaeWithAStrictlyStableLoop) {
   TuneOptions options;
   TuneSummary dut;
   std::string error;
-  ASSERT_TRUE(Tune(plant, options, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(plant, options, &dut)));
   ASSERT_TRUE(dut.stable);
   EXPECT_LT(dut.objective, c.paper_nelder_mead_iae);
   // Independent re-evaluation of the returned gains.
   Evaluation ev;
-  ASSERT_TRUE(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev, &error)) << error;
+  ASSERT_TRUE(IsOk(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev)));
   EXPECT_TRUE(ev.stability.stable);
   EXPECT_NEAR(ev.iae, dut.objective, 1e-9 * dut.objective);
   for (const auto& p : ev.stability.poles)
@@ -83,8 +85,8 @@ TEST(Tune, IsDeterministicForASeed) {
   options.method = TuneMethod::kPaperNelderMead;
   options.seed = 7;
   TuneSummary a, b;
-  ASSERT_TRUE(Tune(plant, options, &a, nullptr));
-  ASSERT_TRUE(Tune(plant, options, &b, nullptr));
+  ASSERT_TRUE(IsOk(Tune(plant, options, &a)));
+  ASSERT_TRUE(IsOk(Tune(plant, options, &b)));
   EXPECT_EQ(a.gains.kp, b.gains.kp);
   EXPECT_EQ(a.gains.ki, b.gains.ki);
   EXPECT_EQ(a.gains.kd, b.gains.kd);
@@ -116,9 +118,9 @@ TEST_P(TuneInParallel, GivesTheSameBitsAsOneEvaluationAfterTheOther) {
   options.refine = false;
   TuneSummary one, parallel;
   std::string error;
-  ASSERT_TRUE(Tune(MakeBuiltin("double_integrator"), options, &one, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(MakeBuiltin("double_integrator"), options, &one)));
   options.parallel_for = ThreeThreads;
-  ASSERT_TRUE(Tune(MakeBuiltin("double_integrator"), options, &parallel, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(MakeBuiltin("double_integrator"), options, &parallel)));
   EXPECT_EQ(parallel.evaluations, one.evaluations);
   EXPECT_EQ(parallel.iterations, one.iterations);
   EXPECT_EQ(parallel.objective, one.objective);  // bit for bit
@@ -160,7 +162,7 @@ TEST_P(DefaultTuneOverSeeds, ReachesTheSameObjectiveForEverySeedAndNoWorseThanAn
     options.method = method;
     TuneSummary other;
     std::string error;
-    ASSERT_TRUE(Tune(plant, options, &other, &error)) << error;
+    ASSERT_TRUE(IsOk(Tune(plant, options, &other)));
     if (other.stable && other.objective < reference) {
       reference = other.objective;
       reference_method = ToString(method);
@@ -173,7 +175,7 @@ TEST_P(DefaultTuneOverSeeds, ReachesTheSameObjectiveForEverySeedAndNoWorseThanAn
     options.seed = seed;
     TuneSummary dut;
     std::string error;
-    ASSERT_TRUE(Tune(plant, options, &dut, &error)) << error;
+    ASSERT_TRUE(IsOk(Tune(plant, options, &dut)));
     ASSERT_TRUE(dut.stable) << "seed " << seed;
     EXPECT_LE(dut.objective, reference * 1.001)
         << "seed " << seed << ": " << dut.BriefReport() << " vs " << reference_method << " " << reference;
@@ -191,7 +193,7 @@ TEST(MultiStart, RefinesFromSeveralDistinctPolishedMinimaAndKeepsTheBest) {
   const Plant plant = MakeBuiltin("stepper_motor");
   TuneOptions options;
   TuneSummary dut;
-  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  ASSERT_TRUE(IsOk(Tune(plant, options, &dut)));
   ASSERT_TRUE(dut.stable);
   ASSERT_GE(dut.local_minima.size(), 2u);
   for (std::size_t i = 1; i < dut.local_minima.size(); ++i)
@@ -212,7 +214,7 @@ TEST(NelderMeadStarts, ShareMaxEvaluationsInFixedPartsWhateverRunsThem) {
   options.parallel_for = ThreeThreads;
   TuneSummary s;
   std::string error;
-  ASSERT_TRUE(Tune(MakeBuiltin("double_integrator"), options, &s, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(MakeBuiltin("double_integrator"), options, &s)));
   EXPECT_EQ(s.evaluations, 10);
   EXPECT_EQ(s.optimizer.starts, 4);
 }
@@ -225,10 +227,10 @@ TEST(Tune, NeverAcceptsALoopThatIsNotStrictlyStable) {
   options.loop.stability_margin = 1e-9;
   options.refine = false;
   TuneSummary dut;
-  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  ASSERT_TRUE(IsOk(Tune(plant, options, &dut)));
   ASSERT_TRUE(dut.stable);
   Evaluation ev;
-  ASSERT_TRUE(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev, nullptr));
+  ASSERT_TRUE(IsOk(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev)));
   for (const auto& p : ev.stability.poles) EXPECT_LT(p.real(), 0.0);
 }
 
@@ -246,7 +248,7 @@ TEST(RefineWithCeres, SaysTheSearchStoppedShortWhenNelderMeadIsStoppedEarly) {
   options.starts = 1;
   options.max_evaluations = 8;  // a handful of evaluations: far from a minimum
   TuneSummary dut;
-  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  ASSERT_TRUE(IsOk(Tune(plant, options, &dut)));
   ASSERT_TRUE(dut.stable);
   ASSERT_TRUE(dut.refine.ran);
   EXPECT_EQ(dut.refine.verdict, RefineVerdict::kSearchStoppedShort);
@@ -263,7 +265,7 @@ TEST(RefineWithCeres, AgreesWithAConvergedNelderMead) {
   TuneOptions options;
   options.method = TuneMethod::kNelderMead;
   TuneSummary dut;
-  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  ASSERT_TRUE(IsOk(Tune(plant, options, &dut)));
   EXPECT_EQ(dut.refine.verdict, RefineVerdict::kAgree);
   EXPECT_EQ(dut.refine.termination, RefineTermination::kConvergence);
   EXPECT_LE(std::abs(dut.refine.relative_improvement), options.agree_tolerance);
@@ -317,7 +319,7 @@ TEST(Tune, ZieglerNicholsOnTheDoubleIntegratorSaysItDoesNotApply) {
   options.method = TuneMethod::kZieglerNichols;
   TuneSummary dut;
   std::string error;
-  EXPECT_FALSE(Tune(MakeBuiltin("double_integrator"), options, &dut, &error));
+  EXPECT_FALSE(OkInto(Tune(MakeBuiltin("double_integrator"), options, &dut), &error));
   EXPECT_NE(error.find("does not apply"), std::string::npos) << error;
 }
 
@@ -328,10 +330,10 @@ TEST(Tune, RespectsAnOvershootConstraint) {
   options.max_overshoot_pct = 0.5;
   options.refine = false;
   TuneSummary dut;
-  ASSERT_TRUE(Tune(plant, options, &dut, nullptr));
+  ASSERT_TRUE(IsOk(Tune(plant, options, &dut)));
   ASSERT_TRUE(dut.stable);
   Evaluation ev;
-  ASSERT_TRUE(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev, nullptr));
+  ASSERT_TRUE(IsOk(Evaluate(plant, dut.gains, LoopOptions{}, EvaluateOptions{}, &ev)));
   EXPECT_LE(ev.step.overshoot_pct, 0.5);
 }
 

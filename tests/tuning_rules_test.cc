@@ -13,6 +13,7 @@
 
 #include "pidlab/plant_sim/polynomial.h"
 #include "pidlab/tune/tune.h"
+#include "test_status.h"
 
 using pidlab::tune::AmigoTune;
 using pidlab::tune::ApplyTuningRule;
@@ -273,7 +274,7 @@ TEST(TuningRules, TuneEvaluatesTheRulesGainsOnceWithoutCeres) {
   o.rule = RuleForm::kPi;
   TuneSummary dut;
   std::string error;
-  ASSERT_TRUE(Tune(plant, o, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(plant, o, &dut)));
   EXPECT_TRUE(dut.stable);
   EXPECT_EQ(dut.evaluations, 1);
   EXPECT_FALSE(dut.refine.ran);
@@ -292,10 +293,10 @@ TEST(TuningRules, TuneScoresARuleOnADelayedPlantInBothLoops) {
   std::string error;
   // Continuous: the method of steps; the rule's ideal derivative on this plant
   // of relative degree 1 would make the loop neutral, so it needs a filter.
-  EXPECT_FALSE(Tune(UnitFopdt(), o, &dut, &error));
+  EXPECT_FALSE(OkInto(Tune(UnitFopdt(), o, &dut), &error));
   EXPECT_NE(error.find("derivative filter"), std::string::npos) << error;
   o.loop.derivative_filter_ratio = 10.0;
-  ASSERT_TRUE(Tune(UnitFopdt(), o, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(UnitFopdt(), o, &dut)));
   EXPECT_NEAR(dut.gains.kp, 0.65, 1e-9);
   EXPECT_TRUE(std::isfinite(dut.objective));
   EXPECT_EQ(dut.tuning_rule.plant_delay_s, 1.0);
@@ -305,7 +306,7 @@ TEST(TuningRules, TuneScoresARuleOnADelayedPlantInBothLoops) {
   // The stored inputs add closed-loop poles whose s-plane images the tuner's
   // default relative margin (0.01) rejects (docs/deadtime.md).
   o.loop.stability_margin = 1e-4;
-  ASSERT_TRUE(Tune(UnitFopdt(), o, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(Tune(UnitFopdt(), o, &dut)));
   EXPECT_NEAR(dut.gains.kp, 0.65, 1e-9);
   EXPECT_TRUE(std::isfinite(dut.objective));
   EXPECT_EQ(dut.tuning_rule.plant_delay_s, 1.0);
@@ -318,7 +319,7 @@ TEST(TuningRules, TuneRefusesTheOscillatorWithOneLine) {
   TuneOptions o;
   o.method = TuneMethod::kSimc;
   TuneSummary dut;
-  EXPECT_FALSE(Tune(oscillator, o, &dut, &error));
+  EXPECT_FALSE(OkInto(Tune(oscillator, o, &dut), &error));
   EXPECT_NE(error.find("complex poles"), std::string::npos) << error;
 }
 

@@ -18,6 +18,7 @@
 #include "pidlab/controller/pid.h"
 #include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/evaluation/evaluation.h"
+#include "test_status.h"
 
 using pidlab::analysis::AnalyzeLoop;
 using pidlab::analysis::LoopAnalysis;
@@ -79,7 +80,7 @@ Evaluation EvaluateWith(const Plant& plant, const PidGains& g, LoopOptions o, do
   o.pid.setpoint_weight_c = c;
   Evaluation ev;
   std::string error;
-  EXPECT_TRUE(Evaluate(plant, g, o, EvaluateOptions{}, &ev, &error)) << error;
+  EXPECT_TRUE(IsOk(Evaluate(plant, g, o, EvaluateOptions{}, &ev)));
   return ev;
 }
 
@@ -198,7 +199,7 @@ void ExpectOnlyTheSetpointResponseMoves(const Plant& plant, const PidGains& g, c
   const Evaluation one = EvaluateWith(plant, g, o, 1.0, 1.0);
   LoopAnalysis a1;
   std::string error;
-  ASSERT_TRUE(AnalyzeLoop(plant, g, o, LoopAnalysisOptions{}, &a1, &error)) << error;
+  ASSERT_TRUE(IsOk(AnalyzeLoop(plant, g, o, LoopAnalysisOptions{}, &a1)));
   ASSERT_TRUE(one.stability.stable);
   for (const auto& [b, c] : std::vector<std::pair<double, double>>{{0.5, 0.0}, {0.0, 0.3}, {0.664, 0.0136}}) {
     const Evaluation two = EvaluateWith(plant, g, o, b, c);
@@ -206,7 +207,7 @@ void ExpectOnlyTheSetpointResponseMoves(const Plant& plant, const PidGains& g, c
     ow.pid.setpoint_weight_b = b;
     ow.pid.setpoint_weight_c = c;
     LoopAnalysis a2;
-    ASSERT_TRUE(AnalyzeLoop(plant, g, ow, LoopAnalysisOptions{}, &a2, &error)) << error;
+    ASSERT_TRUE(IsOk(AnalyzeLoop(plant, g, ow, LoopAnalysisOptions{}, &a2)));
     EXPECT_EQ(two.load_iae, one.load_iae) << b << "," << c;
     EXPECT_EQ(a2.ms, a1.ms);
     EXPECT_EQ(a2.mt, a1.mt);

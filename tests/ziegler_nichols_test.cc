@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "pidlab/plant_sim/plants.h"
+#include "test_status.h"
 
 using pidlab::tune::ParseZieglerNicholsRule;
 using pidlab::tune::ZieglerNicholsResult;
@@ -42,7 +43,7 @@ TEST(ZieglerNichols, ThirdOrderLagMatchesTextbook) {
   const TransferFunction tf{{1.0}, {1.0, 3.0, 3.0, 1.0}};  // 1/(s+1)^3
   ZieglerNicholsResult dut;
   std::string error;
-  ASSERT_TRUE(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut)));
   std::cout << "1/(s+1)^3: " << dut.message << "\n";
   EXPECT_TRUE(dut.applicable);
   EXPECT_NEAR(dut.ultimate_gain, 8.0, 1e-9);
@@ -59,7 +60,7 @@ TEST(ZieglerNichols, FourthOrderLagPutsPolesOnTheAxisAtKu) {
   const TransferFunction tf{{1.0}, {1.0, 4.0, 6.0, 4.0, 1.0}};
   ZieglerNicholsResult dut;
   std::string error;
-  ASSERT_TRUE(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut)));
   EXPECT_NEAR(dut.ultimate_gain, 4.0, 1e-9);
   EXPECT_NEAR(dut.crossover_rad_s, 1.0, 1e-9);
   // And the closed-loop polynomial at Ku really has the roots +/- j wu.
@@ -78,7 +79,7 @@ TEST(ZieglerNichols, StepperMotorMatchesRouthArray) {
   const RouthThirdOrder routh = RouthUltimate(tf.num[0], tf.den[0], tf.den[1], tf.den[2], tf.den[3]);
   ZieglerNicholsResult dut;
   std::string error;
-  ASSERT_TRUE(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut)));
   std::cout << "stepper motor: " << dut.message << "\n"
             << "  Routh array: Ku = " << routh.ku << ", wu = " << routh.wu << " rad/s\n";
   EXPECT_NEAR(dut.ultimate_gain, routh.ku, 1e-7 * routh.ku);
@@ -100,7 +101,7 @@ TEST(ZieglerNichols, RulesScaleTheUltimateValues) {
   for (const Case& c : cases) {
     ZieglerNicholsResult dut;
     std::string error;
-    ASSERT_TRUE(ZieglerNicholsTune(tf, c.rule, &dut, &error)) << error;
+    ASSERT_TRUE(IsOk(ZieglerNicholsTune(tf, c.rule, &dut)));
     const double ku = 8.0, tu = 2.0 * kPi / std::sqrt(3.0), kp = c.kp_over_ku * ku;
     EXPECT_NEAR(dut.gains.kp, kp, 1e-9) << ToString(c.rule);
     EXPECT_NEAR(dut.gains.ki, kp / (c.ti_over_tu * tu), 1e-9) << ToString(c.rule);
@@ -123,7 +124,7 @@ TEST(ZieglerNichols, DoubleIntegratorIsNotApplicable) {
   ZieglerNicholsResult dut;
   dut.applicable = true;
   std::string error;
-  EXPECT_FALSE(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut, &error));
+  EXPECT_FALSE(OkInto(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut), &error));
   std::cout << "1/s^2: " << error << "\n";
   EXPECT_FALSE(dut.applicable);
   EXPECT_NE(error.find("marginally stable"), std::string::npos) << error;
@@ -137,7 +138,7 @@ TEST(ZieglerNichols, OscillatorIsNotApplicable) {
   const TransferFunction tf{{1.0}, {1.0, 0.0, 1.0}};
   ZieglerNicholsResult dut;
   std::string error;
-  EXPECT_FALSE(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut, &error));
+  EXPECT_FALSE(OkInto(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut), &error));
   std::cout << "1/(s^2+1): " << error << "\n";
   EXPECT_FALSE(dut.applicable);
   EXPECT_NE(error.find("marginally stable"), std::string::npos) << error;
@@ -149,7 +150,7 @@ TEST(ZieglerNichols, PlantsThatNeverReachTheBoundaryAreNotApplicable) {
                                      TransferFunction{{1.0}, {1.0, 3.0, 2.0}}}) {  // 1/((s+1)(s+2))
     ZieglerNicholsResult dut;
     std::string error;
-    EXPECT_FALSE(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut, &error)) << tf.ToString();
+    EXPECT_FALSE(OkInto(ZieglerNicholsTune(tf, ZieglerNicholsRule::kClassic, &dut), &error)) << tf.ToString();
     EXPECT_NE(error.find("never reaches the stability boundary"), std::string::npos) << error;
   }
 }
@@ -157,8 +158,9 @@ TEST(ZieglerNichols, PlantsThatNeverReachTheBoundaryAreNotApplicable) {
 TEST(ZieglerNichols, InvalidPlantIsRejected) {
   ZieglerNicholsResult dut;
   std::string error;
-  EXPECT_FALSE(ZieglerNicholsTune(TransferFunction{{1.0, 0.0, 0.0}, {1.0, 1.0}}, ZieglerNicholsRule::kClassic,
-                                  &dut, &error));
+  EXPECT_FALSE(OkInto(
+      ZieglerNicholsTune(TransferFunction{{1.0, 0.0, 0.0}, {1.0, 1.0}}, ZieglerNicholsRule::kClassic, &dut),
+      &error));
   EXPECT_NE(error.find("improper"), std::string::npos) << error;
 }
 

@@ -287,7 +287,8 @@ PidGains ParseGains(const std::string& text) {
 LoopAnalysis AnalyzeOrThrow(const Plant& plant, const PidGains& gains, const LoopOptions& options) {
   LoopAnalysis a;
   std::string error;
-  if (!AnalyzeLoop(plant, gains, options, LoopAnalysisOptions{}, &a, &error)) throw BadInput(error);
+  if (const Status st = AnalyzeLoop(plant, gains, options, LoopAnalysisOptions{}, &a); !st.ok())
+    throw BadInput(st.message());
   return a;
 }
 

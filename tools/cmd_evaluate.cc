@@ -85,8 +85,7 @@ struct EvaluateCommand {
       client = lcm.MakeClient();
       run.runner = [&client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
                              const DisturbanceOptions& d, std::vector<double>* y,
-                             std::vector<SampledStep>* tr,
-                             std::string* err) { return client->Run(pl, ga, lo, d, y, tr, err); };
+                             std::vector<SampledStep>* tr) { return client->Run(pl, ga, lo, d, y, tr); };
     }
     const bool tty = isatty(STDERR_FILENO) != 0;
     run.monte_carlo_progress = [tty](int done, int total) {

@@ -23,9 +23,11 @@ int main() {
   }
   const pidlab::PidGains paper_nm{29.6558, 0.4977, 28.3216};
   pidlab::evaluation::Evaluation evaluation;
-  if (!pidlab::evaluation::Evaluate(plant, paper_nm, pidlab::evaluation::LoopOptions{},
-                                    pidlab::evaluation::EvaluateOptions{}, &evaluation, &error)) {
-    std::fprintf(stderr, "consumer: %s\n", error.c_str());
+  if (const pidlab::Status st =
+          pidlab::evaluation::Evaluate(plant, paper_nm, pidlab::evaluation::LoopOptions{},
+                                       pidlab::evaluation::EvaluateOptions{}, &evaluation);
+      !st.ok()) {
+    std::fprintf(stderr, "consumer: %s\n", st.message().c_str());
     return 2;
   }
   std::printf("evaluate %s iae=%.17g overshoot_pct=%.17g stable=%d\n", plant.name.c_str(), evaluation.iae,
@@ -42,8 +44,8 @@ int main() {
   pidlab::tune::TuneOptions options;
   options.max_evaluations = 400;
   pidlab::tune::TuneSummary summary;
-  if (!pidlab::tune::Tune(oscillator, options, &summary, &error)) {
-    std::fprintf(stderr, "consumer: %s\n", error.c_str());
+  if (const pidlab::Status st = pidlab::tune::Tune(oscillator, options, &summary); !st.ok()) {
+    std::fprintf(stderr, "consumer: %s\n", st.message().c_str());
     return 2;
   }
   std::printf("tune kp=%.17g ki=%.17g kd=%.17g objective=%.17g\n", summary.gains.kp, summary.gains.ki,

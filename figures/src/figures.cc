@@ -34,7 +34,10 @@ bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, co
   what.compute_iae_continuous = false;
   for (const PidGains& g : gains) {
     Evaluation ev;
-    if (!Evaluate(plant, g, options, what, &ev, error)) return false;
+    if (const Status st = Evaluate(plant, g, options, what, &ev); !st.ok()) {
+      if (error) *error = st.message();
+      return false;
+    }
     plot::LoopTrace tr;
     std::ostringstream name;
     name << GainsLabel(g) << std::setprecision(6) << " (IAE " << ev.iae

@@ -62,7 +62,7 @@ bool EvaluateEpisode(const Episode& e, Evaluation* evaluation, std::string* erro
   EpisodeTrajectory(e, &run.trajectory);
   if (options.disturbance.kind != DisturbanceKind::kNone)
     RunSampledLoopInProcess(e.spec.plant, LoopGains(e.spec.gains, options), options, DisturbanceOptions{},
-                            &run.y_undisturbed, nullptr, error);
+                            &run.y_undisturbed, nullptr);
   EvaluateOptions what;
   what.record_trajectory = true;
   const Status s = EvaluateSampledRun(e.spec.plant, e.spec.gains, options, what, run, evaluation);

@@ -34,7 +34,10 @@ bool Simulate(const Plant& plant, const PidGains& gains, double amplitude, doubl
   what.compute_step_info = false;
   what.compute_iae_continuous = false;
   Evaluation ev1;
-  if (!Evaluate(plant, gains, o, what, &ev1, error)) return false;
+  if (const Status st = Evaluate(plant, gains, o, what, &ev1); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   trace->name = name;
   trace->t = ev1.t;
   trace->y1 = ev1.y;
@@ -44,7 +47,10 @@ bool Simulate(const Plant& plant, const PidGains& gains, double amplitude, doubl
   if (amplitude > 0.0) {
     o.disturbance = PaperLoop(amplitude).disturbance;
     Evaluation ev;
-    if (!Evaluate(plant, gains, o, what, &ev, error)) return false;
+    if (const Status st = Evaluate(plant, gains, o, what, &ev); !st.ok()) {
+      if (error) *error = st.message();
+      return false;
+    }
     trace->y = ev.y;
     trace->n = ev.n;
     for (std::size_t i = 0; i < ev.y.size(); ++i) trace->y2[i] = ev.y[i] - ev1.y[i];

@@ -82,7 +82,10 @@ bool RunExperiment(IdentifySection* s, std::string* error) {
   what.compute_iae_continuous = false;
   what.record_trajectory = true;
   Evaluation ev;
-  if (!Evaluate(Motor(), PidGains{}, ExperimentLoop(*s), what, &ev, error)) return false;
+  if (const Status st = Evaluate(Motor(), PidGains{}, ExperimentLoop(*s), what, &ev); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   s->data = identify::IdentifyData{};
   for (std::size_t k = 0; k < ev.trajectory.size(); ++k) {  // steps 0 .. total_steps - 1
     s->data.t.push_back(static_cast<double>(k) * s->dt_s);  // as identify --log reads a log
@@ -123,7 +126,10 @@ bool TuneAndRun(const IdentifySection& s, const Plant& plant, int robust_samples
   if (quick) o.starts = 1;
   tune::ApplyRobustPreset(&o);
   o.robust_samples = robust_samples;
-  if (!tune::Tune(plant, o, &set->tune, error)) return false;
+  if (const Status st = tune::Tune(plant, o, &set->tune); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   set->tuned = set->tune.stable;
   if (!set->tuned) return true;
   LoopOptions run = o.loop;
@@ -133,10 +139,17 @@ bool TuneAndRun(const IdentifySection& s, const Plant& plant, int robust_samples
   for (const bool motor : {false, true}) {
     const Plant target = motor ? Motor() : Eq3();
     Evaluation ev;
-    if (!Evaluate(target, set->tune.gains, run, what, &ev, error)) return false;
-    analysis::LoopAnalysis a;
-    if (!analysis::AnalyzeLoop(target, set->tune.gains, run, analysis::LoopAnalysisOptions{}, &a, error))
+    if (const Status st = Evaluate(target, set->tune.gains, run, what, &ev); !st.ok()) {
+      if (error) *error = st.message();
       return false;
+    }
+    analysis::LoopAnalysis a;
+    if (const Status st =
+            analysis::AnalyzeLoop(target, set->tune.gains, run, analysis::LoopAnalysisOptions{}, &a);
+        !st.ok()) {
+      if (error) *error = st.message();
+      return false;
+    }
     (motor ? set->motor_iae_per_unit : set->eq3_iae_per_unit) = ev.iae_per_unit;
     (motor ? set->motor_stable : set->eq3_stable) = ev.stability.stable;
     (motor ? set->motor_ms : set->eq3_ms) = a.ms;

@@ -87,8 +87,12 @@ bool RunRow(const MotorSection& s, const MotorGainSet& set, double move, bool li
   what.compute_iae_continuous = false;
   what.record_trajectory = trajectory != nullptr;
   Evaluation ev;
-  if (!Evaluate(Motor(limited, s.voltage_limit_v), set.gains, SampledLoop(s, move), what, &ev, error))
+  if (const Status st =
+          Evaluate(Motor(limited, s.voltage_limit_v), set.gains, SampledLoop(s, move), what, &ev);
+      !st.ok()) {
+    if (error) *error = st.message();
     return false;
+  }
   row->move_rad = move;
   row->limited = limited;
   row->stable = ev.stability.stable;
@@ -116,7 +120,10 @@ bool RunEq3(const MotorSection& s, MotorGainSet* set, std::vector<SampledStep>* 
   what.compute_iae_continuous = false;
   what.record_trajectory = trajectory != nullptr;
   Evaluation ev;
-  if (!Evaluate(eq3, set->gains, SampledLoop(s, 1.0), what, &ev, error)) return false;
+  if (const Status st = Evaluate(eq3, set->gains, SampledLoop(s, 1.0), what, &ev); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   set->eq3_stable = ev.stability.stable;
   set->eq3_iae_per_unit = ev.iae_per_unit;
   set->eq3_rise_time_s = ev.step.valid ? ev.step.rise_time_s : NAN;
@@ -243,7 +250,10 @@ bool DefaultSet(const Plant& eq3, const TuneOptions& d, std::uint64_t seed, Moto
                 std::string* error) {
   set->name = "pidlab's multi-start (the paper's objective)";
   TuneSummary ds;
-  if (!Tune(eq3, d, &ds, error)) return false;
+  if (const Status st = Tune(eq3, d, &ds); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   set->gains = ds.gains;
   set->origin = "`pidlab tune --plant stepper_motor --method multi-start --seed " + std::to_string(seed) +
                 "` (" + ToString(d.method) +
@@ -262,7 +272,10 @@ bool RobustSet(const Plant& eq3, const TuneOptions& d, std::uint64_t seed, Motor
   TuneOptions r = d;
   ApplyRobustPreset(&r);
   TuneSummary rs;
-  if (!Tune(eq3, r, &rs, error)) return false;
+  if (const Status st = Tune(eq3, r, &rs); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   set->name = "pidlab's robust preset";
   set->gains = LoopGains(rs.gains, r.loop);
   set->origin = "`pidlab tune --plant stepper_motor --seed " + std::to_string(seed) +
@@ -467,10 +480,8 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
   // The tune on the motor, on its own thread while the other three sets run.
   const TuneOptions t = MotorTuneOptions(quick, seed, &s);
   const Plant limited_motor = Motor(true, s.voltage_limit_v);
-  auto tune = std::async(std::launch::async, [&limited_motor, t, &s] {
-    std::string e;
-    return Tune(limited_motor, t, &s.motor_tune, &e) ? std::string() : e;
-  });
+  auto tune = std::async(std::launch::async,
+                         [&limited_motor, t, &s] { return Tune(limited_motor, t, &s.motor_tune).message(); });
   const bool others = RunGainSet(0, &s, error) && RunGainSet(1, &s, error) && RunGainSet(2, &s, error);
   const std::string tune_error = tune.get();
   if (!others) return false;

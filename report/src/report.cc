@@ -153,7 +153,10 @@ bool EvaluateMetrics(const Plant& plant, const PidGains& gains, double amplitude
   EvaluateOptions what;
   what.compute_iae_continuous = false;
   Evaluation ev;
-  if (!Evaluate(plant, gains, PaperLoop(amplitude), what, &ev, error)) return false;
+  if (const Status st = Evaluate(plant, gains, PaperLoop(amplitude), what, &ev); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   *metrics = Metrics{};
   FillFromEvaluation(ev, metrics);
   return true;

@@ -53,18 +53,30 @@ bool EvaluateSet(const Plant& plant, const StepperMotorParameters* stepper, cons
   what.compute_step_info = false;
   what.compute_iae_continuous = false;
   Evaluation ev;
-  if (!Evaluate(plant, set->gains, loop, what, &ev, error)) return false;
+  if (const Status st = Evaluate(plant, set->gains, loop, what, &ev); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   set->stable = ev.stability.stable;
   set->setpoint_iae = ev.iae_undisturbed;
   set->load_iae = ev.load_iae;
-  if (!AnalyzeLoop(plant, set->gains, loop, LoopAnalysisOptions{}, &set->analysis, error)) return false;
+  if (const Status st = AnalyzeLoop(plant, set->gains, loop, LoopAnalysisOptions{}, &set->analysis);
+      !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   MonteCarloOptions mc;
   mc.samples = s.mc_samples;
   mc.spread = s.mc_spread;
   mc.seed = s.seed;
   mc.overshoot = false;  // only the stable fraction is reported
-  if (!RunMonteCarlo(plant, stepper, set->gains, loop, mc, &set->monte_carlo, error)) return false;
-  return LoopFrequencyResponse(plant, set->gains, loop, s.frequencies_rad_s, &set->response, error);
+  if (const Status st = RunMonteCarlo(plant, stepper, set->gains, loop, mc, &set->monte_carlo); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
+  const Status st = LoopFrequencyResponse(plant, set->gains, loop, s.frequencies_rad_s, &set->response);
+  if (!st.ok() && error) *error = st.message();
+  return st.ok();
 }
 
 std::string MarginCell(double v, const std::string& unit) {
@@ -124,7 +136,10 @@ bool ComputeRobustSection(const std::vector<RobustInput>& inputs, bool quick, st
     TuneOptions d;  // `pidlab tune --plant P --method multi-start --seed S`
     d.seed = seed;
     TuneSummary optimum;
-    if (!Tune(plant, d, &optimum, error)) return false;
+    if (const Status st = Tune(plant, d, &optimum); !st.ok()) {
+      if (error) *error = st.message();
+      return false;
+    }
     if (optimum.stable) {
       RobustGainSet opt;
       opt.name = "pidlab, paper objective";
@@ -136,7 +151,10 @@ bool ComputeRobustSection(const std::vector<RobustInput>& inputs, bool quick, st
     if (quick) o.starts = 1;
     ApplyRobustPreset(&o);
     TuneSummary summary;
-    if (!Tune(plant, o, &summary, error)) return false;
+    if (const Status st = Tune(plant, o, &summary); !st.ok()) {
+      if (error) *error = st.message();
+      return false;
+    }
     RobustGainSet robust;
     robust.name = "pidlab --robust";
     robust.gains = LoopGains(summary.gains, o.loop);

@@ -101,16 +101,25 @@ bool EvaluateSampledLoops(SampledSection* s, std::string* error) {
   EvaluateOptions what;
   what.compute_iae_continuous = false;
   Evaluation ev;
-  if (!Evaluate(stepper, s->gains, sampled, what, &ev, error)) return false;
+  if (const Status st = Evaluate(stepper, s->gains, sampled, what, &ev); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   FillFromEvaluation(ev, &s->sampled_in_process);
   LoopOptions short_horizon = sampled;
   short_horizon.horizon_s = s->trio_horizon_s;
   Evaluation same_as_trio;
-  if (!Evaluate(stepper, s->gains, short_horizon, what, &same_as_trio, error)) return false;
+  if (const Status st = Evaluate(stepper, s->gains, short_horizon, what, &same_as_trio); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   FillFromEvaluation(same_as_trio, &s->sampled_trio_horizon);
   sampled.dt_s = s->fine_dt_s;
   Evaluation fine;
-  if (!Evaluate(stepper, s->gains, sampled, what, &fine, error)) return false;
+  if (const Status st = Evaluate(stepper, s->gains, sampled, what, &fine); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   FillFromEvaluation(fine, &s->sampled_fine);
   for (const auto& p : PolynomialRoots(stepper.tf.den))
     s->fastest_plant_pole_re = std::min(s->fastest_plant_pole_re, p.real());

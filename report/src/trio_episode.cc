@@ -42,8 +42,8 @@ bool RunTrioEpisode(const TrioEpisodeOptions& options, const Plant& plant, const
   loop.dt_s = dt_s;
   loop.horizon_s = horizon_s;
   Evaluation ev;
-  if (!Evaluate(plant, gains, loop, EvaluateOptions{}, &ev, &error, client.AsRunner())) {
-    *note = "the trio episode failed: " + error + " (see " + options.log_path + ")";
+  if (const Status st = Evaluate(plant, gains, loop, EvaluateOptions{}, &ev, client.AsRunner()); !st.ok()) {
+    *note = "the trio episode failed: " + st.message() + " (see " + options.log_path + ")";
     return false;
   }
   trio.Stop();

@@ -34,10 +34,9 @@ bool RunTuning(const ReportOptions& options, const std::string& plant_name, Tune
     if (method == TuneMethod::kGeneticAlgorithm || method == TuneMethod::kPsoGsa) o.max_evaluations = 400;
   }
   const Plant plant = BuiltinPlant(plant_name);
-  std::string why;
-  if (!Tune(plant, o, &t->summary, &why)) {
+  if (const Status st = Tune(plant, o, &t->summary); !st.ok()) {
     t->status = TuningStatus::kNotApplicable;
-    t->message = why;
+    t->message = st.message();
   } else if (!t->summary.stable) {
     t->status = TuningStatus::kNoStableLoop;
     t->message = t->summary.message;

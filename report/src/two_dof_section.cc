@@ -20,8 +20,11 @@ bool ComputeTwoDofSection(const RobustSection& robust, TwoDofSection* section, s
       row.plant = p.plant;
       row.gains = set.gains;
       // The paper's continuous loop (unit step, ts = 0.05 s, n = 25 s), the set's own filter.
-      if (!tune::TuneSetpointWeights(plant, set.gains, evaluation::LoopOptions{}, &row.summary, error))
+      const Status st = tune::TuneSetpointWeights(plant, set.gains, evaluation::LoopOptions{}, &row.summary);
+      if (!st.ok()) {
+        if (error) *error = st.message();
         return false;
+      }
       section->rows.push_back(row);
     }
   }

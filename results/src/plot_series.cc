@@ -117,9 +117,8 @@ Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const LoopOpt
   TimeSeries(plant, gains, options, evaluation, series, &notes);
   const std::vector<double> w = FrequencyGrid(analysis, options, series_options);
   std::vector<LoopFrequencyPoint> response;
-  std::string error;
-  if (!analysis::LoopFrequencyResponse(plant, typed_gains, options, w, &response, &error))
-    return Status::RunnerFailed(error);
+  if (const Status st = analysis::LoopFrequencyResponse(plant, typed_gains, options, w, &response); !st.ok())
+    return Status::RunnerFailed(st.message());
   std::vector<double> s, t, cs, l_re, l_im;
   for (const LoopFrequencyPoint& p : response) {
     s.push_back(std::abs(p.s));
@@ -158,9 +157,8 @@ Status MonteCarloBand(const Plant& nominal, const StepperMotorParameters* steppe
       continue;
     }
     Evaluation ev;
-    std::string error;
-    if (!evaluation::Evaluate(draw, typed_gains, options, what, &ev, &error))
-      return Status::RunnerFailed(error);
+    if (const Status st = evaluation::Evaluate(draw, typed_gains, options, what, &ev); !st.ok())
+      return Status::RunnerFailed(st.message());
     if (!ev.stability.stable) continue;
     if (stable++ == 0) {
       lo = hi = ev.y;

@@ -34,7 +34,7 @@ void AddLinearMotor(const tune::EvaluationProblem& problem, const evaluation::Lo
   what.compute_step_info = false;
   what.compute_iae_continuous = false;
   const bool ran = MakePlant("stepper_motor", problem.stepper, &p, &error) &&
-                   Evaluate(p, problem.gains, loop, what, &ev, &error);
+                   Evaluate(p, problem.gains, loop, what, &ev).ok();
   (*series)["linear_y"] = ran ? nlohmann::json(ev.y) : nlohmann::json(nullptr);
 }
 
@@ -75,7 +75,7 @@ Status FigureFrame(const tune::EvaluationProblem& problem, const std::set<std::s
   if (!built.ok()) return built;
   evaluation::EvaluateOptions what;
   what.record_trajectory = loop->loop == evaluation::LoopKind::kSampled;
-  return evaluation::EvaluateLoop(problem.plant, problem.gains, *loop, what, figure);
+  return evaluation::Evaluate(problem.plant, problem.gains, *loop, what, figure);
 }
 
 }  // namespace

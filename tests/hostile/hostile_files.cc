@@ -87,7 +87,9 @@ bool ReadResult(const std::string& path, std::string* error) {
 
 bool ReadModel(const std::string& path, std::string* error) {
   pidlab::Plant plant;
-  return pidlab::tune::ReadModelFile(path, &plant, error);
+  const pidlab::Status st = pidlab::tune::ReadModelFile(path, &plant);
+  if (error) *error = st.message();
+  return st.ok();
 }
 
 bool ReadCsv(const std::string& path, std::string* error) {

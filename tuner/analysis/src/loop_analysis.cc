@@ -282,8 +282,12 @@ bool LoopAnalysisOptions::IsValid(std::string* error) const {
   return false;
 }
 
-bool AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
-                 const LoopAnalysisOptions& ao, LoopAnalysis* out, std::string* error) {
+namespace {
+
+// AnalyzeLoop() with the refusal's message in *error.
+bool AnalyzeLoopOrExplain(const Plant& plant, const PidGains& typed_gains,
+                          const evaluation::LoopOptions& options, const LoopAnalysisOptions& ao,
+                          LoopAnalysis* out, std::string* error) {
   PidGains g;
   if (!CheckAnalysisInputs(plant, typed_gains, options, ao, &g, error)) return false;
   *out = LoopAnalysis();
@@ -318,14 +322,35 @@ bool AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const evaluati
   return true;
 }
 
-bool CountNyquist(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
-                  NyquistCount* count, std::string* error) {
+}  // namespace
+
+Status AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
+                   const LoopAnalysisOptions& ao, LoopAnalysis* out) {
+  std::string why;
+  if (!AnalyzeLoopOrExplain(plant, typed_gains, options, ao, out, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
+}
+
+namespace {
+
+// CountNyquist() with the refusal's message in *error.
+bool CountNyquistOrExplain(const Plant& plant, const PidGains& typed_gains,
+                           const evaluation::LoopOptions& options, NyquistCount* count, std::string* error) {
   PidGains g;
   evaluation::LoopOptions continuous = options;
   continuous.loop = evaluation::LoopKind::kContinuous;
   const LoopAnalysisOptions ao;
   if (!CheckAnalysisInputs(plant, typed_gains, continuous, ao, &g, error)) return false;
   return evaluation::CountContinuousNyquist(plant.tf, g, plant.delay_s, ao.points_per_decade, count, error);
+}
+
+}  // namespace
+
+Status CountNyquist(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
+                    NyquistCount* count) {
+  std::string why;
+  if (!CountNyquistOrExplain(plant, typed_gains, options, count, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 namespace {
@@ -344,9 +369,13 @@ LoopFrequencyPoint FrequencyPoint(double w, cd a, cd b, cd c) {
 
 }  // namespace
 
-bool LoopFrequencyResponse(const Plant& plant, const PidGains& typed_gains,
-                           const evaluation::LoopOptions& options, const std::vector<double>& w_rad_s,
-                           std::vector<LoopFrequencyPoint>* response, std::string* error) {
+namespace {
+
+// LoopFrequencyResponse() with the refusal's message in *error.
+bool LoopFrequencyResponseOrExplain(const Plant& plant, const PidGains& typed_gains,
+                                    const evaluation::LoopOptions& options,
+                                    const std::vector<double>& w_rad_s,
+                                    std::vector<LoopFrequencyPoint>* response, std::string* error) {
   if (!GainsAreValid(typed_gains, error) || !options.IsValid(error) || !plant.tf.IsValid(error) ||
       !DelayIsValid(plant, options, error))
     return false;
@@ -380,6 +409,17 @@ bool LoopFrequencyResponse(const Plant& plant, const PidGains& typed_gains,
     response->push_back(FrequencyPoint(w, av, Eval(b, cd(0.0, w)), Eval(c, cd(0.0, w))));
   }
   return true;
+}
+
+}  // namespace
+
+Status LoopFrequencyResponse(const Plant& plant, const PidGains& typed_gains,
+                             const evaluation::LoopOptions& options, const std::vector<double>& w_rad_s,
+                             std::vector<LoopFrequencyPoint>* response) {
+  std::string why;
+  if (!LoopFrequencyResponseOrExplain(plant, typed_gains, options, w_rad_s, response, &why))
+    return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::analysis

@@ -162,10 +162,13 @@ std::vector<Plant> DrawPlants(const Plant& nominal, const StepperMotorParameters
   return plants;
 }
 
-bool RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, const PidGains& gains,
-                   const evaluation::LoopOptions& options, const MonteCarloOptions& mc,
-                   MonteCarloSummary* summary, std::string* error,
-                   const std::function<void(int, int)>& progress) {
+namespace {
+
+// RunMonteCarlo() with the refusal's message in *error.
+bool RunMonteCarloOrExplain(const Plant& nominal, const StepperMotorParameters* stepper,
+                            const PidGains& gains, const evaluation::LoopOptions& options,
+                            const MonteCarloOptions& mc, MonteCarloSummary* summary, std::string* error,
+                            const std::function<void(int, int)>& progress) {
   if (!mc.IsValid(error)) return false;
   if (!nominal.tf.IsValid(error) || nominal.tf.den.empty()) return false;
   if (nominal.delay_s != 0.0 && !nominal.model) {
@@ -182,7 +185,10 @@ bool RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, 
   evaluation::EvaluateOptions what;
   what.compute_iae_continuous = false;
   what.compute_step_info = mc.overshoot;
-  if (!evaluation::Evaluate(nominal, gains, options, what, &nominal_ev, error)) return false;
+  if (const Status st = evaluation::Evaluate(nominal, gains, options, what, &nominal_ev); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   *summary = MonteCarloSummary();
   summary->samples = mc.samples;
   summary->perturbed = PerturbedText(nominal, stepper);
@@ -196,8 +202,8 @@ bool RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, 
     LoopAnalysis a;
     if (p.tf.den.empty()) {
       ++summary->invalid;
-    } else if (evaluation::Evaluate(p, gains, options, what, &ev, nullptr) && ev.stability.stable &&
-               AnalyzeLoop(p, gains, options, ao, &a, nullptr)) {
+    } else if (evaluation::Evaluate(p, gains, options, what, &ev).ok() && ev.stability.stable &&
+               AnalyzeLoop(p, gains, options, ao, &a).ok()) {
       ++summary->stable;
       iae.push_back(ev.iae);
       if (ev.step.valid) overshoot.push_back(ev.step.overshoot_pct);
@@ -210,6 +216,17 @@ bool RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, 
   summary->overshoot_pct = Summarize(overshoot);
   summary->ms = Summarize(ms);
   return true;
+}
+
+}  // namespace
+
+Status RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, const PidGains& gains,
+                     const evaluation::LoopOptions& options, const MonteCarloOptions& mc,
+                     MonteCarloSummary* summary, const std::function<void(int, int)>& progress) {
+  std::string why;
+  if (!RunMonteCarloOrExplain(nominal, stepper, gains, options, mc, summary, &why, progress))
+    return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::analysis

@@ -173,8 +173,8 @@ const transport::TransportCounters& EpisodeClient::counters() const { return tra
 evaluation::SampledRunner EpisodeClient::AsRunner() {
   return [this](const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
                 const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                std::vector<evaluation::SampledStep>* trajectory, std::string* error) {
-    return Run(plant, gains, options, disturbance, y_all, trajectory, error);
+                std::vector<evaluation::SampledStep>* trajectory) {
+    return Run(plant, gains, options, disturbance, y_all, trajectory);
   };
 }
 
@@ -312,9 +312,19 @@ bool EpisodeClient::RunOnce(const transport::EpisodeSpec& spec, std::string* err
   return ok;
 }
 
-bool EpisodeClient::Run(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
-                        const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                        std::vector<evaluation::SampledStep>* trajectory, std::string* error) {
+Status EpisodeClient::Run(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
+                          const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                          std::vector<evaluation::SampledStep>* trajectory) {
+  std::string why;
+  if (!RunOrExplain(plant, gains, options, disturbance, y_all, trajectory, &why))
+    return Status::RunnerFailed(why);
+  return Status::Ok();
+}
+
+bool EpisodeClient::RunOrExplain(const Plant& plant, const PidGains& gains,
+                                 const evaluation::LoopOptions& options,
+                                 const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                                 std::vector<evaluation::SampledStep>* trajectory, std::string* error) {
   transport::EpisodeSpec spec;
   try {
     spec = MakeEpisodeSpec(transport::NewEpisodeId(), plant, gains, options, disturbance, options_.recovery);

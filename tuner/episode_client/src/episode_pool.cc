@@ -74,8 +74,9 @@ bool EpisodePool::Run(const Plant& plant, const PidGains& gains, const evaluatio
       std::lock_guard<std::mutex> lock(mutex_);
       if (!trio.alive) continue;  // left out while we waited
     }
-    std::string why;
-    if (trio.client->Run(plant, gains, options, disturbance, y_all, trajectory, &why)) return true;
+    const Status ran = trio.client->Run(plant, gains, options, disturbance, y_all, trajectory);
+    if (ran.ok()) return true;
+    const std::string why = ran.message();
     if (!trio.client->last_failure_retryable()) {
       if (error) *error = why;
       return false;
@@ -94,8 +95,10 @@ bool EpisodePool::Run(const Plant& plant, const PidGains& gains, const evaluatio
 evaluation::SampledRunner EpisodePool::AsRunner() {
   return [this](const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
                 const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                std::vector<evaluation::SampledStep>* trajectory, std::string* error) {
-    return Run(plant, gains, options, disturbance, y_all, trajectory, error);
+                std::vector<evaluation::SampledStep>* trajectory) {
+    std::string why;
+    if (!Run(plant, gains, options, disturbance, y_all, trajectory, &why)) return Status::RunnerFailed(why);
+    return Status::Ok();
   };
 }
 

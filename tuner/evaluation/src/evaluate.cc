@@ -210,7 +210,7 @@ void FinishScores(const Plant& plant, const PidGains& gains, const LoopOptions& 
 }
 
 // Checked, started, stability of the sampled loop: the common head of
-// EvaluateLoop and EvaluateSampledRun. *gains are the loop's.
+// Evaluate and EvaluateSampledRun. *gains are the loop's.
 Status StartSampled(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
                     PidGains* gains, Evaluation* ev) {
   const Status checked = CheckLoop(plant, typed_gains, options, gains);
@@ -223,22 +223,22 @@ Status StartSampled(const Plant& plant, const PidGains& typed_gains, const LoopO
 
 }  // namespace
 
-bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
-                             const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                             std::vector<SampledStep>* trajectory, std::string* /*error*/) {
+Status RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                               const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                               std::vector<SampledStep>* trajectory) {
   const PidOptions pid = options.Pid();
   if (plant.nonlinear) {
     NonlinearStepperPlant motor(*plant.nonlinear, options.dt_s);
     RunNonlinearSampledLoop(&motor, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
                             trajectory, options.reference, options.measurement_noise);
-    return true;
+    return Status::Ok();
   }
   const DiscretePlant discrete = SampledPlant(plant, options.dt_s);
   // A diverged loop (PidStatus::kInvalidInput) is not an error here: its
   // non-finite samples make every objective +inf, as for an unstable loop.
   RunSampledLoop<double>(discrete, gains, pid, Disturbance(disturbance), options.TotalSteps(), 1, y_all,
                          trajectory, options.reference, options.measurement_noise);
-  return true;
+  return Status::Ok();
 }
 
 Status RunSampled(const Plant& plant, const PidGains& gains, const LoopOptions& options,
@@ -257,14 +257,14 @@ Status RunSampled(const Plant& plant, const PidGains& gains, const LoopOptions& 
     const SampledRunner& backend = runner ? runner : SampledRunner(RunSampledLoopInProcess);
     // A backend's nonlinear run always keeps its steps: the motor is re-driven by them.
     const bool steps = record_trajectory || plant.nonlinear;
-    if (!backend(plant, gains, options, options.disturbance, &run->y, steps ? &run->trajectory : nullptr,
-                 &error))
-      return Status::RunnerFailed(error);
+    const Status ran =
+        backend(plant, gains, options, options.disturbance, &run->y, steps ? &run->trajectory : nullptr);
+    if (!ran.ok()) return Status::RunnerFailed(ran.message());
   }
   if (has_disturbance) {
     const SampledRunner& backend = runner ? runner : SampledRunner(RunSampledLoopInProcess);
-    if (!backend(plant, gains, options, DisturbanceOptions{}, &run->y_undisturbed, nullptr, &error))
-      return Status::RunnerFailed(error);
+    const Status ran = backend(plant, gains, options, DisturbanceOptions{}, &run->y_undisturbed, nullptr);
+    if (!ran.ok()) return Status::RunnerFailed(ran.message());
   }
   return Status::Ok();
 }
@@ -287,8 +287,8 @@ Status EvaluateSampledRun(const Plant& plant, const PidGains& typed_gains, const
   return Status::Ok();
 }
 
-Status EvaluateLoop(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
-                    const EvaluateOptions& what, Evaluation* ev, const SampledRunner& runner) {
+Status Evaluate(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
+                const EvaluateOptions& what, Evaluation* ev, const SampledRunner& runner) {
   PidGains gains;
   if (options.loop == LoopKind::kContinuous) {
     const Status checked = CheckLoop(plant, typed_gains, options, &gains);
@@ -309,14 +309,6 @@ Status EvaluateLoop(const Plant& plant, const PidGains& typed_gains, const LoopO
   }
   FinishScores(plant, gains, options, what, ev);
   return Status::Ok();
-}
-
-bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options,
-              const EvaluateOptions& what, Evaluation* evaluation, std::string* error,
-              const SampledRunner& runner) {
-  const Status s = EvaluateLoop(plant, gains, options, what, evaluation, runner);
-  if (!s.ok() && error) *error = s.message();
-  return s.ok();
 }
 
 }  // namespace pidlab::evaluation

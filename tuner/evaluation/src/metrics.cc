@@ -546,12 +546,10 @@ double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {
   if (!SampledLoopIsStable(*discrete_, gains, options_.pid, options_.stability_margin)) return kInf;
   if (runner_ || kind_ == ObjectiveKind::kIaeContinuous || plant_.nonlinear) {
     if (plant_.nonlinear && !runner_) {
-      std::string error;
-      RunSampledLoopInProcess(plant_, gains, options_, options_.disturbance, &y, nullptr, &error);
+      RunSampledLoopInProcess(plant_, gains, options_, options_.disturbance, &y, nullptr);
     } else if (runner_) {
-      std::string error;
-      if (!runner_(plant_, gains, options_, options_.disturbance, &y, nullptr, &error))
-        throw std::runtime_error("sampled-loop runner failed: " + error);
+      if (const Status ran = runner_(plant_, gains, options_, options_.disturbance, &y, nullptr); !ran.ok())
+        throw std::runtime_error("sampled-loop runner failed: " + ran.message());
     } else if (RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(), 1,
                                       &y, nullptr, options_.reference) == PidStatus::kInvalidInput) {
       return kInf;

@@ -76,9 +76,8 @@ Score ScoreGains(const Plant& plant, const PidGains& g, const LoopOptions& loop)
   if (!std::isfinite(sum)) return s;
   s.load_iae = loop.sample_time_s * sum;
   analysis::LoopAnalysis a;
-  std::string error;
-  if (!analysis::AnalyzeLoop(plant, evaluation::LoopGains(g, loop), loop, analysis::LoopAnalysisOptions{}, &a,
-                             &error) ||
+  if (!analysis::AnalyzeLoop(plant, evaluation::LoopGains(g, loop), loop, analysis::LoopAnalysisOptions{}, &a)
+           .ok() ||
       !a.stable)
     return s;
   s.ms = a.ms;
@@ -118,7 +117,7 @@ TuneSummary Search(const Plant& plant, const LoopOptions& loop, const BatchOptio
   }
   TuneSummary s;
   std::string error;
-  if (!Tune(plant, t, &s, &error)) s.message = error;
+  if (const Status st = Tune(plant, t, &s); !st.ok()) s.message = st.message();
   return s;
 }
 
@@ -131,9 +130,9 @@ PidGains DetunedAmigo(const Plant& plant, const PidGains& amigo, const LoopOptio
   const auto scaled = [&amigo](double c) { return PidGains{c * amigo.kp, c * amigo.ki, c * amigo.kd, 0.0}; };
   const auto meets = [&](double c) {
     analysis::LoopAnalysis a;
-    std::string error;
     return analysis::AnalyzeLoop(plant, evaluation::LoopGains(scaled(c), loop), loop,
-                                 analysis::LoopAnalysisOptions{}, &a, &error) &&
+                                 analysis::LoopAnalysisOptions{}, &a)
+               .ok() &&
            a.stable && a.ms <= o.max_ms;
   };
   double lo = 0.0, hi = 1.0;

@@ -251,8 +251,8 @@ Status MigoMsForPhaseMargin(const Plant& plant, double phase_margin_deg, MigoOpt
     MigoDesign d;
     analysis::LoopAnalysis a;
     if (!DesignMigo(plant, o, &d).ok() ||
-        !analysis::AnalyzeLoop(plant, d.gains, evaluation::LoopOptions{}, analysis::LoopAnalysisOptions{}, &a,
-                               nullptr) ||
+        !analysis::AnalyzeLoop(plant, d.gains, evaluation::LoopOptions{}, analysis::LoopAnalysisOptions{}, &a)
+             .ok() ||
         !a.stable)
       return false;
     *pm = std::isfinite(a.phase_margin_deg) ? a.phase_margin_deg : 180.0;
@@ -371,8 +371,8 @@ Status DesignMigoUncached(const Plant& plant, const MigoOptions& options, MigoDe
   // check, and where it fails, the largest stable ki below (bisection).
   const auto stable = [&plant](const PidGains& g) {
     analysis::LoopAnalysis a;
-    return analysis::AnalyzeLoop(plant, g, evaluation::LoopOptions{}, analysis::LoopAnalysisOptions{}, &a,
-                                 nullptr) &&
+    return analysis::AnalyzeLoop(plant, g, evaluation::LoopOptions{}, analysis::LoopAnalysisOptions{}, &a)
+               .ok() &&
            a.stable;
   };
   bool unstable_at_max = false;
@@ -416,12 +416,13 @@ Status DesignMigoUncached(const Plant& plant, const MigoOptions& options, MigoDe
 
 Status MigoSetpointWeights(const Plant& plant, const evaluation::LoopOptions& loop,
                            const MigoOptions& options, MigoDesign* design, TwoDofSummary* two_dof) {
-  std::string error;
   evaluation::LoopOptions l = loop;
   l.pid.derivative_filter_s = 0.0;
   l.derivative_filter_ratio = 0.0;  // the design's own tf
-  if (!SetpointWeightForOvershoot(plant, design->gains, l, 0.0, options.max_overshoot_pct, two_dof, &error))
-    return Status::InvalidInput(error);
+  if (const Status st =
+          SetpointWeightForOvershoot(plant, design->gains, l, 0.0, options.max_overshoot_pct, two_dof);
+      !st.ok())
+    return st;
   design->b = two_dof->b;
   design->c = two_dof->c;
   return Status::Ok();

@@ -156,7 +156,10 @@ bool IsModelPlant(const std::string& plant, std::string* path) {
   return true;
 }
 
-bool ReadModelFile(const std::string& path, Plant* plant, std::string* error) {
+namespace {
+
+// ReadModelFile() with the refusal's message in *error.
+bool ReadModelFileOrExplain(const std::string& path, Plant* plant, std::string* error) {
   std::string text;
   nlohmann::json j;
   std::string why;
@@ -182,6 +185,14 @@ bool ReadModelFile(const std::string& path, Plant* plant, std::string* error) {
   p.model = std::move(m);
   *plant = std::move(p);
   return true;
+}
+
+}  // namespace
+
+Status ReadModelFile(const std::string& path, Plant* plant) {
+  std::string why;
+  if (!ReadModelFileOrExplain(path, plant, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::tune

@@ -86,18 +86,18 @@ Status BuildEvaluation(const spec::EvaluateSpec& s, const BuildOptions& options,
 Status RunEvaluation(const EvaluationProblem& problem, const EvaluationRunOptions& options,
                      EvaluationResult* result) {
   EvaluationResult r;
-  const Status evaluated = evaluation::EvaluateLoop(problem.plant, problem.gains, problem.loop, options.what,
-                                                    &r.evaluation, options.runner);
+  const Status evaluated = evaluation::Evaluate(problem.plant, problem.gains, problem.loop, options.what,
+                                                &r.evaluation, options.runner);
   if (!evaluated.ok()) return evaluated;
-  std::string error;
-  if (!analysis::AnalyzeLoop(problem.plant, problem.gains, problem.loop, analysis::LoopAnalysisOptions{},
-                             &r.analysis, &error))
-    return Status::InvalidInput(error);
+  const Status analysed = analysis::AnalyzeLoop(problem.plant, problem.gains, problem.loop,
+                                                analysis::LoopAnalysisOptions{}, &r.analysis);
+  if (!analysed.ok()) return analysed;
   if (problem.HasMonteCarlo() && options.monte_carlo) {
     const StepperMotorParameters* motor = problem.plant.name == "stepper_motor" ? &problem.stepper : nullptr;
-    if (!analysis::RunMonteCarlo(problem.plant, motor, problem.gains, problem.loop, problem.monte_carlo,
-                                 &r.monte_carlo, &error, options.monte_carlo_progress))
-      return Status::InvalidInput(error);
+    const Status drawn =
+        analysis::RunMonteCarlo(problem.plant, motor, problem.gains, problem.loop, problem.monte_carlo,
+                                &r.monte_carlo, options.monte_carlo_progress);
+    if (!drawn.ok()) return drawn;
     r.monte_carlo_ran = true;
   }
   *result = std::move(r);
@@ -169,7 +169,7 @@ Status CheckSampledController(const spec::EvaluateSpec& s, NameStyle style, Samp
   what.compute_step_info = false;
   what.compute_iae_continuous = false;
   evaluation::Evaluation ev;
-  if (Status run = evaluation::EvaluateLoop(problem.plant, problem.gains, problem.loop, what, &ev); !run.ok())
+  if (Status run = evaluation::Evaluate(problem.plant, problem.gains, problem.loop, what, &ev); !run.ok())
     return run;
   double modulus = 0.0;
   const std::string pole = LargestPole(ev.stability, &modulus);
@@ -212,7 +212,7 @@ TimeScale DerivedTimeScale(const spec::TuningSpec& s, const Plant& plant) {
   std::string from = "the plant's own time constants";
   if (!plant.nonlinear && DesignMigo(plant, o, &design).ok()) {
     evaluation::LoopOptions loop;
-    if (analysis::AnalyzeLoop(plant, design.gains, loop, analysis::LoopAnalysisOptions{}, &a, nullptr) &&
+    if (analysis::AnalyzeLoop(plant, design.gains, loop, analysis::LoopAnalysisOptions{}, &a).ok() &&
         a.stable && std::isfinite(a.slowest_time_constant_s) && design.crossover_rad_s > 0.0) {
       slowest = a.slowest_time_constant_s;
       fastest = std::min(fastest, 1.0 / design.crossover_rad_s);
@@ -238,7 +238,7 @@ double DefaultRobustness(const Plant& plant, std::string* why) {
   evaluation::LoopOptions loop;
   loop.derivative_filter_ratio = kMigoFilterRatio;
   if (plant.nonlinear || !ApplyTuningRule(plant, TuningRule::kSimc, RuleForm::kPid, &simc).ok() ||
-      !analysis::AnalyzeLoop(plant, simc.gains, loop, analysis::LoopAnalysisOptions{}, &a, nullptr) ||
+      !analysis::AnalyzeLoop(plant, simc.gains, loop, analysis::LoopAnalysisOptions{}, &a).ok() ||
       !a.stable || !std::isfinite(a.ms)) {
     *why = "at most " + spec::FormatNumber(kMigoMaxDefaultMs) + " (SIMC does not apply to this plant)";
     return kMigoMaxDefaultMs;
@@ -368,11 +368,10 @@ Status RunTuning(const TuningProblem& problem, const TuningRunOptions& options, 
   TuningResult r;
   TuneOptions o = problem.options;
   if (options.parallel_for) o.parallel_for = options.parallel_for;
-  std::string error;
-  bool tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
+  Status tuned = Tune(problem.plant, o, &r.summary, options.progress, options.runner);
   // A PID that cannot be evaluated (an ideal derivative on relative degree 1
   // with dead time: every loop neutral) gets the best filtered PID instead.
-  if (tuned && !r.summary.stable && !IsTuningRule(o.method) && o.method != TuneMethod::kMigo &&
+  if (tuned.ok() && !r.summary.stable && !IsTuningRule(o.method) && o.method != TuneMethod::kMigo &&
       IdealDerivativeMakesLoopNeutral(problem.plant, o)) {
     o.loop.pid.derivative_filter_s = 0.0;
     o.loop.derivative_filter_ratio = kMigoFilterRatio;
@@ -381,32 +380,32 @@ Status RunTuning(const TuningProblem& problem, const TuningRunOptions& options, 
         "time): tuned the best filtered PID instead, tf = Td / " +
         spec::FormatNumber(kMigoFilterRatio) + " (--derivative-filter-ratio " +
         spec::FormatNumber(kMigoFilterRatio) + ")";
-    tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
+    tuned = Tune(problem.plant, o, &r.summary, options.progress, options.runner);
   }
   // An optimum on the edge of a box nobody gave is the box's, not the
   // plant's: tenfold wider, at most twice (in process; over the trio, and on
   // the paper's plants, whose box is the paper's, the edge is reported).
-  while (tuned && r.summary.stable && problem.box.source != "given" && !IsPaperPlant(problem.spec.plant) &&
-         !IsTuningRule(o.method) &&
-         !options.runner && AtAnUpperEdge(r.summary) && r.widened_from.size() < 2 && o.upper < kMaxGain) {
+  while (tuned.ok() && r.summary.stable && problem.box.source != "given" &&
+         !IsPaperPlant(problem.spec.plant) && !IsTuningRule(o.method) && !options.runner &&
+         AtAnUpperEdge(r.summary) && r.widened_from.size() < 2 && o.upper < kMaxGain) {
     r.widened_from.push_back(o.upper);
     o.upper = std::min(10.0 * o.upper, kMaxGain);
-    tuned = Tune(problem.plant, o, &r.summary, &error, options.progress, options.runner);
+    tuned = Tune(problem.plant, o, &r.summary, options.progress, options.runner);
   }
   r.box_upper = o.upper;
   r.options = o;
-  if (tuned && r.summary.stable) {
+  if (tuned.ok() && r.summary.stable) {
     // With two_dof, the loop with the setpoint weights found.
     r.loop = WithSetpointWeights(o.loop, r.summary.two_dof);
-    const Status evaluated = evaluation::EvaluateLoop(problem.plant, r.summary.gains, r.loop,
-                                                      evaluation::EvaluateOptions{}, &r.evaluation);
+    const Status evaluated = evaluation::Evaluate(problem.plant, r.summary.gains, r.loop,
+                                                  evaluation::EvaluateOptions{}, &r.evaluation);
     if (!evaluated.ok()) return evaluated;
-    if (!analysis::AnalyzeLoop(problem.plant, r.summary.gains, r.loop, analysis::LoopAnalysisOptions{},
-                               &r.analysis, &error))
-      return Status::InvalidInput(error);
+    const Status analysed = analysis::AnalyzeLoop(problem.plant, r.summary.gains, r.loop,
+                                                  analysis::LoopAnalysisOptions{}, &r.analysis);
+    if (!analysed.ok()) return analysed;
   }
   *result = std::move(r);
-  return Checked(tuned, error);
+  return tuned;
 }
 
 }  // namespace pidlab::tune

@@ -55,7 +55,7 @@ std::pair<std::string, std::string> FirstBroken(const Plant& plant, const TuneOp
   analysis::LoopAnalysisOptions coarse;
   coarse.points_per_decade = 20.0;
   analysis::LoopAnalysis a;
-  if (!analysis::AnalyzeLoop(plant, g, options.loop, coarse, &a, nullptr) || !a.stable)
+  if (!analysis::AnalyzeLoop(plant, g, options.loop, coarse, &a).ok() || !a.stable)
     return Unstable(plant, options);
   for (const std::string& v : analysis::LoopBoundsViolations(a, options.bounds))
     for (const Rule& r : kBoundRules)
@@ -66,7 +66,7 @@ std::pair<std::string, std::string> FirstBroken(const Plant& plant, const TuneOp
   evaluation::Evaluation ev;
   evaluation::EvaluateOptions what;
   what.compute_iae_continuous = false;
-  if (!evaluation::Evaluate(plant, typed, undisturbed, what, &ev, nullptr) || !ev.step.valid)
+  if (!evaluation::Evaluate(plant, typed, undisturbed, what, &ev).ok() || !ev.step.valid)
     return {"without a step response to measure", "--horizon longer"};
   if (ev.step.overshoot_pct > options.max_overshoot_pct)
     return {"above --max-overshoot", "raise --max-overshoot, or --two-dof"};

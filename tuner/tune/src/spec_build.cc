@@ -127,10 +127,10 @@ bool BuildPlantModel(const spec::PlantSpec& s, NameStyle style, Plant* out, std:
   if (!BuildStepperParameters(s, style, &sp, error)) return false;
   std::string path;
   if (IsModelPlant(s.plant, &path)) {
-    std::string why;
     if (path.empty()) return Bad(error, name("plant") + " " + Quote(s.plant) + " needs a file: model:FILE");
-    if (!ReadModelFile(path, out, &why))
-      return Bad(error, name("plant") + " " + Quote(s.plant) + ": model file " + Quote(path) + " " + why);
+    if (const Status st = ReadModelFile(path, out); !st.ok())
+      return Bad(error,
+                 name("plant") + " " + Quote(s.plant) + ": model file " + Quote(path) + " " + st.message());
     return true;
   }
   // A plant name is printable and short, so Truncate leaves every valid one

@@ -23,7 +23,7 @@ TimeScale Framed(const Plant& plant, const std::vector<PidGains>& gains, evaluat
     evaluation::Evaluation ev;
     evaluation::EvaluateOptions what;
     what.compute_iae_continuous = false;
-    if (!evaluation::Evaluate(plant, g, loop, what, &ev, nullptr) || !ev.step.valid ||
+    if (!evaluation::Evaluate(plant, g, loop, what, &ev).ok() || !ev.step.valid ||
         !std::isfinite(ev.step.settling_time_s))
       return t;
     settling = std::max(settling, ev.step.settling_time_s);
@@ -48,9 +48,8 @@ TimeScale GainsTimeScale(const Plant& plant, const std::vector<PidGains>& gains,
   bool analysed = false;
   for (const PidGains& g : gains) {
     analysis::LoopAnalysis a;
-    if (plant.nonlinear ||
-        !analysis::AnalyzeLoop(plant, g, loop, analysis::LoopAnalysisOptions{}, &a, nullptr) || !a.stable ||
-        !std::isfinite(a.slowest_time_constant_s) || !(a.slowest_time_constant_s > 0.0))
+    if (plant.nonlinear || !analysis::AnalyzeLoop(plant, g, loop, analysis::LoopAnalysisOptions{}, &a).ok() ||
+        !a.stable || !std::isfinite(a.slowest_time_constant_s) || !(a.slowest_time_constant_s > 0.0))
       continue;
     analysed = true;
     loop_slowest = std::max(loop_slowest, a.slowest_time_constant_s);

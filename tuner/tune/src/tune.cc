@@ -61,7 +61,7 @@ bool MeetsBounds(const Plant& plant, const StateSpace& realization, const TuneOp
     bounds.max_time_constant_s = std::numeric_limits<double>::infinity();
   }
   analysis::LoopAnalysis a;
-  if (!analysis::AnalyzeLoop(plant, g, options.loop, coarse, &a, nullptr) ||
+  if (!analysis::AnalyzeLoop(plant, g, options.loop, coarse, &a).ok() ||
       !analysis::LoopBoundsViolation(a, bounds).empty())
     return false;
   if (!delayed_continuous || !std::isfinite(options.bounds.max_time_constant_s)) return true;
@@ -94,7 +94,7 @@ optim::ObjectiveFunction ConstrainedObjective(const Plant& plant, const TuneOpti
     evaluation::Evaluation ev;
     evaluation::EvaluateOptions what;
     what.compute_iae_continuous = false;
-    if (!evaluation::Evaluate(plant, g, undisturbed, what, &ev, nullptr) || !ev.step.valid) return HUGE_VAL;
+    if (!evaluation::Evaluate(plant, g, undisturbed, what, &ev).ok() || !ev.step.valid) return HUGE_VAL;
     if (ev.step.overshoot_pct > options.max_overshoot_pct) return HUGE_VAL;
     if (ev.step.settling_time_s > options.max_settling_time_s) return HUGE_VAL;
     return value;
@@ -249,7 +249,11 @@ bool Search(const Plant& plant, const TuneOptions& options, const optim::Objecti
       break;
     }
     case TuneMethod::kZieglerNichols: {
-      if (!ZieglerNicholsTune(plant.tf, options.zn_rule, &summary->ziegler_nichols, error)) return false;
+      if (const Status st = ZieglerNicholsTune(plant.tf, options.zn_rule, &summary->ziegler_nichols);
+          !st.ok()) {
+        if (error) *error = st.message();
+        return false;
+      }
       RuleResult(summary->ziegler_nichols.gains, evaluator, summary->ziegler_nichols.message, &opt);
       break;
     }
@@ -368,8 +372,11 @@ bool TuneApplies(const Plant& plant, const TuneOptions& options, bool custom_run
 
 }  // namespace
 
-bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
-          const optim::ProgressCallback& progress, const evaluation::SampledRunner& runner) {
+namespace {
+
+// Tune() with the refusal's message in *error.
+bool TuneOrExplain(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
+                   const optim::ProgressCallback& progress, const evaluation::SampledRunner& runner) {
   const auto start_time = std::chrono::steady_clock::now();
   *summary = TuneSummary();
   summary->method = options.method;
@@ -416,10 +423,24 @@ bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, 
   summary->refine.gains = evaluation::LoopGains(summary->refine.gains, options.loop);
   if (!IsTuningRule(options.method))
     summary->at_bounds = GainsAtBounds(summary->gains, options.lower, options.upper);
-  if (options.two_dof && !TuneSetpointWeights(plant, summary->gains, options.loop, &summary->two_dof, error))
-    return false;
+  if (options.two_dof) {
+    if (const Status st = TuneSetpointWeights(plant, summary->gains, options.loop, &summary->two_dof);
+        !st.ok()) {
+      if (error) *error = st.message();
+      return false;
+    }
+  }
   summary->wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return true;
+}
+
+}  // namespace
+
+Status Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary,
+            const optim::ProgressCallback& progress, const evaluation::SampledRunner& runner) {
+  std::string error;
+  if (!TuneOrExplain(plant, options, summary, &error, progress, runner)) return Status::InvalidInput(error);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::tune

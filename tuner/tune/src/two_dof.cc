@@ -30,7 +30,7 @@ double SetpointIae(const Plant& plant, const PidGains& gains, const evaluation::
   what.compute_iae_continuous = false;
   what.compute_load_iae = false;
   evaluation::Evaluation ev;
-  if (!evaluation::Evaluate(plant, gains, o, what, &ev, nullptr) || !ev.stability.stable) return kInf;
+  if (!evaluation::Evaluate(plant, gains, o, what, &ev).ok() || !ev.stability.stable) return kInf;
   return std::isfinite(ev.iae) ? ev.iae : kInf;
 }
 
@@ -45,7 +45,10 @@ bool Respond(const Plant& plant, const PidGains& gains, const evaluation::LoopOp
   evaluation::EvaluateOptions what;
   what.compute_load_iae = feedback == nullptr;
   evaluation::Evaluation ev;
-  if (!evaluation::Evaluate(plant, gains, o, what, &ev, error)) return false;
+  if (const Status st = evaluation::Evaluate(plant, gains, o, what, &ev); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   r->b = b;
   r->c = c;
   r->setpoint_iae = ev.iae;
@@ -58,7 +61,11 @@ bool Respond(const Plant& plant, const PidGains& gains, const evaluation::LoopOp
     return true;
   }
   analysis::LoopAnalysis a;
-  if (!analysis::AnalyzeLoop(plant, gains, o, analysis::LoopAnalysisOptions{}, &a, error)) return false;
+  if (const Status st = analysis::AnalyzeLoop(plant, gains, o, analysis::LoopAnalysisOptions{}, &a);
+      !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   r->load_iae = ev.load_iae;
   r->ms = a.ms;
   return true;
@@ -66,8 +73,12 @@ bool Respond(const Plant& plant, const PidGains& gains, const evaluation::LoopOp
 
 }  // namespace
 
-bool TuneSetpointWeights(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& loop,
-                         TwoDofSummary* summary, std::string* error) {
+namespace {
+
+// TuneSetpointWeights() with the refusal's message in *error.
+bool TuneSetpointWeightsOrExplain(const Plant& plant, const PidGains& gains,
+                                  const evaluation::LoopOptions& loop, TwoDofSummary* summary,
+                                  std::string* error) {
   *summary = TwoDofSummary();
   const double b0 = loop.pid.setpoint_weight_b, c0 = loop.pid.setpoint_weight_c;
   if (!Respond(plant, gains, loop, b0, c0, &summary->before, error)) return false;
@@ -108,9 +119,22 @@ bool TuneSetpointWeights(const Plant& plant, const PidGains& gains, const evalua
   return true;
 }
 
-bool SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
-                                const evaluation::LoopOptions& loop, double c, double max_overshoot_pct,
-                                TwoDofSummary* summary, std::string* error) {
+}  // namespace
+
+Status TuneSetpointWeights(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& loop,
+                           TwoDofSummary* summary) {
+  std::string why;
+  if (!TuneSetpointWeightsOrExplain(plant, gains, loop, summary, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
+}
+
+namespace {
+
+// SetpointWeightForOvershoot() with the refusal's message in *error.
+bool SetpointWeightForOvershootOrExplain(const Plant& plant, const PidGains& gains,
+                                         const evaluation::LoopOptions& loop, double c,
+                                         double max_overshoot_pct, TwoDofSummary* summary,
+                                         std::string* error) {
   *summary = TwoDofSummary();
   if (!Respond(plant, gains, loop, 1.0, c, &summary->before, error)) return false;
   summary->evaluations = 1;
@@ -125,7 +149,7 @@ bool SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
       what.compute_load_iae = false;
       evaluation::Evaluation ev;
       ++summary->evaluations;
-      if (!evaluation::Evaluate(plant, gains, o, what, &ev, nullptr) || !ev.stability.stable) return kInf;
+      if (!evaluation::Evaluate(plant, gains, o, what, &ev).ok() || !ev.stability.stable) return kInf;
       return ev.step.overshoot_pct;
     };
     double lo = 0.0, hi = 1.0;
@@ -144,6 +168,17 @@ bool SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
   summary->message = os.str();
   summary->ran = true;
   return true;
+}
+
+}  // namespace
+
+Status SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
+                                  const evaluation::LoopOptions& loop, double c, double max_overshoot_pct,
+                                  TwoDofSummary* summary) {
+  std::string why;
+  if (!SetpointWeightForOvershootOrExplain(plant, gains, loop, c, max_overshoot_pct, summary, &why))
+    return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 evaluation::LoopOptions WithSetpointWeights(evaluation::LoopOptions loop, const TwoDofSummary& summary) {

@@ -248,8 +248,11 @@ std::string ToString(ZieglerNicholsRule rule) {
   return "classic";
 }
 
-bool ZieglerNicholsTune(const TransferFunction& tf, ZieglerNicholsRule rule, ZieglerNicholsResult* result,
-                        std::string* error) {
+namespace {
+
+// ZieglerNicholsTune() with the refusal's message in *error.
+bool ZieglerNicholsTuneOrExplain(const TransferFunction& tf, ZieglerNicholsRule rule,
+                                 ZieglerNicholsResult* result, std::string* error) {
   *result = ZieglerNicholsResult{};
   auto not_applicable = [&](const std::string& why) {
     result->applicable = false;
@@ -288,6 +291,14 @@ bool ZieglerNicholsTune(const TransferFunction& tf, ZieglerNicholsRule rule, Zie
                             &result->message);
   if (error) error->clear();
   return true;
+}
+
+}  // namespace
+
+Status ZieglerNicholsTune(const TransferFunction& tf, ZieglerNicholsRule rule, ZieglerNicholsResult* result) {
+  std::string why;
+  if (!ZieglerNicholsTuneOrExplain(tf, rule, result, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::tune

@@ -35,6 +35,7 @@
 
 #include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/evaluation/loop_frequency.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::analysis {
 
@@ -110,17 +111,17 @@ struct LoopAnalysis {
 using evaluation::NyquistCount;
 
 /// The Nyquist count of the continuous loop of `plant` (with plant.delay_s)
-/// with `gains` (LoopGains of `options`). False with *error for invalid input,
-/// as AnalyzeLoop.
-bool CountNyquist(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
-                  NyquistCount* count, std::string* error);
+/// with `gains` (LoopGains of `options`). kInvalidInput naming the value for
+/// invalid input, as AnalyzeLoop.
+Status CountNyquist(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
+                    NyquistCount* count);
 
 /// Analyses the loop of `plant` with `gains` (LoopGains of `options`) for
-/// options.loop. False with *error for invalid input (as Evaluate). An
-/// unstable loop is not an error: analysis->stable is false and only the
-/// poles' time constant and cancellations are filled.
-bool AnalyzeLoop(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
-                 const LoopAnalysisOptions& analysis_options, LoopAnalysis* analysis, std::string* error);
+/// options.loop. kInvalidInput naming the value for invalid input (as
+/// Evaluate). An unstable loop is not an error: analysis->stable is false
+/// and only the poles' time constant and cancellations are filled.
+Status AnalyzeLoop(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
+                   const LoopAnalysisOptions& analysis_options, LoopAnalysis* analysis);
 
 /// The loop at one frequency: L = C G, S = 1/(1+L), T = L/(1+L) and the
 /// noise gain's C S (the report's Bode and Nyquist figures, the workbench's plots).
@@ -136,10 +137,10 @@ struct LoopFrequencyPoint {
 /// (the DiscretePid and the exact ZOH plant, as AnalyzeLoop; 0 < w <= pi/dt).
 /// S, T and C S are computed as b/(a+b), a/(a+b) and c/(a+b) from L = a/b,
 /// so they stay finite where L has a pole on the axis (L infinite, S = 0,
-/// T = 1). False with *error for invalid input or a frequency out of range.
-bool LoopFrequencyResponse(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
-                           const std::vector<double>& w_rad_s, std::vector<LoopFrequencyPoint>* response,
-                           std::string* error);
+/// T = 1). kInvalidInput for invalid input or a frequency out of range.
+Status LoopFrequencyResponse(const Plant& plant, const PidGains& gains,
+                             const evaluation::LoopOptions& options, const std::vector<double>& w_rad_s,
+                             std::vector<LoopFrequencyPoint>* response);
 
 /// Bounds on a loop (+inf / 0 = none), checked by LoopBoundsViolation.
 struct LoopBounds {

@@ -27,6 +27,7 @@
 
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/evaluation/evaluation.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::analysis {
 
@@ -90,12 +91,11 @@ std::vector<Plant> DrawPlants(const Plant& nominal, const StepperMotorParameters
 /// What the draws of `nominal` perturb, in words (MonteCarloSummary::perturbed).
 std::string PerturbedText(const Plant& nominal, const StepperMotorParameters* stepper);
 
-/// Evaluates `gains` on every plant of DrawPlants. False with *error for
-/// invalid input (the nominal evaluation's errors). `progress(done, total)`
+/// Evaluates `gains` on every plant of DrawPlants. kInvalidInput for invalid
+/// input (the nominal evaluation's errors). `progress(done, total)`
 /// is called after each draw when set.
-bool RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, const PidGains& gains,
-                   const evaluation::LoopOptions& options, const MonteCarloOptions& mc,
-                   MonteCarloSummary* summary, std::string* error,
-                   const std::function<void(int, int)>& progress = nullptr);
+Status RunMonteCarlo(const Plant& nominal, const StepperMotorParameters* stepper, const PidGains& gains,
+                     const evaluation::LoopOptions& options, const MonteCarloOptions& mc,
+                     MonteCarloSummary* summary, const std::function<void(int, int)>& progress = nullptr);
 
 }  // namespace pidlab::analysis

@@ -75,11 +75,11 @@ class EpisodeClient {
   ~EpisodeClient();
 
   /// A SampledRunner: y at every step k = 0..TotalSteps() in *y_all, every
-  /// step in *trajectory when not null. False with a one-line *error naming
+  /// step in *trajectory when not null. kRunnerFailed with one line naming
   /// the silent process on failure.
-  bool Run(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
-           const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-           std::vector<evaluation::SampledStep>* trajectory, std::string* error);
+  Status Run(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
+             const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+             std::vector<evaluation::SampledStep>* trajectory);
 
   evaluation::SampledRunner AsRunner();
   const EpisodeClientStats& stats() const { return stats_; }
@@ -92,6 +92,9 @@ class EpisodeClient {
 
  private:
   struct State;
+  bool RunOrExplain(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
+                    const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                    std::vector<evaluation::SampledStep>* trajectory, std::string* error);
   bool StartEpisode(const pidlab::lcmt_episode_config& config, std::string* error);
   /// Waits for every step (asking the plant again for what was missed) from
   /// t0 on; *done_s is when the last step was heard.

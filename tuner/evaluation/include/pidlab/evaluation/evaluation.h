@@ -88,16 +88,16 @@ struct EvaluateOptions {
 /// run too) and returns y at every step k = 0..TotalSteps() in *y_all;
 /// records every step in *trajectory when it is not null. A backend other
 /// than the process itself: the LCM trio (EpisodeClient::Run), with results
-/// bit-identical to the in-process loop. False with *error if the run failed.
-using SampledRunner =
-    std::function<bool(const Plant& plant, const PidGains& gains, const LoopOptions& options,
-                       const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                       std::vector<SampledStep>* trajectory, std::string* error)>;
+/// bit-identical to the in-process loop. kRunnerFailed naming the cause if the
+/// run failed.
+using SampledRunner = std::function<Status(const Plant& plant, const PidGains& gains,
+                                           const LoopOptions& options, const DisturbanceOptions& disturbance,
+                                           std::vector<double>* y_all, std::vector<SampledStep>* trajectory)>;
 
 /// The sampled loop run in process (linear or nonlinear plant), as a SampledRunner.
-bool RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
-                             const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                             std::vector<SampledStep>* trajectory, std::string* error);
+Status RunSampledLoopInProcess(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                               const DisturbanceOptions& disturbance, std::vector<double>* y_all,
+                               std::vector<SampledStep>* trajectory);
 
 /// What one run of the sampled loop leaves, whichever backend ran it (in
 /// process, the trio, a log). Evaluation is: simulate (RunSampled, or read a
@@ -132,15 +132,8 @@ Status EvaluateSampledRun(const Plant& plant, const PidGains& gains, const LoopO
 /// invalid input, kRunnerFailed when the runner failed. An unstable loop is
 /// not an error: evaluation->stability.stable is false and the objectives
 /// are +inf.
-Status EvaluateLoop(const Plant& plant, const PidGains& gains, const LoopOptions& options,
-                    const EvaluateOptions& what, Evaluation* evaluation,
-                    const SampledRunner& runner = nullptr);
-
-/// EvaluateLoop with the message in *error: false for invalid input or a
-/// failed run.
-bool Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options,
-              const EvaluateOptions& what, Evaluation* evaluation, std::string* error,
-              const SampledRunner& runner = nullptr);
+Status Evaluate(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                const EvaluateOptions& what, Evaluation* evaluation, const SampledRunner& runner = nullptr);
 
 /// The continuous-loop objective of `gains` by the general path:
 /// BuildContinuousClosedLoop, ContinuousStability (eigenvalues), then

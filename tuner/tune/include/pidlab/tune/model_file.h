@@ -14,6 +14,7 @@
 #include <string>
 
 #include "pidlab/plant_sim/plants.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::tune {
 
@@ -29,12 +30,12 @@ inline constexpr std::size_t kMaxModelFileBytes = 1u << 20;
 bool IsModelPlant(const std::string& plant, std::string* path = nullptr);
 
 /// Reads the model file at `path` into *plant (name kModelPlantName, tf,
-/// delay_s, model). False with *error, one line without the file's name,
+/// delay_s, model). kInvalidInput with one line without the file's name,
 /// giving the reason: the file cannot be read or is not JSON, a key is
 /// missing or of the wrong type, a number is not finite, the kind is not
 /// one of ProcessModelKindNames(), a covariance that is ok is not p x p,
 /// the parameters are not a model's (ParametersAreValid), or the transfer
 /// function is not a valid, strictly proper plant.
-bool ReadModelFile(const std::string& path, Plant* plant, std::string* error);
+Status ReadModelFile(const std::string& path, Plant* plant);
 
 }  // namespace pidlab::tune

@@ -15,6 +15,7 @@
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/optim/multi_start.h"
 #include "pidlab/optim/optimizer.h"
+#include "pidlab/spec/status.h"
 #include "pidlab/tune/migo.h"
 #include "pidlab/tune/tuning_rules.h"
 #include "pidlab/tune/two_dof.h"
@@ -301,15 +302,15 @@ struct TuneSummary {
   std::string BriefReport() const;
 };
 
-/// Tunes the PID for `plant`. Returns false with *error for invalid input or
-/// when the method does not apply (e.g. Ziegler-Nichols on 1/s^2, SIMC on
-/// 1/(s^2+1), or simc and amigo on a plant with a dead time, which the loops
-/// do not simulate yet: ApplyTuningRule gives its gains); true
-/// otherwise, with summary->stable false if no strictly stable loop was found.
+/// Tunes the PID for `plant`. kInvalidInput naming the cause for invalid
+/// input or when the method does not apply (e.g. Ziegler-Nichols on 1/s^2,
+/// SIMC on 1/(s^2+1), or simc and amigo on a plant with a dead time, which the
+/// loops do not simulate yet: ApplyTuningRule gives its gains); Ok otherwise,
+/// with summary->stable false if no strictly stable loop was found.
 /// `runner` evaluates the sampled loop (episodes over the LCM trio); null: in process.
-bool Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary, std::string* error,
-          const optim::ProgressCallback& progress = nullptr,
-          const evaluation::SampledRunner& runner = nullptr);
+Status Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary,
+            const optim::ProgressCallback& progress = nullptr,
+            const evaluation::SampledRunner& runner = nullptr);
 
 /// The Ceres cross-check alone, from `start` (used by Tune).
 RefineSummary RefineWithCeres(const Plant& plant, const TuneOptions& options, const PidGains& start,

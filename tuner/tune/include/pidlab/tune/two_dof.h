@@ -11,6 +11,7 @@
 #include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/optim/optimizer.h"
 #include "pidlab/plant_sim/plants.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::tune {
 
@@ -43,18 +44,18 @@ inline constexpr int kTwoDofGridPoints = 11;
 inline constexpr int kTwoDofMaxEvaluations = 200;
 
 /// Tunes b, c for `gains` (LoopGains applied) on `loop`, run in process.
-/// False with *error when the loop cannot be evaluated; the responses of an
+/// kInvalidInput when the loop cannot be evaluated; the responses of an
 /// unstable loop are not searched (ran false, message says why).
-bool TuneSetpointWeights(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& loop,
-                         TwoDofSummary* summary, std::string* error);
+Status TuneSetpointWeights(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& loop,
+                           TwoDofSummary* summary);
 
 /// The setpoint weight b in [0, 1] with c fixed: 1 if the setpoint step's
 /// overshoot is at most `max_overshoot_pct` there, else the largest b (by
 /// bisection, 12 steps) whose overshoot is within it (tune --method migo's
 /// second stage). Fills *summary as TuneSetpointWeights does.
-bool SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
-                                const evaluation::LoopOptions& loop, double c, double max_overshoot_pct,
-                                TwoDofSummary* summary, std::string* error);
+Status SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
+                                  const evaluation::LoopOptions& loop, double c, double max_overshoot_pct,
+                                  TwoDofSummary* summary);
 
 /// `loop` with the weights of `summary` when it ran.
 evaluation::LoopOptions WithSetpointWeights(evaluation::LoopOptions loop, const TwoDofSummary& summary);

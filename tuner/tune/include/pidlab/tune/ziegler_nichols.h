@@ -7,6 +7,7 @@
 
 #include "pidlab/controller/pid.h"
 #include "pidlab/plant_sim/transfer_function.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::tune {
 
@@ -29,11 +30,10 @@ struct ZieglerNicholsResult {
   std::string message;             // why not applicable, or a one-line summary
 };
 
-/// Returns false (with *error and result->applicable = false) where the method
+/// kInvalidInput naming the reason (and result->applicable = false) where the method
 /// does not apply: e.g. 1/s^2 is marginally stable under every proportional
 /// gain, so there is no finite ultimate gain; a plant that never reaches the
 /// stability boundary under P control has none either.
-bool ZieglerNicholsTune(const TransferFunction& tf, ZieglerNicholsRule rule, ZieglerNicholsResult* result,
-                        std::string* error);
+Status ZieglerNicholsTune(const TransferFunction& tf, ZieglerNicholsRule rule, ZieglerNicholsResult* result);
 
 }  // namespace pidlab::tune
