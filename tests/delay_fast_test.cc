@@ -17,6 +17,7 @@
 #include "pidlab/evaluation/delayed_loop.h"
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/evaluation/loop_frequency.h"
+#include "test_status.h"
 
 using pidlab::evaluation::BuildDelayedClosedLoop;
 using pidlab::evaluation::ContinuousPidPolynomials;
@@ -145,7 +146,7 @@ TEST(CrossingCount, AgreesWithTheNyquistCountNearTheBoundaryOnThousandsOfRandomL
       const CrossingCount dut = Crossings(tf, g, delay);
       NyquistCount ref;
       std::string error;
-      ASSERT_TRUE(CountContinuousNyquist(tf, g, delay, 100.0, &ref, &error)) << error;
+      ASSERT_TRUE(IsOk(CountContinuousNyquist(tf, g, delay, 100.0, &ref)));
       if (dut.verdict == CrossingVerdict::kUndecided) {
         ++undecided;  // DelayedStability asks the Nyquist count
         continue;
@@ -170,7 +171,7 @@ TEST(CrossingCount, AgreesWithTheNyquistCountNearTheBoundaryOnThousandsOfRandomL
 double SampledIae(const DelayedClosedLoop& loop, double ts, int n, DelayedTrace trace) {
   std::vector<double> y;
   std::string error;
-  EXPECT_TRUE(SampleDelayedLoop(loop, Disturbance(DisturbanceOptions{}), ts, n, &y, &trace, &error)) << error;
+  EXPECT_TRUE(IsOk(SampleDelayedLoop(loop, Disturbance(DisturbanceOptions{}), ts, n, &y, &trace)));
   double sum = 0.0;
   for (double v : y) sum += std::abs(1.0 - v);
   return sum;
@@ -186,8 +187,9 @@ TEST(DelayedContinuous, ExactStepsMatchTheHermiteStoreAsItsStepShrinks) {
     const PidGains g = Scaled(RandomGains(&rng), 0.3);
     DelayedClosedLoop loop;
     std::string error;
-    ASSERT_TRUE(BuildDelayedClosedLoop(tf, Realize(tf), g, Disturbance(DisturbanceOptions{}), 1.5, 1.0, &loop,
-                                       &error))
+    ASSERT_TRUE(
+        OkInto(BuildDelayedClosedLoop(tf, Realize(tf), g, Disturbance(DisturbanceOptions{}), 1.5, 1.0, &loop),
+               &error))
         << error;
     DelayedTrace fine;
     fine.force_step_s = 1.5 / std::ceil(1.5 / (0.25 * evaluation::DelayedStepSize(loop)));
@@ -206,8 +208,9 @@ TEST(DelayedContinuous, UniformHermiteGridEqualsTheNodeByNodeIntegratorToRoundin
     const double delay = std::sqrt(2.0);
     DelayedClosedLoop loop;
     std::string error;
-    ASSERT_TRUE(BuildDelayedClosedLoop(tf, Realize(tf), g, Disturbance(DisturbanceOptions{}), delay, 1.0,
-                                       &loop, &error))
+    ASSERT_TRUE(OkInto(
+        BuildDelayedClosedLoop(tf, Realize(tf), g, Disturbance(DisturbanceOptions{}), delay, 1.0, &loop),
+        &error))
         << error;
     DelayedTrace reference;
     reference.node_by_node = true;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pidlab/evaluation/delayed_loop.h"
+#include "test_status.h"
 
 using pidlab::evaluation::BuildDelayedClosedLoop;
 using pidlab::evaluation::DelayedClosedLoop;
@@ -25,7 +26,7 @@ DelayedClosedLoop Build(const TransferFunction& tf, const PidGains& g, double de
                         double reference = 1.0) {
   DelayedClosedLoop loop;
   std::string error;
-  EXPECT_TRUE(BuildDelayedClosedLoop(tf, Realize(tf), g, d, delay, reference, &loop, &error)) << error;
+  EXPECT_TRUE(IsOk(BuildDelayedClosedLoop(tf, Realize(tf), g, d, delay, reference, &loop)));
   return loop;
 }
 
@@ -35,7 +36,7 @@ std::vector<double> RunLoop(const DelayedClosedLoop& loop, const Disturbance& d,
   DelayedTrace trace;
   trace.force_step_s = force_step_s;
   std::string error;
-  EXPECT_TRUE(SampleDelayedLoop(loop, d, ts, n, &y, &trace, &error)) << error;
+  EXPECT_TRUE(IsOk(SampleDelayedLoop(loop, d, ts, n, &y, &trace)));
   return y;
 }
 
@@ -107,14 +108,15 @@ TEST(DelayedContinuous, TheStepDividesTheDelayAndFollowsTheFastestRate) {
 TEST(DelayedContinuous, AnIdealDerivativeOnRelativeDegreeOneIsRefusedAsNeutral) {
   std::string error;
   const TransferFunction fo{{1.0}, {1.0, 1.0}};
-  EXPECT_FALSE(DelayedLoopIsRetarded(fo, {1.0, 1.0, 0.1}, &error));
+  EXPECT_FALSE(OkInto(DelayedLoopIsRetarded(fo, {1.0, 1.0, 0.1}), &error));
   EXPECT_NE(error.find("neutral"), std::string::npos) << error;
   EXPECT_NE(error.find("--derivative-filter"), std::string::npos) << error;
-  EXPECT_TRUE(DelayedLoopIsRetarded(fo, {1.0, 1.0, 0.1, 0.01}, &error)) << "a filtered derivative";
-  EXPECT_TRUE(DelayedLoopIsRetarded(TransferFunction{{1.0}, {1.0, 2.0, 1.0}}, {1.0, 1.0, 0.1}, &error));
+  EXPECT_TRUE(OkInto(DelayedLoopIsRetarded(fo, {1.0, 1.0, 0.1, 0.01}), &error)) << "a filtered derivative";
+  EXPECT_TRUE(IsOk(DelayedLoopIsRetarded(TransferFunction{{1.0}, {1.0, 2.0, 1.0}}, {1.0, 1.0, 0.1})));
   DelayedClosedLoop loop;
-  EXPECT_FALSE(BuildDelayedClosedLoop(fo, Realize(fo), {1.0, 1.0, 0.1}, Disturbance(DisturbanceOptions{}),
-                                      0.3, 1.0, &loop, &error));
+  EXPECT_FALSE(OkInto(BuildDelayedClosedLoop(fo, Realize(fo), {1.0, 1.0, 0.1},
+                                             Disturbance(DisturbanceOptions{}), 0.3, 1.0, &loop),
+                      &error));
 }
 
 }  // namespace

@@ -268,14 +268,14 @@ TEST(DelayedLoop, ContinuousLoopWithDeadTimeIsEvaluatedAndItsNeutralCaseRefused)
 TEST(DelayedLoop, DelayOutOfRangeIsRefusedNamingTheField) {
   const LoopOptions o = Sampled(0.01);
   std::string error;
-  EXPECT_FALSE(DelayIsValid(Fopdt(-1.0), o, "--delay", &error));
+  EXPECT_FALSE(OkInto(DelayIsValid(Fopdt(-1.0), o, "--delay"), &error));
   EXPECT_EQ(error.rfind("--delay -1 s must be", 0), 0u) << error;
-  EXPECT_FALSE(DelayIsValid(Fopdt(std::nan("")), o, "--delay", &error));
-  EXPECT_FALSE(DelayIsValid(Fopdt(1e9), o, "--delay", &error));
-  EXPECT_FALSE(DelayIsValid(Fopdt(0.01 * (kMaxAnalysedDelaySteps + 1)), o, "--delay", &error));
+  EXPECT_FALSE(OkInto(DelayIsValid(Fopdt(std::nan("")), o, "--delay"), &error));
+  EXPECT_FALSE(OkInto(DelayIsValid(Fopdt(1e9), o, "--delay"), &error));
+  EXPECT_FALSE(OkInto(DelayIsValid(Fopdt(0.01 * (kMaxAnalysedDelaySteps + 1)), o, "--delay"), &error));
   EXPECT_NE(error.find("stored inputs"), std::string::npos) << error;
-  EXPECT_TRUE(DelayIsValid(Fopdt(0.01 * kMaxAnalysedDelaySteps), o, "--delay", &error)) << error;
-  EXPECT_TRUE(DelayIsValid(Fopdt(0.0), LoopOptions{}, "--delay", &error)) << "no delay: any loop";
+  EXPECT_TRUE(IsOk(DelayIsValid(Fopdt(0.01 * kMaxAnalysedDelaySteps), o, "--delay")));
+  EXPECT_TRUE(OkInto(DelayIsValid(Fopdt(0.0), LoopOptions{}, "--delay"), &error)) << "no delay: any loop";
 }
 
 }  // namespace

@@ -58,8 +58,8 @@ struct Reference {
     options.disturbance.kind = kind;
     options.disturbance.amplitude = kind == DisturbanceKind::kNone ? 0.0 : 0.2;
     options.disturbance.period_s = 0.4;
-    EXPECT_TRUE(OkInto(
-        RunSampledLoopInProcess(plant, gains, options, options.disturbance, &y_all, &trajectory), &error));
+    EXPECT_TRUE(
+        IsOk(RunSampledLoopInProcess(plant, gains, options, options.disturbance, &y_all, &trajectory)));
     EvaluateOptions what;
     EXPECT_TRUE(IsOk(Evaluate(plant, gains, options, what, &evaluation)));
   }

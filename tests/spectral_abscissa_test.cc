@@ -49,7 +49,7 @@ PidGains P(double kp) {
 SpectralAbscissa AbscissaOrFail(const TransferFunction& tf, const PidGains& g, double delay_s) {
   SpectralAbscissa sa;
   std::string error;
-  EXPECT_TRUE(ContinuousSpectralAbscissa(tf, g, delay_s, 100.0, &sa, &error)) << error;
+  EXPECT_TRUE(IsOk(ContinuousSpectralAbscissa(tf, g, delay_s, 100.0, &sa)));
   EXPECT_TRUE(sa.found) << sa.note;
   return sa;
 }
@@ -113,7 +113,8 @@ TEST(SpectralAbscissa, ShiftedCountsTheLambertRootsRightOfEachLine) {
       if (r.real() > sigma) want += 2;  // the pair r, conj(r)
     NyquistCount n;
     std::string error;
-    ASSERT_TRUE(CountContinuousRootsRightOf(Tf({1.0}, {1.0, 0.0}), P(kp), delay, sigma, 100.0, &n, &error))
+    ASSERT_TRUE(
+        OkInto(CountContinuousRootsRightOf(Tf({1.0}, {1.0, 0.0}), P(kp), delay, sigma, 100.0, &n), &error))
         << error;
     EXPECT_TRUE(n.decided) << n.note;
     EXPECT_EQ(n.closed_loop_rhp_poles, want) << "sigma " << sigma << ": " << n.note;
@@ -194,7 +195,7 @@ TEST(SpectralAbscissa, IsNotComputedForANeutralLoop) {
   const PidGains pd{1.0, 0.0, 0.2};
   SpectralAbscissa sa;
   std::string error;
-  ASSERT_TRUE(ContinuousSpectralAbscissa(Tf({1.0}, {1.0, 1.0}), pd, 0.5, 100.0, &sa, &error)) << error;
+  ASSERT_TRUE(IsOk(ContinuousSpectralAbscissa(Tf({1.0}, {1.0, 1.0}), pd, 0.5, 100.0, &sa)));
   EXPECT_FALSE(sa.found);
   EXPECT_NE(sa.note.find("neutral"), std::string::npos) << sa.note;
 }

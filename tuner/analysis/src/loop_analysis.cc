@@ -66,7 +66,10 @@ bool DelayIsValid(const Plant& plant, const evaluation::LoopOptions& options, st
   if (!(plant.delay_s >= 0.0) || !std::isfinite(plant.delay_s))
     os << "dead time " << plant.delay_s << " s must be finite and >= 0";
   else if (options.loop != evaluation::LoopKind::kContinuous)  // the stored inputs' bound, a linear plant
-    return evaluation::DelayIsValid(plant, options, "delay", error);
+    if (const Status st = evaluation::DelayIsValid(plant, options, "delay"); !st.ok())
+      os << st.message();
+    else
+      return true;
   else
     return true;
   if (error) *error = os.str();
@@ -211,8 +214,12 @@ bool SetDelayedTimeConstant(const Plant& plant, const PidGains& g, const LoopAna
     return true;
   }
   evaluation::SpectralAbscissa sa;
-  if (!evaluation::ContinuousSpectralAbscissa(plant.tf, g, plant.delay_s, ao.points_per_decade, &sa, error))
+  if (const Status st =
+          evaluation::ContinuousSpectralAbscissa(plant.tf, g, plant.delay_s, ao.points_per_decade, &sa);
+      !st.ok()) {
+    if (error) *error = st.message();
     return false;
+  }
   if (sa.found && sa.alpha < 0.0) {
     a->slowest_time_constant_s = -1.0 / sa.alpha;
     a->time_constant_note.clear();
@@ -239,7 +246,11 @@ bool AnalyzeDelayedLoop(const Plant& plant, const PidGains& g, const evaluation:
   std::vector<double> w;
   std::vector<Point> pts;
   double w_top = 0.0;
-  if (!DelayGrid(r, AnalysisGrid(OpenLoopFrequencies(r), options, ao), &w, &pts, &w_top, error)) return false;
+  if (const Status st = DelayGrid(r, AnalysisGrid(OpenLoopFrequencies(r), options, ao), &w, &pts, &w_top);
+      !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   const NyquistCount n = CountEncirclements(r, w, pts);
   a->stable = n.stable;
   a->stability_note = n.note;
@@ -331,26 +342,15 @@ Status AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const evalua
   return Status::Ok();
 }
 
-namespace {
-
-// CountNyquist() with the refusal's message in *error.
-bool CountNyquistOrExplain(const Plant& plant, const PidGains& typed_gains,
-                           const evaluation::LoopOptions& options, NyquistCount* count, std::string* error) {
+Status CountNyquist(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
+                    NyquistCount* count) {
   PidGains g;
   evaluation::LoopOptions continuous = options;
   continuous.loop = evaluation::LoopKind::kContinuous;
   const LoopAnalysisOptions ao;
-  if (!CheckAnalysisInputs(plant, typed_gains, continuous, ao, &g, error)) return false;
-  return evaluation::CountContinuousNyquist(plant.tf, g, plant.delay_s, ao.points_per_decade, count, error);
-}
-
-}  // namespace
-
-Status CountNyquist(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
-                    NyquistCount* count) {
   std::string why;
-  if (!CountNyquistOrExplain(plant, typed_gains, options, count, &why)) return Status::InvalidInput(why);
-  return Status::Ok();
+  if (!CheckAnalysisInputs(plant, typed_gains, continuous, ao, &g, &why)) return Status::InvalidInput(why);
+  return evaluation::CountContinuousNyquist(plant.tf, g, plant.delay_s, ao.points_per_decade, count);
 }
 
 namespace {

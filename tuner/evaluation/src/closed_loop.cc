@@ -167,7 +167,11 @@ Stability ContinuousStability(const ContinuousClosedLoop<double>& loop, double m
   return s;
 }
 
-bool DelayIsValid(const Plant& plant, const LoopOptions& o, const std::string& name, std::string* error) {
+namespace {
+
+// DelayIsValid() with the refusal's message in *error.
+bool DelayIsValidOrExplain(const Plant& plant, const LoopOptions& o, const std::string& name,
+                           std::string* error) {
   const double l = plant.delay_s;
   std::ostringstream os;
   if (!std::isfinite(l) || !(l >= 0.0) || !(l <= kMaxDelaySeconds))
@@ -189,6 +193,14 @@ bool DelayIsValid(const Plant& plant, const LoopOptions& o, const std::string& n
     return true;
   if (error) *error = os.str();
   return false;
+}
+
+}  // namespace
+
+Status DelayIsValid(const Plant& plant, const LoopOptions& o, const std::string& name) {
+  std::string why;
+  if (!DelayIsValidOrExplain(plant, o, name, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 DiscretePlant SampledPlant(const Plant& plant, double dt_s) {

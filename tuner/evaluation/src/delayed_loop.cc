@@ -214,7 +214,10 @@ class DelayedIntegrator {
 
 }  // namespace
 
-bool DelayedLoopIsRetarded(const TransferFunction& tf, const PidGains& g, std::string* error) {
+namespace {
+
+// DelayedLoopIsRetarded() with the refusal's message in *error.
+bool DelayedLoopIsRetardedOrExplain(const TransferFunction& tf, const PidGains& g, std::string* error) {
   if (!(g.kd > 0.0) || g.tf > 0.0 || tf.RelativeDegree() >= 2) return true;
   if (error) {
     std::ostringstream os;
@@ -226,10 +229,25 @@ bool DelayedLoopIsRetarded(const TransferFunction& tf, const PidGains& g, std::s
   return false;
 }
 
-bool BuildDelayedClosedLoop(const TransferFunction& tf, const StateSpace& plant, const PidGains& g,
-                            const Disturbance& disturbance, double delay_s, double reference,
-                            DelayedClosedLoop* out, std::string* error, const SetpointWeights& weights) {
-  if (!DelayedLoopIsRetarded(tf, g, error)) return false;
+}  // namespace
+
+Status DelayedLoopIsRetarded(const TransferFunction& tf, const PidGains& g) {
+  std::string why;
+  if (!DelayedLoopIsRetardedOrExplain(tf, g, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
+}
+
+namespace {
+
+// BuildDelayedClosedLoop() with the refusal's message in *error.
+bool BuildDelayedClosedLoopOrExplain(const TransferFunction& tf, const StateSpace& plant, const PidGains& g,
+                                     const Disturbance& disturbance, double delay_s, double reference,
+                                     DelayedClosedLoop* out, std::string* error,
+                                     const SetpointWeights& weights) {
+  if (const Status st = DelayedLoopIsRetarded(tf, g); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   const int n = plant.order();
   const bool filtered = g.tf > 0.0;
   const DisturbanceKind kind = disturbance.options().kind;
@@ -275,6 +293,17 @@ bool BuildDelayedClosedLoop(const TransferFunction& tf, const StateSpace& plant,
   return true;
 }
 
+}  // namespace
+
+Status BuildDelayedClosedLoop(const TransferFunction& tf, const StateSpace& plant, const PidGains& g,
+                              const Disturbance& disturbance, double delay_s, double reference,
+                              DelayedClosedLoop* out, const SetpointWeights& weights) {
+  std::string why;
+  if (!BuildDelayedClosedLoopOrExplain(tf, plant, g, disturbance, delay_s, reference, out, &why, weights))
+    return Status::InvalidInput(why);
+  return Status::Ok();
+}
+
 double DelayedStepSize(const DelayedClosedLoop& loop) {
   const Eigen::MatrixXd closed = loop.m + loop.e * loop.kq;
   const double rho = std::max({SpectralRadius(loop.m), SpectralRadius(closed), 1e-12 / loop.delay_s});
@@ -300,8 +329,12 @@ bool SampleByHermiteStore(const DelayedClosedLoop& loop, const Disturbance& dist
 
 }  // namespace
 
-bool SampleDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturbance, double ts,
-                       int num_samples, std::vector<double>* y, DelayedTrace* trace, std::string* error) {
+namespace {
+
+// SampleDelayedLoop() with the refusal's message in *error.
+bool SampleDelayedLoopOrExplain(const DelayedClosedLoop& loop, const Disturbance& disturbance, double ts,
+                                int num_samples, std::vector<double>* y, DelayedTrace* trace,
+                                std::string* error) {
   const double h = trace && trace->force_step_s > 0.0 ? trace->force_step_s : DelayedStepSize(loop);
   const double t_end = (num_samples - 1) * ts;
   if (!(h > 0.0) || t_end / h > static_cast<double>(kMaxDelayedPieces)) {
@@ -325,6 +358,16 @@ bool SampleDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturb
   // its stepinfo); the samples stay the exact ones.
   thread_local std::vector<double> hermite;
   return SampleByHermiteStore(loop, disturbance, h, ts, num_samples, &hermite, trace, error);
+}
+
+}  // namespace
+
+Status SampleDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturbance, double ts,
+                         int num_samples, std::vector<double>* y, DelayedTrace* trace) {
+  std::string why;
+  if (!SampleDelayedLoopOrExplain(loop, disturbance, ts, num_samples, y, trace, &why))
+    return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::evaluation

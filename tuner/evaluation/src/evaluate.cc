@@ -87,10 +87,10 @@ Status CheckLoop(const Plant& plant, const PidGains& typed_gains, const LoopOpti
   if (!GainsAreValid(*gains, &error) || !plant.tf.IsValid(&error)) return Status::InvalidInput(error);
   if (plant.tf.RelativeDegree() < 1)
     return Status::InvalidInput("plant " + plant.tf.ToString() + " must be strictly proper");
-  if (!DelayIsValid(plant, options, "delay", &error)) return Status::InvalidInput(error);
-  if (options.loop == LoopKind::kContinuous && plant.delay_s > 0.0 &&
-      !DelayedLoopIsRetarded(plant.tf, *gains, &error))
-    return Status::InvalidInput(error);
+  if (const Status st = DelayIsValid(plant, options, "delay"); !st.ok()) return st;
+  if (options.loop == LoopKind::kContinuous && plant.delay_s > 0.0) {
+    if (const Status st = DelayedLoopIsRetarded(plant.tf, *gains); !st.ok()) return st;
+  }
   if (plant.nonlinear && options.loop != LoopKind::kSampled)
     return Status::InvalidInput("plant " + plant.name +
                                 " is nonlinear: the exact continuous loop applies to linear plants only, use "

@@ -26,13 +26,18 @@ constexpr double kPointsPerDecade = 100.0;
 bool Sample(const Plant& plant, const PidGains& gains, const LoopOptions& options, const Disturbance& d,
             double a, DelayedPath path, std::vector<double>* y, DelayedTrace* trace, std::string* error) {
   DelayedClosedLoop loop;
-  if (!BuildDelayedClosedLoop(plant.tf, Realize(plant.tf), gains, d, plant.delay_s, a, &loop, error,
-                              SetpointWeightsOf(options.pid)))
+  if (const Status st = BuildDelayedClosedLoop(plant.tf, Realize(plant.tf), gains, d, plant.delay_s, a, &loop,
+                                               SetpointWeightsOf(options.pid));
+      !st.ok()) {
+    if (error) *error = st.message();
     return false;
+  }
   DelayedTrace untraced;
   if (!trace) trace = &untraced;
   trace->node_by_node = path == DelayedPath::kReference;
-  return SampleDelayedLoop(loop, d, options.sample_time_s, options.NumSamples(), y, trace, error);
+  const Status st = SampleDelayedLoop(loop, d, options.sample_time_s, options.NumSamples(), y, trace);
+  if (!st.ok() && error) *error = st.message();
+  return st.ok();
 }
 
 // The integral of |e| over the nodes (trapezoids, a sign change split as
@@ -68,9 +73,9 @@ Status DelayedStability(const Plant& plant, const PidGains& gains, Stability* s,
     }
   }
   NyquistCount count;
-  std::string error;
-  if (!CountContinuousNyquist(plant.tf, gains, plant.delay_s, kPointsPerDecade, &count, &error))
-    return Status::InvalidInput(error);
+  if (const Status st = CountContinuousNyquist(plant.tf, gains, plant.delay_s, kPointsPerDecade, &count);
+      !st.ok())
+    return st;
   s->stable = count.stable;
   return Status::Ok();
 }
@@ -125,7 +130,7 @@ double DelayedLoadIae(const Plant& plant, const PidGains& gains, const LoopOptio
 
 double DelayedContinuousObjective(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
                                   double load_weight, const PidGains& gains, DelayedPath path) {
-  if (!DelayedLoopIsRetarded(plant.tf, gains, nullptr)) return kInf;
+  if (!DelayedLoopIsRetarded(plant.tf, gains).ok()) return kInf;
   Stability s;
   if (!DelayedStability(plant, gains, &s, path).ok() || !s.stable) return kInf;
   if (kind == ObjectiveKind::kLoadIae) return DelayedLoadIae(plant, gains, options, path);

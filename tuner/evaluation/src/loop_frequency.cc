@@ -64,20 +64,23 @@ void ContinuousPidPolynomials(const PidGains& g, std::vector<double>* num, std::
   *num = frequency::Trim(*num);
 }
 
-bool CountContinuousNyquist(const TransferFunction& tf, const PidGains& g, double delay_s,
-                            double points_per_decade, NyquistCount* count, std::string* error) {
+Status CountContinuousNyquist(const TransferFunction& tf, const PidGains& g, double delay_s,
+                              double points_per_decade, NyquistCount* count) {
   // Reused per thread: the tuner counts once per evaluation, and a fresh
   // grid of large vectors each time costs more in page faults than the count.
   thread_local std::vector<double> w;
   thread_local std::vector<frequency::Point> pts;
   return frequency::CountOnAnalysisGrid(frequency::ContinuousResponse(tf, g, delay_s), points_per_decade, &w,
-                                        &pts, count, error);
+                                        &pts, count);
 }
 
 namespace frequency {
 
-bool CountOnAnalysisGrid(const ContinuousResponse& r, double per_decade, std::vector<double>* w,
-                         std::vector<Point>* pts, NyquistCount* count, std::string* error) {
+namespace {
+
+// CountOnAnalysisGrid() with the refusal's message in *error.
+bool CountOnAnalysisGridOrExplain(const ContinuousResponse& r, double per_decade, std::vector<double>* w,
+                                  std::vector<Point>* pts, NyquistCount* count, std::string* error) {
   // The continuous loop's analysis grid: 1e-3 x the slowest to 1e3 x the
   // fastest open-loop feature (as the analysis, AnalysisGrid).
   const std::vector<double> special = OpenLoopFrequencies(r);
@@ -92,13 +95,25 @@ bool CountOnAnalysisGrid(const ContinuousResponse& r, double per_decade, std::ve
   *w = base;
   if (r.delay() > 0.0) {
     double w_top = 0.0;
-    if (!DelayGrid(r, base, w, pts, &w_top, error)) return false;
+    if (const Status st = DelayGrid(r, base, w, pts, &w_top); !st.ok()) {
+      if (error) *error = st.message();
+      return false;
+    }
   } else {
     pts->resize(w->size());
     for (std::size_t i = 0; i < w->size(); ++i) (*pts)[i] = r.At((*w)[i]);
   }
   *count = CountEncirclements(r, *w, *pts);
   return true;
+}
+
+}  // namespace
+
+Status CountOnAnalysisGrid(const ContinuousResponse& r, double per_decade, std::vector<double>* w,
+                           std::vector<Point>* pts, NyquistCount* count) {
+  std::string why;
+  if (!CountOnAnalysisGridOrExplain(r, per_decade, w, pts, count, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace frequency
@@ -151,7 +166,10 @@ int RootsRightOf(const frequency::ContinuousResponse& r, const std::vector<cd>& 
   *sigma = frequency::LineClearOfPoles(poles, *sigma);
   NyquistCount n;
   ++*counts;
-  if (!frequency::CountOnAnalysisGrid(r.Shifted(*sigma), per_decade, w, pts, &n, why)) return -1;
+  if (const Status st = frequency::CountOnAnalysisGrid(r.Shifted(*sigma), per_decade, w, pts, &n); !st.ok()) {
+    *why = st.message();
+    return -1;
+  }
   if (n.decided) return n.closed_loop_rhp_poles;
   std::ostringstream os;
   os << "the count on the line Re s = " << *sigma << " does not decide (" << n.note << ")";
@@ -199,8 +217,12 @@ void Polish(const frequency::ContinuousResponse& r, double lo, double hi, const 
 
 }  // namespace
 
-bool ContinuousSpectralAbscissa(const TransferFunction& tf, const PidGains& g, double delay_s,
-                                double points_per_decade, SpectralAbscissa* out, std::string* error) {
+namespace {
+
+// ContinuousSpectralAbscissa() with the refusal's message in *error.
+bool ContinuousSpectralAbscissaOrExplain(const TransferFunction& tf, const PidGains& g, double delay_s,
+                                         double points_per_decade, SpectralAbscissa* out,
+                                         std::string* error) {
   *out = SpectralAbscissa();
   if (!(delay_s > 0.0) || !std::isfinite(delay_s) || !(points_per_decade > 0.0)) {
     if (error) *error = "the spectral abscissa needs a dead time > 0 and a grid density > 0";
@@ -249,6 +271,16 @@ bool ContinuousSpectralAbscissa(const TransferFunction& tf, const PidGains& g, d
   }
   out->found = true;
   return true;
+}
+
+}  // namespace
+
+Status ContinuousSpectralAbscissa(const TransferFunction& tf, const PidGains& g, double delay_s,
+                                  double points_per_decade, SpectralAbscissa* out) {
+  std::string why;
+  if (!ContinuousSpectralAbscissaOrExplain(tf, g, delay_s, points_per_decade, out, &why))
+    return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::evaluation

@@ -165,8 +165,11 @@ ContinuousResponse ContinuousResponse::Shifted(double sigma) const {
   return r;
 }
 
-bool DelayGrid(const ContinuousResponse& r, const std::vector<double>& base, std::vector<double>* w,
-               std::vector<Point>* pts, double* w_top, std::string* error) {
+namespace {
+
+// DelayGrid() with the refusal's message in *error.
+bool DelayGridOrExplain(const ContinuousResponse& r, const std::vector<double>& base, std::vector<double>* w,
+                        std::vector<Point>* pts, double* w_top, std::string* error) {
   const double delay = r.delay(), step = kMaxDelayTurn / delay;
   std::size_t last = 0;
   for (std::size_t i = 0; i < base.size(); ++i)
@@ -188,6 +191,15 @@ bool DelayGrid(const ContinuousResponse& r, const std::vector<double>& base, std
     *error = os.str();
   }
   return false;
+}
+
+}  // namespace
+
+Status DelayGrid(const ContinuousResponse& r, const std::vector<double>& base, std::vector<double>* w,
+                 std::vector<Point>* pts, double* w_top) {
+  std::string why;
+  if (!DelayGridOrExplain(r, base, w, pts, w_top, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 NyquistCount CountEncirclements(const ContinuousResponse& r, const std::vector<double>& w,
@@ -258,14 +270,14 @@ NyquistCount CountEncirclements(const ContinuousResponse& r, const std::vector<d
 
 namespace pidlab::evaluation {
 
-bool CountContinuousRootsRightOf(const TransferFunction& tf, const PidGains& g, double delay_s, double sigma,
-                                 double points_per_decade, NyquistCount* count, std::string* error) {
+Status CountContinuousRootsRightOf(const TransferFunction& tf, const PidGains& g, double delay_s,
+                                   double sigma, double points_per_decade, NyquistCount* count) {
   const frequency::ContinuousResponse r(tf, g, delay_s);
   if (sigma != 0.0) sigma = frequency::LineClearOfPoles(PolynomialRoots(r.b()), sigma);
   thread_local std::vector<double> w;
   thread_local std::vector<frequency::Point> pts;
   return frequency::CountOnAnalysisGrid(sigma == 0.0 ? r : r.Shifted(sigma), points_per_decade, &w, &pts,
-                                        count, error);
+                                        count);
 }
 
 }  // namespace pidlab::evaluation

@@ -432,11 +432,11 @@ double LoadIaeOfStableLoop(const StateSpace& realization, const DiscretePlant* d
 double LoadIntegralAbsError(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options) {
   // A dead time the loop cannot take (the continuous loop's) has no load
   // response here: NaN, not a number of the undelayed plant.
-  if (!DelayIsValid(plant, options, "delay", nullptr)) return std::numeric_limits<double>::quiet_NaN();
+  if (!DelayIsValid(plant, options, "delay").ok()) return std::numeric_limits<double>::quiet_NaN();
   const PidGains gains = LoopGains(typed_gains, options);
   if (options.loop == LoopKind::kContinuous && plant.delay_s > 0.0) {
     Stability s;
-    if (!DelayedLoopIsRetarded(plant.tf, gains, nullptr)) return std::numeric_limits<double>::quiet_NaN();
+    if (!DelayedLoopIsRetarded(plant.tf, gains).ok()) return std::numeric_limits<double>::quiet_NaN();
     if (!internal::DelayedStability(plant, gains, &s).ok() || !s.stable) return kInf;
     return internal::DelayedLoadIae(plant, gains, options);
   }
@@ -474,8 +474,9 @@ ObjectiveEvaluator::ObjectiveEvaluator(const Plant& plant, const LoopOptions& op
     throw std::invalid_argument(ToString(kind) + " runs the loop in process, not over another runner");
   if (load && plant.nonlinear)
     throw std::invalid_argument(ToString(kind) + " needs a linear plant, not " + plant.name);
-  if (!plant.tf.IsValid(&error) || !DelayIsValid(plant, options, "delay", &error))
-    throw std::invalid_argument(error);
+  if (!plant.tf.IsValid(&error)) throw std::invalid_argument(error);
+  if (const Status st = DelayIsValid(plant, options, "delay"); !st.ok())
+    throw std::invalid_argument(st.message());
   realization_ = Realize(plant.tf);
   if (plant.nonlinear && options.loop != LoopKind::kSampled)
     throw std::invalid_argument("plant " + plant.name +

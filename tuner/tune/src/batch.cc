@@ -202,8 +202,12 @@ Status RunBatchPlant(const BatchPlant& bp, const BatchOptions& o, BatchResult* r
   r->dt_s = loop.dt_s;
   r->horizon_s = loop.horizon_s;
   r->box_upper = kPlantBoxFactor * std::max({rule.gains.kp, rule.gains.ki, rule.gains.kd});
-  if (!loop.IsValid(&error) || !evaluation::DelayIsValid(bp.plant, loop, "delay", &error)) {
+  if (!loop.IsValid(&error)) {
     r->message = error;
+    return Status::Ok();
+  }
+  if (const Status st = evaluation::DelayIsValid(bp.plant, loop, "delay"); !st.ok()) {
+    r->message = st.message();
     return Status::Ok();
   }
   if (loop.loop == evaluation::LoopKind::kContinuous && bp.plant.delay_s > 0.0) {

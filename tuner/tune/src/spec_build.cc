@@ -168,7 +168,9 @@ bool BuildPlant(const spec::PlantSpec& typed, NameStyle style, Plant* out, std::
 
 bool CheckPlantInLoop(const Plant& plant, const evaluation::LoopOptions& loop, NameStyle style,
                       std::string* error) {
-  return evaluation::DelayIsValid(plant, loop, spec::DisplayName("delay", style), error);
+  const Status st = evaluation::DelayIsValid(plant, loop, spec::DisplayName("delay", style));
+  if (!st.ok() && error) *error = st.message();
+  return st.ok();
 }
 
 bool BuildGains(const std::vector<double>& g, NameStyle style, PidGains* out, std::string* error) {

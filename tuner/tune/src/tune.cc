@@ -68,7 +68,8 @@ bool MeetsBounds(const Plant& plant, const StateSpace& realization, const TuneOp
   evaluation::NyquistCount n;
   return evaluation::CountContinuousRootsRightOf(plant.tf, g, plant.delay_s,
                                                  -1.0 / options.bounds.max_time_constant_s,
-                                                 coarse.points_per_decade, &n, nullptr) &&
+                                                 coarse.points_per_decade, &n)
+             .ok() &&
          n.decided && n.closed_loop_rhp_poles == 0;
 }
 
@@ -337,7 +338,11 @@ bool RuleLoopIsRetarded(const Plant& plant, const TuneOptions& options, std::str
 // time a method or a robust set does not take, a load objective off the
 // process or on a nonlinear plant, a robust set of a nonlinear plant.
 bool TuneApplies(const Plant& plant, const TuneOptions& options, bool custom_runner, std::string* error) {
-  if (!options.IsValid(error) || !evaluation::DelayIsValid(plant, options.loop, "delay", error)) return false;
+  if (!options.IsValid(error)) return false;
+  if (const Status st = evaluation::DelayIsValid(plant, options.loop, "delay"); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   if (plant.delay_s > 0.0 && options.method == TuneMethod::kZieglerNichols) {
     if (error)
       *error =

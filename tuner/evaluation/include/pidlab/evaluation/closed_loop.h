@@ -34,6 +34,7 @@
 #include "pidlab/plant_sim/matrix_exp.h"
 #include "pidlab/plant_sim/plants.h"
 #include "pidlab/plant_sim/stepper_nonlinear.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::evaluation {
 
@@ -108,9 +109,9 @@ struct LoopOptions : EpisodeShape {
 /// loop d = ceil(L / dt) at most kMaxAnalysedDelaySteps (below plant_sim's
 /// kMaxDelaySteps). The continuous loop takes any such L (delayed_loop.h);
 /// its gains are checked apart (DelayedLoopIsRetarded: an ideal derivative on
-/// a plant of relative degree 1 is refused). False with *error naming `name`
+/// a plant of relative degree 1 is refused). A failed Status (kInvalidInput) naming `name`
 /// (the field as the caller spells it) and the value. Needs a valid o.dt_s.
-bool DelayIsValid(const Plant& plant, const LoopOptions& o, const std::string& name, std::string* error);
+Status DelayIsValid(const Plant& plant, const LoopOptions& o, const std::string& name);
 
 /// The plant the sampled loop runs at dt_s: the exact ZOH of plant.tf with its
 /// dead time, DiscretePlant(plant.tf, dt_s, plant.delay_s). Throws as

@@ -22,6 +22,7 @@
 #include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/plant_sim/disturbance.h"
 #include "pidlab/plant_sim/transfer_function.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::evaluation {
 
@@ -47,17 +48,17 @@ struct DelayedClosedLoop {
   double Output(const Eigen::VectorXd& w) const { return c.dot(w.head(plant_order)); }
 };
 
-/// False with *error (one line naming the derivative and saying a filter is
+/// A failed Status (kInvalidInput) (one line naming the derivative and saying a filter is
 /// needed) for an ideal derivative (tf = 0 < kd) on a plant of relative degree
 /// 1: that loop is of neutral type.
-bool DelayedLoopIsRetarded(const TransferFunction& tf, const PidGains& loop_gains, std::string* error);
+Status DelayedLoopIsRetarded(const TransferFunction& tf, const PidGains& loop_gains);
 
 /// Builds the delayed loop of `plant` (Realize(tf)) with the loop's gains
 /// (LoopGains), the disturbance, reference A and the 2-DOF setpoint weights
-/// (closed_loop.h). False with *error as DelayedLoopIsRetarded.
-bool BuildDelayedClosedLoop(const TransferFunction& tf, const StateSpace& plant, const PidGains& loop_gains,
-                            const Disturbance& disturbance, double delay_s, double reference,
-                            DelayedClosedLoop* out, std::string* error, const SetpointWeights& weights = {});
+/// (closed_loop.h). A failed Status (kInvalidInput) as DelayedLoopIsRetarded.
+Status BuildDelayedClosedLoop(const TransferFunction& tf, const StateSpace& plant, const PidGains& loop_gains,
+                              const Disturbance& disturbance, double delay_s, double reference,
+                              DelayedClosedLoop* out, const SetpointWeights& weights = {});
 
 /// The step h = L / m, m = ceil(L / h_max), h_max = kDelayedStepFraction /
 /// rho, rho the largest modulus among the eigenvalues of the open system m
@@ -79,9 +80,9 @@ struct DelayedTrace {
 
 /// y at t = 0, ts, ..., (num_samples - 1) ts of the delayed loop, on the
 /// uniform grid t_j = j h where it applies (one map per piece, a ring of the
-/// m = L / h stored pieces), else node by node. False with *error when the
+/// m = L / h stored pieces), else node by node. A failed Status (kInvalidInput) when the
 /// run needs more than kMaxDelayedPieces pieces.
-bool SampleDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturbance, double ts,
-                       int num_samples, std::vector<double>* y, DelayedTrace* trace, std::string* error);
+Status SampleDelayedLoop(const DelayedClosedLoop& loop, const Disturbance& disturbance, double ts,
+                         int num_samples, std::vector<double>* y, DelayedTrace* trace);
 
 }  // namespace pidlab::evaluation

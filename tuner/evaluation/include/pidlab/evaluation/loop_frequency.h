@@ -14,6 +14,7 @@
 
 #include "pidlab/controller/pid.h"
 #include "pidlab/plant_sim/transfer_function.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::evaluation {
 
@@ -42,10 +43,10 @@ struct NyquistCount {
 void ContinuousPidPolynomials(const PidGains& loop_gains, std::vector<double>* num, std::vector<double>* den);
 
 /// The Nyquist count of the continuous loop of tf e^(-s delay_s) with the
-/// loop's gains (LoopGains) on the analysis grid of `points_per_decade`. False
-/// with *error when resolving e^(-jwL) takes more than kMaxDelayGridPoints.
-bool CountContinuousNyquist(const TransferFunction& tf, const PidGains& loop_gains, double delay_s,
-                            double points_per_decade, NyquistCount* count, std::string* error);
+/// loop's gains (LoopGains) on the analysis grid of `points_per_decade`. A failed Status
+/// (kInvalidInput) when resolving e^(-jwL) takes more than kMaxDelayGridPoints.
+Status CountContinuousNyquist(const TransferFunction& tf, const PidGains& loop_gains, double delay_s,
+                              double points_per_decade, NyquistCount* count);
 
 /// The closed-loop roots of 1 + C(s) G(s) e^(-s delay_s) = 0 right of the line
 /// Re s = sigma: the Nyquist count of the loop on that line (s = sigma + jw,
@@ -53,10 +54,9 @@ bool CountContinuousNyquist(const TransferFunction& tf, const PidGains& loop_gai
 /// open-loop poles right of the line, Z = N + P the closed-loop roots right of
 /// it. sigma = 0 is CountContinuousNyquist. A line within 1e-8 max(1, |p|) of
 /// an open-loop pole p's real part is moved left by that much
-/// (frequency::LineClearOfPoles). False with *error as CountContinuousNyquist.
-bool CountContinuousRootsRightOf(const TransferFunction& tf, const PidGains& loop_gains, double delay_s,
-                                 double sigma, double points_per_decade, NyquistCount* count,
-                                 std::string* error);
+/// (frequency::LineClearOfPoles). A failed Status (kInvalidInput) as CountContinuousNyquist.
+Status CountContinuousRootsRightOf(const TransferFunction& tf, const PidGains& loop_gains, double delay_s,
+                                   double sigma, double points_per_decade, NyquistCount* count);
 
 /// The spectral abscissa of the continuous loop with dead time: alpha = max Re s
 /// over the roots of 1 + C(s) G(s) e^(-sL) = 0 (docs/deadtime.md, "The slowest
@@ -85,8 +85,8 @@ struct SpectralAbscissa {
 /// from the strip's best points polishes the rightmost root. False with
 /// *error for invalid input; true with abscissa->found false when the loop
 /// is neutral or a count fails.
-bool ContinuousSpectralAbscissa(const TransferFunction& tf, const PidGains& loop_gains, double delay_s,
-                                double points_per_decade, SpectralAbscissa* abscissa, std::string* error);
+Status ContinuousSpectralAbscissa(const TransferFunction& tf, const PidGains& loop_gains, double delay_s,
+                                  double points_per_decade, SpectralAbscissa* abscissa);
 
 namespace frequency {
 
@@ -208,12 +208,12 @@ std::vector<double> OpenLoopFrequencies(const ContinuousResponse& r);
 // Dead time: the analysis grid `base` (the loop's features) with points added
 // below *w_top so that e^{-jwL} turns by at most pi/16 between neighbours;
 // *w_top is where |L| falls below kSmallLoopGain for good on `base`, raised
-// until the band holds a phase crossover. False with *error when that takes
+// until the band holds a phase crossover. A failed Status (kInvalidInput) when that takes
 // more than kMaxDelayGridPoints.
 inline constexpr double kSmallLoopGain = 0.01;
 inline constexpr std::size_t kMaxDelayGridPoints = 2000000;
-bool DelayGrid(const ContinuousResponse& r, const std::vector<double>& base, std::vector<double>* w,
-               std::vector<Point>* pts, double* w_top, std::string* error);
+Status DelayGrid(const ContinuousResponse& r, const std::vector<double>& base, std::vector<double>* w,
+                 std::vector<Point>* pts, double* w_top);
 
 // sigma, or, within kLineGapFromPoles max(1, |p|) of an open-loop pole p's
 // real part, that far left of it (repeated while another pole is that near):
@@ -224,10 +224,10 @@ double LineClearOfPoles(const std::vector<cd>& poles, double sigma);
 
 // The Nyquist count of r on its analysis grid (1e-3 x the slowest to 1e3 x
 // the fastest open-loop feature at `per_decade`, e^{-jwL} resolved by
-// DelayGrid), the grid and its points left in *w and *pts. False with *error
+// DelayGrid), the grid and its points left in *w and *pts. A failed Status (kInvalidInput)
 // as DelayGrid.
-bool CountOnAnalysisGrid(const ContinuousResponse& r, double per_decade, std::vector<double>* w,
-                         std::vector<Point>* pts, NyquistCount* count, std::string* error);
+Status CountOnAnalysisGrid(const ContinuousResponse& r, double per_decade, std::vector<double>* w,
+                           std::vector<Point>* pts, NyquistCount* count);
 
 // The Nyquist count of the continuous loop over the grid `w` (increasing,
 // reaching where |L| < 1 for good) with its points: encirclements of -1 by
