@@ -524,8 +524,9 @@ TEST(SampleContinuousLoop, EndsOnABreakpointThatDoesNotAdvance) {
   const Disturbance disturbance(d);
   ContinuousClosedLoop<double> loop;
   std::string error;
-  ASSERT_TRUE(BuildContinuousClosedLoop<double>(Realize({{1.0}, {1.0, 1.0}}), PidGains{1.0, 1.0, 0.0},
-                                                disturbance, &loop, &error))
+  ASSERT_TRUE(OkInto(BuildContinuousClosedLoop<double>(Realize({{1.0}, {1.0, 1.0}}), PidGains{1.0, 1.0, 0.0},
+                                                       disturbance, &loop),
+                     &error))
       << error;
   std::vector<double> y;
   SampleContinuousLoop<double>(loop, disturbance, 0.05, 11, &y);

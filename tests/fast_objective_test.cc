@@ -82,8 +82,8 @@ LongMatrix LongExp(const LongMatrix& a) {
 double LongObjective(const TransferFunction& tf, const PidGains& g, const LoopOptions& options,
                      ObjectiveKind kind) {
   ContinuousClosedLoop<double> loop;
-  EXPECT_TRUE(
-      BuildContinuousClosedLoop<double>(Realize(tf), g, Disturbance(DisturbanceOptions{}), &loop, nullptr));
+  EXPECT_TRUE(OkInto(
+      BuildContinuousClosedLoop<double>(Realize(tf), g, Disturbance(DisturbanceOptions{}), &loop), nullptr));
   const LongMatrix phi =
       LongExp(loop.m.cast<long double>() * static_cast<long double>(options.sample_time_s));
   Eigen::Matrix<long double, Eigen::Dynamic, 1> w = loop.w0.cast<long double>();
@@ -217,8 +217,8 @@ TEST(PolynomialStabilityTest, AgreesWithTheEigenvaluesWheneverItDecides) {
     for (int trial = 0; trial < 500; ++trial) {
       const PidGains g = RandomGains(&rng);
       ContinuousClosedLoop<double> loop;
-      ASSERT_TRUE(
-          BuildContinuousClosedLoop<double>(ss, g, Disturbance(DisturbanceOptions{}), &loop, nullptr));
+      ASSERT_TRUE(OkInto(BuildContinuousClosedLoop<double>(ss, g, Disturbance(DisturbanceOptions{}), &loop),
+                         nullptr));
       const Stability eig = ContinuousStability(loop, 1e-9);
       const std::vector<double> p = LoopPolynomial(plant.tf, g);
       const PolynomialStability verdict =

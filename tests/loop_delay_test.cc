@@ -67,8 +67,8 @@ PidGains P(double kp) {
 int RightHalfPlanePoles(const TransferFunction& tf, const PidGains& g, double* abscissa) {
   ContinuousClosedLoop<double> loop;
   std::string error;
-  EXPECT_TRUE(
-      BuildContinuousClosedLoop<double>(Realize(tf), g, Disturbance(DisturbanceOptions{}), &loop, &error))
+  EXPECT_TRUE(OkInto(
+      BuildContinuousClosedLoop<double>(Realize(tf), g, Disturbance(DisturbanceOptions{}), &loop), &error))
       << error;
   const evaluation::Stability st = ContinuousStability(loop, 1e-9);
   int count = 0;

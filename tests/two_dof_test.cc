@@ -116,8 +116,8 @@ TEST(TwoDofPid, UnitWeightsBuildTheOneDofContinuousLoops) {
   for (const double tf : {0.0, 0.122}) {
     const PidGains g{1.12, 0.23, 1.3, tf};
     ContinuousClosedLoop<double> dut;
-    ASSERT_TRUE(
-        BuildContinuousClosedLoop<double>(ss, g, none, &dut, nullptr, 1.0, SetpointWeights{1.0, 1.0}));
+    ASSERT_TRUE(OkInto(BuildContinuousClosedLoop<double>(ss, g, none, &dut, 1.0, SetpointWeights{1.0, 1.0}),
+                       nullptr));
     const int ir = dut.reference_index();
     const double cb = ss.c.dot(ss.b), alpha = 1.0 / (1.0 + g.kd * cb);
     for (int i = 0; i < ss.order(); ++i) {
@@ -148,9 +148,9 @@ TEST(TwoDofPid, WithCZeroTheFirstSampleOfAUnitStepAtRestIsKpB) {
 TEST(TwoDofPid, WithCZeroTheIdealDerivativeGivesTheContinuousLoopNoKick) {
   const StateSpace ss = Realize({{1.0}, {1.0, 0.5, 0.1}});
   ContinuousClosedLoop<double> dut;
-  ASSERT_TRUE(BuildContinuousClosedLoop<double>(ss, PidGains{1.12, 0.23, 1.3},
-                                                Disturbance(DisturbanceOptions{}), &dut, nullptr, 1.0,
-                                                SetpointWeights{0.664, 0.0}));
+  ASSERT_TRUE(
+      IsOk(BuildContinuousClosedLoop<double>(ss, PidGains{1.12, 0.23, 1.3}, Disturbance(DisturbanceOptions{}),
+                                             &dut, 1.0, SetpointWeights{0.664, 0.0})));
   for (int i = 0; i < ss.order(); ++i) EXPECT_EQ(dut.w0(i), 0.0);
 }
 

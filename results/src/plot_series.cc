@@ -68,10 +68,11 @@ void TimeSeries(const Plant& plant, const PidGains& gains, const LoopOptions& op
     ContinuousClosedLoop<double> loop, load;
     std::vector<double> y_clean;
     const Disturbance none{DisturbanceOptions{}};
-    if (BuildContinuousClosedLoop<double>(ss, gains, none, &loop, nullptr, options.reference,
-                                          evaluation::SetpointWeightsOf(options.pid)))
+    if (BuildContinuousClosedLoop<double>(ss, gains, none, &loop, options.reference,
+                                          evaluation::SetpointWeightsOf(options.pid))
+            .ok())
       ContinuousResponseAndCommand(ss, loop, options.sample_time_s, options.NumSamples(), &y_clean, &u);
-    if (BuildContinuousClosedLoop<double>(ss, gains, load_step, &load, nullptr, 0.0))
+    if (BuildContinuousClosedLoop<double>(ss, gains, load_step, &load, 0.0).ok())
       ContinuousResponseAndCommand(ss, load, options.sample_time_s, options.NumSamples(), &load_y, &load_u);
     if (options.disturbance.kind != DisturbanceKind::kNone)
       notes->push_back("u is the command of the undisturbed step response");

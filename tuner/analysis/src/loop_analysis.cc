@@ -110,9 +110,12 @@ struct LoopModel {
 bool ContinuousModel(const Plant& plant, const PidGains& g, const evaluation::LoopOptions& options,
                      LoopModel* m, std::string* error) {
   evaluation::ContinuousClosedLoop<double> loop;
-  if (!evaluation::BuildContinuousClosedLoop<double>(Realize(plant.tf), g, Disturbance(DisturbanceOptions{}),
-                                                     &loop, error))
+  if (const Status st = evaluation::BuildContinuousClosedLoop<double>(
+          Realize(plant.tf), g, Disturbance(DisturbanceOptions{}), &loop);
+      !st.ok()) {
+    if (error) *error = st.message();
     return false;
+  }
   const evaluation::Stability st = evaluation::ContinuousStability(loop, options.stability_margin);
   m->stable = st.stable;
   m->s_poles = st.poles;

@@ -5,12 +5,12 @@
 
 namespace pidlab::evaluation {
 
-template bool BuildFilteredClosedLoop<double>(const StateSpace&, const PidGainsT<double>&, const Disturbance&,
-                                              ContinuousClosedLoop<double>*, std::string*, double,
-                                              const SetpointWeights&);
-template bool BuildContinuousClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
-                                                const Disturbance&, ContinuousClosedLoop<double>*,
-                                                std::string*, double, const SetpointWeights&);
+template Status BuildFilteredClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
+                                                const Disturbance&, ContinuousClosedLoop<double>*, double,
+                                                const SetpointWeights&);
+template Status BuildContinuousClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
+                                                  const Disturbance&, ContinuousClosedLoop<double>*, double,
+                                                  const SetpointWeights&);
 template void SampleContinuousLoop<double>(const ContinuousClosedLoop<double>&, const Disturbance&, double,
                                            int, std::vector<double>*);
 template PidStatus RunSampledLoop<double>(const DiscretePlant&, const PidGainsT<double>&, const PidOptions&,

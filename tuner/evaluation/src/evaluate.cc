@@ -120,16 +120,17 @@ Status EvaluateContinuous(const Plant& plant, const PidGains& gains, const LoopO
   const StateSpace ss = Realize(plant.tf);
   const double a = options.reference, ts = options.sample_time_s;
   ContinuousClosedLoop<double> loop;
-  std::string error;
   const SetpointWeights weights = SetpointWeightsOf(options.pid);
-  if (!BuildContinuousClosedLoop<double>(ss, gains, disturbance, &loop, &error, a, weights))
-    return Status::InvalidInput(error);
+  if (const Status built = BuildContinuousClosedLoop<double>(ss, gains, disturbance, &loop, a, weights);
+      !built.ok())
+    return built;
   ev->stability = ContinuousStability(loop, options.stability_margin);
   if (!ev->stability.stable) return Status::Ok();
   SampleContinuousLoop<double>(loop, disturbance, ts, options.NumSamples(), &ev->y);
   if (options.disturbance.kind != DisturbanceKind::kNone) {
     ContinuousClosedLoop<double> clean;
-    BuildContinuousClosedLoop<double>(ss, gains, none, &clean, &error, a, weights);
+    // The loop above without n: it builds whenever that one did.
+    (void)BuildContinuousClosedLoop<double>(ss, gains, none, &clean, a, weights);
     std::vector<double> y1;
     SampleContinuousLoop<double>(clean, none, ts, options.NumSamples(), &y1);
     ev->iae_undisturbed = ObjectiveFromSamples(ObjectiveKind::kIae, y1, ts, a);
@@ -163,7 +164,8 @@ void ScoreSampled(const Plant& plant, const PidGains& gains, const LoopOptions& 
     ContinuousClosedLoop<double> loop;
     const bool built =
         BuildContinuousClosedLoop<double>(Realize(plant.tf), gains, Disturbance(options.disturbance), &loop,
-                                          nullptr, a, SetpointWeightsOf(options.pid));
+                                          a, SetpointWeightsOf(options.pid))
+            .ok();
     const bool continuous_stable = built && ContinuousStability(loop, options.stability_margin).stable;
     // With a dead time the sampled loop is stable here and its final value is
     // the undelayed loop's steady state (e^(-sL) = 1 at s = 0), whatever the

@@ -110,8 +110,9 @@ Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& gains, cons
   if (what.compute_step_info) {
     // e^(-sL) = 1 at s = 0: the undelayed loop's steady state.
     ContinuousClosedLoop<double> undelayed;
-    const bool built = BuildContinuousClosedLoop<double>(Realize(plant.tf), gains, none, &undelayed, nullptr,
-                                                         a, SetpointWeightsOf(options.pid));
+    const bool built = BuildContinuousClosedLoop<double>(Realize(plant.tf), gains, none, &undelayed, a,
+                                                         SetpointWeightsOf(options.pid))
+                           .ok();
     const double yf = built ? ContinuousFinalValue(undelayed) : a;
     ev->step = SampledStepInfo(clean.t, clean.y, std::isfinite(yf) ? yf : a);
   }

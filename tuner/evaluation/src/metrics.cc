@@ -414,7 +414,7 @@ double LoadIaeOfStableLoop(const StateSpace& realization, const DiscretePlant* d
   thread_local std::vector<double> y;
   if (options.loop == LoopKind::kContinuous) {
     ContinuousClosedLoop<double> loop;
-    if (!BuildContinuousClosedLoop<double>(realization, gains, step, &loop, nullptr, 0.0)) return kInf;
+    if (!BuildContinuousClosedLoop<double>(realization, gains, step, &loop, 0.0).ok()) return kInf;
     SampleContinuousLoop<double>(loop, step, options.sample_time_s, options.NumSamples(), &y);
   } else {
     PidOptions pid = options.Pid();
@@ -442,8 +442,7 @@ double LoadIntegralAbsError(const Plant& plant, const PidGains& typed_gains, con
   }
   const StateSpace realization = Realize(plant.tf);
   ContinuousClosedLoop<double> loop;
-  if (!BuildContinuousClosedLoop<double>(realization, gains, Disturbance(DisturbanceOptions{}), &loop,
-                                         nullptr))
+  if (!BuildContinuousClosedLoop<double>(realization, gains, Disturbance(DisturbanceOptions{}), &loop).ok())
     return kInf;
   std::unique_ptr<DiscretePlant> discrete;
   if (options.loop == LoopKind::kSampled) {
@@ -493,8 +492,9 @@ double GeneralContinuousObjective(const StateSpace& realization, const Disturban
                                   const LoopOptions& options, ObjectiveKind kind, const PidGains& gains) {
   thread_local std::vector<double> y;  // reused: no allocation per evaluation
   ContinuousClosedLoop<double> loop;
-  if (!BuildContinuousClosedLoop<double>(realization, gains, disturbance, &loop, nullptr, options.reference,
-                                         SetpointWeightsOf(options.pid)))
+  if (!BuildContinuousClosedLoop<double>(realization, gains, disturbance, &loop, options.reference,
+                                         SetpointWeightsOf(options.pid))
+           .ok())
     return kInf;
   const Stability s = ContinuousStability(loop, options.stability_margin);
   if (!s.stable) return kInf;
@@ -521,8 +521,9 @@ double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {
     bool stable = false;
     if (options_.loop == LoopKind::kContinuous) {
       ContinuousClosedLoop<double> loop;
-      stable = BuildContinuousClosedLoop<double>(realization_, gains, disturbance_, &loop, nullptr,
-                                                 options_.reference, SetpointWeightsOf(options_.pid)) &&
+      stable = BuildContinuousClosedLoop<double>(realization_, gains, disturbance_, &loop, options_.reference,
+                                                 SetpointWeightsOf(options_.pid))
+                   .ok() &&
                ContinuousStability(loop, options_.stability_margin).stable;
       if (stable && kind_ == ObjectiveKind::kSetpointLoad)
         SampleContinuousLoop<double>(loop, disturbance_, ts, options_.NumSamples(), &y);

@@ -46,13 +46,13 @@ struct ErrorResiduals {
     const double ts = loop->sample_time_s;
     if (loop->loop == evaluation::LoopKind::kContinuous) {
       evaluation::ContinuousClosedLoop<T> cl;
-      if (!evaluation::BuildContinuousClosedLoop<T>(*realization, g, disturbance, &cl, nullptr,
-                                                    loop->reference,
-                                                    evaluation::SetpointWeightsOf(loop->pid)))
+      if (!evaluation::BuildContinuousClosedLoop<T>(*realization, g, disturbance, &cl, loop->reference,
+                                                    evaluation::SetpointWeightsOf(loop->pid))
+               .ok())
         return false;
       evaluation::ContinuousClosedLoop<double> cld;
-      if (!evaluation::BuildContinuousClosedLoop<double>(*realization, gd, disturbance, &cld, nullptr,
-                                                         loop->reference))
+      if (!evaluation::BuildContinuousClosedLoop<double>(*realization, gd, disturbance, &cld, loop->reference)
+               .ok())
         return false;
       if (!evaluation::ContinuousStability(cld, loop->stability_margin).stable) return false;
       evaluation::SampleContinuousLoop<T>(cl, disturbance, ts, loop->NumSamples(), &y);

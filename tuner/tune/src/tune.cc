@@ -43,7 +43,8 @@ bool MeetsBounds(const Plant& plant, const StateSpace& realization, const TuneOp
   if (options.loop.loop == evaluation::LoopKind::kContinuous && plant.delay_s == 0.0) {
     evaluation::ContinuousClosedLoop<double> loop;
     if (!evaluation::BuildContinuousClosedLoop<double>(realization, g, Disturbance(DisturbanceOptions{}),
-                                                       &loop, nullptr))
+                                                       &loop)
+             .ok())
       return false;
     return analysis::ContinuousLoopMeetsBounds(
         plant.tf, g, evaluation::ContinuousStability(loop, options.loop.stability_margin), options.bounds);

@@ -224,12 +224,11 @@ void FinishClosedLoop(const StateSpace& plant, const Disturbance& disturbance, d
 
 /// The filtered PID's loop (see BuildContinuousClosedLoop); g.tf > 0.
 template <typename T>
-bool BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, const Disturbance& disturbance,
-                             ContinuousClosedLoop<T>* out, std::string* error, double reference,
-                             const SetpointWeights& weights = {}) {
+Status BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, const Disturbance& disturbance,
+                               ContinuousClosedLoop<T>* out, double reference,
+                               const SetpointWeights& weights = {}) {
   if (!std::isfinite(ToDouble(g.tf))) {
-    if (error) *error = "the derivative filter tf is not finite";
-    return false;
+    return Status::InvalidInput("the derivative filter tf is not finite");
   }
   const int n = plant.order();
   const DisturbanceKind kind = disturbance.options().kind;
@@ -261,7 +260,7 @@ bool BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, con
   w0(ir) = T(reference);
   FinishClosedLoop<T>(plant, disturbance, reference, /*filter_order=*/1, exo, std::move(m), std::move(w0),
                       out);
-  return true;
+  return Status::Ok();
 }
 
 /// Builds the continuous loop. The ideal PID (g.tf = 0) u = kp e + ki z + kd e' is made
@@ -269,18 +268,17 @@ bool BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, con
 ///   u = alpha (kp (r - C x) + ki z - kd C A x - kd C B n),  alpha = 1/(1 + kd C B),
 /// and the step's impulse kd A delta(t) moves x(0+) = alpha kd A B, with A =
 /// `reference` the size of the step (r state at t = 0).
-/// Returns false (with *error) if 1 + kd C B = 0.
+/// kInvalidInput if 1 + kd C B = 0.
 /// The filtered PID (g.tf > 0) has one more state v = e / (tf s + 1):
 ///   v' = (e - v) / tf,  u = kp e + ki z + (kd / tf) (e - v),
 /// no impulse (x(0+) = 0) and no algebraic loop (the plant is strictly proper).
 /// With setpoint weights b, c (2-DOF) r enters as kp b r and kd c r' (the
 /// impulse kd c A), or as (kp b + kf c) r and v' = (c r - C x - v) / tf.
 template <typename T>
-bool BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, const Disturbance& disturbance,
-                               ContinuousClosedLoop<T>* out, std::string* error, double reference = 1.0,
-                               const SetpointWeights& weights = {}) {
-  if (ToDouble(g.tf) > 0.0)
-    return BuildFilteredClosedLoop(plant, g, disturbance, out, error, reference, weights);
+Status BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g,
+                                 const Disturbance& disturbance, ContinuousClosedLoop<T>* out,
+                                 double reference = 1.0, const SetpointWeights& weights = {}) {
+  if (ToDouble(g.tf) > 0.0) return BuildFilteredClosedLoop(plant, g, disturbance, out, reference, weights);
   const int n = plant.order();
   const DisturbanceKind kind = disturbance.options().kind;
   const int exo = kind == DisturbanceKind::kNone ? 0 : (kind == DisturbanceKind::kSine ? 2 : 1);
@@ -288,8 +286,7 @@ bool BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
   const double cb = plant.c.dot(plant.b);
   const T denom = T(1.0) + g.kd * cb;
   if (std::abs(ToDouble(denom)) < 1e-12) {
-    if (error) *error = "1 + kd*C*B = 0: the ideal PID loop is ill-posed for this plant";
-    return false;
+    return Status::InvalidInput("1 + kd*C*B = 0: the ideal PID loop is ill-posed for this plant");
   }
   const T alpha = T(1.0) / denom;
   const Eigen::RowVectorXd ca = plant.c * plant.a;
@@ -313,7 +310,7 @@ bool BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
   w0(ir) = T(reference);
   FinishClosedLoop<T>(plant, disturbance, reference, /*filter_order=*/0, exo, std::move(m), std::move(w0),
                       out);
-  return true;
+  return Status::Ok();
 }
 
 /// The loop states that are not hidden modes: the plant's, the integral's
@@ -466,12 +463,12 @@ std::optional<bool> CountedSampledStability(const DiscretePlant& plant, const Pi
 
 // The double loops are compiled once (closed_loop_instances.cc), not in
 // every file that runs them; other scalars (Ceres's Jet) instantiate here.
-extern template bool BuildFilteredClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
-                                                     const Disturbance&, ContinuousClosedLoop<double>*,
-                                                     std::string*, double, const SetpointWeights&);
-extern template bool BuildContinuousClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
+extern template Status BuildFilteredClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
                                                        const Disturbance&, ContinuousClosedLoop<double>*,
-                                                       std::string*, double, const SetpointWeights&);
+                                                       double, const SetpointWeights&);
+extern template Status BuildContinuousClosedLoop<double>(const StateSpace&, const PidGainsT<double>&,
+                                                         const Disturbance&, ContinuousClosedLoop<double>*,
+                                                         double, const SetpointWeights&);
 extern template void SampleContinuousLoop<double>(const ContinuousClosedLoop<double>&, const Disturbance&,
                                                   double, int, std::vector<double>*);
 extern template PidStatus RunSampledLoop<double>(const DiscretePlant&, const PidGainsT<double>&,
