@@ -2,10 +2,7 @@
 
 #include <climits>
 #include <exception>
-#include <pidlab/lcmt_episode_config_v1.hpp>
-#include <pidlab/lcmt_episode_config_v2.hpp>
-#include <pidlab/lcmt_episode_config_v3.hpp>
-#include <pidlab/lcmt_episode_config_v4.hpp>
+#include <pidlab/lcmt_episode_config_layout.hpp>
 #include <vector>
 
 #include "pidlab/transport/wire.h"
@@ -94,11 +91,12 @@ std::string MessageType::PrefixOf(const std::string& channel) const {
 DecoderTable::DecoderTable()
     : types_{
           Type<pidlab::lcmt_episode_config>("lcmt_episode_config", "EPISODE_CONFIG"),
-          Frozen<pidlab::lcmt_episode_config_v1>(),  // logs written before the motor's fields
-          Frozen<pidlab::lcmt_episode_config_v2>(),  // before the plant's dead time
-          Frozen<pidlab::lcmt_episode_config_v3>(),  // before the chirp and the measurement noise
-          Frozen<pidlab::lcmt_episode_config_v4>(),  // before the setpoint weights
-          Type<pidlab::lcmt_ready>("lcmt_ready", "READY"),
+// Every frozen copy of the configuration (generated from the .lcm file's
+// "//@frozen" lines): logs written before an append.
+#define PIDLAB_FROZEN_CONFIG(T) Frozen<pidlab::T>(),
+          PIDLAB_lcmt_episode_config_FROZEN(PIDLAB_FROZEN_CONFIG)
+#undef PIDLAB_FROZEN_CONFIG
+              Type<pidlab::lcmt_ready>("lcmt_ready", "READY"),
           Type<pidlab::lcmt_plant_output>("lcmt_plant_output", "PLANT_OUTPUT"),
           Type<pidlab::lcmt_control_command>("lcmt_control_command", "CONTROL"),
           Type<pidlab::lcmt_disturbance_sample>("lcmt_disturbance_sample", "DISTURBANCE"),  // older logs
@@ -110,7 +108,8 @@ DecoderTable::DecoderTable()
           Type<pidlab::lcmt_pacing_progress>("lcmt_pacing_progress",
                                              "PACING"),  // live figures: the SUMMARY's are final
           Type<pidlab::lcmt_tune_progress>("lcmt_tune_progress", "TUNE_PROGRESS"),  // a tuning's progress
-      } {}
+      } {
+}
 
 const MessageType* DecoderTable::Find(int64_t fingerprint) const {
   for (const MessageType& t : types_)

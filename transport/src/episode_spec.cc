@@ -30,6 +30,47 @@ std::string FormatDouble(double v) {
   return os.str();
 }
 
+enum class Direction { kToMessage, kFromMessage };
+
+// The configuration's real numbers and where an EpisodeSpec keeps them, one
+// line a field, for both MakeEpisodeConfig and ParseEpisodeConfig: a number
+// appended to lcmt_episode_config and to EpisodeShape is one line here. (The
+// names, the options spelled as strings, the integers and the motor's
+// fields are converted beside it.)
+void CopyNumbers(EpisodeSpec* s, pidlab::lcmt_episode_config* m, Direction direction) {
+  const auto field = [direction](double& in_spec, double& in_message) {
+    if (direction == Direction::kToMessage)
+      in_message = in_spec;
+    else
+      in_spec = in_message;
+  };
+  field(s->plant.delay_s, m->delay_s);
+  field(s->gains.kp, m->kp);
+  field(s->gains.ki, m->ki);
+  field(s->gains.kd, m->kd);
+  field(s->reference, m->reference);
+  field(s->pid.derivative_filter_s, m->derivative_filter_s);
+  field(s->pid.output_min, m->output_min);
+  field(s->pid.output_max, m->output_max);
+  field(s->pid.back_calculation_gain, m->back_calculation_gain);
+  field(s->pid.setpoint_weight_b, m->setpoint_weight_b);
+  field(s->pid.setpoint_weight_c, m->setpoint_weight_c);
+  field(s->dt_s, m->dt_s);
+  field(s->sample_time_s, m->sample_time_s);
+  field(s->horizon_s, m->horizon_s);
+  field(s->disturbance.amplitude, m->disturbance_amplitude);
+  field(s->disturbance.period_s, m->disturbance_period_s);
+  field(s->disturbance.phase_s, m->disturbance_phase_s);
+  field(s->disturbance.step_time_s, m->disturbance_step_time_s);
+  field(s->disturbance.noise_hold_s, m->noise_hold_s);
+  field(s->disturbance.chirp_f0_hz, m->chirp_f0_hz);
+  field(s->disturbance.chirp_f1_hz, m->chirp_f1_hz);
+  field(s->disturbance.chirp_duration_s, m->chirp_duration_s);
+  field(s->measurement_noise.sigma, m->measurement_noise);
+  field(s->recovery.retransmit_interval_s, m->retransmit_interval_s);
+  field(s->recovery.silence_deadline_s, m->silence_deadline_s);
+}
+
 }  // namespace
 
 bool RecoveryOptions::IsValid(std::string* error) const {
@@ -98,42 +139,17 @@ pidlab::lcmt_episode_config MakeEpisodeConfig(const EpisodeSpec& spec) {
   m.num_size = static_cast<int32_t>(m.num.size());
   m.den = spec.plant.tf.den;
   m.den_size = static_cast<int32_t>(m.den.size());
-  m.delay_s = spec.plant.delay_s;
-  m.kp = spec.gains.kp;
-  m.ki = spec.gains.ki;
-  m.kd = spec.gains.kd;
-  m.reference = spec.reference;
-  const PidOptions& pid = spec.pid;
-  m.derivative_filter_s = pid.derivative_filter_s;
-  m.output_min = pid.output_min;
-  m.output_max = pid.output_max;
-  m.anti_windup = ToString(pid.anti_windup);
-  m.back_calculation_gain = pid.back_calculation_gain;
+  EpisodeSpec numbers = spec;
+  CopyNumbers(&numbers, &m, Direction::kToMessage);
+  m.anti_windup = ToString(spec.pid.anti_windup);
   // derivative_on "measurement" is c = 0, kept for older readers of the log.
   m.derivative_on =
-      ToString(pid.setpoint_weight_c == 0.0 ? DerivativeOn::kMeasurement : DerivativeOn::kError);
-  m.setpoint_weight_b = pid.setpoint_weight_b;
-  m.setpoint_weight_c = pid.setpoint_weight_c;
-  m.integral = ToString(pid.integral);
-  m.dt_s = spec.dt_s;
-  m.sample_time_s = spec.sample_time_s;
-  m.horizon_s = spec.horizon_s;
+      ToString(spec.pid.setpoint_weight_c == 0.0 ? DerivativeOn::kMeasurement : DerivativeOn::kError);
+  m.integral = ToString(spec.pid.integral);
   m.total_steps = spec.total_steps;
-  const DisturbanceOptions& d = spec.disturbance;
-  m.disturbance_kind = ToString(d.kind);
-  m.disturbance_amplitude = d.amplitude;
-  m.disturbance_period_s = d.period_s;
-  m.disturbance_phase_s = d.phase_s;
-  m.disturbance_step_time_s = d.step_time_s;
-  m.noise_hold_s = d.noise_hold_s;
-  m.seed = static_cast<int64_t>(d.seed);
-  m.chirp_f0_hz = d.chirp_f0_hz;
-  m.chirp_f1_hz = d.chirp_f1_hz;
-  m.chirp_duration_s = d.chirp_duration_s;
-  m.measurement_noise = spec.measurement_noise.sigma;
+  m.disturbance_kind = ToString(spec.disturbance.kind);
+  m.seed = static_cast<int64_t>(spec.disturbance.seed);
   m.measurement_noise_seed = static_cast<int64_t>(spec.measurement_noise.seed);
-  m.retransmit_interval_s = spec.recovery.retransmit_interval_s;
-  m.silence_deadline_s = spec.recovery.silence_deadline_s;
   m.motor_resistance_ohm = m.motor_self_inductance_h = m.motor_mutual_inductance_h = 0.0;
   m.motor_inertia_kg_m2 = m.motor_rotor_teeth = m.motor_viscous_friction = m.motor_tooth_pitch_rad = 0.0;
   m.motor_stationary_current_a = m.motor_flux_linkage = m.motor_detent_torque_nm = 0.0;
@@ -220,48 +236,28 @@ bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec,
   } else if (!m.motor_drive.empty()) {
     return Fail("motor fields on plant '" + m.plant_name + "' (only stepper_nonlinear has a motor)", error);
   }
-  s.plant.delay_s = m.delay_s;  // after the motor's plant is made; IsValid checks it
-  s.gains = PidGains{m.kp, m.ki, m.kd};
-  s.reference = m.reference;
-  s.dt_s = m.dt_s;
-  s.sample_time_s = m.sample_time_s;
-  s.horizon_s = m.horizon_s;
+  // The numbers after the motor's plant is made (it sets the plant whole,
+  // the dead time included); IsValid checks them.
+  s.pid = PidOptionsAt(s.pid, m.dt_s);
+  pidlab::lcmt_episode_config numbers = m;
+  CopyNumbers(&s, &numbers, Direction::kFromMessage);
   s.total_steps = static_cast<long>(std::clamp<int64_t>(m.total_steps, -1, kMaxEpisodeSteps + 1));
   PidOptions& pid = s.pid;
-  pid = PidOptionsAt(pid, m.dt_s);
-  pid.derivative_filter_s = m.derivative_filter_s;
-  pid.output_min = m.output_min;
-  pid.output_max = m.output_max;
-  pid.back_calculation_gain = m.back_calculation_gain;
   if (!ParseAntiWindup(m.anti_windup, &pid.anti_windup))
     return Fail("anti-windup '" + m.anti_windup + "' unknown", error);
   DerivativeOn derivative_on = DerivativeOn::kError;
   if (!ParseDerivativeOn(m.derivative_on, &derivative_on))
     return Fail("derivative-on '" + m.derivative_on + "' unknown", error);
-  pid.setpoint_weight_b = m.setpoint_weight_b;
-  pid.setpoint_weight_c = m.setpoint_weight_c;
   if (derivative_on == DerivativeOn::kMeasurement && m.setpoint_weight_c != 0.0)
     return Fail("derivative-on measurement with setpoint weight c = " + std::to_string(m.setpoint_weight_c) +
                     " (measurement is c = 0)",
                 error);
   if (!ParseIntegralMethod(m.integral, &pid.integral))
     return Fail("integral '" + m.integral + "' unknown", error);
-  DisturbanceOptions& d = s.disturbance;
-  if (!ParseDisturbanceKind(m.disturbance_kind, &d.kind))
+  if (!ParseDisturbanceKind(m.disturbance_kind, &s.disturbance.kind))
     return Fail("disturbance '" + m.disturbance_kind + "' unknown", error);
-  d.amplitude = m.disturbance_amplitude;
-  d.period_s = m.disturbance_period_s;
-  d.phase_s = m.disturbance_phase_s;
-  d.step_time_s = m.disturbance_step_time_s;
-  d.noise_hold_s = m.noise_hold_s;
-  d.seed = static_cast<uint64_t>(m.seed);
-  d.chirp_f0_hz = m.chirp_f0_hz;
-  d.chirp_f1_hz = m.chirp_f1_hz;
-  d.chirp_duration_s = m.chirp_duration_s;
-  s.measurement_noise.sigma = m.measurement_noise;
+  s.disturbance.seed = static_cast<uint64_t>(m.seed);
   s.measurement_noise.seed = static_cast<uint64_t>(m.measurement_noise_seed);
-  s.recovery.retransmit_interval_s = m.retransmit_interval_s;
-  s.recovery.silence_deadline_s = m.silence_deadline_s;
   if (!s.IsValid(error)) return false;
   *spec = s;
   return true;

@@ -6,10 +6,6 @@
 #include <pidlab/lcmt_disturbance_request.hpp>
 #include <pidlab/lcmt_disturbance_sample.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
-#include <pidlab/lcmt_episode_config_v1.hpp>
-#include <pidlab/lcmt_episode_config_v2.hpp>
-#include <pidlab/lcmt_episode_config_v3.hpp>
-#include <pidlab/lcmt_episode_config_v4.hpp>
 #include <pidlab/lcmt_episode_summary.hpp>
 #include <pidlab/lcmt_pacing_progress.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
@@ -77,9 +73,10 @@ constexpr int kHeader = 24;  // utime, episode_id, step
 
 int EpisodeConfigVersion(int64_t fingerprint) {
   const int64_t versions[kEpisodeConfigVersion] = {
-      pidlab::lcmt_episode_config_v1::getHash(), pidlab::lcmt_episode_config_v2::getHash(),
-      pidlab::lcmt_episode_config_v3::getHash(), pidlab::lcmt_episode_config_v4::getHash(),
-      pidlab::lcmt_episode_config::getHash()};
+#define PIDLAB_FINGERPRINT_OF(T) pidlab::T::getHash(),
+      PIDLAB_lcmt_episode_config_FROZEN(PIDLAB_FINGERPRINT_OF)
+#undef PIDLAB_FINGERPRINT_OF
+          pidlab::lcmt_episode_config::getHash()};
   for (int v = 0; v < kEpisodeConfigVersion; ++v)
     if (versions[v] == fingerprint) return v + 1;
   return 0;
@@ -89,25 +86,20 @@ bool WireLayoutOk(int64_t fingerprint, const void* data, int size) {
   if (size < 8 + kHeader) return false;
   LayoutCheck c(static_cast<const uint8_t*>(data), size);
   c.Fixed(kHeader);
-  // An episode configuration of any version: the current layout, cut where
-  // that version ended.
+  // An episode configuration of any version: the fields of the .lcm file
+  // (lcmt_episode_config_layout.hpp, generated from it) after the header,
+  // as many as that version had.
   if (const int version = EpisodeConfigVersion(fingerprint); version > 0) {
-    c.String()
-        .Array(8, kMaxPolynomialCoefficients)
-        .Array(8, kMaxPolynomialCoefficients)
-        .Fixed(7 * 8)
-        .String()
-        .Fixed(8)
-        .String()
-        .String()
-        .Fixed(4 * 8)
-        .String()
-        .Fixed(6 * 8)
-        .Fixed(2 * 8);
-    if (version >= 2) c.Fixed(17 * 8).String();  // the motor's fields, then motor_drive
-    if (version >= 3) c.Fixed(8);                // delay_s
-    if (version >= 4) c.Fixed(5 * 8);  // the chirp's band and duration, measurement noise and its seed
-    if (version >= 5) c.Fixed(2 * 8);  // the setpoint weights b, c
+    namespace layout = lcm_layout::lcmt_episode_config;
+    for (int i = 3; i < layout::kFieldsInVersion[version - 1]; ++i) {
+      const layout::Field& f = layout::kFields[i];
+      if (f.kind == layout::WireField::kString)
+        c.String();
+      else if (f.kind == layout::WireField::kArray)
+        c.Array(f.bytes, kMaxPolynomialCoefficients);  // num, den: the plant's polynomials
+      else
+        c.Fixed(f.bytes);
+    }
   } else if (fingerprint == pidlab::lcmt_ready::getHash()) {
     c.Fixed(1).String().Fixed(4).String();
   } else if (fingerprint == pidlab::lcmt_episode_summary::getHash()) {

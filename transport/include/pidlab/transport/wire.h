@@ -7,6 +7,7 @@
 // limits (protocol.h), so decoding only ever runs on a well-formed payload.
 
 #include <cstdint>
+#include <pidlab/lcmt_episode_config_layout.hpp>
 #include <string>
 
 namespace pidlab::transport {
@@ -21,7 +22,7 @@ inline constexpr int kMaxStringBytes = 4096;
 /// lcmt_episode_config_v1.. (generated from the "//@frozen" lines of
 /// lcmtypes/lcmt_episode_config.lcm: each holds the fields before an append),
 /// 0 for any other fingerprint.
-inline constexpr int kEpisodeConfigVersion = 5;
+inline constexpr int kEpisodeConfigVersion = lcm_layout::lcmt_episode_config::kVersions;
 int EpisodeConfigVersion(int64_t fingerprint);
 
 /// True if `data` (size bytes, fingerprint first) has the layout of the
