@@ -24,6 +24,7 @@ Not supported: --auth-key (HMAC tags, docs/security.md) and memq:// URLs.
 """
 
 import argparse
+import json
 import math
 import os
 import select
@@ -257,8 +258,9 @@ class ControllerRole:
     """transport::Role + ControllerRole: answers PING, acknowledges
     configurations, answers plant outputs."""
 
-    def __init__(self, lcm, prefix, log):
+    def __init__(self, lcm, prefix, log, print_configs=False):
         self.lcm, self.prefix, self.log = lcm, prefix, log
+        self.print_configs = print_configs
         self.episode_id = 0  # current episode, 0 before the first
         self.episode = None
         self.counters = dict(episodes=0, commands=0, foreign=0, duplicates=0, bad_configs=0, conflicts=0,
@@ -315,6 +317,8 @@ class ControllerRole:
         self.episode_id = m.episode_id
         self.counters["episodes"] += 1
         self.episode = Episode(m)
+        if self.print_configs:  # what this controller saw: every field by its .lcm name
+            print(json.dumps({name: getattr(m, name) for name in m.__slots__}), flush=True)
         self.ack(self.episode_id)
 
     def on_output(self, m):
@@ -360,6 +364,8 @@ def main():
     parser.add_argument("--channel-prefix", default=os.environ.get("PIDLAB_CHANNEL_PREFIX") or DEFAULT_CHANNEL_PREFIX,
                         help="prefix of every channel (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)")
     parser.add_argument("--verbose", "-v", action="store_true", help="print the counters when stopped")
+    parser.add_argument("--print-configs", action="store_true",
+                        help="print every configuration accepted to stdout, one JSON line of every message field")
     args = parser.parse_args()
     program = "python_controller"
 
@@ -382,7 +388,7 @@ def main():
     except OSError as error:
         log("failed: cannot start LCM on '%s': %s (no multicast route? see docs/trio.md)" % (args.lcm_url, error))
         return 1
-    role = ControllerRole(lcm, args.channel_prefix, log)
+    role = ControllerRole(lcm, args.channel_prefix, log, args.print_configs)
     stop = []
     signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
     signal.signal(signal.SIGINT, lambda *_: stop.append(1))

@@ -179,7 +179,7 @@ void LcmFlags::Register(CLI::App* app) {
   app->add_flag("--quiet,-q", quiet, "--backend lcm: say nothing of episodes run again or trios left out");
   app->add_flag("--verbose,-v", verbose,
                 "--backend lcm: say each episode run again and each trio left out as it happens (default: "
-                "their count, once)");
+                "their count, once); evaluate: also the id of each episode it ran");
   app->add_option("--lcm-url", lcm_url,
                   "--backend lcm: LCM URL of the trio (default $PIDLAB_LCM_URL, else LCM's); tune: one or "
                   "several trios, comma-separated (default: every trio of 'pidlab launch --trios K', "

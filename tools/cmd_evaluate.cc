@@ -99,6 +99,10 @@ struct EvaluateCommand {
     if (!samples_csv.empty()) WriteSamplesCsv(result.evaluation, samples_csv);
     if (!trajectory_csv.empty()) WriteTrajectoryCsv(result.evaluation, trajectory_csv);
     Print(problem, result, client.get());
+    // -v: the episodes' ids, to find them in a log (pidlab replay --episode).
+    if (client && lcm.verbose)
+      for (const int64_t id : client->stats().episode_ids)
+        std::fprintf(stderr, "pidlab: note: episode %lld ran\n", static_cast<long long>(id));
     return 0;
   }
 

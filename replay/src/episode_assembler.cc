@@ -188,6 +188,7 @@ void EpisodeAssembler::On(const std::string& prefix, const pidlab::lcmt_episode_
     return;
   }
   b.config = m;
+  b.episode.config = m;
   std::string error;
   if (transport::ParseEpisodeConfig(m, &b.episode.spec, &error))
     b.episode.has_config = true;

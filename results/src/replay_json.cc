@@ -1,5 +1,9 @@
 #include "pidlab/results/replay_json.h"
 
+#include <pidlab/lcmt_episode_config_fields.h>
+
+#include <cmath>
+
 #include "pidlab/results/results_json.h"
 
 namespace pidlab::results {
@@ -46,6 +50,36 @@ nlohmann::json LogJson(const replay::LogContents& log, const std::string& path) 
   return out;
 }
 
+namespace {
+
+// A number; "inf", "-inf" or "nan" as text, as a spec writes infinity.
+nlohmann::json ConfigNumber(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  return v;
+}
+
+}  // namespace
+
+nlohmann::json ConfigJson(const lcmt_episode_config& m) {
+  nlohmann::json j;
+#define PIDLAB_JSON_D(name) j[#name] = ConfigNumber(m.name);
+#define PIDLAB_JSON_I(name) j[#name] = m.name;
+#define PIDLAB_JSON_S(name) j[#name] = m.name;
+#define PIDLAB_JSON_A(name, count)    \
+  j[#count] = m.count;                \
+  j[#name] = nlohmann::json::array(); \
+  for (double v : m.name) j[#name].push_back(ConfigNumber(v));
+#define PIDLAB_JSON_N(name) j[#name] = m.name;
+  PIDLAB_LCMT_EPISODE_CONFIG_FIELDS(PIDLAB_JSON_D, PIDLAB_JSON_I, PIDLAB_JSON_S, PIDLAB_JSON_A, PIDLAB_JSON_N)
+#undef PIDLAB_JSON_D
+#undef PIDLAB_JSON_I
+#undef PIDLAB_JSON_S
+#undef PIDLAB_JSON_A
+#undef PIDLAB_JSON_N
+  return j;
+}
+
 nlohmann::json EpisodeJson(const replay::Episode& e) {
   nlohmann::json j;
   j["prefix"] = e.prefix;
@@ -66,6 +100,7 @@ nlohmann::json EpisodeJson(const replay::Episode& e) {
     j["gains"] = ToJson(e.spec.gains);
     j["dt_s"] = e.spec.dt_s;
     j["disturbance"] = ToString(e.spec.disturbance.kind);
+    j["config"] = ConfigJson(e.config);
   } else {
     j["config_error"] = e.config_error;
   }

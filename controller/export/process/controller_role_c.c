@@ -8,9 +8,15 @@
  * y_k -> u_k once, a resent y_k -> the same u_k again.
  *
  *   pidlab-controller-c [--lcm-url udpm://GROUP:PORT?ttl=N] [--channel-prefix P] [--verbose]
+ *                       [--print-configs]
+ *
+ * --print-configs writes every configuration it accepts to stdout as one JSON
+ * line, every field of the message by its .lcm name (the X-macro
+ * <pidlab/lcmt_episode_config_fields.h>): what this controller saw.
  *
  * Not supported: --auth-key (HMAC tags, docs/security.md). */
 #include <lcm/lcm.h>
+#include <math.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -20,6 +26,7 @@
 #include <sys/time.h>
 #include <unistd.h>
 
+#include "pidlab/lcmt_episode_config_fields.h"
 #include "pidlab_lcmt_control_command.h"
 #include "pidlab_lcmt_episode_config.h"
 #include "pidlab_lcmt_plant_output.h"
@@ -42,6 +49,7 @@ typedef struct {
   pidlab_lcmt_control_command last;
   int have_last;
   long episodes, commands, foreign, duplicates, bad_configs, conflicts;
+  int print_configs;
 } controller;
 
 static volatile sig_atomic_t stop = 0;
@@ -132,6 +140,65 @@ static void to_config(const pidlab_lcmt_episode_config *m, pidlab_pid_config *p)
                                                       : PIDLAB_INTEGRAL_BACKWARD_EULER;
 }
 
+/* JSON as Python's json module reads it (Infinity, -Infinity, NaN). */
+static void print_double(double v) {
+  if (v != v)
+    fputs("NaN", stdout);
+  else if (isinf(v))
+    fputs(v > 0 ? "Infinity" : "-Infinity", stdout);
+  else
+    printf("%.17g", v);
+}
+
+static void print_string(const char *s) {
+  putchar('"');
+  for (; *s; ++s) {
+    if (*s == '"' || *s == '\\')
+      printf("\\%c", *s);
+    else if ((unsigned char)*s < 0x20)
+      printf("\\u%04x", (unsigned)*s);
+    else
+      putchar(*s);
+  }
+  putchar('"');
+}
+
+/* Every field of the configuration, by its .lcm name, as one JSON line. */
+static void print_config(const pidlab_lcmt_episode_config *m) {
+  const char *sep = "{";
+  int32_t k;
+#define PRINT_D(name)               \
+  printf("%s\"" #name "\": ", sep); \
+  print_double(m->name);            \
+  sep = ", ";
+#define PRINT_I(name)                                       \
+  printf("%s\"" #name "\": %lld", sep, (long long)m->name); \
+  sep = ", ";
+#define PRINT_S(name)               \
+  printf("%s\"" #name "\": ", sep); \
+  print_string(m->name);            \
+  sep = ", ";
+#define PRINT_A(name, count)                                            \
+  printf("%s\"" #count "\": %d, \"" #name "\": [", sep, (int)m->count); \
+  for (k = 0; k < m->count; ++k) {                                      \
+    if (k) fputs(", ", stdout);                                         \
+    print_double(m->name[k]);                                           \
+  }                                                                     \
+  putchar(']');                                                         \
+  sep = ", ";
+#define PRINT_N(name)                               \
+  printf("%s\"" #name "\": %d", sep, (int)m->name); \
+  sep = ", ";
+  PIDLAB_LCMT_EPISODE_CONFIG_FIELDS(PRINT_D, PRINT_I, PRINT_S, PRINT_A, PRINT_N)
+#undef PRINT_D
+#undef PRINT_I
+#undef PRINT_S
+#undef PRINT_A
+#undef PRINT_N
+  fputs("}\n", stdout);
+  fflush(stdout);
+}
+
 static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_lcmt_episode_config *m,
                       void *user) {
   controller *c = (controller *)user;
@@ -161,6 +228,7 @@ static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
   c->expected = 0;
   c->have_last = 0;
   ++c->episodes;
+  if (c->print_configs) print_config(m);
   ack(c, c->episode_id);
 }
 
@@ -249,6 +317,8 @@ int main(int argc, char **argv) {
       prefix = argv[++i];
     else if (!strcmp(argv[i], "--verbose") || !strcmp(argv[i], "-v"))
       verbose = 1;
+    else if (!strcmp(argv[i], "--print-configs"))
+      c.print_configs = 1;
     else {
       fprintf(stderr, "pidlab-controller-c: error: unknown argument '%.80s'\n", argv[i]);
       return 2;

@@ -295,6 +295,7 @@ bool EpisodeClient::RunOnce(const transport::EpisodeSpec& spec, std::string* err
     s.last_progress_s = t0;
     if (!FollowEpisode(t0, &done_s, &requests, error)) return false;
     ++stats_.episodes;
+    stats_.episode_ids.push_back(spec.episode_id);
     stats_.steps += s.total;
     stats_.seconds += (done_s > 0 ? done_s : NowSeconds()) - t0;
     stats_.resend_requests += requests;

@@ -49,6 +49,9 @@ struct Episode {
   bool has_config = false;
   std::string config_error;  // set if a config was logged but is invalid
   transport::EpisodeSpec spec;
+  /// The configuration as logged (its first copy), valid or not; meaningful
+  /// when has_config or config_error is set.
+  lcmt_episode_config config;
   /// The configuration's total_steps; without a valid configuration, the
   /// highest step logged within 0..transport::kMaxEpisodeSteps (listing only).
   long total_steps = 0;

@@ -20,7 +20,12 @@ nlohmann::json RealtimeJson(const transport::RealtimeStats& stats);
 nlohmann::json StreamJson(const replay::StreamStats& s);
 /// The log's counts and notes, with an empty "episodes" array; `path` as given.
 nlohmann::json LogJson(const replay::LogContents& log, const std::string& path);
-/// One episode without its evaluation and redrive.
+/// The logged configuration, every field of the message by its .lcm name
+/// (the X-macro <pidlab/lcmt_episode_config_fields.h>; arrays with their
+/// count): the "config" of an episode. Infinity and NaN as "inf", "-inf",
+/// "nan".
+nlohmann::json ConfigJson(const lcmt_episode_config& m);
+/// One episode without its evaluation and redrive; "config" when it has one.
 nlohmann::json EpisodeJson(const replay::Episode& e);
 /// The `redrive` object of an episode.
 nlohmann::json RedriveJson(const replay::RedriveResult& r);

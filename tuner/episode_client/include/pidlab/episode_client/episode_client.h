@@ -51,6 +51,8 @@ struct EpisodeClientOptions {
 
 struct EpisodeClientStats {
   long episodes = 0;
+  /// The ids of the episodes completed, in order (`pidlab replay --episode`).
+  std::vector<int64_t> episode_ids;
   long steps = 0;            // lockstep steps run
   double seconds = 0.0;      // wall time from the first acknowledgement to the last step
   long resend_requests = 0;  // TRAJECTORY_REQUESTs for steps the client missed
