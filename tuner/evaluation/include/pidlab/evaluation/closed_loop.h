@@ -24,6 +24,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -394,7 +395,12 @@ PidStatus RunSampledLoop(const DiscretePlant& plant, const PidGainsT<T>& gains, 
   PidStatus status = PidStatus::kOk;
   for (long k = 0;; ++k) {
     T y = OutputOf(plant.c(), x);
-    if (noise.enabled()) y += T(noise.Value(k));
+    // What the plant reports, by the function the plant role uses. (A Jet:
+    // the tuner runs the loop without measurement noise.)
+    if constexpr (std::is_same_v<T, double>)
+      y = noise.Measured(y, k);
+    else if (noise.enabled())
+      y += T(noise.Value(k));
     if (k % steps_per_sample == 0) y_samples->push_back(y);
     if (k == total_steps) break;
     const double t = static_cast<double>(k) * dt;
