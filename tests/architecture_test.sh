@@ -136,8 +136,9 @@ for header, shape in (('tuner/evaluation/include/pidlab/evaluation/closed_loop.h
 for f in os.listdir(os.path.join(src, 'lcmtypes')):
     if re.match(r'lcmt_.*_v\d+\.lcm$', f):
         fail(f'lcmtypes/{f}: a frozen copy kept by hand (mark "//@frozen" in the type instead)')
-if len(re.findall(r'//@frozen lcmt_episode_config_v\d', open(os.path.join(src, 'lcmtypes/lcmt_episode_config.lcm')).read())) != 4:
-    fail('lcmtypes/lcmt_episode_config.lcm: expected the four //@frozen lines of v1..v4')
+frozen = [int(n) for n in re.findall(r'//@frozen lcmt_episode_config_v(\d+)', open(os.path.join(src, 'lcmtypes/lcmt_episode_config.lcm')).read())]
+if len(frozen) < 4 or frozen != list(range(1, len(frozen) + 1)):
+    fail('lcmtypes/lcmt_episode_config.lcm: expected //@frozen lines of v1, v2, ... in order, at least v1..v4: %s' % frozen)
 # Nothing in the repository names the folder beside it.
 beside = '..' + '/' + 'shared'
 hits = subprocess.run(['git', '-C', src, 'grep', '-l', '-F', beside, '--', '.'],

@@ -16,10 +16,12 @@
 #include <lcm/lcm-cpp.hpp>
 #include <limits>
 #include <new>
+#include <pidlab/lcmt_episode_config_layout.hpp>
 #include <pidlab/lcmt_episode_config_v1.hpp>
 #include <pidlab/lcmt_episode_config_v2.hpp>
 #include <pidlab/lcmt_episode_config_v3.hpp>
 #include <pidlab/lcmt_episode_config_v4.hpp>
+#include <pidlab/lcmt_episode_config_v5.hpp>
 #include <pidlab/lcmt_ready.hpp>
 
 #include "pidlab/replay/decoder_table.h"
@@ -346,7 +348,9 @@ std::vector<uint8_t> Encode(const Msg& m) {
 
 TEST(DecoderTable, FindsEveryPidlabTypeByItsFingerprint) {
   const DecoderTable table;
-  ASSERT_EQ(table.types().size(), 16u);  // twelve types and the four configurations of older logs
+  // Twelve types and the configurations of older logs (one per //@frozen line).
+  namespace layout = pidlab::lcm_layout::lcmt_episode_config;
+  ASSERT_EQ(table.types().size(), static_cast<std::size_t>(12 + layout::kVersions - 1));
   for (const MessageType& t : table.types()) {
     const MessageType* found = table.Find(t.fingerprint);
     ASSERT_NE(found, nullptr) << t.name;
@@ -431,10 +435,17 @@ TEST(DecoderTable, AConfigurationOfAnOlderLogIsReadAsOneOfALinearPlant) {
     const std::vector<uint8_t> cut_bytes(whole.begin(), whole.end() - static_cast<std::ptrdiff_t>(cut));
     EXPECT_FALSE(current->decode(cut_bytes.data(), cut_bytes.size(), &message)) << cut;
   }
-  // motor_drive's length ("linear": 4 + 7 bytes, then delay_s's 8, the
-  // chirp's and the measurement noise's 5 x 8 and the setpoint weights'
-  // 2 x 8): 2^31 - 1 + ...
-  whole[whole.size() - 75] = 0x7f;
+  // motor_drive's length ("linear": 4 + 7 bytes, then the 8 bytes of each
+  // field after it: delay_s, the chirp's, the measurement noise's, the
+  // setpoint weights', ...): 2^31 - 1 + ...
+  namespace layout = pidlab::lcm_layout::lcmt_episode_config;
+  std::size_t after = 0;
+  bool past = false;
+  for (const layout::Field& f : layout::kFields) {
+    if (past) after += 8;
+    past = past || std::string(f.name) == "motor_drive";
+  }
+  whole[whole.size() - (4 + 7 + after)] = 0x7f;
   EXPECT_FALSE(current->decode(whole.data(), whole.size(), &message));
 }
 
@@ -567,6 +578,9 @@ TEST(DecoderTable, EachGeneratedFrozenConfigurationKeepsTheFingerprintItsLogsCar
   EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v2::getHash()), 0xdaafa1e58acc7835ULL);
   EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v3::getHash()), 0x7996f8fa958b6b63ULL);
   EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v4::getHash()), 0xab82a939990368c8ULL);
+  // v5: the type before measurement_resolution (lcm-gen --python of that
+  // .lcm file gives the same packed fingerprint).
+  EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v5::getHash()), 0xae1743586efaa30bULL);
   EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_episode_config_v1::getHash()), 1);
   EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_episode_config_v4::getHash()), 4);
   EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_episode_config::getHash()),

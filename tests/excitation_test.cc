@@ -217,5 +217,77 @@ TEST(SpecBuild, NamesTheChirpBandAndTheMeasurementNoiseAsTheCallerSpellsThem) {
   EXPECT_EQ(o.measurement_noise.seed, 9u);
 }
 
+TEST(MeasurementNoise, AResolutionRoundsTheMeasuredYToItsNearestMultipleHalvesAwayFromZero) {
+  MeasurementNoise q;
+  q.resolution = 0.25;
+  EXPECT_TRUE(q.enabled());
+  EXPECT_EQ(q.Measured(0.1, 0), 0.0);
+  EXPECT_EQ(q.Measured(0.125, 0), 0.25);
+  EXPECT_EQ(q.Measured(-0.125, 0), -0.25);
+  EXPECT_EQ(q.Measured(1.3, 0), 1.25);
+  EXPECT_EQ(q.Measured(-7.0, 0), -7.0);
+  // With noise: the noisy value is what is rounded.
+  MeasurementNoise noisy{0.01, 3};
+  noisy.resolution = 0.001;
+  for (std::int64_t k : {0, 1, 17}) {
+    const double expected = 0.001 * std::round((0.5 + noisy.Value(k)) / 0.001);
+    EXPECT_EQ(noisy.Measured(0.5, k), expected) << "step " << k;
+  }
+  std::string error;
+  for (double bad : {-0.1, std::nan(""), HUGE_VAL}) {
+    q.resolution = bad;
+    EXPECT_FALSE(q.IsValid(&error)) << bad;
+    EXPECT_EQ(error.rfind("measurement resolution", 0), 0u) << error;
+  }
+}
+
+TEST(SampledLoop, AQuantisedSensorReportsOnlyMultiplesOfItsResolutionToThePid) {
+  Plant plant;
+  std::string error;
+  ASSERT_TRUE(MakeCustomPlant({1.0}, {1.0, 2.0, 1.0}, &plant, &error)) << error;
+  const DiscretePlant discrete(plant.tf, 1e-3);
+  PidOptions pid;
+  pid.dt_s = 1e-3;
+  MeasurementNoise sensor;
+  sensor.resolution = 0.05;
+  std::vector<double> exact, measured;
+  const Disturbance none(DisturbanceOptions{});
+  RunSampledLoop<double>(discrete, PidGains{2.0, 1.0, 0.1}, pid, none, 3000, 1, &exact);
+  RunSampledLoop<double>(discrete, PidGains{2.0, 1.0, 0.1}, pid, none, 3000, 1, &measured, nullptr, 1.0,
+                         sensor);
+  ASSERT_EQ(exact.size(), measured.size());
+  int differ = 0;
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    ASSERT_EQ(measured[k], 0.05 * std::round(measured[k] / 0.05)) << "step " << k;
+    ASSERT_NEAR(measured[k], exact[k], 0.1) << "step " << k;
+    differ += measured[k] != exact[k];
+  }
+  EXPECT_GT(differ, 100) << "the PID saw the quantised y";
+}
+
+TEST(SpecBuild, NamesTheMeasurementResolutionAndKeepsItToTheSampledLoop) {
+  spec::LoopSpec s;
+  s.loop = "sampled";
+  s.horizon_s = 2.0;
+  s.measurement_resolution = 0.01;
+  LoopOptions o;
+  std::string error;
+  ASSERT_TRUE(tune::BuildLoopOptions(s, spec::NameStyle::kFlag, &o, &error)) << error;
+  EXPECT_EQ(o.measurement_noise.resolution, 0.01);
+  s.measurement_resolution = -1.0;
+  EXPECT_FALSE(tune::BuildLoopOptions(s, spec::NameStyle::kFlag, &o, &error));
+  EXPECT_EQ(error, "--measurement-resolution -1 must be >= 0 and finite");
+  s.measurement_resolution = 0.01;
+  s.loop = "continuous";
+  EXPECT_FALSE(tune::BuildLoopOptions(s, spec::NameStyle::kKey, &o, &error));
+  EXPECT_EQ(error.rfind("measurement_resolution 0.01: a quantised measured y needs loop sampled", 0), 0u)
+      << error;
+  LoopOptions direct = Sampled();
+  direct.loop = LoopKind::kContinuous;
+  direct.measurement_noise.resolution = 0.01;
+  EXPECT_FALSE(direct.IsValid(&error));
+  EXPECT_NE(error.find("measurement resolution 0.01"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace pidlab

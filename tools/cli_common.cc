@@ -384,7 +384,10 @@ std::string FormatEvaluation(const Evaluation& ev) {
   else if (d.kind != DisturbanceKind::kNone)
     os << "disturbance      " << ToString(d.kind) << " +/-" << d.amplitude << ", period " << d.period_s
        << " s, at the plant input\n";
-  if (ev.options.measurement_noise.enabled())
+  if (ev.options.measurement_noise.resolution != 0.0)
+    os << "measured y       rounded to a multiple of " << ev.options.measurement_noise.resolution
+       << ": every score is of the measured y\n";
+  if (ev.options.measurement_noise.sigma != 0.0)
     os << "measured y       y + noise of std deviation " << ev.options.measurement_noise.sigma << " (seed "
        << ev.options.measurement_noise.seed << "): every score is of the measured y\n";
   os << "stable           " << (ev.stability.stable ? "yes" : "NO (objectives are +inf)") << "\n";

@@ -179,9 +179,14 @@ double Disturbance::NextBreakpoint(double t) const {
 }
 
 bool MeasurementNoise::IsValid(std::string* error) const {
-  if (sigma >= 0.0 && sigma <= kMaxDisturbanceMagnitude) return true;
+  const bool noise_ok = sigma >= 0.0 && sigma <= kMaxDisturbanceMagnitude;
+  if (noise_ok && resolution >= 0.0 && resolution <= kMaxDisturbanceMagnitude) return true;
   std::ostringstream os;
-  os << "measurement noise " << sigma << " must be >= 0, finite and at most " << kMaxDisturbanceMagnitude;
+  if (noise_ok)
+    os << "measurement resolution " << resolution << " must be >= 0, finite and at most "
+       << kMaxDisturbanceMagnitude;
+  else
+    os << "measurement noise " << sigma << " must be >= 0, finite and at most " << kMaxDisturbanceMagnitude;
   if (error) *error = os.str();
   return false;
 }

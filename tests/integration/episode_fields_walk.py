@@ -6,7 +6,8 @@ episode) and follows each field's example value through the house:
   1. the Python keyword: pidlab.evaluate(..., key=example) echoes it in
      result["spec"];
   2. the CLI flag: `pidlab evaluate --FLAG TEXT --backend lcm --json`, run on
-     a trio, echoes the same spec;
+     a trio, echoes the same spec, and its IAE and ISE are those of
+     pidlab.evaluate in process, bit for bit;
   3. the LCM message: the episode configuration logged by lcm-logger differs
      from its base's;
   4. `pidlab replay --json`: the episode's "config" is that message;
@@ -74,6 +75,7 @@ check("the spec lists episode fields (%d)" % len(fields), len(fields) >= 30)
 
 # 1. The Python keyword: every combination of field and base that evaluates.
 runs = [("base", name, base) for name, base in BASES.items()]
+local = [pidlab.evaluate(**base) for base in BASES.values()]
 for f in fields:
     accepted = 0
     for name, base in BASES.items():
@@ -88,6 +90,7 @@ for f in fields:
             continue
         accepted += 1
         runs.append((f["key"], name, spec))
+        local.append(result)
     check("pidlab.evaluate takes the keyword %s=%r on some base and echoes it" % (f["key"], f["example"]),
           accepted > 0)
 
@@ -131,6 +134,10 @@ for which, command in controllers.items():
             echo = result["spec"].get(key)
             if echo != spec[key]:
                 check("%s: the flag %s echoes %r" % (which, flags[key], spec[key]), False, "echo %r" % echo)
+        # The trio runs what the process computes alone, to the bit.
+        if (result["iae"], result["ise"]) != (local[i]["iae"], local[i]["ise"]):
+            check("%s: %s on %s over the trio equals pidlab.evaluate" % (which, key, base), False,
+                  "IAE %r against %r" % (result["iae"], local[i]["iae"]))
         results.append(result)
     # 4. What replay reads back from the log, by episode id (each run's ids
     # from its -v notes: a run with a disturbance also runs the undisturbed

@@ -67,6 +67,7 @@ void CopyNumbers(EpisodeSpec* s, pidlab::lcmt_episode_config* m, Direction direc
   field(s->disturbance.chirp_f1_hz, m->chirp_f1_hz);
   field(s->disturbance.chirp_duration_s, m->chirp_duration_s);
   field(s->measurement_noise.sigma, m->measurement_noise);
+  field(s->measurement_noise.resolution, m->measurement_resolution);
   field(s->recovery.retransmit_interval_s, m->retransmit_interval_s);
   field(s->recovery.silence_deadline_s, m->silence_deadline_s);
 }

@@ -63,9 +63,12 @@ bool LoopOptions::IsValid(std::string* error) const {
   else if (loop == LoopKind::kContinuous && disturbance.kind == DisturbanceKind::kChirp)
     os << "disturbance chirp: the continuous loop cannot integrate a chirp exactly (its exosystem holds "
           "constants and sines), use --loop sampled";
-  else if (loop == LoopKind::kContinuous && measurement_noise.enabled())
+  else if (loop == LoopKind::kContinuous && measurement_noise.sigma != 0.0)
     os << "measurement noise " << measurement_noise.sigma
        << ": noise on the measured y needs the sampled loop, use --loop sampled";
+  else if (loop == LoopKind::kContinuous && measurement_noise.resolution != 0.0)
+    os << "measurement resolution " << measurement_noise.resolution
+       << ": a quantised measured y needs the sampled loop, use --loop sampled";
   else if (loop == LoopKind::kSampled && disturbance.kind == DisturbanceKind::kChirp &&
            !(disturbance.chirp_f1_hz < 0.5 / dt_s))
     os << "chirp band " << disturbance.chirp_f0_hz << "," << disturbance.chirp_f1_hz

@@ -239,6 +239,13 @@ bool BuildMeasurementNoise(const spec::LoopSpec& s, NameStyle style, Measurement
                value + ": noise on the measured y needs " + spec::DisplayName("loop", style) + " sampled");
   noise->sigma = s.measurement_noise;
   noise->seed = s.seed;
+  const std::string q =
+      spec::DisplayName("measurement_resolution", style) + " " + spec::FormatNumber(s.measurement_resolution);
+  if (!(s.measurement_resolution >= 0.0) || !std::isfinite(s.measurement_resolution))
+    return Bad(error, q + " must be >= 0 and finite");
+  if (s.measurement_resolution > 0.0 && s.loop != "sampled")
+    return Bad(error, q + ": a quantised measured y needs " + spec::DisplayName("loop", style) + " sampled");
+  noise->resolution = s.measurement_resolution;
   return true;
 }
 
@@ -460,7 +467,12 @@ bool BuildTuneOptions(const spec::TuningSpec& s, NameStyle style, TuneOptions* o
   // The tuner's objective runs the noise-free loop: a noisy y would make the
   // IAE a random variable the search cannot minimise (evaluate and the trio
   // take it; docs/identify.md).
-  if (o.loop.measurement_noise.enabled())
+  if (o.loop.measurement_noise.resolution != 0.0)
+    return Bad(error,
+               spec::DisplayName("measurement_resolution", style) + " " +
+                   spec::FormatNumber(s.loop.measurement_resolution) +
+                   ": tune does not take a quantised measurement (evaluate and launch experiments do)");
+  if (o.loop.measurement_noise.sigma != 0.0)
     return Bad(error, spec::DisplayName("measurement_noise", style) + " " +
                           spec::FormatNumber(s.loop.measurement_noise) +
                           ": tune does not take measurement noise (evaluate and launch experiments do)");

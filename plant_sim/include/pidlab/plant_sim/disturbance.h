@@ -2,6 +2,7 @@
 // Disturbance signals n(t), added to the plant input as in eq. (18):
 // the plant sees u(t) + n(t).
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -97,19 +98,28 @@ bool PrbsBit(std::int64_t i);
 /// generator (no state: a step sent again or replayed gets the same v_k).
 /// Its stream differs from the noise disturbance's for the same seed: the
 /// draw is the noise disturbance's with the seed SplitMix64(seed ^
-/// kMeasurementNoiseStream).
+/// kMeasurementNoiseStream). With a resolution q (a sensor's or an ADC's
+/// step), the report is then rounded to the nearest multiple of q, halves
+/// away from zero: q round((y_k + v_k) / q).
 struct MeasurementNoise {
   /// Standard deviation of v_k, in the output's unit; 0 = none.
   double sigma = 0.0;
   std::uint64_t seed = 1;
+  /// Resolution q of the measured y, in the output's unit; 0 = exact.
+  double resolution = 0.0;
 
-  /// sigma >= 0, finite, at most kMaxDisturbanceMagnitude.
+  /// sigma and resolution >= 0, finite, at most kMaxDisturbanceMagnitude.
   bool IsValid(std::string* error) const;
-  bool enabled() const { return sigma != 0.0; }
+  bool enabled() const { return sigma != 0.0 || resolution != 0.0; }
   /// v_k (0 when sigma is 0).
   double Value(std::int64_t k) const;
-  /// y + v_k, or y itself (the same bits) when sigma is 0.
-  double Measured(double y, std::int64_t k) const { return enabled() ? y + Value(k) : y; }
+  /// q round((y + v_k) / q); y + v_k without a resolution; y itself (the
+  /// same bits) with neither.
+  double Measured(double y, std::int64_t k) const {
+    if (!enabled()) return y;
+    const double noisy = sigma != 0.0 ? y + Value(k) : y;
+    return resolution != 0.0 ? resolution * std::round(noisy / resolution) : noisy;
+  }
 };
 
 inline constexpr std::uint64_t kMeasurementNoiseStream = 0x6d65617375726564ULL;  // "measured"

@@ -135,6 +135,9 @@ struct LoopSpec {
   /// Standard deviation of the seeded Gaussian noise on the measured y
   /// (sampled loop; 0 = none).
   double measurement_noise = 0.0;
+  /// Resolution q of the measured y (a sensor's or an ADC's step; sampled
+  /// loop; 0 = exact).
+  double measurement_resolution = 0.0;
   double derivative_filter_s = 0.0, derivative_filter_ratio = 0.0;
   std::pair<double, double> output_limits{-kInf, kInf};
   std::string anti_windup = "clamping", derivative_on = "error", integral = "backward-euler";
@@ -208,6 +211,11 @@ struct LoopSpec {
          "PID, the trajectory and IAE etc. see y + noise",
          "", kEpisode, "0.01"},
         &measurement_noise);
+    a->Visit({"measurement_resolution",
+              "resolution q of the measured y, a sensor's or an ADC's step (sampled loop only): the PID, the "
+              "trajectory and IAE etc. see q round((y + noise) / q); 0 = exact",
+              "", kEpisode, "0.01"},
+             &measurement_resolution);
     a->Visit({"derivative_filter",
               "derivative filter time constant Tf, both loops: C(s) = kp + ki/s + kd s/(Tf s + 1); 0 = the "
               "paper's ideal PID",
