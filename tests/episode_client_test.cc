@@ -155,6 +155,24 @@ TEST(EpisodeClient, SampledLoopOptionsRoundTripsDtHorizonPidAndDisturbance) {
   EXPECT_TRUE(back.IsValid(&error)) << error;
 }
 
+TEST(EpisodeClient, AnLcmThatCannotStartIsAStatusOfEveryRunNotAnException) {
+  EpisodeClientOptions options;
+  options.lcm_url = "udpm://239.255.76.67:99999";  // no such port: LCM does not start
+  std::unique_ptr<EpisodeClient> dut;
+  EXPECT_NO_THROW(dut = std::make_unique<EpisodeClient>(options));
+  EXPECT_EQ(dut->status().code(), pidlab::StatusCode::kRunnerFailed);
+  EXPECT_NE(dut->status().message().find("99999"), std::string::npos) << dut->status().message();
+  pidlab::Plant plant;
+  std::string error;
+  ASSERT_TRUE(pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant, &error));
+  LoopOptions loop;
+  loop.loop = LoopKind::kSampled;
+  std::vector<double> y;
+  const pidlab::Status run = dut->Run(plant, pidlab::PidGains{1, 1, 1}, loop, loop.disturbance, &y, nullptr);
+  EXPECT_EQ(run.code(), pidlab::StatusCode::kRunnerFailed);
+  EXPECT_EQ(run.message(), dut->status().message());
+}
+
 TEST(EpisodeClient, RejectsInvalidOptionsNamingTheValue) {
   EpisodeClientOptions o = InProcessTrio::Defaults();
   o.start_timeout_s = 0.0;

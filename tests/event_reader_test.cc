@@ -28,6 +28,7 @@
 #include "pidlab/replay/episode_assembler.h"
 #include "pidlab/transport/episode_spec.h"
 #include "pidlab/transport/wire.h"
+#include "test_status.h"
 
 namespace {
 std::atomic<bool> g_watching{false};
@@ -120,7 +121,7 @@ class EventReaderTest : public ::testing::Test {
   // Every event of the file; skipped stretches in *skipped.
   std::vector<LogEvent> ReadAll(EventReader* reader, std::vector<SkippedBytes>* skipped = nullptr) {
     std::string error;
-    EXPECT_TRUE(reader->Open(path_, &error)) << error;
+    EXPECT_TRUE(IsOk(reader->Open(path_)));
     if (skipped) reader->OnSkip([skipped](const SkippedBytes& s) { skipped->push_back(s); });
     std::vector<LogEvent> events;
     for (LogEvent ev; reader->Next(&ev);) events.push_back(ev);
@@ -330,10 +331,10 @@ TEST_F(EventReaderTest, AnEmptyFileIsReadCleanlyWithNoEvents) {
 TEST_F(EventReaderTest, AMissingFileOrADirectoryCannotBeOpened) {
   std::string error;
   EventReader missing;
-  EXPECT_FALSE(missing.Open((dir_ / "missing.lcmlog").string(), &error));
+  EXPECT_FALSE(OkInto(missing.Open((dir_ / "missing.lcmlog").string()), &error));
   EXPECT_NE(error.find("cannot be opened"), std::string::npos) << error;
   EventReader directory;
-  EXPECT_FALSE(directory.Open(dir_.string(), &error));
+  EXPECT_FALSE(OkInto(directory.Open(dir_.string()), &error));
   EXPECT_NE(error.find("not a regular file"), std::string::npos) << error;
 }
 

@@ -82,8 +82,8 @@ LongMatrix LongExp(const LongMatrix& a) {
 double LongObjective(const TransferFunction& tf, const PidGains& g, const LoopOptions& options,
                      ObjectiveKind kind) {
   ContinuousClosedLoop<double> loop;
-  EXPECT_TRUE(OkInto(
-      BuildContinuousClosedLoop<double>(Realize(tf), g, Disturbance(DisturbanceOptions{}), &loop), nullptr));
+  EXPECT_TRUE(
+      IsOk(BuildContinuousClosedLoop<double>(Realize(tf), g, Disturbance(DisturbanceOptions{}), &loop)));
   const LongMatrix phi =
       LongExp(loop.m.cast<long double>() * static_cast<long double>(options.sample_time_s));
   Eigen::Matrix<long double, Eigen::Dynamic, 1> w = loop.w0.cast<long double>();

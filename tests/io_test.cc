@@ -12,6 +12,7 @@
 
 #include "pidlab/io/files.h"
 #include "pidlab/spec/json.h"
+#include "test_status.h"
 
 namespace {
 
@@ -156,19 +157,19 @@ TEST(JsonNesting, ADocumentDeeperThanTheBoundIsRefusedBeforeParsing) {
   const std::string deep = "{\"a\":" + std::string(depth, '[') + std::string(depth, ']') + "}";
   nlohmann::json j;
   std::string error;
-  EXPECT_FALSE(pidlab::spec::ParseJsonText(deep, &j, &error));
+  EXPECT_FALSE(OkInto(pidlab::spec::ParseJsonText(deep, &j), &error));
   EXPECT_EQ(error, "is nested deeper than 64 levels (at byte 68)");
 }
 
 TEST(JsonNesting, BracketsInsideStringsAndEscapedQuotesDoNotCount) {
   const std::string text = R"({"a": "[[[[\"[[[[", "b": [[1]]})";
-  EXPECT_TRUE(pidlab::spec::CheckJsonNesting(text, 3, nullptr));
-  EXPECT_FALSE(pidlab::spec::CheckJsonNesting(text, 2, nullptr));
+  EXPECT_TRUE(IsOk(pidlab::spec::CheckJsonNesting(text, 3)));
+  EXPECT_FALSE(OkInto(pidlab::spec::CheckJsonNesting(text, 2), nullptr));
   nlohmann::json j;
   std::string error;
   const std::string at_bound = std::string(64, '[') + std::string(64, ']');
-  EXPECT_TRUE(pidlab::spec::ParseJsonText(at_bound, &j, &error)) << error;
-  EXPECT_FALSE(pidlab::spec::ParseJsonText("[" + at_bound + "]", &j, &error));
+  EXPECT_TRUE(IsOk(pidlab::spec::ParseJsonText(at_bound, &j)));
+  EXPECT_FALSE(OkInto(pidlab::spec::ParseJsonText("[" + at_bound + "]", &j), &error));
 }
 
 }  // namespace

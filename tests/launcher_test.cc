@@ -41,6 +41,7 @@
 #include "pidlab/launcher/log_capture.h"
 #include "pidlab/launcher/supervisor.h"
 #include "pidlab/replay/log_reader.h"
+#include "test_status.h"
 
 using pidlab::episode_client::EpisodeClient;
 using pidlab::episode_client::EpisodeClientOptions;
@@ -343,13 +344,13 @@ TEST(FreeBytesBeside, IsKnownForAWritableDirectoryAndUnknownForAMissingOne) {
 
 TEST(RunAndWait, SucceedsOnExitZeroAndQuotesTheCommandOtherwise) {
   std::string error = "untouched";
-  EXPECT_TRUE(RunAndWait({"sh", "-c", "exit 0"}, &error));
+  EXPECT_TRUE(IsOk(RunAndWait({"sh", "-c", "exit 0"})));
   EXPECT_EQ(error, "untouched");
-  EXPECT_FALSE(RunAndWait({"sh", "-c", "exit 4"}, &error));
+  EXPECT_FALSE(OkInto(RunAndWait({"sh", "-c", "exit 4"}), &error));
   EXPECT_EQ(error, "'sh -c exit 4' exited with status 4");
-  EXPECT_FALSE(RunAndWait({"/nonexistent/pidlab-no-such-program", "--flag"}, &error));
+  EXPECT_FALSE(OkInto(RunAndWait({"/nonexistent/pidlab-no-such-program", "--flag"}), &error));
   EXPECT_EQ(error, "'/nonexistent/pidlab-no-such-program --flag' exited with status 127");
-  EXPECT_FALSE(RunAndWait({"sh", "-c", "kill -TERM $$"}, nullptr));  // no error wanted
+  EXPECT_FALSE(OkInto(RunAndWait({"sh", "-c", "kill -TERM $$"}), nullptr));  // no error wanted
 }
 
 // ---- Missing steps of a logged episode
@@ -512,8 +513,10 @@ TEST(MergeEventLogs, InterleavesTheInputsAndTheRebuiltEventsByTimestamp) {
   WriteLog(dir.File("lane2"), {{25, "PIDLAB_CONTROL", {5}}, {45, "PIDLAB_CONTROL", {6}}});
   const std::vector<ln::TimedPayload> rebuilt = {{30, Output(1, 1, 1.5)}, {60, Output(1, 3, 3.5)}};
   std::string error;
-  ASSERT_TRUE(ln::MergeEventLogs({dir.File("base"), dir.File("lane1"), dir.File("absent"), dir.File("lane2")},
-                                 rebuilt, "PIDLAB_PLANT_OUTPUT", dir.File("merged"), &error))
+  ASSERT_TRUE(
+      OkInto(ln::MergeEventLogs({dir.File("base"), dir.File("lane1"), dir.File("absent"), dir.File("lane2")},
+                                rebuilt, "PIDLAB_PLANT_OUTPUT", dir.File("merged")),
+             &error))
       << error;
   using E = std::tuple<int64_t, std::string, int64_t>;
   const auto events = ReadEvents(dir.File("merged"));
@@ -527,8 +530,8 @@ TEST(MergeEventLogs, InterleavesTheInputsAndTheRebuiltEventsByTimestamp) {
 TEST(MergeEventLogs, FailsNamingAnUnreadableBaseLogAndWritesNothing) {
   TempDir dir;
   std::string error;
-  EXPECT_FALSE(
-      ln::MergeEventLogs({dir.File("absent")}, {}, "PIDLAB_PLANT_OUTPUT", dir.File("merged"), &error));
+  EXPECT_FALSE(OkInto(ln::MergeEventLogs({dir.File("absent")}, {}, "PIDLAB_PLANT_OUTPUT", dir.File("merged")),
+                      &error));
   EXPECT_NE(error.find(dir.File("absent")), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir.File("merged")));
 }
@@ -578,7 +581,7 @@ TEST(LaunchOptions, RolesAreANonEmptySetOfPlantControllerDisturbance) {
 /// uses LCM calls it first (ASSERT_NO_FATAL_FAILURE), so none sends outside.
 void EnterIsolatedNetworkOnce() {
   static std::string error;
-  static const bool entered = ln::EnterIsolatedNetwork(&error);
+  static const bool entered = OkInto(ln::EnterIsolatedNetwork(), &error);
   ASSERT_TRUE(entered) << "launcher_test needs a private network namespace (root): " << error;
 }
 
@@ -656,7 +659,7 @@ class Launcher : public ::testing::Test {
     ro.channel_prefix = prefix;
     replay::LogContents log;
     std::string error;
-    EXPECT_TRUE(replay::ReadLog(path, ro, &log, &error)) << error;
+    EXPECT_TRUE(IsOk(replay::ReadLog(path, ro, &log)));
     return log.episodes;
   }
 
@@ -771,6 +774,16 @@ TEST_F(Launcher, ARoleThatNeverAnswersIsNamedWhenNotReady) {
   EXPECT_TRUE(Contains(error, "not ready within 0.5 s: pidlab-controller (")) << error;
   EXPECT_FALSE(Contains(error, "pidlab-plant")) << error;
   EXPECT_FALSE(Contains(error, "pidlab-disturbance")) << error;
+}
+
+TEST_F(Launcher, AnLcmThatCannotStartIsAStartStatusNotAnException) {
+  LaunchOptions o = Options();
+  o.lcm_url = "udpm://239.255.76.67:99999";  // no such port: LCM does not start
+  std::unique_ptr<ln::Launcher> l;
+  EXPECT_NO_THROW(l = std::make_unique<ln::Launcher>(o, Notes()));
+  std::string error;
+  EXPECT_EQ(l->Start(nullptr, &error), LaunchStatus::kLcmFailed);
+  EXPECT_TRUE(Contains(error, "cannot start LCM on 'udpm://239.255.76.67:99999")) << error;
 }
 
 TEST_F(Launcher, CommandEnvironmentNamesTheUrlPrefixPidsAndPath) {

@@ -186,7 +186,7 @@ class LogReaderTest : public ::testing::Test {
   LogContents Read(const ReadOptions& options = ReadOptions{}) {
     LogContents contents;
     std::string error;
-    EXPECT_TRUE(ReadLog(path_, options, &contents, &error)) << error;
+    EXPECT_TRUE(IsOk(ReadLog(path_, options, &contents)));
     return contents;
   }
   static std::string Notes(const LogContents& c) {
@@ -216,7 +216,7 @@ TEST_F(LogReaderTest, HonestLogGivesTheLiveIaeExactlyAndIsComplete) {
   EXPECT_EQ(e.total_steps, 100);
   Evaluation ev;
   std::string error;
-  ASSERT_TRUE(EvaluateEpisode(e, &ev, &error)) << error;
+  ASSERT_TRUE(IsOk(EvaluateEpisode(e, &ev)));
   EXPECT_EQ(ev.iae, ref.evaluation.iae);  // bit for bit, no tolerance
   EXPECT_EQ(ev.ise, ref.evaluation.ise);
   EXPECT_EQ(ev.iae_undisturbed, ref.evaluation.iae_undisturbed);
@@ -250,7 +250,7 @@ TEST_F(LogReaderTest, RetransmissionsAndOutOfOrderStepsAreCountedNotHidden) {
   EXPECT_EQ(e.commands.out_of_order, 1);
   Evaluation ev;
   std::string error;
-  ASSERT_TRUE(EvaluateEpisode(e, &ev, &error)) << error;
+  ASSERT_TRUE(IsOk(EvaluateEpisode(e, &ev)));
   EXPECT_EQ(ev.iae, ref.evaluation.iae);
 }
 
@@ -275,7 +275,7 @@ TEST_F(LogReaderTest, TruncatedTailIsReportedAndEverythingBeforeIsRead) {
   EXPECT_NE(e.CompletenessNote().find("steps 100"), std::string::npos) << e.CompletenessNote();
   Evaluation ev;
   std::string error;
-  EXPECT_FALSE(EvaluateEpisode(e, &ev, &error));
+  EXPECT_FALSE(OkInto(EvaluateEpisode(e, &ev), &error));
   EXPECT_NE(error.find("incomplete"), std::string::npos) << error;
   // Every command that is there is still checked.
   const RedriveResult r = Redrive(e);
@@ -347,7 +347,7 @@ TEST_F(LogReaderTest, GarbageForeignAndSelfTestEventsAreCountedAndSkipped) {
   EXPECT_TRUE(e.Complete()) << e.CompletenessNote();
   Evaluation ev;
   std::string error;
-  ASSERT_TRUE(EvaluateEpisode(e, &ev, &error)) << error;
+  ASSERT_TRUE(IsOk(EvaluateEpisode(e, &ev)));
   EXPECT_EQ(ev.iae, ref.evaluation.iae);
 }
 
@@ -370,7 +370,7 @@ TEST_F(LogReaderTest, EpisodesOfSeveralPrefixesAreKeptApartAndCanBeFiltered) {
   EXPECT_EQ(all.episodes[1].prefix, "LAB_B_");
   Evaluation ev;
   std::string error;
-  ASSERT_TRUE(EvaluateEpisode(all.episodes[1], &ev, &error)) << error;
+  ASSERT_TRUE(IsOk(EvaluateEpisode(all.episodes[1], &ev)));
   EXPECT_EQ(ev.iae, clean.evaluation.iae);
   ReadOptions only_a;
   only_a.channel_prefix = "LAB_A_";
@@ -414,7 +414,7 @@ TEST_F(LogReaderTest, DataWithoutConfigurationIsListedButNotEvaluated) {
   EXPECT_EQ(dut.orphan_messages, 1);
   Evaluation ev;
   std::string error;
-  EXPECT_FALSE(EvaluateEpisode(dut.episodes[0], &ev, &error));
+  EXPECT_FALSE(OkInto(EvaluateEpisode(dut.episodes[0], &ev), &error));
   EXPECT_NE(error.find("configuration"), std::string::npos) << error;
 }
 
@@ -425,10 +425,10 @@ TEST_F(LogReaderTest, AFileThatIsNotALogIsRefused) {
   }
   LogContents contents;
   std::string error;
-  EXPECT_FALSE(ReadLog(path_, ReadOptions{}, &contents, &error));
+  EXPECT_FALSE(OkInto(ReadLog(path_, ReadOptions{}, &contents), &error));
   EXPECT_NE(error.find("not an LCM log"), std::string::npos) << error;
   EXPECT_TRUE(contents.opened);
-  EXPECT_FALSE(ReadLog((dir_ / "missing.lcmlog").string(), ReadOptions{}, &contents, &error));
+  EXPECT_FALSE(OkInto(ReadLog((dir_ / "missing.lcmlog").string(), ReadOptions{}, &contents), &error));
   EXPECT_NE(error.find("cannot be opened"), std::string::npos) << error;
   EXPECT_FALSE(contents.opened);
 }
@@ -437,7 +437,7 @@ TEST_F(LogReaderTest, AnEmptyFileHoldsNoLcmEventAndIsRefused) {
   std::ofstream(path_).close();
   LogContents contents;
   std::string error;
-  EXPECT_FALSE(ReadLog(path_, ReadOptions{}, &contents, &error));
+  EXPECT_FALSE(OkInto(ReadLog(path_, ReadOptions{}, &contents), &error));
   EXPECT_TRUE(contents.opened);
   EXPECT_EQ(contents.file_bytes, 0);
   EXPECT_EQ(contents.events, 0);
@@ -480,7 +480,7 @@ TEST_F(LogReaderTest, DisturbanceBlocksRebuildEveryStepAndALostBlockIsNamed) {
     EXPECT_EQ(e.disturbances.received, 100);
     Evaluation ev;
     std::string error;
-    ASSERT_TRUE(EvaluateEpisode(e, &ev, &error)) << error;
+    ASSERT_TRUE(IsOk(EvaluateEpisode(e, &ev)));
     EXPECT_EQ(ev.iae, ref.evaluation.iae);
     ASSERT_EQ(ev.trajectory.size(), ref.trajectory.size());
     for (std::size_t k = 0; k < ev.trajectory.size(); ++k)

@@ -109,6 +109,16 @@ TEST(LiveMonitorOptions, IsValidNamesTheFieldAndValue) {
   EXPECT_NE(error.find("max_kept_steps 9999999"), std::string::npos) << error;
 }
 
+TEST(LiveMonitor, AnLcmThatCannotStartIsAStatusAndPollsNothingNotAnException) {
+  LiveMonitorOptions o;
+  o.lcm_url = "udpm://239.255.76.67:99999";  // no such port: LCM does not start
+  std::unique_ptr<LiveMonitor> dut;
+  EXPECT_NO_THROW(dut = std::make_unique<LiveMonitor>(o));
+  EXPECT_EQ(dut->status().code(), StatusCode::kRunnerFailed);
+  EXPECT_NE(dut->status().message().find("99999"), std::string::npos) << dut->status().message();
+  EXPECT_EQ(dut->Poll(0.0), -1);
+}
+
 // Handles everything waiting on a memq:// instance.
 void Drain(LiveMonitor* dut) {
   while (dut->Poll(0.0) > 0) {

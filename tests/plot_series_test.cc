@@ -24,7 +24,7 @@ namespace {
 evaluation::Evaluation EvaluateDirectly(const nlohmann::json& spec_json) {
   spec::EvaluateSpec s;
   std::string error;
-  EXPECT_TRUE(spec::FromJson(spec_json, &s, nullptr, &error)) << error;
+  EXPECT_TRUE(IsOk(spec::FromJson(spec_json, &s, nullptr)));
   s.plant.Normalize();
   Plant p;
   PidGains g;

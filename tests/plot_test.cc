@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "pidlab/plot/loop_figure.h"
+#include "test_status.h"
 
 namespace pidlab::plot {
 namespace {
@@ -57,7 +58,7 @@ TEST_F(PlotTest, StackedLoopFigureIsAPngOfTheRequestedSizeBackedByTheExactData) 
   }
   Figure dut;
   std::string error;
-  ASSERT_TRUE(MakeLoopFigure({tr}, UnitsOfPlant("stepper_motor"), "test figure", &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(MakeLoopFigure({tr}, UnitsOfPlant("stepper_motor"), "test figure", &dut)));
   ASSERT_EQ(dut.panels.size(), 4u);
   EXPECT_EQ(dut.panels[0].y_label, "y [rad]");
   EXPECT_EQ(dut.panels[2].x_label, "t [s]");
@@ -65,7 +66,7 @@ TEST_F(PlotTest, StackedLoopFigureIsAPngOfTheRequestedSizeBackedByTheExactData) 
   dut.height_px = 900;
   dut.output_path = (dir_ / "loop.png").string();
   dut.data_dir = (dir_ / "data").string();
-  ASSERT_TRUE(DrawPng(dut, &error)) << error;
+  ASSERT_TRUE(IsOk(DrawPng(dut)));
   int w = 0, h = 0;
   ASSERT_TRUE(ReadPngSize(dut.output_path, &w, &h));
   EXPECT_EQ(w, 640);
@@ -89,14 +90,14 @@ TEST_F(PlotTest, InvalidFiguresAreRefusedWithTheField) {
   Figure dut;
   dut.output_path = (dir_ / "x.png").string();
   std::string error;
-  EXPECT_FALSE(DrawPng(dut, &error));
+  EXPECT_FALSE(OkInto(DrawPng(dut), &error));
   EXPECT_NE(error.find("no panels"), std::string::npos) << error;
   dut.panels.push_back(Panel{"", "t [s]", "y [-]", {Series{"y", {0.0, 1.0}, {1.0}, Style::kLines, ""}}});
-  EXPECT_FALSE(DrawPng(dut, &error));
+  EXPECT_FALSE(OkInto(DrawPng(dut), &error));
   EXPECT_NE(error.find("2 x values but 1 y values"), std::string::npos) << error;
   dut.panels[0].series[0].y.push_back(2.0);
   dut.width_px = 10;
-  EXPECT_FALSE(DrawPng(dut, &error));
+  EXPECT_FALSE(OkInto(DrawPng(dut), &error));
   EXPECT_NE(error.find("size"), std::string::npos) << error;
   EXPECT_FALSE(fs::exists(dut.output_path));
 }
@@ -107,7 +108,7 @@ TEST_F(PlotTest, AFailingGnuplotIsReportedAndLeavesNoPng) {
   dut.panels.push_back(Panel{"", "t [s]", "y [-]", {Series{"y", {0.0, 1.0}, {1.0, 2.0}, Style::kLines, ""}}});
   ::setenv("PIDLAB_GNUPLOT", "false", 1);
   std::string error;
-  const bool ok = DrawPng(dut, &error);
+  const bool ok = OkInto(DrawPng(dut), &error);
   ::unsetenv("PIDLAB_GNUPLOT");
   EXPECT_FALSE(ok);
   EXPECT_NE(error.find("failed with exit status 1"), std::string::npos) << error;

@@ -218,7 +218,7 @@ TEST(BuildTuning, EveryFieldTaggedSearchAsksForASearchAndNoneGivenIsMigo) {
     spec::TuningSpec s;
     BuildOptions o;
     std::string error;
-    if (!spec::FromJson(j, &s, &o.given, &error)) return Status::InvalidInput(error);
+    if (!OkInto(spec::FromJson(j, &s, &o.given), &error)) return Status::InvalidInput(error);
     TuningProblem problem;
     const Status built = BuildTuning(s, o, &problem);
     *method = ToString(problem.options.method);

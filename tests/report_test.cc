@@ -12,6 +12,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "test_status.h"
+
 using pidlab::analysis::LoopFrequencyPoint;
 using pidlab::tune::RefineVerdict;
 using pidlab::tune::TuneMethod;
@@ -24,14 +26,14 @@ const char* const kPaperTables = PIDLAB_PAPER_TABLES;
 ReportData QuickReport(std::uint64_t seed) {
   std::vector<PaperRow> paper;
   std::string error;
-  EXPECT_TRUE(ReadPaperTables(kPaperTables, &paper, &error)) << error;
+  EXPECT_TRUE(IsOk(ReadPaperTables(kPaperTables, &paper)));
   ReportOptions options;
   options.paper_tables = kPaperTables;
   options.quick = true;
   options.figures = false;
   options.seed = seed;
   ReportData data;
-  EXPECT_TRUE(ComputeReport(options, paper, &data, &error)) << error;
+  EXPECT_TRUE(IsOk(ComputeReport(options, paper, &data)));
   return data;
 }
 
@@ -168,14 +170,14 @@ TEST(Report, TheMotorItselfRunsEveryMoveWithAndWithoutTheVoltageLimitNextToEquat
 TEST(Report, RobustTuningComparesThePaperTheOptimumAndThePresetOnEveryPlant) {
   std::vector<PaperRow> paper;
   std::string error;
-  ASSERT_TRUE(ReadPaperTables(kPaperTables, &paper, &error)) << error;
+  ASSERT_TRUE(IsOk(ReadPaperTables(kPaperTables, &paper)));
   std::vector<RobustInput> inputs;
   for (const PaperRow& r : paper)
     if (r.method == "nelder_mead" && (r.table == "II" || r.table == "III" || r.table == "IV"))
       inputs.push_back({r.plant, r.gains});
   ASSERT_EQ(inputs.size(), 3u);
   RobustSection s;
-  ASSERT_TRUE(ComputeRobustSection(inputs, true, 1, &s, &error)) << error;
+  ASSERT_TRUE(IsOk(ComputeRobustSection(inputs, true, 1, &s)));
   ASSERT_EQ(s.plants.size(), 3u);
   for (const RobustPlant& p : s.plants) {
     ASSERT_EQ(p.sets.size(), 3u) << p.plant;
@@ -253,7 +255,7 @@ TEST(Report, DeterministicForASeed) {
 TEST(Report, MissingPaperTablesNamesThePath) {
   std::vector<PaperRow> rows;
   std::string error;
-  EXPECT_FALSE(ReadPaperTables("/nonexistent/paper_tables.csv", &rows, &error));
+  EXPECT_FALSE(OkInto(ReadPaperTables("/nonexistent/paper_tables.csv", &rows), &error));
   EXPECT_NE(error.find("/nonexistent/paper_tables.csv"), std::string::npos) << error;
 }
 
@@ -267,7 +269,7 @@ TEST(Report, BadNumberNamesLineAndColumn) {
   }
   std::vector<PaperRow> rows;
   std::string error;
-  EXPECT_FALSE(ReadPaperTables(path, &rows, &error));
+  EXPECT_FALSE(OkInto(ReadPaperTables(path, &rows), &error));
   EXPECT_NE(error.find("line 2"), std::string::npos) << error;
   EXPECT_NE(error.find("ki"), std::string::npos) << error;
   std::remove(path.c_str());
@@ -281,7 +283,7 @@ TEST(Report, MissingColumnIsNamed) {
   }
   std::vector<PaperRow> rows;
   std::string error;
-  EXPECT_FALSE(ReadPaperTables(path, &rows, &error));
+  EXPECT_FALSE(OkInto(ReadPaperTables(path, &rows), &error));
   EXPECT_NE(error.find("missing column"), std::string::npos) << error;
   std::remove(path.c_str());
 }

@@ -18,6 +18,7 @@
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/transport/episode_spec.h"
 #include "spec_build.h"  // internal to pidlab::tune: the steps tested one by one
+#include "test_status.h"
 
 using pidlab::episode_client::MakeEpisodeSpec;
 using pidlab::evaluation::LoopOptions;
@@ -69,13 +70,13 @@ void ExpectEveryFieldHasAValidExampleThatRoundTripsThroughJson() {
     Spec s;
     std::set<std::string> given;
     std::string error;
-    ASSERT_TRUE(spec::FromJson(json{{e.field.key, example}}, &s, &given, &error)) << error;
+    ASSERT_TRUE(IsOk(spec::FromJson(json{{e.field.key, example}}, &s, &given)));
     EXPECT_EQ(given, std::set<std::string>{e.field.key});
     const json back = spec::ToJson(s);
     EXPECT_TRUE(SameValue(back.at(e.field.key), example)) << back.at(e.field.key);
     // Written and read again: the same spec, bit for bit.
     Spec again;
-    ASSERT_TRUE(spec::FromJson(json::parse(back.dump()), &again, nullptr, &error)) << error;
+    ASSERT_TRUE(IsOk(spec::FromJson(json::parse(back.dump()), &again, nullptr)));
     EXPECT_EQ(spec::ToJson(again).dump(), back.dump());
   }
 }
@@ -91,15 +92,15 @@ TEST(Spec, EveryTuneFieldHasAnExampleThatRoundTripsThroughJson) {
 TEST(Spec, JsonNamesAnUnknownKeyAWrongTypeAndAnotherVersion) {
   spec::EvaluateSpec s;
   std::string error;
-  EXPECT_FALSE(spec::FromJson(json{{"horizn", 3}}, &s, nullptr, &error));
+  EXPECT_FALSE(OkInto(spec::FromJson(json{{"horizn", 3}}, &s, nullptr), &error));
   EXPECT_NE(error.find("'horizn' is unknown"), std::string::npos) << error;
-  EXPECT_FALSE(spec::FromJson(json{{"horizon", "long"}}, &s, nullptr, &error));
+  EXPECT_FALSE(OkInto(spec::FromJson(json{{"horizon", "long"}}, &s, nullptr), &error));
   EXPECT_NE(error.find("'horizon' must be a number"), std::string::npos) << error;
-  EXPECT_FALSE(spec::FromJson(json{{"seed", -1}}, &s, nullptr, &error));
+  EXPECT_FALSE(OkInto(spec::FromJson(json{{"seed", -1}}, &s, nullptr), &error));
   EXPECT_NE(error.find("'seed'"), std::string::npos) << error;
-  EXPECT_FALSE(spec::FromJson(json{{"version", 99}}, &s, nullptr, &error));
+  EXPECT_FALSE(OkInto(spec::FromJson(json{{"version", 99}}, &s, nullptr), &error));
   EXPECT_NE(error.find("99"), std::string::npos) << error;
-  EXPECT_FALSE(spec::FromJson(json::array(), &s, nullptr, &error));
+  EXPECT_FALSE(OkInto(spec::FromJson(json::array(), &s, nullptr), &error));
 }
 
 TEST(Spec, InfinityIsWrittenAsTextAndReadBack) {
@@ -110,10 +111,10 @@ TEST(Spec, InfinityIsWrittenAsTextAndReadBack) {
   EXPECT_EQ(j["voltage_limit"], "inf");
   spec::EvaluateSpec back;
   std::string error;
-  ASSERT_TRUE(spec::FromJson(j, &back, nullptr, &error)) << error;
+  ASSERT_TRUE(IsOk(spec::FromJson(j, &back, nullptr)));
   EXPECT_TRUE(std::isinf(back.loop.output_limits.first) && back.loop.output_limits.first < 0);
   // Not where the field takes no infinity.
-  EXPECT_FALSE(spec::FromJson(json{{"horizon", "inf"}}, &back, nullptr, &error));
+  EXPECT_FALSE(OkInto(spec::FromJson(json{{"horizon", "inf"}}, &back, nullptr), &error));
 }
 
 // The command-line words of one field's value, as a user types them.
@@ -147,8 +148,8 @@ void ExpectEveryFieldIsAFlag() {
     SCOPED_TRACE(e.field.key);
     Spec example_spec;
     std::string error;
-    ASSERT_TRUE(
-        spec::FromJson(json{{e.field.key, json::parse(e.field.example)}}, &example_spec, nullptr, &error));
+    ASSERT_TRUE(OkInto(
+        spec::FromJson(json{{e.field.key, json::parse(e.field.example)}}, &example_spec, nullptr), &error));
     // The example as the user types it: the flag's own text of the value.
     std::vector<std::string> args = {"pidlab"};
     const std::string flag = spec::FlagName(e.field.key);
@@ -229,8 +230,8 @@ TEST(Spec, EveryEpisodeFieldChangesTheEpisodeConfigurationAndSurvivesTheWire) {
       ASSERT_TRUE(ConfigOf(base, &before));
       spec::EvaluateSpec changed = base;
       std::string error;
-      ASSERT_TRUE(
-          spec::FromJson(json{{e.field.key, json::parse(e.field.example)}}, &changed, nullptr, &error));
+      ASSERT_TRUE(OkInto(spec::FromJson(json{{e.field.key, json::parse(e.field.example)}}, &changed, nullptr),
+                         &error));
       if (!ConfigOf(changed, &after) || Encode(after) == Encode(before)) continue;
       transport::EpisodeSpec decoded;
       ASSERT_TRUE(transport::ParseEpisodeConfig(after, &decoded, &error)) << error;
@@ -255,7 +256,7 @@ TEST(Spec, FieldsNotMarkedForTheEpisodeLeaveItAlone) {
     for (const spec::FieldEntry& e : FieldsOf<spec::EvaluateSpec>())
       if (std::string(e.field.key) == key) {
         EXPECT_FALSE(e.field.Has(spec::kEpisode));
-        ASSERT_TRUE(spec::FromJson(json{{key, json::parse(e.field.example)}}, &changed, nullptr, &error));
+        ASSERT_TRUE(IsOk(spec::FromJson(json{{key, json::parse(e.field.example)}}, &changed, nullptr)));
       }
     ASSERT_TRUE(ConfigOf(changed, &after));
     EXPECT_EQ(Encode(after), Encode(before));

@@ -401,5 +401,24 @@ TEST(TuneOptions, MultiStartNeedsTwoEvaluations) {
   EXPECT_TRUE(options.IsValid(&error)) << error;
 }
 
+TEST(Tune, ATrioThatFailsUnderTheSearchIsARunnerFailedStatusNotAnException) {
+  TuneOptions options;
+  options.loop.loop = LoopKind::kSampled;
+  options.loop.horizon_s = 2.0;
+  std::atomic<int> calls{0};
+  const evaluation::SampledRunner runner = [&calls](const Plant&, const PidGains&, const LoopOptions&,
+                                                    const DisturbanceOptions&, std::vector<double>*,
+                                                    std::vector<evaluation::SampledStep>*) {
+    ++calls;
+    return Status::RunnerFailed("pidlab-plant went silent");
+  };
+  TuneSummary dut;
+  Status st;
+  EXPECT_NO_THROW(st = Tune(MakeBuiltin("double_integrator"), options, &dut, nullptr, runner));
+  EXPECT_EQ(st.code(), StatusCode::kRunnerFailed) << st.message();
+  EXPECT_NE(st.message().find("pidlab-plant went silent"), std::string::npos) << st.message();
+  EXPECT_GT(calls.load(), 0);
+}
+
 }  // namespace
 }  // namespace pidlab

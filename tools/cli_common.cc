@@ -206,7 +206,9 @@ void LcmFlags::Register(CLI::App* app) {
 }
 
 std::unique_ptr<EpisodeClient> LcmFlags::MakeClient() const {
-  return std::make_unique<EpisodeClient>(ClientOptions(Url()));  // throws runtime_error: exit 1
+  auto client = std::make_unique<EpisodeClient>(ClientOptions(Url()));
+  Require(client->status());  // LCM did not start: exit 1
+  return client;
 }
 
 std::string LcmFlags::Url() const {
@@ -226,7 +228,9 @@ std::unique_ptr<EpisodePool> LcmFlags::MakePool() const {
   if (urls.empty()) throw BadInput("--lcm-url " + Quote(lcm_url) + " names no URL");
   std::vector<EpisodeClientOptions> trios;
   for (const std::string& url : urls) trios.push_back(ClientOptions(url));
-  return std::make_unique<EpisodePool>(trios);  // throws runtime_error: exit 1
+  auto pool = std::make_unique<EpisodePool>(trios);
+  Require(pool->status());  // a trio's LCM did not start: exit 1
+  return pool;
 }
 
 EpisodeClientOptions LcmFlags::ClientOptions(const std::string& url) const {

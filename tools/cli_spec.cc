@@ -106,8 +106,7 @@ nlohmann::json SpecFlags::ReadSpecFile() const {
   if (Status s = io::ReadFile(spec_file_, kMaxSpecFileBytes, &text); !s.ok())
     Require(Status(s.code(), "--spec " + s.message()));
   nlohmann::json j;
-  std::string error;
-  if (!spec::ParseJsonText(text, &j, &error)) ThrowSpecFileError(error);
+  if (const Status st = spec::ParseJsonText(text, &j); !st.ok()) ThrowSpecFileError(st.message());
   // A --json result: its "spec".
   if (j.is_object() && j.contains("spec") && j["spec"].is_object()) j = nlohmann::json(j["spec"]);
   // A plant named on the command line (--plant, --model, --num/--den)

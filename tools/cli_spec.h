@@ -106,8 +106,8 @@ class SpecFlags {
   void AddList(const spec::Field& f, const std::string& default_text);
   template <typename Spec>
   void LoadFile(Spec* spec, std::set<std::string>* given) const {
-    std::string error;
-    if (!spec::FromJson(ReadSpecFile(), spec, given, &error)) ThrowSpecFileError(error);
+    if (const Status st = spec::FromJson(ReadSpecFile(), spec, given); !st.ok())
+      ThrowSpecFileError(st.message());
   }
   nlohmann::json ReadSpecFile() const;
   [[noreturn]] void ThrowSpecFileError(const std::string& why) const;

@@ -101,7 +101,7 @@ void DrawFigure(const std::vector<BatchResult>& results, const std::string& path
   }
   if (p.series.empty()) p.series.push_back({"no ratio", {0.0}, {NAN}, plot::Style::kPoints, ""});
   std::string error;
-  if (!plot::DrawPng(fig, &error)) throw std::runtime_error(error);
+  Require(plot::DrawPng(fig));
 }
 
 void WriteFile(const std::string& path, const std::string& text) { WriteOutputFile(path, text); }

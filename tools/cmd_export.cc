@@ -32,7 +32,8 @@ nlohmann::json ReadResult(const std::string& path) {
   const std::string text = ReadInputFile(path, "--from", kMaxSpecFileBytes);
   nlohmann::json j;
   std::string error;
-  if (!spec::ParseJsonText(text, &j, &error)) throw BadInput("--from " + Quote(path) + ": " + error);
+  if (const Status st = spec::ParseJsonText(text, &j); !st.ok())
+    throw BadInput("--from " + Quote(path) + ": " + st.message());
   if (!j.is_object() || !j.contains("spec") || !j["spec"].is_object() || !j.contains("gains") ||
       !j["gains"].is_object())
     throw BadInput("--from " + Quote(path) +
@@ -44,16 +45,15 @@ nlohmann::json ReadResult(const std::string& path) {
 /// is; a tuning's plant and loop).
 void LoadResult(const std::string& path, spec::EvaluateSpec* s) {
   const nlohmann::json j = ReadResult(path);
-  std::string error;
   spec::EvaluateSpec evaluate;
   spec::TuningSpec tuning;
-  if (spec::FromJson(j["spec"], &evaluate, nullptr, &error)) {
+  if (const Status st = spec::FromJson(j["spec"], &evaluate, nullptr); st.ok()) {
     *s = evaluate;
-  } else if (std::string ignored; spec::FromJson(j["spec"], &tuning, nullptr, &ignored)) {
+  } else if (spec::FromJson(j["spec"], &tuning, nullptr).ok()) {
     s->plant = tuning.plant;
     s->loop = tuning.loop;
   } else {
-    throw BadInput("--from " + Quote(path) + ": " + error);
+    throw BadInput("--from " + Quote(path) + ": " + st.message());
   }
   // A tuning's setpoint weights (--two-dof, migo) go with its gains.
   if (j.contains("two_dof") && j["two_dof"].is_object() && j["two_dof"].value("ran", false)) {

@@ -241,9 +241,8 @@ struct IdentifyCommand {
       return data;
     }
     replay::LogContents contents;
-    std::string error;
-    if (!replay::ReadLog(log, replay::ReadOptions{}, &contents, &error))
-      throw BadInput("--log " + Quote(log) + ": " + error);
+    if (const Status st = replay::ReadLog(log, replay::ReadOptions{}, &contents); !st.ok())
+      throw BadInput("--log " + Quote(log) + ": " + st.message());
     // Without --episode: the one episode whose plant input u + n varies (an
     // evaluate run logs its undisturbed twin too, whose input is constant).
     std::vector<const replay::Episode*> found;
@@ -417,9 +416,10 @@ struct IdentifyCommand {
     if (!plot_path.empty()) {
       plot::Figure figure;
       std::string error;
-      if (!figures::IdentifyFigure(data, result, &figure, &error)) throw std::runtime_error(error);
+      if (const Status st = figures::IdentifyFigure(data, result, &figure); !st.ok())
+        throw std::runtime_error(st.message());
       figure.output_path = plot_path;
-      if (!plot::DrawPng(figure, &error)) throw std::runtime_error(error);
+      Require(plot::DrawPng(figure));
     }
     for (const std::string& w : result.warnings) std::cerr << "warning: " << w << "\n";
     std::cout << (json ? j.dump() + "\n"

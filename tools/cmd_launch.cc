@@ -89,7 +89,7 @@ int RunLaunch(LaunchFlags* flags, const CLI::Option* roles, const CLI::Option* r
   if (!flags->options.IsValid(&error)) throw BadInput(error);
   // An unwritable --log is bad input (exit 2), found before anything starts.
   CheckOutputFile(flags->options.log_file, "--log");
-  if (flags->isolated && !launcher::EnterIsolatedNetwork(&error)) throw std::runtime_error(error);
+  if (flags->isolated) Require(launcher::EnterIsolatedNetwork());
   ResolveRtPriority(&flags->options);
   struct sigaction sa {};
   sa.sa_handler = OnSignal;

@@ -72,7 +72,8 @@ struct PlotCommand {
         throw BadInput("--log cannot be combined with --plant/--gains (the log carries its own)");
       PrepareOutputDir(out_dir, "--out");  // bad input before any work
       std::string report;
-      if (!figures::LogFigure(log_path, episodes, &figure, &report, &error)) throw BadInput(error);
+      if (const Status st = figures::LogFigure(log_path, episodes, &figure, &report); !st.ok())
+        throw BadInput(st.message());
       if (!report.empty()) std::cerr << report;
       if (name.empty()) name = std::filesystem::path(log_path).stem().string();
     } else {
@@ -80,13 +81,11 @@ struct PlotCommand {
       if (gains.empty()) throw BadInput("--gains is required (or --log FILE)");
       Plant p;
       LoopOptions options;
-      Require(tune::BuildPlantInLoop(ps.plant, ps.loop, NameStyle::kFlag, &p, &options));
       std::vector<PidGains> sets;
       for (const auto& g : gains) sets.push_back(ParseGains(g));
       // Framed for the loop: with neither --horizon nor --sample-time, the
       // closed loops' time scale, on every plant (tune/time_scale.h).
-      tune::ResolveGainsTimeScale(ps.plant, p, sets, given, tune::TimeScaleScope::kFigure, &ps.loop);
-      Require(tune::BuildPlantInLoop(ps.plant, ps.loop, NameStyle::kFlag, &p, &options));
+      Require(tune::BuildFigureLoop(ps.plant, ps.loop, sets, given, NameStyle::kFlag, &p, &options));
       const long points = options.loop == LoopKind::kSampled ? options.TotalSteps() : options.NumSamples();
       if (static_cast<double>(points) * static_cast<double>(sets.size()) > kMaxRecordedPoints)
         throw BadInput(
@@ -94,7 +93,8 @@ struct PlotCommand {
             " points each are more than 1e7 points: use a coarser --dt or --sample-time, a shorter "
             "--horizon or fewer --gains");
       PrepareOutputDir(out_dir, "--out");  // bad input before any work
-      if (!figures::EvaluationFigure(p, sets, options, &figure, &error)) throw BadInput(error);
+      if (const Status st = figures::EvaluationFigure(p, sets, options, &figure); !st.ok())
+        throw BadInput(st.message());
       if (name.empty()) name = "evaluation";
     }
     if (name.empty() || name.find('/') != std::string::npos)
@@ -102,7 +102,7 @@ struct PlotCommand {
     figure.output_path = out_dir + "/" + name + ".png";
     figure.data_dir = out_dir + "/" + name + "_data";
     if (!figure.IsValid(&error)) throw BadInput(error);
-    if (!plot::DrawPng(figure, &error)) throw std::runtime_error(error);
+    Require(plot::DrawPng(figure));
     std::cout << figure.output_path << "\n";
     return 0;
   }

@@ -87,11 +87,11 @@ struct ReplayCommand {
   }
 
   replay::RedriveResult RedriveLive(const replay::Episode& e) const {
-    try {
-      return replay::RedriveOverLcm(e, Url(), Prefix(), 2.0);
-    } catch (const std::invalid_argument& bad_url) {
-      throw BadInput(std::string("--lcm-url: ") + bad_url.what());
-    }
+    replay::RedriveResult r;
+    const Status st = replay::RedriveOverLcm(e, Url(), Prefix(), 2.0, &r);
+    if (st.code() == StatusCode::kInvalidInput) throw BadInput("--lcm-url: " + st.message());
+    if (!st.ok()) throw std::runtime_error(st.message());
+    return r;
   }
 
   int Run() {
@@ -132,12 +132,11 @@ struct ReplayCommand {
       options.auth_key = key;
     }
     replay::LogContents log;
-    std::string error;
-    if (!replay::ReadLog(log_path, options, &log, &error)) {
+    if (const Status st = replay::ReadLog(log_path, options, &log); !st.ok()) {
       // A file that opened but holds no LCM event, an empty one included, is
       // damaged content (exit 1), not a path the user mistyped (exit 2).
-      if (log.opened) throw std::runtime_error(error);
-      throw BadInput(error);
+      if (log.opened) throw std::runtime_error(st.message());
+      throw BadInput(st.message());
     }
     return log;
   }

@@ -69,21 +69,23 @@ struct ReportCommand {
       };
     }
     std::vector<report::PaperRow> paper;
-    std::string error;
     if (options.paper_tables.empty()) {
-      if (!report::ParsePaperTables(report::BuiltinPaperTablesCsv(), "data/paper_tables.csv (built in)",
-                                    &paper, &error))
-        throw std::runtime_error(error);
+      if (const Status st = report::ParsePaperTables(report::BuiltinPaperTablesCsv(),
+                                                     "data/paper_tables.csv (built in)", &paper);
+          !st.ok())
+        throw std::runtime_error(st.message());
     } else {
       if (!std::filesystem::is_regular_file(options.paper_tables))
         throw BadInput("paper tables not found: " + Quote(options.paper_tables) +
                        " (use --paper-tables FILE)");
-      if (!report::ReadPaperTables(options.paper_tables, &paper, &error)) throw BadInput(error);
+      if (const Status st = report::ReadPaperTables(options.paper_tables, &paper); !st.ok())
+        throw BadInput(st.message());
     }
     report::ReportData data;
-    if (!report::ComputeReport(options, paper, &data, &error))
-      throw std::runtime_error(stage->Unstaged(error));
-    if (!report::WriteReport(&data, &error)) throw std::runtime_error(stage->Unstaged(error));
+    if (const Status st = report::ComputeReport(options, paper, &data); !st.ok())
+      throw std::runtime_error(stage->Unstaged(st.message()));
+    if (const Status st = report::WriteReport(&data); !st.ok())
+      throw std::runtime_error(stage->Unstaged(st.message()));
     Require(stage->Commit());
     std::cout << "wrote " << (std::filesystem::path(out_dir) / "report.md").string() << " and "
               << data.figures.size() << " figures (" << data.rows.size() << " published rows, "

@@ -169,8 +169,8 @@ bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
 nlohmann::json TrioResult(const nlohmann::json& spec_json,
                           const episode_client::EpisodeClientOptions& client) {
   spec::EvaluateSpec s;
-  std::string error;
-  if (!spec::FromJson(spec_json, &s, nullptr, &error)) throw std::invalid_argument(error);
+  if (const Status st = spec::FromJson(spec_json, &s, nullptr); !st.ok())
+    throw std::invalid_argument(st.message());
   s.loop.loop = "sampled";  // the trio runs the sampled loop
   tune::EvaluationProblem problem;
   if (Status built = tune::BuildEvaluation(s, tune::BuildOptions{}, &problem); !built.ok())
@@ -229,7 +229,10 @@ server::Reply LiveService::Impl::RunOnTrio(const nlohmann::json& request,
 
 LiveService::LiveService(const std::vector<episode_client::EpisodeClientOptions>& trios,
                          const std::string& lcm_url)
-    : impl_(std::make_unique<Impl>(trios, lcm_url)) {}
+    : impl_(std::make_unique<Impl>(trios, lcm_url)) {
+  // LCM did not start on a URL: cmd_serve names --lcm-url (exit 2).
+  if (const Status st = impl_->scope.status(); !st.ok()) throw std::runtime_error(st.message());
+}
 
 LiveService::~LiveService() = default;
 

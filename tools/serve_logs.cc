@@ -112,9 +112,9 @@ void LogStore::Remember(const std::string& id, std::shared_ptr<OpenLog> log) {
 server::Reply LogStore::OpenFile(const std::string& file, const std::string& name) {
   auto log = std::make_shared<OpenLog>();
   log->name = name;
-  std::string error;
   replay::ReadOptions options;  // every prefix, as `pidlab replay` without flags
-  if (!replay::ReadLog(file, options, &log->contents, &error)) {
+  if (const Status st = replay::ReadLog(file, options, &log->contents); !st.ok()) {
+    std::string error = st.message();
     // The page is told the name it gave, never the server's own path.
     for (std::size_t at; (at = error.find(file)) != std::string::npos;) error.replace(at, file.size(), name);
     return Bad("log " + Quote(name) + ": " + Truncate(error, 200));

@@ -58,7 +58,8 @@ server::Reply Export(const nlohmann::json& request) {
   spec::EvaluateSpec s;
   std::string error;
   controller_export::Controller controller;
-  if (!spec::FromJson(request["spec"], &s, nullptr, &error)) return {400, {{"error", error}}};
+  if (const Status st = spec::FromJson(request["spec"], &s, nullptr); !st.ok())
+    return {400, {{"error", st.message()}}};
   s.plant.Normalize();
   if (!ExportController(s, spec::NameStyle::kKey, &controller, &error)) return {400, {{"error", error}}};
   controller_export::Options options;
@@ -93,9 +94,9 @@ nlohmann::json PaperDesigns() {
   nlohmann::json designs = nlohmann::json::array();
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
   std::vector<report::PaperRow> rows;
-  std::string error;
-  if (!report::ParsePaperTables(report::BuiltinPaperTablesCsv(), "paper_tables.csv", &rows, &error))
-    throw std::runtime_error(error);
+  if (const Status st = report::ParsePaperTables(report::BuiltinPaperTablesCsv(), "paper_tables.csv", &rows);
+      !st.ok())
+    throw std::runtime_error(st.message());
   for (const report::PaperRow& r : rows)
     designs.push_back({{"table", r.table},
                        {"plant", r.plant},

@@ -26,18 +26,15 @@ std::string GainsLabel(const PidGains& g) {
 
 }  // namespace
 
-bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, const LoopOptions& options,
-                      plot::Figure* figure, std::string* error) {
+Status EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, const LoopOptions& options,
+                        plot::Figure* figure) {
   std::vector<plot::LoopTrace> traces;
   EvaluateOptions what;
   what.record_trajectory = true;
   what.compute_iae_continuous = false;
   for (const PidGains& g : gains) {
     Evaluation ev;
-    if (const Status st = Evaluate(plant, g, options, what, &ev); !st.ok()) {
-      if (error) *error = st.message();
-      return false;
-    }
+    if (Status st = Evaluate(plant, g, options, what, &ev); !st.ok()) return st;
     plot::LoopTrace tr;
     std::ostringstream name;
     name << GainsLabel(g) << std::setprecision(6) << " (IAE " << ev.iae
@@ -45,8 +42,7 @@ bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, co
     tr.name = name.str();
     if (!ev.stability.stable) {
       // Unstable: nothing was simulated; keep the legend entry honest with no curve.
-      if (error) *error = "gains " + GainsLabel(g) + " give an unstable loop: nothing to plot";
-      return false;
+      return Status::InvalidInput("gains " + GainsLabel(g) + " give an unstable loop: nothing to plot");
     }
     if (options.loop == LoopKind::kSampled) {
       for (const SampledStep& s : ev.trajectory) {
@@ -77,13 +73,13 @@ bool EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, co
           << " s; no sampled u";
   if (options.disturbance.kind != DisturbanceKind::kNone)
     title << ", " << ToString(options.disturbance.kind) << " disturbance " << options.disturbance.amplitude;
-  return plot::MakeLoopFigure(traces, plot::UnitsOfPlant(plant.name), title.str(), figure, error);
+  return plot::MakeLoopFigure(traces, plot::UnitsOfPlant(plant.name), title.str(), figure);
 }
 
-bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, plot::Figure* figure,
-               std::string* report, std::string* error) {
+Status LogFigure(const std::string& log_path, const std::vector<long>& episodes, plot::Figure* figure,
+                 std::string* report) {
   replay::LogContents log;
-  if (!replay::ReadLog(log_path, replay::ReadOptions{}, &log, error)) return false;
+  if (Status st = replay::ReadLog(log_path, replay::ReadOptions{}, &log); !st.ok()) return st;
   for (const auto& n : log.notes) *report += "note: " + n + "\n";
   std::vector<plot::LoopTrace> traces;
   std::string plant_name;
@@ -92,8 +88,7 @@ bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, p
     bool found = false;
     for (const auto& e : log.episodes) found = found || e.episode_id == id;
     if (!found) {
-      if (error) *error = "--episode " + std::to_string(id) + " is not in " + log_path;
-      return false;
+      return Status::InvalidInput("--episode " + std::to_string(id) + " is not in " + log_path);
     }
   }
   for (const replay::Episode& e : log.episodes) {
@@ -116,8 +111,7 @@ bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, p
     else
       name << ", " << ToString(d.kind) << " " << d.amplitude;
     Evaluation ev;
-    std::string why;
-    if (replay::EvaluateEpisode(e, &ev, &why)) name << std::setprecision(6) << " (IAE " << ev.iae << ")";
+    if (replay::EvaluateEpisode(e, &ev).ok()) name << std::setprecision(6) << " (IAE " << ev.iae << ")";
     tr.name = name.str();
     const double dt = e.spec.dt_s, r = e.spec.reference;
     for (long k = 0; k < e.total_steps; ++k) {
@@ -134,15 +128,14 @@ bool LogFigure(const std::string& log_path, const std::vector<long>& episodes, p
     traces.push_back(std::move(tr));
   }
   if (traces.empty()) {
-    if (error) *error = "no episode with a configuration to plot in " + log_path;
-    return false;
+    return Status::InvalidInput("no episode with a configuration to plot in " + log_path);
   }
   std::ostringstream title;
   title << "log " << std::filesystem::path(log_path).filename().string() << ": "
         << (mixed_plants ? std::string("several plants") : plant_name)
         << ", sampled loop over LCM, every step";
-  return plot::MakeLoopFigure(traces, plot::UnitsOfPlant(mixed_plants ? "" : plant_name), title.str(), figure,
-                              error);
+  return plot::MakeLoopFigure(traces, plot::UnitsOfPlant(mixed_plants ? "" : plant_name), title.str(),
+                              figure);
 }
 
 }  // namespace pidlab::figures

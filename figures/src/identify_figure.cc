@@ -8,8 +8,8 @@
 
 namespace pidlab::figures {
 
-bool IdentifyFigure(const identify::IdentifyData& data, const identify::IdentifyResult& result,
-                    plot::Figure* figure, std::string* error) {
+Status IdentifyFigure(const identify::IdentifyData& data, const identify::IdentifyResult& result,
+                      plot::Figure* figure) {
   std::ostringstream title;
   title << std::setprecision(6) << "identify: " << identify::ToString(result.model.kind) << ", fit "
         << result.fit_percent << " %, AIC " << result.aic
@@ -23,7 +23,7 @@ bool IdentifyFigure(const identify::IdentifyData& data, const identify::Identify
                              result.residuals,
                              result.whiteness.autocorrelation,
                              result.whiteness.band};
-  if (!plot::MakeFitFigure(trace, "y", figure, error)) return false;
+  if (Status st = plot::MakeFitFigure(trace, "y", figure); !st.ok()) return st;
   // The samples a robust loss down-weighted, marked on the measured output.
   if (!result.downweighted.empty()) {
     plot::Series marked;
@@ -37,7 +37,7 @@ bool IdentifyFigure(const identify::IdentifyData& data, const identify::Identify
     }
     figure->panels.front().series.push_back(marked);
   }
-  return true;
+  return Status::Ok();
 }
 
 }  // namespace pidlab::figures

@@ -34,19 +34,16 @@ const std::vector<std::string>& AllRoles() {
   return roles;
 }
 
-bool EnterIsolatedNetwork(std::string* error) {
-  if (unshare(CLONE_NEWNET) != 0) {
-    if (error)
-      *error = std::string("cannot enter a private network namespace (unshare: ") + strerror(errno) +
-               "; root is needed)";
-    return false;
-  }
+Status EnterIsolatedNetwork() {
+  if (unshare(CLONE_NEWNET) != 0)
+    return Status::RunnerFailed(std::string("cannot enter a private network namespace (unshare: ") +
+                                strerror(errno) + "; root is needed)");
   for (const std::vector<std::string>& args : {std::vector<std::string>{"ip", "link", "set", "lo", "up"},
                                                {"ip", "link", "set", "lo", "multicast", "on"},
                                                {"ip", "route", "add", "224.0.0.0/4", "dev", "lo"}}) {
-    if (!RunAndWait(args, error)) return false;
+    if (Status st = RunAndWait(args); !st.ok()) return st;
   }
-  return true;
+  return Status::Ok();
 }
 
 std::string SelfDirectory() {
@@ -129,11 +126,12 @@ Launcher::Launcher(const LaunchOptions& options, NoteFn note)
   if (options_.bin_dir.empty()) options_.bin_dir = SelfDirectory();
   if (options_.bin_dir.back() != '/') options_.bin_dir += '/';
   lcm_ = std::make_unique<lcm::LCM>(url_);
-  if (!lcm_->good())
-    throw std::runtime_error(
-        "cannot start LCM on '" + url_ +
-        "': no multicast route? Add one with 'sudo ip route add 224.0.0.0/4 dev lo' or use "
-        "--isolated (see docs/trio.md)");
+  if (!lcm_->good()) {
+    lcm_failure_ = "cannot start LCM on '" + url_ +
+                   "': no multicast route? Add one with 'sudo ip route add 224.0.0.0/4 dev lo' or use "
+                   "--isolated (see docs/trio.md)";
+    return;
+  }
   transport::TransportOptions topt;
   topt.channel_prefix = options_.channel_prefix;
   if (!options_.auth_key_file.empty()) {
@@ -141,7 +139,12 @@ Launcher::Launcher(const LaunchOptions& options, NoteFn note)
     if (!transport::LoadAuthKey(options_.auth_key_file, &key, &error)) throw std::invalid_argument(error);
     topt.auth_key = key;
   }
-  transport_ = std::make_unique<transport::Transport>(lcm_.get(), topt);
+  try {
+    transport_ = std::make_unique<transport::Transport>(lcm_.get(), topt);
+  } catch (const std::runtime_error& e) {  // the step lanes' LCM
+    lcm_failure_ = e.what();
+    return;
+  }
   transport_->Subscribe<pidlab::lcmt_ready>(transport::kReadyChannel, [this](const pidlab::lcmt_ready& m) {
     if (m.state == pidlab::lcmt_ready::ALIVE) alive_[m.role] = m.pid;
   });
@@ -226,6 +229,10 @@ LaunchStatus Launcher::WaitReady(const volatile std::sig_atomic_t* stop, std::st
 }
 
 LaunchStatus Launcher::Start(const volatile std::sig_atomic_t* stop, std::string* error) {
+  if (!lcm_failure_.empty()) {
+    if (error) *error = lcm_failure_;
+    return LaunchStatus::kLcmFailed;
+  }
   if (log_) {
     const long long free_bytes = FreeBytesBeside(options_.log_file);
     if (free_bytes >= 0 && free_bytes < kLowSpaceBytes)
@@ -385,13 +392,13 @@ bool Launcher::FinishLog(bool interrupted) {
 void Launcher::Stop() {
   if (!supervisor_) return;
   if (logger_ > 0) supervisor_->StopChild(logger_, SIGINT, 3.0);
-  std::string error;
   if (logger_died_) {
     // The lane files were kept as they are (failure() names them). What the
     // log misses is read now, after COMMAND was stopped, not before.
     failure_ = logger_end_ + "; " + log_->DescribeMissing() + (kept_.empty() ? "" : "; " + kept_);
-  } else if (log_ && !log_->MergeLanes(&error)) {
-    if (failure_.empty()) failure_ = error + " (" + options_.log_file + " holds the base port's events only)";
+  } else if (const Status merged = log_ ? log_->MergeLanes() : Status::Ok(); !merged.ok()) {
+    if (failure_.empty())
+      failure_ = merged.message() + " (" + options_.log_file + " holds the base port's events only)";
   } else if (log_ && log_->rebuilt_outputs() > 0)
     Note("note: lcm-logger lost " + std::to_string(log_->rebuilt_outputs()) +
          " PLANT_OUTPUT datagrams on the step lane; written into " + options_.log_file +

@@ -161,8 +161,7 @@ std::string LogCapture::DescribeMissing() const {
   read_options.channel_prefix = options_.channel_prefix;
   read_options.auth_key = options_.auth_key;
   replay::LogContents log;
-  std::string error;
-  if (!replay::ReadLog(options_.log_file, read_options, &log, &error))
+  if (!replay::ReadLog(options_.log_file, read_options, &log).ok())
     return options_.log_file + " cannot be read";
   const replay::Episode* first = nullptr;
   long more = 0;
@@ -238,8 +237,12 @@ std::vector<TimedPayload> RebuildLaneOutputs(const replay::LogContents& log, con
   return out;
 }
 
-bool MergeEventLogs(const std::vector<std::string>& inputs, const std::vector<TimedPayload>& extra,
-                    const std::string& extra_channel, const std::string& out_file, std::string* error) {
+namespace {
+
+// MergeEventLogs() with the refusal's message in *error.
+bool MergeEventLogsOrExplain(const std::vector<std::string>& inputs, const std::vector<TimedPayload>& extra,
+                             const std::string& extra_channel, const std::string& out_file,
+                             std::string* error) {
   std::vector<lcm_eventlog_t*> logs;
   bool ok = true;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
@@ -300,6 +303,15 @@ bool MergeEventLogs(const std::vector<std::string>& inputs, const std::vector<Ti
   return ok;
 }
 
+}  // namespace
+
+Status MergeEventLogs(const std::vector<std::string>& inputs, const std::vector<TimedPayload>& extra,
+                      const std::string& extra_channel, const std::string& out_file) {
+  std::string why;
+  if (!MergeEventLogsOrExplain(inputs, extra, extra_channel, out_file, &why)) return Status::IoFailed(why);
+  return Status::Ok();
+}
+
 std::vector<TimedPayload> LogCapture::MissingLaneOutputs(const std::string& lane_file) const {
   // A controller driven from the log by lcm-logplayer waits for y_k forever
   // if y_k is missing. Authenticated runs are left as they are (the rebuilt
@@ -308,14 +320,13 @@ std::vector<TimedPayload> LogCapture::MissingLaneOutputs(const std::string& lane
   replay::ReadOptions read_options;
   read_options.channel_prefix = options_.channel_prefix;
   replay::LogContents log;
-  std::string error;
-  if (!replay::ReadLog(options_.log_file, read_options, &log, &error)) return {};
+  if (!replay::ReadLog(options_.log_file, read_options, &log).ok()) return {};
   return RebuildLaneOutputs(log, lane_file, options_.channel_prefix);
 }
 
-bool LogCapture::MergeLanes(std::string* error) {
+Status LogCapture::MergeLanes() {
   rebuilt_outputs_ = 0;
-  if (lane_loggers_.empty()) return true;
+  if (lane_loggers_.empty()) return Status::Ok();
   for (const auto& [pid, file] : lane_loggers_)
     if (pid > 0 && !supervisor_->StopChild(pid, SIGINT, 3.0)) supervisor_->StopChild(pid, SIGKILL, 1.0);
   std::vector<std::string> inputs{options_.log_file};
@@ -328,23 +339,24 @@ bool LogCapture::MergeLanes(std::string* error) {
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   rebuilt_outputs_ = static_cast<long>(rebuilt.size());
   const std::string merged = options_.log_file + ".merging";
-  bool ok = MergeEventLogs(inputs, rebuilt, options_.channel_prefix + transport::kPlantOutputChannel, merged,
-                           error);
+  std::string error;
+  bool ok = MergeEventLogsOrExplain(inputs, rebuilt, options_.channel_prefix + transport::kPlantOutputChannel,
+                                    merged, &error);
   if (ok && std::rename(merged.c_str(), options_.log_file.c_str()) != 0) {
     ok = false;
-    if (error) *error = "cannot rename " + merged + " to " + options_.log_file;
+    error = "cannot rename " + merged + " to " + options_.log_file;
     std::remove(merged.c_str());
   }
   if (ok) {
     for (const auto& lane : lane_loggers_) std::remove(lane.second.c_str());
-  } else if (error) {
+  } else {
     // What the lanes hold exists nowhere else: keep it and say where.
     std::string kept;
     for (const auto& lane : lane_loggers_) kept += (kept.empty() ? "" : ", ") + lane.second;
-    *error += "; kept " + kept;
+    error += "; kept " + kept;
   }
   lane_loggers_.clear();
-  return ok;
+  return ok ? Status::Ok() : Status::IoFailed(error);
 }
 
 bool LogCapture::WaitForMarker(const std::string& what) {
@@ -379,10 +391,9 @@ bool LogCapture::FindGaps(std::vector<Gap>* gaps, RepairSummary* summary) const 
   read_options.channel_prefix = options_.channel_prefix;
   read_options.auth_key = options_.auth_key;
   replay::LogContents log;
-  std::string error;
-  if (!replay::ReadLog(options_.log_file, read_options, &log, &error)) {
+  if (const Status st = replay::ReadLog(options_.log_file, read_options, &log); !st.ok()) {
     summary->status = RepairStatus::kUnreadable;
-    summary->lines.push_back("cannot read " + options_.log_file + " to check it: " + error);
+    summary->lines.push_back("cannot read " + options_.log_file + " to check it: " + st.message());
     return false;
   }
   gaps->clear();

@@ -39,12 +39,11 @@ int ExitCodeOf(int status) {
   return 1;
 }
 
-bool RunAndWait(const std::vector<std::string>& args, std::string* error) {
+Status RunAndWait(const std::vector<std::string>& args) {
   std::vector<std::string> copy = args;
   const pid_t pid = fork();
   if (pid < 0) {
-    if (error) *error = "fork failed";
-    return false;
+    return Status::RunnerFailed("fork failed");
   }
   if (pid == 0) {
     auto argv = Argv(&copy);
@@ -53,11 +52,10 @@ bool RunAndWait(const std::vector<std::string>& args, std::string* error) {
   }
   int status = 0;
   waitpid(pid, &status, 0);
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return true;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return Status::Ok();
   std::string line;
   for (const auto& a : args) line += (line.empty() ? "" : " ") + a;
-  if (error) *error = "'" + line + "' " + DescribeStatus(status);
-  return false;
+  return Status::RunnerFailed("'" + line + "' " + DescribeStatus(status));
 }
 
 Supervisor::~Supervisor() { KillAll(); }

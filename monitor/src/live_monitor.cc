@@ -212,8 +212,16 @@ LiveMonitor::LiveMonitor(const LiveMonitorOptions& options) : options_(options) 
   std::string error;
   if (!options_.IsValid(&error)) throw std::invalid_argument("LiveMonitor: " + error);
   own_lcm_ = std::make_unique<lcm::LCM>(options_.lcm_url);
-  if (!own_lcm_->good()) throw std::runtime_error("LCM cannot start on '" + options_.lcm_url + "'");
-  transport_ = std::make_unique<transport::Transport>(own_lcm_.get(), options_.transport);
+  if (!own_lcm_->good()) {
+    status_ = Status::RunnerFailed("LCM cannot start on '" + options_.lcm_url + "'");
+    return;
+  }
+  try {
+    transport_ = std::make_unique<transport::Transport>(own_lcm_.get(), options_.transport);
+  } catch (const std::runtime_error& e) {  // the step lanes' LCM
+    status_ = Status::RunnerFailed(e.what());
+    return;
+  }
   Subscribe();
 }
 
@@ -257,6 +265,7 @@ void LiveMonitor::Subscribe() {
 }
 
 int LiveMonitor::Poll(double timeout_s) {
+  if (!transport_) return -1;
   const int handled = transport_->WaitAndHandle(timeout_s);
   std::lock_guard<std::mutex> lock(state_->mutex);
   const transport::TransportCounters& c = transport_->counters();

@@ -216,6 +216,12 @@ struct LiveScope::State {
 
 LiveScope::LiveScope(const std::vector<LiveMonitorOptions>& trios) : state_(std::make_unique<State>(trios)) {}
 
+Status LiveScope::status() const {
+  for (const auto& m : state_->monitors)
+    if (!m->status().ok()) return m->status();
+  return Status::Ok();
+}
+
 LiveScope::~LiveScope() = default;
 
 void LiveScope::Subscribe(const void* key, std::shared_ptr<LiveOutlet> outlet, int columns) {

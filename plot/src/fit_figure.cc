@@ -2,8 +2,11 @@
 
 namespace pidlab::plot {
 
-bool MakeFitFigure(const FitTrace& trace, const std::string& output_label, Figure* figure,
-                   std::string* error) {
+namespace {
+
+// MakeFitFigure() with the refusal's message in *error.
+bool MakeFitFigureOrExplain(const FitTrace& trace, const std::string& output_label, Figure* figure,
+                            std::string* error) {
   const std::size_t n = trace.t.size();
   if (n == 0 || trace.measured.size() != n || trace.simulated.size() != n || trace.residuals.size() != n) {
     *error = "the fit has no simulated output to draw";
@@ -39,6 +42,14 @@ bool MakeFitFigure(const FitTrace& trace, const std::string& output_label, Figur
   acf.series.push_back({"+-1.96/sqrt(N)", lags, up, Style::kDashed, "#7f7f7f"});
   acf.series.push_back({"", lags, down, Style::kDashed, "#7f7f7f"});
   return true;
+}
+
+}  // namespace
+
+Status MakeFitFigure(const FitTrace& trace, const std::string& output_label, Figure* figure) {
+  std::string why;
+  if (!MakeFitFigureOrExplain(trace, output_label, figure, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::plot

@@ -20,8 +20,11 @@ LoopUnits UnitsOfPlant(const std::string& plant_name) {
   return u;
 }
 
-bool MakeLoopFigure(const std::vector<LoopTrace>& traces, const LoopUnits& units, const std::string& title,
-                    Figure* figure, std::string* error) {
+namespace {
+
+// MakeLoopFigure() with the refusal's message in *error.
+bool MakeLoopFigureOrExplain(const std::vector<LoopTrace>& traces, const LoopUnits& units,
+                             const std::string& title, Figure* figure, std::string* error) {
   bool any_points = false, any_u = false;
   for (const LoopTrace& tr : traces) {
     for (const auto* v : {&tr.r, &tr.y, &tr.e, &tr.u, &tr.n}) {
@@ -97,6 +100,15 @@ bool MakeLoopFigure(const std::vector<LoopTrace>& traces, const LoopUnits& units
     if (!p->series.empty()) figure->panels.push_back(std::move(*p));
   }
   return true;
+}
+
+}  // namespace
+
+Status MakeLoopFigure(const std::vector<LoopTrace>& traces, const LoopUnits& units, const std::string& title,
+                      Figure* figure) {
+  std::string why;
+  if (!MakeLoopFigureOrExplain(traces, units, title, figure, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::plot

@@ -262,7 +262,10 @@ bool Figure::IsValid(std::string* error) const {
   return false;
 }
 
-bool DrawPng(const Figure& figure, std::string* error) {
+namespace {
+
+// DrawPng() with the refusal's message in *error.
+bool DrawPngOrExplain(const Figure& figure, std::string* error) {
   if (!figure.IsValid(error)) return false;
   std::string e;
   auto fail = [&]() {
@@ -306,6 +309,14 @@ bool DrawPng(const Figure& figure, std::string* error) {
     return fail();
   }
   return true;
+}
+
+}  // namespace
+
+Status DrawPng(const Figure& figure) {
+  std::string why;
+  if (!DrawPngOrExplain(figure, &why)) return Status::IoFailed(why);
+  return Status::Ok();
 }
 
 bool ReadPngSize(const std::string& path, int* width_px, int* height_px) {

@@ -38,29 +38,25 @@ EventReader::~EventReader() {
   if (fd_ >= 0) close(fd_);
 }
 
-bool EventReader::Open(const std::string& path, std::string* error) {
+Status EventReader::Open(const std::string& path) {
   if (fd_ >= 0) {
-    if (error) *error = "log '" + path + "': this reader already has a file open";
-    return false;
+    return Status::IoFailed("log '" + path + "': this reader already has a file open");
   }
   struct stat st {};
   if (stat(path.c_str(), &st) != 0) {
-    if (error) *error = "log '" + path + "' cannot be opened: " + std::strerror(errno);
-    return false;
+    return Status::IoFailed("log '" + path + "' cannot be opened: " + std::strerror(errno));
   }
   if (!S_ISREG(st.st_mode)) {
-    if (error) *error = "log '" + path + "' is not a regular file";
-    return false;
+    return Status::IoFailed("log '" + path + "' is not a regular file");
   }
   fd_ = open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0 || fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
-    if (error) *error = "log '" + path + "' cannot be opened as an LCM log";
-    return false;
+    return Status::IoFailed("log '" + path + "' cannot be opened as an LCM log");
   }
   // Only what the file holds now: a logger may still be appending.
   file_bytes_ = static_cast<long long>(st.st_size);
   buffer_.resize(kBufferBytes);
-  return true;
+  return Status::Ok();
 }
 
 bool EventReader::Next(LogEvent* event) {

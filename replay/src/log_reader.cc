@@ -200,10 +200,10 @@ std::string Episode::CompletenessNote() const {
 
 // The event reader's events, through the decoder table, into the episode
 // assembler.
-bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* out, std::string* error) {
+Status ReadLog(const std::string& path, const ReadOptions& options, LogContents* out) {
   *out = LogContents();
   EventReader reader;
-  if (!reader.Open(path, error)) return false;
+  if (Status st = reader.Open(path); !st.ok()) return st;
   out->opened = true;
   out->file_bytes = reader.file_bytes();
   Tallies tallies;
@@ -218,14 +218,13 @@ bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* o
   out->episodes = std::move(assembled.episodes);
   RecordTallies(tallies, out);
   if (out->events == 0) {
-    if (error)
-      *error = "'" + path + "' holds no LCM event (" +
-               (out->file_bytes == 0 ? std::string("an empty file")
+    return Status::InvalidInput("'" + path + "' holds no LCM event (" +
+                                (out->file_bytes == 0
+                                     ? std::string("an empty file")
                                      : std::to_string(out->file_bytes) + " bytes: not an LCM log?") +
-               ")";
-    return false;
+                                ")");
   }
-  return true;
+  return Status::Ok();
 }
 
 }  // namespace pidlab::replay

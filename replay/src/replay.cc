@@ -44,15 +44,9 @@ bool EpisodeTrajectory(const Episode& e, std::vector<SampledStep>* trajectory) {
   return true;
 }
 
-bool EvaluateEpisode(const Episode& e, Evaluation* evaluation, std::string* error) {
-  if (!e.has_config) {
-    if (error) *error = e.CompletenessNote();
-    return false;
-  }
-  if (!e.Complete()) {
-    if (error) *error = "incomplete: " + e.CompletenessNote();
-    return false;
-  }
+Status EvaluateEpisode(const Episode& e, Evaluation* evaluation) {
+  if (!e.has_config) return Status::InvalidInput(e.CompletenessNote());
+  if (!e.Complete()) return Status::InvalidInput("incomplete: " + e.CompletenessNote());
   // The run as the log recorded it; the undisturbed response, which no
   // episode of the log holds, is the loop run in process without the
   // disturbance.
@@ -65,9 +59,7 @@ bool EvaluateEpisode(const Episode& e, Evaluation* evaluation, std::string* erro
                             &run.y_undisturbed, nullptr);
   EvaluateOptions what;
   what.record_trajectory = true;
-  const Status s = EvaluateSampledRun(e.spec.plant, e.spec.gains, options, what, run, evaluation);
-  if (!s.ok() && error) *error = s.message();
-  return s.ok();
+  return EvaluateSampledRun(e.spec.plant, e.spec.gains, options, what, run, evaluation);
 }
 
 RedriveResult Redrive(const Episode& e) {
@@ -105,11 +97,14 @@ RedriveResult Redrive(const Episode& e) {
   return r;
 }
 
+namespace {
+
 // Re-drives a live pidlab-controller (started alone, without plant and
 // disturbance) with the logged plant outputs, one step at a time: publish y_k,
 // wait for the command of step k (resending y_k on silence), compare bits.
-RedriveResult RedriveOverLcm(const Episode& e, const std::string& url, const std::string& prefix,
-                             double deadline_s) {
+// Throws std::invalid_argument (LCM) or std::runtime_error (the controller).
+RedriveResult RedriveOverLcmThrowing(const Episode& e, const std::string& url, const std::string& prefix,
+                                     double deadline_s) {
   RedriveResult r;
   if (!e.has_config) {
     r.message = e.CompletenessNote();
@@ -173,6 +168,20 @@ RedriveResult RedriveOverLcm(const Episode& e, const std::string& url, const std
   r.message =
       "all " + std::to_string(r.steps_checked) + " commands reproduced bit for bit by the live controller";
   return r;
+}
+
+}  // namespace
+
+Status RedriveOverLcm(const Episode& e, const std::string& url, const std::string& prefix, double deadline_s,
+                      RedriveResult* result) {
+  try {
+    *result = RedriveOverLcmThrowing(e, url, prefix, deadline_s);
+  } catch (const std::invalid_argument& bad_url) {
+    return Status::InvalidInput(bad_url.what());
+  } catch (const std::runtime_error& failed) {  // no acknowledgement, no answer, a step lane
+    return Status::RunnerFailed(failed.what());
+  }
+  return Status::Ok();
 }
 
 }  // namespace pidlab::replay

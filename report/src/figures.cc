@@ -129,9 +129,8 @@ std::string OutPath(const ReportData& data, const std::string& file) {
 }
 
 bool Draw(const plot::Figure& fig, ReportData* data, const std::string& caption, std::string* error) {
-  std::string e;
-  if (!plot::DrawPng(fig, &e)) {
-    *error = "figure " + fig.output_path + ": " + e;
+  if (const Status st = plot::DrawPng(fig); !st.ok()) {
+    *error = "figure " + fig.output_path + ": " + st.message();
     return false;
   }
   data->figures.push_back({std::filesystem::path(fig.output_path).filename().string(), caption});
@@ -267,7 +266,10 @@ bool DrawVeryHighDisturbanceFigure(ReportData* data, std::string* error) {
 bool DrawMotorSectionFigure(ReportData* data, std::string* error) {
   std::string caption;
   const std::string file = "fig_motor_itself.png";
-  if (!DrawMotorFigure(data->motor, data->options.out_dir, file, &caption, error)) return false;
+  if (const Status st = DrawMotorFigure(data->motor, data->options.out_dir, file, &caption); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   data->figures.push_back({file, caption});
   return true;
 }
@@ -275,14 +277,21 @@ bool DrawMotorSectionFigure(ReportData* data, std::string* error) {
 bool DrawIdentifySectionFigure(ReportData* data, std::string* error) {
   std::string caption;
   const std::string file = "fig_motor_identified.png";
-  if (!DrawIdentifyFigure(data->identified, data->options.out_dir, file, &caption, error)) return false;
+  if (const Status st = DrawIdentifyFigure(data->identified, data->options.out_dir, file, &caption);
+      !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   data->figures.push_back({file, caption});
   return true;
 }
 
 bool DrawRobustSectionFigures(ReportData* data, std::string* error) {
   std::vector<std::pair<std::string, std::string>> drawn;
-  if (!DrawRobustFigures(data->robust, data->options.out_dir, &drawn, error)) return false;
+  if (const Status st = DrawRobustFigures(data->robust, data->options.out_dir, &drawn); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   for (auto& [file, caption] : drawn) data->figures.push_back({file, caption});
   return true;
 }

@@ -166,7 +166,11 @@ std::string PlusMinus(double v, double se, int digits) { return Num(v, digits) +
 
 }  // namespace
 
-bool ComputeIdentifySection(bool quick, std::uint64_t seed, IdentifySection* section, std::string* error) {
+namespace {
+
+// ComputeIdentifySection() with the refusal's message in *error.
+bool ComputeIdentifySectionOrExplain(bool quick, std::uint64_t seed, IdentifySection* section,
+                                     std::string* error) {
   IdentifySection& s = *section;
   s = IdentifySection{};
   if (quick) s.horizon_s = 1.0, s.robust_samples = 4;
@@ -188,6 +192,14 @@ bool ComputeIdentifySection(bool quick, std::uint64_t seed, IdentifySection* sec
     *error = e.what();
     return false;
   }
+}
+
+}  // namespace
+
+Status ComputeIdentifySection(bool quick, std::uint64_t seed, IdentifySection* section) {
+  std::string why;
+  if (!ComputeIdentifySectionOrExplain(quick, seed, section, &why)) return Status::RunnerFailed(why);
+  return Status::Ok();
 }
 
 void RenderIdentifySection(std::ostream& os, const IdentifySection& s) {
@@ -241,8 +253,11 @@ void RenderIdentifySection(std::ostream& os, const IdentifySection& s) {
      << ".\n\n";
 }
 
-bool DrawIdentifyFigure(const IdentifySection& s, const std::string& out_dir, const std::string& file,
-                        std::string* caption, std::string* error) {
+namespace {
+
+// DrawIdentifyFigure() with the refusal's message in *caption.
+bool DrawIdentifyFigureOrExplain(const IdentifySection& s, const std::string& out_dir,
+                                 const std::string& file, std::string* caption, std::string* error) {
   plot::Figure figure;
   figure.title = "The motor identified: a P2DU with delay fitted to an open-loop PRBS experiment";
   const plot::FitTrace trace{s.data.t,
@@ -251,14 +266,29 @@ bool DrawIdentifyFigure(const IdentifySection& s, const std::string& out_dir, co
                              s.fit.residuals,
                              s.fit.whiteness.autocorrelation,
                              s.fit.whiteness.band};
-  if (!plot::MakeFitFigure(trace, "angle [rad]", &figure, error)) return false;
+  if (const Status st = plot::MakeFitFigure(trace, "angle [rad]", &figure); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   figure.output_path = (std::filesystem::path(out_dir) / file).string();
-  if (!plot::DrawPng(figure, error)) return false;
+  if (const Status st = plot::DrawPng(figure); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   *caption =
       "Identifying the motor: the measured angle of the open-loop PRBS experiment on the nonlinear stepper "
       "with "
       "the identified P2DU's, the residuals, and their autocorrelation with the 95 % band of white noise.";
   return true;
+}
+
+}  // namespace
+
+Status DrawIdentifyFigure(const IdentifySection& s, const std::string& out_dir, const std::string& file,
+                          std::string* caption) {
+  std::string why;
+  if (!DrawIdentifyFigureOrExplain(s, out_dir, file, caption, &why)) return Status::IoFailed(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::report

@@ -457,8 +457,11 @@ void RenderLinearisationNotes(std::ostream& os, const MotorSection& s) {
 
 }  // namespace
 
-bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t seed, MotorSection* section,
-                         std::string* error) {
+namespace {
+
+// ComputeMotorSection() with the refusal's message in *error.
+bool ComputeMotorSectionOrExplain(const PidGains& paper_nm, bool quick, std::uint64_t seed,
+                                  MotorSection* section, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
   MotorSection& s = *section;
   s = MotorSection{};
@@ -495,6 +498,14 @@ bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t see
   return true;
 }
 
+}  // namespace
+
+Status ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t seed, MotorSection* section) {
+  std::string why;
+  if (!ComputeMotorSectionOrExplain(paper_nm, quick, seed, section, &why)) return Status::RunnerFailed(why);
+  return Status::Ok();
+}
+
 void RenderMotorSection(std::ostream& os, const MotorSection& s) {
   RenderIntroduction(os, s);
   for (const MotorGainSet& set : s.sets) RenderSet(os, s, set);
@@ -506,8 +517,11 @@ void RenderMotorSection(std::ostream& os, const MotorSection& s) {
   if (!s.sets.empty()) RenderLinearisationNotes(os, s);
 }
 
-bool DrawMotorFigure(const MotorSection& s, const std::string& out_dir, const std::string& file,
-                     std::string* caption, std::string* error) {
+namespace {
+
+// DrawMotorFigure() with the refusal's message in *caption.
+bool DrawMotorFigureOrExplain(const MotorSection& s, const std::string& out_dir, const std::string& file,
+                              std::string* caption, std::string* error) {
   plot::Figure fig;
   fig.title = "Nonlinear stepper against eq. (3): y(t)/A for the paper's Nelder-Mead gains";
   fig.output_path = (std::filesystem::path(out_dir) / file).string();
@@ -537,9 +551,8 @@ bool DrawMotorFigure(const MotorSection& s, const std::string& out_dir, const st
                           eq3 ? "black" : kPalette[color++ % (sizeof(kPalette) / sizeof(kPalette[0]))]});
     }
   }
-  std::string e;
-  if (!plot::DrawPng(fig, &e)) {
-    *error = "figure " + fig.output_path + ": " + e;
+  if (const Status st = plot::DrawPng(fig); !st.ok()) {
+    *error = "figure " + fig.output_path + ": " + st.message();
     return false;
   }
   *caption =
@@ -550,6 +563,15 @@ bool DrawMotorFigure(const MotorSection& s, const std::string& out_dir, const st
       " ms, where the gains tuned on the motor at one tooth pitch are shown too. The y axis is cut at -0.5 "
       "and 2.";
   return true;
+}
+
+}  // namespace
+
+Status DrawMotorFigure(const MotorSection& s, const std::string& out_dir, const std::string& file,
+                       std::string* caption) {
+  std::string why;
+  if (!DrawMotorFigureOrExplain(s, out_dir, file, caption, &why)) return Status::IoFailed(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::report

@@ -158,8 +158,12 @@ bool EvaluatePaperRows(const std::vector<PaperRow>& paper, ReportData* data, std
   for (const PaperRow& row : paper) {
     RowResult r;
     r.paper = row;
-    if (!EvaluateMetrics(BuiltinPlant(row.plant), row.gains, row.disturbance_amplitude, &r.pidlab, error))
+    if (const Status st =
+            EvaluateMetrics(BuiltinPlant(row.plant), row.gains, row.disturbance_amplitude, &r.pidlab);
+        !st.ok()) {
+      if (error) *error = st.message();
       return false;
+    }
     r.differences = ExplainDifferences(row, r.pidlab);
     data->rows.push_back(std::move(r));
   }

@@ -101,7 +101,10 @@ PaperRow ParseRow(const std::vector<std::string>& cells, const Columns& col, con
 
 }  // namespace
 
-bool ReadPaperTables(const std::string& path, std::vector<PaperRow>* rows, std::string* error) {
+namespace {
+
+// ReadPaperTables() with the refusal's message in *error.
+bool ReadPaperTablesOrExplain(const std::string& path, std::vector<PaperRow>* rows, std::string* error) {
   std::ifstream file(path);
   if (!file) {
     *error = "cannot read the paper's tables at " + path;
@@ -109,11 +112,24 @@ bool ReadPaperTables(const std::string& path, std::vector<PaperRow>* rows, std::
   }
   std::ostringstream text;
   text << file.rdbuf();
-  return ParsePaperTables(text.str(), path, rows, error);
+  const Status st = ParsePaperTables(text.str(), path, rows);
+  if (!st.ok()) *error = st.message();
+  return st.ok();
 }
 
-bool ParsePaperTables(const std::string& csv, const std::string& path, std::vector<PaperRow>* rows,
-                      std::string* error) {
+}  // namespace
+
+Status ReadPaperTables(const std::string& path, std::vector<PaperRow>* rows) {
+  std::string why;
+  if (!ReadPaperTablesOrExplain(path, rows, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
+}
+
+namespace {
+
+// ParsePaperTables() with the refusal's message in *error.
+bool ParsePaperTablesOrExplain(const std::string& csv, const std::string& path, std::vector<PaperRow>* rows,
+                               std::string* error) {
   std::istringstream in(csv);
   std::string line;
   if (!std::getline(in, line)) {
@@ -139,6 +155,14 @@ bool ParsePaperTables(const std::string& csv, const std::string& path, std::vect
     return false;
   }
   return true;
+}
+
+}  // namespace
+
+Status ParsePaperTables(const std::string& csv, const std::string& path, std::vector<PaperRow>* rows) {
+  std::string why;
+  if (!ParsePaperTablesOrExplain(csv, path, rows, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::report

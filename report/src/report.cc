@@ -121,8 +121,8 @@ bool ComputeRobust(const ReportOptions& options, const std::vector<PaperRow>& pa
     }
     if (found) inputs.push_back(in);
   }
-  if (!ComputeRobustSection(inputs, options.quick, options.seed, &data->robust, error)) {
-    *error = "robust section: " + *error;
+  if (const Status st = ComputeRobustSection(inputs, options.quick, options.seed, &data->robust); !st.ok()) {
+    *error = "robust section: " + st.message();
     return false;
   }
   return true;
@@ -148,8 +148,11 @@ void FillFromEvaluation(const Evaluation& ev, Metrics* m) {
   }
 }
 
-bool EvaluateMetrics(const Plant& plant, const PidGains& gains, double amplitude, Metrics* metrics,
-                     std::string* error) {
+namespace {
+
+// EvaluateMetrics() with the refusal's message in *error.
+bool EvaluateMetricsOrExplain(const Plant& plant, const PidGains& gains, double amplitude, Metrics* metrics,
+                              std::string* error) {
   EvaluateOptions what;
   what.compute_iae_continuous = false;
   Evaluation ev;
@@ -162,8 +165,19 @@ bool EvaluateMetrics(const Plant& plant, const PidGains& gains, double amplitude
   return true;
 }
 
-bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& paper, ReportData* data,
-                   std::string* error) {
+}  // namespace
+
+Status EvaluateMetrics(const Plant& plant, const PidGains& gains, double amplitude, Metrics* metrics) {
+  std::string why;
+  if (!EvaluateMetricsOrExplain(plant, gains, amplitude, metrics, &why)) return Status::RunnerFailed(why);
+  return Status::Ok();
+}
+
+namespace {
+
+// ComputeReport() with the refusal's message in *error.
+bool ComputeReportOrExplain(const ReportOptions& options, const std::vector<PaperRow>& paper,
+                            ReportData* data, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
   *data = ReportData{};
   data->options = options;
@@ -175,24 +189,21 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
   BackgroundTrio trio(options, s);
   // "The motor itself" (motor_section.h), beside the rest as well.
   auto motor = std::async(std::launch::async, [&options, data, gains = s.gains] {
-    std::string e;
-    return ComputeMotorSection(gains, options.quick, options.seed, &data->motor, &e) ? std::string()
-                                                                                     : "motor section: " + e;
+    const Status st = ComputeMotorSection(gains, options.quick, options.seed, &data->motor);
+    return st.ok() ? std::string() : "motor section: " + st.message();
   });
   // "Identifying the motor" (identify_section.h), beside the rest too.
   auto identified = std::async(std::launch::async, [&options, data] {
-    std::string e;
-    return ComputeIdentifySection(options.quick, options.seed, &data->identified, &e)
-               ? std::string()
-               : "identify section: " + e;
+    const Status st = ComputeIdentifySection(options.quick, options.seed, &data->identified);
+    return st.ok() ? std::string() : "identify section: " + st.message();
   });
   try {
     if (!EvaluatePaperRows(paper, data, error)) return false;
     if (!RunTunings(options, data, error)) return false;
     if (!EvaluateSampledLoops(&s, error)) return false;
     if (!ComputeRobust(options, paper, data, error)) return false;
-    if (!ComputeTwoDofSection(data->robust, &data->two_dof, error)) {
-      *error = "two-dof section: " + *error;
+    if (const Status st = ComputeTwoDofSection(data->robust, &data->two_dof); !st.ok()) {
+      *error = "two-dof section: " + st.message();
       return false;
     }
     trio.Collect(options.trio_absent_note, &s);
@@ -204,6 +215,14 @@ bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& pa
   }
   data->compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return true;
+}
+
+}  // namespace
+
+Status ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& paper, ReportData* data) {
+  std::string why;
+  if (!ComputeReportOrExplain(options, paper, data, &why)) return Status::RunnerFailed(why);
+  return Status::Ok();
 }
 
 std::string RenderMarkdown(const ReportData& data) {
@@ -226,7 +245,10 @@ std::string RenderMarkdown(const ReportData& data) {
   return os.str();
 }
 
-bool WriteReport(ReportData* data, std::string* error) {
+namespace {
+
+// WriteReport() with the refusal's message in *error.
+bool WriteReportOrExplain(ReportData* data, std::string* error) {
   std::error_code ec;
   std::filesystem::create_directories(data->options.out_dir, ec);
   if (ec) {
@@ -243,6 +265,14 @@ bool WriteReport(ReportData* data, std::string* error) {
     return false;
   }
   return true;
+}
+
+}  // namespace
+
+Status WriteReport(ReportData* data) {
+  std::string why;
+  if (!WriteReportOrExplain(data, &why)) return Status::IoFailed(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::report

@@ -113,8 +113,11 @@ std::string Verdict(const RobustPlant& p, const RobustSection& s) {
 
 }  // namespace
 
-bool ComputeRobustSection(const std::vector<RobustInput>& inputs, bool quick, std::uint64_t seed,
-                          RobustSection* section, std::string* error) {
+namespace {
+
+// ComputeRobustSection() with the refusal's message in *error.
+bool ComputeRobustSectionOrExplain(const std::vector<RobustInput>& inputs, bool quick, std::uint64_t seed,
+                                   RobustSection* section, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
   RobustSection& s = *section;
   s = RobustSection{};
@@ -167,6 +170,15 @@ bool ComputeRobustSection(const std::vector<RobustInput>& inputs, bool quick, st
   return true;
 }
 
+}  // namespace
+
+Status ComputeRobustSection(const std::vector<RobustInput>& inputs, bool quick, std::uint64_t seed,
+                            RobustSection* section) {
+  std::string why;
+  if (!ComputeRobustSectionOrExplain(inputs, quick, seed, section, &why)) return Status::RunnerFailed(why);
+  return Status::Ok();
+}
+
 void RenderRobustSection(std::ostream& os, const RobustSection& s) {
   os << "## Robust tuning\n\n"
      << "Three gain sets per plant on the paper's continuous loop (unit step, ts = 0.05 s, n = 25 s): the "
@@ -208,8 +220,12 @@ void RenderRobustSection(std::ostream& os, const RobustSection& s) {
   }
 }
 
-bool DrawRobustFigures(const RobustSection& s, const std::string& out_dir,
-                       std::vector<std::pair<std::string, std::string>>* figures, std::string* error) {
+namespace {
+
+// DrawRobustFigures() with the refusal's message in *error.
+bool DrawRobustFiguresOrExplain(const RobustSection& s, const std::string& out_dir,
+                                std::vector<std::pair<std::string, std::string>>* figures,
+                                std::string* error) {
   static const char* kColors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728"};
   const double ms_db = 20.0 * std::log10(s.max_ms), radius = 1.0 / s.max_ms;
   for (const RobustPlant& p : s.plants) {
@@ -261,9 +277,8 @@ bool DrawRobustFigures(const RobustSection& s, const std::string& out_dir,
       ny.series.push_back({set.name, re, im, plot::Style::kLines, color});
     }
     fig.panels = {bs, bt, ny};
-    std::string e;
-    if (!plot::DrawPng(fig, &e)) {
-      *error = "figure " + fig.output_path + ": " + e;
+    if (const Status st = plot::DrawPng(fig); !st.ok()) {
+      *error = "figure " + fig.output_path + ": " + st.message();
       return false;
     }
     figures->push_back(
@@ -278,6 +293,15 @@ bool DrawRobustFigures(const RobustSection& s, const std::string& out_dir,
              Num(s.max_ms, 4) + " around -1 that Ms <= " + Num(s.max_ms, 4) + " keeps the curve out of."});
   }
   return true;
+}
+
+}  // namespace
+
+Status DrawRobustFigures(const RobustSection& s, const std::string& out_dir,
+                         std::vector<std::pair<std::string, std::string>>* figures) {
+  std::string why;
+  if (!DrawRobustFiguresOrExplain(s, out_dir, figures, &why)) return Status::IoFailed(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::report

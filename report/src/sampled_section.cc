@@ -94,7 +94,10 @@ void RenderSampledDiscussion(std::ostream& os, const SampledSection& s) {
 // horizon, and the plant's fastest pole.
 bool EvaluateSampledLoops(SampledSection* s, std::string* error) {
   const Plant stepper = BuiltinPlant("stepper_motor");
-  if (!EvaluateMetrics(stepper, s->gains, 0.0, &s->continuous, error)) return false;
+  if (const Status st = EvaluateMetrics(stepper, s->gains, 0.0, &s->continuous); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   LoopOptions sampled = PaperLoop(0.0);
   sampled.loop = LoopKind::kSampled;
   sampled.dt_s = s->dt_s;

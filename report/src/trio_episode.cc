@@ -19,9 +19,11 @@ namespace pidlab::report {
 bool RunTrioEpisode(const TrioEpisodeOptions& options, const Plant& plant, const PidGains& gains, double dt_s,
                     double horizon_s, Metrics* metrics, std::string* note) {
   std::string error;
-  if (options.isolated && !launcher::EnterIsolatedNetwork(&error)) {
-    *note = error;
-    return false;
+  if (options.isolated) {
+    if (const Status st = launcher::EnterIsolatedNetwork(); !st.ok()) {
+      *note = st.message();
+      return false;
+    }
   }
   auto log = std::make_shared<std::ofstream>(options.log_path, std::ios::app);
   launcher::LaunchOptions lo;

@@ -41,7 +41,11 @@ bool RunTuning(const ReportOptions& options, const std::string& plant_name, Tune
     t->status = TuningStatus::kNoStableLoop;
     t->message = t->summary.message;
   } else {
-    if (!EvaluateMetrics(plant, t->summary.gains, amplitude, &t->metrics, error)) return false;
+    if (const Status metrics = EvaluateMetrics(plant, t->summary.gains, amplitude, &t->metrics);
+        !metrics.ok()) {
+      if (error) *error = metrics.message();
+      return false;
+    }
     t->status = TuningStatus::kTuned;
     t->message = t->summary.message;
   }

@@ -7,7 +7,10 @@
 
 namespace pidlab::report {
 
-bool ComputeTwoDofSection(const RobustSection& robust, TwoDofSection* section, std::string* error) {
+namespace {
+
+// ComputeTwoDofSection() with the refusal's message in *error.
+bool ComputeTwoDofSectionOrExplain(const RobustSection& robust, TwoDofSection* section, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
   *section = TwoDofSection{};
   const StepperMotorParameters table_one;
@@ -30,6 +33,14 @@ bool ComputeTwoDofSection(const RobustSection& robust, TwoDofSection* section, s
   }
   section->compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return true;
+}
+
+}  // namespace
+
+Status ComputeTwoDofSection(const RobustSection& robust, TwoDofSection* section) {
+  std::string why;
+  if (!ComputeTwoDofSectionOrExplain(robust, section, &why)) return Status::RunnerFailed(why);
+  return Status::Ok();
 }
 
 void RenderTwoDofSection(std::ostream& os, const TwoDofSection& s) {

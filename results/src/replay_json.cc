@@ -123,13 +123,13 @@ nlohmann::json EvaluatedEpisodeJson(const replay::Episode& e, evaluation::Evalua
                                     bool* evaluated) {
   nlohmann::json j = EpisodeJson(e);
   evaluation::Evaluation ev;
-  std::string why;
-  const bool ok = replay::EvaluateEpisode(e, &ev, &why);
+  const Status st = replay::EvaluateEpisode(e, &ev);
+  const bool ok = st.ok();
   if (ok) {
     j["evaluation"] = ToJson(ev);
   } else {
     j["evaluation"] = nullptr;
-    j["evaluation_error"] = why;
+    j["evaluation_error"] = st.message();
   }
   if (evaluation) *evaluation = std::move(ev);
   if (evaluated) *evaluated = ok;

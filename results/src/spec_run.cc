@@ -95,8 +95,7 @@ Status EvaluateSpecJson(const nlohmann::json& spec_json, nlohmann::json* result,
                         const std::set<std::string>* given) {
   spec::EvaluateSpec s;
   tune::BuildOptions build;
-  std::string error;
-  if (!spec::FromJson(spec_json, &s, &build.given, &error)) return Status::InvalidInput(error);
+  if (Status st = spec::FromJson(spec_json, &s, &build.given); !st.ok()) return st;
   if (given) build.given = *given;
   tune::EvaluationProblem problem;
   const Status built = tune::BuildEvaluation(s, build, &problem);

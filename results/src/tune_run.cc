@@ -31,8 +31,7 @@ Status TuneSpecJson(const nlohmann::json& spec_json, const optim::ProgressCallba
                     nlohmann::json* result) {
   spec::TuningSpec ts;
   tune::BuildOptions build;
-  std::string error;
-  if (!spec::FromJson(spec_json, &ts, &build.given, &error)) return Status::InvalidInput(error);
+  if (Status st = spec::FromJson(spec_json, &ts, &build.given); !st.ok()) return st;
   tune::TuningProblem problem;
   const Status built = tune::BuildTuning(ts, build, &problem);
   if (!built.ok()) return built;

@@ -170,13 +170,12 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   Reply Answer(const std::string& text, const std::shared_ptr<Connection>& connection = nullptr) {
     // The one JSON reader of every file and request: nesting beyond
     // spec::kMaxJsonDepth is refused before any parser runs.
-    std::string why;
-    if (!spec::CheckJsonNesting(text, spec::kMaxJsonDepth, &why)) {
+    if (const Status st = spec::CheckJsonNesting(text, spec::kMaxJsonDepth); !st.ok()) {
       Count(&ServerCounters::malformed);
-      return {400, {{"error", "the request's JSON " + why}}};
+      return {400, {{"error", "the request's JSON " + st.message()}}};
     }
     nlohmann::json request;
-    if (!spec::ParseJsonText(text, &request, &why) || !request.is_object()) {
+    if (!spec::ParseJsonText(text, &request).ok() || !request.is_object()) {
       Count(&ServerCounters::malformed);
       return {400, {{"error", "a request must be one JSON object"}}};
     }

@@ -39,6 +39,8 @@ bool Number(const nlohmann::json& j, const Field& f, double* v, std::string* err
 
 int kSpecVersionForJson() { return kSpecVersion; }
 
+namespace internal {
+
 bool CheckVersion(const nlohmann::json& j, std::string* error) {
   const auto it = j.find("version");
   if (it == j.end() || (it->is_number_integer() && it->get<long long>() == kSpecVersion)) return true;
@@ -49,7 +51,9 @@ bool CheckVersion(const nlohmann::json& j, std::string* error) {
   return false;
 }
 
-bool CheckJsonNesting(const std::string& text, int max_depth, std::string* error) {
+}  // namespace internal
+
+Status CheckJsonNesting(const std::string& text, int max_depth) {
   int depth = 0;
   bool in_string = false;
   for (std::size_t i = 0; i < text.size(); ++i) {
@@ -63,28 +67,25 @@ bool CheckJsonNesting(const std::string& text, int max_depth, std::string* error
       in_string = true;
     } else if (c == '[' || c == '{') {
       if (++depth > max_depth) {
-        if (error)
-          *error = "is nested deeper than " + std::to_string(max_depth) + " levels (at byte " +
-                   std::to_string(i) + ")";
-        return false;
+        return Status::InvalidInput("is nested deeper than " + std::to_string(max_depth) +
+                                    " levels (at byte " + std::to_string(i) + ")");
       }
     } else if (c == ']' || c == '}') {
       --depth;
     }
   }
-  return true;
+  return Status::Ok();
 }
 
-bool ParseJsonText(const std::string& text, nlohmann::json* out, std::string* error) {
+Status ParseJsonText(const std::string& text, nlohmann::json* out) {
   // Checked before parsing: nlohmann's parser is iterative, but copying,
   // comparing and printing a value recurse once per level.
-  if (!CheckJsonNesting(text, kMaxJsonDepth, error)) return false;
+  if (Status st = CheckJsonNesting(text, kMaxJsonDepth); !st.ok()) return st;
   *out = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (out->is_discarded()) {
-    if (error) *error = "is not valid JSON";
-    return false;
+    return Status::InvalidInput("is not valid JSON");
   }
-  return true;
+  return Status::Ok();
 }
 
 nlohmann::json ToJsonValue(double v) {
@@ -108,6 +109,8 @@ nlohmann::json ToJsonValue(const std::map<std::string, double>& v) {
   for (const auto& [name, x] : v) j[name] = ToJsonValue(x);
   return j;
 }
+
+namespace internal {
 
 bool FromJsonValue(const nlohmann::json& j, const Field& f, double* v, std::string* error) {
   return Number(j, f, v, error);
@@ -171,5 +174,7 @@ bool FromJsonValue(const nlohmann::json& j, const Field& f, std::map<std::string
   *v = std::move(out);
   return true;
 }
+
+}  // namespace internal
 
 }  // namespace pidlab::spec

@@ -40,6 +40,12 @@
 #include "pidlab/transport/episode_spec.h"
 #include "pidlab/tune/model_file.h"
 
+// s.ok(), with its message in *error.
+static bool OkWithMessage(const pidlab::Status& s, std::string* error) {
+  if (error) *error = s.message();
+  return s.ok();
+}
+
 namespace {
 
 // A library's message; the command adds at most about 50 characters
@@ -60,7 +66,7 @@ bool ReadJsonFile(const std::string& path, nlohmann::json* j, std::string* error
     *error = s.message();
     return false;
   }
-  return pidlab::spec::ParseJsonText(text, j, error);
+  return OkWithMessage(pidlab::spec::ParseJsonText(text, j), error);
 }
 
 bool ReadSpec(const std::string& path, std::string* error) {
@@ -68,9 +74,9 @@ bool ReadSpec(const std::string& path, std::string* error) {
   if (!ReadJsonFile(path, &j, error)) return false;
   if (j.is_object() && j.contains("spec") && j["spec"].is_object()) j = nlohmann::json(j["spec"]);
   pidlab::spec::EvaluateSpec evaluate;
-  if (pidlab::spec::FromJson(j, &evaluate, nullptr, error)) return true;
+  if (OkWithMessage(pidlab::spec::FromJson(j, &evaluate, nullptr), error)) return true;
   pidlab::spec::TuningSpec tuning;
-  return pidlab::spec::FromJson(j, &tuning, nullptr, error);
+  return OkWithMessage(pidlab::spec::FromJson(j, &tuning, nullptr), error);
 }
 
 bool ReadResult(const std::string& path, std::string* error) {
@@ -82,7 +88,7 @@ bool ReadResult(const std::string& path, std::string* error) {
     return false;
   }
   pidlab::spec::EvaluateSpec evaluate;
-  return pidlab::spec::FromJson(j["spec"], &evaluate, nullptr, error);
+  return OkWithMessage(pidlab::spec::FromJson(j["spec"], &evaluate, nullptr), error);
 }
 
 bool ReadModel(const std::string& path, std::string* error) {
@@ -105,7 +111,7 @@ bool ReadCsv(const std::string& path, std::string* error) {
 
 bool ReadLogFile(const std::string& path, std::string* error) {
   pidlab::replay::LogContents contents;
-  return pidlab::replay::ReadLog(path, pidlab::replay::ReadOptions{}, &contents, error);
+  return OkWithMessage(pidlab::replay::ReadLog(path, pidlab::replay::ReadOptions{}, &contents), error);
 }
 
 // ---- Seeds

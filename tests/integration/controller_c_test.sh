@@ -46,6 +46,8 @@ iae() { python3 -c 'import json,sys; print(repr(json.load(open(sys.argv[1]))["ia
 
 "$controller" --lcm-url 'udpm://239.255.76.67:99999' 2>bad.err; rc=$?
 check "a bad URL is exit 2 with one line" "[ $rc -eq 2 ] && [ \$(wc -l < bad.err) -eq 1 ]"
+"$controller" --help >help.out 2>&1; rc=$?
+check "--help is exit 0 and names every option" "[ $rc -eq 0 ] && grep -q -- --print-configs help.out && grep -q -- --lcm-url help.out"
 
 run_case() {  # run_case NAME LAUNCH_FLAGS -- EVALUATE_FLAGS...
   local name=$1; shift

@@ -30,9 +30,8 @@ struct Commands {
 
 bool Read(const char* path, const std::string& channel, Commands* out) {
   pidlab::replay::EventReader reader;
-  std::string error;
-  if (!reader.Open(path, &error)) {
-    std::fprintf(stderr, "%s\n", error.c_str());
+  if (const pidlab::Status st = reader.Open(path); !st.ok()) {
+    std::fprintf(stderr, "%s\n", st.message().c_str());
     return false;
   }
   pidlab::replay::LogEvent e;
@@ -69,9 +68,8 @@ int main(int argc, char** argv) {
   pidlab::replay::ReadOptions options;
   options.channel_prefix = prefix;
   pidlab::replay::LogContents log;
-  std::string error;
-  if (!pidlab::replay::ReadLog(argv[first], options, &log, &error)) {
-    std::fprintf(stderr, "cannot read %s: %s\n", argv[first], error.c_str());
+  if (const pidlab::Status st = pidlab::replay::ReadLog(argv[first], options, &log); !st.ok()) {
+    std::fprintf(stderr, "cannot read %s: %s\n", argv[first], st.message().c_str());
     return 2;
   }
   long incomplete = 0;

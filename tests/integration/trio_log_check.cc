@@ -18,9 +18,8 @@ int main(int argc, char** argv) {
   pidlab::replay::ReadOptions options;
   options.channel_prefix = argc > 2 ? argv[2] : "PIDLAB_";
   pidlab::replay::LogContents log;
-  std::string error;
-  if (!pidlab::replay::ReadLog(argv[1], options, &log, &error)) {
-    std::fprintf(stderr, "cannot read %s: %s\n", argv[1], error.c_str());
+  if (const pidlab::Status st = pidlab::replay::ReadLog(argv[1], options, &log); !st.ok()) {
+    std::fprintf(stderr, "cannot read %s: %s\n", argv[1], st.message().c_str());
     return 2;
   }
   if (log.episodes.empty()) {

@@ -319,7 +319,17 @@ int main(int argc, char **argv) {
       verbose = 1;
     else if (!strcmp(argv[i], "--print-configs"))
       c.print_configs = 1;
-    else {
+    else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+      printf(
+          "pidlab-controller-c: the trio's controller role in C (docs/export.md)\n"
+          "usage: pidlab-controller-c [--lcm-url URL] [--channel-prefix P] [--verbose] [--print-configs]\n"
+          "  --lcm-url URL       udpm://GROUP:PORT?ttl=N (default $PIDLAB_LCM_URL, else "
+          "udpm://239.255.76.67:7667?ttl=0)\n"
+          "  --channel-prefix P  prefix of every channel (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)\n"
+          "  --verbose, -v       print the counters when stopped\n"
+          "  --print-configs     print every configuration accepted, one JSON line of every message field\n");
+      return 0;
+    } else {
       fprintf(stderr, "pidlab-controller-c: error: unknown argument '%.80s'\n", argv[i]);
       return 2;
     }

@@ -132,19 +132,31 @@ EpisodeClient::EpisodeClient(const EpisodeClientOptions& options) : options_(opt
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
   own_lcm_ = std::make_unique<lcm::LCM>(options.lcm_url);
-  if (!own_lcm_->good())
-    throw std::runtime_error("cannot start LCM on '" + options.lcm_url +
-                             "' (see docs/trio.md: multicast route)");
-  transport_ = std::make_unique<transport::Transport>(own_lcm_.get(), options.transport);
-  Listen();
+  if (!own_lcm_->good()) {
+    status_ = Status::RunnerFailed("cannot start LCM on '" + options.lcm_url +
+                                   "' (see docs/trio.md: multicast route)");
+    return;
+  }
+  Start(own_lcm_.get());
 }
 
 EpisodeClient::EpisodeClient(const EpisodeClientOptions& options, lcm::LCM* lcm) : options_(options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
-  if (!lcm || !lcm->good())
-    throw std::runtime_error("the LCM instance given for " + options.lcm_url + " is not good");
-  transport_ = std::make_unique<transport::Transport>(lcm, options.transport);
+  if (!lcm || !lcm->good()) {
+    status_ = Status::RunnerFailed("the LCM instance given for " + options.lcm_url + " is not good");
+    return;
+  }
+  Start(lcm);
+}
+
+void EpisodeClient::Start(lcm::LCM* lcm) {
+  try {
+    transport_ = std::make_unique<transport::Transport>(lcm, options_.transport);
+  } catch (const std::runtime_error& e) {  // the step lanes' LCM
+    status_ = Status::RunnerFailed(e.what());
+    return;
+  }
   Listen();
 }
 
@@ -168,7 +180,10 @@ void EpisodeClient::Listen() {
 
 EpisodeClient::~EpisodeClient() = default;
 
-const transport::TransportCounters& EpisodeClient::counters() const { return transport_->counters(); }
+const transport::TransportCounters& EpisodeClient::counters() const {
+  static const transport::TransportCounters kNone{};
+  return transport_ ? transport_->counters() : kNone;
+}
 
 evaluation::SampledRunner EpisodeClient::AsRunner() {
   return [this](const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
@@ -316,6 +331,7 @@ bool EpisodeClient::RunOnce(const transport::EpisodeSpec& spec, std::string* err
 Status EpisodeClient::Run(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
                           const DisturbanceOptions& disturbance, std::vector<double>* y_all,
                           std::vector<evaluation::SampledStep>* trajectory) {
+  if (!status_.ok()) return status_;
   std::string why;
   if (!RunOrExplain(plant, gains, options, disturbance, y_all, trajectory, &why))
     return Status::RunnerFailed(why);

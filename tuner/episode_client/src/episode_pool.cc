@@ -40,6 +40,7 @@ EpisodePool::EpisodePool(const std::vector<EpisodeClientOptions>& trios) {
   for (const EpisodeClientOptions& options : trios) {
     auto trio = std::make_unique<Trio>();
     trio->client = std::make_unique<EpisodeClient>(options);
+    if (status_.ok() && !trio->client->status().ok()) status_ = trio->client->status();
     trio->url = options.lcm_url;
     trios_.push_back(std::move(trio));
   }

@@ -551,7 +551,7 @@ double ObjectiveEvaluator::operator()(const PidGains& typed_gains) const {
       RunSampledLoopInProcess(plant_, gains, options_, options_.disturbance, &y, nullptr);
     } else if (runner_) {
       if (const Status ran = runner_(plant_, gains, options_, options_.disturbance, &y, nullptr); !ran.ok())
-        throw std::runtime_error("sampled-loop runner failed: " + ran.message());
+        throw RunnerFailure("sampled-loop runner failed: " + ran.message());
     } else if (RunSampledLoop<double>(*discrete_, gains, options_.pid, disturbance_, options_.TotalSteps(), 1,
                                       &y, nullptr, options_.reference) == PidStatus::kInvalidInput) {
       return kInf;

@@ -164,7 +164,10 @@ bool ReadModelFileOrExplain(const std::string& path, Plant* plant, std::string* 
   nlohmann::json j;
   std::string why;
   if (!ReadText(path, &text, error)) return false;
-  if (!spec::ParseJsonText(text, &j, error)) return false;  // "is not valid JSON"
+  if (const Status st = spec::ParseJsonText(text, &j); !st.ok()) {  // "is not valid JSON"
+    *error = st.message();
+    return false;
+  }
   if (!j.is_object()) return FileBad(error, "is not a JSON object");
   auto m = std::make_shared<ProcessModelUncertainty>();
   if (!ReadParameters(j, m.get(), error) || !ReadCovariance(j, m.get(), error)) return false;

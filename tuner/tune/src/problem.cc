@@ -116,6 +116,17 @@ Status BuildPlantInLoop(const spec::PlantSpec& plant, const spec::LoopSpec& loop
   return Status::Ok();
 }
 
+Status BuildFigureLoop(const spec::PlantSpec& plant, const spec::LoopSpec& loop,
+                       const std::vector<PidGains>& gains, const std::set<std::string>& given,
+                       NameStyle style, Plant* p, evaluation::LoopOptions* options) {
+  Plant built;
+  evaluation::LoopOptions unframed;
+  if (Status st = BuildPlantInLoop(plant, loop, style, &built, &unframed); !st.ok()) return st;
+  spec::LoopSpec framed = loop;
+  ResolveGainsTimeScale(plant, built, gains, given, TimeScaleScope::kFigure, &framed);
+  return BuildPlantInLoop(plant, framed, style, p, options);
+}
+
 Status BuildController(const spec::EvaluateSpec& s, NameStyle style, PidGains* gains,
                        evaluation::LoopOptions* loop) {
   std::string error;

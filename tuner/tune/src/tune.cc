@@ -445,7 +445,13 @@ bool TuneOrExplain(const Plant& plant, const TuneOptions& options, TuneSummary* 
 Status Tune(const Plant& plant, const TuneOptions& options, TuneSummary* summary,
             const optim::ProgressCallback& progress, const evaluation::SampledRunner& runner) {
   std::string error;
-  if (!TuneOrExplain(plant, options, summary, &error, progress, runner)) return Status::InvalidInput(error);
+  try {
+    if (!TuneOrExplain(plant, options, summary, &error, progress, runner)) return Status::InvalidInput(error);
+  } catch (const evaluation::RunnerFailure& e) {
+    // The trio failed under the search (the episode client already ran the
+    // episode again as often as it may): a Status, not an exception.
+    return Status::RunnerFailed(e.what());
+  }
   return Status::Ok();
 }
 

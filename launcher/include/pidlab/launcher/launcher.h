@@ -18,6 +18,7 @@
 
 #include "pidlab/launcher/log_capture.h"
 #include "pidlab/launcher/supervisor.h"
+#include "pidlab/spec/status.h"
 #include "pidlab/transport/transport.h"
 
 namespace pidlab::launcher {
@@ -25,8 +26,8 @@ namespace pidlab::launcher {
 /// Puts this process (and every child it starts later) in a private network
 /// namespace with multicast routed over its loopback: nothing it sends leaves
 /// the namespace. Needs root (CAP_SYS_ADMIN). Call it before any thread that
-/// uses the network starts. False with *error if it cannot.
-bool EnterIsolatedNetwork(std::string* error);
+/// uses the network starts. A failed Status (kRunnerFailed) if it cannot.
+Status EnterIsolatedNetwork();
 
 /// The directory of this executable, with a trailing '/'.
 std::string SelfDirectory();
@@ -88,6 +89,7 @@ enum class LaunchStatus {
   kNotReady,      // not every process answered within ready_timeout_s
   kLoggerSilent,  // lcm-logger did not record anything
   kInterrupted,   // *stop became true
+  kLcmFailed,     // LCM did not start on the URL (nothing was started)
 };
 
 class Launcher {
@@ -97,8 +99,8 @@ class Launcher {
   using NoteFn = std::function<void(const std::string& line)>;
 
   /// Throws std::invalid_argument for invalid options (a key file that cannot
-  /// be read included) and
-  /// std::runtime_error if LCM cannot start on the URL.
+  /// be read included): a caller's mistake. If LCM cannot start on the URL,
+  /// Start returns kLcmFailed with the reason.
   Launcher(const LaunchOptions& options, NoteFn note);
   ~Launcher();
 
@@ -165,6 +167,7 @@ class Launcher {
   NoteFn note_;
   std::string url_;
   std::unique_ptr<lcm::LCM> lcm_;
+  std::string lcm_failure_;  // why LCM did not start (Start returns kLcmFailed)
   std::unique_ptr<transport::Transport> transport_;
   std::unique_ptr<Supervisor> supervisor_;
   std::unique_ptr<LogCapture> log_;

@@ -15,6 +15,7 @@
 
 #include "pidlab/launcher/supervisor.h"
 #include "pidlab/replay/log_reader.h"
+#include "pidlab/spec/status.h"
 #include "pidlab/transport/transport.h"
 
 namespace pidlab::launcher {
@@ -45,10 +46,11 @@ std::vector<TimedPayload> RebuildLaneOutputs(const replay::LogContents& log, con
 /// `extra_channel`), merged by timestamp; on a tie an earlier input comes
 /// first, and an extra event goes before any logged event with a later
 /// timestamp. A truncated tail (a logger killed mid-write) ends that input;
-/// an input other than inputs[0] that does not exist is skipped. False with
-/// *error if inputs[0] cannot be read or out_file cannot be written.
-bool MergeEventLogs(const std::vector<std::string>& inputs, const std::vector<TimedPayload>& extra,
-                    const std::string& extra_channel, const std::string& out_file, std::string* error);
+/// an input other than inputs[0] that does not exist is skipped. A failed
+/// Status (kIoFailed) if inputs[0] cannot be read or out_file cannot be
+/// written.
+Status MergeEventLogs(const std::vector<std::string>& inputs, const std::vector<TimedPayload>& extra,
+                      const std::string& extra_channel, const std::string& out_file);
 
 /// Bytes free for an unprivileged writer on the file system that holds
 /// `file` (its directory), or -1 if that cannot be told.
@@ -132,12 +134,12 @@ class LogCapture {
   /// Stops the lane loggers and merges their events into the log by
   /// timestamp (the base port's events first on a tie), so the log holds the
   /// per-step datagrams too and lcm-logplayer can drive a controller from it.
-  /// Call after the base logger stopped. False with *error if it failed (the
-  /// log is then left as the base logger wrote it, and the lane files are
-  /// kept and named in *error).
+  /// Call after the base logger stopped. A failed Status (kIoFailed) if it
+  /// failed (the log is then left as the base logger wrote it, and the lane
+  /// files are kept and named in the message).
   /// Outputs the PLANT_OUTPUT lane's logger lost are rebuilt from the
   /// trajectory chunks (not for authenticated runs); rebuilt_outputs() counts them.
-  bool MergeLanes(std::string* error);
+  Status MergeLanes();
   long rebuilt_outputs() const { return rebuilt_outputs_; }
 
   /// Publishes a MARKER until lcm-logger has written it to the log (so

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/spec/status.h"
+
 namespace pidlab::launcher {
 
 struct Child {
@@ -24,9 +26,9 @@ std::string DescribeStatus(int status);
 /// The shell's convention: the exit status, or 128 + signal.
 int ExitCodeOf(int status);
 
-/// Runs a short command and waits for it. False with *error quoting the
+/// Runs a short command and waits for it. A failed Status (kRunnerFailed) quoting the
 /// command line if it could not run or did not exit 0.
-bool RunAndWait(const std::vector<std::string>& args, std::string* error);
+Status RunAndWait(const std::vector<std::string>& args);
 
 class Supervisor {
  public:

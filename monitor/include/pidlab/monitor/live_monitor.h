@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/spec/status.h"
 #include "pidlab/transport/pacing.h"
 #include "pidlab/transport/protocol.h"
 #include "pidlab/transport/transport.h"
@@ -138,14 +139,18 @@ class LiveMonitor {
  public:
   /// Tunings kept, oldest dropped first.
   static constexpr std::size_t kMaxTunings = 8;
-  /// Joins options.lcm_url. Options must be valid; throws std::runtime_error
-  /// if LCM cannot start on the URL.
+  /// Joins options.lcm_url. Options must be valid (std::invalid_argument
+  /// otherwise: a caller's mistake). If LCM cannot start on the URL, status()
+  /// says so (kRunnerFailed) and Poll returns -1.
   explicit LiveMonitor(const LiveMonitorOptions& options);
   /// On an LCM instance of the caller's (memq:// tests), which must outlive it.
   LiveMonitor(lcm::LCM* lcm, const LiveMonitorOptions& options);
   ~LiveMonitor();
   LiveMonitor(const LiveMonitor&) = delete;
   LiveMonitor& operator=(const LiveMonitor&) = delete;
+
+  /// Ok, or why this monitor hears nothing (LCM did not start).
+  const Status& status() const { return status_; }
 
   /// Waits at most timeout_s for traffic and handles it: the number of
   /// messages handled, -1 on an LCM error. One thread only.
@@ -168,6 +173,7 @@ class LiveMonitor {
   LiveMonitorOptions options_;
   std::unique_ptr<lcm::LCM> own_lcm_;
   std::unique_ptr<transport::Transport> transport_;
+  Status status_;
   std::unique_ptr<State> state_;
 };
 

@@ -58,8 +58,8 @@ class LiveScope {
   /// View frames' columns unless a subscriber asks for others.
   static constexpr int kDefaultColumns = 1000;
 
-  /// Watches each trio (at least one). Throws std::runtime_error if LCM
-  /// cannot start on a URL (LiveMonitor).
+  /// Watches each trio (at least one). If LCM cannot start on a URL,
+  /// status() names it (LiveMonitor::status).
   explicit LiveScope(const std::vector<LiveMonitorOptions>& trios);
   /// Stops the monitor and sender threads and joins them.
   ~LiveScope();
@@ -81,6 +81,9 @@ class LiveScope {
   /// A kind-2 frame of the whole episode, `dropped` in its header; empty if
   /// the episode is not kept.
   std::string DataFrame(int64_t episode_id, long dropped) const;
+
+  /// Ok, or the first trio this scope cannot hear (LCM did not start).
+  Status status() const;
 
  private:
   struct State;

@@ -16,9 +16,8 @@ struct FitTrace {
   double band = 0.0;                    // 1.96 / sqrt(N)
 };
 
-/// Three panels into *figure (title left to the caller). False with *error
+/// Three panels into *figure (title left to the caller). A failed Status (kInvalidInput)
 /// if the lengths disagree or there is no autocorrelation.
-bool MakeFitFigure(const FitTrace& trace, const std::string& output_label, Figure* figure,
-                   std::string* error);
+Status MakeFitFigure(const FitTrace& trace, const std::string& output_label, Figure* figure);
 
 }  // namespace pidlab::plot

@@ -30,10 +30,10 @@ struct LoopUnits {
 /// are dimensionless.
 LoopUnits UnitsOfPlant(const std::string& plant_name);
 
-/// Builds the figure (width x height px, written to output_path). Returns
-/// false with *error if a trace's vectors disagree in length or no trace has
-/// points.
-bool MakeLoopFigure(const std::vector<LoopTrace>& traces, const LoopUnits& units, const std::string& title,
-                    Figure* figure, std::string* error);
+/// Builds the figure (width x height px, written to output_path). A failed
+/// Status (kInvalidInput) if a trace's vectors disagree in length or no trace
+/// has points.
+Status MakeLoopFigure(const std::vector<LoopTrace>& traces, const LoopUnits& units, const std::string& title,
+                      Figure* figure);
 
 }  // namespace pidlab::plot

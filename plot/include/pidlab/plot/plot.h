@@ -23,12 +23,13 @@
 //   p.y_label = "y [-]";
 //   p.series.push_back({"reference r", t, r, pidlab::plot::Style::kDashed});
 //   p.series.push_back({"output y", t, y});
-//   std::string error;
-//   if (!pidlab::plot::DrawPng(fig, &error)) { /* report error */ }
+//   if (const pidlab::Status s = pidlab::plot::DrawPng(fig); !s.ok()) { /* report s.message() */ }
 
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "pidlab/spec/status.h"
 
 namespace pidlab::plot {
 
@@ -71,10 +72,10 @@ struct Figure {
   bool IsValid(std::string* error) const;
 };
 
-/// Draws `figure`. Returns false with a one-line *error (invalid figure,
-/// gnuplot missing or failing — its first error line is quoted — or no PNG
-/// written). Never throws for a bad figure.
-bool DrawPng(const Figure& figure, std::string* error);
+/// Draws `figure`. A failed Status (kIoFailed) with one line: invalid figure,
+/// gnuplot missing or failing (its first error line is quoted) or no PNG
+/// written. Never throws for a bad figure.
+Status DrawPng(const Figure& figure);
 
 /// Width and height of a PNG file from its IHDR chunk; false if `path` is
 /// not a PNG file (signature and IHDR checked).

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/spec/status.h"
+
 namespace pidlab::replay {
 
 /// One event of the log.
@@ -54,9 +56,9 @@ class EventReader {
   EventReader(const EventReader&) = delete;
   EventReader& operator=(const EventReader&) = delete;
 
-  /// Opens the log at `path` (a regular file; once per reader). False with
-  /// *error, a line naming the path, if it cannot be opened.
-  bool Open(const std::string& path, std::string* error);
+  /// Opens the log at `path` (a regular file; once per reader). A failed
+  /// Status (kIoFailed), a line naming the path, if it cannot be opened.
+  Status Open(const std::string& path);
 
   /// Called for every stretch of bytes skipped while looking for the next
   /// event (optional; the counts below are kept either way).

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/spec/status.h"
 #include "pidlab/transport/auth.h"
 #include "pidlab/transport/episode_spec.h"
 #include "pidlab/transport/pacing.h"
@@ -106,10 +107,10 @@ struct LogContents {
   std::vector<Episode> episodes;
 };
 
-/// Reads the log at `path`. Returns false with *error only if the file
-/// cannot be opened, or holds no LCM event at all, an empty file included
-/// (then contents->opened and contents->events == 0); anything wrong inside
-/// a readable log is reported in *contents.
-bool ReadLog(const std::string& path, const ReadOptions& options, LogContents* contents, std::string* error);
+/// Reads the log at `path`. A failed Status only if the file cannot be
+/// opened (kIoFailed), or holds no LCM event at all, an empty file included
+/// (kInvalidInput; then contents->opened and contents->events == 0);
+/// anything wrong inside a readable log is reported in *contents.
+Status ReadLog(const std::string& path, const ReadOptions& options, LogContents* contents);
 
 }  // namespace pidlab::replay

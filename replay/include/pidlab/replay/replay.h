@@ -8,6 +8,7 @@
 
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/replay/log_reader.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::replay {
 
@@ -19,9 +20,9 @@ bool EpisodeTrajectory(const Episode& episode, std::vector<evaluation::SampledSt
 /// `pidlab evaluate`: the logged plant outputs stand in for the sampled loop
 /// (so the IAE is the live episode's IAE exactly); the undisturbed companion
 /// run that Evaluate also needs is simulated in process. Records the logged
-/// trajectory in evaluation->trajectory. False with *error if the episode has
+/// trajectory in evaluation->trajectory. A failed Status (kInvalidInput) if the episode has
 /// no valid configuration or is not complete.
-bool EvaluateEpisode(const Episode& episode, evaluation::Evaluation* evaluation, std::string* error);
+Status EvaluateEpisode(const Episode& episode, evaluation::Evaluation* evaluation);
 
 /// Result of re-driving a fresh controller with the logged plant outputs.
 struct RedriveResult {
@@ -40,10 +41,10 @@ RedriveResult Redrive(const Episode& episode);
 /// Re-drives a live pidlab-controller (started alone, without plant and
 /// disturbance) on `lcm_url` / `channel_prefix` with the logged plant
 /// outputs, one step at a time: publish y_k, wait for the command of step k
-/// (resending y_k on silence), compare bits. Throws std::invalid_argument if
-/// LCM cannot start on the URL, std::runtime_error if the controller does not
-/// acknowledge or answer within deadline_s.
-RedriveResult RedriveOverLcm(const Episode& episode, const std::string& lcm_url, const std::string& channel_prefix,
-                             double deadline_s);
+/// (resending y_k on silence), compare bits into *result. A failed Status:
+/// kInvalidInput if LCM cannot start on the URL, kRunnerFailed if the
+/// controller does not acknowledge or answer within deadline_s.
+Status RedriveOverLcm(const Episode& episode, const std::string& lcm_url, const std::string& channel_prefix,
+                      double deadline_s, RedriveResult* result);
 
 }  // namespace pidlab::replay

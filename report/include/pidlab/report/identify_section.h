@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "pidlab/identify/identify.h"
+#include "pidlab/spec/status.h"
 #include "pidlab/tune/tune.h"
 
 namespace pidlab::report {
@@ -44,16 +45,16 @@ struct IdentifySection {
   IdentifyGainSet on_model, on_eq3;
 };
 
-/// Runs the experiment, the fit, the tunings and the runs. False with *error
+/// Runs the experiment, the fit, the tunings and the runs. A failed Status (kRunnerFailed)
 /// if a step cannot run (a fit or tune that fails is reported, not an error).
-bool ComputeIdentifySection(bool quick, std::uint64_t seed, IdentifySection* section, std::string* error);
+Status ComputeIdentifySection(bool quick, std::uint64_t seed, IdentifySection* section);
 
 /// The Markdown of the section (heading "## Identifying the motor").
 void RenderIdentifySection(std::ostream& os, const IdentifySection& section);
 
 /// Draws out_dir/file (measured and simulated angle, residuals and their
-/// autocorrelation) and sets *caption. False with *error if drawing fails.
-bool DrawIdentifyFigure(const IdentifySection& section, const std::string& out_dir, const std::string& file,
-                        std::string* caption, std::string* error);
+/// autocorrelation) and sets *caption. A failed Status (kIoFailed) if drawing fails.
+Status DrawIdentifyFigure(const IdentifySection& section, const std::string& out_dir, const std::string& file,
+                          std::string* caption);
 
 }  // namespace pidlab::report

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/spec/status.h"
 #include "pidlab/tune/tune.h"
 
 namespace pidlab::report {
@@ -74,17 +75,16 @@ struct MotorSection {
 
 /// Runs every row, the eq. (3) references and the tune on the motor.
 /// `paper_nm` are the paper's Table IV Nelder-Mead gains; `quick` shortens
-/// the horizon and the tune's budget (smoke tests). False with *error only if
+/// the horizon and the tune's budget (smoke tests). A failed Status (kRunnerFailed) only if
 /// an evaluation cannot run.
-bool ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t seed, MotorSection* section,
-                         std::string* error);
+Status ComputeMotorSection(const PidGains& paper_nm, bool quick, std::uint64_t seed, MotorSection* section);
 
 /// The Markdown of the section (heading "## The motor itself").
 void RenderMotorSection(std::ostream& os, const MotorSection& section);
 
 /// Draws out_dir/file (the motor's and eq. (3)'s responses overlaid, without
-/// and with the limit) and sets *caption. False with *error if drawing fails.
-bool DrawMotorFigure(const MotorSection& section, const std::string& out_dir, const std::string& file,
-                     std::string* caption, std::string* error);
+/// and with the limit) and sets *caption. A failed Status (kIoFailed) if drawing fails.
+Status DrawMotorFigure(const MotorSection& section, const std::string& out_dir, const std::string& file,
+                       std::string* caption);
 
 }  // namespace pidlab::report

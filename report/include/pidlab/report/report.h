@@ -21,6 +21,7 @@
 #include "pidlab/report/motor_section.h"
 #include "pidlab/report/robust_section.h"
 #include "pidlab/report/two_dof_section.h"
+#include "pidlab/spec/status.h"
 #include "pidlab/tune/tune.h"
 
 namespace pidlab::report {
@@ -39,12 +40,11 @@ struct PaperRow {
   double ref_rise_time_s = 0, ref_overshoot_pct = 0, ref_settling_time_s = 0, ref_iae = 0;
 };
 
-/// Reads the CSV (header line with the columns above, in any order). False
-/// with *error naming the path, line or column on failure.
-bool ReadPaperTables(const std::string& path, std::vector<PaperRow>* rows, std::string* error);
+/// Reads the CSV (header line with the columns above, in any order). A failed Status
+/// (kInvalidInput) naming the path, line or column on failure.
+Status ReadPaperTables(const std::string& path, std::vector<PaperRow>* rows);
 /// The same from the CSV text; `path` names it in errors.
-bool ParsePaperTables(const std::string& csv, const std::string& path, std::vector<PaperRow>* rows,
-                      std::string* error);
+Status ParsePaperTables(const std::string& csv, const std::string& path, std::vector<PaperRow>* rows);
 /// data/paper_tables.csv as it was when pidlab was built (the default of
 /// `pidlab report`, so the command works anywhere).
 const std::string& BuiltinPaperTablesCsv();
@@ -148,12 +148,13 @@ struct ReportData {
   double compute_time_s = 0, figure_time_s = 0;
 };
 
-/// Re-evaluates every published row and runs every tuning (no files).
-bool ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& paper, ReportData* data,
-                   std::string* error);
+/// Re-evaluates every published row and runs every tuning (no files). A
+/// failed Status (kRunnerFailed) names the stage that could not run.
+Status ComputeReport(const ReportOptions& options, const std::vector<PaperRow>& paper, ReportData* data);
 
-/// Draws the figures (if options.figures) and writes out_dir/report.md.
-bool WriteReport(ReportData* data, std::string* error);
+/// Draws the figures (if options.figures) and writes out_dir/report.md. A
+/// failed Status (kIoFailed) if a figure or the file cannot be written.
+Status WriteReport(ReportData* data);
 
 /// The Markdown text of report.md.
 std::string RenderMarkdown(const ReportData& data);
@@ -162,8 +163,9 @@ std::string RenderMarkdown(const ReportData& data);
 void FillFromEvaluation(const evaluation::Evaluation& evaluation, Metrics* metrics);
 
 /// Metrics of `gains` on `plant` under the paper's continuous loop with a
-/// ±amplitude square disturbance (period 2 s; 0: none).
-bool EvaluateMetrics(const Plant& plant, const PidGains& gains, double disturbance_amplitude,
-                     Metrics* metrics, std::string* error);
+/// ±amplitude square disturbance (period 2 s; 0: none). A failed Status
+/// (kRunnerFailed) if the evaluation cannot run.
+Status EvaluateMetrics(const Plant& plant, const PidGains& gains, double disturbance_amplitude,
+                       Metrics* metrics);
 
 }  // namespace pidlab::report

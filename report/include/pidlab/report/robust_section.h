@@ -17,6 +17,7 @@
 
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/analysis/monte_carlo.h"
+#include "pidlab/spec/status.h"
 #include "pidlab/tune/tune.h"
 
 namespace pidlab::report {
@@ -57,18 +58,18 @@ struct RobustSection {
 
 /// Runs the default tune and the preset on each plant (seeded) and evaluates
 /// the three sets. `quick`: one start of the robust tune and 50 Monte-Carlo
-/// draws. False with *error only
+/// draws. A failed Status (kRunnerFailed) only
 /// if an evaluation cannot run.
-bool ComputeRobustSection(const std::vector<RobustInput>& inputs, bool quick, std::uint64_t seed,
-                          RobustSection* section, std::string* error);
+Status ComputeRobustSection(const std::vector<RobustInput>& inputs, bool quick, std::uint64_t seed,
+                            RobustSection* section);
 
 /// The Markdown of the section (heading "## Robust tuning").
 void RenderRobustSection(std::ostream& os, const RobustSection& section);
 
 /// One PNG per plant, out_dir/fig_robust_<plant>.png: |S| and |T| in dB over
 /// log10 w and the Nyquist plot of L with the circle |1 + L| = 1/max_ms.
-/// Appends (file, caption) pairs. False with *error if drawing fails.
-bool DrawRobustFigures(const RobustSection& section, const std::string& out_dir,
-                       std::vector<std::pair<std::string, std::string>>* figures, std::string* error);
+/// Appends (file, caption) pairs. A failed Status (kIoFailed) if drawing fails.
+Status DrawRobustFigures(const RobustSection& section, const std::string& out_dir,
+                         std::vector<std::pair<std::string, std::string>>* figures);
 
 }  // namespace pidlab::report

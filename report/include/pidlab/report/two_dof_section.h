@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pidlab/report/robust_section.h"
+#include "pidlab/spec/status.h"
 #include "pidlab/tune/two_dof.h"
 
 namespace pidlab::report {
@@ -28,8 +29,8 @@ struct TwoDofSection {
 };
 
 /// Tunes b, c for the "pidlab --robust" set of every plant of `robust`.
-/// False with *error if a loop cannot be evaluated.
-bool ComputeTwoDofSection(const RobustSection& robust, TwoDofSection* section, std::string* error);
+/// A failed Status (kRunnerFailed) if a loop cannot be evaluated.
+Status ComputeTwoDofSection(const RobustSection& robust, TwoDofSection* section);
 
 /// The Markdown of the section (heading "## Two degrees of freedom").
 void RenderTwoDofSection(std::ostream& os, const TwoDofSection& section);

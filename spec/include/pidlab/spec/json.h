@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "pidlab/spec/field.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::spec {
 
-// One value to and from JSON. From*: false with *error naming `key` and what
-// was expected.
+// One value to JSON.
 nlohmann::json ToJsonValue(double v);
 nlohmann::json ToJsonValue(std::uint64_t v);
 nlohmann::json ToJsonValue(int v);
@@ -28,6 +28,10 @@ nlohmann::json ToJsonValue(const std::string& v);
 nlohmann::json ToJsonValue(const std::vector<double>& v);
 nlohmann::json ToJsonValue(const std::pair<double, double>& v);
 nlohmann::json ToJsonValue(const std::map<std::string, double>& v);
+// The reader's pieces, for JsonReader and FromJson below (templates, so in
+// this header); callers use FromJson. From*: false with *error naming `key`
+// and what was expected.
+namespace internal {
 bool FromJsonValue(const nlohmann::json& j, const Field& f, double* v, std::string* error);
 bool FromJsonValue(const nlohmann::json& j, const Field& f, std::uint64_t* v, std::string* error);
 bool FromJsonValue(const nlohmann::json& j, const Field& f, int* v, std::string* error);
@@ -37,21 +41,23 @@ bool FromJsonValue(const nlohmann::json& j, const Field& f, std::vector<double>*
 bool FromJsonValue(const nlohmann::json& j, const Field& f, std::pair<double, double>* v, std::string* error);
 bool FromJsonValue(const nlohmann::json& j, const Field& f, std::map<std::string, double>* v,
                    std::string* error);
+/// True if "version" is absent or kSpecVersion; else false with *error.
+bool CheckVersion(const nlohmann::json& j, std::string* error);
+}  // namespace internal
 
 /// kSpecVersion (loop_spec.h), for ToJson.
 int kSpecVersionForJson();
-/// True if "version" is absent or kSpecVersion; else false with *error.
-bool CheckVersion(const nlohmann::json& j, std::string* error);
 /// The deepest nesting of arrays and objects any JSON pidlab reads may have
 /// (a spec, a model file, a result, a request to the server).
 inline constexpr int kMaxJsonDepth = 64;
-/// False with *error ("is nested deeper than 64 levels (at byte N)") if
-/// `text` opens more than `max_depth` arrays or objects at once; strings are
-/// skipped. One pass, no recursion, before any parser runs.
-bool CheckJsonNesting(const std::string& text, int max_depth, std::string* error);
+/// A failed Status (kInvalidInput: "is nested deeper than 64 levels (at byte
+/// N)") if `text` opens more than `max_depth` arrays or objects at once;
+/// strings are skipped. One pass, no recursion, before any parser runs.
+Status CheckJsonNesting(const std::string& text, int max_depth);
 /// The one JSON reader of every file and request: the nesting checked
-/// (kMaxJsonDepth), then parsed; false with *error ("is not valid JSON").
-bool ParseJsonText(const std::string& text, nlohmann::json* out, std::string* error);
+/// (kMaxJsonDepth), then parsed; a failed Status (kInvalidInput: "is not
+/// valid JSON") otherwise.
+Status ParseJsonText(const std::string& text, nlohmann::json* out);
 
 /// Writes every field (Archive for Serialize).
 class JsonWriter {
@@ -76,7 +82,7 @@ class JsonReader {
     known_.insert(f.key);
     const auto it = in_.find(f.key);
     if (it == in_.end() || !error_.empty()) return;
-    if (FromJsonValue(*it, f, v, &error_) && given_) given_->insert(f.key);
+    if (internal::FromJsonValue(*it, f, v, &error_) && given_) given_->insert(f.key);
   }
   const std::set<std::string>& known() const { return known_; }
   const std::string& error() const { return error_; }
@@ -112,29 +118,22 @@ nlohmann::json ToJson(Spec spec) {
   return j;
 }
 
-/// Reads `j` over *spec (fields absent keep their value). False with *error
-/// for a key no field has, a value of the wrong type, or another version.
-/// *given (may be null) gets the keys present.
+/// Reads `j` over *spec (fields absent keep their value). A failed Status
+/// (kInvalidInput) for a key no field has, a value of the wrong type, or
+/// another version. *given (may be null) gets the keys present.
 template <typename Spec>
-bool FromJson(const nlohmann::json& j, Spec* spec, std::set<std::string>* given, std::string* error) {
-  if (!j.is_object()) {
-    if (error) *error = "a spec must be a JSON object, not " + std::string(j.type_name());
-    return false;
-  }
-  if (!CheckVersion(j, error)) return false;
+Status FromJson(const nlohmann::json& j, Spec* spec, std::set<std::string>* given) {
+  if (!j.is_object())
+    return Status::InvalidInput("a spec must be a JSON object, not " + std::string(j.type_name()));
+  std::string error;
+  if (!internal::CheckVersion(j, &error)) return Status::InvalidInput(error);
   JsonReader r(j, given);
   spec->Serialize(&r);
-  if (!r.error().empty()) {
-    if (error) *error = r.error();
-    return false;
-  }
-  for (const auto& item : j.items()) {
-    if (item.key() != "version" && r.known().count(item.key()) == 0) {
-      if (error) *error = "spec key " + Quote(item.key()) + " is unknown";
-      return false;
-    }
-  }
-  return true;
+  if (!r.error().empty()) return Status::InvalidInput(r.error());
+  for (const auto& item : j.items())
+    if (item.key() != "version" && r.known().count(item.key()) == 0)
+      return Status::InvalidInput("spec key " + Quote(item.key()) + " is unknown");
+  return Status::Ok();
 }
 
 /// The fields of `Spec` with the defaults of `spec`.

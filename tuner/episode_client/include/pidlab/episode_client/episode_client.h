@@ -65,7 +65,9 @@ struct EpisodeClientStats {
 
 class EpisodeClient {
  public:
-  /// Throws std::runtime_error if LCM cannot be initialised on the URL.
+  /// Throws std::invalid_argument for invalid options (a caller's mistake).
+  /// If LCM cannot start on the URL, status() says so (kRunnerFailed) and
+  /// every Run returns it.
   explicit EpisodeClient(const EpisodeClientOptions& options);
   /// On `lcm` (not owned: it must outlive the client, and not be handled
   /// once the client is gone, as a Transport does not unsubscribe) instead of
@@ -75,6 +77,9 @@ class EpisodeClient {
   /// handle their messages too.
   EpisodeClient(const EpisodeClientOptions& options, lcm::LCM* lcm);
   ~EpisodeClient();
+
+  /// Ok, or why the client cannot run episodes (LCM did not start).
+  const Status& status() const { return status_; }
 
   /// A SampledRunner: y at every step k = 0..TotalSteps() in *y_all, every
   /// step in *trajectory when not null. kRunnerFailed with one line naming
@@ -94,6 +99,8 @@ class EpisodeClient {
 
  private:
   struct State;
+  // The transport on `lcm` and the subscriptions, or status_.
+  void Start(lcm::LCM* lcm);
   bool RunOrExplain(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
                     const DisturbanceOptions& disturbance, std::vector<double>* y_all,
                     std::vector<evaluation::SampledStep>* trajectory, std::string* error);
@@ -110,6 +117,7 @@ class EpisodeClient {
 
   std::unique_ptr<lcm::LCM> own_lcm_;
   std::unique_ptr<transport::Transport> transport_;
+  Status status_;
   std::unique_ptr<transport::EpisodeStarter> starter_;
   std::unique_ptr<State> state_;
   EpisodeClientOptions options_;

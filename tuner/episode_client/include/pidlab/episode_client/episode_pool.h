@@ -23,13 +23,17 @@ std::vector<std::string> SplitUrlList(const std::string& list);
 
 class EpisodePool {
  public:
-  /// One client per entry (at least one); throws as EpisodeClient does.
+  /// One client per entry (at least one: std::invalid_argument otherwise, as
+  /// for invalid options). A trio whose LCM does not start makes status()
+  /// fail (kRunnerFailed, naming its URL).
   explicit EpisodePool(const std::vector<EpisodeClientOptions>& trios);
   ~EpisodePool();
   EpisodePool(const EpisodePool&) = delete;
   EpisodePool& operator=(const EpisodePool&) = delete;
 
   int size() const { return static_cast<int>(trios_.size()); }
+  /// Ok, or the first trio whose client cannot run (EpisodeClient::status).
+  const Status& status() const { return status_; }
   /// One worker thread per trio still alive; body(i) runs on a worker, and
   /// the episodes it starts go to that worker's trio.
   optim::ParallelFor AsParallelFor();
@@ -56,6 +60,7 @@ class EpisodePool {
   mutable std::mutex mutex_;  // guards Trio::alive and lost_
   std::vector<std::string> lost_;
   std::function<void(const std::string&)> on_note_;
+  Status status_;
 };
 
 }  // namespace pidlab::episode_client

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -149,6 +150,13 @@ class FastContinuousObjective;
 /// The unit step at the plant input from t = 0 of the load response.
 DisturbanceOptions UnitLoadStep();
 
+/// What ObjectiveEvaluator::operator() throws when its runner (the trio)
+/// fails: the search stops, and Tune returns it as a kRunnerFailed Status, so
+/// it never leaves the tuner.
+struct RunnerFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 /// The tuner's inner loop: the objective of one gain vector, +inf for any loop
 /// that is not strictly stable. Realisation and discretisation are done once.
 class ObjectiveEvaluator {
@@ -159,6 +167,7 @@ class ObjectiveEvaluator {
   /// `load_weight` (finite, >= 0): W of setpoint-load.
   ObjectiveEvaluator(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
                      SampledRunner runner = nullptr, double load_weight = 1.0);
+  /// Throws RunnerFailure if the runner fails.
   double operator()(const PidGains& gains) const;
   /// Evaluations so far. operator() may be called from several threads at
   /// once (parallel starts over several trios).

@@ -119,6 +119,14 @@ Status RunEvaluation(const EvaluationProblem& problem, const EvaluationRunOption
 Status BuildPlantInLoop(const spec::PlantSpec& plant, const spec::LoopSpec& loop, spec::NameStyle style,
                         Plant* p, evaluation::LoopOptions* options);
 
+/// The loop of a figure of several gain sets (pidlab plot): the plant in its
+/// loop, framed for them. With neither horizon nor sample_time in `given`,
+/// the closed loops' time scale (ResolveGainsTimeScale, kFigure); else the
+/// loop as given. kInvalidInput naming the field as `style` spells it.
+Status BuildFigureLoop(const spec::PlantSpec& plant, const spec::LoopSpec& loop,
+                       const std::vector<PidGains>& gains, const std::set<std::string>& given,
+                       spec::NameStyle style, Plant* p, evaluation::LoopOptions* options);
+
 /// The PID an evaluation spec describes, without its plant (pidlab export,
 /// the workbench's export): the gains and the loop options it runs with.
 Status BuildController(const spec::EvaluateSpec& s, spec::NameStyle style, PidGains* gains,
