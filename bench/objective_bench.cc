@@ -29,7 +29,7 @@ const Case kCases[] = {{"double_integrator", {29.6558, 0.4977, 28.3216}},
 void BM_PaperObjectiveContinuous(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
   pidlab::Plant plant;
-  pidlab::MakePlant(c.plant, {}, &plant, nullptr);
+  pidlab::MakePlant(c.plant, {}, &plant).ok();
   const pidlab::evaluation::ObjectiveEvaluator dut(plant, pidlab::evaluation::LoopOptions{},
                                                    pidlab::evaluation::ObjectiveKind::kIae);
   double iae = 0.0;
@@ -47,7 +47,7 @@ BENCHMARK(BM_PaperObjectiveContinuous)->DenseRange(0, 2)->Unit(benchmark::kMicro
 void BM_GeneralPathContinuous(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
   pidlab::Plant plant;
-  pidlab::MakePlant(c.plant, {}, &plant, nullptr);
+  pidlab::MakePlant(c.plant, {}, &plant).ok();
   const pidlab::StateSpace realization = pidlab::Realize(plant.tf);
   const pidlab::Disturbance none(pidlab::DisturbanceOptions{});
   const pidlab::evaluation::LoopOptions options;
@@ -64,7 +64,7 @@ BENCHMARK(BM_GeneralPathContinuous)->DenseRange(0, 2)->Unit(benchmark::kMicrosec
 void BM_PaperObjectiveSampled(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
   pidlab::Plant plant;
-  pidlab::MakePlant(c.plant, {}, &plant, nullptr);
+  pidlab::MakePlant(c.plant, {}, &plant).ok();
   pidlab::evaluation::LoopOptions options;
   options.loop = pidlab::evaluation::LoopKind::kSampled;
   options.dt_s = plant.name == "stepper_motor" ? 1e-4 : 1e-3;
@@ -125,7 +125,7 @@ BENCHMARK(BM_DelayContinuous)->DenseRange(0, 1)->Unit(benchmark::kMicrosecond);
 void BM_TuneDefault(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
   pidlab::Plant plant;
-  pidlab::MakePlant(c.plant, {}, &plant, nullptr);
+  pidlab::MakePlant(c.plant, {}, &plant).ok();
   const pidlab::tune::TuneOptions options;
   int evaluations = 0;
   double iae = 0.0;
@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
   // runs the same objective elsewhere: "num=...;den=...;gains=kp,ki,kd".
   for (const Case& c : kCases) {
     pidlab::Plant plant;
-    pidlab::MakePlant(c.plant, {}, &plant, nullptr);
+    pidlab::MakePlant(c.plant, {}, &plant).ok();
     benchmark::AddCustomContext(std::string("plant.") + c.plant,
                                 "num=" + Coefficients(plant.tf.num) + ";den=" + Coefficients(plant.tf.den) +
                                     ";gains=" + Coefficients({c.gains.kp, c.gains.ki, c.gains.kd}));

@@ -130,11 +130,10 @@ int main(int argc, char** argv) {
   pidlab::episode_client::EpisodeClientOptions co;
   co.lcm_url = url;
   if (const char* p = std::getenv("PIDLAB_CHANNEL_PREFIX")) co.transport.channel_prefix = p;
-  std::string error;
   if (const char* key_file = std::getenv(pidlab::transport::kAuthKeyFileEnv); key_file && *key_file) {
     pidlab::transport::AuthKey key;
-    if (!pidlab::transport::LoadAuthKey(key_file, &key, &error)) {
-      std::fprintf(stderr, "trio_bench: %s\n", error.c_str());
+    if (const pidlab::Status st = pidlab::transport::LoadAuthKey(key_file, &key); !st.ok()) {
+      std::fprintf(stderr, "trio_bench: %s\n", st.message().c_str());
       return 2;
     }
     co.transport.auth_key = key;
@@ -152,7 +151,7 @@ int main(int argc, char** argv) {
   const double client0 = SelfCpu();
 
   pidlab::Plant plant;
-  pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant, &error);
+  (void)pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant);
   pidlab::evaluation::LoopOptions options;
   options.loop = pidlab::evaluation::LoopKind::kSampled;
   options.horizon_s = horizon;

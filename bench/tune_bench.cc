@@ -20,7 +20,7 @@ const char* const kPlants[] = {"double_integrator", "oscillator", "stepper_motor
 
 void RunTunes(benchmark::State& state, const pidlab::tune::TuneOptions& base) {
   pidlab::Plant plant;
-  pidlab::MakePlant(kPlants[state.range(0)], {}, &plant, nullptr);
+  pidlab::MakePlant(kPlants[state.range(0)], {}, &plant).ok();
   double iae_sum = 0.0;
   long evaluations = 0, tunes = 0;
   std::uint64_t seed = 1;

@@ -22,7 +22,7 @@ import os, re, subprocess, sys
 dot, src = sys.argv[1], sys.argv[2]
 # Levels of the house, bottom (0) to top. A library may link only lower levels.
 level = {
-    'pidlab_lcmtypes': 0, 'pidlab_controller': 0,
+    'pidlab_lcmtypes': 0, 'pidlab_controller': 0, 'pidlab_status': 0,
     'pidlab_spec': 1, 'pidlab_plant_sim': 1, 'pidlab_optim': 1, 'pidlab_plot': 3,
     'pidlab_server': 2,
     'pidlab_io': 2, 'pidlab_transport': 2, 'pidlab_evaluation': 2, 'pidlab_controller_export': 2,

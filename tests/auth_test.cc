@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "test_status.h"
+
 namespace pidlab::transport {
 namespace {
 
@@ -37,7 +39,7 @@ AuthKey Key(const std::string& contents) {
   KeyFile file(contents);
   AuthKey key;
   std::string error;
-  EXPECT_TRUE(LoadAuthKey(file.path(), &key, &error)) << error;
+  EXPECT_TRUE(IsOk(LoadAuthKey(file.path(), &key)));
   return key;
 }
 
@@ -76,7 +78,7 @@ TEST(LoadAuthKey, AFileShorterThanTheMinimumIsRefusedNamingItsSize) {
   KeyFile file(std::string(kMinAuthKeyFileBytes - 1, 'k'));
   AuthKey key;
   std::string error;
-  EXPECT_FALSE(LoadAuthKey(file.path(), &key, &error));
+  EXPECT_FALSE(OkInto(LoadAuthKey(file.path(), &key), &error));
   EXPECT_NE(error.find(file.path()), std::string::npos) << error;
   EXPECT_NE(error.find("holds 15 bytes, at least 16"), std::string::npos) << error;
 }
@@ -84,7 +86,7 @@ TEST(LoadAuthKey, AFileShorterThanTheMinimumIsRefusedNamingItsSize) {
 TEST(LoadAuthKey, AMissingFileIsRefusedNamingIt) {
   AuthKey key;
   std::string error;
-  EXPECT_FALSE(LoadAuthKey("/nonexistent/pidlab.key", &key, &error));
+  EXPECT_FALSE(OkInto(LoadAuthKey("/nonexistent/pidlab.key", &key), &error));
   EXPECT_NE(error.find("'/nonexistent/pidlab.key': cannot be read"), std::string::npos) << error;
 }
 
@@ -92,7 +94,7 @@ TEST(LoadAuthKey, AFileOverOneMebibyteIsRefused) {
   KeyFile file(std::string((std::size_t{1} << 20) + 1, 'k'));
   AuthKey key;
   std::string error;
-  EXPECT_FALSE(LoadAuthKey(file.path(), &key, &error));
+  EXPECT_FALSE(OkInto(LoadAuthKey(file.path(), &key), &error));
   EXPECT_NE(error.find("larger than 1 MiB"), std::string::npos) << error;
 }
 

@@ -22,7 +22,7 @@ namespace {
 Plant Fopdt(double t, double l) {
   Plant p;
   std::string error;
-  EXPECT_TRUE(MakeCustomPlant({1.0}, {t, 1.0}, &p, &error)) << error;
+  EXPECT_TRUE(IsOk(MakeCustomPlant({1.0}, {t, 1.0}, &p)));
   p.delay_s = l;
   return p;
 }
@@ -48,7 +48,7 @@ TEST(SearchBox, KeepsThePapersBoxOnThePapersPlants) {
   for (const char* name : {"double_integrator", "oscillator", "stepper_motor"}) {
     Plant p;
     std::string error;
-    ASSERT_TRUE(MakePlant(name, StepperMotorParameters{}, &p, &error)) << error;
+    ASSERT_TRUE(IsOk(MakePlant(name, StepperMotorParameters{}, &p)));
     SearchBox dut;
     EXPECT_FALSE(PlantSearchBox(p, &dut).ok()) << name;
     EXPECT_EQ(dut.upper, 30.0) << name;
@@ -82,7 +82,7 @@ TEST(AtBounds, NamesEveryGainOnAnEnd) {
 TEST(AtBounds, TheRobustDoubleIntegratorSaysItsGainsLieOnTheBox) {
   Plant p;
   std::string error;
-  ASSERT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &p, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &p)));
   TuneOptions o;
   ApplyRobustPreset(&o);
   TuneSummary s;

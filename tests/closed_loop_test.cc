@@ -47,7 +47,7 @@ Evaluation EvaluateOrFail(const TransferFunction& tf, const PidGains& gains, con
 Plant Builtin(const std::string& name) {
   Plant p;
   std::string error;
-  EXPECT_TRUE(MakePlant(name, StepperMotorParameters{}, &p, &error)) << error;
+  EXPECT_TRUE(IsOk(MakePlant(name, StepperMotorParameters{}, &p)));
   return p;
 }
 

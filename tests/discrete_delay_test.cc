@@ -19,6 +19,7 @@
 #include "pidlab/plant_sim/matrix_exp.h"
 #include "pidlab/plant_sim/plants.h"
 #include "pidlab/plant_sim/transfer_function.h"
+#include "test_status.h"
 
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
@@ -44,7 +45,8 @@ std::vector<Plant> PaperPlants() {
   for (const char* name : {"double_integrator", "oscillator", "stepper_motor"}) {
     Plant p;
     std::string error;
-    if (!MakePlant(name, StepperMotorParameters{}, &p, &error)) ADD_FAILURE() << name << ": " << error;
+    if (!OkInto(MakePlant(name, StepperMotorParameters{}, &p), &error))
+      ADD_FAILURE() << name << ": " << error;
     plants.push_back(p);
   }
   return plants;

@@ -51,7 +51,7 @@ struct Loop {
 Loop DoubleIntegrator(double horizon_s = 2.0) {
   Loop l;
   std::string error;
-  EXPECT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &l.plant, &error)) << error;
+  EXPECT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &l.plant)));
   l.options.loop = LoopKind::kSampled;
   l.options.horizon_s = horizon_s;
   l.options.disturbance.kind = DisturbanceKind::kSquare;
@@ -164,7 +164,7 @@ TEST(EpisodeClient, AnLcmThatCannotStartIsAStatusOfEveryRunNotAnException) {
   EXPECT_NE(dut->status().message().find("99999"), std::string::npos) << dut->status().message();
   pidlab::Plant plant;
   std::string error;
-  ASSERT_TRUE(pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant, &error));
+  ASSERT_TRUE(IsOk(pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant)));
   LoopOptions loop;
   loop.loop = LoopKind::kSampled;
   std::vector<double> y;

@@ -48,7 +48,7 @@ struct Loop {
 Loop ShortLoop() {
   Loop l;
   std::string error;
-  EXPECT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &l.plant, &error)) << error;
+  EXPECT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &l.plant)));
   l.options.loop = LoopKind::kSampled;
   l.options.horizon_s = 0.5;
   return l;

@@ -734,7 +734,7 @@ TEST(DecoderTable, TheChannelPrefixIsTheChannelWithoutTheTypesSuffix) {
 pidlab::lcmt_episode_config Config(int64_t id, long steps) {
   transport::EpisodeSpec spec;
   std::string error;
-  EXPECT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &spec.plant, &error)) << error;
+  EXPECT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &spec.plant)));
   spec.episode_id = id;
   spec.gains = {2.0, 0.5, 1.5};
   spec.dt_s = spec.pid.dt_s = 0.01;

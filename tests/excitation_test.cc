@@ -13,6 +13,7 @@
 #include "pidlab/plant_sim/disturbance.h"
 #include "pidlab/spec/loop_spec.h"
 #include "spec_build.h"  // internal to pidlab::tune: the steps tested one by one
+#include "test_status.h"
 
 namespace pidlab {
 namespace {
@@ -143,7 +144,7 @@ TEST(MeasurementNoise, RejectsANegativeOrNonFiniteSigma) {
 TEST(SampledLoop, OpenLoopReportsTheTrueOutputPlusTheNoiseOfEachStep) {
   Plant plant;
   std::string error;
-  ASSERT_TRUE(MakeCustomPlant({1.0}, {1.0, 2.0, 1.0}, &plant, &error)) << error;
+  ASSERT_TRUE(IsOk(MakeCustomPlant({1.0}, {1.0, 2.0, 1.0}, &plant)));
   const DiscretePlant discrete(plant.tf, 1e-3);
   PidOptions pid;
   pid.dt_s = 1e-3;
@@ -244,7 +245,7 @@ TEST(MeasurementNoise, AResolutionRoundsTheMeasuredYToItsNearestMultipleHalvesAw
 TEST(SampledLoop, AQuantisedSensorReportsOnlyMultiplesOfItsResolutionToThePid) {
   Plant plant;
   std::string error;
-  ASSERT_TRUE(MakeCustomPlant({1.0}, {1.0, 2.0, 1.0}, &plant, &error)) << error;
+  ASSERT_TRUE(IsOk(MakeCustomPlant({1.0}, {1.0, 2.0, 1.0}, &plant)));
   const DiscretePlant discrete(plant.tf, 1e-3);
   PidOptions pid;
   pid.dt_s = 1e-3;

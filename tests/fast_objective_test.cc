@@ -44,7 +44,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 Plant Builtin(const std::string& name) {
   Plant p;
   std::string error;
-  EXPECT_TRUE(MakePlant(name, StepperMotorParameters{}, &p, &error)) << error;
+  EXPECT_TRUE(IsOk(MakePlant(name, StepperMotorParameters{}, &p)));
   return p;
 }
 

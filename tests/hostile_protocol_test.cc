@@ -82,7 +82,7 @@ struct Arena {
         disturbance_t(&lcm, trio_options),
         client_t(&lcm, trio_options) {
     std::string error;
-    EXPECT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &model, &error)) << error;
+    EXPECT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &model)));
     options.loop = LoopKind::kSampled;
     options.horizon_s = 1.0;
     options.disturbance.kind = DisturbanceKind::kSquare;
@@ -230,16 +230,16 @@ TEST(Authentication, AKeyFileIsReadAndAShortOneIsRefusedNamingTheFile) {
   }
   AuthKey a, b;
   std::string error;
-  ASSERT_TRUE(LoadAuthKey(path, &a, &error)) << error;
-  ASSERT_TRUE(LoadAuthKey(path, &b, &error)) << error;
+  ASSERT_TRUE(IsOk(LoadAuthKey(path, &a)));
+  ASSERT_TRUE(IsOk(LoadAuthKey(path, &b)));
   EXPECT_EQ(a.bytes, b.bytes);
   {
     std::ofstream f(path, std::ios::binary);
     f << "short";
   }
-  EXPECT_FALSE(LoadAuthKey(path, &a, &error));
+  EXPECT_FALSE(OkInto(LoadAuthKey(path, &a), &error));
   EXPECT_NE(error.find(path), std::string::npos) << error;
-  EXPECT_FALSE(LoadAuthKey("/nonexistent/key", &a, &error));
+  EXPECT_FALSE(OkInto(LoadAuthKey("/nonexistent/key", &a), &error));
 }
 
 TEST(HostileTraffic, AForgedControlCommandFailsTheEpisodeNamingControlAndTheStep) {

@@ -642,7 +642,7 @@ class Launcher : public ::testing::Test {
     co.max_attempts = 1;
     EpisodeClient client(co);
     Plant plant;
-    if (!MakePlant("double_integrator", StepperMotorParameters{}, &plant, error)) return false;
+    if (!OkInto(MakePlant("double_integrator", StepperMotorParameters{}, &plant), error)) return false;
     LoopOptions options;
     options.loop = LoopKind::kSampled;
     options.dt_s = 1e-3;

@@ -30,7 +30,7 @@ namespace {
 Plant Custom(std::vector<double> num, std::vector<double> den) {
   Plant plant;
   std::string error;
-  EXPECT_TRUE(MakeCustomPlant(num, den, &plant, &error)) << error;
+  EXPECT_TRUE(IsOk(MakeCustomPlant(num, den, &plant)));
   return plant;
 }
 
@@ -100,7 +100,7 @@ TEST(LoadIntegralAbsError, IsInfiniteForAnUnstableLoop) {
 
 TEST(SetpointLoadObjective, IsTheSetpointIaePlusTheWeightedLoadIae) {
   Plant plant;
-  ASSERT_TRUE(MakePlant("stepper_motor", StepperMotorParameters{}, &plant, nullptr));
+  ASSERT_TRUE(IsOk(MakePlant("stepper_motor", StepperMotorParameters{}, &plant)));
   const PidGains g{20.8836, 26.607, 12.4866};  // the paper's Table IV Nelder-Mead gains
   Evaluation ev;
   ASSERT_TRUE(IsOk(Evaluate(plant, g, LoopOptions{}, EvaluateOptions{}, &ev)));
@@ -118,7 +118,7 @@ TEST(Tune, OnTheLoadIaeOfTheDoubleIntegratorUsesIntegralAction) {
   // 1/kp under a load: its load IAE is in the hundreds. Tuned for the load,
   // the integral action removes it.
   Plant plant;
-  ASSERT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &plant, nullptr));
+  ASSERT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &plant)));
   TuneOptions options;
   options.objective = ObjectiveKind::kLoadIae;
   TuneSummary dut;

@@ -49,7 +49,7 @@ struct Reference {
 
   explicit Reference(DisturbanceKind kind = DisturbanceKind::kSquare) {
     std::string error;
-    EXPECT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &plant, &error)) << error;
+    EXPECT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &plant)));
     options.loop = LoopKind::kSampled;
     options.dt_s = 0.01;
     options.pid.dt_s = 0.01;

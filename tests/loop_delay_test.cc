@@ -80,7 +80,7 @@ int RightHalfPlanePoles(const TransferFunction& tf, const PidGains& g, double* a
 Plant StepperMotor() {
   Plant p;
   std::string error;
-  EXPECT_TRUE(MakePlant("stepper_motor", StepperMotorParameters{}, &p, &error)) << error;
+  EXPECT_TRUE(IsOk(MakePlant("stepper_motor", StepperMotorParameters{}, &p)));
   return p;
 }
 

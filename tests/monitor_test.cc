@@ -146,7 +146,7 @@ TEST(LiveMonitor, AssemblesAnEpisodeOfTheInProcessTrioBitForBitWithItsHealth) {
 
   Plant p;
   std::string error;
-  ASSERT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &p, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &p)));
   evaluation::LoopOptions options;
   options.loop = evaluation::LoopKind::kSampled;
   options.horizon_s = 2.0;

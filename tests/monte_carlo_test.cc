@@ -103,7 +103,7 @@ TEST(MonteCarlo, StepperDrawsPerturbTableOneParameters) {
   Plant stepper;
   std::string error;
   const StepperMotorParameters p;
-  ASSERT_TRUE(MakePlant("stepper_motor", p, &stepper, &error));
+  ASSERT_TRUE(IsOk(MakePlant("stepper_motor", p, &stepper)));
   MonteCarloOptions mc;
   mc.samples = 30;
   const auto plants = DrawPlants(stepper, &p, mc);

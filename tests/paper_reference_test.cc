@@ -99,7 +99,7 @@ const std::vector<Evaluated>& EvaluatedRows() {
     std::string error;
     for (const Row& r : ReadRows(&error)) {
       Plant plant;
-      if (!MakePlant(r.plant, StepperMotorParameters{}, &plant, &error)) break;
+      if (!OkInto(MakePlant(r.plant, StepperMotorParameters{}, &plant), &error)) break;
       LoopOptions o;
       if (r.amplitude != 0.0) {
         o.disturbance.kind = DisturbanceKind::kSquare;

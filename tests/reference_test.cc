@@ -25,7 +25,7 @@ namespace {
 Plant Stepper() {
   Plant p;
   std::string error;
-  EXPECT_TRUE(MakePlant("stepper_motor", StepperMotorParameters{}, &p, &error)) << error;
+  EXPECT_TRUE(IsOk(MakePlant("stepper_motor", StepperMotorParameters{}, &p)));
   return p;
 }
 

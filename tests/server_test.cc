@@ -21,6 +21,8 @@
 #include <thread>
 #include <vector>
 
+#include "test_status.h"
+
 namespace pidlab::server {
 namespace {
 
@@ -43,7 +45,7 @@ class Served {
                                     }),
                                     std::vector<Asset>{});
     std::string error;
-    EXPECT_TRUE(dut_->Start(&error)) << error;
+    EXPECT_TRUE(IsOk(dut_->Start()));
     thread_ = std::thread([this] { dut_->Run(); });
   }
   ~Served() {

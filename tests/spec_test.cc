@@ -148,8 +148,8 @@ void ExpectEveryFieldIsAFlag() {
     SCOPED_TRACE(e.field.key);
     Spec example_spec;
     std::string error;
-    ASSERT_TRUE(OkInto(
-        spec::FromJson(json{{e.field.key, json::parse(e.field.example)}}, &example_spec, nullptr), &error));
+    ASSERT_TRUE(
+        IsOk(spec::FromJson(json{{e.field.key, json::parse(e.field.example)}}, &example_spec, nullptr)));
     // The example as the user types it: the flag's own text of the value.
     std::vector<std::string> args = {"pidlab"};
     const std::string flag = spec::FlagName(e.field.key);
@@ -234,7 +234,7 @@ TEST(Spec, EveryEpisodeFieldChangesTheEpisodeConfigurationAndSurvivesTheWire) {
                          &error));
       if (!ConfigOf(changed, &after) || Encode(after) == Encode(before)) continue;
       transport::EpisodeSpec decoded;
-      ASSERT_TRUE(transport::ParseEpisodeConfig(after, &decoded, &error)) << error;
+      ASSERT_TRUE(IsOk(transport::ParseEpisodeConfig(after, &decoded)));
       EXPECT_EQ(Encode(transport::MakeEpisodeConfig(decoded)), Encode(after));
       reached = true;
       break;

@@ -60,7 +60,7 @@ TEST(StepperLinearization, JacobianByAutodiffIsEquationThreeForTableOne) {
   NonlinearStepperOptions o;
   StepperLinearization dut;
   std::string error;
-  ASSERT_TRUE(LinearizeStepper(o, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(LinearizeStepper(o, &dut)));
   ExpectSameTransferFunction(dut.tf, StepperMotorTransferFunction(o.motor));
 }
 
@@ -73,7 +73,7 @@ TEST(StepperLinearization, JacobianIsEquationThreeForOtherParameters) {
   o.motor.tooth_pitch_rad = 0.2;  // N_r lambda = 1.2, not pi/2
   StepperLinearization dut;
   std::string error;
-  ASSERT_TRUE(LinearizeStepper(o, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(LinearizeStepper(o, &dut)));
   ExpectSameTransferFunction(dut.tf, StepperMotorTransferFunction(o.motor));
 }
 
@@ -82,7 +82,7 @@ TEST(StepperLinearization, PhysicalAngleCommandHasDcGainOne) {
   o.input_scale = 1.0;
   StepperLinearization dut;
   std::string error;
-  ASSERT_TRUE(LinearizeStepper(o, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(LinearizeStepper(o, &dut)));
   EXPECT_NEAR(dut.tf.num.back() / dut.tf.den.back(), 1.0, 1e-12);
   // Eq. (3)'s DC gain is (r/L) / (r/Lp) = Lp/L: the default input scale.
   const TransferFunction eq3 = StepperMotorTransferFunction(o.motor);
@@ -95,7 +95,7 @@ TEST(StepperLinearization, RefusesAPointThatIsNotAnEquilibrium) {
   o.detent_torque_nm = 1e-3;  // sin(4 N_r lambda/2) != 0: the detent moves the rest point
   StepperLinearization dut;
   std::string error;
-  EXPECT_FALSE(LinearizeStepper(o, &dut, &error));
+  EXPECT_FALSE(OkInto(LinearizeStepper(o, &dut), &error));
   EXPECT_NE(error.find("equilibrium"), std::string::npos) << error;
 }
 
@@ -182,7 +182,7 @@ TEST(StepperLinearization, MicrostepTableHasTheSameLinearisation) {
   o.microstep_table = true;
   StepperLinearization dut;
   std::string error;
-  ASSERT_TRUE(LinearizeStepper(o, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(LinearizeStepper(o, &dut)));
   ExpectSameTransferFunction(dut.tf, StepperMotorTransferFunction(o.motor));
 }
 
@@ -196,8 +196,8 @@ TEST(NonlinearStepperLoop, PapersGainsAgreeWithEquationThreeWithinOnePercentForA
   const PidGains nm{20.8836, 26.607, 12.4866};
   Plant linear, motor;
   std::string error;
-  ASSERT_TRUE(MakePlant("stepper_motor", StepperMotorParameters{}, &linear, &error)) << error;
-  ASSERT_TRUE(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("stepper_motor", StepperMotorParameters{}, &linear)));
+  ASSERT_TRUE(IsOk(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor)));
   Evaluation lin, dut;
   ASSERT_TRUE(IsOk(Evaluate(linear, nm, o, EvaluateOptions{}, &lin)));
   ASSERT_TRUE(IsOk(Evaluate(motor, nm, o, EvaluateOptions{}, &dut)));
@@ -212,7 +212,7 @@ TEST(NonlinearStepperLoop, PapersGainsAgreeWithEquationThreeWithinOnePercentForA
 TEST(NonlinearStepperLoop, ContinuousLoopIsRefusedForTheNonlinearMotor) {
   Plant motor;
   std::string error;
-  ASSERT_TRUE(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor)));
   Evaluation ev;
   EXPECT_FALSE(OkInto(Evaluate(motor, {1.0, 1.0, 0.1}, LoopOptions{}, EvaluateOptions{}, &ev), &error));
   EXPECT_NE(error.find("--loop sampled"), std::string::npos) << error;
@@ -221,7 +221,7 @@ TEST(NonlinearStepperLoop, ContinuousLoopIsRefusedForTheNonlinearMotor) {
 TEST(NonlinearStepperLoop, FastContinuousObjectiveNeverClaimsTheNonlinearMotor) {
   Plant motor;
   std::string error;
-  ASSERT_TRUE(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor)));
   // Its tf (the linearisation, eq. (3)) alone would be covered; the plant is not.
   EXPECT_TRUE(FastContinuousObjective::Covers(motor.tf, LoopOptions{}, ObjectiveKind::kIae));
   for (const ObjectiveKind kind : {ObjectiveKind::kIae, ObjectiveKind::kIse, ObjectiveKind::kItae})
@@ -230,7 +230,7 @@ TEST(NonlinearStepperLoop, FastContinuousObjectiveNeverClaimsTheNonlinearMotor) 
   sampled.loop = LoopKind::kSampled;
   EXPECT_FALSE(FastContinuousObjective::CoversPlant(motor, sampled, ObjectiveKind::kIae));
   Plant linear;
-  ASSERT_TRUE(MakePlant("stepper_motor", StepperMotorParameters{}, &linear, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("stepper_motor", StepperMotorParameters{}, &linear)));
   EXPECT_TRUE(FastContinuousObjective::CoversPlant(linear, LoopOptions{}, ObjectiveKind::kIae));
 }
 
@@ -243,7 +243,7 @@ TEST(NonlinearStepperLoop, ObjectiveEvaluatorRunsTheNonlinearMotor) {
   o.stability_margin = 0.0;
   Plant motor;
   std::string error;
-  ASSERT_TRUE(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("stepper_nonlinear", StepperMotorParameters{}, &motor)));
   const ObjectiveEvaluator dut(motor, o, ObjectiveKind::kIae);
   Evaluation ev;
   ASSERT_TRUE(IsOk(Evaluate(motor, {20.8836, 26.607, 12.4866}, o, EvaluateOptions{}, &ev)));

@@ -17,6 +17,7 @@
 #include "pidlab/plant_sim/matrix_exp.h"
 #include "pidlab/plant_sim/plants.h"
 #include "pidlab/plant_sim/polynomial.h"
+#include "test_status.h"
 
 namespace pidlab {
 namespace {
@@ -186,11 +187,11 @@ TEST(MakePlant, RejectsStepperParametersWhoseCoefficientsAreOutOfRange) {
   p.inertia_kg_m2 = 1e-300;
   Plant plant;
   std::string error;
-  EXPECT_FALSE(MakePlant("stepper", p, &plant, &error));
+  EXPECT_FALSE(OkInto(MakePlant("stepper", p, &plant), &error));
   EXPECT_NE(error.find("stepper motor parameters"), std::string::npos) << error;
   p = StepperMotorParameters{};
   p.rotor_teeth = 1e13;
-  EXPECT_FALSE(MakePlant("stepper", p, &plant, &error));
+  EXPECT_FALSE(OkInto(MakePlant("stepper", p, &plant), &error));
   EXPECT_NE(error.find("rotor_teeth"), std::string::npos) << error;
 }
 
@@ -288,8 +289,8 @@ void ExpectSameTf(const TransferFunction& a, const TransferFunction& b) {
 TEST(MakePlant, LinearIsTheDoubleIntegrator) {
   Plant dut, alias;
   std::string error;
-  ASSERT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &dut, &error)) << error;
-  ASSERT_TRUE(MakePlant("linear", StepperMotorParameters{}, &alias, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &dut)));
+  ASSERT_TRUE(IsOk(MakePlant("linear", StepperMotorParameters{}, &alias)));
   EXPECT_EQ(dut.name, "double_integrator");
   EXPECT_EQ(alias.name, "double_integrator");
   ExpectSameTf(dut.tf, {{1.0}, {1.0, 0.0, 0.0}});
@@ -299,8 +300,8 @@ TEST(MakePlant, LinearIsTheDoubleIntegrator) {
 TEST(MakePlant, NonlinearIsTheOscillator) {
   Plant dut, alias;
   std::string error;
-  ASSERT_TRUE(MakePlant("oscillator", StepperMotorParameters{}, &dut, &error)) << error;
-  ASSERT_TRUE(MakePlant("nonlinear", StepperMotorParameters{}, &alias, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("oscillator", StepperMotorParameters{}, &dut)));
+  ASSERT_TRUE(IsOk(MakePlant("nonlinear", StepperMotorParameters{}, &alias)));
   EXPECT_EQ(dut.name, "oscillator");
   EXPECT_EQ(alias.name, "oscillator");
   ExpectSameTf(dut.tf, {{1.0}, {1.0, 0.0, 1.0}});
@@ -310,8 +311,8 @@ TEST(MakePlant, NonlinearIsTheOscillator) {
 TEST(MakePlant, StepperIsTheStepperMotor) {
   Plant dut, alias;
   std::string error;
-  ASSERT_TRUE(MakePlant("stepper_motor", StepperMotorParameters{}, &dut, &error)) << error;
-  ASSERT_TRUE(MakePlant("stepper", StepperMotorParameters{}, &alias, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("stepper_motor", StepperMotorParameters{}, &dut)));
+  ASSERT_TRUE(IsOk(MakePlant("stepper", StepperMotorParameters{}, &alias)));
   EXPECT_EQ(dut.name, "stepper_motor");
   EXPECT_EQ(alias.name, "stepper_motor");
   ExpectSameTf(dut.tf, StepperMotorTransferFunction(StepperMotorParameters{}));
@@ -321,14 +322,14 @@ TEST(MakePlant, StepperIsTheStepperMotor) {
 TEST(MakePlant, RejectsAnUnknownNameNamingIt) {
   Plant dut;
   std::string error;
-  EXPECT_FALSE(MakePlant("triple_integrator", StepperMotorParameters{}, &dut, &error));
+  EXPECT_FALSE(OkInto(MakePlant("triple_integrator", StepperMotorParameters{}, &dut), &error));
   EXPECT_NE(error.find("triple_integrator"), std::string::npos) << error;
 }
 
 TEST(MakeCustomPlant, AcceptsAStrictlyProperPlant) {
   Plant dut;
   std::string error;
-  ASSERT_TRUE(MakeCustomPlant({1.0, 2.0}, {1.0, 3.0, 2.0}, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(MakeCustomPlant({1.0, 2.0}, {1.0, 3.0, 2.0}, &dut)));
   EXPECT_EQ(dut.name, "custom");
   ExpectSameTf(dut.tf, {{1.0, 2.0}, {1.0, 3.0, 2.0}});
 }
@@ -336,14 +337,14 @@ TEST(MakeCustomPlant, AcceptsAStrictlyProperPlant) {
 TEST(MakeCustomPlant, RejectsABiproperPlant) {
   Plant dut;
   std::string error;
-  EXPECT_FALSE(MakeCustomPlant({1.0, 2.0}, {1.0, 3.0}, &dut, &error));
+  EXPECT_FALSE(OkInto(MakeCustomPlant({1.0, 2.0}, {1.0, 3.0}, &dut), &error));
   EXPECT_NE(error.find("strictly proper"), std::string::npos) << error;
 }
 
 TEST(MakeCustomPlant, RejectsANanCoefficient) {
   Plant dut;
   std::string error;
-  EXPECT_FALSE(MakeCustomPlant({kNaN}, {1.0, 3.0}, &dut, &error));
+  EXPECT_FALSE(OkInto(MakeCustomPlant({kNaN}, {1.0, 3.0}, &dut), &error));
   EXPECT_NE(error.find("nan"), std::string::npos) << error;
 }
 

@@ -48,7 +48,7 @@ struct Episode {
 Episode DoubleIntegrator(double horizon_s = 2.0) {
   Episode e;
   std::string error;
-  EXPECT_TRUE(MakePlant("double_integrator", StepperMotorParameters{}, &e.plant, &error)) << error;
+  EXPECT_TRUE(IsOk(MakePlant("double_integrator", StepperMotorParameters{}, &e.plant)));
   e.options.loop = LoopKind::kSampled;
   e.options.horizon_s = horizon_s;
   e.options.disturbance.kind = DisturbanceKind::kSquare;
@@ -141,7 +141,7 @@ TEST(EpisodeConfig, RoundTripsEveryField) {
       7, e.plant, e.gains, e.options, e.options.disturbance, RecoveryOptions{}));
   EpisodeSpec dut;
   std::string error;
-  ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(ParseEpisodeConfig(msg, &dut)));
   EXPECT_EQ(dut.episode_id, 7);
   EXPECT_EQ(dut.plant.tf.den, e.plant.tf.den);
   EXPECT_EQ(dut.gains.kd, 1.5);
@@ -161,19 +161,19 @@ TEST(EpisodeConfig, RejectsMalformedFieldsByName) {
   std::string error;
   auto bad = msg;
   bad.kp = -1;
-  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
   EXPECT_NE(error.find("kp"), std::string::npos) << error;
   bad = msg;
   bad.total_steps += 1;
-  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
   EXPECT_NE(error.find("total steps"), std::string::npos) << error;
   bad = msg;
   bad.anti_windup = "sometimes";
-  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
   EXPECT_NE(error.find("sometimes"), std::string::npos) << error;
   bad = msg;
   bad.episode_id = 0;
-  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
 }
 
 Episode Motor(double reference, double voltage_limit_v = HUGE_VAL, bool microstep = true) {
@@ -183,7 +183,7 @@ Episode Motor(double reference, double voltage_limit_v = HUGE_VAL, bool microste
   o.detent_torque_nm = 0.0002;
   o.microstep_table = microstep;
   std::string error;
-  EXPECT_TRUE(MakeNonlinearStepperPlant(o, &e.plant, &error)) << error;
+  EXPECT_TRUE(IsOk(MakeNonlinearStepperPlant(o, &e.plant)));
   e.gains = {20.8836, 26.607, 12.4866};
   e.options.loop = LoopKind::kSampled;
   e.options.dt_s = 1e-4;
@@ -201,7 +201,7 @@ TEST(EpisodeConfig, CarriesTheNonlinearMotorWithItsOptions) {
   EXPECT_EQ(msg.motor_drive, "microstep");
   EpisodeSpec dut;
   std::string error;
-  ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(ParseEpisodeConfig(msg, &dut)));
   ASSERT_TRUE(dut.plant.nonlinear);
   EXPECT_EQ(dut.plant.tf.den, e.plant.tf.den);
   EXPECT_EQ(dut.plant.nonlinear->voltage_limit_v, 24.0);
@@ -214,7 +214,7 @@ TEST(EpisodeConfig, CarriesTheNonlinearMotorWithItsOptions) {
       8, linear.plant, linear.gains, linear.options, linear.options.disturbance, RecoveryOptions{}));
   EXPECT_EQ(plain.motor_drive, "");
   EXPECT_EQ(plain.motor_resistance_ohm, 0.0);
-  ASSERT_TRUE(ParseEpisodeConfig(plain, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(ParseEpisodeConfig(plain, &dut)));
   EXPECT_FALSE(dut.plant.nonlinear);
 }
 
@@ -226,22 +226,22 @@ TEST(EpisodeConfig, RejectsABadMotorByName) {
   std::string error;
   auto bad = msg;
   bad.motor_drive = "fullstep";
-  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
   EXPECT_NE(error.find("fullstep"), std::string::npos) << error;
   bad = msg;
   bad.motor_resistance_ohm = -1.0;
-  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
   EXPECT_NE(error.find("motor"), std::string::npos) << error;
   bad = msg;
   bad.motor_inertia_kg_m2 = std::nan("");
-  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
   bad = msg;
   bad.den[1] *= 1.001;  // num/den that are not the motor's linearisation
-  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
   EXPECT_NE(error.find("linearisation"), std::string::npos) << error;
   bad = msg;
   bad.plant_name = "double_integrator";  // motor fields on a linear plant
-  EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
 }
 
 TEST(TrioProtocol, TheNonlinearMotorIsBitIdenticalToTheInProcessLoop) {
@@ -396,7 +396,7 @@ TEST(Trio, MatchesTheInProcessSampledLoopBitForBit) {
 Episode Fopdt(double delay_s) {
   Episode e;
   std::string error;
-  EXPECT_TRUE(MakeCustomPlant({1.0}, {1.0, 1.0}, &e.plant, &error)) << error;
+  EXPECT_TRUE(IsOk(MakeCustomPlant({1.0}, {1.0, 1.0}, &e.plant)));
   e.plant.delay_s = delay_s;
   e.gains = PidGains{1.0, 1.0, 0.0};
   e.options.loop = LoopKind::kSampled;
@@ -429,19 +429,19 @@ TEST(EpisodeConfig, CarriesThePlantsDeadTimeAndRejectsABadOneByName) {
   EXPECT_EQ(msg.delay_s, 0.3);
   EpisodeSpec dut;
   std::string error;
-  ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(ParseEpisodeConfig(msg, &dut)));
   EXPECT_EQ(dut.plant.delay_s, 0.3);
   for (const double bad_delay : {-1.0, std::nan(""), HUGE_VAL, 1e9, 2e4}) {
     SCOPED_TRACE(bad_delay);
     auto bad = msg;
     bad.delay_s = bad_delay;  // 2e4 s at dt 1e-3 is 2e7 stored inputs, more than 1e7
-    EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error));
+    EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error));
     EXPECT_EQ(error.rfind("delay_s", 0), 0u) << error;
   }
   auto motor = transport::MakeEpisodeConfig(pidlab::episode_client::MakeEpisodeSpec(
       7, Motor(1.0).plant, e.gains, Motor(1.0).options, DisturbanceOptions{}, RecoveryOptions{}));
   motor.delay_s = 0.01;
-  EXPECT_FALSE(ParseEpisodeConfig(motor, &dut, &error));
+  EXPECT_FALSE(OkInto(ParseEpisodeConfig(motor, &dut), &error));
   EXPECT_NE(error.find("delay_s"), std::string::npos) << error;
 }
 
@@ -450,7 +450,7 @@ TEST(EpisodeConfig, CarriesThePlantsDeadTimeAndRejectsABadOneByName) {
 Episode Experiment(bool closed, double sigma) {
   Episode e;
   std::string error;
-  EXPECT_TRUE(MakeCustomPlant({1.0}, {1.0, 2.0, 1.0}, &e.plant, &error)) << error;
+  EXPECT_TRUE(IsOk(MakeCustomPlant({1.0}, {1.0, 2.0, 1.0}, &e.plant)));
   e.gains = closed ? PidGains{2.0, 1.0, 0.5} : PidGains{0.0, 0.0, 0.0};
   e.options.loop = LoopKind::kSampled;
   e.options.horizon_s = 2.0;
@@ -492,13 +492,13 @@ TEST(EpisodeConfig, CarriesTheChirpAndTheMeasurementNoiseAndRejectsBadOnesByName
   EXPECT_EQ(msg.measurement_noise, 0.01);
   EpisodeSpec dut;
   std::string error;
-  ASSERT_TRUE(ParseEpisodeConfig(msg, &dut, &error)) << error;
+  ASSERT_TRUE(IsOk(ParseEpisodeConfig(msg, &dut)));
   EXPECT_EQ(dut.disturbance.chirp_f0_hz, 0.2);
   EXPECT_EQ(dut.disturbance.chirp_duration_s, 1.5);
   EXPECT_EQ(dut.measurement_noise.sigma, 0.01);
   EXPECT_EQ(dut.measurement_noise.seed, 4u);
   const auto refuse = [&](pidlab::lcmt_episode_config bad, const std::string& name) {
-    EXPECT_FALSE(ParseEpisodeConfig(bad, &dut, &error)) << name;
+    EXPECT_FALSE(OkInto(ParseEpisodeConfig(bad, &dut), &error)) << name;
     EXPECT_NE(error.find(name), std::string::npos) << error;
   };
   for (const double sigma : {-1.0, std::nan(""), HUGE_VAL}) {

@@ -36,7 +36,7 @@ namespace {
 Plant MakeBuiltin(const std::string& name) {
   Plant plant;
   std::string error;
-  EXPECT_TRUE(MakePlant(name, StepperMotorParameters{}, &plant, &error)) << error;
+  EXPECT_TRUE(IsOk(MakePlant(name, StepperMotorParameters{}, &plant)));
   return plant;
 }
 

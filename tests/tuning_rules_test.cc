@@ -38,7 +38,7 @@ constexpr double kTol = 1e-9;
 Plant MakePlantOrDie(const std::vector<double>& num, const std::vector<double>& den, double delay_s) {
   Plant p;
   std::string error;
-  EXPECT_TRUE(MakeCustomPlant(num, den, &p, &error)) << error;
+  EXPECT_TRUE(IsOk(MakeCustomPlant(num, den, &p)));
   p.delay_s = delay_s;
   return p;
 }
@@ -234,7 +234,7 @@ void ExpectRefused(const Plant& plant, TuningRule rule, RuleForm form, const std
 TEST(TuningRules, TheOscillatorIsRefusedForItsComplexPoles) {
   Plant oscillator;
   std::string error;
-  ASSERT_TRUE(MakePlant("oscillator", StepperMotorParameters{}, &oscillator, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("oscillator", StepperMotorParameters{}, &oscillator)));
   ExpectRefused(oscillator, TuningRule::kSimc, RuleForm::kPid, "complex poles");
   ExpectRefused(oscillator, TuningRule::kAmigo, RuleForm::kPi, "complex poles");
 }
@@ -315,7 +315,7 @@ TEST(TuningRules, TuneScoresARuleOnADelayedPlantInBothLoops) {
 TEST(TuningRules, TuneRefusesTheOscillatorWithOneLine) {
   Plant oscillator;
   std::string error;
-  ASSERT_TRUE(MakePlant("oscillator", StepperMotorParameters{}, &oscillator, &error)) << error;
+  ASSERT_TRUE(IsOk(MakePlant("oscillator", StepperMotorParameters{}, &oscillator)));
   TuneOptions o;
   o.method = TuneMethod::kSimc;
   TuneSummary dut;

@@ -248,7 +248,7 @@ EpisodeClientOptions LcmFlags::ClientOptions(const std::string& url) const {
   const std::string key_file = FromEnv(auth_key_file, transport::kAuthKeyFileEnv, "");
   if (!key_file.empty()) {
     transport::AuthKey key;
-    if (!transport::LoadAuthKey(key_file, &key, &error)) throw BadInput(error);
+    if (const Status st = transport::LoadAuthKey(key_file, &key); !st.ok()) throw BadInput(st.message());
     co.transport.auth_key = key;
   }
   if (!co.IsValid(&error)) throw BadInput(error);

@@ -41,7 +41,7 @@ struct LinearizeCommand {
     NonlinearStepperOptions o;
     Require(pidlab::tune::BuildNonlinearStepper(plant, NameStyle::kFlag, &o));
     StepperLinearization lin;
-    if (!LinearizeStepper(o, &lin, &error)) throw BadInput(error);
+    if (const Status st = LinearizeStepper(o, &lin); !st.ok()) throw BadInput(st.message());
     const TransferFunction eq3 = StepperMotorTransferFunction(o.motor);
     if (json) {
       const nlohmann::json j = results::LinearizeJson(lin.tf, eq3, o.InputScale());

@@ -128,7 +128,7 @@ struct ReplayCommand {
     if (!key_file.empty()) {
       transport::AuthKey key;
       std::string why;
-      if (!transport::LoadAuthKey(key_file, &key, &why)) throw BadInput(why);
+      if (const Status st = transport::LoadAuthKey(key_file, &key); !st.ok()) throw BadInput(st.message());
       options.auth_key = key;
     }
     replay::LogContents log;

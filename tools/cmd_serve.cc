@@ -78,7 +78,7 @@ struct ServeCommand {
         server::WorkbenchAssets());
     s.SetUploadHandler(
         [&logs](const std::string& name, const std::string& body) { return logs->Upload(name, body); });
-    if (!s.Start(&error)) throw BadInput(error);
+    if (const Status st = s.Start(); !st.ok()) throw BadInput(st.message());
     live_requests = live.get();
     const std::string host =
         options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind;

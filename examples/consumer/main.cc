@@ -12,13 +12,13 @@
 #include "pidlab/tune/tune.h"
 
 int main() {
-  std::string error;
-
   // 1. The plant by name, the gains of Table II, the paper's loop
   //    (continuous, ts = 0.05 s, n = 25 s).
   pidlab::Plant plant;
-  if (!pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant, &error)) {
-    std::fprintf(stderr, "consumer: %s\n", error.c_str());
+  if (const pidlab::Status st =
+          pidlab::MakePlant("double_integrator", pidlab::StepperMotorParameters{}, &plant);
+      !st.ok()) {
+    std::fprintf(stderr, "consumer: %s\n", st.message().c_str());
     return 2;
   }
   const pidlab::PidGains paper_nm{29.6558, 0.4977, 28.3216};
@@ -37,8 +37,8 @@ int main() {
   //    most 400 evaluations: 200 Sobol' design points, then 16 Nelder-Mead
   //    polishes), then cross-checked by Ceres.
   pidlab::Plant oscillator;
-  if (!pidlab::MakeCustomPlant({1.0}, {1.0, 0.0, 1.0}, &oscillator, &error)) {
-    std::fprintf(stderr, "consumer: %s\n", error.c_str());
+  if (const pidlab::Status st = pidlab::MakeCustomPlant({1.0}, {1.0, 0.0, 1.0}, &oscillator); !st.ok()) {
+    std::fprintf(stderr, "consumer: %s\n", st.message().c_str());
     return 2;
   }
   pidlab::tune::TuneOptions options;

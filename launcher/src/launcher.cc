@@ -136,7 +136,8 @@ Launcher::Launcher(const LaunchOptions& options, NoteFn note)
   topt.channel_prefix = options_.channel_prefix;
   if (!options_.auth_key_file.empty()) {
     transport::AuthKey key;
-    if (!transport::LoadAuthKey(options_.auth_key_file, &key, &error)) throw std::invalid_argument(error);
+    if (const Status st = transport::LoadAuthKey(options_.auth_key_file, &key); !st.ok())
+      throw std::invalid_argument(st.message());
     topt.auth_key = key;
   }
   try {

@@ -63,8 +63,11 @@ std::vector<std::string> BuiltinPlantNames() {
           "stepper_motor",     "stepper", "stepper_nonlinear"};
 }
 
-bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, Plant* plant,
-               std::string* error) {
+namespace {
+
+// MakePlant() with the refusal's message in *error.
+bool MakePlantOrExplain(const std::string& name, const StepperMotorParameters& stepper, Plant* plant,
+                        std::string* error) {
   if (name == "double_integrator" || name == "linear") {
     *plant = {"double_integrator", {{1.0}, {1.0, 0.0, 0.0}}};
   } else if (name == "oscillator" || name == "nonlinear") {
@@ -80,7 +83,9 @@ bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, P
   } else if (name == "stepper_nonlinear") {
     NonlinearStepperOptions o;
     o.motor = stepper;
-    return MakeNonlinearStepperPlant(o, plant, error);
+    const Status st = MakeNonlinearStepperPlant(o, plant);
+    if (!st.ok() && error) *error = st.message();
+    return st.ok();
   } else {
     if (error)
       *error = "unknown plant '" + name +
@@ -91,12 +96,27 @@ bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, P
   return true;
 }
 
-bool MakeNonlinearStepperPlant(const NonlinearStepperOptions& options, Plant* plant, std::string* error) {
+}  // namespace
+
+Status MakePlant(const std::string& name, const StepperMotorParameters& stepper, Plant* plant) {
+  std::string why;
+  if (!MakePlantOrExplain(name, stepper, plant, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
+}
+
+namespace {
+
+// MakeNonlinearStepperPlant() with the refusal's message in *error.
+bool MakeNonlinearStepperPlantOrExplain(const NonlinearStepperOptions& options, Plant* plant,
+                                        std::string* error) {
   if (!options.IsValid(error)) return false;
   // The linearisation is taken without load (and its detent must keep the
   // holding point an equilibrium): it is the stability gate and the reference.
   StepperLinearization lin;
-  if (!LinearizeStepper(options, &lin, error)) return false;
+  if (const Status st = LinearizeStepper(options, &lin); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   std::string why;
   if (!lin.tf.IsValid(&why)) {
     if (error) *error = "the linearised stepper G(s) = " + lin.tf.ToString() + " is out of range: " + why;
@@ -106,8 +126,19 @@ bool MakeNonlinearStepperPlant(const NonlinearStepperOptions& options, Plant* pl
   return true;
 }
 
-bool MakeCustomPlant(const std::vector<double>& num, const std::vector<double>& den, Plant* plant,
-                     std::string* error) {
+}  // namespace
+
+Status MakeNonlinearStepperPlant(const NonlinearStepperOptions& options, Plant* plant) {
+  std::string why;
+  if (!MakeNonlinearStepperPlantOrExplain(options, plant, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
+}
+
+namespace {
+
+// MakeCustomPlant() with the refusal's message in *error.
+bool MakeCustomPlantOrExplain(const std::vector<double>& num, const std::vector<double>& den, Plant* plant,
+                              std::string* error) {
   TransferFunction tf{num, den};
   if (!tf.IsValid(error)) return false;
   if (tf.RelativeDegree() < 1) {
@@ -116,6 +147,14 @@ bool MakeCustomPlant(const std::vector<double>& num, const std::vector<double>& 
   }
   *plant = {"custom", tf};
   return true;
+}
+
+}  // namespace
+
+Status MakeCustomPlant(const std::vector<double>& num, const std::vector<double>& den, Plant* plant) {
+  std::string why;
+  if (!MakeCustomPlantOrExplain(num, den, plant, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab

@@ -63,7 +63,11 @@ std::vector<double> StepperHoldingState(const NonlinearStepperOptions& o) {
   return {io, io, o.motor.tooth_pitch_rad / 2.0, 0.0};
 }
 
-bool LinearizeStepper(const NonlinearStepperOptions& o, StepperLinearization* out, std::string* error) {
+namespace {
+
+// LinearizeStepper() with the refusal's message in *error.
+bool LinearizeStepperOrExplain(const NonlinearStepperOptions& o, StepperLinearization* out,
+                               std::string* error) {
   if (!o.IsValid(error)) return false;
   NonlinearStepperOptions unloaded = o;
   unloaded.load_torque_nm = 0.0;
@@ -108,6 +112,14 @@ bool LinearizeStepper(const NonlinearStepperOptions& o, StepperLinearization* ou
   while (num.size() > 1 && std::abs(num.front()) <= 1e-12 * top) num.erase(num.begin());
   out->tf = {num, den};
   return true;
+}
+
+}  // namespace
+
+Status LinearizeStepper(const NonlinearStepperOptions& o, StepperLinearization* out) {
+  std::string why;
+  if (!LinearizeStepperOrExplain(o, out, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 NonlinearStepperPlant::NonlinearStepperPlant(const NonlinearStepperOptions& o, double dt_s)

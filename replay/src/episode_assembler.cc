@@ -189,11 +189,10 @@ void EpisodeAssembler::On(const std::string& prefix, const pidlab::lcmt_episode_
   }
   b.config = m;
   b.episode.config = m;
-  std::string error;
-  if (transport::ParseEpisodeConfig(m, &b.episode.spec, &error))
+  if (const Status st = transport::ParseEpisodeConfig(m, &b.episode.spec); st.ok())
     b.episode.has_config = true;
   else
-    b.episode.config_error = error;
+    b.episode.config_error = st.message();
 }
 
 void EpisodeAssembler::On(const std::string& prefix, const pidlab::lcmt_plant_output& m) {

@@ -24,17 +24,15 @@ namespace {
 
 Plant Motor() {
   Plant p;
-  std::string error;
-  if (!MakeNonlinearStepperPlant(NonlinearStepperOptions{}, &p, &error))
-    throw std::runtime_error("stepper_nonlinear: " + error);
+  if (const Status st = MakeNonlinearStepperPlant(NonlinearStepperOptions{}, &p); !st.ok())
+    throw std::runtime_error("stepper_nonlinear: " + st.message());
   return p;
 }
 
 Plant Eq3() {
   Plant p;
-  std::string error;
-  if (!MakePlant("stepper_motor", StepperMotorParameters{}, &p, &error))
-    throw std::runtime_error("stepper_motor: " + error);
+  if (const Status st = MakePlant("stepper_motor", StepperMotorParameters{}, &p); !st.ok())
+    throw std::runtime_error("stepper_motor: " + st.message());
   return p;
 }
 

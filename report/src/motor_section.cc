@@ -50,8 +50,8 @@ Plant Motor(bool limited, double limit_v) {
   NonlinearStepperOptions o;
   if (limited) o.voltage_limit_v = limit_v;
   Plant p;
-  std::string error;
-  if (!MakeNonlinearStepperPlant(o, &p, &error)) throw std::runtime_error("stepper_nonlinear: " + error);
+  if (const Status st = MakeNonlinearStepperPlant(o, &p); !st.ok())
+    throw std::runtime_error("stepper_nonlinear: " + st.message());
   return p;
 }
 
@@ -115,7 +115,10 @@ bool RunRow(const MotorSection& s, const MotorGainSet& set, double move, bool li
 bool RunEq3(const MotorSection& s, MotorGainSet* set, std::vector<SampledStep>* trajectory,
             std::string* error) {
   Plant eq3;
-  if (!MakePlant("stepper_motor", StepperMotorParameters{}, &eq3, error)) return false;
+  if (const Status st = MakePlant("stepper_motor", StepperMotorParameters{}, &eq3); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   EvaluateOptions what;
   what.compute_iae_continuous = false;
   what.record_trajectory = trajectory != nullptr;
@@ -472,7 +475,10 @@ bool ComputeMotorSectionOrExplain(const PidGains& paper_nm, bool quick, std::uin
   s.sets.push_back(PaperSet(paper_nm));
   const TuneOptions d = Eq3TuneOptions(quick, seed);
   Plant eq3;
-  if (!MakePlant("stepper_motor", StepperMotorParameters{}, &eq3, error)) return false;
+  if (const Status st = MakePlant("stepper_motor", StepperMotorParameters{}, &eq3); !st.ok()) {
+    if (error) *error = st.message();
+    return false;
+  }
   MotorGainSet pidlab_default;
   if (!DefaultSet(eq3, d, seed, &pidlab_default, error)) return false;
   s.sets.push_back(pidlab_default);

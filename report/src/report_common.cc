@@ -38,7 +38,8 @@ bool RelClose(double a, double b, double rel) {
 Plant BuiltinPlant(const std::string& name) {
   Plant p;
   std::string error;
-  if (!MakePlant(name, StepperMotorParameters{}, &p, &error)) throw std::invalid_argument(error);
+  if (const Status st = MakePlant(name, StepperMotorParameters{}, &p); !st.ok())
+    throw std::invalid_argument(st.message());
   return p;
 }
 

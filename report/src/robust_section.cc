@@ -128,7 +128,10 @@ bool ComputeRobustSectionOrExplain(const std::vector<RobustInput>& inputs, bool 
   const StepperMotorParameters table_one;
   for (const RobustInput& in : inputs) {
     Plant plant;
-    if (!MakePlant(in.plant, table_one, &plant, error)) return false;
+    if (const Status st = MakePlant(in.plant, table_one, &plant); !st.ok()) {
+      if (error) *error = st.message();
+      return false;
+    }
     const StepperMotorParameters* stepper = in.plant == "stepper_motor" ? &table_one : nullptr;
     RobustPlant p;
     p.plant = in.plant;

@@ -18,7 +18,10 @@ bool ComputeTwoDofSectionOrExplain(const RobustSection& robust, TwoDofSection* s
     for (const RobustGainSet& set : p.sets) {
       if (set.name.rfind("pidlab --robust", 0) != 0) continue;
       Plant plant;
-      if (!MakePlant(p.plant, table_one, &plant, error)) return false;
+      if (const Status st = MakePlant(p.plant, table_one, &plant); !st.ok()) {
+        if (error) *error = st.message();
+        return false;
+      }
       TwoDofRow row;
       row.plant = p.plant;
       row.gains = set.gains;

@@ -29,11 +29,10 @@ void AddLinearMotor(const tune::EvaluationProblem& problem, const evaluation::Lo
                     nlohmann::json* series) {
   Plant p;
   Evaluation ev;
-  std::string error;
   evaluation::EvaluateOptions what;
   what.compute_step_info = false;
   what.compute_iae_continuous = false;
-  const bool ran = MakePlant("stepper_motor", problem.stepper, &p, &error) &&
+  const bool ran = MakePlant("stepper_motor", problem.stepper, &p).ok() &&
                    Evaluate(p, problem.gains, loop, what, &ev).ok();
   (*series)["linear_y"] = ran ? nlohmann::json(ev.y) : nlohmann::json(nullptr);
 }

@@ -559,8 +559,8 @@ Server::~Server() { Stop(); }
 
 void Server::SetUploadHandler(UploadHandler handler) { impl_->upload_handler = std::move(handler); }
 
-bool Server::Start(std::string* error) {
-  if (!impl_->options.IsValid(error)) return false;
+Status Server::Start() {
+  if (std::string why; !impl_->options.IsValid(&why)) return Status::InvalidInput(why);
   beast::error_code ec;
   const tcp::endpoint endpoint{net::ip::make_address(impl_->options.bind),
                                static_cast<unsigned short>(impl_->options.port)};
@@ -568,15 +568,12 @@ bool Server::Start(std::string* error) {
   if (!ec) impl_->acceptor.set_option(net::socket_base::reuse_address(true), ec);
   if (!ec) impl_->acceptor.bind(endpoint, ec);
   if (!ec) impl_->acceptor.listen(net::socket_base::max_listen_connections, ec);
-  if (ec) {
-    if (error)
-      *error = "cannot listen on " + impl_->options.bind + " port " + std::to_string(impl_->options.port) +
-               ": " + ec.message();
-    return false;
-  }
+  if (ec)
+    return Status::RunnerFailed("cannot listen on " + impl_->options.bind + " port " +
+                                std::to_string(impl_->options.port) + ": " + ec.message());
   impl_->port = impl_->acceptor.local_endpoint().port();
   Accept(impl_);
-  return true;
+  return Status::Ok();
 }
 
 int Server::port() const { return impl_->port; }

@@ -24,7 +24,10 @@ int64_t ReadInt64(const uint8_t* p) {
 
 }  // namespace
 
-bool LoadAuthKey(const std::string& path, AuthKey* key, std::string* error) {
+namespace {
+
+// LoadAuthKey() with the refusal's message in *error.
+bool LoadAuthKeyOrExplain(const std::string& path, AuthKey* key, std::string* error) {
   auto fail = [&](const std::string& what) {
     if (error) *error = "--auth-key '" + path.substr(0, 200) + "': " + what;
     return false;
@@ -44,6 +47,14 @@ bool LoadAuthKey(const std::string& path, AuthKey* key, std::string* error) {
   crypto_hash_sha256(key->bytes.data(), reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
   sodium_memzero(bytes.data(), bytes.size());
   return true;
+}
+
+}  // namespace
+
+Status LoadAuthKey(const std::string& path, AuthKey* key) {
+  std::string why;
+  if (!LoadAuthKeyOrExplain(path, key, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 std::array<uint8_t, kAuthTagBytes> AuthTag(const AuthKey& key, const std::string& channel,

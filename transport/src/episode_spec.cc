@@ -209,8 +209,8 @@ bool ParseMotor(const pidlab::lcmt_episode_config& m, Plant* plant, std::string*
   if (m.motor_drive != "linear" && m.motor_drive != "microstep")
     return Fail("motor drive '" + m.motor_drive + "' unknown (linear or microstep)", error);
   o.microstep_table = m.motor_drive == "microstep";
-  std::string why;
-  if (!MakeNonlinearStepperPlant(o, plant, &why)) return Fail("motor: " + why, error);
+  if (const Status st = MakeNonlinearStepperPlant(o, plant); !st.ok())
+    return Fail("motor: " + st.message(), error);
   // num/den are the linearisation the sender computed: the same code gives
   // the same numbers (to rounding on another machine).
   const auto close = [](const std::vector<double>& a, const std::vector<double>& b) {
@@ -226,7 +226,11 @@ bool ParseMotor(const pidlab::lcmt_episode_config& m, Plant* plant, std::string*
 
 }  // namespace
 
-bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec, std::string* error) {
+namespace {
+
+// ParseEpisodeConfig() with the refusal's message in *error.
+bool ParseEpisodeConfigOrExplain(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec,
+                                 std::string* error) {
   EpisodeSpec s;
   s.episode_id = m.episode_id;
   s.plant.name = m.plant_name;
@@ -262,6 +266,14 @@ bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec,
   if (!s.IsValid(error)) return false;
   *spec = s;
   return true;
+}
+
+}  // namespace
+
+Status ParseEpisodeConfig(const pidlab::lcmt_episode_config& m, EpisodeSpec* spec) {
+  std::string why;
+  if (!ParseEpisodeConfigOrExplain(m, spec, &why)) return Status::InvalidInput(why);
+  return Status::Ok();
 }
 
 }  // namespace pidlab::transport

@@ -38,10 +38,9 @@ void Role::OnConfig(const pidlab::lcmt_episode_config& m) {
     return;
   }
   EpisodeSpec spec;
-  std::string error;
-  if (!ParseEpisodeConfig(m, &spec, &error)) {
+  if (const Status st = ParseEpisodeConfig(m, &spec); !st.ok()) {
     ++counters_.bad_configs;
-    Log("ignoring configuration of episode " + std::to_string(m.episode_id) + ": " + error);
+    Log("ignoring configuration of episode " + std::to_string(m.episode_id) + ": " + st.message());
     return;
   }
   episode_id_ = spec.episode_id;

@@ -75,7 +75,7 @@ std::string CheckRoleFlags(RoleFlags* f, RealtimeFlags* realtime) {
   }
   if (!f->auth_key_file.empty()) {
     AuthKey key;
-    if (!LoadAuthKey(f->auth_key_file, &key, &error)) return error;
+    if (const Status st = LoadAuthKey(f->auth_key_file, &key); !st.ok()) return st.message();
     f->transport.auth_key = key;
   }
   if (f->realtime_option && f->realtime_option->count() > 0 &&

@@ -180,7 +180,8 @@ bool ReadModelFileOrExplain(const std::string& path, Plant* plant, std::string* 
       !NumberList(*num, "transfer_function.num", &p.tf.num, error) ||
       !NumberList(*den, "transfer_function.den", &p.tf.den, error))
     return false;
-  if (!MakeCustomPlant(p.tf.num, p.tf.den, &p, &why)) return FileBad(error, "is not a valid plant: " + why);
+  if (const Status st = MakeCustomPlant(p.tf.num, p.tf.den, &p); !st.ok())
+    return FileBad(error, "is not a valid plant: " + st.message());
   if (!Number(*delay, "transfer_function.delay_s", &p.delay_s, error)) return false;
   if (p.delay_s < 0.0)
     return FileBad(error, "\"transfer_function.delay_s\" " + spec::FormatNumber(p.delay_s) + " must be >= 0");

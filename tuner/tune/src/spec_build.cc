@@ -21,6 +21,9 @@ bool Bad(std::string* error, const std::string& message) {
   return false;
 }
 
+// A library's Status as this file's steps report it.
+bool Into(const Status& st, std::string* error) { return st.ok() || Bad(error, st.message()); }
+
 }  // namespace
 
 namespace internal {
@@ -107,7 +110,7 @@ bool BuildPlantModel(const spec::PlantSpec& s, NameStyle style, Plant* out, std:
   if (custom) {
     if (s.num.empty() || s.den.empty())
       return Bad(error, "a custom plant needs both " + name("num") + " and " + name("den"));
-    return MakeCustomPlant(s.num, s.den, out, error);
+    return Into(MakeCustomPlant(s.num, s.den, out), error);
   }
   if (s.plant.empty())
     return Bad(error, name("plant") + " is required (or " + name("num") + " and " + name("den") +
@@ -116,7 +119,7 @@ bool BuildPlantModel(const spec::PlantSpec& s, NameStyle style, Plant* out, std:
     return Bad(error, name("plant") + " custom needs " + name("num") + " and " + name("den"));
   if (s.plant == "stepper_nonlinear") {
     NonlinearStepperOptions o;
-    return BuildNonlinearOptions(s, style, &o, error) && MakeNonlinearStepperPlant(o, out, error);
+    return BuildNonlinearOptions(s, style, &o, error) && Into(MakeNonlinearStepperPlant(o, out), error);
   }
   if (HasNonlinearOption(s))
     return Bad(error, name("detent_torque") + ", " + name("load_torque") + ", " + name("load_step") + ", " +
@@ -135,7 +138,7 @@ bool BuildPlantModel(const spec::PlantSpec& s, NameStyle style, Plant* out, std:
   }
   // A plant name is printable and short, so Truncate leaves every valid one
   // as it is, and MakePlant's "unknown plant '...'" echoes at most 200 chars.
-  return MakePlant(spec::Truncate(s.plant), sp, out, error);
+  return Into(MakePlant(spec::Truncate(s.plant), sp, out), error);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "pidlab/plant_sim/process_model.h"
 #include "pidlab/plant_sim/transfer_function.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab {
 
@@ -59,17 +60,17 @@ std::vector<std::string> BuiltinPlantNames();
 /// Builds a built-in plant by name or alias: double_integrator (linear) = 1/s^2,
 /// oscillator (nonlinear) = 1/(s^2+1), stepper_motor (stepper) = eq. (3) with
 /// `stepper`, stepper_nonlinear = the nonlinear motor of stepper_nonlinear.h
-/// with `stepper` and default options (MakeNonlinearStepperPlant for others). Returns false and sets *error
+/// with `stepper` and default options (MakeNonlinearStepperPlant for others). A failed Status (kInvalidInput)
 /// naming the value for an unknown name, invalid stepper parameters, or parameters whose G(s) is not a valid
 /// TransferFunction (a coefficient out of the limits).
-bool MakePlant(const std::string& name, const StepperMotorParameters& stepper, Plant* plant,
-               std::string* error);
+Status MakePlant(const std::string& name, const StepperMotorParameters& stepper, Plant* plant);
 
-/// The nonlinear stepper with its options; tf is its linearisation.
-bool MakeNonlinearStepperPlant(const NonlinearStepperOptions& options, Plant* plant, std::string* error);
+/// The nonlinear stepper with its options; tf is its linearisation. A failed
+/// Status (kInvalidInput) naming the option.
+Status MakeNonlinearStepperPlant(const NonlinearStepperOptions& options, Plant* plant);
 
-/// A user plant from coefficient lists; must be valid and strictly proper.
-bool MakeCustomPlant(const std::vector<double>& num, const std::vector<double>& den, Plant* plant,
-                     std::string* error);
+/// A user plant from coefficient lists; must be valid and strictly proper (a
+/// failed Status, kInvalidInput, otherwise).
+Status MakeCustomPlant(const std::vector<double>& num, const std::vector<double>& den, Plant* plant);
 
 }  // namespace pidlab

@@ -129,7 +129,7 @@ struct StepperLinearization {
   Eigen::Vector4d b;  // d f / d u
   TransferFunction tf;
 };
-bool LinearizeStepper(const NonlinearStepperOptions& o, StepperLinearization* out, std::string* error);
+Status LinearizeStepper(const NonlinearStepperOptions& o, StepperLinearization* out);
 
 /// Peak quantities seen while integrating.
 struct StepperPeaks {

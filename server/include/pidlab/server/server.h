@@ -33,6 +33,8 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/spec/status.h"
+
 namespace pidlab::server {
 
 struct ServerOptions {
@@ -139,8 +141,9 @@ class Server {
 
   /// Serves POST /api/upload with `handler` (404 without one); call before Start.
   void SetUploadHandler(UploadHandler handler);
-  /// Binds and listens; false with *error (the address, the port and why).
-  bool Start(std::string* error);
+  /// Binds and listens. A failed Status naming the address, the port and
+  /// why: kInvalidInput for invalid options, kRunnerFailed if it cannot listen.
+  Status Start();
   /// The bound port (after Start).
   int port() const;
   /// Serves until Stop(); call after Start.

@@ -13,6 +13,8 @@
 #include <string>
 #include <unordered_set>
 
+#include "pidlab/spec/status.h"
+
 namespace pidlab::transport {
 
 inline constexpr std::size_t kAuthTagBytes = 32;
@@ -28,9 +30,9 @@ struct AuthKey {
 };
 
 /// The key of a key file: SHA-256 of its contents (at least
-/// kMinAuthKeyFileBytes bytes, at most 1 MiB). False with *error naming the
+/// kMinAuthKeyFileBytes bytes, at most 1 MiB). A failed Status (kInvalidInput) naming the
 /// file and what is wrong.
-bool LoadAuthKey(const std::string& path, AuthKey* key, std::string* error);
+Status LoadAuthKey(const std::string& path, AuthKey* key);
 
 /// The tag of `payload` on `channel` (the full, prefixed channel name).
 std::array<uint8_t, kAuthTagBytes> AuthTag(const AuthKey& key, const std::string& channel,

@@ -13,6 +13,7 @@
 #include "pidlab/plant_sim/disturbance.h"
 #include "pidlab/plant_sim/episode_shape.h"
 #include "pidlab/plant_sim/plants.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::transport {
 
@@ -45,7 +46,7 @@ struct EpisodeSpec : EpisodeShape {
   long total_steps = 0;  // horizon_s / dt_s
   RecoveryOptions recovery;
 
-  /// False with *error naming the field (a stranger's malformed config must
+  /// A failed Status (kInvalidInput) naming the field (a stranger's malformed config must
   /// not crash a process).
   bool IsValid(std::string* error) const;
 };
@@ -53,8 +54,8 @@ struct EpisodeSpec : EpisodeShape {
 /// The message for an episode (utime 0; Transport::Publish stamps it).
 pidlab::lcmt_episode_config MakeEpisodeConfig(const EpisodeSpec& spec);
 
-/// Decodes and validates a configuration. Returns false with *error naming
+/// Decodes and validates a configuration. A failed Status (kInvalidInput) naming
 /// the offending field.
-bool ParseEpisodeConfig(const pidlab::lcmt_episode_config& msg, EpisodeSpec* spec, std::string* error);
+Status ParseEpisodeConfig(const pidlab::lcmt_episode_config& msg, EpisodeSpec* spec);
 
 }  // namespace pidlab::transport
