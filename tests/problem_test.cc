@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -90,6 +91,39 @@ TEST(BuildEvaluation, RunsTheSampledLoopOnARunnerAndRefusesAnotherLoopGiven) {
   BuildOptions given = Flags(Backend::kRunner);
   given.given = {"loop"};
   ExpectRefused(&BuildEvaluation, s, given, "--backend lcm runs the sampled loop, not --loop 'continuous'");
+}
+
+TEST(BuildEvaluation, DerivesTheTimeScaleOfASampledLoopWhoseDtEqFourSpacingIsNoMultipleOf) {
+  // A thermal plant sampled every second: eq. (4)'s 0.05 s is no multiple of
+  // dt = 1 s, and neither horizon nor spacing was given, so both come from
+  // the closed loop, the spacing a multiple of dt.
+  spec::EvaluateSpec s;
+  s.plant.plant = "custom";
+  s.plant.num = {1.0};
+  s.plant.den = {100.0, 1.0};
+  s.plant.delay_s = 10.0;
+  s.gains = {2.0, 0.02, 0.0};
+  s.loop.loop = "sampled";
+  s.loop.dt_s = 1.0;
+  EvaluationProblem dut;
+  const Status status = BuildEvaluation(s, Flags(), &dut);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(dut.time_scale.source, "plant");
+  EXPECT_GE(dut.spec.loop.sample_time_s, 1.0);
+  EXPECT_EQ(dut.spec.loop.sample_time_s, std::round(dut.spec.loop.sample_time_s));
+  EXPECT_GT(dut.spec.loop.horizon_s, 100.0) << "ten closed-loop time constants of a 100 s plant";
+}
+
+TEST(BuildController, BuildsTheSampledControllerAtADtEqFourSpacingIsNoMultipleOf) {
+  spec::EvaluateSpec s = Oscillator();
+  s.loop.loop = "sampled";
+  s.loop.dt_s = 1.0;
+  PidGains gains;
+  evaluation::LoopOptions loop;
+  const Status status = BuildController(s, NameStyle::kKey, &gains, &loop);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(loop.dt_s, 1.0);
+  EXPECT_EQ(gains.kp, 2.0);
 }
 
 TEST(BuildEvaluation, RefusesADeadTimeLongerThanTheSampledLoopsDelayLine) {

@@ -13,6 +13,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "identify_record.h"
 #include "pidlab/figures/figures.h"
 #include "pidlab/identify/csv_data.h"
 #include "pidlab/identify/identify.h"
@@ -232,12 +233,7 @@ struct IdentifyCommand {
   identify::IdentifyData ReadData() const {
     identify::IdentifyData data;
     if (!csv.empty()) {
-      std::vector<long> rows;
-      Require(identify::ReadCsvData(csv, &data, &rows));
-      // The record's rules checked here too, so that a refusal names the row.
-      identify::Sampling sampling;
-      const Status checked = identify::CheckData(data, &sampling, &rows);
-      if (!checked.ok()) throw BadInput(Source() + ": " + checked.message());
+      Require(ReadCsvRecord(csv, Source(), &data));
       return data;
     }
     replay::LogContents contents;
@@ -247,7 +243,8 @@ struct IdentifyCommand {
     // evaluate run logs its undisturbed twin too, whose input is constant).
     std::vector<const replay::Episode*> found;
     for (const replay::Episode& e : contents.episodes)
-      if (episode.empty() ? e.has_config && e.Complete() && InputVaries(e) : e.episode_id == episode[0])
+      if (episode.empty() ? e.has_config && e.Complete() && EpisodeInputVaries(e)
+                          : e.episode_id == episode[0])
         found.push_back(&e);
     if (!episode.empty() && found.empty())
       throw BadInput("--episode " + std::to_string(episode[0]) + " is not in " + Quote(log));
@@ -264,22 +261,7 @@ struct IdentifyCommand {
     if (!e.Complete())
       throw BadInput("--log " + Quote(log) + ": episode " + std::to_string(e.episode_id) +
                      " is incomplete: " + Truncate(e.CompletenessNote(), 200));
-    // Step k: y_k measured, then u_k + n_k held over [k dt, (k + 1) dt).
-    for (long k = 0; k < e.total_steps; ++k) {
-      const auto i = static_cast<std::size_t>(k);
-      data.t.push_back(static_cast<double>(k) * e.spec.dt_s);
-      data.u.push_back(e.u[i] + e.n[i]);
-      data.y.push_back(e.y[i]);
-    }
-    return data;
-  }
-
-  static bool InputVaries(const replay::Episode& e) {
-    for (long k = 1; k < e.total_steps; ++k) {
-      const auto i = static_cast<std::size_t>(k);
-      if (e.u[i] + e.n[i] != e.u[0] + e.n[0]) return true;
-    }
-    return false;
+    return EpisodeRecord(e);
   }
 
   // --poles and --zeros: given with tf only, within their ranges.
@@ -379,16 +361,15 @@ struct IdentifyCommand {
     // On a terminal only: a log or a test's captured stderr keeps its one
     // line (README, "Exit status and limits").
     if (!quiet && ::isatty(STDERR_FILENO)) options.progress = ProgressPrinter();
-    IdentifyResult result;
-    nlohmann::json j;
+    results::IdentifyRun run;
+    const Status status = results::RunIdentify(data, automatic ? "auto" : model, options, &run);
+    if (status.code() == StatusCode::kInvalidInput) throw BadInput(Source() + ": " + status.message());
+    Require(Status(status.code(), Source() + ": " + status.message()));
+    const IdentifyResult& result = run.result;
+    nlohmann::json& j = run.json;
     std::string header;
     if (automatic) {
-      identify::AutoResult a;
-      const Status status = identify::IdentifyAuto(data, options, &a);
-      if (status.code() == StatusCode::kInvalidInput) throw BadInput(Source() + ": " + status.message());
-      Require(Status(status.code(), Source() + ": " + status.message()));
-      result = a.candidates[static_cast<std::size_t>(a.chosen)].result;
-      j = results::IdentifyAutoJson(a);
+      const identify::AutoResult& a = run.automatic;
       std::ostringstream os;
       os << "auto: " << a.reason << "\n";
       for (const identify::AutoCandidate& c : a.candidates)
@@ -397,11 +378,6 @@ struct IdentifyCommand {
                              : "failed: " + c.status.message())
            << "\n";
       header = os.str();
-    } else {
-      const Status status = identify::Identify(data, kind, options, &result);
-      if (status.code() == StatusCode::kInvalidInput) throw BadInput(Source() + ": " + status.message());
-      Require(Status(status.code(), Source() + ": " + status.message()));
-      j = results::IdentifyResultJson(result);
     }
     if (!log.empty()) {
       j["source"] = {{"log", log}, {"episode", chosen_episode}};

@@ -222,7 +222,70 @@ server::Reply LogStore::Upload(const std::string& name, const std::string& body)
   return {200, {{"log_id", id}, {"name", name}, {"bytes", body.size()}}};
 }
 
+// An id as the page sent it: a string, or any other JSON as its text.
+static std::string IdText(const nlohmann::json& id) {
+  return id.is_string() ? id.get<std::string>() : id.dump();
+}
+
+bool LogStore::UploadedFile(const nlohmann::json& id, std::string* path, std::string* name,
+                            std::string* error) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::string key = IdText(id);
+  const auto upload = uploads_.find(key);
+  if (upload == uploads_.end()) {
+    *error = "upload_id " + Quote(Truncate(key, 200)) + " is no upload (at most " +
+             std::to_string(kMaxUploads) + " are kept: upload it again)";
+    return false;
+  }
+  *path = upload->second.path;
+  *name = upload->second.name;
+  return true;
+}
+
+bool LogStore::OpenedEpisode(const nlohmann::json& log_id, const nlohmann::json& index,
+                             replay::Episode* episode, std::string* name, std::string* error) {
+  std::shared_ptr<OpenLog> log;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = open_.find(IdText(log_id));
+    if (it == open_.end()) {
+      *error = "log_id " + Quote(Truncate(IdText(log_id), 200)) + " is not open (at most " +
+               std::to_string(kMaxOpenLogs) + " logs are kept open: open it again)";
+      return false;
+    }
+    log = it->second;
+  }
+  const long count = static_cast<long>(log->contents.episodes.size());
+  if (!index.is_number_integer() || index.get<long>() < 0 || index.get<long>() >= count) {
+    *error = "index " + Truncate(index.dump(), 50) + " is not an episode of the log (0.." +
+             std::to_string(count - 1) + ")";
+    return false;
+  }
+  *episode = log->contents.episodes[static_cast<std::size_t>(index.get<long>())];
+  *name = log->name;
+  return true;
+}
+
+std::string LogStore::StoreModel(const std::string& text, std::string* error) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::string file =
+      (fs::path(upload_dir_) / ("model" + std::to_string(++next_model_) + ".json")).string();
+  if (const Status stored = io::WriteFile(file, text); !stored.ok()) {
+    *error = "the model could not be stored: " + stored.message();
+    return "";
+  }
+  models_.push_back(file);
+  while (models_.size() > kMaxModels) {
+    std::error_code ignored;
+    fs::remove(models_.front(), ignored);
+    models_.pop_front();
+  }
+  return file;
+}
+
 void ServeLogs(LogStore* store) { g_store = store; }
+
+LogStore* ServedLogs() { return g_store; }
 
 server::Reply AnswerLogOpen(const nlohmann::json& request) {
   return g_store ? g_store->Open(request) : Bad("logs are not served here");

@@ -45,6 +45,18 @@ class LogStore {
 
   const std::string& upload_dir() const { return upload_dir_; }
 
+  /// The file of upload `id` and the name it was uploaded as; 400 text in
+  /// *error when there is none.
+  bool UploadedFile(const nlohmann::json& id, std::string* path, std::string* name, std::string* error);
+  /// A copy of episode `index` of the opened log `log_id`, and the log's name.
+  bool OpenedEpisode(const nlohmann::json& log_id, const nlohmann::json& index, replay::Episode* episode,
+                     std::string* name, std::string* error);
+  /// Writes `text` as a new model file in the uploads' directory (at most
+  /// kMaxModels kept, the oldest deleted first); its path, or "" when it
+  /// could not be written (*error says why).
+  std::string StoreModel(const std::string& text, std::string* error);
+  static constexpr std::size_t kMaxModels = 32;
+
  private:
   struct OpenLog {
     std::string name;
@@ -64,11 +76,15 @@ class LogStore {
   std::deque<std::string> open_order_;                    // ids in open_, oldest first
   std::map<std::string, StoredUpload> uploads_;           // upload's log id -> file
   std::deque<std::string> upload_order_;                  // ids in uploads_, oldest first
+  std::deque<std::string> models_;                        // model files written, oldest first
+  long next_model_ = 0;
   void Remember(const std::string& id, std::shared_ptr<OpenLog> log);
 };
 
 /// The store log_open, log_episode and uploads use (null: not served).
 void ServeLogs(LogStore* store);
+/// The store of ServeLogs (null: logs and uploads are not served).
+LogStore* ServedLogs();
 /// The log requests' answers through the store of ServeLogs (400 without one).
 server::Reply AnswerLogOpen(const nlohmann::json& request);
 server::Reply AnswerLogEpisode(const nlohmann::json& request);

@@ -122,14 +122,17 @@ server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
   if (type == "export") return Export(request);
   if (type == "tune") return AnswerTune(request, connection);
   if (type == "tune_cancel") return AnswerTuneCancel(connection);
+  if (type == "identify") return AnswerIdentify(request, connection);
+  if (type == "identify_cancel")
+    return {200, {{"type", "identify_cancel"}, {"cancelling", CancelConnectionJob(connection, "identify")}}};
 #else
   (void)connection;
 #endif
   return {
       400,
       {{"error", "request type '" + type +
-                     "' is not one of evaluate, fields, paper_designs, export, tune, tune_cancel, log_open, "
-                     "log_episode"}}};
+                     "' is not one of evaluate, fields, paper_designs, export, tune, tune_cancel, identify, "
+                     "identify_cancel, log_open, log_episode"}}};
 }
 
 }  // namespace pidlab::cli

@@ -3,8 +3,10 @@
 // answered with the code of the command line: evaluate (with the plot
 // series), fields, paper_designs. `pidlab serve` passes Answer to the server.
 
+#include <atomic>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "pidlab/server/server.h"
 
@@ -25,6 +27,25 @@ server::Reply AnswerTune(const nlohmann::json& request,
                          const std::shared_ptr<server::Connection>& connection);
 /// tune_cancel: stops the connection's running tuning at its next iteration.
 server::Reply AnswerTuneCancel(const std::shared_ptr<server::Connection>& connection);
+
+/// A job on a thread of its own for one connection (a tuning, a fit): at
+/// most one of each kind per connection, cancelled when it closes.
+struct ConnectionJob {
+  std::atomic<bool> cancel{false};
+  std::atomic<bool> done{false};
+};
+/// A new job of `kind` ("tune", "identify") on `connection`, or null with
+/// *refusal set when one of that kind is still running.
+std::shared_ptr<ConnectionJob> StartConnectionJob(const std::shared_ptr<server::Connection>& connection,
+                                                  const std::string& kind, std::string* refusal);
+/// Asks the connection's running job of `kind` to stop; false if none runs.
+bool CancelConnectionJob(const std::shared_ptr<server::Connection>& connection, const std::string& kind);
+
+/// identify (serve_identify.cc): fits request["model"] to an uploaded CSV
+/// (upload_id) or an opened log's episode (log_id, index) on a thread, as
+/// `pidlab identify` does; progress and result are posted on `connection`.
+server::Reply AnswerIdentify(const nlohmann::json& request,
+                             const std::shared_ptr<server::Connection>& connection);
 
 /// The paper's published gains (Tables II-VI, the report's built-in
 /// data/paper_tables.csv): [{table, plant, method, disturbance_amplitude,

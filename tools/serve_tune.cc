@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <string>
 #include <thread>
@@ -16,23 +17,18 @@
 namespace pidlab::cli {
 namespace {
 
-struct TuneJob {
-  std::atomic<bool> cancel{false};
-  std::atomic<bool> done{false};
-};
-
-// The connection's state: its latest tuning, cancelled when the connection closes.
-struct TuneSlot {
-  std::shared_ptr<TuneJob> job;
-  ~TuneSlot() {
-    if (job) job->cancel = true;
+// The connection's jobs, one per kind, cancelled when the connection closes.
+struct ConnectionJobs {
+  std::map<std::string, std::shared_ptr<ConnectionJob>> jobs;
+  ~ConnectionJobs() {
+    for (auto& [kind, job] : jobs) job->cancel = true;
   }
 };
 
 struct Cancelled {};
 
-optim::ProgressCallback ProgressPoster(std::shared_ptr<TuneJob> job, std::shared_ptr<server::Connection> out,
-                                       nlohmann::json id) {
+optim::ProgressCallback ProgressPoster(std::shared_ptr<ConnectionJob> job,
+                                       std::shared_ptr<server::Connection> out, nlohmann::json id) {
   auto last = std::make_shared<std::chrono::steady_clock::time_point>();
   return [job, out, id, last](const optim::TracePoint& tp) {
     if (job->cancel || out->closed()) throw Cancelled{};
@@ -47,8 +43,8 @@ optim::ProgressCallback ProgressPoster(std::shared_ptr<TuneJob> job, std::shared
   };
 }
 
-void RunTuning(std::shared_ptr<TuneJob> job, std::shared_ptr<server::Connection> out, nlohmann::json spec,
-               nlohmann::json id) {
+void RunTuning(std::shared_ptr<ConnectionJob> job, std::shared_ptr<server::Connection> out,
+               nlohmann::json spec, nlohmann::json id) {
   nlohmann::json reply;
   try {
     nlohmann::json result;
@@ -69,29 +65,46 @@ void RunTuning(std::shared_ptr<TuneJob> job, std::shared_ptr<server::Connection>
 
 }  // namespace
 
+std::shared_ptr<ConnectionJob> StartConnectionJob(const std::shared_ptr<server::Connection>& connection,
+                                                  const std::string& kind, std::string* refusal) {
+  auto jobs = std::static_pointer_cast<ConnectionJobs>(connection->state);
+  if (!jobs) {
+    jobs = std::make_shared<ConnectionJobs>();
+    connection->state = jobs;
+  }
+  std::shared_ptr<ConnectionJob>& job = jobs->jobs[kind];
+  if (job && !job->done) {
+    *refusal = "a " + kind + " job is already running on this connection: " + kind + "_cancel it first";
+    return nullptr;
+  }
+  job = std::make_shared<ConnectionJob>();
+  return job;
+}
+
+bool CancelConnectionJob(const std::shared_ptr<server::Connection>& connection, const std::string& kind) {
+  auto jobs = connection ? std::static_pointer_cast<ConnectionJobs>(connection->state) : nullptr;
+  if (!jobs) return false;
+  const auto it = jobs->jobs.find(kind);
+  const bool running = it != jobs->jobs.end() && it->second && !it->second->done;
+  if (running) it->second->cancel = true;
+  return running;
+}
+
 server::Reply AnswerTune(const nlohmann::json& request,
                          const std::shared_ptr<server::Connection>& connection) {
   if (!connection) return {400, {{"error", "tune runs over the WebSocket /ws, which carries its progress"}}};
   if (!request.contains("spec") || !request["spec"].is_object())
     return {400, {{"error", "a tune request needs a spec object"}}};
-  auto slot = std::static_pointer_cast<TuneSlot>(connection->state);
-  if (slot && slot->job && !slot->job->done)
-    return {400, {{"error", "a tuning is already running on this connection: tune_cancel it first"}}};
-  if (!slot) {
-    slot = std::make_shared<TuneSlot>();
-    connection->state = slot;
-  }
-  slot->job = std::make_shared<TuneJob>();
-  std::thread(RunTuning, slot->job, connection, request["spec"], request.value("id", nlohmann::json(nullptr)))
+  std::string refusal;
+  const std::shared_ptr<ConnectionJob> job = StartConnectionJob(connection, "tune", &refusal);
+  if (!job) return {400, {{"error", refusal}}};
+  std::thread(RunTuning, job, connection, request["spec"], request.value("id", nlohmann::json(nullptr)))
       .detach();
   return {200, nullptr};  // the progress and the result follow on the connection
 }
 
 server::Reply AnswerTuneCancel(const std::shared_ptr<server::Connection>& connection) {
-  auto slot = connection ? std::static_pointer_cast<TuneSlot>(connection->state) : nullptr;
-  const bool running = slot && slot->job && !slot->job->done;
-  if (running) slot->job->cancel = true;
-  return {200, {{"type", "tune_cancel"}, {"cancelling", running}}};
+  return {200, {{"type", "tune_cancel"}, {"cancelling", CancelConnectionJob(connection, "tune")}}};
 }
 
 }  // namespace pidlab::cli

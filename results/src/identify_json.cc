@@ -148,4 +148,35 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
   return j;
 }
 
+Status RunIdentify(const identify::IdentifyData& data, const std::string& model,
+                   const identify::IdentifyOptions& options, IdentifyRun* run) {
+  if (model == "auto") {
+    identify::AutoResult& a = run->automatic;
+    if (Status st = identify::IdentifyAuto(data, options, &a); !st.ok()) return st;
+    run->result = a.candidates[static_cast<std::size_t>(a.chosen)].result;
+    run->json = IdentifyAutoJson(a);
+    return Status::Ok();
+  }
+  identify::ProcessModelKind kind = identify::ProcessModelKind::kP1D;
+  if (!identify::Parse(model, &kind))
+    return Status::InvalidInput("model '" + model + "' must be one of " + identify::ProcessModelKindNames() +
+                                "|auto");
+  if (Status st = identify::Identify(data, kind, options, &run->result); !st.ok()) return st;
+  run->json = IdentifyResultJson(run->result);
+  return Status::Ok();
+}
+
+nlohmann::json IdentifyFitSeries(const identify::IdentifyData& data, const identify::IdentifyResult& r) {
+  const auto numbers = [](const std::vector<double>& v) {
+    nlohmann::json out = nlohmann::json::array();
+    for (double x : v) out.push_back(JsonNumber(x));
+    return out;
+  };
+  return {{"t", numbers(data.t)},
+          {"u", numbers(data.u)},
+          {"y", numbers(data.y)},
+          {"simulated", numbers(r.simulated)},
+          {"residuals", numbers(r.residuals)}};
+}
+
 }  // namespace pidlab::results

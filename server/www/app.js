@@ -4,6 +4,7 @@
 import { createPlots, destroyPlots, drawPlots } from './plots.js';
 import { initLive, initTrio } from './live.js';
 import { initLogs } from './logs.js';
+import { initDesign, suggestDt } from './design.js';
 
 const token = new URLSearchParams(location.search).get('token');
 const plants = ['double_integrator', 'oscillator', 'stepper_motor', 'custom', 'stepper_nonlinear', 'model'];
@@ -145,13 +146,33 @@ function showMetrics(r) {
   }
 }
 
+// The few numbers an engineer reads first, beside the knobs.
+function showKeyMetrics(r) {
+  const rb = r.robustness || {};
+  const g = r.gains || {};
+  const rows = [['kp, ki, kd', [g.kp, g.ki, g.kd].map(fmt).join(', ')], ['tf s', fmt(g.tf)],
+    ['overshoot %', fmt(r.overshoot_pct)], ['settling s', fmt(r.settling_time_s)], ['load IAE', fmt(r.load_iae)],
+    ['Ms', fmt(rb.ms)], ['phase margin', fmt(rb.phase_margin_deg) + ' deg'], ['stable', fmt(r.stable)]];
+  const body = document.querySelector('#key-metrics tbody');
+  body.textContent = '';
+  for (const [name, text] of rows) {
+    const tr = document.createElement('tr');
+    const th = document.createElement('th'); th.textContent = name;
+    const td = document.createElement('td'); td.textContent = text;
+    tr.append(th, td);
+    body.append(tr);
+  }
+}
+
 function show(reply, sent, reply_ms) {
   pidlab.lastResult = reply.result;
   pidlab.lastSeries = reply.series;
   setStatus('');
   showMetrics(reply.result);
+  showKeyMetrics(reply.result);
+  if (!$('fw-dt').value) { const dt = suggestDt(reply.result); if (dt) $('fw-dt').value = dt; }
   $('notes').textContent = (reply.series.notes || []).join('; ') + ((reply.result.robustness || {}).violations || []).map((v) => '; breaks ' + v).join('');
-  drawPlots(pidlab.plots, reply.series, pidlab.pinned, pidlab.trioOverlay);
+  drawPlots(pidlab.plots, reply.series, pidlab.pinned, pidlab.trioOverlay, sampledOverlay());
   $('spec').textContent = JSON.stringify(reply.result.spec);
   $('command').textContent = pidlab.command();
   renderDiff();
@@ -170,6 +191,7 @@ function onMessage(reply, arrived_ms) {
     return;
   }
   if (reply.type === 'tune_progress') { tuneProgress(reply); return; }
+  if (reply.type === 'identify_progress') { views.design.onIdentifyProgress(reply); return; }
   if (views.live.onMessage(reply) || views.trio.onMessage(reply)) {
     if (reply.id === undefined || !waiting.has(reply.id)) return;
   }
@@ -218,9 +240,37 @@ function setGainBoxes(g) {
   $(g + '-slider').value = state[g] > 0 ? Math.log10(state[g]) : -3;
 }
 
+// The firmware's sampled loop, while it belongs to the design drawn.
+function sampledOverlay() {
+  const d = views.design && views.design.sampled;
+  return d && d.spec === JSON.stringify(withoutLoop(spec())) ? d.series : null;
+}
+function withoutLoop(s) { const c = { ...s }; delete c.loop; delete c.dt; return c; }
+
+// What belongs to a plant goes when the plant changes: the filter, the
+// weights, the limits, the bounds, the pinned designs, the trio's and the
+// firmware's runs, the knobs. `fields`: the new plant's state fields.
+function resetPlant(fields) {
+  for (const k of ['derivative_filter', 'setpoint_weight_b', 'setpoint_weight_c', 'limit_lo', 'limit_hi', 'max_ms', 'max_mt',
+    'max_noise_gain', 'min_phase_margin', 'monte_carlo', 'spread', 'dt']) state[k] = '';
+  state.loop = 'continuous';
+  Object.assign(state, fields);
+  pidlab.pinned = [];
+  pidlab.trioOverlay = null;
+  pidlab.lastTune = null;
+  if (views.design) { views.design.sampled = null; views.design.export = null; views.design.resetKnob(); }
+  $('fw-dt').value = '';
+  $('fw-verdict').textContent = '';
+  for (const id of ['fw-download-c', 'fw-download-h']) $(id).classList.add('hidden');
+  renderPinned();
+  rebuildPlots();
+  showForm();
+}
+pidlab.resetPlant = resetPlant;
+
 // Sets the design from a spec-like object (a paper design, a tuning, a pin).
 function setDesign(d) {
-  if (d.plant !== undefined) state.plant = d.plant;
+  if (d.plant !== undefined && d.plant !== state.plant) resetPlant({ plant: d.plant });
   if (d.gains) [state.kp, state.ki, state.kd] = d.gains;
   showForm();
   send();
@@ -244,7 +294,7 @@ function rebuildPlots() {
   destroyPlots(pidlab.plots);
   const el = (k) => $('plot-' + k);
   pidlab.plots = createPlots({ step: el('step'), effort: el('effort'), load: el('load'), freq: el('freq'), nyquist: el('nyquist') }, pidlab.pinned);
-  if (pidlab.lastSeries) drawPlots(pidlab.plots, pidlab.lastSeries, pidlab.pinned, pidlab.trioOverlay);
+  if (pidlab.lastSeries) drawPlots(pidlab.plots, pidlab.lastSeries, pidlab.pinned, pidlab.trioOverlay, sampledOverlay());
 }
 
 function pin(label) {
@@ -355,6 +405,24 @@ async function tune(options) {
   }
 }
 
+// A tuning spec run on the server, its gains, filter and setpoint weights
+// made the design, and the design evaluated (the knobs' designs).
+async function tuneSpec(s) {
+  const reply = await ask({ type: 'tune', spec: s });
+  const r = reply.result;
+  pidlab.lastTune = r;
+  const g = r.gains;
+  state.kp = g.kp; state.ki = g.ki; state.kd = g.kd;
+  state.derivative_filter = g.tf > 0 ? g.tf : '';
+  const w = r.two_dof && r.two_dof.ran ? r.two_dof.setpoint_weights : null;
+  state.setpoint_weight_b = w ? w[0] : '';
+  state.setpoint_weight_c = w ? w[1] : '';
+  showForm();
+  await evaluated();
+  return r;
+}
+pidlab.tuneSpec = tuneSpec;
+
 // Resolves once the current design's reply is drawn.
 function evaluated() {
   send();
@@ -406,7 +474,10 @@ for (const p of plants) {
   $('plant').append(o);
 }
 for (const name of ['kp', 'ki', 'kd']) slider(name);
-$('plant').addEventListener('change', () => { state.plant = $('plant').value; showForm(); send(); });
+$('plant').addEventListener('change', () => {
+  resetPlant({ plant: $('plant').value });
+  send();
+});
 $('loop').addEventListener('change', () => { state.loop = $('loop').value; send(); });
 for (const k of textFields) $(k).addEventListener('change', () => { state[k] = $(k).value; send(); });
 // The bounds also as sliders (linear, or log10 for the noise gain): moving
@@ -445,6 +516,8 @@ const views = {};
 views.live = initLive({ rawSend });
 views.trio = initTrio({ ask, spec, setStatus, redraw: rebuildPlots });
 initLogs({ ask, token });
+views.design = initDesign({ state, ask, rawSend, token, spec, setStatus, fmt, resetPlant, tune: tuneSpec,
+  redraw: rebuildPlots, lastResult: () => pidlab.lastResult });
 // server_info: live when pidlab serve has --lcm-url (an older server does not know the request).
 async function serverInfo() {
   try {

@@ -19,37 +19,114 @@ function size(el) {
   return { width: Math.max(300, el.clientWidth || 560), height: 220 };
 }
 
-function timeChart(el, title, yLabel, label, pinned, band) {
+// The optional series of the step plot, in order, each drawn only when the
+// reply has it (a legend lists only what is drawn).
+const stepExtras = {
+  linear: { label: 'eq. (3) linear model', stroke: '#555', width: 1, dash: [2, 3] },
+  band: null,  // the Monte-Carlo max and min, filled between
+  sampled: { label: 'sampled at dt (firmware)', stroke: '#8c564b', width: 1.5 },
+  trio: { label: 'trio y', stroke: '#ff7f0e', width: 2, dash: [3, 3] },
+};
+
+function timeChart(el, title, yLabel, label, pinned, extras, clip) {
   const series = [{ label: 't s' }, { label, stroke: colours[0], width: 2 }];
   pinned.forEach((p, i) => series.push({ label: p.label, stroke: pinColour(i), width: 1, dash: [6, 3] }));
   const opts = { title, ...size(el), series, scales: { x: { time: false } }, axes: [{ label: 't (s)' }, { label: yLabel }] };
-  if (band) {  // eq. (3)'s linear motor (nonlinear stepper), then the Monte-Carlo band: the last two series, filled between
-    series.push({ label: 'eq. (3) linear model', stroke: '#555', width: 1, dash: [2, 3] });
-    const n = series.length;
-    series.push({ label: 'Monte Carlo max', stroke: 'rgba(31,119,180,0.3)', width: 1 });
-    series.push({ label: 'Monte Carlo min', stroke: 'rgba(31,119,180,0.3)', width: 1 });
-    opts.bands = [{ series: [n, n + 1], fill: 'rgba(31,119,180,0.15)' }];
-    // "Run on the trio": the trio's y at the same sample times, last.
-    series.push({ label: 'trio y', stroke: '#ff7f0e', width: 2, dash: [3, 3] });
+  for (const k of extras || []) {
+    if (k === 'band') {
+      const n = series.length;
+      series.push({ label: 'Monte Carlo max', stroke: 'rgba(31,119,180,0.3)', width: 1 });
+      series.push({ label: 'Monte Carlo min', stroke: 'rgba(31,119,180,0.3)', width: 1 });
+      opts.bands = [{ series: [n, n + 1], fill: 'rgba(31,119,180,0.15)' }];
+    } else {
+      series.push({ ...stepExtras[k] });
+    }
   }
-  return new uPlot(opts, series.map((_, i) => (i === 0 ? [] : [])), el);
+  if (clip) {  // the effort: the axis fitted to u after the derivative kick (chart.pidlabClip), the kick marked
+    opts.scales.y = { range: (u, lo, hi) => (u.pidlabClip && u.pidlabClip.range) || [lo, hi] };
+    opts.hooks = { draw: [(u) => drawKick(u, u.pidlabClip)] };
+  }
+  const chart = new uPlot(opts, series.map(() => []), el);
+  chart.pidlabExtras = (extras || []).join(',');
+  return chart;
 }
 
+// The derivative kick: u at the first samples, far outside the rest. The
+// axis is fitted to u from the first sample where |u| is back within 3 times
+// the rest's span; the clipped samples are named in the chart.
+function effortClip(t, u) {
+  const finite = u.filter((v) => v !== null && isFinite(v));
+  if (finite.length < 10) return { range: null, kick: null };
+  let start = 0;
+  const restOf = (k) => finite.slice(k);
+  const spanOf = (v) => Math.max(...v) - Math.min(...v);
+  // The tail after the first 2 % of the samples sets the scale.
+  const tail = restOf(Math.ceil(finite.length * 0.02));
+  const lo = Math.min(...tail), hi = Math.max(...tail);
+  const span = Math.max(spanOf(tail), Math.abs(hi), Math.abs(lo), 1e-12);
+  while (start < u.length && u[start] !== null && (u[start] > hi + 3 * span || u[start] < lo - 3 * span)) start++;
+  if (start === 0) return { range: null, kick: null };
+  const peak = u.slice(0, start).reduce((m, v) => (Math.abs(v) > Math.abs(m) ? v : m), 0);
+  const pad = 0.1 * (hi - lo || span);
+  return { range: [Math.min(lo, 0) - pad, Math.max(hi, 0) + pad], kick: { t: t[0], until: t[start], peak } };
+}
+
+function drawKick(u, clip) {
+  if (!clip || !clip.kick) return;
+  const ctx = u.ctx;
+  const x = u.valToPos(clip.kick.t, 'x', true);
+  ctx.save();
+  ctx.fillStyle = '#b00';
+  ctx.font = (12 * devicePixelRatio) + 'px system-ui, sans-serif';
+  ctx.fillText('\u2191 derivative kick, u up to ' + Number(clip.kick.peak.toPrecision(4)) + ' (clipped)', x + 6 * devicePixelRatio, u.bbox.top + 14 * devicePixelRatio);
+  ctx.restore();
+}
+
+// Bode: |L|, |S|, |T| and |CS| in dB (the Ms line dashed), the phase of L
+// in degrees on the right axis.
 function freqChart(el, pinned) {
   const series = [{ label: 'w rad/s' },
-    { label: '|S|', stroke: colours[0], width: 2 },
-    { label: '|T|', stroke: colours[2], width: 2 },
-    { label: '|CS|', stroke: colours[4], width: 1 },
-    { label: 'Ms', stroke: '#888', width: 1, dash: [4, 4] }];
+    { label: '|L| dB', stroke: '#000', width: 1.5 },
+    { label: '|S| dB', stroke: colours[0], width: 2 },
+    { label: '|T| dB', stroke: colours[2], width: 2 },
+    { label: '|CS| dB', stroke: colours[4], width: 1 },
+    { label: 'Ms dB', stroke: '#888', width: 1, dash: [4, 4] },
+    { label: 'phase L deg', stroke: '#9467bd', width: 1.5, dash: [8, 3], scale: 'deg' }];
   pinned.forEach((p, i) => {
-    series.push({ label: p.label + ' |S|', stroke: pinColour(i), width: 1, dash: [6, 3] });
-    series.push({ label: p.label + ' |T|', stroke: pinColour(i), width: 1, dash: [2, 2] });
+    series.push({ label: p.label + ' |S| dB', stroke: pinColour(i), width: 1, dash: [6, 3] });
+    series.push({ label: p.label + ' |T| dB', stroke: pinColour(i), width: 1, dash: [2, 2] });
   });
   return new uPlot({
-    title: '|S|, |T|, |CS| (Ms dashed)', ...size(el), series,
-    scales: { x: { time: false, distr: 3 }, y: { distr: 3 } },
-    axes: [{ label: 'w (rad/s)', values: logTicks }, { label: 'gain', values: logTicks }],
-  }, [[], [], [], [], [], ...pinned.flatMap(() => [[], []])], el);
+    title: 'Bode: |L|, |S|, |T|, |CS| (dB) and the phase of L', ...size(el), series,
+    scales: { x: { time: false, distr: 3 }, y: { auto: true }, deg: { auto: true } },
+    axes: [{ label: 'w (rad/s)', values: logTicks }, { label: 'dB' }, { label: 'phase (deg)', scale: 'deg', side: 1, grid: { show: false } }],
+  }, [[], [], [], [], [], [], [], ...pinned.flatMap(() => [[], []])], el);
+}
+
+const dB = (v) => (v === null || !(v > 0) ? null : 20 * Math.log10(v));
+
+// The phase of L in degrees, unwrapped along the grid (drawing only).
+function phaseDeg(re, im) {
+  const out = [];
+  let last = null, turn = 0;
+  for (let i = 0; i < re.length; i++) {
+    if (re[i] === null || im[i] === null) { out.push(null); continue; }
+    let p = (Math.atan2(im[i], re[i]) * 180) / Math.PI + turn;
+    if (last !== null) {
+      while (p - last > 180) { p -= 360; turn -= 360; }
+      while (p - last < -180) { p += 360; turn += 360; }
+    }
+    out.push(p);
+    last = p;
+  }
+  return out;
+}
+
+const kNyquistX = [-3.5, 1.5];
+const aspect = (u) => (u.bbox && u.bbox.width > 0 ? u.bbox.height / u.bbox.width : 1);
+function square(el) {
+  const w = Math.max(300, Math.min(el.clientWidth || 420, 420));
+  return { width: w, height: w - 10 };
 }
 
 // Each design's Nyquist curve is drawn as up to kSegments series, one per
@@ -66,9 +143,12 @@ function nyquistChart(el, pinned) {
   pinned.forEach((p, i) => series.push(...segments(p.label, pinColour(i), 1, [6, 3])));
   const empty = () => [[], []];
   return new uPlot({
-    mode: 2, title: 'Nyquist of L (1/Ms circle around -1)', ...size(el), series,
+    mode: 2, title: 'Nyquist of L (1/Ms circle around -1, equal axes)', ...square(el), series,
     legend: { show: false }, cursor: { show: false },
-    scales: { x: { time: false, auto: false, range: [-4, 2] }, y: { auto: false, range: [-3, 3] } },
+    // Equal aspect: the y span is the x span times the plotting area's
+    // height over its width, so the circle is round.
+    scales: { x: { time: false, auto: false, range: kNyquistX },
+      y: { auto: false, range: (u) => { const h = (kNyquistX[1] - kNyquistX[0]) * aspect(u) / 2; return [-h, h]; } } },
     axes: [{ label: 'Re L' }, { label: 'Im L' }],
   }, [null, ...Array.from({ length: kSegments }, empty), empty(), [[-1], [0]],
     ...pinned.flatMap(() => Array.from({ length: kSegments }, empty))], el);
@@ -138,12 +218,24 @@ function atSampleTimes(trio, t) {
   });
 }
 
+// The step plot's optional series present in a reply (and the overlays).
+function stepExtrasOf(series, trio, sampled) {
+  const mc = series.monte_carlo || {};
+  const out = [];
+  if (Array.isArray(series.linear_y)) out.push('linear');
+  if (Array.isArray(mc.y_max)) out.push('band');
+  if (sampled) out.push('sampled');
+  if (trio) out.push('trio');
+  return out;
+}
+
 // Builds the five charts in `elements` ({step, effort, load, freq, nyquist})
 // with a dashed series per pinned design.
 export function createPlots(elements, pinned) {
   return {
-    step: timeChart(elements.step, 'Setpoint step response y (Monte-Carlo band on request)', 'y', 'y', pinned, true),
-    effort: timeChart(elements.effort, 'Control effort u (step response)', 'u', 'u', pinned),
+    elements, pinnedCount: pinned.length,
+    step: timeChart(elements.step, 'Setpoint step response y', 'y', 'y', pinned, []),
+    effort: timeChart(elements.effort, 'Control effort u (step response)', 'u', 'u', pinned, [], {}),
     load: timeChart(elements.load, 'Load response y (unit step at the plant input)', 'y', 'y', pinned),
     freq: freqChart(elements.freq, pinned),
     nyquist: nyquistChart(elements.nyquist, pinned),
@@ -151,26 +243,46 @@ export function createPlots(elements, pinned) {
 }
 
 export function destroyPlots(plots) {
-  for (const k of Object.keys(plots || {})) plots[k].destroy();
+  for (const k of ['step', 'effort', 'load', 'freq', 'nyquist']) if (plots && plots[k]) plots[k].destroy();
+}
+
+// y of a series on its own grid `ts`, held from each sample to the next, at the times `t`.
+function heldAt(ts, ys, t) {
+  let j = 0;
+  return t.map((x) => {
+    if (x < ts[0] || x > ts[ts.length - 1]) return null;
+    while (j + 1 < ts.length && ts[j + 1] <= x) j++;
+    return ys[j];
+  });
 }
 
 // Sets every chart's data: the current design's `series` and the pinned ones'.
 // `trio` ({t, y}, optional): the trio's run, drawn on the step plot where
-// its sample times are the series' own.
-export function drawPlots(plots, series, pinned, trio) {
+// its sample times are the series' own. `sampled` (optional): the series of
+// the sampled loop at the firmware's dt, held between its samples.
+export function drawPlots(plots, series, pinned, trio, sampled) {
   const n = series.t.length;
-  const trioY = trio ? atSampleTimes(trio, series.t) : new Array(n).fill(null);
+  const extras = stepExtrasOf(series, trio, sampled);
+  if (plots.step.pidlabExtras !== extras.join(',')) {
+    plots.step.destroy();
+    plots.step = timeChart(plots.elements.step, 'Setpoint step response y', 'y', 'y', pinned, extras);
+  }
   const pin = (key) => pinned.map((p) => orEmpty(p.series && p.series[key], n));
   const mc = series.monte_carlo || {};
-  plots.step.setData([series.t, series.y, ...pin('y'), orEmpty(series.linear_y, n), orEmpty(mc.y_max, n), orEmpty(mc.y_min, n), trioY]);
-  plots.effort.setData([series.t, orEmpty(series.u, n), ...pin('u')]);
+  const extraData = { linear: () => [series.linear_y], band: () => [mc.y_max, mc.y_min],
+    sampled: () => [heldAt(sampled.t, sampled.y, series.t)], trio: () => [atSampleTimes(trio, series.t)] };
+  plots.step.setData([series.t, series.y, ...pin('y'), ...extras.flatMap((k) => extraData[k]())]);
+  const u = orEmpty(series.u, n);
+  plots.effort.pidlabClip = effortClip(series.t, u);
+  plots.effort.setData([series.t, u, ...pin('u')]);
   plots.load.setData([series.t, orEmpty(series.load_y, n), ...pin('load_y')]);
   const m = series.w.length;
   // A pinned design has its own grid: its curve is drawn at this grid's
   // frequencies by interpolation on log w (drawing only; its numbers are its reply's).
-  const onGrid = (p, key) => (p.series ? resample(p.series.w, p.series[key], series.w) : new Array(m).fill(null));
-  plots.freq.setData([series.w, series.s, series.t_mag, series.cs, new Array(m).fill(series.ms),
-    ...pinned.flatMap((p) => [onGrid(p, 's'), onGrid(p, 't_mag')])]);
+  const onGrid = (p, key) => (p.series ? resample(p.series.w, p.series[key], series.w).map(dB) : new Array(m).fill(null));
+  const lMag = series.l_re.map((re, i) => (re === null || series.l_im[i] === null ? null : Math.hypot(re, series.l_im[i])));
+  plots.freq.setData([series.w, lMag.map(dB), series.s.map(dB), series.t_mag.map(dB), series.cs.map(dB), new Array(m).fill(dB(series.ms)),
+    phaseDeg(series.l_re, series.l_im), ...pinned.flatMap((p) => [onGrid(p, 's'), onGrid(p, 't_mag')])]);
   plots.nyquist.setData([null, ...nyquistSegments(series), circle(series.ms), [[-1], [0]],
     ...pinned.flatMap((p) => nyquistSegments(p.series))]);
 }

@@ -132,7 +132,17 @@ Status BuildController(const spec::EvaluateSpec& s, NameStyle style, PidGains* g
   std::string error;
   PidGains g;
   evaluation::LoopOptions l;
-  if (!BuildGains(s.gains, style, &g, &error) || !BuildLoopOptions(s.loop, style, &l, &error))
+  // The controller does not sample the response: on the sampled loop the
+  // evaluation's grid is made a multiple of dt, so that a dt the default
+  // spacing is no multiple of (1 s against eq. (4)'s 0.05 s) builds.
+  spec::LoopSpec loop_spec = s.loop;
+  if (loop_spec.loop == "sampled" && loop_spec.dt_s > 0.0 && std::isfinite(loop_spec.dt_s)) {
+    loop_spec.sample_time_s =
+        loop_spec.dt_s * std::max(1.0, std::round(loop_spec.sample_time_s / loop_spec.dt_s));
+    loop_spec.horizon_s =
+        loop_spec.sample_time_s * std::ceil(loop_spec.horizon_s / loop_spec.sample_time_s - 1e-9);
+  }
+  if (!BuildGains(s.gains, style, &g, &error) || !BuildLoopOptions(loop_spec, style, &l, &error))
     return Status::InvalidInput(error);
   *gains = g;
   *loop = l;

@@ -78,9 +78,19 @@ TimeScale ResolveGainsTimeScale(const spec::PlantSpec& plant_spec, const Plant& 
   std::string error;
   const bool timed = given.count("horizon") > 0 || given.count("sample_time") > 0;
   if ((paper && scope == TimeScaleScope::kNotPaper) || (timed && scope == TimeScaleScope::kFigure) ||
-      plant.nonlinear ||
-      !BuildLoopOptions(*loop, spec::NameStyle::kKey, &options, &error))
-    return t;  // (a loop that does not build is reported by its caller)
+      plant.nonlinear)
+    return t;
+  if (!BuildLoopOptions(*loop, spec::NameStyle::kKey, &options, &error)) {
+    // The sampled loop at a dt that eq. (4)'s spacing is no multiple of
+    // (dt = 1 s on a thermal plant): the loop is analysed at the spacing dt,
+    // which the derived time scale then replaces.
+    const bool sampled_default = !timed && loop->loop == "sampled" && loop->dt_s > 0.0;
+    spec::LoopSpec probe = *loop;
+    probe.sample_time_s = loop->dt_s;
+    probe.horizon_s = loop->dt_s * std::ceil(loop->horizon_s / loop->dt_s - 1e-9);
+    if (!sampled_default || !BuildLoopOptions(probe, spec::NameStyle::kKey, &options, &error))
+      return t;  // (a loop that does not build is reported by its caller)
+  }
   TimeScale derived = GainsTimeScale(plant, gains, options);
   if (loop->loop == "sampled" && loop->dt_s > 0.0) {
     const double k = std::max(1.0, std::round(derived.sample_time_s / loop->dt_s));

@@ -4,8 +4,10 @@
 // the same keys.
 
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "pidlab/identify/identify.h"
+#include "pidlab/spec/status.h"
 
 namespace pidlab::results {
 
@@ -22,5 +24,27 @@ nlohmann::json WhitenessJson(const identify::Whiteness& w);
 /// The chosen kind's IdentifyResultJson with "auto" {chosen, reason,
 /// candidates [{model, ok, aic, delta_aic, fit_percent | message}]}.
 nlohmann::json IdentifyAutoJson(const identify::AutoResult& a);
+
+/// One fit as `pidlab identify --model MODEL` makes it: its JSON (the
+/// object of --json and --out) and the result it describes (auto: the
+/// chosen candidate's).
+struct IdentifyRun {
+  nlohmann::json json;
+  identify::IdentifyResult result;
+  /// "auto": every candidate (empty otherwise).
+  identify::AutoResult automatic;
+};
+
+/// Fits `data` with `model`, one of identify::ProcessModelKindNames() or
+/// "auto" (every process kind, the lowest AIC kept; tf needs
+/// options.poles). kInvalidInput names a bad model or record; the fit's
+/// own failures keep their code. The command line and the page's identify
+/// request both run it.
+Status RunIdentify(const identify::IdentifyData& data, const std::string& model,
+                   const identify::IdentifyOptions& options, IdentifyRun* run);
+
+/// The fit's curves for a plot: {t, u, y, simulated, residuals} (null
+/// where a number is not finite), the record's samples in order.
+nlohmann::json IdentifyFitSeries(const identify::IdentifyData& data, const identify::IdentifyResult& r);
 
 }  // namespace pidlab::results

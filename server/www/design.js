@@ -1,0 +1,246 @@
+// The tuning app's path on the Design tab (docs/workbench.md, "From data to
+// C"): a step-test CSV uploaded and fitted (the identify request: `pidlab
+// identify`'s code and JSON), the model accepted as the plant, the design's
+// two knobs (response time and robustness: `pidlab tune`'s migo with
+// --response-time and --robustness) and the firmware at a chosen dt (the
+// sampled loop beside the continuous one, the export request's check, the
+// .c and .h to download). Every number is the server's; the page only draws.
+
+const $ = (id) => document.getElementById(id);
+let app = null;  // {state, ask, spec, setDesign, setStatus, fmt, resetPlant, evaluate}
+let design = null;  // window.pidlab.design
+
+// ---- Data -> model.
+async function uploadCsv(file) {
+  const url = '/api/upload?name=' + encodeURIComponent(file.name) + (app.token ? '&token=' + encodeURIComponent(app.token) : '');
+  const res = await fetch(url, { method: 'POST', body: file, headers: { 'Content-Type': 'application/octet-stream' } });
+  const body = await res.json().catch(() => ({}));
+  if (!res.ok) throw new Error(body.error || 'upload: HTTP ' + res.status);
+  design.upload = { upload_id: body.log_id, name: body.name, bytes: body.bytes };
+  $('data-name').textContent = body.name + ' (' + body.bytes + ' bytes)';
+  $('data-identify').disabled = false;
+  return design.upload;
+}
+
+function dataStatus(text) { $('data-status').textContent = text; }
+
+function identifyProgress(m) {
+  dataStatus('fitting ' + m.model + ': ' + m.done + ' of ' + m.total + ' starts, best cost ' + app.fmt(m.best_cost));
+}
+
+// Fits the uploaded CSV (or {log_id, index} of the Logs tab) with `model`.
+async function identify(model, source) {
+  const from = source || (design.upload ? { upload_id: design.upload.upload_id } : null);
+  if (!from) throw new Error('upload a CSV first');
+  dataStatus('fitting ' + model + ' ...');
+  $('data-accept').disabled = true;
+  const u0Text = $('data-u0').value.trim();
+  const u0 = u0Text === '' ? {} : { u0: u0Text === 'estimate' ? u0Text : Number(u0Text) };
+  const reply = await app.ask({ type: 'identify', model, ...from, ...u0 });
+  design.fit = reply;
+  showFit(reply);
+  $('data-accept').disabled = false;
+  return reply;
+}
+
+function showFit(reply) {
+  const r = reply.result;
+  const chosen = r.auto ? ' (auto: ' + r.auto.reason + ')' : '';
+  dataStatus('model ' + r.model + chosen + '; fit ' + app.fmt(r.fit_percent) + ' %, residuals ' +
+    (r.whiteness.white ? 'white' : 'NOT white') + ' (Ljung-Box p = ' + app.fmt(r.whiteness.p_value) + ')');
+  const table = $('data-params');
+  table.textContent = '';
+  const head = document.createElement('tr');
+  for (const h of ['parameter', 'value', '95 % interval']) { const th = document.createElement('th'); th.textContent = h; head.append(th); }
+  table.append(head);
+  for (const [name, p] of Object.entries(r.parameters)) {
+    const tr = document.createElement('tr');
+    tr.dataset.parameter = name;
+    const se = p.standard_error;
+    const interval = p.at_bound ? 'at its ' + p.at_bound + ' bound' : se === null ? '-' : '\u00b1 ' + app.fmt(1.96 * se);
+    for (const [i, text] of [name, app.fmt(p.value), interval].entries()) {
+      const td = document.createElement(i ? 'td' : 'th'); td.textContent = text; tr.append(td);
+    }
+    tr.children[1].dataset.value = String(p.value);
+    table.append(tr);
+  }
+  $('data-warnings').textContent = (r.warnings || []).map((w) => 'warning: ' + w).join(' ');
+  drawFit(reply.fit, r.whiteness);
+  $('data-box').classList.remove('hidden');
+}
+
+function drawFit(fit, whiteness) {
+  for (const c of design.fitCharts) c.destroy();
+  design.fitCharts = [];
+  const width = Math.max(280, $('data-plots').clientWidth || 320);
+  const t = fit.t;
+  design.fitCharts.push(new uPlot({
+    title: 'measured (grey) and model (blue) y', width, height: 150, scales: { x: { time: false } },
+    series: [{ label: 't s' }, { label: 'measured', stroke: '#555', width: 1 }, { label: 'model', stroke: '#1f77b4', width: 2 }],
+    legend: { show: false }, axes: [{}, {}],
+  }, [t, fit.y, fit.simulated], $('data-plots')));
+  const lags = whiteness.autocorrelation.map((_, i) => i + 1);
+  const band = whiteness.band;
+  design.fitCharts.push(new uPlot({
+    title: 'residuals', width, height: 110, scales: { x: { time: false } },
+    series: [{ label: 't s' }, { label: 'y - model', stroke: '#d62728', width: 1 }], legend: { show: false }, axes: [{}, {}],
+  }, [t, fit.residuals], $('data-plots')));
+  design.fitCharts.push(new uPlot({
+    title: 'residual autocorrelation (\u00b1' + app.fmt(band) + ' band)', width, height: 110, scales: { x: { time: false } },
+    series: [{ label: 'lag' }, { label: 'r', stroke: '#1f77b4', width: 0, points: { show: true, size: 4 } },
+      { label: 'band', stroke: '#888', dash: [4, 4], width: 1 }, { label: '-band', stroke: '#888', dash: [4, 4], width: 1 }],
+    legend: { show: false }, axes: [{}, {}],
+  }, [lags, whiteness.autocorrelation, lags.map(() => band), lags.map(() => -band)], $('data-plots')));
+}
+
+// The fitted model becomes the plant ("model:PATH", the file the server
+// wrote), and the default design is made for it.
+function acceptModel() {
+  if (!design.fit) return null;
+  app.resetPlant({ plant: 'model', model: design.fit.plant.slice('model:'.length), delay: '' });
+  $('data-box').open = false;  // the fit stays one click away
+  return knobDesign();
+}
+
+// ---- The two knobs: migo's --response-time and --robustness.
+// Response time: the slider is log10 of T over [T0, 30 T0], T0 = 2/wc of the
+// fastest design the bound allows; its right end is "as fast as allowed" (0).
+const kSlowest = 30;
+function knobValues() {
+  const k = design.knob;
+  const speed = Number($('knob-speed').value);  // 0 slowest .. 1 fastest
+  const robust = Number($('knob-robustness').value);
+  const values = {};
+  if (speed < 1 && k.fastestTime > 0) values.response_time = Number((k.fastestTime * Math.pow(kSlowest, 1 - speed)).toPrecision(3));
+  if (k.robustnessMoved) values.robustness = Number(robust.toFixed(2));
+  return values;
+}
+
+function showKnob() {
+  const v = knobValues();
+  $('knob-speed-value').textContent = v.response_time ? 'T = ' + app.fmt(v.response_time) + ' s' : 'fastest';
+  $('knob-robustness-value').textContent = v.robustness ? 'Ms \u2264 ' + v.robustness : 'default (SIMC\u2019s Ms)';
+}
+
+// The tuning spec of the current plant with the knobs' values.
+function knobSpec() {
+  const s = app.spec();
+  for (const k of ['gains', 'monte_carlo', 'spread', 'derivative_filter', 'setpoint_weights', 'max_ms', 'max_mt', 'max_noise_gain',
+    'min_phase_margin', 'loop', 'dt']) delete s[k];
+  s.method = 'migo';
+  Object.assign(s, knobValues());
+  return s;
+}
+
+// Runs the knob's design; while one runs, the latest knob position waits
+// (latest wins).
+async function knobDesign() {
+  const k = design.knob;
+  if (k.running) { k.pending = true; return k.running; }
+  const s = knobSpec();
+  $('knob-status').textContent = 'designing ...';
+  k.running = app.tune(s, { quiet: true }).then((result) => {
+    k.last = { spec: s, result };
+    const m = result.migo || {};
+    if (!s.response_time && m.crossover_rad_s > 0) k.fastestTime = 2 / m.crossover_rad_s;
+    if (!k.robustnessMoved && m.ms_bound > 0) $('knob-robustness').value = m.ms_bound;
+    showKnob();
+    $('knob-status').textContent = 'pidlab tune ' + Object.entries(knobValues()).map(([a, b]) => '--' + a.replace('_', '-') + ' ' + b).join(' ');
+    return result;
+  }).catch((e) => { $('knob-status').textContent = 'design: ' + e.message; throw e; })
+    .finally(() => {
+      k.running = null;
+      if (k.pending) { k.pending = false; knobDesign().catch(() => {}); }
+    });
+  return k.running;
+}
+
+function resetKnob() {
+  Object.assign(design.knob, { fastestTime: 0, robustnessMoved: false, last: null });
+  $('knob-speed').value = 1;
+  $('knob-robustness').value = 1.4;
+  showKnob();
+}
+
+// ---- Firmware at a chosen dt.
+function fwDt() {
+  const dt = Number($('fw-dt').value);
+  if (!(dt > 0) || !isFinite(dt)) throw new Error('dt ' + $('fw-dt').value + ' must be a positive number of seconds');
+  return dt;
+}
+
+// The sampled loop at dt (drawn beside the continuous one) and the export
+// request's check and files.
+async function firmware() {
+  const dt = fwDt();
+  const s = app.spec();
+  delete s.loop; delete s.dt;
+  const key = JSON.stringify(s);  // the design it belongs to (app.js draws it while it is current)
+  s.loop = 'sampled';
+  s.dt = dt;
+  delete s.monte_carlo; delete s.spread;
+  const sampled = await app.ask({ type: 'evaluate', spec: s });
+  design.sampled = { dt, spec: key, result: sampled.result, series: sampled.series };
+  app.redraw();
+  let reply;
+  try {
+    reply = await app.ask({ type: 'export', spec: s });
+  } catch (e) {
+    $('fw-verdict').textContent = 'not exported: ' + e.message;
+    $('fw-verdict').dataset.stable = 'false';
+    throw e;
+  }
+  design.export = { dt, spec: s, files: reply.files, loop_check: reply.loop_check };
+  $('fw-verdict').textContent = 'sampled loop at dt = ' + dt + ' s: ' + reply.loop_check.verdict +
+    '; IAE ' + app.fmt(sampled.result.iae) + ' (continuous ' + app.fmt((app.lastResult() || {}).iae) + ')';
+  $('fw-verdict').dataset.stable = String(reply.loop_check.stable);
+  for (const [id, name] of [['fw-download-c', 'pidlab_pid.c'], ['fw-download-h', 'pidlab_pid.h']]) {
+    const a = $(id);
+    if (a.href.startsWith('blob:')) URL.revokeObjectURL(a.href);
+    a.href = URL.createObjectURL(new Blob([reply.files[name]], { type: 'text/x-c' }));
+    a.download = name;
+    a.classList.remove('hidden');
+  }
+  return design.export;
+}
+
+// A dt a tenth of the design's fastest time (1/crossover), rounded down to
+// 1, 2 or 5 times a power of ten: the default the box offers.
+export function suggestDt(result) {
+  const wc = result && result.robustness && result.robustness.gain_crossover_rad_s;
+  if (!(wc > 0)) return null;
+  const x = 0.1 / wc;
+  const p = Math.pow(10, Math.floor(Math.log10(x)));
+  return [5, 2, 1].map((m) => m * p).find((v) => v <= x);
+}
+
+export function initDesign(context) {
+  app = context;
+  design = window.pidlab.design = {
+    upload: null, fit: null, fitCharts: [], sampled: null, export: null,
+    knob: { fastestTime: 0, robustnessMoved: false, running: null, pending: false, last: null },
+    uploadCsv, identify, acceptModel, knobDesign, firmware, resetKnob, onIdentifyProgress: identifyProgress,
+  };
+  $('data-file').addEventListener('change', () => {
+    const f = $('data-file').files[0];
+    if (f) uploadCsv(f).catch((e) => dataStatus(e.message));
+  });
+  const drop = $('data-drop');
+  drop.addEventListener('dragover', (e) => { e.preventDefault(); drop.classList.add('over'); });
+  drop.addEventListener('dragleave', () => drop.classList.remove('over'));
+  drop.addEventListener('drop', (e) => {
+    e.preventDefault();
+    drop.classList.remove('over');
+    const f = e.dataTransfer.files[0];
+    if (f) uploadCsv(f).catch((err) => dataStatus(err.message));
+  });
+  $('data-identify').addEventListener('click', () => identify($('data-model').value).catch((e) => dataStatus(e.message)));
+  $('data-cancel').addEventListener('click', () => app.rawSend({ type: 'identify_cancel' }));
+  $('data-accept').addEventListener('click', () => { acceptModel(); });
+  $('knob-speed').addEventListener('input', () => { showKnob(); knobDesign().catch(() => {}); });
+  $('knob-robustness').addEventListener('input', () => { design.knob.robustnessMoved = true; showKnob(); knobDesign().catch(() => {}); });
+  $('knob-design').addEventListener('click', () => knobDesign().catch(() => {}));
+  $('fw-check').addEventListener('click', () => firmware().catch((e) => app.setStatus('firmware: ' + e.message)));
+  showKnob();
+  return design;
+}

@@ -1,0 +1,179 @@
+// browser.tuning_path (run by tuning_path_test.sh inside its network
+// namespace, under CPU load): the tuning app's whole path in headless
+// Chromium at 1280x800, each step checked against the command line.
+//   node tuning_path_test.js --url URL --pidlab BIN --modules DIR --chromium BIN --csv FILE --out DIR --tmp DIR
+// 0. Every request of a burst of different kinds in flight at once is answered.
+// 1. A step-test CSV is uploaded; 2. identified with auto (the JSON of pidlab
+// identify --model auto --json); 3. the model accepted as the plant; 4. the
+// response-time and robustness knobs moved: the gains equal pidlab tune
+// --response-time T --robustness R --json's (1e-12); 5. exported at a dt;
+// the downloaded pidlab_pid.c and .h, and the export's spec, are written to
+// --tmp for the shell half (6. gcc, 7. the trio against evaluate --loop sampled).
+'use strict';
+const fs = require('fs');
+const path = require('path');
+const { execFileSync } = require('child_process');
+const { parseArgs, launch, waitForPage, makeStep } = require('./page_driver.js');
+
+const args = parseArgs(process.argv.slice(2), ['url', 'pidlab', 'modules', 'chromium', 'csv', 'out', 'tmp']);
+const waitMs = 60000;  // a fit or a design on a loaded machine
+
+function pidlab(argv) {
+  return execFileSync(args.pidlab, argv, { encoding: 'utf8', maxBuffer: 64 << 20, timeout: 120000 });
+}
+function relDiff(a, b) { return Math.abs(a - b) / Math.max(Math.abs(a), Math.abs(b), 1e-300); }
+function expectClose(what, got, want, tol) {
+  if (typeof got !== 'number' || typeof want !== 'number' || !(relDiff(got, want) <= tol))
+    throw new Error(what + ': page ' + got + ', CLI ' + want);
+}
+
+// The burst: N requests of six kinds sent at once on a WebSocket of the
+// page's origin, as the page sends them; resolves with the ids answered.
+async function burst(page, count) {
+  return page.evaluate(async (count) => {
+    const url = 'ws://' + location.host + '/ws';
+    const ws = new WebSocket(url);
+    await new Promise((resolve, reject) => { ws.onopen = resolve; ws.onerror = reject; });
+    const kinds = [
+      { type: 'evaluate', spec: { plant: 'stepper_motor', gains: [1, 1, 0.001] } },
+      { type: 'fields' },
+      { type: 'paper_designs' },
+      { type: 'export', spec: { plant: 'oscillator', gains: [2, 1, 1.5], loop: 'sampled', dt: 0.01 } },
+      { type: 'evaluate', spec: { plant: 'custom', num: [1], den: [10, 1], delay: 2, gains: [1, 0.1, 0] }, series: false },
+      { type: 'log_open', path: '../outside.lcmlog' },  // answered with an error: still a reply
+    ];
+    const answered = new Map();
+    const done = new Promise((resolve) => {
+      ws.onmessage = (e) => {
+        const m = JSON.parse(e.data);
+        if (m.id !== undefined) answered.set(m.id, m.type || (m.error ? 'error' : '?'));
+        if (answered.size === count) resolve();
+      };
+    });
+    for (let i = 1; i <= count; ++i) ws.send(JSON.stringify({ ...kinds[i % kinds.length], id: i }));
+    await Promise.race([done, new Promise((resolve) => setTimeout(resolve, 60000))]);
+    ws.close();
+    const missing = [];
+    for (let i = 1; i <= count; ++i) if (!answered.has(i)) missing.push(i + ' (' + kinds[i % kinds.length].type + ')');
+    return { answered: answered.size, missing };
+  }, count);
+}
+
+async function main() {
+  fs.mkdirSync(args.out, { recursive: true });
+  const session = await launch({ modules: args.modules, chromium: args.chromium, profileDir: path.join(args.tmp, 'profile') });
+  const { browser, page } = session;
+  await page.setViewport({ width: 1280, height: 800 });
+  const downloads = path.join(args.tmp, 'downloads');
+  fs.mkdirSync(downloads, { recursive: true });
+  const cdp = await page.target().createCDPSession();
+  await cdp.send('Browser.setDownloadBehavior', { behavior: 'allow', downloadPath: downloads });
+  const shot = (name, full) => page.screenshot({ path: path.join(args.out, 'tuning-' + name + '.png'), fullPage: !!full });
+  const step = makeStep(session, () => shot('failure', true));
+
+  await step('the page loads under load and every first request is answered (13 paper designs, fields, a drawn design)', async () => {
+    await page.goto(args.url, { waitUntil: 'load' });
+    await waitForPage(session, 'the page did not draw its first design', waitMs, () => window.pidlab.rendered > 0);
+    await waitForPage(session, 'the paper designs did not arrive', waitMs,
+      () => document.querySelectorAll('#paper-designs button.paper-design').length === 13);
+    return 'rendered ' + (await page.evaluate(() => window.pidlab.rendered));
+  });
+
+  await step('0. 240 requests of six kinds in flight at once are each answered', async () => {
+    const r = await burst(page, 240);
+    if (r.missing.length) throw new Error(r.missing.length + ' unanswered: ' + r.missing.slice(0, 10).join(', '));
+    return r.answered + ' replies';
+  });
+
+  let fit = null;
+  await step('1-2. the CSV uploads and identify auto gives pidlab identify --model auto --json\'s model and parameters', async () => {
+    const input = await page.$('#data-file');
+    await input.uploadFile(args.csv);
+    await waitForPage(session, 'the upload did not finish', waitMs, () => !!window.pidlab.design.upload);
+    await page.evaluate(() => { document.getElementById('data-u0').value = '0'; document.getElementById('data-model').value = 'auto'; });
+    await page.click('#data-identify');
+    await waitForPage(session, 'no fit', waitMs * 2, () => !!window.pidlab.design.fit);
+    fit = await page.evaluate(() => window.pidlab.design.fit);
+    const cli = JSON.parse(pidlab(['identify', '--csv', args.csv, '--model', 'auto', '--u0', '0', '--json', '--quiet']));
+    if (fit.result.model !== cli.model) throw new Error('model ' + fit.result.model + ', CLI ' + cli.model);
+    for (const [name, p] of Object.entries(cli.parameters))
+      if (fit.result.parameters[name].value !== p.value) throw new Error(name + ': page ' + fit.result.parameters[name].value + ', CLI ' + p.value);
+    if (fit.result.aic !== cli.aic) throw new Error('AIC ' + fit.result.aic + ', CLI ' + cli.aic);
+    const rows = await page.$$eval('#data-params tr[data-parameter]', (trs) => trs.length);
+    if (rows !== Object.keys(cli.parameters).length) throw new Error('#data-params has ' + rows + ' rows');
+    if (fit.fit.simulated.length !== fit.fit.y.length) throw new Error('the fit\'s curves differ in length');
+    await shot('fit');
+    return cli.model + ', AIC ' + cli.aic.toFixed(3) + ', ' + rows + ' parameters, bit for bit';
+  });
+
+  const knobGains = async (what) => {
+    await waitForPage(session, what, waitMs, () => {
+      const k = window.pidlab.design.knob;
+      return k.last && !k.running && !k.pending;
+    });
+    return page.evaluate(() => ({ spec: window.pidlab.design.knob.last.spec, result: window.pidlab.design.knob.last.result,
+      shown: window.pidlab.lastResult && window.pidlab.lastResult.gains }));
+  };
+  const compareWithTune = (got) => {
+    const flags = ['tune', '--plant', got.spec.plant, '--json'];
+    if (got.spec.response_time) flags.push('--response-time', String(got.spec.response_time));
+    if (got.spec.robustness) flags.push('--robustness', String(got.spec.robustness));
+    const cli = JSON.parse(pidlab(flags));
+    for (const k of ['kp', 'ki', 'kd', 'tf']) expectClose(k, got.result.gains[k], cli.gains[k], 1e-12);
+    for (const k of ['kp', 'ki', 'kd', 'tf']) expectClose('drawn ' + k, got.shown[k], cli.gains[k], 1e-12);
+    return flags.slice(1).join(' ');
+  };
+
+  await step('3. the model is accepted as the plant and designed for (pidlab tune --plant model:FILE)', async () => {
+    await page.click('#data-accept');
+    const got = await knobGains('no design for the accepted model');
+    if (got.spec.plant !== fit.plant) throw new Error('the design ran on ' + got.spec.plant + ', not ' + fit.plant);
+    return compareWithTune(got);
+  });
+
+  await step('4. the response-time knob, then the robustness knob: the gains of pidlab tune with the same knobs (1e-12)', async () => {
+    const moved = [];
+    for (const [id, value] of [['knob-speed', '0.5'], ['knob-robustness', '1.3']]) {
+      await page.evaluate((id, value) => {
+        const r = document.getElementById(id);
+        r.value = value;
+        r.dispatchEvent(new Event('input', { bubbles: true }));
+      }, id, value);
+      const got = await knobGains('no design for ' + id + ' = ' + value);
+      if (id === 'knob-speed' && !got.spec.response_time) throw new Error('the response-time knob set no response_time');
+      if (id === 'knob-robustness' && got.spec.robustness !== 1.3) throw new Error('robustness ' + got.spec.robustness);
+      moved.push(compareWithTune(got));
+    }
+    await shot('knob');
+    return moved.join('; ');
+  });
+
+  await step('5. export at a chosen dt: the loop check is stable, pidlab_pid.c and .h download', async () => {
+    const dt = await page.evaluate(() => Number(document.getElementById('fw-dt').value));
+    if (!(dt > 0)) throw new Error('#fw-dt offers no dt');
+    await page.click('#fw-check');
+    await waitForPage(session, 'no export', waitMs, () => !!window.pidlab.design.export);
+    const ex = await page.evaluate(() => window.pidlab.design.export);
+    if (!ex.loop_check.stable) throw new Error('the loop check: ' + ex.loop_check.verdict);
+    await page.click('#fw-download-c');
+    await page.click('#fw-download-h');
+    const deadline = Date.now() + 20000;
+    while (!['pidlab_pid.c', 'pidlab_pid.h'].every((f) => fs.existsSync(path.join(downloads, f))) && Date.now() < deadline)
+      await new Promise((r) => setTimeout(r, 50));
+    for (const f of ['pidlab_pid.c', 'pidlab_pid.h']) {
+      const file = path.join(downloads, f);
+      if (!fs.existsSync(file)) throw new Error(f + ' was not downloaded');
+      if (fs.readFileSync(file, 'utf8') !== ex.files[f]) throw new Error(f + ' differs from the export reply');
+    }
+    const sampled = await page.evaluate(() => (window.pidlab.plots.step.series || []).some((s) => /sampled at dt/.test(s.label)));
+    if (!sampled) throw new Error('the sampled loop is not drawn on the step plot');
+    fs.writeFileSync(path.join(args.tmp, 'export_spec.json'), JSON.stringify(ex.spec));
+    await shot('firmware');
+    await shot('firmware-full', true);
+    return 'dt ' + dt + ' s: ' + ex.loop_check.verdict;
+  });
+
+  await browser.close();
+}
+
+main().catch((e) => { console.log('FAIL ' + (e && e.stack ? e.stack : e)); process.exit(1); });
