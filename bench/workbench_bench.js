@@ -21,6 +21,9 @@ const path = require('path');
 const { parseArgs, launch, waitForPage, moveSlider, selectPlant } = require('../tests/browser/page_driver.js');
 
 const args = parseArgs(process.argv.slice(2), ['url', 'modules', 'chromium', 'tmp', 'moves']);
+// --plants FILE: the "any plant" batch instead (lines NAME|num|den|delay, from
+// bench/any_plant_bench.sh's list): on each, the kp slider as above, then the
+// response-time knob (a migo design on the server, then its evaluation).
 const plants = ['double_integrator', 'oscillator', 'stepper_motor'];
 const target = { median: 30, p99: 100 };  // ms, input -> drawn (issue 26)
 
@@ -41,8 +44,74 @@ function summary(values) {
 }
 const ms = (x) => x.toFixed(1).padStart(6);
 
+// Sets the page's plant to a custom num/den/delay, the way a user types them.
+async function setCustom(page, p) {
+  await page.evaluate((p) => {
+    const set = (id, v) => { const e = document.getElementById(id); e.value = v; e.dispatchEvent(new Event('change', { bubbles: true })); };
+    set('plant', 'custom'); set('num', p.num); set('den', p.den); set('delay', p.delay);
+  }, p);
+}
+
+// Moves the response-time knob to `value` (0 slowest .. 1 fastest) and waits
+// until the design it asked for is drawn; input -> drawn on the page's clock.
+async function moveKnob(session, value) {
+  const inputMs = await session.page.evaluate((value) => {
+    const r = document.getElementById('knob-speed');
+    window.pidlab.design.knob.last = null;
+    r.value = String(value);
+    const t = performance.now();
+    r.dispatchEvent(new Event('input', { bubbles: true }));
+    return t;
+  }, value);
+  await waitForPage(session, 'no redraw for the knob at ' + value, 60000, () => {
+    const k = window.pidlab.design.knob;
+    return k.last && !k.running && !k.pending && window.pidlab.lastResult && window.pidlab.lastResult.gains.kp === k.last.result.gains.kp;
+  });
+  const t = await session.page.evaluate(() => window.pidlab.timings[window.pidlab.timings.length - 1]);
+  return { total: t.drawn_ms - inputMs, server: t.server_ms };
+}
+
+async function anyPlant(session, lines, moves) {
+  const { page } = session;
+  const random = generator(41);
+  const kp = [], knob = [];
+  console.log('plant                                       kp slider med/p99 ms   knob (migo + evaluate) med/p99 ms');
+  for (const line of lines) {
+    const [name, num, den, delay] = line.split('|');
+    await setCustom(page, { num, den, delay });
+    await page.click('#knob-design');
+    await waitForPage(session, 'no first design for ' + name, 60000, () => window.pidlab.design.knob.last && !window.pidlab.design.knob.running);
+    const centre = await page.$eval('#kp-slider', (e) => Number(e.value));
+    const a = [], b = [];
+    for (let i = 0; i < moves; ++i) {
+      const { inputMs } = await moveSlider(session, 'kp', Math.round((centre - 0.2 + 0.4 * random()) * 1000) / 1000, 30000);
+      const t = await page.evaluate(() => window.pidlab.timings[window.pidlab.timings.length - 1]);
+      a.push(t.drawn_ms - inputMs);
+    }
+    for (let i = 0; i < moves; ++i) b.push((await moveKnob(session, Math.round(random() * 99) / 100)).total);
+    kp.push(...a); knob.push(...b);
+    const sa = summary(a), sb = summary(b);
+    console.log(name.padEnd(42) + '  ' + ms(sa.median) + ' ' + ms(sa.p99) + '            ' + ms(sb.median) + ' ' + ms(sb.p99));
+  }
+  const sa = summary(kp), sb = summary(knob);
+  const pass = (x) => (x.median < target.median && x.p99 < target.p99 ? 'PASS' : 'FAIL');
+  console.log('all ' + lines.length + ' plants: kp slider input->drawn med/p99 ' + ms(sa.median) + ' ' + ms(sa.p99) + ' ms ' + pass(sa) +
+              '; response-time knob input->drawn med/p99 ' + ms(sb.median) + ' ' + ms(sb.p99) + ' ms ' + pass(sb) +
+              ' (target med < ' + target.median + ', p99 < ' + target.p99 + ')');
+  return pass(sa) === 'PASS' && pass(sb) === 'PASS';
+}
+
 async function main() {
   const moves = Number(args.moves);
+  if (args.plants) {
+    const session = await launch({ modules: args.modules, chromium: args.chromium, profileDir: path.join(args.tmp, 'profile') });
+    await session.page.goto(args.url, { waitUntil: 'load', timeout: 30000 });
+    await session.page.waitForFunction(() => window.pidlab && window.pidlab.rendered >= 1, { timeout: 30000, polling: 50 });
+    const lines = require('fs').readFileSync(args.plants, 'utf8').trim().split('\n');
+    const ok = await anyPlant(session, lines, moves);
+    await session.browser.close();
+    process.exit(ok && !session.log.errors.length ? 0 : 1);
+  }
   const session = await launch({ modules: args.modules, chromium: args.chromium,
                                                 profileDir: path.join(args.tmp, 'profile') });
   const { browser, page, log } = session;

@@ -10,14 +10,19 @@
 # WAKEUP_BENCH says), bench/wakeup_bench's floor over 5 s, so that a loaded
 # machine shows; then the same number of requests from a Python WebSocket
 # client, without the browser. Exit 1 when a plant misses a target.
-#   bench/workbench_bench.sh [PIDLAB] [MOVES]     (root; defaults build/bin/pidlab 200)
+# With --any-plant (first): the 33 plants of bench/any_plant_bench.sh instead, the
+# kp slider and the response-time knob (a migo design, then its evaluation) MOVES
+# times each on every plant.
+#   bench/workbench_bench.sh [--any-plant] [PIDLAB] [MOVES]     (root; defaults build/bin/pidlab 200, 10 with --any-plant)
 set -euo pipefail
-case "${1:-}" in -h|--help) sed -n '2,13p' "$0"; exit 0 ;; esac
+case "${1:-}" in -h|--help) sed -n '2,17p' "$0"; exit 0 ;; esac
+any_plant=0
+if [ "${1:-}" = --any-plant ]; then any_plant=1; shift; fi
 pidlab=${1:-}
 [ -z "$pidlab" ] || pidlab=$(realpath -m -- "$pidlab")  # relative to where it is run from
 cd "$(dirname "$0")/.."
 pidlab=${pidlab:-build/bin/pidlab}
-moves=${2:-200}
+moves=${2:-$([ $any_plant = 1 ] && echo 10 || echo 200)}
 root=$PWD
 chromium=/usr/bin/chromium
 [ -x "$pidlab" ] || { echo "workbench_bench.sh: $pidlab is not an executable (build pidlab first)" >&2; exit 2; }
@@ -26,7 +31,7 @@ if [ ! -x "$chromium" ] || [ ! -f node_modules/puppeteer-core/package.json ] || 
   exit 2
 fi
 if [[ ${PIDLAB_BENCH_IN_NAMESPACE:-} != 1 ]]; then
-  PIDLAB_BENCH_IN_NAMESPACE=1 exec unshare -n bash "$0" "$pidlab" "$moves"
+  PIDLAB_BENCH_IN_NAMESPACE=1 exec unshare -n bash "$0" $([ $any_plant = 1 ] && echo --any-plant) "$pidlab" "$moves"
 fi
 ip link set lo up
 echo "machine: $(nproc) processors; uptime:$(uptime)"
@@ -46,6 +51,16 @@ url=$(sed -n 's/^pidlab serve: //p' "$tmp/serve.out" | head -1)
 [ -n "$url" ] || { echo "workbench_bench.sh: pidlab serve printed no URL" >&2; exit 1; }
 echo "chromium: $("$chromium" --version 2>/dev/null | head -1); pidlab serve at $url"
 status=0
+if [ $any_plant = 1 ]; then
+  # NAME|num|den|delay of every plant of the "any plant" batch.
+  sed -n 's/^  "\([^|]*\)|[^|]*|--num \([^ ]*\) --den \([^ ]*\)\( --delay \([^ "]*\)\)\{0,1\}"$/\1|\2|\3|\5/p' \
+    bench/any_plant_bench.sh > "$tmp/plants"
+  echo "the any-plant batch: $(wc -l < "$tmp/plants") plants, $moves moves of each control"
+  node bench/workbench_bench.js --url "$url" --modules "$root/node_modules" --chromium "$chromium" \
+    --tmp "$tmp" --moves "$moves" --plants "$tmp/plants" || status=$?
+  echo "uptime after:$(uptime)"
+  exit $status
+fi
 node bench/workbench_bench.js --url "$url" --modules "$root/node_modules" --chromium "$chromium" \
   --tmp "$tmp" --moves "$moves" || status=$?
 # The same requests without the browser: what the server and the loopback

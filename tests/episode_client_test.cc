@@ -337,7 +337,7 @@ TEST(TuneProgressPublisher, SendsTheSearchAtMostOnceAnIntervalAndTheResultAtTheE
   better.best_f = 1.5;
   better.best_x = Eigen::Vector3d(1, 2, 3);
   dut.Running(better);  // within the interval: not sent
-  dut.Finished(true, PidGains{1, 2, 3}, 1.25);
+  dut.Finished(true, PidGains{1, 2, 3}, 1.25, 9);
   while (listener.WaitAndHandle(0.0) > 0) {
   }
   ASSERT_EQ(heard.size(), 2u);
@@ -347,7 +347,7 @@ TEST(TuneProgressPublisher, SendsTheSearchAtMostOnceAnIntervalAndTheResultAtTheE
   EXPECT_TRUE(std::isnan(heard[0].best_gains[0]));
   EXPECT_EQ(heard[1].status, pidlab::lcmt_tune_progress::DONE);
   EXPECT_EQ(heard[1].step, 2);  // the last point seen, sent or not
-  EXPECT_EQ(heard[1].evaluations, 8);
+  EXPECT_EQ(heard[1].evaluations, 9) << "the tuning's own count, not the last point's 8";
   EXPECT_EQ(heard[1].best_objective, 1.25);
   EXPECT_EQ(heard[1].best_gains[2], 3.0);
   EXPECT_EQ(heard[1].trios, 3);

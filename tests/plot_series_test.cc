@@ -111,6 +111,26 @@ TEST(PlotSeries, SensitivityPeakOnTheGridIsTheReportedMs) {
   }
 }
 
+TEST(PlotSeries, TheFrequencyGridSpansSixDecadesAroundTheCrossoverWhereMtPeaksAtDc) {
+  // A slow thermal loop whose |T| peaks at DC: analysis puts Mt's frequency
+  // near 1e-23 rad/s, which the grid leaves out rather than span 20 decades.
+  nlohmann::json result;
+  const nlohmann::json series =
+      SeriesOf({{"plant", "custom"},
+                {"num", {1}},
+                {"den", {1000, 1}},
+                {"delay", 100},
+                {"gains", {0.3832272962062109, 0.0003790998403732822, 1198.2716840666376}},
+                {"derivative_filter", 312.6791060890034}},
+               &result);
+  const std::vector<double> w = series["w"].get<std::vector<double>>();
+  const double crossover = result["robustness"]["gain_crossover_rad_s"].get<double>();
+  ASSERT_FALSE(w.empty());
+  EXPECT_LT(result["robustness"]["mt_rad_s"].get<double>(), 1e-15) << "the case the grid must leave out";
+  EXPECT_GE(w.front(), crossover * 1e-3 * (1 - 1e-9));
+  EXPECT_LE(w.back(), crossover * 1e3 * (1 + 1e-9));
+}
+
 TEST(PlotSeries, CommandCancelsTheLoadStepAtSteadyState) {
   // With integral action, the unit step at the plant input ends with u = -1
   // and y = 0, on both loops.

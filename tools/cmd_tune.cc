@@ -88,7 +88,7 @@ struct TuneCommand {
     tune::TuningResult result;
     const Status tuned = tune::RunTuning(problem, run, &result);
     const TuneSummary& s = result.summary;
-    if (publisher) publisher->Finished(tuned.ok() && s.stable, s.gains, s.objective);
+    if (publisher) publisher->Finished(tuned.ok() && s.stable, s.gains, s.objective, s.evaluations);
     Require(tuned);
     if (tty) std::fprintf(stderr, "\r%70s\r", "");
     if (!trace.empty()) WriteTrace(s);

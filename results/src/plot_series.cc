@@ -85,7 +85,7 @@ void TimeSeries(const Plant& plant, const PidGains& gains, const LoopOptions& op
 }
 
 // The log grid around the gain crossover (the sampled loop's up to pi/dt),
-// with the peaks' frequencies.
+// with the peaks' frequencies that fall within it.
 std::vector<double> FrequencyGrid(const LoopAnalysis& a, const LoopOptions& options,
                                   const PlotSeriesOptions& o) {
   const double top = options.loop == LoopKind::kSampled ? 3.14159265358979323846 / options.dt_s
@@ -97,8 +97,12 @@ std::vector<double> FrequencyGrid(const LoopAnalysis& a, const LoopOptions& opti
   std::vector<double> w;
   for (int i = 0; i < o.frequency_points; ++i)
     w.push_back(std::min(top, std::pow(10.0, lo + (hi - lo) * i / (o.frequency_points - 1))));
+  // A peak's frequency joins the grid within its span only: Mt's peak of a
+  // loop with integral action may sit at 1e-23 rad/s (|T| -> 1 at DC), which
+  // would stretch the axis over twenty decades.
+  const double first = std::pow(10.0, lo), last = std::min(top, std::pow(10.0, hi));
   for (double peak : {a.ms_rad_s, a.mt_rad_s, a.noise_gain_rad_s})
-    if (std::isfinite(peak) && peak > 0.0 && peak <= top) w.push_back(peak);
+    if (std::isfinite(peak) && peak >= first && peak <= last) w.push_back(peak);
   std::sort(w.begin(), w.end());
   w.erase(std::unique(w.begin(), w.end()), w.end());
   return w;

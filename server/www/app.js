@@ -479,7 +479,14 @@ $('plant').addEventListener('change', () => {
   send();
 });
 $('loop').addEventListener('change', () => { state.loop = $('loop').value; send(); });
-for (const k of textFields) $(k).addEventListener('change', () => { state[k] = $(k).value; send(); });
+// A plant field is another plant: what belonged to the old one goes (resetPlant).
+const plantFields = ['num', 'den', 'model', 'delay', 'stepper'];
+for (const k of textFields) {
+  $(k).addEventListener('change', () => {
+    if (plantFields.includes(k)) resetPlant({ [k]: $(k).value }); else state[k] = $(k).value;
+    send();
+  });
+}
 // The bounds also as sliders (linear, or log10 for the noise gain): moving
 // one sets its number box and the bound; an empty box is no bound.
 const boundSliders = { max_ms: [1.05, 4, 0.01, false], max_mt: [1, 4, 0.01, false],

@@ -144,6 +144,8 @@ async function knobDesign() {
     const m = result.migo || {};
     if (!s.response_time && m.crossover_rad_s > 0) k.fastestTime = 2 / m.crossover_rad_s;
     if (!k.robustnessMoved && m.ms_bound > 0) $('knob-robustness').value = m.ms_bound;
+    const dt = suggestDt(result);  // the firmware's dt offered for this design
+    if (dt) $('fw-dt').value = dt;
     showKnob();
     $('knob-status').textContent = 'pidlab tune ' + Object.entries(knobValues()).map(([a, b]) => '--' + a.replace('_', '-') + ' ' + b).join(' ');
     return result;

@@ -74,7 +74,7 @@ function draw(f) {
   charts.u.setData([x, nanToNull(f.u_max), nanToNull(f.u_min)]);
   charts.n.setData([x, nanToNull(f.n_max), nanToNull(f.n_min)]);
   live.drawn += 1;
-  $('live-frames').textContent = 'episode ' + f.episode_id + ': ' + f.steps_done + ' of ' + (f.total_steps + 1) +
+  $('live-frames').textContent = 'episode ' + (ep ? idText(ep) : f.episode_id) + ': ' + f.steps_done + ' of ' + (f.total_steps + 1) +
     ' steps, ' + live.frames + ' frames received, ' + live.drawn + ' drawn, ' + f.dropped_frames +
     ' dropped by the server';
 }

@@ -43,7 +43,7 @@ function timeChart(el, title, yLabel, label, pinned, extras, clip) {
     }
   }
   if (clip) {  // the effort: the axis fitted to u after the derivative kick (chart.pidlabClip), the kick marked
-    opts.scales.y = { range: (u, lo, hi) => (u.pidlabClip && u.pidlabClip.range) || [lo, hi] };
+    opts.scales.y = { range: (u, lo, hi) => (u.pidlabClip && u.pidlabClip.range) || autoRange(lo, hi) };
     opts.hooks = { draw: [(u) => drawKick(u, u.pidlabClip)] };
   }
   const chart = new uPlot(opts, series.map(() => []), el);
@@ -67,8 +67,13 @@ function effortClip(t, u) {
   while (start < u.length && u[start] !== null && (u[start] > hi + 3 * span || u[start] < lo - 3 * span)) start++;
   if (start === 0) return { range: null, kick: null };
   const peak = u.slice(0, start).reduce((m, v) => (Math.abs(v) > Math.abs(m) ? v : m), 0);
-  const pad = 0.1 * (hi - lo || span);
-  return { range: [Math.min(lo, 0) - pad, Math.max(hi, 0) + pad], kick: { t: t[0], until: t[start], peak } };
+  // Padded by a tenth of the span, never less than 1e-6 of the values'
+  // size: a flat tail must not make a range uPlot cannot split.
+  const a = Math.min(lo, 0), b = Math.max(hi, 0);
+  const pad = 0.1 * Math.max(b - a, 1e-6 * Math.max(Math.abs(a), Math.abs(b)), 1e-9);
+  const range = [a - pad, b + pad];
+  if (!range.every(isFinite)) return { range: null, kick: null };
+  return { range, kick: { t: t[0], until: t[start], peak } };
 }
 
 function drawKick(u, clip) {
@@ -123,7 +128,12 @@ function phaseDeg(re, im) {
 }
 
 const kNyquistX = [-3.5, 1.5];
-const aspect = (u) => (u.bbox && u.bbox.width > 0 ? u.bbox.height / u.bbox.width : 1);
+const aspect = (u) => (u.bbox && u.bbox.width > 0 && u.bbox.height > 0 ? u.bbox.height / u.bbox.width : 1);
+// uPlot's own padded range, and [0, 1] where there is no data (every value null).
+function autoRange(lo, hi) {
+  if (lo === null || hi === null || !isFinite(lo) || !isFinite(hi)) return [0, 1];
+  return uPlot.rangeNum(lo, hi, 0.1, true);
+}
 function square(el) {
   const w = Math.max(300, Math.min(el.clientWidth || 420, 420));
   return { width: w, height: w - 10 };
@@ -272,7 +282,16 @@ export function drawPlots(plots, series, pinned, trio, sampled) {
   const extraData = { linear: () => [series.linear_y], band: () => [mc.y_max, mc.y_min],
     sampled: () => [heldAt(sampled.t, sampled.y, series.t)], trio: () => [atSampleTimes(trio, series.t)] };
   plots.step.setData([series.t, series.y, ...pin('y'), ...extras.flatMap((k) => extraData[k]())]);
-  const u = orEmpty(series.u, n);
+  // The continuous loop with dead time has no u: the firmware's sampled
+  // loop, when it is drawn, gives it (held between its samples).
+  const u = Array.isArray(series.u) ? series.u
+    : sampled && Array.isArray(sampled.u) ? heldAt(sampled.t, sampled.u, series.t) : orEmpty(series.u, n);
+  const title = (chart, text) => { const el = chart.root.querySelector('.u-title'); if (el) el.textContent = text; };
+  title(plots.effort, Array.isArray(series.u) ? 'Control effort u (step response)'
+    : sampled && Array.isArray(sampled.u) ? 'Control effort u of the sampled loop at the firmware\'s dt'
+      : 'Control effort u: not computed for the continuous loop with dead time (the firmware\'s sampled loop draws it)');
+  title(plots.load, Array.isArray(series.load_y) ? 'Load response y (unit step at the plant input)'
+    : 'Load response: not computed for the continuous loop with dead time');
   plots.effort.pidlabClip = effortClip(series.t, u);
   plots.effort.setData([series.t, u, ...pin('u')]);
   plots.load.setData([series.t, orEmpty(series.load_y, n), ...pin('load_y')]);

@@ -210,8 +210,17 @@ async function main() {
       const want = [tuned.gains.kp, tuned.gains.ki, tuned.gains.kd];
       if (!want.every((g, i) => Object.is(shown.gains[i], g)) || !Object.is(shown.objective, tuned.objective))
         throw new Error('page ' + JSON.stringify(shown) + ', tune --json ' + JSON.stringify(want) + ' ' + tuned.objective);
-      if (!(shown.evaluations > 0)) throw new Error('no evaluations shown');
-      return shown.evaluations + ' evaluations, best ' + JSON.stringify(shown.gains);
+      if (shown.evaluations !== tuned.evaluations)
+        throw new Error('#live-tunings says ' + shown.evaluations + ' evaluations, tune --json ' + tuned.evaluations);
+      // Every table and the page fit a 1280-pixel window.
+      await page.setViewport({ width: 1280, height: 800 });
+      const wide = await page.evaluate(() => [...document.querySelectorAll('#view-live table:not(.u-legend)')]
+        .map((e) => ({ id: e.id || e.className, right: e.getBoundingClientRect().right }))
+        .filter((e) => e.right > 1280));
+      await page.screenshot({ path: path.join(args.out, 'live-1280.png') });
+      await page.setViewport({ width: 1400, height: 1000 });
+      if (wide.length) throw new Error('wider than 1280 px: ' + JSON.stringify(wide));
+      return shown.evaluations + ' evaluations (tune --json\'s), best ' + JSON.stringify(shown.gains) + '; every table within 1280 px';
     });
   } else {
     await step('(logs only) a 25 s episode at dt = 1 ms recorded by pidlab launch --log', async () => {

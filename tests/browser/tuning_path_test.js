@@ -116,6 +116,8 @@ async function main() {
   };
   const compareWithTune = (got) => {
     const flags = ['tune', '--plant', got.spec.plant, '--json'];
+    if (got.spec.plant === 'custom') flags.push('--num', got.spec.num.join(','), '--den', got.spec.den.join(','));
+    if (got.spec.delay) flags.push('--delay', String(got.spec.delay));
     if (got.spec.response_time) flags.push('--response-time', String(got.spec.response_time));
     if (got.spec.robustness) flags.push('--robustness', String(got.spec.robustness));
     const cli = JSON.parse(pidlab(flags));
@@ -168,9 +170,47 @@ async function main() {
     const sampled = await page.evaluate(() => (window.pidlab.plots.step.series || []).some((s) => /sampled at dt/.test(s.label)));
     if (!sampled) throw new Error('the sampled loop is not drawn on the step plot');
     fs.writeFileSync(path.join(args.tmp, 'export_spec.json'), JSON.stringify(ex.spec));
-    await shot('firmware');
-    await shot('firmware-full', true);
+    await page.evaluate(() => window.scrollTo(0, 0));
+    await shot('fitted');
+    await shot('fitted-full', true);
     return 'dt ' + dt + ' s: ' + ex.loop_check.verdict;
+  });
+
+  // Switching the plant resets what belongs to the plant; the knob's design
+  // for the stepper motor and for a thermal plant equals pidlab tune's.
+  const designFor = async (what, setPlant) => {
+    await page.evaluate(setPlant);
+    const state = await page.evaluate(() => ({ filter: window.pidlab.state.derivative_filter, pinned: window.pidlab.pinned.length,
+      sampled: !!window.pidlab.design.sampled, speed: document.getElementById('knob-speed').value,
+      links: document.querySelectorAll('#firmware a:not(.hidden)').length }));
+    if (state.filter !== '' || state.pinned || state.sampled || state.speed !== '1' || state.links)
+      throw new Error('switching to ' + what + ' kept ' + JSON.stringify(state));
+    await page.evaluate(() => { window.pidlab.design.knob.last = null; });
+    await page.click('#knob-design');
+    const got = await knobGains('no design for ' + what);
+    await waitForPage(session, 'no redraw for ' + what, waitMs, () => !window.pidlab.design.knob.running &&
+      window.pidlab.lastResult && window.pidlab.lastResult.gains.kp === window.pidlab.design.knob.last.result.gains.kp);
+    return compareWithTune(got);
+  };
+  await step('8. the stepper motor: the plant switch resets the filter, pins, firmware and knobs; its design equals pidlab tune --plant stepper_motor', async () => {
+    const flags = await designFor('the stepper motor', () => {
+      const p = document.getElementById('plant');
+      p.value = 'stepper_motor';
+      p.dispatchEvent(new Event('change', { bubbles: true }));
+    });
+    await shot('stepper');
+    return flags;
+  });
+  await step('9. a thermal plant 2 e^-8s / (60 s + 1): its design equals pidlab tune --num 2 --den 60,1 --delay 8', async () => {
+    const flags = await designFor('a thermal plant', () => {
+      const set = (id, v) => { const e = document.getElementById(id); e.value = v; e.dispatchEvent(new Event('change', { bubbles: true })); };
+      set('plant', 'custom');
+      set('num', '2');
+      set('den', '60,1');
+      set('delay', '8');
+    });
+    await shot('thermal');
+    return flags;
   });
 
   await browser.close();

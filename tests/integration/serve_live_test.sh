@@ -141,9 +141,9 @@ ok = [t['lcm_url'] for t in trios] == urls and all(t['health']['roles']['plant']
 print(('ok   ' if ok else 'FAIL ') + 'live_status lists each trio with its URL and its plant heard')
 tunings = status.get('tunings', []) if status else []
 t = tunings[-1] if tunings else {}
-ok = (len(tunings) == 1 and t['status'] == 'done' and t['trios'] == 2 and t['evaluations'] > 0
+ok = (len(tunings) == 1 and t['status'] == 'done' and t['trios'] == 2 and t['evaluations'] == tuned.get('evaluations')
       and t['best_gains'] == [tuned['gains'][k] for k in ('kp', 'ki', 'kd')] and t['best_objective'] == tuned.get('objective'))
-print(('ok   ' if ok else 'FAIL ') + 'the tuning is in live_status: done over 2 trios, its best gains and objective '
+print(('ok   ' if ok else 'FAIL ') + 'the tuning is in live_status: done over 2 trios, its evaluations, best gains and objective '
       'those tune --json printed: %s' % json.dumps(t))
 PY
 status=$?

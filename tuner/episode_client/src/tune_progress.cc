@@ -45,8 +45,9 @@ void TuneProgressPublisher::Running(const optim::TracePoint& point) {
   Send(pidlab::lcmt_tune_progress::RUNNING, point.best_f, gains);
 }
 
-void TuneProgressPublisher::Finished(bool ok, const PidGains& gains, double objective) {
+void TuneProgressPublisher::Finished(bool ok, const PidGains& gains, double objective, long evaluations) {
   const double g[3] = {gains.kp, gains.ki, gains.kd};
+  last_.evaluations = static_cast<int>(evaluations);
   Send(ok ? pidlab::lcmt_tune_progress::DONE : pidlab::lcmt_tune_progress::FAILED,
        ok ? objective : std::numeric_limits<double>::infinity(), g);
 }

@@ -32,7 +32,9 @@ class TuneProgressPublisher {
   /// one was sent less than min_interval_s ago.
   void Running(const optim::TracePoint& point);
   /// The end: the result's gains and objective (ok), or a failure.
-  void Finished(bool ok, const PidGains& gains, double objective);
+  /// The final message: `evaluations` the tuning's own count (its summary,
+  /// what `pidlab tune` reports), which the last trace point may fall short of.
+  void Finished(bool ok, const PidGains& gains, double objective, long evaluations);
   /// The tuning's id, the messages' episode_id.
   int64_t id() const { return id_; }
 
