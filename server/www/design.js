@@ -139,6 +139,7 @@ async function knobDesign() {
   if (k.running) { k.pending = true; return k.running; }
   const s = knobSpec();
   $('knob-status').textContent = 'designing ...';
+  k.error = null;
   k.running = app.tune(s, { quiet: true }).then((result) => {
     k.last = { spec: s, result };
     const m = result.migo || {};
@@ -149,7 +150,7 @@ async function knobDesign() {
     showKnob();
     $('knob-status').textContent = 'pidlab tune ' + Object.entries(knobValues()).map(([a, b]) => '--' + a.replace('_', '-') + ' ' + b).join(' ');
     return result;
-  }).catch((e) => { $('knob-status').textContent = 'design: ' + e.message; throw e; })
+  }).catch((e) => { k.error = { spec: s, message: e.message }; $('knob-status').textContent = 'design: ' + e.message; throw e; })
     .finally(() => {
       k.running = null;
       if (k.pending) { k.pending = false; knobDesign().catch(() => {}); }
@@ -193,8 +194,11 @@ async function firmware() {
     throw e;
   }
   design.export = { dt, spec: s, files: reply.files, loop_check: reply.loop_check };
+  // Overshoot and settling compare across the two loops (each IAE is a sum on its own grid).
+  const c = app.lastResult() || {};
   $('fw-verdict').textContent = 'sampled loop at dt = ' + dt + ' s: ' + reply.loop_check.verdict +
-    '; IAE ' + app.fmt(sampled.result.iae) + ' (continuous ' + app.fmt((app.lastResult() || {}).iae) + ')';
+    '; overshoot ' + app.fmt(sampled.result.overshoot_pct) + ' % (continuous ' + app.fmt(c.overshoot_pct) + ' %), settling ' +
+    app.fmt(sampled.result.settling_time_s) + ' s (continuous ' + app.fmt(c.settling_time_s) + ' s)';
   $('fw-verdict').dataset.stable = String(reply.loop_check.stable);
   for (const [id, name] of [['fw-download-c', 'pidlab_pid.c'], ['fw-download-h', 'pidlab_pid.h']]) {
     const a = $(id);
@@ -220,7 +224,7 @@ export function initDesign(context) {
   app = context;
   design = window.pidlab.design = {
     upload: null, fit: null, fitCharts: [], sampled: null, export: null,
-    knob: { fastestTime: 0, robustnessMoved: false, running: null, pending: false, last: null },
+    knob: { fastestTime: 0, robustnessMoved: false, running: null, pending: false, last: null, error: null },
     uploadCsv, identify, acceptModel, knobDesign, firmware, resetKnob, onIdentifyProgress: identifyProgress,
   };
   $('data-file').addEventListener('change', () => {
