@@ -161,5 +161,14 @@ export function initLogs({ ask: askServer, token: urlToken }) {
   $('log-redrive').addEventListener('change', () => {
     if (logs.episode) openEpisode(logs.episode.index).catch((e) => status(e.message));
   });
+  // The shown episode fitted on the Design tab (the identify request with
+  // its log_id and index: pidlab identify --log's record), with the model chosen there.
+  $('log-identify').addEventListener('click', () => {
+    if (!logs.episode) return;
+    window.pidlab.showView('design');
+    const model = document.getElementById('data-model').value;
+    window.pidlab.design.identify(model, { log_id: logs.episode.log_id, index: logs.episode.index })
+      .catch((e) => { document.getElementById('data-status').textContent = e.message; });
+  });
   Object.assign(logs, { openPath, openEpisode, upload, scrub });
 }

@@ -258,6 +258,26 @@ async function main() {
     return 'IAE ' + iae + '; ' + scrub.text;
   });
 
+  await step('"Identify this episode": the Design tab fits it as pidlab identify --log --episode --model p1d --json does', async () => {
+    await page.evaluate(() => { document.getElementById('data-model').value = 'p1d'; document.getElementById('data-u0').value = ''; });
+    await page.click('#log-identify');
+    await waitForPage(session, 'no fit of the episode', 90000, () => window.pidlab.design && window.pidlab.design.fit);
+    const fit = await page.evaluate(() => window.pidlab.design.fit);
+    // The episode's id, an int64 past a double's 2^53, read exactly from pidlab replay --json by Python.
+    const index = await page.evaluate(() => window.pidlab.logs.episode.index);
+    const exactId = execFileSync('/usr/bin/python3', ['-c', 'import json, subprocess, sys; ' +
+      'print(json.loads(subprocess.run([sys.argv[1], "replay", "--json", sys.argv[2]], capture_output=True).stdout)["episodes"][int(sys.argv[3])]["episode_id"])',
+      args.pidlab, log25, String(index)], { encoding: 'utf8' }).trim();
+    const cli = JSON.parse(pidlab(['identify', '--log', log25, '--episode', exactId, '--model', 'p1d', '--json', '--quiet']));
+    for (const [name, p] of Object.entries(cli.parameters))
+      if (!Object.is(fit.result.parameters[name].value, p.value)) throw new Error(name + ': page ' + fit.result.parameters[name].value + ', CLI ' + p.value);
+    if (fit.result.source.episode !== cli.source.episode) throw new Error('episode ' + fit.result.source.episode + ', CLI ' + cli.source.episode);
+    const view = await page.evaluate(() => window.pidlab.view);
+    await page.click('#tab-logs');
+    if (view !== 'design') throw new Error('the fit is not shown on the Design tab');
+    return 'episode ' + exactId + ', ' + Object.entries(cli.parameters).map(([k, p]) => k + ' ' + p.value).join(', ');
+  });
+
   await step('the same log uploaded (POST /api/upload): the same IAE; a path outside --log-dir is refused', async () => {
     const bytes = fs.readFileSync(log25).toString('base64');
     const got = await page.evaluate(async (b64) => {
