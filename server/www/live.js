@@ -4,6 +4,7 @@
 // per column, never averaged, drawn as bands. Frames are kept as they come and
 // drawn at the next animation frame (the latest only, once); when an episode completes
 // its whole data (live_data, Float64) lands in window.pidlab.live.final.
+import { clippedAxis } from './plots.js';
 
 const kMagic = 0x31564c50;  // "PLV1"
 const $ = (id) => document.getElementById(id);
@@ -15,10 +16,13 @@ function bandChart(el, title, label, colour, extra) {
     { label: label + ' min', stroke: colour, width: 1 }];
   for (const e of extra || []) series.push(e);
   const fill = colour === '#1f77b4' ? 'rgba(31,119,180,0.25)' : colour === '#d62728' ? 'rgba(214,39,40,0.25)' : 'rgba(44,160,44,0.25)';
+  // u and n: the docs' axis rules (plots.js clippedAxis): a derivative kick
+  // clipped and marked, a flat signal (n = 0) on a readable range.
+  const axis = label === 'y' ? null : clippedAxis();
   return new uPlot({
     title, width: Math.max(400, el.clientWidth || 800), height: 170, series,
-    scales: { x: { time: false } }, axes: [{ label: 't (s)' }, { label }],
-    bands: [{ series: [1, 2], fill }],
+    scales: { x: { time: false }, ...(axis ? { y: { range: axis.range } } : {}) }, axes: [{ label: 't (s)' }, { label }],
+    bands: [{ series: [1, 2], fill }], ...(axis ? { hooks: { draw: [axis.draw] } } : {}),
   }, series.map(() => []), el);
 }
 

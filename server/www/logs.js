@@ -2,6 +2,7 @@
 // uploaded to POST /api/upload), its episodes as `pidlab replay --json` lists
 // them, and one episode's y, u, n with a cursor that scrubs every plot. Every
 // number is the server's (the code of `pidlab replay`); the page only draws.
+import { clippedAxis } from './plots.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -42,11 +43,12 @@ function status(text) { $('log-status').textContent = text; }
 
 function chart(el, title, label, colour, extra) {
   const series = [{ label: 't s' }, { label, stroke: colour, width: 1.5 }, ...(extra || [])];
+  const axis = label === 'y' ? null : clippedAxis();  // u and n: the kick clipped and marked, a flat n readable
   return new uPlot({
     title, width: Math.max(400, el.clientWidth || 900), height: 200, series,
-    scales: { x: { time: false } }, axes: [{ label: 't (s)' }, { label }],
+    scales: { x: { time: false }, ...(axis ? { y: { range: axis.range } } : {}) }, axes: [{ label: 't (s)' }, { label }],
     cursor: { sync: { key: syncKey }, drag: { x: true, y: false } },
-    plugins: [marksPlugin(marks)],
+    plugins: [marksPlugin(marks)], ...(axis ? { hooks: { draw: [axis.draw] } } : {}),
   }, series.map(() => []), el);
 }
 

@@ -42,9 +42,10 @@ function timeChart(el, title, yLabel, label, pinned, extras, clip) {
       series.push({ ...stepExtras[k] });
     }
   }
-  if (clip) {  // the effort: the axis fitted to u after the derivative kick (chart.pidlabClip), the kick marked
-    opts.scales.y = { range: (u, lo, hi) => (u.pidlabClip && u.pidlabClip.range) || autoRange(lo, hi) };
-    opts.hooks = { draw: [(u) => drawKick(u, u.pidlabClip)] };
+  if (clip) {  // the effort: the axis fitted to u after the derivative kick, the kick marked
+    const axis = clippedAxis();
+    opts.scales.y = { range: axis.range };
+    opts.hooks = { draw: [axis.draw] };
   }
   const chart = new uPlot(opts, series.map(() => []), el);
   chart.pidlabExtras = (extras || []).join(',');
@@ -52,28 +53,58 @@ function timeChart(el, title, yLabel, label, pinned, extras, clip) {
 }
 
 // The derivative kick: u at the first samples, far outside the rest. The
-// axis is fitted to u from the first sample where |u| is back within 3 times
-// the rest's span; the clipped samples are named in the chart.
-function effortClip(t, u) {
-  const finite = u.filter((v) => v !== null && isFinite(v));
-  if (finite.length < 10) return { range: null, kick: null };
-  let start = 0;
-  const restOf = (k) => finite.slice(k);
-  const spanOf = (v) => Math.max(...v) - Math.min(...v);
-  // The tail after the first 2 % of the samples sets the scale.
-  const tail = restOf(Math.ceil(finite.length * 0.02));
-  const lo = Math.min(...tail), hi = Math.max(...tail);
-  const span = Math.max(spanOf(tail), Math.abs(hi), Math.abs(lo), 1e-12);
-  while (start < u.length && u[start] !== null && (u[start] > hi + 3 * span || u[start] < lo - 3 * span)) start++;
+// axis is fitted to the signal from the first sample where it is back within
+// 3 times the rest's span; the clipped samples are named in the chart.
+// `lo` and `hi` are the signal's least and largest value at each time (one
+// curve: the same array twice; the live view's min/max columns: two).
+function effortClip(t, lo, hi) {
+  hi = hi || lo;
+  const n = Math.min(lo.length, hi.length);
+  const head = Math.ceil(n * 0.02);
+  let a = Infinity, b = -Infinity;
+  for (let i = head; i < n; i++) {
+    if (lo[i] !== null && isFinite(lo[i])) a = Math.min(a, lo[i]);
+    if (hi[i] !== null && isFinite(hi[i])) b = Math.max(b, hi[i]);
+  }
+  if (!(a <= b) || n < 10) return { range: null, kick: null };
+  const span = Math.max(b - a, Math.abs(a), Math.abs(b), 1e-12);
+  let start = 0, peak = 0;
+  while (start < n && ((hi[start] !== null && hi[start] > b + 3 * span) || (lo[start] !== null && lo[start] < a - 3 * span))) {
+    for (const v of [hi[start], lo[start]]) if (v !== null && Math.abs(v) > Math.abs(peak)) peak = v;
+    start++;
+  }
   if (start === 0) return { range: null, kick: null };
-  const peak = u.slice(0, start).reduce((m, v) => (Math.abs(v) > Math.abs(m) ? v : m), 0);
   // Padded by a tenth of the span, never less than 1e-6 of the values'
   // size: a flat tail must not make a range uPlot cannot split.
-  const a = Math.min(lo, 0), b = Math.max(hi, 0);
-  const pad = 0.1 * Math.max(b - a, 1e-6 * Math.max(Math.abs(a), Math.abs(b)), 1e-9);
-  const range = [a - pad, b + pad];
+  const x = Math.min(a, 0), y = Math.max(b, 0);
+  const pad = 0.1 * Math.max(y - x, 1e-6 * Math.max(Math.abs(x), Math.abs(y)), 1e-9);
+  const range = [x - pad, y + pad];
   if (!range.every(isFinite)) return { range: null, kick: null };
   return { range, kick: { t: t[0], until: t[start], peak } };
+}
+
+// A y axis that clips a derivative kick (and marks it) and gives a flat
+// signal a readable range: uPlot options' `range` and `draw` hook, the clip
+// computed from the chart's own data at each redraw (every series but x).
+export function clippedAxis() {
+  const range = (u, lo, hi) => {
+    const series = u.data.slice(1).filter((d) => d && d.length);
+    const n = series.length ? Math.min(...series.map((d) => d.length)) : 0;
+    const los = new Array(n), his = new Array(n);
+    for (let i = 0; i < n; i++) {
+      let a = null, b = null;
+      for (const d of series) {
+        const v = d[i];
+        if (v === null || v === undefined || !isFinite(v)) continue;
+        a = a === null ? v : Math.min(a, v);
+        b = b === null ? v : Math.max(b, v);
+      }
+      los[i] = a; his[i] = b;
+    }
+    u.pidlabClip = effortClip(u.data[0] || [], los, his);
+    return u.pidlabClip.range || autoRange(lo, hi);
+  };
+  return { range, draw: (u) => drawKick(u, u.pidlabClip) };
 }
 
 function drawKick(u, clip) {
@@ -82,6 +113,8 @@ function drawKick(u, clip) {
   const x = u.valToPos(clip.kick.t, 'x', true);
   ctx.save();
   ctx.fillStyle = '#b00';
+  ctx.textAlign = 'left';
+  ctx.textBaseline = 'alphabetic';
   ctx.font = (12 * devicePixelRatio) + 'px system-ui, sans-serif';
   ctx.fillText('\u2191 derivative kick, u up to ' + Number(clip.kick.peak.toPrecision(4)) + ' (clipped)', x + 6 * devicePixelRatio, u.bbox.top + 14 * devicePixelRatio);
   ctx.restore();
@@ -132,6 +165,7 @@ const aspect = (u) => (u.bbox && u.bbox.width > 0 && u.bbox.height > 0 ? u.bbox.
 // uPlot's own padded range, and [0, 1] where there is no data (every value null).
 function autoRange(lo, hi) {
   if (lo === null || hi === null || !isFinite(lo) || !isFinite(hi)) return [0, 1];
+  if (lo === hi) { const d = Math.abs(lo) * 0.1 || 1; return [lo - d, hi + d]; }  // a flat signal (n = 0): not 0..100
   return uPlot.rangeNum(lo, hi, 0.1, true);
 }
 function square(el) {
@@ -292,7 +326,6 @@ export function drawPlots(plots, series, pinned, trio, sampled) {
       : 'Control effort u: not computed for the continuous loop with dead time (the firmware\'s sampled loop draws it)');
   title(plots.load, Array.isArray(series.load_y) ? 'Load response y (unit step at the plant input)'
     : 'Load response: not computed for the continuous loop with dead time');
-  plots.effort.pidlabClip = effortClip(series.t, u);
   plots.effort.setData([series.t, u, ...pin('u')]);
   plots.load.setData([series.t, orEmpty(series.load_y, n), ...pin('load_y')]);
   const m = series.w.length;
