@@ -1,5 +1,5 @@
 """Hostile uploads and identify requests against a running `pidlab serve`
-(tests/hostile/serve_identify_test.sh): seeded malformed CSV records uploaded
+(tests/hostile/serve_identify_fuzz.py, run by serve_hostile_test.sh): seeded malformed CSV records uploaded
 (POST /api/upload) and fitted, and malformed identify and identify_cancel
 requests on the WebSocket. Every identify gets exactly one answer (an error
 at once, or identify_result / identify_cancelled), never a crash; the
