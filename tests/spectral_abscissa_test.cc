@@ -1,6 +1,7 @@
 // The slowest time constant of the continuous loop with dead time: the
 // spectral abscissa alpha = max Re s over the roots of 1 + C G e^{-sL} = 0 by
-// Nyquist counts on shifted lines, bisection and Newton, against the Lambert W
+// Nyquist counts on shifted lines (a Newton guess certified by two of them,
+// else bisection) and Newton, against the Lambert W
 // roots of kp e^{-sL}/s, roots found independently for e^{-s}/(s + 1), and the
 // delay-free loop's poles as L -> 0.
 
@@ -91,6 +92,17 @@ TEST(SpectralAbscissa, IsThePrincipalLambertWRootForPControlOfADelayedIntegrator
     EXPECT_TRUE(sa.polished) << sa.note;
     EXPECT_NEAR(sa.alpha, c.re, 1e-9) << "kp " << c.kp << " L " << c.delay_s;
     EXPECT_NEAR(sa.root.imag(), c.im, 1e-9 * std::max(1.0, c.im));
+  }
+}
+
+TEST(SpectralAbscissa, CertifiesNewtonsGuessWithThreeCountsInsteadOfBisecting) {
+  // One count on the stable side, Newton from its line, and two counts that
+  // bracket the guess within 0.4e-7 |alpha| each side: no walk, no bisection.
+  for (const LambertCase& c : kLambert) {
+    const SpectralAbscissa sa = AbscissaOrFail(Tf({1.0}, {1.0, 0.0}), P(c.kp), c.delay_s);
+    EXPECT_EQ(sa.counts, 3) << "kp " << c.kp << " L " << c.delay_s;
+    EXPECT_LE(sa.strip_width, 1e-7 * std::abs(c.re));
+    EXPECT_NEAR(sa.alpha, c.re, 1e-12 * std::abs(c.re)) << "kp " << c.kp << " L " << c.delay_s;
   }
 }
 

@@ -128,6 +128,9 @@ using frequency::Polynomial;
 constexpr double kStripFraction = 1e-7;
 // Newton's polish from this many of the best points on the strip's line.
 constexpr std::size_t kNewtonStarts = 6;
+// The certified guess's strip, as a fraction of |alpha|: within the
+// bisection's kStripFraction.
+constexpr double kGuessStrip = 0.4 * kStripFraction;
 
 Polynomial Derivative(const Polynomial& p) {
   Polynomial d;
@@ -186,12 +189,9 @@ double SlowestFeature(const frequency::ContinuousResponse& r) {
   return lo;
 }
 
-// Newton from the best local minima of |1 + L| on the line of the strip's
-// middle (its grid w, pts): the rightmost root found inside [lo, hi], widened
-// by the polish's own tolerance, into *out.
-void Polish(const frequency::ContinuousResponse& r, double lo, double hi, const std::vector<double>& w,
-            const std::vector<frequency::Point>& pts, SpectralAbscissa* out) {
-  const Characteristic f{r.a(), r.b(), Derivative(r.a()), Derivative(r.b()), r.delay()};
+// The frequencies of the kNewtonStarts best local minima of |1 + L| on a
+// line's grid (w, pts), 0 first.
+std::vector<double> BestMinima(const std::vector<double>& w, const std::vector<frequency::Point>& pts) {
   auto residual = [&](std::size_t i) {
     return std::abs(pts[i].a + pts[i].b) / (std::abs(pts[i].a) + std::abs(pts[i].b));
   };
@@ -204,8 +204,19 @@ void Polish(const frequency::ContinuousResponse& r, double lo, double hi, const 
   }
   std::sort(minima.begin() + 1, minima.end());
   if (minima.size() > kNewtonStarts) minima.resize(kNewtonStarts);
+  std::vector<double> starts;
+  for (const auto& m : minima) starts.push_back(m.second);
+  return starts;
+}
+
+// Newton from the best local minima of |1 + L| on the line of the strip's
+// middle (its grid w, pts): the rightmost root found inside [lo, hi], widened
+// by the polish's own tolerance, into *out.
+void Polish(const frequency::ContinuousResponse& r, double lo, double hi, const std::vector<double>& w,
+            const std::vector<frequency::Point>& pts, SpectralAbscissa* out) {
+  const Characteristic f{r.a(), r.b(), Derivative(r.a()), Derivative(r.b()), r.delay()};
   const double mid = 0.5 * (lo + hi), slack = hi - lo + 1e-12 * std::max(1.0, std::abs(hi));
-  for (const auto& [unused, wi] : minima) {
+  for (double wi : BestMinima(w, pts)) {
     const cd root = NewtonRoot(f, cd(mid, wi));
     if (!(root.real() >= lo - slack && root.real() <= hi + slack)) continue;
     if (!out->polished || root.real() > out->alpha) {
@@ -214,6 +225,20 @@ void Polish(const frequency::ContinuousResponse& r, double lo, double hi, const 
       out->root = root;
     }
   }
+}
+
+// A guess at alpha from the stable side: Newton from the best local minima
+// of |1 + L| on the line Re s = sigma (its grid w, pts), the rightmost root
+// found left of the line (Im >= 0). False when no start converges.
+bool GuessRightmost(const frequency::ContinuousResponse& r, double sigma, const std::vector<double>& w,
+                    const std::vector<frequency::Point>& pts, cd* rightmost) {
+  const Characteristic f{r.a(), r.b(), Derivative(r.a()), Derivative(r.b()), r.delay()};
+  bool found = false;
+  for (double wi : BestMinima(w, pts)) {
+    const cd root = NewtonRoot(f, cd(sigma, wi));
+    if (root.real() < sigma && (!found || root.real() > rightmost->real())) *rightmost = root, found = true;
+  }
+  return found;
 }
 
 }  // namespace
@@ -239,10 +264,37 @@ bool ContinuousSpectralAbscissaOrExplain(const TransferFunction& tf, const PidGa
   thread_local std::vector<double> w;
   thread_local std::vector<frequency::Point> pts;
   // Left from the stable loop's line Re s = 0 by doublings until a root lies
-  // right of the line, then bisection of the strip.
+  // right of the line, then bisection of the strip (unless a guess is
+  // certified first).
   const double start = 1e-3 * SlowestFeature(r);
   double hi = 0.0, lo = -start;
   std::string why;
+  // First a guess, certified by two counts: no root right of guess + d and
+  // one right of guess - d, d = kGuessStrip |guess|. The strip then needs no
+  // bisection; where either count does not confirm it, the walk below runs
+  // from the start.
+  {
+    double line = -start;
+    cd guess;
+    if (RootsRightOf(r, poles, points_per_decade, &line, &w, &pts, &out->counts, &why) == 0 &&
+        GuessRightmost(r, line, w, pts, &guess)) {
+      const double d = kGuessStrip * std::abs(guess.real());
+      double right = guess.real() + d, left = guess.real() - d;
+      if (right < line &&
+          RootsRightOf(r, poles, points_per_decade, &right, &w, &pts, &out->counts, &why) == 0 &&
+          RootsRightOf(r, poles, points_per_decade, &left, &w, &pts, &out->counts, &why) > 0 &&
+          left < guess.real() && guess.real() < right && right < line) {
+        // The guess is a root (Newton's), inside the strip that holds alpha.
+        out->strip_width = right - left;
+        out->polished = true;
+        out->alpha = guess.real();
+        out->root = guess;
+        out->found = true;
+        return true;
+      }
+    }
+    why.clear();
+  }
   for (int k = 0;; ++k, lo *= 2.0) {
     const int z = k < 200 ? RootsRightOf(r, poles, points_per_decade, &lo, &w, &pts, &out->counts, &why) : -1;
     if (z < 0) {

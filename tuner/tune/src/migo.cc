@@ -89,13 +89,65 @@ class Designer {
         slowest_(slowest_s),
         rational_(!(plant.delay_s > 0.0)),
         num_(plant.tf.num),
-        den_(plant.tf.den) {}
+        den_(plant.tf.den) {
+    for (std::size_t i = 0; i < grid_.w.size(); ++i) {
+      const cd b = grid_.g[i] / cd(0.0, grid_.w[i]);
+      br_.push_back(b.real());
+      bi_.push_back(b.imag());
+    }
+    const double wmax = MaxCrossover();
+    above_max_crossover_ =
+        static_cast<std::size_t>(std::upper_bound(grid_.w.begin(), grid_.w.end(), wmax) - grid_.w.begin());
+  }
 
-  bool Feasible(const PidGains& g) const {
-    if (!(g.kp > 0.0) || !(g.ki > 0.0) || !(g.ki <= kMaxMigoGain) || !(g.kp <= kMaxMigoGain)) return false;
-    const Peaks p = PeaksOn(grid_, g);
-    if (!(p.ms <= o_.ms) || !(p.mt <= o_.ms) || !(p.crossover <= MaxCrossover())) return false;
-    return rational_ ? RationalLoopIsStable(g) : true;
+  // The loop at (kp, td) apart from ki, L = A + ki B on the grid: A = kp G
+  // (1 + td s / (1 + tf s)), B = G / s. MaxKi's scan varies ki only, so the
+  // peaks of each step cost a multiply-add per point, no complex division.
+  struct Loop {
+    double kp = 0.0, td = 0.0;
+    std::vector<double> ar, ai;
+  };
+
+  void LoopAt(double kp, double td, Loop* loop) const {
+    loop->kp = kp;
+    loop->td = td;
+    const std::size_t n = grid_.w.size();
+    loop->ar.resize(n);
+    loop->ai.resize(n);
+    const double tf = td > 0.0 ? td / o_.filter_ratio : 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const cd s(0.0, grid_.w[i]);
+      const cd a = kp * grid_.g[i] * (td > 0.0 ? 1.0 + td * s / (1.0 + tf * s) : cd(1.0));
+      loop->ar[i] = a.real();
+      loop->ai[i] = a.imag();
+    }
+  }
+
+  // The peaks' test of Feasible on L = A + ki B: Ms, Mt <= the bound and no
+  // gain crossover above MaxCrossover(). The point that failed last is
+  // tried first, so that a step past the bound costs a few points.
+  bool PeaksFeasible(const Loop& loop, double ki) const {
+    const std::size_t n = grid_.w.size();
+    const double ms2 = o_.ms * o_.ms;
+    const auto fails = [&](std::size_t i) {
+      const double lr = loop.ar[i] + ki * br_[i], li = loop.ai[i] + ki * bi_[i];
+      const double l2 = lr * lr + li * li, d2 = (1.0 + lr) * (1.0 + lr) + li * li;
+      return !(ms2 * d2 >= 1.0) || !(l2 <= ms2 * d2) || (i >= above_max_crossover_ && l2 >= 1.0);
+    };
+    if (last_failed_ < n && fails(last_failed_)) return false;
+    for (std::size_t i = 0; i < n; ++i)
+      if (fails(i)) {
+        last_failed_ = i;
+        return false;
+      }
+    return true;
+  }
+
+  bool Feasible(const Loop& loop, double ki) const {
+    const double kp = loop.kp;
+    if (!(kp > 0.0) || !(ki > 0.0) || !(ki <= kMaxMigoGain) || !(kp <= kMaxMigoGain)) return false;
+    if (!PeaksFeasible(loop, ki)) return false;
+    return rational_ ? RationalLoopIsStable(Gains(kp, ki, loop.td)) : true;
   }
 
   // Without dead time the closed loop's poles are the roots of
@@ -143,12 +195,13 @@ class Designer {
 
   // The largest feasible ki at (kp, td), scanned up from `from` (0: none).
   double MaxKi(double kp, double td, double from) const {
+    LoopAt(kp, td, &loop_);
     double ki = from;
-    if (!Feasible(Gains(kp, ki, td))) return 0.0;
+    if (!Feasible(loop_, ki)) return 0.0;
     double bad = 0.0;
     for (int i = 0; i < 400; ++i) {
       const double next = ki * kKiStep;
-      if (!Feasible(Gains(kp, next, td))) {
+      if (!Feasible(loop_, next)) {
         bad = next;
         break;
       }
@@ -157,7 +210,7 @@ class Designer {
     if (bad == 0.0) return ki;
     for (int i = 0; i < kKiBisections; ++i) {
       const double mid = std::sqrt(ki * bad);
-      (Feasible(Gains(kp, mid, td)) ? ki : bad) = mid;
+      (Feasible(loop_, mid) ? ki : bad) = mid;
     }
     return ki;
   }
@@ -206,6 +259,10 @@ class Designer {
   double fastest_, slowest_;
   bool rational_;
   std::vector<double> num_, den_;
+  std::vector<double> br_, bi_;          // B = G / s on the grid
+  std::size_t above_max_crossover_ = 0;  // the first grid point above MaxCrossover()
+  mutable Loop loop_;                    // MaxKi's A
+  mutable std::size_t last_failed_ = static_cast<std::size_t>(-1);
 };
 
 }  // namespace
