@@ -7,8 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
+#include <thread>
+#include <utility>
 
 #include "test_status.h"
 
@@ -317,6 +320,72 @@ TEST(LoopFrequencyResponse, SampledLoopPeaksAtTheAnalysisMsMtAndNoiseGain) {
   EXPECT_NEAR(std::abs(r[1].t), a.mt, 1e-9 * a.mt);
   EXPECT_NEAR(std::abs(r[2].cs), a.noise_gain, 1e-9 * a.noise_gain);
   EXPECT_NEAR(std::abs(r[0].s + r[0].t), 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace pidlab
+
+namespace pidlab {
+namespace {
+
+// AnalyzeLoop keeps its last answers per thread (a served evaluation asks
+// for the same loop three times at other horizons): a kept answer equals a
+// new analysis bit for bit, and an input the analysis reads is never mixed up.
+LoopAnalysis FreshAnalysis(const Plant& plant, const PidGains& g, const LoopOptions& o) {
+  LoopAnalysis a;
+  std::thread([&] { EXPECT_TRUE(IsOk(AnalyzeLoop(plant, g, o, LoopAnalysisOptions{}, &a))); }).join();
+  return a;
+}
+
+void ExpectSameBits(const LoopAnalysis& a, const LoopAnalysis& b) {
+  for (const auto& [x, y] : {std::pair{a.ms, b.ms},
+                             {a.mt, b.mt},
+                             {a.phase_margin_deg, b.phase_margin_deg},
+                             {a.gain_margin, b.gain_margin},
+                             {a.noise_gain, b.noise_gain},
+                             {a.slowest_time_constant_s, b.slowest_time_constant_s},
+                             {a.gain_crossover_rad_s, b.gain_crossover_rad_s}})
+    EXPECT_EQ(std::memcmp(&x, &y, sizeof x), 0) << x << " vs " << y;
+  EXPECT_EQ(a.stable, b.stable);
+}
+
+TEST(AnalyzeLoop, KeepsItsAnswerAcrossHorizonsBitForBitAndNeverForAnotherLoop) {
+  Plant plant;
+  plant.name = "custom";
+  plant.tf.num = {2.0};
+  plant.tf.den = {60.0, 1.0};
+  plant.delay_s = 8.0;
+  const PidGains g{1.98, 0.128, 8.5, 0.43};
+  LoopOptions o;
+  LoopAnalysis first, again;
+  ASSERT_TRUE(IsOk(AnalyzeLoop(plant, g, o, LoopAnalysisOptions{}, &first)));
+  o.horizon_s = 500.0;
+  o.sample_time_s = 1.0;
+  ASSERT_TRUE(IsOk(AnalyzeLoop(plant, g, o, LoopAnalysisOptions{}, &again)));
+  ExpectSameBits(again, first);
+  ExpectSameBits(again, FreshAnalysis(plant, g, o));
+  // Another gain, filter, delay or plant name is another analysis.
+  PidGains other = g;
+  other.kp *= 1.0 + 1e-15;
+  LoopAnalysis a;
+  ASSERT_TRUE(IsOk(AnalyzeLoop(plant, other, o, LoopAnalysisOptions{}, &a)));
+  ExpectSameBits(a, FreshAnalysis(plant, other, o));
+  Plant slower = plant;
+  slower.delay_s = 9.0;
+  ASSERT_TRUE(IsOk(AnalyzeLoop(slower, g, o, LoopAnalysisOptions{}, &a)));
+  EXPECT_GT(a.ms, first.ms);
+  ExpectSameBits(a, FreshAnalysis(slower, g, o));
+  LoopOptions filtered = o;
+  PidGains unfiltered = g;
+  unfiltered.tf = 0.0;
+  filtered.derivative_filter_ratio = 5.0;
+  ASSERT_TRUE(IsOk(AnalyzeLoop(plant, unfiltered, filtered, LoopAnalysisOptions{}, &a)));
+  ExpectSameBits(a, FreshAnalysis(plant, unfiltered, filtered));
+  filtered.derivative_filter_ratio = 20.0;
+  LoopAnalysis b;
+  ASSERT_TRUE(IsOk(AnalyzeLoop(plant, unfiltered, filtered, LoopAnalysisOptions{}, &b)));
+  EXPECT_NE(a.noise_gain, b.noise_gain);
+  ExpectSameBits(b, FreshAnalysis(plant, unfiltered, filtered));
 }
 
 }  // namespace

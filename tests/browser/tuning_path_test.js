@@ -6,7 +6,9 @@
 // 1. A step-test CSV is uploaded; 2. identified with auto (the JSON of pidlab
 // identify --model auto --json); 3. the model accepted as the plant; 4. the
 // response-time and robustness knobs moved: the gains equal pidlab tune
-// --response-time T --robustness R --json's (1e-12); 5. exported at a dt;
+// --response-time T --robustness R --json's (1e-12); 4b. the knob's 51
+// positions designed ahead: a move is drawn from what they kept, without a
+// request, and equals pidlab tune's (1e-12); 5. exported at a dt;
 // the downloaded pidlab_pid.c and .h, and the export's spec, are written to
 // --tmp for the shell half (6. gcc, 7. the trio against evaluate --loop sampled).
 'use strict';
@@ -148,6 +150,30 @@ async function main() {
     }
     await shot('knob');
     return moved.join('; ');
+  });
+
+  await step('4b. the knob\'s positions are designed ahead: a move is drawn from them, no request, and equals pidlab tune', async () => {
+    const started = Date.now();
+    await waitForPage(session, 'the knob positions not designed ahead', 240000, () => window.pidlab.design.knob.ready);
+    const ahead = await page.$eval('#knob-ahead', (e) => e.textContent);
+    if (!/^51 of 51 knob positions designed$/.test(ahead)) throw new Error('#knob-ahead says: ' + ahead);
+    const moved = [];
+    for (const value of ['0.3', '0.92']) {
+      await page.evaluate((value) => {
+        window.pidlab.design.knob.last = null;
+        const r = document.getElementById('knob-speed');
+        r.value = value;
+        r.dispatchEvent(new Event('input', { bubbles: true }));
+      }, value);
+      const got = await knobGains('no design for knob-speed = ' + value);
+      await waitForPage(session, 'no redraw for knob-speed = ' + value, waitMs, () =>
+        window.pidlab.lastResult && window.pidlab.lastResult.gains.kp === window.pidlab.design.knob.last.result.gains.kp);
+      const t = await page.evaluate(() => window.pidlab.timings[window.pidlab.timings.length - 1]);
+      if (!t.kept) throw new Error('the move to ' + value + ' sent a request: ' + JSON.stringify(t));
+      if (got.spec.robustness !== 1.3) throw new Error('designed ahead at robustness ' + got.spec.robustness);
+      moved.push(compareWithTune(got) + ' (drawn ' + (t.drawn_ms - t.sent_ms).toFixed(1) + ' ms after the input)');
+    }
+    return 'ready ' + ((Date.now() - started) / 1000).toFixed(1) + ' s after the robustness move; ' + moved.join('; ');
   });
 
   await step('5. export at a chosen dt: the loop check is stable, pidlab_pid.c and .h download', async () => {

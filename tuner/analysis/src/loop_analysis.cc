@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <sstream>
 
@@ -338,11 +339,115 @@ bool AnalyzeLoopOrExplain(const Plant& plant, const PidGains& typed_gains,
 
 }  // namespace
 
+namespace {
+
+// The last analyses of this thread, by their inputs. A served evaluation
+// asks for the same loop's analysis three times (its time scale, the
+// figure's frame and the result), each at another horizon: the analysis
+// reads neither the horizon nor the sample time, and every other input is in
+// the key, compared bit for bit, so a hit is the answer a new analysis gives.
+// Only valid options of a linear plant without an uncertainty model are kept.
+struct AnalysisMemo {
+  struct Entry {
+    std::string plant;
+    std::vector<double> key;
+    Status status;
+    LoopAnalysis result;
+  };
+  static constexpr std::size_t kEntries = 4;
+  std::vector<Entry> entries;  // the newest last
+};
+
+// A field added to these structs must join the key below.
+static_assert(sizeof(PidGains) == 4 * sizeof(double));
+static_assert(sizeof(PidOptions) == 9 * 8);
+static_assert(sizeof(DisturbanceOptions) == 10 * 8);
+static_assert(sizeof(MeasurementNoise) == 3 * 8);
+static_assert(sizeof(EpisodeShape) ==
+              4 * 8 + sizeof(PidOptions) + sizeof(DisturbanceOptions) + sizeof(MeasurementNoise));
+static_assert(sizeof(evaluation::LoopOptions) == sizeof(EpisodeShape) + 4 * 8);
+static_assert(sizeof(LoopAnalysisOptions) == 3 * 8 + 8);
+
+double Bits(std::uint64_t v) {
+  double d;
+  std::memcpy(&d, &v, sizeof d);
+  return d;
+}
+
+std::vector<double> AnalysisKey(const Plant& plant, const PidGains& g, const evaluation::LoopOptions& o,
+                                const LoopAnalysisOptions& ao) {
+  const PidOptions& p = o.pid;
+  const DisturbanceOptions& d = o.disturbance;
+  const MeasurementNoise& n = o.measurement_noise;
+  std::vector<double> k = {static_cast<double>(plant.tf.num.size()),
+                           plant.delay_s,
+                           g.kp,
+                           g.ki,
+                           g.kd,
+                           g.tf,
+                           o.dt_s,
+                           o.reference,
+                           p.dt_s,
+                           p.derivative_filter_s,
+                           p.output_min,
+                           p.output_max,
+                           static_cast<double>(p.anti_windup),
+                           p.back_calculation_gain,
+                           static_cast<double>(p.integral),
+                           p.setpoint_weight_b,
+                           p.setpoint_weight_c,
+                           static_cast<double>(d.kind),
+                           d.amplitude,
+                           d.period_s,
+                           d.phase_s,
+                           d.step_time_s,
+                           d.noise_hold_s,
+                           Bits(d.seed),
+                           d.chirp_f0_hz,
+                           d.chirp_f1_hz,
+                           d.chirp_duration_s,
+                           n.sigma,
+                           Bits(n.seed),
+                           n.resolution,
+                           static_cast<double>(o.loop),
+                           o.derivative_filter_ratio,
+                           o.derivative_filter_min_s,
+                           o.stability_margin,
+                           ao.points_per_decade,
+                           ao.refine_peaks ? 1.0 : 0.0,
+                           ao.hamiltonian_check ? 1.0 : 0.0,
+                           ao.cancellation_tolerance,
+                           ao.delayed_time_constant ? 1.0 : 0.0};
+  k.insert(k.end(), plant.tf.num.begin(), plant.tf.num.end());
+  k.insert(k.end(), plant.tf.den.begin(), plant.tf.den.end());
+  return k;
+}
+
+}  // namespace
+
 Status AnalyzeLoop(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
                    const LoopAnalysisOptions& ao, LoopAnalysis* out) {
+  const bool kept = !plant.nonlinear && !plant.model && options.IsValid(nullptr);
+  thread_local AnalysisMemo memo;
+  std::vector<double> key;
+  if (kept) {
+    key = AnalysisKey(plant, typed_gains, options, ao);
+    for (const AnalysisMemo::Entry& e : memo.entries)
+      if (e.plant == plant.name && e.key.size() == key.size() &&
+          std::memcmp(e.key.data(), key.data(), key.size() * sizeof(double)) == 0) {
+        *out = e.result;
+        return e.status;
+      }
+  }
   std::string why;
-  if (!AnalyzeLoopOrExplain(plant, typed_gains, options, ao, out, &why)) return Status::InvalidInput(why);
-  return Status::Ok();
+  const Status status = AnalyzeLoopOrExplain(plant, typed_gains, options, ao, out, &why)
+                            ? Status::Ok()
+                            : Status::InvalidInput(why);
+  if (kept) {
+    if (memo.entries.size() == AnalysisMemo::kEntries) memo.entries.erase(memo.entries.begin());
+    memo.entries.push_back({plant.name, std::move(key), status, *out});
+  }
+  return status;
 }
 
 Status CountNyquist(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,
