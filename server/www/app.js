@@ -96,6 +96,17 @@ function ask(message) {
   });
 }
 
+// The evaluations answered, by their spec: the reply is a pure function of
+// it, so a design drawn before (or evaluated ahead: the knob's positions,
+// design.js) is drawn again without a request. The newest kept last.
+const kKeptEvaluations = 200;
+const evaluations = new Map();
+function keepEvaluation(key, reply) {
+  evaluations.delete(key);
+  evaluations.set(key, reply);
+  if (evaluations.size > kKeptEvaluations) evaluations.delete(evaluations.keys().next().value);
+}
+
 // Evaluates the current design: latest wins, no queue.
 function send() {
   writeHash();
@@ -103,8 +114,86 @@ function send() {
   if (inflight) { pending = true; return; }
   let s;
   try { s = spec(); } catch (e) { setStatus('bad design: ' + e.message); return; }
-  inflight = { seq: ++seq, sent_ms: performance.now() };
+  const key = JSON.stringify(s);
+  const kept = evaluations.get(key);
+  if (kept) {
+    keepEvaluation(key, kept);
+    const now = performance.now();
+    show(kept, { seq: ++seq, sent_ms: now, kept: true }, now);
+    return;
+  }
+  inflight = { seq: ++seq, sent_ms: performance.now(), key };
   if (!rawSend({ id: inflight.seq, type: 'evaluate', spec: s })) inflight = null;
+}
+
+// The spec of the current design with `fields` of the state changed (the
+// state itself unchanged).
+function specWith(fields) {
+  const saved = {};
+  for (const k of Object.keys(fields)) saved[k] = state[k];
+  Object.assign(state, fields);
+  try { return spec(); } finally { Object.assign(state, saved); }
+}
+
+// What a tuning's result sets in the design: gains, filter, setpoint weights.
+function tunedFields(r) {
+  const g = r.gains;
+  const w = r.two_dof && r.two_dof.ran ? r.two_dof.setpoint_weights : null;
+  return { kp: g.kp, ki: g.ki, kd: g.kd, derivative_filter: g.tf > 0 ? g.tf : '',
+    setpoint_weight_b: w ? w[0] : '', setpoint_weight_c: w ? w[1] : '' };
+}
+
+// A second connection for work done ahead of the user (design.js's knob
+// positions): its own tune slot on the server, so that the user's requests
+// never queue behind it. Its requests run one at a time.
+let background = null;
+function backgroundAsk(message) {
+  if (!background) {
+    const ws = new WebSocket(wsUrl());
+    const b = { ws, waits: new Map(), seq: 0, chain: null };
+    b.chain = new Promise((resolve, reject) => {
+      ws.addEventListener('open', resolve);
+      ws.addEventListener('error', () => reject(new Error('the background connection failed')));
+    });
+    ws.addEventListener('message', (e) => {
+      if (typeof e.data !== 'string') return;
+      const reply = JSON.parse(e.data);
+      const w = b.waits.get(reply.id);
+      if (!w || reply.type === 'tune_progress' || reply.type === 'identify_progress') return;
+      b.waits.delete(reply.id);
+      if (reply.error) w.reject(new Error(reply.error)); else w.resolve(reply);
+    });
+    ws.addEventListener('close', () => {
+      for (const w of b.waits.values()) w.reject(new Error('the background connection closed'));
+      b.waits.clear();
+      if (background === b) background = null;
+    });
+    background = b;
+  }
+  const b = background;
+  const asked = b.chain.then(() => new Promise((resolve, reject) => {
+    const id = ++b.seq;
+    b.waits.set(id, { resolve, reject });
+    b.ws.send(JSON.stringify({ ...message, id }));
+  }));
+  b.chain = asked.catch(() => {});
+  return asked;
+}
+
+// Evaluates `s` ahead on the background connection, unless it is kept.
+async function evaluateAhead(s) {
+  const key = JSON.stringify(s);
+  if (evaluations.has(key)) return;
+  const reply = await backgroundAsk({ type: 'evaluate', spec: s });
+  keepEvaluation(key, reply);
+}
+
+// Resolves when no request of the user's is waiting for its reply.
+function idle() {
+  return new Promise((resolve) => {
+    const poll = () => (!inflight && !pending && waiting.size === 0 ? resolve() : setTimeout(poll, 20));
+    poll();
+  });
 }
 
 function fmt(v) {
@@ -177,7 +266,8 @@ function show(reply, sent, reply_ms) {
   $('command').textContent = pidlab.command();
   renderDiff();
   queueMicrotask(() => {  // after uPlot's own commit (a microtask queued by setData)
-    pidlab.timings.push({ seq: sent.seq, sent_ms: sent.sent_ms, reply_ms, drawn_ms: performance.now(), server_ms: reply.compute_ms });
+    pidlab.timings.push({ seq: sent.seq, sent_ms: sent.sent_ms, reply_ms, drawn_ms: performance.now(),
+      server_ms: sent.kept ? 0 : reply.compute_ms, kept: !!sent.kept });
     pidlab.rendered += 1;
   });
 }
@@ -186,7 +276,7 @@ function onMessage(reply, arrived_ms) {
   if (inflight && reply.id === inflight.seq) {
     const sent = inflight;
     inflight = null;
-    if (reply.error) setStatus(reply.error); else show(reply, sent, arrived_ms);
+    if (reply.error) setStatus(reply.error); else keepEvaluation(sent.key, reply), show(reply, sent, arrived_ms);
     if (pending) { pending = false; send(); }
     return;
   }
@@ -407,16 +497,11 @@ async function tune(options) {
 
 // A tuning spec run on the server, its gains, filter and setpoint weights
 // made the design, and the design evaluated (the knobs' designs).
-async function tuneSpec(s) {
-  const reply = await ask({ type: 'tune', spec: s });
-  const r = reply.result;
+// `known`: the result of this spec's tuning when it was run before.
+async function tuneSpec(s, options, known) {
+  const r = known || (await ask({ type: 'tune', spec: s })).result;
   pidlab.lastTune = r;
-  const g = r.gains;
-  state.kp = g.kp; state.ki = g.ki; state.kd = g.kd;
-  state.derivative_filter = g.tf > 0 ? g.tf : '';
-  const w = r.two_dof && r.two_dof.ran ? r.two_dof.setpoint_weights : null;
-  state.setpoint_weight_b = w ? w[0] : '';
-  state.setpoint_weight_c = w ? w[1] : '';
+  Object.assign(state, tunedFields(r));
   showForm();
   await evaluated();
   return r;
@@ -455,10 +540,13 @@ async function exportC() {
 pidlab.exportC = exportC;
 
 // ---- Start.
-function connect() {
-  const url = (location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + '/ws' +
+function wsUrl() {
+  return (location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + '/ws' +
       (token ? '?token=' + encodeURIComponent(token) : '');
-  socket = new WebSocket(url);
+}
+
+function connect() {
+  socket = new WebSocket(wsUrl());
   socket.binaryType = 'arraybuffer';  // the live view's frames (live.js)
   socket.addEventListener('open', () => { send(); loadPaperDesigns(); serverInfo(); });
   socket.addEventListener('message', (e) => {
@@ -524,6 +612,7 @@ views.live = initLive({ rawSend });
 views.trio = initTrio({ ask, spec, setStatus, redraw: rebuildPlots });
 initLogs({ ask, token });
 views.design = initDesign({ state, ask, rawSend, token, spec, setStatus, fmt, resetPlant, tune: tuneSpec,
+  backgroundAsk, evaluateAhead, idle, specAfterTune: (r) => specWith(tunedFields(r)),
   redraw: rebuildPlots, lastResult: () => pidlab.lastResult });
 // server_info: live when pidlab serve has --lcm-url (an older server does not know the request).
 async function serverInfo() {

@@ -106,9 +106,11 @@ function acceptModel() {
 // Response time: the slider is log10 of T over [T0, 30 T0], T0 = 2/wc of the
 // fastest design the bound allows; its right end is "as fast as allowed" (0).
 const kSlowest = 30;
-function knobValues() {
+// The response-time knob's positions: 0, 1/kKnobSteps, ..., 1 (index.html's step).
+const kKnobSteps = 50;
+function knobValues(at) {
   const k = design.knob;
-  const speed = Number($('knob-speed').value);  // 0 slowest .. 1 fastest
+  const speed = at === undefined ? Number($('knob-speed').value) : at;  // 0 slowest .. 1 fastest
   const robust = Number($('knob-robustness').value);
   const values = {};
   if (speed < 1 && k.fastestTime > 0) values.response_time = Number((k.fastestTime * Math.pow(kSlowest, 1 - speed)).toPrecision(3));
@@ -122,25 +124,32 @@ function showKnob() {
   $('knob-robustness-value').textContent = v.robustness ? 'Ms \u2264 ' + v.robustness : 'default (SIMC\u2019s Ms)';
 }
 
-// The tuning spec of the current plant with the knobs' values.
-function knobSpec() {
+// The tuning spec of the current plant with the knobs' values (the
+// response-time knob at `at` when given).
+function knobSpec(at) {
   const s = app.spec();
   for (const k of ['gains', 'monte_carlo', 'spread', 'derivative_filter', 'setpoint_weights', 'max_ms', 'max_mt', 'max_noise_gain',
     'min_phase_margin', 'loop', 'dt']) delete s[k];
   s.method = 'migo';
-  Object.assign(s, knobValues());
+  Object.assign(s, knobValues(at));
   return s;
 }
 
 // Runs the knob's design; while one runs, the latest knob position waits
 // (latest wins).
+// A position designed ahead (designAhead) is drawn from what it kept.
 async function knobDesign() {
   const k = design.knob;
   if (k.running) { k.pending = true; return k.running; }
   const s = knobSpec();
-  $('knob-status').textContent = 'designing ...';
+  const key = JSON.stringify(s);
+  const known = k.designs.get(key);
+  $('knob-status').textContent = known ? '' : 'designing ...';
   k.error = null;
-  k.running = app.tune(s, { quiet: true }).then((result) => {
+  const designed = known ? (known.error ? Promise.reject(new Error(known.error)) : app.tune(s, { quiet: true }, known.result))
+    : app.tune(s, { quiet: true });
+  k.running = designed.then((result) => {
+    k.designs.set(key, { result });
     k.last = { spec: s, result };
     const m = result.migo || {};
     if (!s.response_time && m.crossover_rad_s > 0) k.fastestTime = 2 / m.crossover_rad_s;
@@ -150,16 +159,79 @@ async function knobDesign() {
     showKnob();
     $('knob-status').textContent = 'pidlab tune ' + Object.entries(knobValues()).map(([a, b]) => '--' + a.replace('_', '-') + ' ' + b).join(' ');
     return result;
-  }).catch((e) => { k.error = { spec: s, message: e.message }; $('knob-status').textContent = 'design: ' + e.message; throw e; })
-    .finally(() => {
-      k.running = null;
-      if (k.pending) { k.pending = false; knobDesign().catch(() => {}); }
-    });
+  }).catch((e) => {
+    if (!known && /migo/.test(e.message)) k.designs.set(key, { error: e.message });  // migo's refusal of this position
+    k.error = { spec: s, message: e.message };
+    $('knob-status').textContent = 'design: ' + e.message;
+    throw e;
+  }).finally(() => {
+    k.running = null;
+    if (k.pending) { k.pending = false; knobDesign().catch(() => {}); } else designAhead();
+  });
   return k.running;
 }
 
+// ---- The knob's positions designed ahead, on the background connection:
+// after a design, every position of the response-time knob at the current
+// robustness, nearest first, each tuned and its design evaluated, while no
+// request of the user's waits. A move to a position designed ahead is drawn
+// without a request (the same server answers, kept). A plant switch or a
+// robustness move starts over (the generation).
+async function designAhead() {
+  const k = design.knob;
+  if (!(k.fastestTime > 0) || k.ahead === k.generation) return;
+  const generation = k.ahead = k.generation;
+  const robustness = $('knob-robustness').value;
+  const current = Number($('knob-speed').value);
+  const positions = [];
+  for (let i = 0; i <= kKnobSteps; ++i) positions.push(i / kKnobSteps);
+  positions.sort((a, b) => Math.abs(a - current) - Math.abs(b - current));
+  const stale = () => k.generation !== generation || $('knob-robustness').value !== robustness;
+  let done = 0;
+  const progress = () => { $('knob-ahead').textContent = done + ' of ' + positions.length + ' knob positions designed'; };
+  progress();
+  for (const at of positions) {
+    await app.idle();
+    if (stale()) break;
+    const s = knobSpec(at);
+    const key = JSON.stringify(s);
+    let known = k.designs.get(key);
+    try {
+      if (!known) {
+        try {
+          known = { result: (await app.backgroundAsk({ type: 'tune', spec: s })).result };
+        } catch (e) {
+          if (!/migo/.test(e.message)) throw e;
+          known = { error: e.message };
+        }
+        if (stale()) break;
+        k.designs.set(key, known);
+      }
+      if (known.result) await app.evaluateAhead(app.specAfterTune(known.result));
+    } catch (e) {
+      $('knob-ahead').textContent = 'designs ahead stopped: ' + e.message;
+      if (k.ahead === generation) k.ahead = -1;
+      return;
+    }
+    if (stale()) break;
+    done += 1;
+    progress();
+  }
+  if (stale()) {
+    if (k.ahead === generation) k.ahead = -1;
+    if (k.generation === generation && !k.running) designAhead();  // the robustness moved: its positions
+    return;
+  }
+  k.ready = true;
+}
+
 function resetKnob() {
-  Object.assign(design.knob, { fastestTime: 0, robustnessMoved: false, last: null });
+  const k = design.knob;
+  k.generation += 1;
+  k.designs.clear();
+  k.ready = false;
+  $('knob-ahead').textContent = '';
+  Object.assign(k, { fastestTime: 0, robustnessMoved: false, last: null });
   $('knob-speed').value = 1;
   $('knob-robustness').value = 1.4;
   showKnob();
@@ -224,7 +296,8 @@ export function initDesign(context) {
   app = context;
   design = window.pidlab.design = {
     upload: null, fit: null, fitCharts: [], sampled: null, export: null,
-    knob: { fastestTime: 0, robustnessMoved: false, running: null, pending: false, last: null, error: null },
+    knob: { fastestTime: 0, robustnessMoved: false, running: null, pending: false, last: null, error: null,
+      designs: new Map(), generation: 0, ahead: -1, ready: false },
     uploadCsv, identify, acceptModel, knobDesign, firmware, resetKnob, onIdentifyProgress: identifyProgress,
   };
   $('data-file').addEventListener('change', () => {
@@ -244,7 +317,12 @@ export function initDesign(context) {
   $('data-cancel').addEventListener('click', () => app.rawSend({ type: 'identify_cancel' }));
   $('data-accept').addEventListener('click', () => { acceptModel(); });
   $('knob-speed').addEventListener('input', () => { showKnob(); knobDesign().catch(() => {}); });
-  $('knob-robustness').addEventListener('input', () => { design.knob.robustnessMoved = true; showKnob(); knobDesign().catch(() => {}); });
+  $('knob-robustness').addEventListener('input', () => {
+    design.knob.robustnessMoved = true;
+    design.knob.ready = false;
+    showKnob();
+    knobDesign().catch(() => {});
+  });
   $('knob-design').addEventListener('click', () => knobDesign().catch(() => {}));
   $('fw-check').addEventListener('click', () => firmware().catch((e) => app.setStatus('firmware: ' + e.message)));
   showKnob();
