@@ -50,7 +50,8 @@ Status FigureFrame(const tune::EvaluationProblem& problem, const std::set<std::s
                    tune::TimeScale* frame) {
   spec::LoopSpec framed = problem.spec.loop;
   *frame = tune::ResolveGainsTimeScale(problem.spec.plant, problem.plant, {problem.gains}, given,
-                                       tune::TimeScaleScope::kFigure, &framed);
+                                       tune::TimeScaleScope::kFigure, &framed,
+                                       {&problem.gains, &problem.loop, &evaluated});
   // A derived frame is drawn with at most kMaxFigureIntervals + 1 points a
   // curve (a loop whose fast rise and slow tail both stay in it would send
   // the page tens of thousands): its spacing doubled (a multiple of dt still),

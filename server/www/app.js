@@ -367,8 +367,15 @@ function setDesign(d) {
 }
 pidlab.setDesign = setDesign;
 
+// The design in the address (a link reopens it), written once the design
+// has stopped moving for 300 ms: replaceState is an IPC to the browser
+// process, and a slider moves many times a second.
+let hashTimer = null;
 function writeHash() {
-  history.replaceState(null, '', location.pathname + location.search + '#' + encodeURIComponent(JSON.stringify(state)));
+  clearTimeout(hashTimer);
+  hashTimer = setTimeout(() => {
+    history.replaceState(null, '', location.pathname + location.search + '#' + encodeURIComponent(JSON.stringify(state)));
+  }, 300);
 }
 
 function readHash() {

@@ -188,7 +188,7 @@ async function designAhead() {
   positions.sort((a, b) => Math.abs(a - current) - Math.abs(b - current));
   const stale = () => k.generation !== generation || $('knob-robustness').value !== robustness;
   let done = 0;
-  const progress = () => { $('knob-ahead').textContent = done + ' of ' + positions.length + ' knob positions designed'; };
+  const progress = () => { $('knob-ahead').textContent = '(designed ahead: ' + done + ' of ' + positions.length + ' positions)'; };
   progress();
   for (const at of positions) {
     await app.idle();

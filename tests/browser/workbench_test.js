@@ -125,6 +125,28 @@ async function main() {
     return copied;
   });
 
+  await step('(e2) the URL\'s hash holds the design once it stops moving, and a new page opened on that URL shows it', async () => {
+    await waitForPage(session, 'the hash does not hold the design', redrawMs, () => {
+      try {
+        const saved = JSON.parse(decodeURIComponent(location.hash.slice(1)));
+        return saved.kp === window.pidlab.state.kp && saved.plant === window.pidlab.state.plant;
+      } catch (e) { return false; }
+    });
+    const { url: link, kp, plant } = await page.evaluate(() => ({ url: location.href, kp: window.pidlab.state.kp, plant: window.pidlab.state.plant }));
+    const other = await browser.newPage();
+    try {
+      await other.goto(link, { waitUntil: 'load', timeout: 30000 });
+      await other.waitForFunction(() => window.pidlab && window.pidlab.rendered >= 1, { timeout: redrawMs, polling: 50 });
+      const shown = await other.evaluate(() => ({ kp: window.pidlab.state.kp, plant: window.pidlab.state.plant,
+        drawn: window.pidlab.lastResult.spec.gains[0] }));
+      if (shown.kp !== kp || shown.plant !== plant || shown.drawn !== kp)
+        throw new Error('the link opened ' + JSON.stringify(shown) + ', not kp ' + kp + ' on ' + plant);
+    } finally {
+      await other.close();
+    }
+    return 'kp ' + kp + ' on ' + plant;
+  });
+
   await step('(b2) the Ms bound slider sets max_ms in the spec the page runs; an Ms above it is marked; clearing the box removes it', async () => {
     const moveMs = async (value) => {
       const before = await page.evaluate(() => window.pidlab.rendered);

@@ -358,66 +358,19 @@ struct AnalysisMemo {
   std::vector<Entry> entries;  // the newest last
 };
 
-// A field added to these structs must join the key below.
+// A field added here must join the key below.
 static_assert(sizeof(PidGains) == 4 * sizeof(double));
-static_assert(sizeof(PidOptions) == 9 * 8);
-static_assert(sizeof(DisturbanceOptions) == 10 * 8);
-static_assert(sizeof(MeasurementNoise) == 3 * 8);
-static_assert(sizeof(EpisodeShape) ==
-              4 * 8 + sizeof(PidOptions) + sizeof(DisturbanceOptions) + sizeof(MeasurementNoise));
-static_assert(sizeof(evaluation::LoopOptions) == sizeof(EpisodeShape) + 4 * 8);
 static_assert(sizeof(LoopAnalysisOptions) == 3 * 8 + 8);
-
-double Bits(std::uint64_t v) {
-  double d;
-  std::memcpy(&d, &v, sizeof d);
-  return d;
-}
 
 std::vector<double> AnalysisKey(const Plant& plant, const PidGains& g, const evaluation::LoopOptions& o,
                                 const LoopAnalysisOptions& ao) {
-  const PidOptions& p = o.pid;
-  const DisturbanceOptions& d = o.disturbance;
-  const MeasurementNoise& n = o.measurement_noise;
-  std::vector<double> k = {static_cast<double>(plant.tf.num.size()),
-                           plant.delay_s,
-                           g.kp,
-                           g.ki,
-                           g.kd,
-                           g.tf,
-                           o.dt_s,
-                           o.reference,
-                           p.dt_s,
-                           p.derivative_filter_s,
-                           p.output_min,
-                           p.output_max,
-                           static_cast<double>(p.anti_windup),
-                           p.back_calculation_gain,
-                           static_cast<double>(p.integral),
-                           p.setpoint_weight_b,
-                           p.setpoint_weight_c,
-                           static_cast<double>(d.kind),
-                           d.amplitude,
-                           d.period_s,
-                           d.phase_s,
-                           d.step_time_s,
-                           d.noise_hold_s,
-                           Bits(d.seed),
-                           d.chirp_f0_hz,
-                           d.chirp_f1_hz,
-                           d.chirp_duration_s,
-                           n.sigma,
-                           Bits(n.seed),
-                           n.resolution,
-                           static_cast<double>(o.loop),
-                           o.derivative_filter_ratio,
-                           o.derivative_filter_min_s,
-                           o.stability_margin,
-                           ao.points_per_decade,
-                           ao.refine_peaks ? 1.0 : 0.0,
-                           ao.hamiltonian_check ? 1.0 : 0.0,
-                           ao.cancellation_tolerance,
-                           ao.delayed_time_constant ? 1.0 : 0.0};
+  evaluation::LoopOptions timeless = o;  // the analysis reads neither
+  timeless.horizon_s = 0.0;
+  timeless.sample_time_s = 0.0;
+  std::vector<double> k = evaluation::LoopOptionsKey(timeless);
+  k.insert(k.end(), {static_cast<double>(plant.tf.num.size()), plant.delay_s, g.kp, g.ki, g.kd, g.tf,
+                     ao.points_per_decade, ao.refine_peaks ? 1.0 : 0.0, ao.hamiltonian_check ? 1.0 : 0.0,
+                     ao.cancellation_tolerance, ao.delayed_time_constant ? 1.0 : 0.0});
   k.insert(k.end(), plant.tf.num.begin(), plant.tf.num.end());
   k.insert(k.end(), plant.tf.den.begin(), plant.tf.den.end());
   return k;

@@ -1,7 +1,10 @@
 #include "pidlab/evaluation/closed_loop.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <sstream>
+#include <vector>
 
 namespace pidlab::evaluation {
 namespace {
@@ -28,6 +31,58 @@ bool ParseLoopKind(const std::string& s, LoopKind* kind) {
 }
 
 std::string ToString(LoopKind kind) { return kind == LoopKind::kContinuous ? "continuous" : "sampled"; }
+
+// A field added to these structs must join LoopOptionsKey.
+static_assert(sizeof(PidOptions) == 9 * 8);
+static_assert(sizeof(DisturbanceOptions) == 10 * 8);
+static_assert(sizeof(MeasurementNoise) == 3 * 8);
+static_assert(sizeof(EpisodeShape) ==
+              4 * 8 + sizeof(PidOptions) + sizeof(DisturbanceOptions) + sizeof(MeasurementNoise));
+static_assert(sizeof(LoopOptions) == sizeof(EpisodeShape) + 4 * 8);
+
+namespace {
+double Bits(std::uint64_t v) {
+  double d;
+  std::memcpy(&d, &v, sizeof d);
+  return d;
+}
+}  // namespace
+
+std::vector<double> LoopOptionsKey(const LoopOptions& o) {
+  const PidOptions& p = o.pid;
+  const DisturbanceOptions& d = o.disturbance;
+  const MeasurementNoise& n = o.measurement_noise;
+  return {o.dt_s,
+          o.sample_time_s,
+          o.horizon_s,
+          o.reference,
+          p.dt_s,
+          p.derivative_filter_s,
+          p.output_min,
+          p.output_max,
+          static_cast<double>(p.anti_windup),
+          p.back_calculation_gain,
+          static_cast<double>(p.integral),
+          p.setpoint_weight_b,
+          p.setpoint_weight_c,
+          static_cast<double>(d.kind),
+          d.amplitude,
+          d.period_s,
+          d.phase_s,
+          d.step_time_s,
+          d.noise_hold_s,
+          Bits(d.seed),
+          d.chirp_f0_hz,
+          d.chirp_f1_hz,
+          d.chirp_duration_s,
+          n.sigma,
+          Bits(n.seed),
+          n.resolution,
+          static_cast<double>(o.loop),
+          o.derivative_filter_ratio,
+          o.derivative_filter_min_s,
+          o.stability_margin};
+}
 
 bool LoopOptions::IsValid(std::string* error) const {
   std::ostringstream os;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/spec/field.h"
@@ -15,18 +16,22 @@ namespace {
 
 // TimeScaleScope::kFigure's frame of `t` (see there).
 TimeScale Framed(const Plant& plant, const std::vector<PidGains>& gains, evaluation::LoopOptions loop,
-                 const TimeScale& t) {
+                 const TimeScale& t, const KnownEvaluation& known) {
   loop.horizon_s = t.horizon_s;
   loop.sample_time_s = t.sample_time_s;
   double settling = 0.0;
   for (const PidGains& g : gains) {
     evaluation::Evaluation ev;
-    evaluation::EvaluateOptions what;
-    what.compute_iae_continuous = false;
-    if (!evaluation::Evaluate(plant, g, loop, what, &ev).ok() || !ev.step.valid ||
-        !std::isfinite(ev.step.settling_time_s))
-      return t;
-    settling = std::max(settling, ev.step.settling_time_s);
+    const evaluation::Evaluation* e = &ev;
+    if (known.Matches(g, loop)) {
+      e = known.evaluation;
+    } else {
+      evaluation::EvaluateOptions what;
+      what.compute_iae_continuous = false;
+      if (!evaluation::Evaluate(plant, g, loop, what, &ev).ok()) return t;
+    }
+    if (!e->step.valid || !std::isfinite(e->step.settling_time_s)) return t;
+    settling = std::max(settling, e->step.settling_time_s);
   }
   const double horizon = NiceUp(3.0 * settling + plant.delay_s);
   if (!(settling > 0.0) || !(horizon < t.horizon_s)) return t;
@@ -39,6 +44,14 @@ TimeScale Framed(const Plant& plant, const std::vector<PidGains>& gains, evaluat
 }
 
 }  // namespace
+
+bool KnownEvaluation::Matches(const PidGains& g, const evaluation::LoopOptions& l) const {
+  if (!gains || !loop || !evaluation) return false;
+  const double a[] = {g.kp, g.ki, g.kd, g.tf}, b[] = {gains->kp, gains->ki, gains->kd, gains->tf};
+  const std::vector<double> x = evaluation::LoopOptionsKey(l), y = evaluation::LoopOptionsKey(*loop);
+  return std::memcmp(a, b, sizeof a) == 0 && x.size() == y.size() &&
+         std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
+}
 
 TimeScale GainsTimeScale(const Plant& plant, const std::vector<PidGains>& gains,
                          const evaluation::LoopOptions& loop) {
@@ -65,7 +78,7 @@ TimeScale GainsTimeScale(const Plant& plant, const std::vector<PidGains>& gains,
 
 TimeScale ResolveGainsTimeScale(const spec::PlantSpec& plant_spec, const Plant& plant,
                                 const std::vector<PidGains>& gains, const std::set<std::string>& given,
-                                TimeScaleScope scope, spec::LoopSpec* loop) {
+                                TimeScaleScope scope, spec::LoopSpec* loop, const KnownEvaluation& known) {
   const bool paper = IsPaperPlant(plant_spec);
   TimeScale t;
   t.horizon_s = loop->horizon_s;
@@ -97,7 +110,7 @@ TimeScale ResolveGainsTimeScale(const spec::PlantSpec& plant_spec, const Plant& 
     derived.sample_time_s = k * loop->dt_s;
     derived.horizon_s = std::ceil(derived.horizon_s / derived.sample_time_s - 1e-9) * derived.sample_time_s;
   }
-  if (scope == TimeScaleScope::kFigure) derived = Framed(plant, gains, options, derived);
+  if (scope == TimeScaleScope::kFigure) derived = Framed(plant, gains, options, derived, known);
   if (timed) {
     // Given as the loop gives them (a result's echo): the loop's still.
     const bool same = loop->horizon_s == derived.horizon_s && loop->sample_time_s == derived.sample_time_s;

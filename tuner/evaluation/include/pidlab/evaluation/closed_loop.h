@@ -114,6 +114,12 @@ struct LoopOptions : EpisodeShape {
 /// (the field as the caller spells it) and the value. Needs a valid o.dt_s.
 Status DelayIsValid(const Plant& plant, const LoopOptions& o, const std::string& name);
 
+/// Every field of `o` as doubles (enums and seeds by value and bits): two
+/// loops are the same loop when their keys are equal bit for bit (memcmp).
+/// For the per-thread memos of answers that are pure functions of a loop
+/// (analysis::AnalyzeLoop) and for reusing a result on the same loop.
+std::vector<double> LoopOptionsKey(const LoopOptions& o);
+
 /// The plant the sampled loop runs at dt_s: the exact ZOH of plant.tf with its
 /// dead time, DiscretePlant(plant.tf, dt_s, plant.delay_s). Throws as
 /// DiscretePlant.

@@ -38,8 +38,21 @@ enum class TimeScaleScope {
 /// otherwise (or the derived one, when the given loop has its numbers: a
 /// result's echo). A loop that does not build keeps its own (its caller
 /// reports it).
+/// An evaluation of `gains` on `loop` (of the same plant, the in-process
+/// runner, step info computed) that the caller already has: kFigure's frame
+/// reads its settling time where the frame's loop is that loop bit for bit
+/// (evaluation::LoopOptionsKey), instead of evaluating it again. The step
+/// info does not depend on the other EvaluateOptions.
+struct KnownEvaluation {
+  const PidGains* gains = nullptr;
+  const evaluation::LoopOptions* loop = nullptr;
+  const evaluation::Evaluation* evaluation = nullptr;
+  bool Matches(const PidGains& g, const evaluation::LoopOptions& l) const;
+};
+
 TimeScale ResolveGainsTimeScale(const spec::PlantSpec& plant_spec, const Plant& plant,
                                 const std::vector<PidGains>& gains, const std::set<std::string>& given,
-                                TimeScaleScope scope, spec::LoopSpec* loop);
+                                TimeScaleScope scope, spec::LoopSpec* loop,
+                                const KnownEvaluation& known = {});
 
 }  // namespace pidlab::tune
