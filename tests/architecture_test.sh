@@ -26,6 +26,7 @@ level = {
     'pidlab_spec': 1, 'pidlab_plant_sim': 1, 'pidlab_optim': 1, 'pidlab_plot': 3,
     'pidlab_server': 2,
     'pidlab_io': 2, 'pidlab_transport': 2, 'pidlab_evaluation': 2, 'pidlab_controller_export': 2,
+    'pidlab_autotune': 2,
     'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_analysis': 3,
     'pidlab_monitor': 3,
     'pidlab_tune': 4, 'pidlab_identify': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
@@ -71,9 +72,11 @@ for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
     else: print(f'ok   {exe} links only ' + ', '.join(sorted(d for d in closure(exe) if d.startswith("pidlab"))))
 # Sources: a folder includes only headers of its own level or below.
 header_level = {'io': 2, 'spec': 1, 'plant_sim': 1, 'controller': 0, 'optim': 1, 'plot': 3, 'server': 2, 'transport': 2, 'evaluation': 2, 'controller_export': 2,
+                'autotune': 2,
                 'analysis': 3, 'monitor': 3, 'tune': 4, 'identify': 4, 'episode_client': 4, 'replay': 4, 'results': 5, 'launcher': 5, 'report': 6,
                 'figures': 6}
 lib_dirs = {'io': 2, 'spec': 1, 'server': 2, 'transport': 2, 'tuner/optim': 1, 'tuner/evaluation': 2, 'tuner/analysis': 3, 'monitor': 3,
+            'tuner/autotune': 2,
             'tuner/tune': 4, 'tuner/identify': 4, 'tuner/episode_client': 4, 'replay': 5, 'launcher': 5,
             'plot': 3, 'results': 5, 'report': 6, 'figures': 6}
 for d, lv in lib_dirs.items():
@@ -85,7 +88,7 @@ for d, lv in lib_dirs.items():
 # The tuner's libraries other than the episode client (identify included): no LCM (<lcm/...>, a
 # message's lcmt_*.hpp), no transport, no episode client; every pidlab/<x>/
 # header they include is of their own level or below (and has a level).
-for d in ('optim', 'evaluation', 'analysis', 'tune', 'identify'):
+for d in ('optim', 'evaluation', 'analysis', 'tune', 'identify', 'autotune'):
     lv = header_level[d]
     for root, _, files in os.walk(os.path.join(src, 'tuner', d)):
         for f in files:

@@ -1,0 +1,103 @@
+#pragma once
+// The relay experiment of an autotune (Åström and Hägglund's relay feedback,
+// Berner's asymmetric relay): a relay with hysteresis around the operating
+// point (u0, r) drives the process into a limit cycle; its cycles give the
+// ultimate period and gain, and, for the asymmetric relay, a first-order plus
+// dead-time model from the limit cycle's closed forms.
+//
+// In deviation variables e = y - r and v = u - u0, the relay puts out
+// v = +d_high while -e > hysteresis (y below the band), v = -d_low while
+// e > hysteresis, and holds in between (reverse acting: a process of positive
+// gain). A cycle runs from one switch to high to the next.
+//
+// For K e^(-sL)/(Ts + 1) the limit cycle is, with E = e^(-L/T) and eps the
+// hysteresis (each extreme is reached L after the switch):
+//   e_min = -K d_low + (K d_low - eps) E,  t_on  = L + T ln((K d_high - e_min) / (K d_high - eps))
+//   e_max =  K d_high - (K d_high - eps) E, t_off = L + T ln((K d_low + e_max) / (K d_low - eps))
+// and, for any stable linear process, the mean of e over a cycle is K times
+// the mean of v: K = (integral of e over a cycle) / (d_high t_on - d_low t_off),
+// which the asymmetric relay makes nonzero.
+
+#include <string>
+#include <vector>
+
+#include "pidlab/spec/status.h"
+
+namespace pidlab::autotune {
+
+struct RelayOptions {
+  double setpoint = 0.0;    ///< r
+  double u0 = 0.0;          ///< the operating point's input (y = r at rest)
+  double d_high = 1.0;      ///< v = +d_high below the band, > 0
+  double d_low = 1.0;       ///< v = -d_low above it, > 0 (d_low != d_high: asymmetric)
+  double hysteresis = 0.0;  ///< the band's half width eps, >= 0
+  /// Converged when the last `settled_cycles` cycles' periods and amplitudes
+  /// each lie within `tolerance` (relative) of their mean.
+  int settled_cycles = 3;
+  double tolerance = 0.01;
+  bool IsValid(std::string* error) const;
+};
+
+/// One cycle of the limit cycle: from a switch to high to the next.
+struct RelayCycle {
+  double start_s = 0.0;
+  double t_on_s = 0.0, t_off_s = 0.0;  ///< time at +d_high, at -d_low
+  double e_max = 0.0, e_min = 0.0;     ///< extremes of e = y - r
+  double integral_e = 0.0;             ///< of e over the cycle (trapezoids)
+  double period_s() const { return t_on_s + t_off_s; }
+  double amplitude() const { return 0.5 * (e_max - e_min); }
+};
+
+/// A first-order plus dead-time model K e^(-sL)/(Ts + 1).
+struct FopdtModel {
+  double gain = 0.0, time_constant_s = 0.0, delay_s = 0.0;
+};
+
+struct RelayEstimates {
+  bool converged = false;
+  int cycles = 0;            ///< the settled cycles averaged
+  double period_s = 0.0;     ///< mean period of the settled cycles
+  double period_ci_s = 0.0;  ///< its 95 % half width over those cycles
+  double amplitude = 0.0;    ///< mean (e_max - e_min) / 2
+  double amplitude_ci = 0.0;
+  /// The describing function's ultimate gain 4 d / (pi sqrt(a^2 - eps^2)),
+  /// d = (d_high + d_low) / 2: labelled as such; it is 10-20 % off on
+  /// dead-time processes (the relay's output is no sine).
+  double ku_describing_function = 0.0;
+  bool model_found = false;
+  FopdtModel model;     ///< from the settled cycles (closed forms above)
+  double ku = 0.0;      ///< the model's ultimate gain (its phase crossover)
+  double pu_s = 0.0;    ///< the model's ultimate period
+  std::string message;  ///< why something was not found
+};
+
+/// The relay as a step-by-step state machine: Step() takes each measurement
+/// and returns the input to apply until the next one.
+class RelayExperiment {
+ public:
+  explicit RelayExperiment(const RelayOptions& options);
+  /// The input for measurement y at time t_s (strictly increasing).
+  double Step(double t_s, double y);
+  bool Converged() const;
+  const std::vector<RelayCycle>& Cycles() const { return cycles_; }
+  /// The estimates from the settled cycles (or the last ones seen).
+  RelayEstimates Estimate() const;
+
+ private:
+  RelayOptions o_;
+  bool started_ = false, high_ = false;
+  double t_prev_ = 0.0, e_prev_ = 0.0;
+  double t_high_ = -1.0, t_low_ = -1.0;  // the current cycle's switches (-1: none yet)
+  double e_max_ = 0.0, e_min_ = 0.0, integral_ = 0.0;
+  std::vector<RelayCycle> cycles_;
+};
+
+/// The ultimate gain and period of K e^(-sL)/(Ts + 1): the phase crossover
+/// w (atan(wT) + wL = pi), Ku = sqrt(1 + (wT)^2) / |K|, Pu = 2 pi / w.
+Status FopdtUltimate(const FopdtModel& model, double* ku, double* pu_s);
+
+/// K, T and L from a limit cycle's mean t_on, t_off, e_max, e_min and
+/// integral of e (RelayCycle) under `options`' relay: the closed forms above.
+Status FopdtFromCycle(const RelayOptions& options, const RelayCycle& cycle, FopdtModel* model);
+
+}  // namespace pidlab::autotune

@@ -1,0 +1,208 @@
+// The relay experiment and its estimates (relay.h).
+
+#include "pidlab/autotune/relay.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace pidlab::autotune {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Student's t at 97.5 % for n - 1 degrees of freedom (n = 2..10), else 1.96.
+double T975(int n) {
+  static const double t[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262};
+  return n >= 2 && n <= 10 ? t[n - 2] : 1.96;
+}
+
+// Mean and 95 % half width of values.
+void MeanInterval(const std::vector<double>& v, double* mean, double* half_width) {
+  double m = 0.0;
+  for (double x : v) m += x;
+  m /= static_cast<double>(v.size());
+  double ss = 0.0;
+  for (double x : v) ss += (x - m) * (x - m);
+  const int n = static_cast<int>(v.size());
+  *mean = m;
+  *half_width = n > 1 ? T975(n) * std::sqrt(ss / (n - 1)) / std::sqrt(static_cast<double>(n)) : 0.0;
+}
+
+std::string Number(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+bool RelayOptions::IsValid(std::string* error) const {
+  std::string e;
+  if (!std::isfinite(setpoint))
+    e = "setpoint " + Number(setpoint) + " must be finite";
+  else if (!std::isfinite(u0))
+    e = "u0 " + Number(u0) + " must be finite";
+  else if (!(d_high > 0.0) || !std::isfinite(d_high))
+    e = "relay amplitude d_high " + Number(d_high) + " must be > 0 and finite";
+  else if (!(d_low > 0.0) || !std::isfinite(d_low))
+    e = "relay amplitude d_low " + Number(d_low) + " must be > 0 and finite";
+  else if (!(hysteresis >= 0.0) || !std::isfinite(hysteresis))
+    e = "hysteresis " + Number(hysteresis) + " must be >= 0 and finite";
+  else if (settled_cycles < 2)
+    e = "settled cycles " + std::to_string(settled_cycles) + " must be at least 2";
+  else if (!(tolerance > 0.0 && tolerance < 1.0))
+    e = "tolerance " + Number(tolerance) + " must be in (0, 1)";
+  if (e.empty()) return true;
+  if (error) *error = e;
+  return false;
+}
+
+RelayExperiment::RelayExperiment(const RelayOptions& options) : o_(options) {}
+
+double RelayExperiment::Step(double t_s, double y) {
+  const double e = y - o_.setpoint;
+  if (!started_) {
+    started_ = true;
+    high_ = e < 0.0;  // towards the setpoint
+  } else {
+    if (t_high_ >= 0.0) {  // inside a cycle: its integral and extremes
+      integral_ += 0.5 * (e + e_prev_) * (t_s - t_prev_);
+      e_max_ = std::max(e_max_, e);
+      e_min_ = std::min(e_min_, e);
+    }
+    if (!high_ && e < -o_.hysteresis) {
+      if (t_high_ >= 0.0 && t_low_ > t_high_) {
+        RelayCycle c;
+        c.start_s = t_high_;
+        c.t_on_s = t_low_ - t_high_;
+        c.t_off_s = t_s - t_low_;
+        c.e_max = e_max_;
+        c.e_min = e_min_;
+        c.integral_e = integral_;
+        cycles_.push_back(c);
+      }
+      high_ = true;
+      t_high_ = t_s;
+      t_low_ = -1.0;
+      integral_ = 0.0;
+      e_max_ = e_min_ = e;
+    } else if (high_ && e > o_.hysteresis) {
+      high_ = false;
+      if (t_high_ >= 0.0) t_low_ = t_s;
+    }
+  }
+  t_prev_ = t_s;
+  e_prev_ = e;
+  return o_.u0 + (high_ ? o_.d_high : -o_.d_low);
+}
+
+bool RelayExperiment::Converged() const {
+  const int n = o_.settled_cycles;
+  if (static_cast<int>(cycles_.size()) < n + 1) return false;  // the first cycle is the approach
+  double period = 0.0, amplitude = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const RelayCycle& c = cycles_[cycles_.size() - 1 - i];
+    period += c.period_s() / n;
+    amplitude += c.amplitude() / n;
+  }
+  for (int i = 0; i < n; ++i) {
+    const RelayCycle& c = cycles_[cycles_.size() - 1 - i];
+    if (!(std::abs(c.period_s() - period) <= o_.tolerance * period) ||
+        !(std::abs(c.amplitude() - amplitude) <= o_.tolerance * amplitude))
+      return false;
+  }
+  return true;
+}
+
+RelayEstimates RelayExperiment::Estimate() const {
+  RelayEstimates r;
+  r.converged = Converged();
+  const int available = static_cast<int>(cycles_.size()) - 1;  // without the approach
+  const int n = std::min(o_.settled_cycles, available);
+  if (n < 1) {
+    r.message = "no full relay cycle after the first yet (" + std::to_string(cycles_.size()) + " cycles)";
+    return r;
+  }
+  r.cycles = n;
+  std::vector<double> periods, amplitudes;
+  RelayCycle mean;
+  for (int i = 0; i < n; ++i) {
+    const RelayCycle& c = cycles_[cycles_.size() - 1 - i];
+    periods.push_back(c.period_s());
+    amplitudes.push_back(c.amplitude());
+    mean.t_on_s += c.t_on_s / n;
+    mean.t_off_s += c.t_off_s / n;
+    mean.e_max += c.e_max / n;
+    mean.e_min += c.e_min / n;
+    mean.integral_e += c.integral_e / n;
+  }
+  MeanInterval(periods, &r.period_s, &r.period_ci_s);
+  MeanInterval(amplitudes, &r.amplitude, &r.amplitude_ci);
+  const double d = 0.5 * (o_.d_high + o_.d_low), eps = o_.hysteresis;
+  if (r.amplitude > eps)
+    r.ku_describing_function = 4.0 * d / (kPi * std::sqrt(r.amplitude * r.amplitude - eps * eps));
+  const Status fitted = FopdtFromCycle(o_, mean, &r.model);
+  if (!fitted.ok()) {
+    r.message = fitted.message();
+    return r;
+  }
+  const Status ultimate = FopdtUltimate(r.model, &r.ku, &r.pu_s);
+  if (!ultimate.ok()) {
+    r.message = ultimate.message();
+    return r;
+  }
+  r.model_found = true;
+  return r;
+}
+
+Status FopdtUltimate(const FopdtModel& m, double* ku, double* pu_s) {
+  if (!(m.gain != 0.0) || !std::isfinite(m.gain) || !(m.time_constant_s >= 0.0) || !(m.delay_s > 0.0) ||
+      !std::isfinite(m.time_constant_s) || !std::isfinite(m.delay_s))
+    return Status::InvalidInput(
+        "a FOPDT model needs a gain != 0, T >= 0 and L > 0 for a phase crossover (K " + Number(m.gain) +
+        ", T " + Number(m.time_constant_s) + " s, L " + Number(m.delay_s) + " s)");
+  // atan(wT) + wL is increasing: -pi at 0, > 0 at w = pi / L.
+  double lo = 0.0, hi = kPi / m.delay_s;
+  for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+    const double w = 0.5 * (lo + hi);
+    (std::atan(w * m.time_constant_s) + w * m.delay_s < kPi ? lo : hi) = w;
+  }
+  const double w = 0.5 * (lo + hi);
+  *ku = std::sqrt(1.0 + w * m.time_constant_s * (w * m.time_constant_s)) / std::abs(m.gain);
+  *pu_s = 2.0 * kPi / w;
+  return Status::Ok();
+}
+
+Status FopdtFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
+  std::string error;
+  if (!o.IsValid(&error)) return Status::InvalidInput(error);
+  const double eps = o.hysteresis, dh = o.d_high, dl = o.d_low;
+  const double mean_v = dh * c.t_on_s - dl * c.t_off_s;
+  if (!(std::abs(mean_v) > 1e-6 * (dh * c.t_on_s + dl * c.t_off_s)))
+    return Status::InvalidInput(
+        "the relay's mean output over a cycle is zero (a symmetric relay): the process gain cannot be "
+        "identified; make d_low differ from d_high");
+  const double k = c.integral_e / mean_v;
+  if (!(k > 0.0) || !std::isfinite(k))
+    return Status::InvalidInput("the identified gain " + Number(k) +
+                                " is not positive (the relay is reverse acting: a process of positive gain)");
+  const double kh = k * dh, kl = k * dl;
+  const double e1 = (kh - c.e_max) / (kh - eps), e2 = (kl + c.e_min) / (kl - eps);
+  const double big_e = 0.5 * (e1 + e2);  // e^(-L/T) from either extreme
+  if (!(big_e > 0.0 && big_e < 1.0) || !(kh > eps) || !(kl > eps))
+    return Status::InvalidInput("the cycle's extremes give e^(-L/T) = " + Number(big_e) +
+                                ", not in (0, 1): the process is no first order plus dead time");
+  const double l_over_t = -std::log(big_e);
+  const double on = l_over_t + std::log((kh - c.e_min) / (kh - eps));
+  const double off = l_over_t + std::log((kl + c.e_max) / (kl - eps));
+  const double t = 0.5 * (c.t_on_s / on + c.t_off_s / off);
+  if (!(t > 0.0) || !std::isfinite(t))
+    return Status::InvalidInput("the cycle's half periods give a time constant " + Number(t) + " s");
+  model->gain = k;
+  model->time_constant_s = t;
+  model->delay_s = t * l_over_t;
+  return Status::Ok();
+}
+
+}  // namespace pidlab::autotune
