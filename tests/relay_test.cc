@@ -1,5 +1,5 @@
 // The relay experiment (tuner/autotune, issue 43) on first-order plus
-// dead-time processes simulated in process: the ultimate gain and period
+// dead-time and integrating processes simulated in process: the ultimate gain and period
 // from the asymmetric relay's FOPDT model against pidlab's own frequency
 // analysis of the same process (within 5 %), the model against the process
 // (within 10 %), and the plain describing function's error on a symmetric
@@ -41,7 +41,10 @@ RelayEstimates RunRelay(const FopdtModel& p, const RelayOptions& o, double h, Re
     const double u = relay->Step(k * h, x);
     const double arriving = delay_steps > 0 ? pipe[head] : u;
     if (delay_steps > 0) pipe[head] = u, head = (head + 1) % pipe.size();
-    x = a * x + (1.0 - a) * p.gain * arriving;  // exact for an input held over the step
+    if (p.integrating)
+      x += h * p.gain * (arriving - o.u0);  // K e^(-sL)/s at rest at u0
+    else
+      x = a * x + (1.0 - a) * p.gain * arriving;  // exact for an input held over the step
     if (relay->Converged()) break;
   }
   return relay->Estimate();
@@ -53,7 +56,7 @@ void ExactUltimate(const FopdtModel& p, double* ku, double* pu) {
   Plant plant;
   plant.name = "custom";
   plant.tf.num = {p.gain};
-  plant.tf.den = {p.time_constant_s, 1.0};
+  plant.tf.den = p.integrating ? std::vector<double>{1.0, 0.0} : std::vector<double>{p.time_constant_s, 1.0};
   plant.delay_s = p.delay_s;
   PidGains g;
   g.kp = 0.01 / std::abs(p.gain);
@@ -96,6 +99,32 @@ TEST(Relay, AsymmetricRelayGivesTheUltimateGainAndPeriodWithin5PercentAndTheMode
   }
 }
 
+TEST(Relay, AsymmetricRelayOnAnIntegratingProcessGivesItsModelAndUltimatePoint) {
+  for (double eps : {0.0, 0.02}) {
+    FopdtModel p;
+    p.gain = 0.5;
+    p.delay_s = 1.0;
+    p.integrating = true;
+    RelayOptions o;
+    o.setpoint = 1.0;
+    o.u0 = 0.3;
+    o.d_high = 0.5;
+    o.d_low = 0.25;
+    o.hysteresis = eps;
+    RelayExperiment relay(o);
+    const RelayEstimates e = RunRelay(p, o, p.delay_s / 400.0, &relay);
+    ASSERT_TRUE(e.converged) << "eps " << eps;
+    ASSERT_TRUE(e.model_found) << e.message;
+    EXPECT_TRUE(e.model.integrating) << "a first-order model was fitted";
+    double ku = 0.0, pu = 0.0;
+    ExactUltimate(p, &ku, &pu);
+    EXPECT_LT(Rel(e.ku, ku), 0.05) << "eps " << eps << ": Ku " << e.ku << ", exact " << ku;
+    EXPECT_LT(Rel(e.pu_s, pu), 0.05) << "eps " << eps << ": Pu " << e.pu_s << ", exact " << pu;
+    EXPECT_LT(Rel(e.model.gain, p.gain), 0.10) << "eps " << eps << ": K " << e.model.gain;
+    EXPECT_LT(Rel(e.model.delay_s, p.delay_s), 0.10) << "eps " << eps << ": L " << e.model.delay_s;
+  }
+}
+
 TEST(Relay, PlainDescribingFunctionIsAbout15PercentLowOnASymmetricRelayAndTheGainIsRefused) {
   // The issue's figure: 4d/(pi a) on e^(-0.5 s)/(s + 1).
   const FopdtModel p{1.0, 1.0, 0.5};
@@ -116,8 +145,8 @@ TEST(Relay, PlainDescribingFunctionIsAbout15PercentLowOnASymmetricRelayAndTheGai
 }
 
 TEST(Relay, FopdtUltimateMatchesTheFrequencyAnalysis) {
-  for (const FopdtModel& m :
-       {FopdtModel{1.0, 1.0, 0.1}, FopdtModel{2.0, 60.0, 8.0}, FopdtModel{0.5, 1.0, 10.0}}) {
+  for (const FopdtModel& m : {FopdtModel{1.0, 1.0, 0.1}, FopdtModel{2.0, 60.0, 8.0},
+                              FopdtModel{0.5, 1.0, 10.0}, FopdtModel{0.5, 0.0, 1.0, true}}) {
     double ku = 0.0, pu = 0.0, exact_ku = 0.0, exact_pu = 0.0;
     ASSERT_TRUE(IsOk(FopdtUltimate(m, &ku, &pu)));
     ExactUltimate(m, &exact_ku, &exact_pu);

@@ -142,7 +142,11 @@ RelayEstimates RelayExperiment::Estimate() const {
   const double d = 0.5 * (o_.d_high + o_.d_low), eps = o_.hysteresis;
   if (r.amplitude > eps)
     r.ku_describing_function = 4.0 * d / (kPi * std::sqrt(r.amplitude * r.amplitude - eps * eps));
-  const Status fitted = FopdtFromCycle(o_, mean, &r.model);
+  const double mean_v = o_.d_high * mean.t_on_s - o_.d_low * mean.t_off_s;
+  const bool integrating =
+      o_.d_high != o_.d_low && std::abs(mean_v) <= 0.02 * (o_.d_high * mean.t_on_s + o_.d_low * mean.t_off_s);
+  const Status fitted =
+      integrating ? IntegratingFromCycle(o_, mean, &r.model) : FopdtFromCycle(o_, mean, &r.model);
   if (!fitted.ok()) {
     r.message = fitted.message();
     return r;
@@ -157,6 +161,15 @@ RelayEstimates RelayExperiment::Estimate() const {
 }
 
 Status FopdtUltimate(const FopdtModel& m, double* ku, double* pu_s) {
+  if (m.integrating) {
+    if (!(m.gain != 0.0) || !std::isfinite(m.gain) || !(m.delay_s > 0.0) || !std::isfinite(m.delay_s))
+      return Status::InvalidInput("an integrating model needs a gain != 0 and L > 0 (K " + Number(m.gain) +
+                                  ", L " + Number(m.delay_s) + " s)");
+    const double w = kPi / (2.0 * m.delay_s);
+    *ku = w / std::abs(m.gain);
+    *pu_s = 4.0 * m.delay_s;
+    return Status::Ok();
+  }
   if (!(m.gain != 0.0) || !std::isfinite(m.gain) || !(m.time_constant_s >= 0.0) || !(m.delay_s > 0.0) ||
       !std::isfinite(m.time_constant_s) || !std::isfinite(m.delay_s))
     return Status::InvalidInput(
@@ -174,6 +187,24 @@ Status FopdtUltimate(const FopdtModel& m, double* ku, double* pu_s) {
   return Status::Ok();
 }
 
+Status IntegratingFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
+  std::string error;
+  if (!o.IsValid(&error)) return Status::InvalidInput(error);
+  const double eps = o.hysteresis, dh = o.d_high, dl = o.d_low;
+  const double kl = (c.e_max - c.e_min - 2.0 * eps) / (dh + dl);  // K L
+  const double k_on = (kl + (2.0 * eps + kl * dl) / dh) / c.t_on_s;
+  const double k_off = (kl + (2.0 * eps + kl * dh) / dl) / c.t_off_s;
+  const double k = 0.5 * (k_on + k_off);
+  if (!(kl > 0.0) || !(k > 0.0) || !std::isfinite(k))
+    return Status::InvalidInput("the cycle gives K L = " + Number(kl) + " and K = " + Number(k) +
+                                ": not an integrating process of positive gain");
+  model->gain = k;
+  model->time_constant_s = 0.0;
+  model->delay_s = kl / k;
+  model->integrating = true;
+  return Status::Ok();
+}
+
 Status FopdtFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
   std::string error;
   if (!o.IsValid(&error)) return Status::InvalidInput(error);
@@ -181,8 +212,8 @@ Status FopdtFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtModel* mo
   const double mean_v = dh * c.t_on_s - dl * c.t_off_s;
   if (!(std::abs(mean_v) > 1e-6 * (dh * c.t_on_s + dl * c.t_off_s)))
     return Status::InvalidInput(
-        "the relay's mean output over a cycle is zero (a symmetric relay): the process gain cannot be "
-        "identified; make d_low differ from d_high");
+        "the relay's mean output over a cycle is zero (a symmetric relay, or an integrating process): a "
+        "first-order process's gain cannot be identified; make d_low differ from d_high");
   const double k = c.integral_e / mean_v;
   if (!(k > 0.0) || !std::isfinite(k))
     return Status::InvalidInput("the identified gain " + Number(k) +
@@ -202,6 +233,7 @@ Status FopdtFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtModel* mo
   model->gain = k;
   model->time_constant_s = t;
   model->delay_s = t * l_over_t;
+  model->integrating = false;
   return Status::Ok();
 }
 

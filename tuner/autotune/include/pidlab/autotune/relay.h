@@ -48,9 +48,11 @@ struct RelayCycle {
   double amplitude() const { return 0.5 * (e_max - e_min); }
 };
 
-/// A first-order plus dead-time model K e^(-sL)/(Ts + 1).
+/// A first-order plus dead-time model K e^(-sL)/(Ts + 1); an integrating
+/// one, K e^(-sL)/s, when `integrating` (time_constant_s unused).
 struct FopdtModel {
   double gain = 0.0, time_constant_s = 0.0, delay_s = 0.0;
+  bool integrating = false;
 };
 
 struct RelayEstimates {
@@ -65,7 +67,10 @@ struct RelayEstimates {
   /// dead-time processes (the relay's output is no sine).
   double ku_describing_function = 0.0;
   bool model_found = false;
-  FopdtModel model;     ///< from the settled cycles (closed forms above)
+  /// From the settled cycles (closed forms above): integrating where the
+  /// relay is asymmetric and its mean output over a cycle is zero (within
+  /// 2 % of its mean magnitude), first order plus dead time otherwise.
+  FopdtModel model;
   double ku = 0.0;      ///< the model's ultimate gain (its phase crossover)
   double pu_s = 0.0;    ///< the model's ultimate period
   std::string message;  ///< why something was not found
@@ -93,8 +98,16 @@ class RelayExperiment {
 };
 
 /// The ultimate gain and period of K e^(-sL)/(Ts + 1): the phase crossover
-/// w (atan(wT) + wL = pi), Ku = sqrt(1 + (wT)^2) / |K|, Pu = 2 pi / w.
+/// w (atan(wT) + wL = pi), Ku = sqrt(1 + (wT)^2) / |K|, Pu = 2 pi / w; of
+/// K e^(-sL)/s: w = pi / (2L), Ku = w / |K|, Pu = 4L.
 Status FopdtUltimate(const FopdtModel& model, double* ku, double* pu_s);
+
+/// K and L of K e^(-sL)/s from a limit cycle (RelayCycle means): the process
+/// integrates the relay's output, so y moves at K d_high, -K d_low, and
+///   e_max - e_min = 2 eps + K L (d_high + d_low),
+///   t_on = L + (2 eps + K L d_low) / (K d_high),  t_off = L + (2 eps + K L d_high) / (K d_low);
+/// a periodic cycle needs d_high t_on = d_low t_off (the mean output zero).
+Status IntegratingFromCycle(const RelayOptions& options, const RelayCycle& cycle, FopdtModel* model);
 
 /// K, T and L from a limit cycle's mean t_on, t_off, e_max, e_min and
 /// integral of e (RelayCycle) under `options`' relay: the closed forms above.
