@@ -22,6 +22,7 @@
 #include <pidlab/lcmt_episode_config_v3.hpp>
 #include <pidlab/lcmt_episode_config_v4.hpp>
 #include <pidlab/lcmt_episode_config_v5.hpp>
+#include <pidlab/lcmt_episode_config_v6.hpp>
 #include <pidlab/lcmt_ready.hpp>
 
 #include "pidlab/replay/decoder_table.h"
@@ -436,14 +437,15 @@ TEST(DecoderTable, AConfigurationOfAnOlderLogIsReadAsOneOfALinearPlant) {
     const std::vector<uint8_t> cut_bytes(whole.begin(), whole.end() - static_cast<std::ptrdiff_t>(cut));
     EXPECT_FALSE(current->decode(cut_bytes.data(), cut_bytes.size(), &message)) << cut;
   }
-  // motor_drive's length ("linear": 4 + 7 bytes, then the 8 bytes of each
+  // motor_drive's length ("linear": 4 + 7 bytes, then the bytes of each
   // field after it: delay_s, the chirp's, the measurement noise's, the
-  // setpoint weights', ...): 2^31 - 1 + ...
+  // setpoint weights', the relay's, ...): 2^31 - 1 + ...
   namespace layout = pidlab::lcm_layout::lcmt_episode_config;
   std::size_t after = 0;
   bool past = false;
   for (const layout::Field& f : layout::kFields) {
-    if (past) after += 8;
+    // A string after it (controller_mode, "" here) is its length and its 0.
+    if (past) after += f.kind == layout::WireField::kString ? 4 + 1 : 8;
     past = past || std::string(f.name) == "motor_drive";
   }
   whole[whole.size() - (4 + 7 + after)] = 0x7f;
@@ -582,6 +584,8 @@ TEST(DecoderTable, EachGeneratedFrozenConfigurationKeepsTheFingerprintItsLogsCar
   // v5: the type before measurement_resolution (lcm-gen --python of that
   // .lcm file gives the same packed fingerprint).
   EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v5::getHash()), 0xae1743586efaa30bULL);
+  // v6: the type before the relay autotune's fields (controller_mode, relay_*).
+  EXPECT_EQ(static_cast<uint64_t>(pidlab::lcmt_episode_config_v6::getHash()), 0x60ba0c6d742c79c4ULL);
   EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_episode_config_v1::getHash()), 1);
   EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_episode_config_v4::getHash()), 4);
   EXPECT_EQ(transport::EpisodeConfigVersion(pidlab::lcmt_episode_config::getHash()),

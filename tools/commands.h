@@ -8,6 +8,7 @@
 
 namespace pidlab::cli {
 
+std::function<int()> RegisterAutotune(CLI::App* app);
 std::function<int()> RegisterEvaluate(CLI::App* app);
 std::function<int()> RegisterTune(CLI::App* app);
 std::function<int()> RegisterLaunch(CLI::App* app);

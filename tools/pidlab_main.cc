@@ -26,6 +26,8 @@ struct Command {
 // (and version).
 const Command kCommands[] = {
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
+    {"autotune", "relay autotune on the running trio: Ku, Pu, a FOPDT model, a design, a verified step",
+     pidlab::cli::RegisterAutotune},
     {"batch", "the AMIGO test batch: AMIGO's PID against pidlab's optimum on P1-P9",
      pidlab::cli::RegisterBatch},
 #endif

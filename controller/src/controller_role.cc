@@ -1,9 +1,11 @@
 #include "pidlab/controller/controller_role.h"
 
+#include <cmath>
 #include <cstring>
 #include <pidlab/lcmt_control_command.hpp>
 
 #include "pidlab/controller/pid.h"
+#include "pidlab/controller/relay.h"
 
 namespace pidlab::controller {
 using transport::EpisodeSpec;
@@ -30,6 +32,7 @@ int8_t ToCommandStatus(PidStatus status) {
 struct ControllerRole::Episode {
   EpisodeSpec spec;
   std::unique_ptr<DiscretePid<double>> pid;
+  std::unique_ptr<RelayTuner> relay;  // a relay episode (spec.relay)
   long expected = 0;
   pidlab::lcmt_control_command last;
   bool have_last = false;
@@ -50,6 +53,8 @@ void ControllerRole::StartEpisode(const EpisodeSpec& spec) {
   auto ep = std::make_unique<Episode>();
   ep->spec = spec;
   ep->pid = std::make_unique<DiscretePid<double>>(spec.gains, PidOptionsAt(spec.pid, spec.dt_s));
+  if (spec.relay)
+    ep->relay = std::make_unique<RelayTuner>(spec.relay_tune, spec.gains, PidOptionsAt(spec.pid, spec.dt_s));
   ep->duplicates_at_start = counters_.duplicates;
   ep->dropped_at_start = transport_->counters().dropped;
   ep_ = std::move(ep);
@@ -63,7 +68,18 @@ void ControllerRole::OnOutput(const pidlab::lcmt_plant_output& m) {
   Episode& e = *ep_;
   if (m.step == e.expected && m.step < e.spec.total_steps) {
     double u = 0.0;
-    const PidStatus status = e.pid->Step(e.spec.reference, m.y, &u);
+    PidStatus status = PidStatus::kInvalidInput;
+    if (!e.relay) {
+      status = e.pid->Step(e.spec.reference, m.y, &u);
+    } else if (std::isfinite(m.y)) {
+      const RelayPhase before = e.relay->phase();
+      u = e.relay->Step(m.t_s, e.spec.reference, m.y);
+      status = PidStatus::kOk;
+      if (e.relay->phase() != before && verbose_)
+        Log("episode " + std::to_string(e.spec.episode_id) + ": relay " + ToString(e.relay->phase()) +
+            " at t = " + std::to_string(m.t_s) + " s" +
+            (e.relay->why().empty() ? std::string() : ": " + e.relay->why()));
+    }
     pidlab::lcmt_control_command& c = e.last;
     c.episode_id = e.spec.episode_id;
     c.step = m.step;

@@ -70,6 +70,15 @@ void CopyNumbers(EpisodeSpec* s, pidlab::lcmt_episode_config* m, Direction direc
   field(s->measurement_noise.resolution, m->measurement_resolution);
   field(s->recovery.retransmit_interval_s, m->retransmit_interval_s);
   field(s->recovery.silence_deadline_s, m->silence_deadline_s);
+  field(s->relay_tune.hold_s, m->relay_hold_s);
+  field(s->relay_tune.u0, m->relay_u0);
+  field(s->relay_tune.amplitude, m->relay_amplitude);
+  field(s->relay_tune.bias, m->relay_bias);
+  field(s->relay_tune.hysteresis, m->relay_hysteresis);
+  field(s->relay_tune.noise_multiple, m->relay_noise_multiple);
+  field(s->relay_tune.y_limit, m->relay_y_limit);
+  field(s->relay_tune.tolerance, m->relay_tolerance);
+  field(s->relay_tune.timeout_periods, m->relay_timeout_periods);
 }
 
 }  // namespace
@@ -127,6 +136,10 @@ bool EpisodeSpec::IsValid(std::string* error) const {
     return Fail("chirp_f1_hz " + FormatDouble(disturbance.chirp_f1_hz) +
                     " Hz is not below the Nyquist frequency 1/(2 dt_s)",
                 error);
+  if (relay) {
+    std::string bad;
+    if (!relay_tune.IsValid(&bad)) return Fail("relay: " + bad, error);
+  }
   return recovery.IsValid(error);
 }
 
@@ -178,6 +191,14 @@ pidlab::lcmt_episode_config MakeEpisodeConfig(const EpisodeSpec& spec) {
     m.motor_abs_tolerance = o.abs_tolerance;
     m.motor_rel_tolerance = o.rel_tolerance;
     m.motor_drive = o.microstep_table ? "microstep" : "linear";
+  }
+  m.controller_mode = spec.relay ? "relay" : "pid";
+  m.relay_settled_cycles = spec.relay_tune.settled_cycles;
+  m.relay_max_restarts = spec.relay_tune.max_restarts;
+  if (!spec.relay) {  // the relay_ fields are 0 outside a relay episode
+    m.relay_hold_s = m.relay_u0 = m.relay_amplitude = m.relay_bias = m.relay_hysteresis = 0.0;
+    m.relay_noise_multiple = m.relay_y_limit = m.relay_tolerance = m.relay_timeout_periods = 0.0;
+    m.relay_settled_cycles = m.relay_max_restarts = 0;
   }
   return m;
 }
@@ -263,6 +284,13 @@ bool ParseEpisodeConfigOrExplain(const pidlab::lcmt_episode_config& m, EpisodeSp
     return Fail("disturbance '" + m.disturbance_kind + "' unknown", error);
   s.disturbance.seed = static_cast<uint64_t>(m.seed);
   s.measurement_noise.seed = static_cast<uint64_t>(m.measurement_noise_seed);
+  if (m.controller_mode == "relay") {
+    s.relay = true;
+    s.relay_tune.settled_cycles = static_cast<int>(std::clamp<int64_t>(m.relay_settled_cycles, -1, 1000));
+    s.relay_tune.max_restarts = static_cast<int>(std::clamp<int64_t>(m.relay_max_restarts, -1, 1000));
+  } else if (m.controller_mode != "" && m.controller_mode != "pid") {
+    return Fail("controller mode '" + m.controller_mode + "' unknown (pid or relay)", error);
+  }
   if (!s.IsValid(error)) return false;
   *spec = s;
   return true;

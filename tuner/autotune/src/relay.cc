@@ -115,20 +115,23 @@ bool RelayExperiment::Converged() const {
   return true;
 }
 
-RelayEstimates RelayExperiment::Estimate() const {
+RelayEstimates RelayExperiment::Estimate() const { return EstimateFromCycles(o_, cycles_, Converged(), 0.0); }
+
+RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<RelayCycle>& cycles,
+                                  bool converged, double noise_sigma) {
   RelayEstimates r;
-  r.converged = Converged();
-  const int available = static_cast<int>(cycles_.size()) - 1;  // without the approach
-  const int n = std::min(o_.settled_cycles, available);
+  r.converged = converged;
+  const int available = static_cast<int>(cycles.size()) - 1;  // without the approach
+  const int n = std::min(o.settled_cycles, available);
   if (n < 1) {
-    r.message = "no full relay cycle after the first yet (" + std::to_string(cycles_.size()) + " cycles)";
+    r.message = "no full relay cycle after the first yet (" + std::to_string(cycles.size()) + " cycles)";
     return r;
   }
   r.cycles = n;
   std::vector<double> periods, amplitudes;
   RelayCycle mean;
   for (int i = 0; i < n; ++i) {
-    const RelayCycle& c = cycles_[cycles_.size() - 1 - i];
+    const RelayCycle& c = cycles[cycles.size() - 1 - i];
     periods.push_back(c.period_s());
     amplitudes.push_back(c.amplitude());
     mean.t_on_s += c.t_on_s / n;
@@ -139,14 +142,23 @@ RelayEstimates RelayExperiment::Estimate() const {
   }
   MeanInterval(periods, &r.period_s, &r.period_ci_s);
   MeanInterval(amplitudes, &r.amplitude, &r.amplitude_ci);
-  const double d = 0.5 * (o_.d_high + o_.d_low), eps = o_.hysteresis;
+  const double d = 0.5 * (o.d_high + o.d_low), eps = o.hysteresis;
   if (r.amplitude > eps)
     r.ku_describing_function = 4.0 * d / (kPi * std::sqrt(r.amplitude * r.amplitude - eps * eps));
-  const double mean_v = o_.d_high * mean.t_on_s - o_.d_low * mean.t_off_s;
+  const double mean_v = o.d_high * mean.t_on_s - o.d_low * mean.t_off_s;
   const bool integrating =
-      o_.d_high != o_.d_low && std::abs(mean_v) <= 0.02 * (o_.d_high * mean.t_on_s + o_.d_low * mean.t_off_s);
-  const Status fitted =
-      integrating ? IntegratingFromCycle(o_, mean, &r.model) : FopdtFromCycle(o_, mean, &r.model);
+      o.d_high != o.d_low && std::abs(mean_v) <= 0.02 * (o.d_high * mean.t_on_s + o.d_low * mean.t_off_s);
+  Status fitted;
+  if (integrating) {
+    fitted = IntegratingFromCycle(o, mean, &r.model);
+    r.model_from = "extremes";
+  } else if (3.0 * noise_sigma > 0.01 * r.amplitude) {
+    fitted = FopdtFromTimes(o, mean, &r.model);
+    r.model_from = "switching times";
+  } else {
+    fitted = FopdtFromCycle(o, mean, &r.model);
+    r.model_from = "extremes";
+  }
   if (!fitted.ok()) {
     r.message = fitted.message();
     return r;
@@ -158,6 +170,55 @@ RelayEstimates RelayExperiment::Estimate() const {
   }
   r.model_found = true;
   return r;
+}
+
+Status FopdtFromTimes(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
+  std::string error;
+  if (!o.IsValid(&error)) return Status::InvalidInput(error);
+  const double eps = o.hysteresis, dh = o.d_high, dl = o.d_low;
+  const double mean_v = dh * c.t_on_s - dl * c.t_off_s;
+  if (!(std::abs(mean_v) > 1e-6 * (dh * c.t_on_s + dl * c.t_off_s)))
+    return Status::InvalidInput(
+        "the relay's mean output over a cycle is zero (a symmetric relay, or an integrating process): a "
+        "first-order process's gain cannot be identified; make d_low differ from d_high");
+  const double k = c.integral_e / mean_v;
+  if (!(k > 0.0) || !std::isfinite(k))
+    return Status::InvalidInput("the identified gain " + Number(k) +
+                                " is not positive (the relay is reverse acting: a process of positive gain)");
+  const double kh = k * dh, kl = k * dl;
+  if (!(kh > eps) || !(kl > eps))
+    return Status::InvalidInput("the hysteresis " + Number(eps) + " is not below K d_high and K d_low (" +
+                                Number(kh) + ", " + Number(kl) + ")");
+  // t_on = T g_on(tau), t_off = T g_off(tau), E = e^(-tau).
+  const auto g_on = [&](double tau) {
+    const double e = std::exp(-tau);
+    return tau + std::log((kh + kl - (kl - eps) * e) / (kh - eps));
+  };
+  const auto g_off = [&](double tau) {
+    const double e = std::exp(-tau);
+    return tau + std::log((kh + kl - (kh - eps) * e) / (kl - eps));
+  };
+  // f(tau) = t_on g_off - t_off g_on changes sign once on (0, inf).
+  const auto f = [&](double tau) { return c.t_on_s * g_off(tau) - c.t_off_s * g_on(tau); };
+  double lo = 1e-9, hi = 1.0;
+  const double f_lo = f(lo);
+  while (hi < 1e3 && (f(hi) > 0.0) == (f_lo > 0.0)) hi *= 2.0;
+  if ((f(hi) > 0.0) == (f_lo > 0.0))
+    return Status::InvalidInput("the half periods " + Number(c.t_on_s) + " s and " + Number(c.t_off_s) +
+                                " s fit no first order plus dead time under this relay");
+  for (int i = 0; i < 200 && hi - lo > 1e-14 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    ((f(mid) > 0.0) == (f_lo > 0.0) ? lo : hi) = mid;
+  }
+  const double tau = 0.5 * (lo + hi);
+  const double t = 0.5 * (c.t_on_s / g_on(tau) + c.t_off_s / g_off(tau));
+  if (!(t > 0.0) || !std::isfinite(t))
+    return Status::InvalidInput("the cycle's half periods give a time constant " + Number(t) + " s");
+  model->gain = k;
+  model->time_constant_s = t;
+  model->delay_s = t * tau;
+  model->integrating = false;
+  return Status::Ok();
 }
 
 Status FopdtUltimate(const FopdtModel& m, double* ku, double* pu_s) {

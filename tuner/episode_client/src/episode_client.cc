@@ -338,16 +338,34 @@ Status EpisodeClient::Run(const Plant& plant, const PidGains& gains, const evalu
   return Status::Ok();
 }
 
+Status EpisodeClient::RunRelay(const Plant& plant, const PidGains& previous,
+                               const evaluation::LoopOptions& options, const DisturbanceOptions& disturbance,
+                               const RelayTuneOptions& relay,
+                               std::vector<evaluation::SampledStep>* trajectory) {
+  if (!status_.ok()) return status_;
+  std::string why;
+  std::vector<double> y_all;
+  if (!RunOrExplain(plant, previous, options, disturbance, &y_all, trajectory, &why, &relay))
+    return Status::RunnerFailed(why);
+  return Status::Ok();
+}
+
 bool EpisodeClient::RunOrExplain(const Plant& plant, const PidGains& gains,
                                  const evaluation::LoopOptions& options,
                                  const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                                 std::vector<evaluation::SampledStep>* trajectory, std::string* error) {
+                                 std::vector<evaluation::SampledStep>* trajectory, std::string* error,
+                                 const RelayTuneOptions* relay) {
   transport::EpisodeSpec spec;
   try {
     spec = MakeEpisodeSpec(transport::NewEpisodeId(), plant, gains, options, disturbance, options_.recovery);
   } catch (const std::invalid_argument& e) {
     if (error) *error = e.what();
     return false;
+  }
+  if (relay) {
+    spec.relay = true;
+    spec.relay_tune = *relay;
+    if (!spec.IsValid(error)) return false;
   }
   std::string why;
   for (int attempt = 1;; ++attempt) {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "pidlab/controller/pid.h"
+#include "pidlab/controller/relay.h"
 #include "pidlab/plant_sim/disturbance.h"
 #include "pidlab/plant_sim/episode_shape.h"
 #include "pidlab/plant_sim/plants.h"
@@ -45,6 +46,11 @@ struct EpisodeSpec : EpisodeShape {
   /// The EpisodeShape's pid.dt_s equals dt_s here.
   long total_steps = 0;  // horizon_s / dt_s
   RecoveryOptions recovery;
+  /// The relay autotune in place of the PID (controller/relay.h,
+  /// docs/autotune.md): the controller runs a RelayTuner with `gains` as the
+  /// previous PID. Carried as controller_mode "relay" and the relay_ fields.
+  bool relay = false;
+  RelayTuneOptions relay_tune;
 
   /// A failed Status (kInvalidInput) naming the field (a stranger's malformed config must
   /// not crash a process).

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/controller/relay.h"
 #include "pidlab/spec/status.h"
 
 namespace pidlab::autotune {
@@ -38,15 +39,7 @@ struct RelayOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// One cycle of the limit cycle: from a switch to high to the next.
-struct RelayCycle {
-  double start_s = 0.0;
-  double t_on_s = 0.0, t_off_s = 0.0;  ///< time at +d_high, at -d_low
-  double e_max = 0.0, e_min = 0.0;     ///< extremes of e = y - r
-  double integral_e = 0.0;             ///< of e over the cycle (trapezoids)
-  double period_s() const { return t_on_s + t_off_s; }
-  double amplitude() const { return 0.5 * (e_max - e_min); }
-};
+using pidlab::RelayCycle;  // controller/relay.h
 
 /// A first-order plus dead-time model K e^(-sL)/(Ts + 1); an integrating
 /// one, K e^(-sL)/s, when `integrating` (time_constant_s unused).
@@ -73,6 +66,10 @@ struct RelayEstimates {
   FopdtModel model;
   double ku = 0.0;      ///< the model's ultimate gain (its phase crossover)
   double pu_s = 0.0;    ///< the model's ultimate period
+  /// How the FOPDT model was found: "extremes" (the cycle's extremes and
+  /// integral, exact without noise) or "switching times" (its half periods
+  /// and integral, FopdtFromTimes: the extremes of a noisy y are biased).
+  std::string model_from;
   std::string message;  ///< why something was not found
 };
 
@@ -96,6 +93,18 @@ class RelayExperiment {
   double e_max_ = 0.0, e_min_ = 0.0, integral_ = 0.0;
   std::vector<RelayCycle> cycles_;
 };
+
+/// The estimates from `cycles` (the first is the approach: the last
+/// min(settled_cycles, size - 1) are averaged) under `options`' relay;
+/// where 3 noise_sigma is more than 1 % of the amplitude, the FOPDT model
+/// from the switching times (FopdtFromTimes), else from the extremes.
+RelayEstimates EstimateFromCycles(const RelayOptions& options, const std::vector<RelayCycle>& cycles,
+                                  bool converged, double noise_sigma);
+
+/// K, T and L from a cycle's mean t_on, t_off and integral of e alone (not
+/// its extremes): K from the integral, then tau = L/T from t_on / t_off,
+/// which runs from d_low/d_high (tau -> 0) to 1 (tau -> inf), by bisection.
+Status FopdtFromTimes(const RelayOptions& options, const RelayCycle& cycle, FopdtModel* model);
 
 /// The ultimate gain and period of K e^(-sL)/(Ts + 1): the phase crossover
 /// w (atan(wT) + wL = pi), Ku = sqrt(1 + (wT)^2) / |K|, Pu = 2 pi / w; of

@@ -88,6 +88,13 @@ class EpisodeClient {
              const DisturbanceOptions& disturbance, std::vector<double>* y_all,
              std::vector<evaluation::SampledStep>* trajectory);
 
+  /// A relay episode (controller/relay.h): the controller runs a
+  /// RelayTuner with `relay` and `previous` as the loop in place; every step
+  /// in *trajectory. Ok, or kRunnerFailed/kInvalidInput as Run.
+  Status RunRelay(const Plant& plant, const PidGains& previous, const evaluation::LoopOptions& options,
+                  const DisturbanceOptions& disturbance, const RelayTuneOptions& relay,
+                  std::vector<evaluation::SampledStep>* trajectory);
+
   evaluation::SampledRunner AsRunner();
   const EpisodeClientStats& stats() const { return stats_; }
   /// After Run failed: true if the trio went silent or died (the episode may
@@ -103,7 +110,8 @@ class EpisodeClient {
   void Start(lcm::LCM* lcm);
   bool RunOrExplain(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
                     const DisturbanceOptions& disturbance, std::vector<double>* y_all,
-                    std::vector<evaluation::SampledStep>* trajectory, std::string* error);
+                    std::vector<evaluation::SampledStep>* trajectory, std::string* error,
+                    const RelayTuneOptions* relay = nullptr);
   bool StartEpisode(const pidlab::lcmt_episode_config& config, std::string* error);
   /// Waits for every step (asking the plant again for what was missed) from
   /// t0 on; *done_s is when the last step was heard.

@@ -1,0 +1,263 @@
+// The relay autotune's state machine (relay.h).
+
+#include "pidlab/controller/relay.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace pidlab {
+namespace {
+
+std::string Num(double v) {
+  std::ostringstream os;
+  os.precision(4);
+  os << v;
+  return os.str();
+}
+
+double Clip(double u, double lo, double hi) { return std::min(std::max(u, lo), hi); }
+
+}  // namespace
+
+const char* ToString(RelayPhase phase) {
+  switch (phase) {
+    case RelayPhase::kHold:
+      return "hold";
+    case RelayPhase::kRelay:
+      return "relay";
+    case RelayPhase::kDone:
+      return "done";
+    case RelayPhase::kAborted:
+      break;
+  }
+  return "aborted";
+}
+
+bool RelayTuneOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  if (!(hold_s >= 0.0) || !std::isfinite(hold_s))
+    os << "hold " << hold_s << " s must be >= 0 and finite";
+  else if (!std::isfinite(u0))
+    os << "u0 " << u0 << " must be finite";
+  else if (!(amplitude > 0.0) || !std::isfinite(amplitude))
+    os << "relay amplitude " << amplitude << " must be > 0 and finite";
+  else if (!(std::abs(bias) < amplitude))
+    os << "relay bias " << bias << " must be smaller in magnitude than the amplitude " << amplitude;
+  else if (!(hysteresis >= 0.0) || !std::isfinite(hysteresis))
+    os << "hysteresis " << hysteresis << " must be >= 0 and finite";
+  else if (!(noise_multiple >= 0.0) || !std::isfinite(noise_multiple))
+    os << "noise multiple " << noise_multiple << " must be >= 0 and finite";
+  else if (!(y_limit > 0.0))
+    os << "y limit " << y_limit << " must be > 0";
+  else if (settled_cycles < 2 || settled_cycles > 100)
+    os << "settled cycles " << settled_cycles << " must be in [2, 100]";
+  else if (!(tolerance > 0.0 && tolerance < 1.0))
+    os << "tolerance " << tolerance << " must be in (0, 1)";
+  else if (!(timeout_periods > settled_cycles + 1) || !std::isfinite(timeout_periods))
+    os << "timeout " << timeout_periods << " periods must be finite and more than settled cycles + 1";
+  else if (max_restarts < 0 || max_restarts > 100)
+    os << "max restarts " << max_restarts << " must be in [0, 100]";
+  else
+    return true;
+  if (error) *error = os.str();
+  return false;
+}
+
+RelayTuner::RelayTuner(const RelayTuneOptions& options, const PidGains& previous, const PidOptions& pid)
+    : o_(options),
+      previous_(previous),
+      pid_(previous, pid),
+      out_min_(pid.output_min),
+      out_max_(pid.output_max) {}
+
+bool RelayTuner::HasPid() const { return previous_.kp != 0.0 || previous_.ki != 0.0 || previous_.kd != 0.0; }
+
+void RelayTuner::StartHold(double t_s) {
+  phase_ = RelayPhase::kHold;
+  hold_start_s_ = t_s;
+  sum_u_ = sum_y_ = sum_d_ = sum_d2_ = 0.0;
+  n_u_ = n_d_ = 0;
+  n_prev_ = 0;
+}
+
+double RelayTuner::After(double r, double y) {
+  if (!HasPid()) return Clip(phase_ == RelayPhase::kHold ? o_.u0 : u0_, out_min_, out_max_);
+  double u = 0.0;
+  pid_.Step(r, y, &u);
+  return u;
+}
+
+void RelayTuner::End(RelayPhase phase, double t_s, const std::string& why) {
+  phase_ = phase;
+  end_s_ = t_s;
+  why_ = why;
+}
+
+double RelayTuner::Step(double t_s, double r, double y) {
+  if (first_) {
+    first_ = false;
+    StartHold(t_s);
+  }
+  if (phase_ == RelayPhase::kHold && t_s - hold_start_s_ >= o_.hold_s) EndHold(t_s, r, y);
+  if (phase_ == RelayPhase::kRelay) return RelayStep(t_s, r, y);
+  if (phase_ != RelayPhase::kHold) {  // done or aborted: the loop as before
+    if (HasPid()) return After(r, y);
+    return Clip(u0_, out_min_, out_max_);
+  }
+  const double u = After(r, y);
+  if (2.0 * (t_s - hold_start_s_) >= o_.hold_s) {  // the hold's second half
+    sum_u_ += u;
+    sum_y_ += y;
+    ++n_u_;
+    if (n_prev_ >= 2) {  // second differences: a smooth drift gives ~0, white noise 6 sigma^2
+      const double d = y - 2.0 * y_prev_ + y_prev2_;
+      sum_d_ += d;
+      sum_d2_ += d * d;
+      ++n_d_;
+    }
+    y_prev2_ = y_prev_;
+    y_prev_ = y;
+    ++n_prev_;
+  }
+  return u;
+}
+
+void RelayTuner::EndHold(double t_s, double r, double y) {
+  u0_ = HasPid() && n_u_ > 0 ? sum_u_ / static_cast<double>(n_u_) : Clip(o_.u0, out_min_, out_max_);
+  y0_ = n_u_ > 0 ? sum_y_ / static_cast<double>(n_u_) : r;
+  sigma_ = 0.0;
+  if (n_d_ > 1) {
+    const double n = static_cast<double>(n_d_);
+    const double var = (sum_d2_ - sum_d_ * sum_d_ / n) / (n - 1.0);
+    sigma_ = var > 0.0 ? std::sqrt(var / 6.0) : 0.0;
+  }
+  eps_ = o_.hysteresis + o_.noise_multiple * sigma_;
+  d_high_ = std::min(o_.amplitude + o_.bias, out_max_ - u0_);
+  d_low_ = std::min(o_.amplitude - o_.bias, u0_ - out_min_);
+  if (!(d_high_ > 0.0) || !(d_low_ > 0.0) || !std::isfinite(u0_)) {
+    End(RelayPhase::kAborted, t_s,
+        "no room for a relay around u0 = " + Num(u0_) + " within the output range [" + Num(out_min_) + ", " +
+            Num(out_max_) + "]");
+    return;
+  }
+  phase_ = RelayPhase::kRelay;
+  relay_start_s_ = t_s;
+  high_ = y - y0_ < 0.0;  // towards the operating point
+  t_prev_ = t_s;
+  e_prev_ = y - y0_;
+  t_high_ = t_low_ = -1.0;
+  integral_ = 0.0;
+  cycles_.clear();
+  changes_.clear();
+}
+
+double RelayTuner::RelayStep(double t_s, double r, double y) {
+  const double e = y - y0_;
+  if (t_s > relay_start_s_) {
+    if (!(std::abs(e) <= o_.y_limit)) {
+      End(RelayPhase::kAborted, t_s,
+          "y - y0 = " + Num(e) + " at t = " + Num(t_s) + " s is beyond the limit " + Num(o_.y_limit));
+      return After(r, y);
+    }
+    if (t_high_ >= 0.0) {  // inside a cycle: its integral and extremes
+      integral_ += 0.5 * (e + e_prev_) * (t_s - t_prev_);
+      e_max_ = std::max(e_max_, e);
+      e_min_ = std::min(e_min_, e);
+    }
+    if (!high_ && e < -eps_) {
+      const bool complete = t_high_ >= 0.0 && t_low_ > t_high_;
+      RelayCycle c;
+      if (complete) {
+        c.start_s = t_high_;
+        c.t_on_s = t_low_ - t_high_;
+        c.t_off_s = t_s - t_low_;
+        c.e_max = e_max_;
+        c.e_min = e_min_;
+        c.integral_e = integral_;
+      }
+      high_ = true;
+      t_high_ = t_s;
+      t_low_ = -1.0;
+      integral_ = 0.0;
+      e_max_ = e_min_ = e;
+      if (complete) OnCycle(c, t_s);
+      if (phase_ == RelayPhase::kHold) return After(r, y);  // restarted
+      if (phase_ != RelayPhase::kRelay) return After(r, y);
+    } else if (high_ && e > eps_) {
+      high_ = false;
+      if (t_high_ >= 0.0) t_low_ = t_s;
+    }
+    if (!cycles_.empty() && t_s - relay_start_s_ > o_.timeout_periods * cycles_.back().period_s()) {
+      End(RelayPhase::kAborted, t_s,
+          "the oscillation did not converge within " + Num(o_.timeout_periods) + " periods (" +
+              Num(o_.timeout_periods * cycles_.back().period_s()) + " s): " + std::to_string(cycles_.size()) +
+              " cycles, the last periods and amplitudes differ by more than " + Num(100.0 * o_.tolerance) +
+              " %");
+      return After(r, y);
+    }
+  }
+  t_prev_ = t_s;
+  e_prev_ = e;
+  return u0_ + (high_ ? d_high_ : -d_low_);
+}
+
+double RelayTuner::Tolerance(const RelayCycle& c) const {
+  // The extremes of a noisy y, and the switching times with them, jitter by
+  // about sigma / amplitude: a cycle agrees within that as well.
+  return o_.tolerance + (c.amplitude() > 0.0 ? 2.0 * sigma_ / c.amplitude() : 0.0);
+}
+
+void RelayTuner::OnCycle(const RelayCycle& c, double t_s) {
+  if (!cycles_.empty()) {
+    const RelayCycle& p = cycles_.back();
+    const double change = std::max({std::abs(c.period_s() - p.period_s()) / p.period_s(),
+                                    std::abs(c.amplitude() - p.amplitude()) / p.amplitude(),
+                                    std::abs(c.t_on_s / c.period_s() - p.t_on_s / p.period_s())});
+    // A change that grows where a converging oscillation's shrink, after the
+    // approach (cycles_[0]) and one cycle to compare with.
+    if (changes_.size() >= 2 && change > 5.0 * Tolerance(p) && change > 2.0 * changes_.back()) {
+      load_changes_s_.push_back(c.start_s);
+      if (!HasPid()) {
+        End(RelayPhase::kAborted, t_s,
+            "a load change near t = " + Num(c.start_s) +
+                " s (the oscillation changed after settling); with no previous PID to hold the process, the "
+                "test "
+                "stops");
+        return;
+      }
+      if (restarts_ >= o_.max_restarts) {
+        End(RelayPhase::kAborted, t_s,
+            "a load change near t = " + Num(c.start_s) + " s after " + std::to_string(restarts_) +
+                " restarts: the process does not stay at its operating point");
+        return;
+      }
+      ++restarts_;
+      StartHold(t_s);
+      return;
+    }
+    changes_.push_back(change);
+  } else {
+    changes_.push_back(0.0);
+  }
+  cycles_.push_back(c);
+  const int n = o_.settled_cycles;
+  if (static_cast<int>(cycles_.size()) < n + 1) return;  // the first cycle is the approach
+  double period = 0.0, amplitude = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const RelayCycle& k = cycles_[cycles_.size() - 1 - i];
+    period += k.period_s() / n;
+    amplitude += k.amplitude() / n;
+  }
+  for (int i = 0; i < n; ++i) {
+    const RelayCycle& k = cycles_[cycles_.size() - 1 - i];
+    if (!(std::abs(k.period_s() - period) <= Tolerance(k) * period) ||
+        !(std::abs(k.amplitude() - amplitude) <= Tolerance(k) * amplitude))
+      return;
+  }
+  End(RelayPhase::kDone, t_s,
+      "converged after " + std::to_string(cycles_.size()) + " cycles: period " + Num(period) +
+          " s, amplitude " + Num(amplitude));
+}
+
+}  // namespace pidlab

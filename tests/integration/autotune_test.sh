@@ -1,0 +1,120 @@
+#!/usr/bin/env bash
+# pidlab autotune over the trio (docs/autotune.md), one case per private
+# network namespace: the relay's estimates against the exact ultimate gain and
+# period of the simulated plant (the phase crossover of its transfer
+# function, solved here with scipy), the FOPDT parameters against the plant's,
+# and the adopted gains' Ms on the true plant (pidlab evaluate) within the
+# bound. Runs in the private network namespace ctest gives it (unshare -n).
+# usage: autotune_test.sh BIN_DIR CASE
+set -uo pipefail
+bin=$1 case=$2
+. "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+private_network_up
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" || exit 1
+autotune() { "$bin/pidlab" launch --isolated -- "$bin/pidlab" autotune --backend lcm --json "$@" >out.json 2>err; }
+
+# check KIND K T L [tolerances]: the estimates of out.json against the plant
+# K e^(-Ls)/(Ts+1) (KIND fopdt) or K e^(-Ls)/s (KIND ipdt); then the adopted
+# gains on the true plant.
+check() {
+  /usr/bin/python3 - "$bin" "$@" <<'PY'
+import json, math, subprocess, sys
+from scipy.optimize import brentq
+bin_dir, kind, K, T, L = sys.argv[1], sys.argv[2], *map(float, sys.argv[3:6])
+ku_tol = float(sys.argv[6]) if len(sys.argv) > 6 else 0.05
+model_tol = float(sys.argv[7]) if len(sys.argv) > 7 else 0.10
+r = json.load(open("out.json"))
+ok = True
+def say(good, what):
+    global ok
+    print(("PASS " if good else "FAIL ") + what)
+    ok = ok and good
+x, e = r["experiment"], r["estimates"]
+say(x["end"] == "done", f"the relay converged ({x['end']}: {x['why']})")
+if kind == "fopdt":
+    w = brentq(lambda w: math.atan(w * T) + w * L - math.pi, 1e-9, math.pi / L)
+    ku, pu = math.sqrt(1 + (w * T) ** 2) / K, 2 * math.pi / w
+else:
+    w = math.pi / (2 * L)
+    ku, pu = w / K, 4 * L
+m = e["model"]
+print(f"exact Ku {ku:.6g}, Pu {pu:.6g} s; estimated Ku {e['ku']:.6g}, Pu {e['pu_s']:.6g} s, "
+      f"describing function {e['ku_describing_function']:.6g}; model {m}")
+say(abs(e["ku"] / ku - 1) <= ku_tol, f"Ku within {ku_tol:.0%} of the exact {ku:.6g}: {e['ku']:.6g}")
+say(abs(e["pu_s"] / pu - 1) <= ku_tol, f"Pu within {ku_tol:.0%} of the exact {pu:.6g} s: {e['pu_s']:.6g} s")
+say(m["kind"] == kind, f"the model is {kind}: {m['kind']}")
+say(abs(m["gain"] / K - 1) <= model_tol, f"K within {model_tol:.0%}: {m['gain']:.6g} (true {K})")
+say(abs(m["delay_s"] / L - 1) <= model_tol, f"L within {model_tol:.0%}: {m['delay_s']:.6g} (true {L})")
+if kind == "fopdt":
+    say(abs(m["time_constant_s"] / T - 1) <= model_tol,
+        f"T within {model_tol:.0%}: {m['time_constant_s']:.6g} (true {T})")
+say(e["period_ci_s"] >= 0 and e["amplitude_ci"] >= 0, "the period and amplitude carry intervals")
+say(r["adopted"] is True, f"the gains were adopted: {r['verdict']}")
+g = r["gains"]
+den = [T, 1] if kind == "fopdt" else [1, 0]
+ev = json.loads(subprocess.run(
+    [f"{bin_dir}/pidlab", "evaluate", "--num", str(K), "--den", ",".join(map(str, den)), "--delay", str(L),
+     "--gains", f"{g['kp']!r},{g['ki']!r},{g['kd']!r}", "--derivative-filter", repr(g.get("tf", 0.0)),
+     "--json"], capture_output=True, text=True, check=True).stdout)
+ms = ev["robustness"]["ms"]
+say(ev["robustness"]["stable"] and ms <= 2.0, f"on the true plant the adopted loop is stable with Ms {ms:.4g} <= 2")
+sys.exit(0 if ok else 1)
+PY
+}
+
+case $case in
+  fopdt_0.1) autotune --num 1 --den 1,1 --delay 0.1 --dt 0.0005 || echo "FAIL autotune: $(tail -1 err)"
+    check fopdt 1 1 0.1 ;;
+  fopdt_0.5) autotune --num 2 --den 4,1 --delay 2 --dt 0.002 || echo "FAIL autotune: $(tail -1 err)"
+    check fopdt 2 4 2 ;;
+  fopdt_2) autotune --num 0.5 --den 1,1 --delay 2 --dt 0.002 || echo "FAIL autotune: $(tail -1 err)"
+    check fopdt 0.5 1 2 ;;
+  integrating) autotune --num 0.5 --den 1,0 --delay 1 --dt 0.001 || echo "FAIL autotune: $(tail -1 err)"
+    check ipdt 0.5 0 1 ;;
+  noise)  # measurement noise at 5 % of the relay amplitude (d = 1, K = 1): the hysteresis comes from the hold
+    autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --measurement-noise 0.05 --seed 7 \
+      || echo "FAIL autotune: $(tail -1 err)"
+    # Not yet the 5 % of the clean plants (issue 43 stays open): noise peaks cross the hysteresis band
+    # early, which shortens the measured half periods; Ku is 5 %, Pu 15 % and T, L 12-16 % off here.
+    check fopdt 1 1 0.5 0.2 0.2
+    /usr/bin/python3 -c '
+import json; x = json.load(open("out.json"))["experiment"]
+ok = 0.03 < x["noise_sigma"] < 0.07 and abs(x["hysteresis"] - 3 * x["noise_sigma"]) < 1e-12
+print(("PASS " if ok else "FAIL ") + "the hold measured the noise (sigma %.4g of 0.05) and set the hysteresis to 3 sigma (%.4g)"
+      % (x["noise_sigma"], x["hysteresis"]))' ;;
+  heat_only)  # u in [0, 2], the previous PI holding r = 0.2: the relay's low side is cut to u = 0
+    autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --reference 0.2 --output-limits 0,2 --gains 0.5,0.5,0 \
+      || echo "FAIL autotune: $(tail -1 err)"
+    check fopdt 1 1 0.5
+    /usr/bin/python3 -c '
+import json; x = json.load(open("out.json"))["experiment"]
+ok = abs(x["u0"] - 0.2) < 1e-3 and abs(x["u0"] - x["d_low"]) < 1e-12 and x["d_high"] > x["d_low"]
+print(("PASS " if ok else "FAIL ") + "a heat-only relay: u0 %.6g, low side cut to u = 0 (d_low %.6g), high side %.6g"
+      % (x["u0"], x["d_low"], x["d_high"]))' ;;
+  load_step)  # a load step on the plant input at t = 14.5 s, once the relay has settled (its cycles start at
+    # 10.5, 12.3, 14.1 and 15.8 s without it, converged at 17.6 s): detected, the test restarts from the hold
+    autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --gains 1,1,0 --disturbance step \
+      --disturbance-amplitude 0.3 --disturbance-step-time 14.5 || echo "FAIL autotune: $(tail -1 err)"
+    check fopdt 1 1 0.5
+    /usr/bin/python3 -c '
+import json; x = json.load(open("out.json"))["experiment"]
+ok = x["restarts"] == 1 and len(x["load_changes_s"]) == 1 and 13 < x["load_changes_s"][0] < 16
+print(("PASS " if ok else "FAIL ") + "the load change was detected near t = 14.5 s and the test restarted: %s, %d restart(s)"
+      % (x["load_changes_s"], x["restarts"]))' ;;
+  stepper)  # the nonlinear stepper under a PID: its lightly damped resonance is no FOPDT. The relay
+    # converges; the test then adopts verified gains or ends with one line and keeps the previous ones.
+    "$bin/pidlab" launch --isolated -- "$bin/pidlab" autotune --backend lcm --json --plant stepper_nonlinear \
+      --gains 0.05,0.05,0.05 --dt 1e-4 --hold 1 --relay-amplitude 0.5 --relay-time 2 >out.json 2>err
+    rc=$?
+    /usr/bin/python3 - "$rc" <<'PY'
+import json, sys
+rc = int(sys.argv[1]); r = json.load(open("out.json")); x = r["experiment"]
+err = open("err").read().strip().splitlines()
+ok = x["end"] == "done" and ((rc == 0 and r["adopted"]) or
+     (rc == 1 and not r["adopted"] and r["gains"] == r["previous_gains"] and err[-1].endswith("the previous gains stay")))
+print(("PASS " if ok else "FAIL ") + "the stepper: the relay %s (%s); exit %d, %s" % (x["end"], x["why"], rc, r["verdict"]))
+PY
+    ;;
+  *) echo "FAIL unknown case $case"; exit 1 ;;
+esac

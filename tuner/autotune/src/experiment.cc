@@ -1,0 +1,138 @@
+// The relay experiment over relay episodes (experiment.h).
+
+#include "pidlab/autotune/experiment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+namespace pidlab::autotune {
+namespace {
+
+std::string Num(double v) {
+  std::ostringstream os;
+  os.precision(5);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+bool ExperimentOptions::IsValid(std::string* error) const {
+  std::string e;
+  if (!relay.IsValid(&e)) {
+  } else if (!GainsAreValid(previous, &e)) {
+  } else if (!pid.IsValid(&e)) {
+  } else if (!(first_window_s > 0.0) || !std::isfinite(first_window_s)) {
+    e = "the first relay window " + Num(first_window_s) + " s must be > 0 and finite";
+  } else if (!(max_window_s >= first_window_s) || !std::isfinite(max_window_s)) {
+    e = "the longest relay window " + Num(max_window_s) + " s must be finite and at least the first " +
+        Num(first_window_s) + " s";
+  } else {
+    return true;
+  }
+  if (error) *error = e;
+  return false;
+}
+
+Status ReplayRelay(const RelayTuneOptions& relay, const PidGains& previous, const PidOptions& pid,
+                   const std::vector<RelaySample>& samples, RelayTuner* tuner) {
+  *tuner = RelayTuner(relay, previous, pid);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const RelaySample& s = samples[k];
+    if (!std::isfinite(s.y))
+      return Status::RunnerFailed("the measurement at t = " + Num(s.t_s) +
+                                  " s is not finite: the test stops");
+    const double u = tuner->Step(s.t_s, s.r, s.y);
+    if (std::memcmp(&u, &s.u, sizeof u) != 0)
+      return Status::RunnerFailed("step " + std::to_string(k) + " (t = " + Num(s.t_s) +
+                                  " s): the controller put out " + Num(s.u) + ", the relay gives " + Num(u) +
+                                  ": the controller does not run this relay");
+  }
+  return Status::Ok();
+}
+
+Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner& runner,
+                     ExperimentSummary* summary, const ExperimentProgress& progress) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::InvalidInput(error);
+  const auto say = [&](const std::string& line) {
+    if (progress) progress(line);
+  };
+  ExperimentSummary& out = *summary;
+  out = ExperimentSummary{};
+  double window = options.first_window_s;
+  for (;;) {
+    const double horizon = options.relay.hold_s + window;
+    say("relay episode " + std::to_string(out.episodes + 1) + ": hold " + Num(options.relay.hold_s) +
+        " s, then up to " + Num(window) + " s of relay");
+    std::vector<RelaySample> samples;
+    if (const Status st = runner(options.relay, horizon, &samples); !st.ok()) return st;
+    ++out.episodes;
+    if (samples.empty()) return Status::RunnerFailed("the relay episode gave no steps");
+    RelayTuner tuner(options.relay, options.previous, options.pid);
+    if (const Status st = ReplayRelay(options.relay, options.previous, options.pid, samples, &tuner);
+        !st.ok())
+      return st;
+    out.end = tuner.phase();
+    out.why = tuner.why();
+    out.u0 = tuner.u0();
+    out.y0 = tuner.y0();
+    out.noise_sigma = tuner.noise_sigma();
+    out.hysteresis = tuner.hysteresis();
+    out.d_high = tuner.d_high();
+    out.d_low = tuner.d_low();
+    out.relay_start_s = tuner.relay_start_s();
+    out.end_s = tuner.end_s();
+    out.horizon_s = samples.back().t_s;
+    out.restarts = tuner.restarts();
+    out.load_changes_s = tuner.load_changes_s();
+    out.cycles = tuner.cycles();
+    out.samples = std::move(samples);
+    const double dt = out.samples.size() > 1 ? out.samples[1].t_s - out.samples[0].t_s : 0.0;
+    say("  " + std::string(ToString(out.end)) + ": u0 " + Num(out.u0) + ", y0 " + Num(out.y0) +
+        ", noise sigma " + Num(out.noise_sigma) + ", hysteresis " + Num(out.hysteresis) + ", " +
+        std::to_string(out.cycles.size()) + " cycles" +
+        (out.cycles.empty() ? std::string() : ", last period " + Num(out.cycles.back().period_s()) + " s") +
+        (out.why.empty() ? std::string() : ": " + out.why));
+    if (out.end == RelayPhase::kDone || out.end == RelayPhase::kAborted) break;
+    if (window >= options.max_window_s) {
+      out.why = "the relay ran " + Num(window) + " s (the longest window, --max-time) without " +
+                (out.cycles.empty() ? std::string("a single cycle: the process did not oscillate")
+                                    : "converging (" + std::to_string(out.cycles.size()) + " cycles)");
+      break;
+    }
+    double next = 2.0 * window;
+    if (!out.cycles.empty()) {  // the timeout the last period sets, and a little more
+      const double needed = options.relay.timeout_periods * out.cycles.back().period_s() + 2.0 * dt + 1e-9;
+      if (needed > window) next = needed;
+    }
+    if (out.end == RelayPhase::kHold) next = 2.0 * window;  // a restart's hold at the end
+    window = std::min(next, options.max_window_s);
+  }
+  out.relay.setpoint = out.y0;
+  out.relay.u0 = out.u0;
+  out.relay.d_high = out.d_high > 0.0 ? out.d_high : 1.0;
+  out.relay.d_low = out.d_low > 0.0 ? out.d_low : 1.0;
+  out.relay.hysteresis = out.hysteresis;
+  out.relay.settled_cycles = options.relay.settled_cycles;
+  out.relay.tolerance = options.relay.tolerance;
+  if (out.end == RelayPhase::kDone) {
+    // Under noise every settled cycle after the approach is averaged.
+    RelayOptions averaged = out.relay;
+    if (3.0 * out.noise_sigma > 0.01 * out.cycles.back().amplitude())
+      averaged.settled_cycles = std::max(averaged.settled_cycles, static_cast<int>(out.cycles.size()) - 1);
+    out.estimates = EstimateFromCycles(averaged, out.cycles, true, out.noise_sigma);
+    if (out.estimates.model_found)
+      say("  estimates: period " + Num(out.estimates.period_s) + " +- " + Num(out.estimates.period_ci_s) +
+          " s, Ku " + Num(out.estimates.ku) + " (describing function " +
+          Num(out.estimates.ku_describing_function) + "), model K " + Num(out.estimates.model.gain) +
+          (out.estimates.model.integrating ? std::string()
+                                           : ", T " + Num(out.estimates.model.time_constant_s) + " s") +
+          ", L " + Num(out.estimates.model.delay_s) + " s");
+  }
+  return Status::Ok();
+}
+
+}  // namespace pidlab::autotune
