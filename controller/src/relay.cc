@@ -175,6 +175,7 @@ double RelayTuner::RelayStep(double t_s, double r, double y) {
         c.e_max = e_max_;
         c.e_min = e_min_;
         c.integral_e = integral_;
+        c.integral_on_e = integral_on_;
       }
       high_ = true;
       t_high_ = t_s;
@@ -186,7 +187,10 @@ double RelayTuner::RelayStep(double t_s, double r, double y) {
       if (phase_ != RelayPhase::kRelay) return After(r, y);
     } else if (high_ && e > eps_) {
       high_ = false;
-      if (t_high_ >= 0.0) t_low_ = t_s;
+      if (t_high_ >= 0.0) {
+        t_low_ = t_s;
+        integral_on_ = integral_;
+      }
     }
     if (!cycles_.empty() && t_s - relay_start_s_ > o_.timeout_periods * cycles_.back().period_s()) {
       End(RelayPhase::kAborted, t_s,
@@ -241,7 +245,10 @@ void RelayTuner::OnCycle(const RelayCycle& c, double t_s) {
     changes_.push_back(0.0);
   }
   cycles_.push_back(c);
-  const int n = o_.settled_cycles;
+  // Under noise the estimates average more cycles: a noisy cycle does not
+  // start where the last one did, and only a sum over many telescopes that out.
+  const int n = 3.0 * sigma_ > 0.01 * c.amplitude() ? std::max(o_.settled_cycles, kNoisySettledCycles)
+                                                    : o_.settled_cycles;
   if (static_cast<int>(cycles_.size()) < n + 1) return;  // the first cycle is the approach
   double period = 0.0, amplitude = 0.0;
   for (int i = 0; i < n; ++i) {

@@ -75,9 +75,7 @@ case $case in
   noise)  # measurement noise at 5 % of the relay amplitude (d = 1, K = 1): the hysteresis comes from the hold
     autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --measurement-noise 0.05 --seed 7 \
       || echo "FAIL autotune: $(tail -1 err)"
-    # Not yet the 5 % of the clean plants (issue 43 stays open): noise peaks cross the hysteresis band
-    # early, which shortens the measured half periods; Ku is 5 %, Pu 15 % and T, L 12-16 % off here.
-    check fopdt 1 1 0.5 0.2 0.2
+    check fopdt 1 1 0.5
     /usr/bin/python3 -c '
 import json; x = json.load(open("out.json"))["experiment"]
 ok = 0.03 < x["noise_sigma"] < 0.07 and abs(x["hysteresis"] - 3 * x["noise_sigma"]) < 1e-12

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace pidlab::autotune {
@@ -80,6 +81,7 @@ double RelayExperiment::Step(double t_s, double y) {
         c.e_max = e_max_;
         c.e_min = e_min_;
         c.integral_e = integral_;
+        c.integral_on_e = integral_on_;
         cycles_.push_back(c);
       }
       high_ = true;
@@ -89,7 +91,10 @@ double RelayExperiment::Step(double t_s, double y) {
       e_max_ = e_min_ = e;
     } else if (high_ && e > o_.hysteresis) {
       high_ = false;
-      if (t_high_ >= 0.0) t_low_ = t_s;
+      if (t_high_ >= 0.0) {
+        t_low_ = t_s;
+        integral_on_ = integral_;
+      }
     }
   }
   t_prev_ = t_s;
@@ -139,6 +144,7 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
     mean.e_max += c.e_max / n;
     mean.e_min += c.e_min / n;
     mean.integral_e += c.integral_e / n;
+    mean.integral_on_e += c.integral_on_e / n;
   }
   MeanInterval(periods, &r.period_s, &r.period_ci_s);
   MeanInterval(amplitudes, &r.amplitude, &r.amplitude_ci);
@@ -154,7 +160,7 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
     r.model_from = "extremes";
   } else if (3.0 * noise_sigma > 0.01 * r.amplitude) {
     fitted = FopdtFromTimes(o, mean, &r.model);
-    r.model_from = "switching times";
+    r.model_from = "switching times and integrals";
   } else {
     fitted = FopdtFromCycle(o, mean, &r.model);
     r.model_from = "extremes";
@@ -172,24 +178,15 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
   return r;
 }
 
-Status FopdtFromTimes(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
-  std::string error;
-  if (!o.IsValid(&error)) return Status::InvalidInput(error);
-  const double eps = o.hysteresis, dh = o.d_high, dl = o.d_low;
-  const double mean_v = dh * c.t_on_s - dl * c.t_off_s;
-  if (!(std::abs(mean_v) > 1e-6 * (dh * c.t_on_s + dl * c.t_off_s)))
-    return Status::InvalidInput(
-        "the relay's mean output over a cycle is zero (a symmetric relay, or an integrating process): a "
-        "first-order process's gain cannot be identified; make d_low differ from d_high");
-  const double k = c.integral_e / mean_v;
-  if (!(k > 0.0) || !std::isfinite(k))
-    return Status::InvalidInput("the identified gain " + Number(k) +
-                                " is not positive (the relay is reverse acting: a process of positive gain)");
+namespace {
+
+// tau = L/T and T of K e^(-sL)/(Ts + 1) from a cycle's half periods under a
+// relay d_high, d_low switching at e = -eps (to high) and +eps (to low):
+// t_on = T g_on(tau), t_off = T g_off(tau), E = e^(-tau). False if no tau fits.
+bool TauFromHalfPeriods(double k, double eps, double dh, double dl, double t_on, double t_off,
+                        double* tau_out, double* t_out) {
   const double kh = k * dh, kl = k * dl;
-  if (!(kh > eps) || !(kl > eps))
-    return Status::InvalidInput("the hysteresis " + Number(eps) + " is not below K d_high and K d_low (" +
-                                Number(kh) + ", " + Number(kl) + ")");
-  // t_on = T g_on(tau), t_off = T g_off(tau), E = e^(-tau).
+  if (!(kh > eps) || !(kl > eps) || !(kh + kl - (kl - eps) > 0.0)) return false;
   const auto g_on = [&](double tau) {
     const double e = std::exp(-tau);
     return tau + std::log((kh + kl - (kl - eps) * e) / (kh - eps));
@@ -199,21 +196,96 @@ Status FopdtFromTimes(const RelayOptions& o, const RelayCycle& c, FopdtModel* mo
     return tau + std::log((kh + kl - (kh - eps) * e) / (kl - eps));
   };
   // f(tau) = t_on g_off - t_off g_on changes sign once on (0, inf).
-  const auto f = [&](double tau) { return c.t_on_s * g_off(tau) - c.t_off_s * g_on(tau); };
+  const auto f = [&](double tau) { return t_on * g_off(tau) - t_off * g_on(tau); };
   double lo = 1e-9, hi = 1.0;
   const double f_lo = f(lo);
   while (hi < 1e3 && (f(hi) > 0.0) == (f_lo > 0.0)) hi *= 2.0;
-  if ((f(hi) > 0.0) == (f_lo > 0.0))
-    return Status::InvalidInput("the half periods " + Number(c.t_on_s) + " s and " + Number(c.t_off_s) +
-                                " s fit no first order plus dead time under this relay");
+  if ((f(hi) > 0.0) == (f_lo > 0.0) || !std::isfinite(f_lo)) return false;
   for (int i = 0; i < 200 && hi - lo > 1e-14 * hi; ++i) {
     const double mid = 0.5 * (lo + hi);
     ((f(mid) > 0.0) == (f_lo > 0.0) ? lo : hi) = mid;
   }
   const double tau = 0.5 * (lo + hi);
-  const double t = 0.5 * (c.t_on_s / g_on(tau) + c.t_off_s / g_off(tau));
-  if (!(t > 0.0) || !std::isfinite(t))
-    return Status::InvalidInput("the cycle's half periods give a time constant " + Number(t) + " s");
+  const double t = 0.5 * (t_on / g_on(tau) + t_off / g_off(tau));
+  if (!(t > 0.0) || !std::isfinite(t)) return false;
+  *tau_out = tau;
+  *t_out = t;
+  return true;
+}
+
+// The integral of e over the part at +d_high (from e = -eps, the input low
+// for L more, then high until t_on).
+double OnIntegral(double k, double t, double l, double eps, double dh, double dl, double t_on) {
+  const double big_e = std::exp(-l / t);
+  const double e_min = -k * dl + (k * dl - eps) * big_e;
+  const double before = -k * dl * l + (k * dl - eps) * t * (1.0 - big_e);
+  const double d = t_on - l;
+  return before + k * dh * d + (e_min - k * dh) * t * (1.0 - std::exp(-d / t));
+}
+
+}  // namespace
+
+Status FopdtFromTimes(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
+  std::string error;
+  if (!o.IsValid(&error)) return Status::InvalidInput(error);
+  const double dh = o.d_high, dl = o.d_low;
+  const double mean_v = dh * c.t_on_s - dl * c.t_off_s;
+  if (!(std::abs(mean_v) > 1e-6 * (dh * c.t_on_s + dl * c.t_off_s)))
+    return Status::InvalidInput(
+        "the relay's mean output over a cycle is zero (a symmetric relay, or an integrating process): a "
+        "first-order process's gain cannot be identified; make d_low differ from d_high");
+  const double k = c.integral_e / mean_v;
+  if (!(k > 0.0) || !std::isfinite(k))
+    return Status::InvalidInput("the identified gain " + Number(k) +
+                                " is not positive (the relay is reverse acting: a process of positive gain)");
+  // The level eps_eff the relay really switched at: noise on y crosses the
+  // band before the process does, so eps_eff < eps. It is the one whose
+  // model gives the measured integral over the part at +d_high.
+  const double top = 0.99 * k * std::min(dh, dl);
+  const auto mismatch = [&](double eps, double* tau, double* t) {
+    if (!TauFromHalfPeriods(k, eps, dh, dl, c.t_on_s, c.t_off_s, tau, t))
+      return std::numeric_limits<double>::quiet_NaN();
+    return OnIntegral(k, *t, *t * *tau, eps, dh, dl, c.t_on_s) - c.integral_on_e;
+  };
+  double tau = 0.0, t = 0.0;
+  const int kGrid = 200;
+  double a = std::numeric_limits<double>::quiet_NaN(), fa = a, b = a, fb = a;
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 0; i + 1 < kGrid; ++i) {  // on [0, top]: the sign change nearest the nominal hysteresis
+    const double e0 = top * i / (kGrid - 1), e1 = top * (i + 1) / (kGrid - 1);
+    const double f0 = mismatch(e0, &tau, &t), f1 = mismatch(e1, &tau, &t);
+    if (!std::isfinite(f0) || !std::isfinite(f1) || (f0 > 0.0) == (f1 > 0.0)) continue;
+    const double distance = std::abs(0.5 * (e0 + e1) - o.hysteresis);
+    if (distance < best) {
+      best = distance;
+      a = e0, fa = f0, b = e1, fb = f1;
+    }
+  }
+  if (!std::isfinite(best)) {  // no level fits the integral: the nominal hysteresis
+    if (!TauFromHalfPeriods(k, o.hysteresis, dh, dl, c.t_on_s, c.t_off_s, &tau, &t))
+      return Status::InvalidInput("the half periods " + Number(c.t_on_s) + " s and " + Number(c.t_off_s) +
+                                  " s fit no first order plus dead time under this relay");
+    model->gain = k;
+    model->time_constant_s = t;
+    model->delay_s = t * tau;
+    model->integrating = false;
+    return Status::Ok();
+  }
+  for (int i = 0; i < 200 && b - a > 1e-14 * std::max(1.0, std::abs(a)); ++i) {
+    const double m = 0.5 * (a + b);
+    const double fm = mismatch(m, &tau, &t);
+    if (!std::isfinite(fm)) break;
+    if ((fm > 0.0) == (fa > 0.0)) {
+      a = m;
+      fa = fm;
+    } else {
+      b = m;
+      fb = fm;
+    }
+  }
+  (void)fb;
+  if (!std::isfinite(mismatch(0.5 * (a + b), &tau, &t)))
+    return Status::InvalidInput("the half periods give no time constant");
   model->gain = k;
   model->time_constant_s = t;
   model->delay_s = t * tau;
@@ -223,12 +295,26 @@ Status FopdtFromTimes(const RelayOptions& o, const RelayCycle& c, FopdtModel* mo
 
 Status FopdtUltimate(const FopdtModel& m, double* ku, double* pu_s) {
   if (m.integrating) {
-    if (!(m.gain != 0.0) || !std::isfinite(m.gain) || !(m.delay_s > 0.0) || !std::isfinite(m.delay_s))
-      return Status::InvalidInput("an integrating model needs a gain != 0 and L > 0 (K " + Number(m.gain) +
-                                  ", L " + Number(m.delay_s) + " s)");
-    const double w = kPi / (2.0 * m.delay_s);
-    *ku = w / std::abs(m.gain);
-    *pu_s = 4.0 * m.delay_s;
+    if (!(m.gain != 0.0) || !std::isfinite(m.gain) || !(m.delay_s > 0.0) || !std::isfinite(m.delay_s) ||
+        !(m.time_constant_s >= 0.0) || !std::isfinite(m.time_constant_s))
+      return Status::InvalidInput("an integrating model needs a gain != 0, T >= 0 and L > 0 (K " +
+                                  Number(m.gain) + ", T " + Number(m.time_constant_s) + " s, L " +
+                                  Number(m.delay_s) + " s)");
+    if (m.time_constant_s == 0.0) {
+      const double w = kPi / (2.0 * m.delay_s);
+      *ku = w / std::abs(m.gain);
+      *pu_s = 4.0 * m.delay_s;
+      return Status::Ok();
+    }
+    // K e^(-sL) / (s (Ts + 1)): atan(wT) + wL = pi / 2.
+    double lo = 0.0, hi = kPi / (2.0 * m.delay_s);
+    for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+      const double w = 0.5 * (lo + hi);
+      (std::atan(w * m.time_constant_s) + w * m.delay_s < 0.5 * kPi ? lo : hi) = w;
+    }
+    const double w = 0.5 * (lo + hi);
+    *ku = w * std::sqrt(1.0 + w * m.time_constant_s * (w * m.time_constant_s)) / std::abs(m.gain);
+    *pu_s = 2.0 * kPi / w;
     return Status::Ok();
   }
   if (!(m.gain != 0.0) || !std::isfinite(m.gain) || !(m.time_constant_s >= 0.0) || !(m.delay_s > 0.0) ||

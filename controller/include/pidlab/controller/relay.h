@@ -17,7 +17,8 @@
 //          output range (a heat-only actuator gets a one-sided relay). A cycle
 //          runs from one switch to high to the next; the first is the
 //          approach. It ends:
-//            done     the last settled_cycles cycles' periods and amplitudes
+//            done     the last settled_cycles (under noise at least
+//                     kNoisySettledCycles) cycles' periods and amplitudes
 //                     lie within tolerance + 2 sigma / amplitude (relative:
 //                     a noisy y's extremes and switches jitter) of their mean;
 //            aborted  |y - y0| > y_limit; or no convergence within timeout_periods
@@ -39,6 +40,10 @@
 #include "pidlab/controller/pid.h"
 
 namespace pidlab {
+
+/// Under noise (3 sigma above 1 % of a cycle's amplitude) the relay runs at
+/// least this many settled cycles.
+inline constexpr int kNoisySettledCycles = 10;
 
 struct RelayTuneOptions {
   double hold_s = 10.0;         ///< the hold before the relay, s, >= 0
@@ -66,6 +71,7 @@ struct RelayCycle {
   double t_on_s = 0.0, t_off_s = 0.0;  ///< time at +d_high, at -d_low
   double e_max = 0.0, e_min = 0.0;     ///< extremes of e = y - r
   double integral_e = 0.0;             ///< of e over the cycle (trapezoids)
+  double integral_on_e = 0.0;          ///< of e over its first part, at +d_high
   double period_s() const { return t_on_s + t_off_s; }
   double amplitude() const { return 0.5 * (e_max - e_min); }
 };
@@ -126,7 +132,7 @@ class RelayTuner {
   bool high_ = false;
   double t_prev_ = 0.0, e_prev_ = 0.0;
   double t_high_ = -1.0, t_low_ = -1.0;
-  double e_max_ = 0.0, e_min_ = 0.0, integral_ = 0.0;
+  double e_max_ = 0.0, e_min_ = 0.0, integral_ = 0.0, integral_on_ = 0.0;
   std::vector<RelayCycle> cycles_;
   std::vector<double> changes_;  // each cycle's change from the one before
   int restarts_ = 0;

@@ -42,7 +42,8 @@ struct RelayOptions {
 using pidlab::RelayCycle;  // controller/relay.h
 
 /// A first-order plus dead-time model K e^(-sL)/(Ts + 1); an integrating
-/// one, K e^(-sL)/s, when `integrating` (time_constant_s unused).
+/// one, K e^(-sL)/(s (Ts + 1)), when `integrating` (T = 0 from the closed
+/// forms: K e^(-sL)/s).
 struct FopdtModel {
   double gain = 0.0, time_constant_s = 0.0, delay_s = 0.0;
   bool integrating = false;
@@ -67,8 +68,9 @@ struct RelayEstimates {
   double ku = 0.0;      ///< the model's ultimate gain (its phase crossover)
   double pu_s = 0.0;    ///< the model's ultimate period
   /// How the FOPDT model was found: "extremes" (the cycle's extremes and
-  /// integral, exact without noise) or "switching times" (its half periods
-  /// and integral, FopdtFromTimes: the extremes of a noisy y are biased).
+  /// integral, exact without noise) or "switching times and integrals" (its
+  /// half periods and integrals, FopdtFromTimes: the extremes of a noisy y are
+  /// biased).
   std::string model_from;
   std::string message;  ///< why something was not found
 };
@@ -90,7 +92,7 @@ class RelayExperiment {
   bool started_ = false, high_ = false;
   double t_prev_ = 0.0, e_prev_ = 0.0;
   double t_high_ = -1.0, t_low_ = -1.0;  // the current cycle's switches (-1: none yet)
-  double e_max_ = 0.0, e_min_ = 0.0, integral_ = 0.0;
+  double e_max_ = 0.0, e_min_ = 0.0, integral_ = 0.0, integral_on_ = 0.0;
   std::vector<RelayCycle> cycles_;
 };
 
@@ -101,14 +103,19 @@ class RelayExperiment {
 RelayEstimates EstimateFromCycles(const RelayOptions& options, const std::vector<RelayCycle>& cycles,
                                   bool converged, double noise_sigma);
 
-/// K, T and L from a cycle's mean t_on, t_off and integral of e alone (not
-/// its extremes): K from the integral, then tau = L/T from t_on / t_off,
-/// which runs from d_low/d_high (tau -> 0) to 1 (tau -> inf), by bisection.
+/// K, T and L from a cycle's mean t_on, t_off, integral of e and integral
+/// over the part at +d_high, not its extremes: K from the integral; then,
+/// for a switching level eps_eff (noise on y crosses the band early, so the
+/// relay switches where the process is short of eps), tau = L/T from
+/// t_on / t_off by bisection and T from t_on; eps_eff is the one (nearest
+/// the hysteresis) whose model gives the measured integral over the part at
+/// +d_high. Integrals average the noise out; extremes do not.
 Status FopdtFromTimes(const RelayOptions& options, const RelayCycle& cycle, FopdtModel* model);
 
 /// The ultimate gain and period of K e^(-sL)/(Ts + 1): the phase crossover
 /// w (atan(wT) + wL = pi), Ku = sqrt(1 + (wT)^2) / |K|, Pu = 2 pi / w; of
-/// K e^(-sL)/s: w = pi / (2L), Ku = w / |K|, Pu = 4L.
+/// K e^(-sL)/(s (Ts + 1)): atan(wT) + wL = pi / 2, Ku = w sqrt(1 + (wT)^2) / |K|
+/// (T = 0: w = pi / (2L), Ku = w / |K|, Pu = 4L).
 Status FopdtUltimate(const FopdtModel& model, double* ku, double* pu_s);
 
 /// K and L of K e^(-sL)/s from a limit cycle (RelayCycle means): the process
