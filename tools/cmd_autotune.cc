@@ -14,6 +14,8 @@
 #include "commands.h"
 #include "pidlab/autotune/experiment.h"
 #include "pidlab/episode_client/episode_client.h"
+#include "pidlab/replay/log_reader.h"
+#include "pidlab/replay/replay.h"
 #include "pidlab/results/spec_run.h"
 #include "pidlab/results/tune_run.h"
 #include "pidlab/tune/problem.h"
@@ -42,6 +44,10 @@ struct AutotuneCommand {
   std::string backend = "lcm";
   LcmFlags lcm;
   RelayTuneOptions relay;
+  std::string log_path;
+  int64_t episode_id = 0;
+  const replay::LogContents* log_ = nullptr;  // --log: the log read
+  std::size_t log_index_ = 0;                 // its relay episode
   double amplitude = 0.0;  // 0: from the output range
   std::string bias_text;   // "": amplitude / 3
   double hysteresis = -1.0;
@@ -108,12 +114,17 @@ struct AutotuneCommand {
     app->add_option("--max-overshoot", max_overshoot_pct,
                     "adopt only gains whose step on the trio overshoots at most this, %")
         ->capture_default_str();
+    app->add_option("--log", log_path,
+                    "recompute from a log instead (pidlab launch --log): its relay episode's record analysed "
+                    "again, the design, and the logged verification step; no trio is needed");
+    app->add_option("--episode", episode_id, "--log: this relay episode (default: the last one)");
     app->add_flag("--json", json_out, "print one JSON object (experiment, estimates, design, verification)");
     lcm.Register(app);
     return [this] { return Run(); };
   }
 
   int Run() {
+    if (!log_path.empty()) return RunFromLog();
     spec::EvaluateSpec s;
     s.gains = {0.0, 0.0, 0.0};
     s.bounds.max_ms = 2.0;
@@ -170,9 +181,58 @@ struct AutotuneCommand {
     };
     ExperimentSummary x;
     Require(autotune::RunExperiment(xo, runner, &x, say));
+    std::vector<int64_t> ids = client->stats().episode_ids;
+    return Finish(x, previous, s, given, loop, client.get(), ids, say);
+  }
 
+  // From a log: its relay episode's record analysed again, the design, the
+  // logged verification step.
+  int RunFromLog() {
+    replay::LogContents contents;
+    if (const Status st = replay::ReadLog(log_path, replay::ReadOptions{}, &contents); !st.ok())
+      throw BadInput("--log " + Quote(log_path) + ": " + st.message());
+    long index = -1;
+    for (std::size_t i = 0; i < contents.episodes.size(); ++i) {
+      const replay::Episode& e = contents.episodes[i];
+      if (e.has_config && e.spec.relay && (episode_id == 0 || e.episode_id == episode_id))
+        index = static_cast<long>(i);
+    }
+    if (index < 0)
+      throw BadInput("--log " + Quote(log_path) + ": " +
+                     (episode_id == 0 ? std::string("no relay episode in it")
+                                      : "no relay episode " + std::to_string(episode_id) + " in it"));
+    const replay::Episode& e = contents.episodes[static_cast<std::size_t>(index)];
+    if (!e.Complete())
+      throw std::runtime_error("relay episode " + std::to_string(e.episode_id) +
+                               " is incomplete in the log: " + e.CompletenessNote());
+    ExperimentOptions xo;
+    xo.relay = e.spec.relay_tune;
+    xo.previous = e.spec.gains;
+    xo.pid = PidOptionsAt(e.spec.pid, e.spec.dt_s);
+    std::vector<RelaySample> samples;
+    for (long k = 0; k < e.total_steps; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      samples.push_back({static_cast<double>(k) * e.spec.dt_s, e.spec.reference, e.y[i], e.u[i]});
+    }
+    const auto say = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+    ExperimentSummary x;
+    Require(autotune::AnalyzeRelayRecord(xo, std::move(samples), &x));
+    x.episodes = 1;
+    autotune::EstimateFromRecord(xo, &x, say);
+    log_ = &contents;
+    log_index_ = static_cast<std::size_t>(index);
+    spec::EvaluateSpec s;
+    const LoopOptions loop = episode_client::SampledLoopOptions(e.spec);
+    return Finish(x, e.spec.gains, s, {}, loop, nullptr, {e.episode_id}, say);
+  }
+
+  template <typename Say>
+  int Finish(const ExperimentSummary& x, const PidGains& previous, const spec::EvaluateSpec& s,
+             const std::set<std::string>& given, const LoopOptions& loop, EpisodeClient* client,
+             const std::vector<int64_t>& episode_ids, const Say& say) {
     json out;
-    out["backend"] = "lcm";
+    out["backend"] = log_ ? "log" : "lcm";
+    if (log_) out["log"] = log_path;
     out["previous_gains"] = ToJson(previous);
     out["experiment"] = ExperimentJson(x);
     out["estimates"] = EstimatesJson(x);
@@ -184,14 +244,12 @@ struct AutotuneCommand {
     } else if (!x.estimates.model_found) {
       verdict = "no model from the cycles: " + x.estimates.message;
     } else {
-      ok = DesignAndVerify(s, given, loop, x, client.get(), say, &out, &adopted, &verdict);
+      ok = DesignAndVerify(s, given, loop, x, client, say, &out, &adopted, &verdict);
     }
     out["adopted"] = ok;
     out["verdict"] = verdict;
     out["gains"] = ToJson(adopted);
-    json ids = json::array();
-    for (const int64_t id : client->stats().episode_ids) ids.push_back(id);
-    out["episode_ids"] = ids;
+    out["episode_ids"] = episode_ids;
     if (json_out) {
       std::cout << out.dump(2) << "\n";
     } else {
@@ -316,24 +374,49 @@ struct AutotuneCommand {
     build.given = keys;
     tune::EvaluationProblem problem;
     Status st = tune::BuildEvaluation(s, build, &problem);
-    if (!st.ok()) {
+    if (!st.ok() && !log_) {
       *verdict = "the verification step does not build: " + st.message();
       return false;
     }
-    tune::EvaluationRunOptions run;
-    run.monte_carlo = false;
-    run.runner = [client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
-                          const DisturbanceOptions& d, std::vector<double>* y,
-                          std::vector<SampledStep>* tr) { return client->Run(pl, ga, lo, d, y, tr); };
-    say("verification: a closed-loop step on the trio, " + std::to_string(s.loop.horizon_s) + " s");
-    tune::EvaluationResult result;
-    st = tune::RunEvaluation(problem, run, &result);
-    if (!st.ok()) {
-      *verdict = "the verification step failed: " + st.message();
-      return false;
+    evaluation::Evaluation ev;
+    json v;
+    if (log_) {
+      // From the log: the first episode after the relay's that ran these gains.
+      const replay::Episode* step = nullptr;
+      for (std::size_t i = log_index_ + 1; i < log_->episodes.size() && !step; ++i) {
+        const replay::Episode& e = log_->episodes[i];
+        if (e.has_config && !e.spec.relay && e.spec.gains.kp == gains.kp && e.spec.gains.ki == gains.ki &&
+            e.spec.gains.kd == gains.kd)
+          step = &e;
+      }
+      if (!step) {
+        *verdict = "the log holds no verification step with these gains after the relay episode";
+        return false;
+      }
+      st = replay::EvaluateEpisode(*step, &ev);
+      if (!st.ok()) {
+        *verdict = "the logged verification step cannot be evaluated: " + st.message();
+        return false;
+      }
+      s.loop.horizon_s = step->spec.horizon_s;
+      v = ToJson(ev);
+      v["episode_id"] = step->episode_id;
+    } else {
+      tune::EvaluationRunOptions run;
+      run.monte_carlo = false;
+      run.runner = [client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
+                            const DisturbanceOptions& d, std::vector<double>* y,
+                            std::vector<SampledStep>* tr) { return client->Run(pl, ga, lo, d, y, tr); };
+      say("verification: a closed-loop step on the trio, " + std::to_string(s.loop.horizon_s) + " s");
+      tune::EvaluationResult result;
+      st = tune::RunEvaluation(problem, run, &result);
+      if (!st.ok()) {
+        *verdict = "the verification step failed: " + st.message();
+        return false;
+      }
+      ev = result.evaluation;
+      v = results::EvaluationJson(problem, result, "lcm");
     }
-    const evaluation::Evaluation& ev = result.evaluation;
-    json v = results::EvaluationJson(problem, result, "lcm");
     const double overshoot = ev.step.overshoot_pct;
     const double settling = ev.step.settling_time_s;
     const bool settled = std::isfinite(ev.iae) && std::isfinite(settling) && settling < s.loop.horizon_s;

@@ -1,13 +1,16 @@
 #include "pidlab/replay/replay.h"
 
+#include <cmath>
 #include <cstring>
 #include <iomanip>
 #include <lcm/lcm-cpp.hpp>
+#include <memory>
 #include <pidlab/lcmt_control_command.hpp>
 #include <pidlab/lcmt_plant_output.hpp>
 #include <sstream>
 #include <stdexcept>
 
+#include "pidlab/controller/relay.h"
 #include "pidlab/episode_client/episode_client.h"
 #include "pidlab/transport/episode_start.h"
 
@@ -71,6 +74,10 @@ RedriveResult Redrive(const Episode& e) {
   PidOptions pid = e.spec.pid;
   pid = PidOptionsAt(pid, e.spec.dt_s);
   DiscretePid<double> dut(e.spec.gains, pid);
+  // A relay episode (docs/autotune.md): the controller's RelayTuner, stepped
+  // at the times the plant published, t_k = k dt.
+  std::unique_ptr<RelayTuner> relay;
+  if (e.spec.relay) relay = std::make_unique<RelayTuner>(e.spec.relay_tune, e.spec.gains, pid);
   for (long k = 0; k < e.total_steps; ++k) {
     if (!e.has_y[k] || !e.has_u[k]) {
       r.message = "cannot re-drive past step " + std::to_string(k) + ": the log has no " +
@@ -78,7 +85,11 @@ RedriveResult Redrive(const Episode& e) {
       return r;
     }
     double u = 0.0;
-    dut.Step(e.spec.reference, e.y[k], &u);
+    if (relay)
+      u = std::isfinite(e.y[k]) ? relay->Step(static_cast<double>(k) * e.spec.dt_s, e.spec.reference, e.y[k])
+                                : 0.0;
+    else
+      dut.Step(e.spec.reference, e.y[k], &u);
     ++r.steps_checked;
     if (!SameBits(u, e.u[k])) {
       r.first_mismatch = k;

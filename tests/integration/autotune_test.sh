@@ -114,5 +114,27 @@ ok = x["end"] == "done" and ((rc == 0 and r["adopted"]) or
 print(("PASS " if ok else "FAIL ") + "the stepper: the relay %s (%s); exit %d, %s" % (x["end"], x["why"], rc, r["verdict"]))
 PY
     ;;
+  log)  # logged, then recomputed from the log alone; the relay's commands re-driven bit for bit
+    "$bin/pidlab" launch --isolated --log run.lcmlog -- "$bin/pidlab" autotune --backend lcm --num 1 --den 1,1 \
+      --delay 0.5 --dt 0.001 --gains 1,1,0 --json >live.json 2>err || echo "FAIL autotune: $(tail -1 err)"
+    "$bin/pidlab" autotune --log run.lcmlog --json >fromlog.json 2>err || echo "FAIL autotune --log: $(tail -1 err)"
+    /usr/bin/python3 - <<'PY'
+import json
+a, b = json.load(open("live.json")), json.load(open("fromlog.json"))
+same = [k for k in ("experiment", "estimates", "design", "gains", "adopted", "verdict", "previous_gains") if a[k] == b[k]]
+ok = len(same) == 7 and a["adopted"] and b["backend"] == "log"
+print(("PASS " if ok else "FAIL ") + "the log alone gives the same experiment, estimates, design and gains: %s" % same)
+va, vb = a["verification"], b["verification"]
+ok = all(va[k] == vb[k] for k in ("iae", "overshoot_pct", "settling_time_s", "settled"))
+print(("PASS " if ok else "FAIL ") + "and the logged verification step the same IAE %r" % vb["iae"])
+PY
+    "$bin/pidlab" replay run.lcmlog --redrive >replay.txt 2>&1 || echo "FAIL replay --redrive: $(tail -1 replay.txt)"
+    if [ "$(grep -c 'redrive: OK' replay.txt)" = 2 ]; then
+      pass_line="PASS replay --redrive reproduces the relay episode's and the step's commands bit for bit"
+      echo "$pass_line"
+    else echo "FAIL replay --redrive: $(grep redrive replay.txt)"; fi
+    "$bin/pidlab" autotune --log run.lcmlog --episode 42 >/dev/null 2>err; rc=$?
+    if [ $rc = 2 ] && grep -q "no relay episode 42" err; then echo "PASS --episode naming no relay episode: exit 2, one line"
+    else echo "FAIL --episode 42: exit $rc, $(cat err)"; fi ;;
   *) echo "FAIL unknown case $case"; exit 1 ;;
 esac

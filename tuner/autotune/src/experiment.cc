@@ -53,64 +53,37 @@ Status ReplayRelay(const RelayTuneOptions& relay, const PidGains& previous, cons
   return Status::Ok();
 }
 
-Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner& runner,
-                     ExperimentSummary* summary, const ExperimentProgress& progress) {
-  std::string error;
-  if (!options.IsValid(&error)) return Status::InvalidInput(error);
+Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySample> samples,
+                          ExperimentSummary* summary) {
+  ExperimentSummary& out = *summary;
+  if (samples.empty()) return Status::RunnerFailed("the relay episode gave no steps");
+  RelayTuner tuner(options.relay, options.previous, options.pid);
+  if (const Status st = ReplayRelay(options.relay, options.previous, options.pid, samples, &tuner); !st.ok())
+    return st;
+  out.end = tuner.phase();
+  out.why = tuner.why();
+  out.u0 = tuner.u0();
+  out.y0 = tuner.y0();
+  out.noise_sigma = tuner.noise_sigma();
+  out.hysteresis = tuner.hysteresis();
+  out.d_high = tuner.d_high();
+  out.d_low = tuner.d_low();
+  out.relay_start_s = tuner.relay_start_s();
+  out.end_s = tuner.end_s();
+  out.horizon_s = samples.back().t_s;
+  out.restarts = tuner.restarts();
+  out.load_changes_s = tuner.load_changes_s();
+  out.cycles = tuner.cycles();
+  out.samples = std::move(samples);
+  return Status::Ok();
+}
+
+void EstimateFromRecord(const ExperimentOptions& options, ExperimentSummary* summary,
+                        const ExperimentProgress& progress) {
+  ExperimentSummary& out = *summary;
   const auto say = [&](const std::string& line) {
     if (progress) progress(line);
   };
-  ExperimentSummary& out = *summary;
-  out = ExperimentSummary{};
-  double window = options.first_window_s;
-  for (;;) {
-    const double horizon = options.relay.hold_s + window;
-    say("relay episode " + std::to_string(out.episodes + 1) + ": hold " + Num(options.relay.hold_s) +
-        " s, then up to " + Num(window) + " s of relay");
-    std::vector<RelaySample> samples;
-    if (const Status st = runner(options.relay, horizon, &samples); !st.ok()) return st;
-    ++out.episodes;
-    if (samples.empty()) return Status::RunnerFailed("the relay episode gave no steps");
-    RelayTuner tuner(options.relay, options.previous, options.pid);
-    if (const Status st = ReplayRelay(options.relay, options.previous, options.pid, samples, &tuner);
-        !st.ok())
-      return st;
-    out.end = tuner.phase();
-    out.why = tuner.why();
-    out.u0 = tuner.u0();
-    out.y0 = tuner.y0();
-    out.noise_sigma = tuner.noise_sigma();
-    out.hysteresis = tuner.hysteresis();
-    out.d_high = tuner.d_high();
-    out.d_low = tuner.d_low();
-    out.relay_start_s = tuner.relay_start_s();
-    out.end_s = tuner.end_s();
-    out.horizon_s = samples.back().t_s;
-    out.restarts = tuner.restarts();
-    out.load_changes_s = tuner.load_changes_s();
-    out.cycles = tuner.cycles();
-    out.samples = std::move(samples);
-    const double dt = out.samples.size() > 1 ? out.samples[1].t_s - out.samples[0].t_s : 0.0;
-    say("  " + std::string(ToString(out.end)) + ": u0 " + Num(out.u0) + ", y0 " + Num(out.y0) +
-        ", noise sigma " + Num(out.noise_sigma) + ", hysteresis " + Num(out.hysteresis) + ", " +
-        std::to_string(out.cycles.size()) + " cycles" +
-        (out.cycles.empty() ? std::string() : ", last period " + Num(out.cycles.back().period_s()) + " s") +
-        (out.why.empty() ? std::string() : ": " + out.why));
-    if (out.end == RelayPhase::kDone || out.end == RelayPhase::kAborted) break;
-    if (window >= options.max_window_s) {
-      out.why = "the relay ran " + Num(window) + " s (the longest window, --max-time) without " +
-                (out.cycles.empty() ? std::string("a single cycle: the process did not oscillate")
-                                    : "converging (" + std::to_string(out.cycles.size()) + " cycles)");
-      break;
-    }
-    double next = 2.0 * window;
-    if (!out.cycles.empty()) {  // the timeout the last period sets, and a little more
-      const double needed = options.relay.timeout_periods * out.cycles.back().period_s() + 2.0 * dt + 1e-9;
-      if (needed > window) next = needed;
-    }
-    if (out.end == RelayPhase::kHold) next = 2.0 * window;  // a restart's hold at the end
-    window = std::min(next, options.max_window_s);
-  }
   out.relay.setpoint = out.y0;
   out.relay.u0 = out.u0;
   out.relay.d_high = out.d_high > 0.0 ? out.d_high : 1.0;
@@ -132,6 +105,48 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
                                            : ", T " + Num(out.estimates.model.time_constant_s) + " s") +
           ", L " + Num(out.estimates.model.delay_s) + " s");
   }
+}
+
+Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner& runner,
+                     ExperimentSummary* summary, const ExperimentProgress& progress) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::InvalidInput(error);
+  const auto say = [&](const std::string& line) {
+    if (progress) progress(line);
+  };
+  ExperimentSummary& out = *summary;
+  out = ExperimentSummary{};
+  double window = options.first_window_s;
+  for (;;) {
+    const double horizon = options.relay.hold_s + window;
+    say("relay episode " + std::to_string(out.episodes + 1) + ": hold " + Num(options.relay.hold_s) +
+        " s, then up to " + Num(window) + " s of relay");
+    std::vector<RelaySample> samples;
+    if (const Status st = runner(options.relay, horizon, &samples); !st.ok()) return st;
+    ++out.episodes;
+    if (const Status st = AnalyzeRelayRecord(options, std::move(samples), &out); !st.ok()) return st;
+    const double dt = out.samples.size() > 1 ? out.samples[1].t_s - out.samples[0].t_s : 0.0;
+    say("  " + std::string(ToString(out.end)) + ": u0 " + Num(out.u0) + ", y0 " + Num(out.y0) +
+        ", noise sigma " + Num(out.noise_sigma) + ", hysteresis " + Num(out.hysteresis) + ", " +
+        std::to_string(out.cycles.size()) + " cycles" +
+        (out.cycles.empty() ? std::string() : ", last period " + Num(out.cycles.back().period_s()) + " s") +
+        (out.why.empty() ? std::string() : ": " + out.why));
+    if (out.end == RelayPhase::kDone || out.end == RelayPhase::kAborted) break;
+    if (window >= options.max_window_s) {
+      out.why = "the relay ran " + Num(window) + " s (the longest window, --max-time) without " +
+                (out.cycles.empty() ? std::string("a single cycle: the process did not oscillate")
+                                    : "converging (" + std::to_string(out.cycles.size()) + " cycles)");
+      break;
+    }
+    double next = 2.0 * window;
+    if (!out.cycles.empty()) {  // the timeout the last period sets, and a little more
+      const double needed = options.relay.timeout_periods * out.cycles.back().period_s() + 2.0 * dt + 1e-9;
+      if (needed > window) next = needed;
+    }
+    if (out.end == RelayPhase::kHold) next = 2.0 * window;  // a restart's hold at the end
+    window = std::min(next, options.max_window_s);
+  }
+  EstimateFromRecord(options, &out, say);
   return Status::Ok();
 }
 

@@ -69,6 +69,18 @@ using ExperimentProgress = std::function<void(const std::string& line)>;
 Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner& runner,
                      ExperimentSummary* summary, const ExperimentProgress& progress = nullptr);
 
+/// One relay episode's record (every step, as the controller saw it):
+/// ReplayRelay, then the tuner's end, operating point, relay and cycles into
+/// *summary (its estimates untouched). The runner's failure or ReplayRelay's.
+Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySample> samples,
+                          ExperimentSummary* summary);
+
+/// summary->relay from its operating point and relay, and, where the relay
+/// is done, summary->estimates from its cycles (every settled one after the
+/// approach under noise).
+void EstimateFromRecord(const ExperimentOptions& options, ExperimentSummary* summary,
+                        const ExperimentProgress& progress = nullptr);
+
 /// Steps a RelayTuner over `samples` (y, r, t), as the controller did, and
 /// checks each u bit for bit. kRunnerFailed naming the first step that
 /// differs.
