@@ -75,6 +75,7 @@ void LoadResult(const std::string& path, spec::EvaluateSpec* s) {
 struct ExportCommand {
   SpecFlags flags;
   std::string from, lang, out, scalar = "double";
+  bool autotune = false;
   std::vector<double> input_range;
   bool force = false;
 
@@ -100,6 +101,10 @@ struct ExportCommand {
                     "fixed point: LO,HI, the range of r and y the scalings are chosen for (outside it the "
                     "inputs saturate)")
         ->delimiter(',');
+    app->add_flag(
+        "--autotune", autotune,
+        "also write pidlab_relay.h and pidlab_relay.c: the relay autotune's state machine over this PID "
+        "(docs/autotune.md), bit for bit pidlab-controller's; --scalar double only");
     app->add_flag("--force", force,
                   "write the module even when the plant's sampled loop at --dt is unstable (it is refused "
                   "otherwise, exit 2)");
@@ -130,6 +135,10 @@ struct ExportCommand {
     o.plant = DescribePlant(s.plant);
     o.spec_json = SpecText(spec::ToJson(s));
     o.pidlab_version = PIDLAB_VERSION;
+    o.autotune = autotune;
+    if (autotune && o.scalar != Scalar::kDouble)
+      throw BadInput("--autotune with --scalar " + scalar +
+                     ": the relay autotune is exported in double only");
     return o;
   }
 
@@ -170,6 +179,16 @@ struct ExportCommand {
     const std::string header = out + "/pidlab_pid.h", source = out + "/pidlab_pid.c";
     // Both files or neither: a header beside a source of another run would
     // compile into a controller nobody generated.
+    if (autotune) {
+      const std::string relay_header = out + "/pidlab_relay.h", relay_source = out + "/pidlab_relay.c";
+      Require(io::WriteFiles({{header, code.header},
+                              {source, code.source},
+                              {relay_header, code.relay_header},
+                              {relay_source, code.relay_source}}));
+      std::cout << "wrote " << header << ", " << source << ", " << relay_header << " and " << relay_source
+                << " (" << scalar << ")\n";
+      return 0;
+    }
     Require(io::WriteFiles({{header, code.header}, {source, code.source}}));
     std::cout << "wrote " << header << " and " << source << " (" << scalar << ")\n";
     return 0;

@@ -121,6 +121,18 @@ bad "setpoint weight above 1" "1.5" --gains 1,1,1 --setpoint-weights 1.5,0 --lan
 bad "c = 0.5 with derivative on measurement" "0.5" --gains 1,1,1 --derivative-on measurement \
   --setpoint-weights 1,0.5 --lang c --out x
 bad "unreadable --from" "nothing.json" --from nothing.json --lang c --out x
+bad "--autotune in fixed point" "q31" --gains 1,1,1 --lang c --out x --scalar q31 --input-range -1,1 --autotune
+
+# ---- --autotune: the relay autotune beside the PID (docs/autotune.md), strict C99 with both compilers.
+if "$pidlab" export --num 1 --den 1,1 --delay 0.5 --gains 1,1,0 --dt 0.001 --lang c --out relay --autotune \
+  >relay.out 2>relay.err && [[ -f relay/pidlab_relay.h && -f relay/pidlab_relay.c && -f relay/pidlab_pid.c ]]; then
+  pass "--autotune writes pidlab_relay.h and pidlab_relay.c beside the PID: $(cat relay.out)"
+  for cc in gcc clang; do
+    if "$cc" "${strict[@]}" -pedantic -c relay/pidlab_relay.c -Irelay -o relay/relay.$cc.o 2>relay/$cc.log; then
+      pass "--autotune: $cc ${strict[*]} -pedantic compiles pidlab_relay.c"
+    else fail "--autotune: $cc refuses pidlab_relay.c: $(head -c 600 relay/$cc.log)"; fi
+  done
+else fail "--autotune: $(cat relay.err)"; fi
 echo '{"spec": {"plant": "oscillator"}}' >nogains.json
 bad "--from without gains" "gains" --from nogains.json --lang c --out x
 bad "q31 without --input-range" "--input-range" --gains 1,1,1 --output-limits -1,1 --lang c --out x --scalar q31

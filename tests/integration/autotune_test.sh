@@ -136,5 +136,30 @@ PY
     "$bin/pidlab" autotune --log run.lcmlog --episode 42 >/dev/null 2>err; rc=$?
     if [ $rc = 2 ] && grep -q "no relay episode 42" err; then echo "PASS --episode naming no relay episode: exit 2, one line"
     else echo "FAIL --episode 42: exit $rc, $(cat err)"; fi ;;
+  firmware)  # pidlab-controller-c (its relay the module `pidlab export --autotune` writes) in the trio: every
+    # input bit for bit pidlab-controller's (autotune checks each), so the same estimates and gains
+    url='udpm://239.255.76.67:7667?ttl=0'
+    for run in "noise --num 1 --den 1,1 --delay 0.5 --dt 0.001 --measurement-noise 0.05 --seed 7" \
+               "load --num 1 --den 1,1 --delay 0.5 --dt 0.001 --gains 1,1,0 --disturbance step --disturbance-amplitude 0.3 --disturbance-step-time 14.5" \
+               "heat --num 1 --den 1,1 --delay 0.5 --dt 0.001 --reference 0.2 --output-limits 0,2 --gains 0.5,0.5,0"; do
+      set -- $run; name=$1; shift
+      "$bin/pidlab" launch --isolated -- "$bin/pidlab" autotune --backend lcm --json "$@" >"$name.cpp.json" 2>"$name.cpp.err" ||
+        echo "FAIL $name: autotune with pidlab-controller: $(tail -1 "$name.cpp.err")"
+      "$bin/pidlab-controller-c" --lcm-url "$url" 2>"$name.c.ctl" & pc=$!
+      "$bin/pidlab" launch --roles plant,disturbance --lcm-url "$url" -- "$bin/pidlab" autotune --backend lcm --json \
+        "$@" >"$name.c.json" 2>"$name.c.err" || echo "FAIL $name: autotune with pidlab-controller-c: $(tail -1 "$name.c.err")"
+      kill -TERM $pc; wait $pc
+      /usr/bin/python3 - "$name" <<'PY'
+import json, sys
+name = sys.argv[1]
+a, b = json.load(open(name + ".cpp.json")), json.load(open(name + ".c.json"))
+keys = ("experiment", "estimates", "design", "gains", "adopted", "verdict")
+same = [k for k in keys if a[k] == b[k]]
+x = b["experiment"]
+ok = len(same) == len(keys) and b["adopted"]
+print(("PASS " if ok else "FAIL ") + "%s: the exported C relay in the trio (%s, %d cycles, %d restart(s)) gives pidlab's "
+      "experiment, estimates and gains bit for bit: %s" % (name, x["end"], len(x["cycles"]), x["restarts"], same))
+PY
+    done ;;
   *) echo "FAIL unknown case $case"; exit 1 ;;
 esac

@@ -32,6 +32,7 @@
 #include "pidlab_lcmt_plant_output.h"
 #include "pidlab_lcmt_ready.h"
 #include "pidlab_pid.h"
+#include "pidlab_relay.h"
 
 /* transport/transport.h: PLANT_OUTPUT on the base port + 1, CONTROL on + 2. */
 enum { kPlantOutputLane = 1, kControlLane = 2, kLanes = 3 };
@@ -46,6 +47,8 @@ typedef struct {
   int64_t total_steps, expected;
   double reference;
   pidlab_pid pid;
+  pidlab_relay relay; /* a relay episode (controller_mode "relay", docs/autotune.md) */
+  int relay_on;
   pidlab_lcmt_control_command last;
   int have_last;
   long episodes, commands, foreign, duplicates, bad_configs, conflicts;
@@ -112,7 +115,28 @@ static const char *config_error(const pidlab_lcmt_episode_config *m) {
   if (strcmp(m->integral, "backward-euler") && strcmp(m->integral, "forward-euler") &&
       strcmp(m->integral, "trapezoidal"))
     return "integral unknown";
+  if (strcmp(m->controller_mode, "") && strcmp(m->controller_mode, "pid") &&
+      strcmp(m->controller_mode, "relay"))
+    return "controller mode unknown";
   return NULL;
+}
+
+/* The relay's options as the message carries them (RelayTuneOptions). */
+static void to_relay_config(const pidlab_lcmt_episode_config *m, pidlab_relay_config *r) {
+  memset(r, 0, sizeof *r);
+  r->hold_s = m->relay_hold_s;
+  r->u0 = m->relay_u0;
+  r->amplitude = m->relay_amplitude;
+  r->bias = m->relay_bias;
+  r->hysteresis = m->relay_hysteresis;
+  r->noise_multiple = m->relay_noise_multiple;
+  r->y_limit = m->relay_y_limit;
+  r->settled_cycles =
+      m->relay_settled_cycles < -1 || m->relay_settled_cycles > 1000 ? -1 : (int)m->relay_settled_cycles;
+  r->tolerance = m->relay_tolerance;
+  r->timeout_periods = m->relay_timeout_periods;
+  r->max_restarts =
+      m->relay_max_restarts < -1 || m->relay_max_restarts > 1000 ? -1 : (int)m->relay_max_restarts;
 }
 
 /* The episode's configuration as the exported module's: the setpoint weights
@@ -215,6 +239,15 @@ static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
   to_config(m, &config);
   if (!error && pidlab_pid_init(&c->pid, &config) != PIDLAB_PID_OK)
     error = "the module refused the configuration";
+  c->relay_on = !error && !strcmp(m->controller_mode, "relay");
+  if (c->relay_on) {
+    pidlab_relay_config relay;
+    to_relay_config(m, &relay);
+    if (pidlab_relay_init(&c->relay, &relay, &c->pid) != 0) {
+      error = "the relay's options are out of range";
+      c->relay_on = 0;
+    }
+  }
   if (error) {
     ++c->bad_configs;
     fprintf(stderr, "pidlab-controller-c: ignoring configuration of episode %lld: %s\n",
@@ -256,7 +289,13 @@ static void on_output(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
   }
   if (m->step == c->expected && m->step < c->total_steps) {
     double u = 0.0; /* INVALID_INPUT: the C++ sends the 0.0 its u was initialised with */
-    const pidlab_pid_status status = pidlab_pid_step(&c->pid, c->reference, m->y, &u);
+    pidlab_pid_status status = PIDLAB_PID_INVALID_INPUT;
+    if (!c->relay_on) {
+      status = pidlab_pid_step(&c->pid, c->reference, m->y, &u);
+    } else if (finite(m->y)) { /* the relay: its u, status OK, as pidlab-controller's */
+      u = pidlab_relay_step(&c->relay, m->t_s, c->reference, m->y);
+      status = PIDLAB_PID_OK;
+    }
     c->last.episode_id = c->episode_id;
     c->last.step = m->step;
     c->last.t_s = m->t_s;

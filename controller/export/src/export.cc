@@ -215,9 +215,16 @@ bool ControllerIsValid(const Controller& c, std::string* error) {
 GeneratedCode Generate(const Options& options, const Controller& controller) {
   std::string error;
   if (!options.IsValid(&error) || !ControllerIsValid(controller, &error)) throw std::invalid_argument(error);
+  if (options.autotune && options.scalar != Scalar::kDouble)
+    throw std::invalid_argument("--autotune: the relay autotune is exported in double only, not " +
+                                ToString(options.scalar));
   if (options.scalar == Scalar::kQ31 || options.scalar == Scalar::kQ15)
     return internal::GenerateFixed(options, controller, CommentBody(CommentLines(options, controller)));
-  GeneratedCode code{kRealHeader, kRealSource};
+  GeneratedCode code{kRealHeader, kRealSource, "", ""};
+  if (options.autotune) {
+    code.relay_header = internal::kRelayHeader;
+    code.relay_source = internal::kRelaySource;
+  }
   Replace(&code.header, "COMMENT", CommentBody(CommentLines(options, controller)));
   Replace(&code.header, "REAL", options.scalar == Scalar::kFloat ? "float" : "double");
   Replace(&code.source, "CONFIG", RealConfig(controller, options.scalar));

@@ -139,7 +139,7 @@ std::string FixedConfig(const Controller& c) {
 GeneratedCode GenerateFixed(const Options& options, const Controller& controller,
                             const std::string& comment) {
   const Scaling s = Scale(options, controller);
-  GeneratedCode code{kFixedHeader, kFixedSource};
+  GeneratedCode code{kFixedHeader, kFixedSource, "", ""};
   Replace(&code.header, "COMMENT", comment + " *\n" + RangeAnalysis(options, controller, s));
   for (std::string* text : {&code.header, &code.source}) {
     Replace(text, "QNAME", s.nio == 31 ? "Q31" : "Q15");

@@ -10,6 +10,9 @@ extern const char* const kRealSource;
 /// Fixed point (q31, q15): @COMMENT@ and the scalings (fixed_point.cc).
 extern const char* const kFixedHeader;
 extern const char* const kFixedSource;
+// The relay autotune (double, with pidlab_pid.h): pidlab_relay.h, pidlab_relay.c.
+extern const char* const kRelayHeader;
+extern const char* const kRelaySource;
 
 }  // namespace pidlab::controller_export::internal
 

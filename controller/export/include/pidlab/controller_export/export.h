@@ -64,6 +64,10 @@ struct Options {
   std::string dt_source;
   /// What pidlab found of the plant's sampled loop at dt, for the header comment.
   std::string loop_check;
+  /// Also the relay autotune (`--autotune`, docs/autotune.md): pidlab_relay.h
+  /// and pidlab_relay.c, controller/relay.h's RelayTuner over this PID.
+  /// Double only.
+  bool autotune = false;
 
   /// False with *error naming the field, its value and the rule broken.
   bool IsValid(std::string* error) const;
@@ -73,6 +77,8 @@ struct Options {
 struct GeneratedCode {
   std::string header;  // pidlab_pid.h
   std::string source;  // pidlab_pid.c
+  std::string relay_header;  // pidlab_relay.h (Options::autotune), else empty
+  std::string relay_source;  // pidlab_relay.c
 };
 
 /// The controller as C99. Throws std::invalid_argument naming the value for
