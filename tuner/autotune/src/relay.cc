@@ -11,6 +11,9 @@ namespace pidlab::autotune {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// How far the T of the two half periods may differ, relative, for the
+// extremes' closed forms (FopdtFromCycle) to be used.
+constexpr double kHalfPeriodAgreement = 0.02;
 
 // Student's t at 97.5 % for n - 1 degrees of freedom (n = 2..10), else 1.96.
 double T975(int n) {
@@ -164,6 +167,10 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
   } else {
     fitted = FopdtFromCycle(o, mean, &r.model);
     r.model_from = "extremes";
+    if (!fitted.ok()) {  // no FOPDT by its extremes: its half periods and integrals
+      fitted = FopdtFromTimes(o, mean, &r.model);
+      r.model_from = "switching times and integrals";
+    }
   }
   if (!fitted.ok()) {
     r.message = fitted.message();
@@ -374,9 +381,16 @@ Status FopdtFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtModel* mo
   const double l_over_t = -std::log(big_e);
   const double on = l_over_t + std::log((kh - c.e_min) / (kh - eps));
   const double off = l_over_t + std::log((kl + c.e_max) / (kl - eps));
-  const double t = 0.5 * (c.t_on_s / on + c.t_off_s / off);
+  const double t_from_on = c.t_on_s / on, t_from_off = c.t_off_s / off;
+  const double t = 0.5 * (t_from_on + t_from_off);
   if (!(t > 0.0) || !std::isfinite(t))
     return Status::InvalidInput("the cycle's half periods give a time constant " + Number(t) + " s");
+  // A first order plus dead time gives the same T from either half period;
+  // where they differ the process is not one, and its extremes mislead (a
+  // near-pure delay: e^(-L/T) near 0 leaves them only the gain).
+  if (!(std::abs(t_from_on - t_from_off) <= kHalfPeriodAgreement * t))
+    return Status::InvalidInput("the half periods give T " + Number(t_from_on) + " s and " +
+                                Number(t_from_off) + " s: no first order plus dead time by its extremes");
   model->gain = k;
   model->time_constant_s = t;
   model->delay_s = t * l_over_t;
