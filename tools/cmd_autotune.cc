@@ -306,11 +306,16 @@ struct AutotuneCommand {
     e["message"] = r.message;
     if (r.model_found) {
       e["ku"] = JsonNumber(r.ku);
+      e["ku_ci"] = JsonNumber(r.ku_ci);
       e["pu_s"] = JsonNumber(r.pu_s);
+      e["pu_ci_s"] = JsonNumber(r.pu_ci_s);
       e["model"] = {{"kind", r.model.integrating ? "ipdt" : "fopdt"},
                     {"gain", r.model.gain},
                     {"time_constant_s", r.model.time_constant_s},
                     {"delay_s", r.model.delay_s},
+                    {"gain_ci", JsonNumber(r.gain_ci)},
+                    {"time_constant_ci_s", JsonNumber(r.time_constant_ci_s)},
+                    {"delay_ci_s", JsonNumber(r.delay_ci_s)},
                     {"from", r.model_from}};
     }
     return e;
@@ -465,8 +470,11 @@ struct AutotuneCommand {
                   e["amplitude_ci"].get<double>());
       if (e["model_found"].get<bool>()) {
         const json& m = e["model"];
-        std::printf("Ku, Pu:       %.6g, %.6g s (the model's phase crossover)\n", e["ku"].get<double>(),
-                    e["pu_s"].get<double>());
+        const auto ci = [](const json& v) { return v.is_number() ? v.get<double>() : NAN; };
+        std::printf(
+            "Ku, Pu:       %.6g +- %.2g, %.6g +- %.2g s (the model's phase crossover; 95 %% over the "
+            "cycles)\n",
+            e["ku"].get<double>(), ci(e["ku_ci"]), e["pu_s"].get<double>(), ci(e["pu_ci_s"]));
         std::printf("Ku (DF):      %.6g (describing function 4d/(pi a), labelled: no correction)\n",
                     e["ku_describing_function"].get<double>());
         if (m["kind"] == "ipdt")

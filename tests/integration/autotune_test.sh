@@ -49,7 +49,10 @@ say(abs(m["delay_s"] / L - 1) <= model_tol, f"L within {model_tol:.0%}: {m['dela
 if kind == "fopdt":
     say(abs(m["time_constant_s"] / T - 1) <= model_tol,
         f"T within {model_tol:.0%}: {m['time_constant_s']:.6g} (true {T})")
-say(e["period_ci_s"] >= 0 and e["amplitude_ci"] >= 0, "the period and amplitude carry intervals")
+say(all(isinstance(v, float) and v >= 0 for v in (e["period_ci_s"], e["amplitude_ci"], e["ku_ci"], e["pu_ci_s"],
+                                                     m["gain_ci"], m["delay_ci_s"])),
+    "the period, amplitude, Ku, Pu, K and L carry 95 %% intervals over the cycles: Ku +- %.3g, Pu +- %.3g s"
+    % (e["ku_ci"], e["pu_ci_s"]))
 say(r["adopted"] is True, f"the gains were adopted: {r['verdict']}")
 g = r["gains"]
 den = [T, 1] if kind == "fopdt" else [1, 0]

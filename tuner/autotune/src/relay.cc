@@ -182,6 +182,41 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
     return r;
   }
   r.model_found = true;
+  // The intervals: the same fit on each settled cycle alone, the spread of
+  // its K, T, L, Ku and Pu (95 %, Student's t).
+  std::vector<double> ks, ts, ls, kus, pus;
+  for (int i = 0; i < n; ++i) {
+    const RelayCycle& c = cycles[cycles.size() - 1 - i];
+    FopdtModel m;
+    Status st;
+    if (r.model.integrating)
+      st = IntegratingFromCycle(o, c, &m);
+    else if (r.model_from == "extremes")
+      st = FopdtFromCycle(o, c, &m);
+    else
+      st = FopdtFromTimes(o, c, &m);
+    double ku = 0.0, pu = 0.0;
+    if (!st.ok() || !FopdtUltimate(m, &ku, &pu).ok()) {
+      ks.clear();
+      break;
+    }
+    ks.push_back(m.gain);
+    ts.push_back(m.time_constant_s);
+    ls.push_back(m.delay_s);
+    kus.push_back(ku);
+    pus.push_back(pu);
+  }
+  if (!ks.empty()) {
+    double centre = 0.0;
+    MeanInterval(ks, &centre, &r.gain_ci);
+    MeanInterval(ts, &centre, &r.time_constant_ci_s);
+    MeanInterval(ls, &centre, &r.delay_ci_s);
+    MeanInterval(kus, &centre, &r.ku_ci);
+    MeanInterval(pus, &centre, &r.pu_ci_s);
+  } else {
+    r.gain_ci = r.time_constant_ci_s = r.delay_ci_s = r.ku_ci = r.pu_ci_s =
+        std::numeric_limits<double>::quiet_NaN();
+  }
   return r;
 }
 

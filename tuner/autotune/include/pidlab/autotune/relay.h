@@ -67,6 +67,10 @@ struct RelayEstimates {
   FopdtModel model;
   double ku = 0.0;      ///< the model's ultimate gain (its phase crossover)
   double pu_s = 0.0;    ///< the model's ultimate period
+  /// 95 % half widths of Ku, Pu and the model's K, T and L: the same fit on
+  /// each averaged cycle alone, their spread (Student's t; 0 over identical
+  /// cycles, NaN where a cycle alone gives no model).
+  double ku_ci = 0.0, pu_ci_s = 0.0, gain_ci = 0.0, time_constant_ci_s = 0.0, delay_ci_s = 0.0;
   /// How the FOPDT model was found: "extremes" (the cycle's extremes and
   /// integral, exact without noise) or "switching times and integrals" (its
   /// half periods and integrals, FopdtFromTimes: the extremes of a noisy y are
