@@ -31,7 +31,7 @@ level = {
     'pidlab_monitor': 3,
     'pidlab_tune': 4, 'pidlab_identify': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
     'pidlab_tuner': 5, 'pidlab_results': 5, 'pidlab_identify_json': 6, 'pidlab_replay': 5, 'pidlab_launcher': 5,
-    'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_live_json': 7, 'pidlab_figures': 6, 'pidlab_cli': 7,
+    'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_autotune_json': 6, 'pidlab_live_json': 7, 'pidlab_figures': 6, 'pidlab_cli': 7,
     'pidlab': 8, 'pidlab_python': 8,
 }
 labels, edges = {}, []

@@ -14,8 +14,7 @@
 #include "commands.h"
 #include "pidlab/autotune/experiment.h"
 #include "pidlab/episode_client/episode_client.h"
-#include "pidlab/replay/log_reader.h"
-#include "pidlab/replay/replay.h"
+#include "pidlab/results/autotune_json.h"
 #include "pidlab/results/spec_run.h"
 #include "pidlab/results/tune_run.h"
 #include "pidlab/tune/problem.h"
@@ -46,14 +45,12 @@ struct AutotuneCommand {
   RelayTuneOptions relay;
   std::string log_path;
   int64_t episode_id = 0;
-  const replay::LogContents* log_ = nullptr;  // --log: the log read
-  std::size_t log_index_ = 0;                 // its relay episode
   double amplitude = 0.0;  // 0: from the output range
   std::string bias_text;   // "": amplitude / 3
   double hysteresis = -1.0;
   double first_window_s = 60.0, max_window_s = 7200.0;
   std::string method = "amigo";
-  mutable double max_ms = 2.0;
+  double max_ms = 2.0;
   double robustness = 1.4, response_time_s = 0.0, max_overshoot_pct = 60.0;
 
   std::function<int()> Register(CLI::App* app) {
@@ -123,8 +120,31 @@ struct AutotuneCommand {
     return [this] { return Run(); };
   }
 
+  results::AutotuneDesignOptions Design() const {
+    results::AutotuneDesignOptions o;
+    o.method = method;
+    o.robustness = robustness;
+    o.response_time_s = response_time_s;
+    o.max_ms = max_ms;
+    o.max_overshoot_pct = max_overshoot_pct;
+    std::string why;
+    Require(o.IsValid(&why), why);
+    return o;
+  }
+
+  static void Say(const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); }
+
   int Run() {
-    if (!log_path.empty()) return RunFromLog();
+    if (!log_path.empty()) {
+      spec::EvaluateSpec unused;
+      std::set<std::string> given;
+      flags.Apply(&unused, &given);
+      max_ms = given.count("max_ms") ? unused.bounds.max_ms : 2.0;
+      json out;
+      bool adopted = false;
+      Require(results::AutotuneLogJson(log_path, episode_id, Design(), Say, &out, &adopted));
+      return Print(out, adopted);
+    }
     spec::EvaluateSpec s;
     s.gains = {0.0, 0.0, 0.0};
     s.bounds.max_ms = 2.0;
@@ -142,9 +162,9 @@ struct AutotuneCommand {
     Require(GainsAreValid(previous, &why), "--gains: " + why);
     const PidOptions pid = PidOptionsAt(loop.pid, loop.dt_s);
     const double range = pid.output_max - pid.output_min;
-    relay.amplitude = amplitude > 0.0 ? amplitude : std::isfinite(range) ? 0.2 * range : 1.0;
     if (amplitude < 0.0)
       throw BadInput("--relay-amplitude " + Quote(std::to_string(amplitude)) + " must be > 0");
+    relay.amplitude = amplitude > 0.0 ? amplitude : std::isfinite(range) ? 0.2 * range : 1.0;
     relay.bias = bias_text.empty() ? relay.amplitude / 3.0 : ParseDouble(bias_text, "--relay-bias");
     if (hysteresis >= 0.0) {
       relay.hysteresis = hysteresis;
@@ -161,13 +181,9 @@ struct AutotuneCommand {
     xo.first_window_s = first_window_s;
     xo.max_window_s = max_window_s;
     Require(xo.IsValid(&why), why);
-    if (!(max_ms > 1.0)) throw BadInput("--max-ms " + std::to_string(max_ms) + " must be > 1");
+    const results::AutotuneDesignOptions design = Design();
 
     std::unique_ptr<EpisodeClient> client = lcm.MakeClient();
-    const bool quiet_progress = json_out && isatty(STDERR_FILENO) == 0 && false;
-    const auto say = [quiet_progress](const std::string& line) {
-      if (!quiet_progress) std::fprintf(stderr, "%s\n", line.c_str());
-    };
     const auto runner = [&](const RelayTuneOptions& r, double horizon_s, std::vector<RelaySample>* out) {
       LoopOptions lo = loop;
       lo.sample_time_s = lo.dt_s;
@@ -180,275 +196,61 @@ struct AutotuneCommand {
       return Status::Ok();
     };
     ExperimentSummary x;
-    Require(autotune::RunExperiment(xo, runner, &x, say));
-    std::vector<int64_t> ids = client->stats().episode_ids;
-    return Finish(x, previous, s, given, loop, client.get(), ids, say);
+    Require(autotune::RunExperiment(xo, runner, &x, Say));
+    // The verification: a closed-loop step on the trio, the spec of the
+    // flags with the new gains, 15 Pu at Pu/100 unless given.
+    const results::StepRunner step = [&](const PidGains& gains, double pu, results::StepRun* run) {
+      spec::EvaluateSpec v = s;
+      v.gains = {gains.kp, gains.ki, gains.kd};
+      v.loop.loop = "sampled";
+      if (gains.tf > 0.0) {
+        v.loop.derivative_filter_s = gains.tf;
+        v.loop.derivative_filter_ratio = 0.0;
+      }
+      std::set<std::string> keys = given;
+      if (!given.count("sample_time")) v.loop.sample_time_s = CeilTo(pu / 100.0, loop.dt_s);
+      if (!given.count("horizon")) v.loop.horizon_s = CeilTo(15.0 * pu, v.loop.sample_time_s);
+      for (const char* k : {"sample_time", "horizon", "gains", "loop"}) keys.insert(k);
+      tune::BuildOptions build;
+      build.style = NameStyle::kFlag;
+      build.backend = tune::Backend::kRunner;
+      build.given = keys;
+      tune::EvaluationProblem problem;
+      if (const Status st = tune::BuildEvaluation(v, build, &problem); !st.ok())
+        return Status::RunnerFailed("the verification step does not build: " + st.message());
+      tune::EvaluationRunOptions options;
+      options.monte_carlo = false;
+      options.runner = [&client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
+                                 const DisturbanceOptions& d, std::vector<double>* y,
+                                 std::vector<SampledStep>* tr) { return client->Run(pl, ga, lo, d, y, tr); };
+      Say("verification: a closed-loop step on the trio, " + std::to_string(v.loop.horizon_s) + " s");
+      tune::EvaluationResult result;
+      if (const Status st = tune::RunEvaluation(problem, options, &result); !st.ok())
+        return Status::RunnerFailed("the verification step failed: " + st.message());
+      run->evaluation = result.evaluation;
+      run->horizon_s = v.loop.horizon_s;
+      run->json = results::EvaluationJson(problem, result, "lcm");
+      return Status::Ok();
+    };
+    bool adopted = false;
+    json out = results::AutotuneJson(x, previous, design, step, Say, &adopted);
+    out["backend"] = "lcm";
+    out["episode_ids"] = client->stats().episode_ids;
+    return Print(out, adopted);
   }
 
-  // From a log: its relay episode's record analysed again, the design, the
-  // logged verification step.
-  int RunFromLog() {
-    replay::LogContents contents;
-    if (const Status st = replay::ReadLog(log_path, replay::ReadOptions{}, &contents); !st.ok())
-      throw BadInput("--log " + Quote(log_path) + ": " + st.message());
-    long index = -1;
-    for (std::size_t i = 0; i < contents.episodes.size(); ++i) {
-      const replay::Episode& e = contents.episodes[i];
-      if (e.has_config && e.spec.relay && (episode_id == 0 || e.episode_id == episode_id))
-        index = static_cast<long>(i);
-    }
-    if (index < 0)
-      throw BadInput("--log " + Quote(log_path) + ": " +
-                     (episode_id == 0 ? std::string("no relay episode in it")
-                                      : "no relay episode " + std::to_string(episode_id) + " in it"));
-    const replay::Episode& e = contents.episodes[static_cast<std::size_t>(index)];
-    if (!e.Complete())
-      throw std::runtime_error("relay episode " + std::to_string(e.episode_id) +
-                               " is incomplete in the log: " + e.CompletenessNote());
-    ExperimentOptions xo;
-    xo.relay = e.spec.relay_tune;
-    xo.previous = e.spec.gains;
-    xo.pid = PidOptionsAt(e.spec.pid, e.spec.dt_s);
-    std::vector<RelaySample> samples;
-    for (long k = 0; k < e.total_steps; ++k) {
-      const auto i = static_cast<std::size_t>(k);
-      samples.push_back({static_cast<double>(k) * e.spec.dt_s, e.spec.reference, e.y[i], e.u[i]});
-    }
-    const auto say = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
-    ExperimentSummary x;
-    Require(autotune::AnalyzeRelayRecord(xo, std::move(samples), &x));
-    x.episodes = 1;
-    autotune::EstimateFromRecord(xo, &x, say);
-    log_ = &contents;
-    log_index_ = static_cast<std::size_t>(index);
-    spec::EvaluateSpec s;
-    const LoopOptions loop = episode_client::SampledLoopOptions(e.spec);
-    return Finish(x, e.spec.gains, s, {}, loop, nullptr, {e.episode_id}, say);
-  }
-
-  template <typename Say>
-  int Finish(const ExperimentSummary& x, const PidGains& previous, const spec::EvaluateSpec& s,
-             const std::set<std::string>& given, const LoopOptions& loop, EpisodeClient* client,
-             const std::vector<int64_t>& episode_ids, const Say& say) {
-    json out;
-    out["backend"] = log_ ? "log" : "lcm";
-    if (log_) out["log"] = log_path;
-    out["previous_gains"] = ToJson(previous);
-    out["experiment"] = ExperimentJson(x);
-    out["estimates"] = EstimatesJson(x);
-    PidGains adopted = previous;
-    bool ok = false;
-    std::string verdict;
-    if (x.end != RelayPhase::kDone) {
-      verdict = "the relay did not converge: " + x.why;
-    } else if (!x.estimates.model_found) {
-      verdict = "no model from the cycles: " + x.estimates.message;
-    } else {
-      ok = DesignAndVerify(s, given, loop, x, client, say, &out, &adopted, &verdict);
-    }
-    out["adopted"] = ok;
-    out["verdict"] = verdict;
-    out["gains"] = ToJson(adopted);
-    out["episode_ids"] = episode_ids;
-    if (json_out) {
+  int Print(const json& out, bool adopted) const {
+    if (json_out)
       std::cout << out.dump(2) << "\n";
-    } else {
+    else
       PrintTable(out);
-    }
     FlushRunNotes();
-    if (!ok) {
-      std::fprintf(stderr, "pidlab autotune: %s; the previous gains stay\n", verdict.c_str());
+    if (!adopted) {
+      std::fprintf(stderr, "pidlab autotune: %s; the previous gains stay\n",
+                   out["verdict"].get<std::string>().c_str());
       return 1;
     }
     return 0;
-  }
-
-  static json ExperimentJson(const ExperimentSummary& x) {
-    json e;
-    e["end"] = ToString(x.end);
-    e["why"] = x.why;
-    e["episodes"] = x.episodes;
-    e["u0"] = JsonNumber(x.u0);
-    e["y0"] = JsonNumber(x.y0);
-    e["noise_sigma"] = JsonNumber(x.noise_sigma);
-    e["hysteresis"] = JsonNumber(x.hysteresis);
-    e["d_high"] = JsonNumber(x.d_high);
-    e["d_low"] = JsonNumber(x.d_low);
-    e["relay_start_s"] = JsonNumber(x.relay_start_s);
-    e["end_s"] = JsonNumber(x.end_s);
-    e["horizon_s"] = JsonNumber(x.horizon_s);
-    e["restarts"] = x.restarts;
-    e["load_changes_s"] = x.load_changes_s;
-    json cycles = json::array();
-    for (const RelayCycle& c : x.cycles)
-      cycles.push_back({{"start_s", c.start_s},
-                        {"t_on_s", c.t_on_s},
-                        {"t_off_s", c.t_off_s},
-                        {"e_max", c.e_max},
-                        {"e_min", c.e_min},
-                        {"integral_e", c.integral_e}});
-    e["cycles"] = cycles;
-    return e;
-  }
-
-  static json EstimatesJson(const ExperimentSummary& x) {
-    const autotune::RelayEstimates& r = x.estimates;
-    if (x.end != RelayPhase::kDone) return nullptr;
-    json e;
-    e["converged"] = r.converged;
-    e["cycles"] = r.cycles;
-    e["period_s"] = JsonNumber(r.period_s);
-    e["period_ci_s"] = JsonNumber(r.period_ci_s);
-    e["amplitude"] = JsonNumber(r.amplitude);
-    e["amplitude_ci"] = JsonNumber(r.amplitude_ci);
-    e["ku_describing_function"] = JsonNumber(r.ku_describing_function);
-    e["model_found"] = r.model_found;
-    e["message"] = r.message;
-    if (r.model_found) {
-      e["ku"] = JsonNumber(r.ku);
-      e["ku_ci"] = JsonNumber(r.ku_ci);
-      e["pu_s"] = JsonNumber(r.pu_s);
-      e["pu_ci_s"] = JsonNumber(r.pu_ci_s);
-      e["model"] = {{"kind", r.model.integrating ? "ipdt" : "fopdt"},
-                    {"gain", r.model.gain},
-                    {"time_constant_s", r.model.time_constant_s},
-                    {"delay_s", r.model.delay_s},
-                    {"gain_ci", JsonNumber(r.gain_ci)},
-                    {"time_constant_ci_s", JsonNumber(r.time_constant_ci_s)},
-                    {"delay_ci_s", JsonNumber(r.delay_ci_s)},
-                    {"from", r.model_from}};
-    }
-    return e;
-  }
-
-  template <typename Say>
-  bool DesignAndVerify(spec::EvaluateSpec s, const std::set<std::string>& given, const LoopOptions& loop,
-                       const ExperimentSummary& x, EpisodeClient* client, const Say& say, json* out,
-                       PidGains* adopted, std::string* verdict) const {
-    const autotune::FopdtModel& m = x.estimates.model;
-    // The design: the assembly's tune on the identified model.
-    json spec = {{"num", {m.gain}},
-                 {"delay", m.delay_s},
-                 {"method", method},
-                 {"robustness", robustness},
-                 {"response_time", response_time_s}};
-    spec["den"] = m.integrating ? json::array({1.0, 0.0}) : json::array({m.time_constant_s, 1.0});
-    json design;
-    const Status designed = results::TuneSpecJson(spec, nullptr, &design);
-    if (!designed.ok()) {
-      *verdict = "no design on the identified model: " + designed.message();
-      (*out)["design"] = {{"spec", spec}, {"error", designed.message()}};
-      return false;
-    }
-    const json& g = design["gains"];
-    PidGains gains{g.value("kp", 0.0), g.value("ki", 0.0), g.value("kd", 0.0), g.value("tf", 0.0)};
-    const double ms = design["robustness"].is_object() && design["robustness"]["ms"].is_number()
-                          ? design["robustness"]["ms"].get<double>()
-                          : kInf;
-    (*out)["design"] = {{"method", method},
-                        {"spec", spec},
-                        {"gains", design["gains"]},
-                        {"ms", JsonNumber(ms)},
-                        {"robustness", design["robustness"]},
-                        {"stable", design["stable"]}};
-    say("design (" + method + " on the identified model): kp " + std::to_string(gains.kp) + ", ki " +
-        std::to_string(gains.ki) + ", kd " + std::to_string(gains.kd) + ", Ms " + std::to_string(ms));
-    if (!(ms <= max_ms) || !design.value("stable", false)) {
-      *verdict = "the design's Ms on the identified model is " + std::to_string(ms) + ", above --max-ms " +
-                 std::to_string(max_ms);
-      return false;
-    }
-    // The verification: a closed-loop step on the trio with the new gains.
-    const double pu = x.estimates.pu_s;
-    s.gains = {gains.kp, gains.ki, gains.kd};
-    s.loop.loop = "sampled";
-    if (gains.tf > 0.0) {
-      s.loop.derivative_filter_s = gains.tf;
-      s.loop.derivative_filter_ratio = 0.0;
-    }
-    std::set<std::string> keys = given;
-    if (!given.count("sample_time")) s.loop.sample_time_s = CeilTo(pu / 100.0, loop.dt_s);
-    if (!given.count("horizon")) s.loop.horizon_s = CeilTo(15.0 * pu, s.loop.sample_time_s);
-    keys.insert("sample_time");
-    keys.insert("horizon");
-    keys.insert("gains");
-    keys.insert("loop");
-    tune::BuildOptions build;
-    build.style = NameStyle::kFlag;
-    build.backend = tune::Backend::kRunner;
-    build.given = keys;
-    tune::EvaluationProblem problem;
-    Status st = tune::BuildEvaluation(s, build, &problem);
-    if (!st.ok() && !log_) {
-      *verdict = "the verification step does not build: " + st.message();
-      return false;
-    }
-    evaluation::Evaluation ev;
-    json v;
-    if (log_) {
-      // From the log: the first episode after the relay's that ran these gains.
-      const replay::Episode* step = nullptr;
-      for (std::size_t i = log_index_ + 1; i < log_->episodes.size() && !step; ++i) {
-        const replay::Episode& e = log_->episodes[i];
-        if (e.has_config && !e.spec.relay && e.spec.gains.kp == gains.kp && e.spec.gains.ki == gains.ki &&
-            e.spec.gains.kd == gains.kd)
-          step = &e;
-      }
-      if (!step) {
-        *verdict = "the log holds no verification step with these gains after the relay episode";
-        return false;
-      }
-      st = replay::EvaluateEpisode(*step, &ev);
-      if (!st.ok()) {
-        *verdict = "the logged verification step cannot be evaluated: " + st.message();
-        return false;
-      }
-      s.loop.horizon_s = step->spec.horizon_s;
-      v = ToJson(ev);
-      v["episode_id"] = step->episode_id;
-    } else {
-      tune::EvaluationRunOptions run;
-      run.monte_carlo = false;
-      run.runner = [client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
-                            const DisturbanceOptions& d, std::vector<double>* y,
-                            std::vector<SampledStep>* tr) { return client->Run(pl, ga, lo, d, y, tr); };
-      say("verification: a closed-loop step on the trio, " + std::to_string(s.loop.horizon_s) + " s");
-      tune::EvaluationResult result;
-      st = tune::RunEvaluation(problem, run, &result);
-      if (!st.ok()) {
-        *verdict = "the verification step failed: " + st.message();
-        return false;
-      }
-      ev = result.evaluation;
-      v = results::EvaluationJson(problem, result, "lcm");
-    }
-    const double overshoot = ev.step.overshoot_pct;
-    const double settling = ev.step.settling_time_s;
-    const bool settled = std::isfinite(ev.iae) && std::isfinite(settling) && settling < s.loop.horizon_s;
-    const bool calm = overshoot <= max_overshoot_pct;
-    (*out)["verification"] = {{"iae", JsonNumber(ev.iae)},
-                              {"overshoot_pct", JsonNumber(overshoot)},
-                              {"settling_time_s", JsonNumber(settling)},
-                              {"horizon_s", s.loop.horizon_s},
-                              {"settled", settled},
-                              {"overshoot_ok", calm},
-                              {"evaluation", v}};
-    say("  step on the trio: IAE " + std::to_string(ev.iae) + ", overshoot " + std::to_string(overshoot) +
-        " %, settling " + std::to_string(settling) + " s");
-    if (!settled) {
-      *verdict = "the step on the trio with the new gains did not settle within " +
-                 std::to_string(s.loop.horizon_s) + " s";
-      return false;
-    }
-    if (!calm) {
-      *verdict = "the step on the trio overshoots " + std::to_string(overshoot) +
-                 " %, above --max-overshoot " + std::to_string(max_overshoot_pct);
-      return false;
-    }
-    *adopted = gains;
-    *verdict = "adopted: " + method + " on the identified model, Ms " + std::to_string(ms) +
-               ", verified on the trio";
-    return true;
   }
 
   static void PrintTable(const json& out) {

@@ -5,9 +5,9 @@
 # function, solved here with scipy), the FOPDT parameters against the plant's,
 # and the adopted gains' Ms on the true plant (pidlab evaluate) within the
 # bound. Runs in the private network namespace ctest gives it (unshare -n).
-# usage: autotune_test.sh BIN_DIR CASE
+# usage: autotune_test.sh BIN_DIR CASE [PYTHON_DIR]
 set -uo pipefail
-bin=$1 case=$2
+bin=$1 case=$2 python_dir=${3:-}
 . "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 private_network_up
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
@@ -130,6 +130,21 @@ print(("PASS " if ok else "FAIL ") + "the log alone gives the same experiment, e
 va, vb = a["verification"], b["verification"]
 ok = all(va[k] == vb[k] for k in ("iae", "overshoot_pct", "settling_time_s", "settled"))
 print(("PASS " if ok else "FAIL ") + "and the logged verification step the same IAE %r" % vb["iae"])
+PY
+    # Python's pidlab.autotune: the same object from the same log.
+    PYTHONPATH="$python_dir" /usr/bin/python3 - <<'PY'
+import json
+import pidlab
+r = pidlab.autotune("run.lcmlog")
+b = json.load(open("fromlog.json"))
+ok = r == b and r["adopted"] and r["estimates"]["model"]["kind"] == "fopdt"
+print(("PASS " if ok else "FAIL ") + "pidlab.autotune(log) returns the object of autotune --log --json: Ku %r, gains %r"
+      % (r["estimates"]["ku"], r["gains"]))
+try:
+    pidlab.autotune("run.lcmlog", episode=42)
+    print("FAIL pidlab.autotune(episode=42) raised nothing")
+except ValueError as e:
+    print(("PASS " if "no relay episode 42" in str(e) else "FAIL ") + "pidlab.autotune(episode=42): ValueError: %s" % e)
 PY
     "$bin/pidlab" replay run.lcmlog --redrive >replay.txt 2>&1 || echo "FAIL replay --redrive: $(tail -1 replay.txt)"
     if [ "$(grep -c 'redrive: OK' replay.txt)" = 2 ]; then

@@ -19,6 +19,7 @@
 
 #include "identify_binding.h"
 #include "pidlab/evaluation/evaluation.h"
+#include "pidlab/results/autotune_json.h"
 #include "pidlab/results/results_json.h"
 #include "pidlab/results/spec_run.h"
 #include "pidlab/results/tune_run.h"
@@ -262,5 +263,33 @@ PYBIND11_MODULE(_pidlab, m) {
       "The fields of evaluate's or tune's spec: key (the keyword), flag, help, unit, default, example, and "
       "whether it travels to the trio (episode).",
       py::arg("which") = "evaluate");
+  m.def(
+      "autotune",
+      [](const std::string& log, int64_t episode, const std::string& method, double robustness,
+         double response_time, double max_ms, double max_overshoot) {
+        pidlab::results::AutotuneDesignOptions o;
+        o.method = method;
+        o.robustness = robustness;
+        o.response_time_s = response_time;
+        o.max_ms = max_ms;
+        o.max_overshoot_pct = max_overshoot;
+        nlohmann::json out;
+        bool adopted = false;
+        const pidlab::Status st = pidlab::results::AutotuneLogJson(log, episode, o, nullptr, &out, &adopted);
+        if (st.code() == pidlab::StatusCode::kInvalidInput) Bad(st.message());
+        if (!st.ok()) throw std::runtime_error(st.message());
+        return ToPython(out);
+      },
+      "autotune(log, episode=0, method='amigo', robustness=1.4, response_time=0, max_ms=2, "
+      "max_overshoot=60): "
+      "the relay autotune of a logged run (pidlab launch --log ... -- pidlab autotune --backend lcm) "
+      "recomputed "
+      "from the log alone, as `pidlab autotune --log LOG --json` (docs/autotune.md): the experiment, the "
+      "estimates "
+      "with their intervals, the model, the design, the verification step found in the log, adopted, verdict "
+      "and "
+      "gains. ValueError for an unreadable log or no relay episode in it.",
+      py::arg("log"), py::arg("episode") = 0, py::arg("method") = "amigo", py::arg("robustness") = 1.4,
+      py::arg("response_time") = 0.0, py::arg("max_ms") = 2.0, py::arg("max_overshoot") = 60.0);
   DefineIdentify(m);
 }

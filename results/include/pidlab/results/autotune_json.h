@@ -1,0 +1,63 @@
+#pragma once
+// The result object of `pidlab autotune --json` (docs/autotune.md), shared by
+// the command line and Python's pidlab.autotune: the relay experiment, its
+// estimates, the design on the identified model (the assembly's tune,
+// tune_run.h) and the verification step's verdict; and the same recomputed
+// from a log (AutotuneLogJson), with no trio.
+
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "pidlab/autotune/experiment.h"
+#include "pidlab/evaluation/evaluation.h"
+#include "pidlab/spec/status.h"
+
+namespace pidlab::results {
+
+/// The design on the identified model and what adopting it takes.
+struct AutotuneDesignOptions {
+  std::string method = "amigo";     ///< amigo | simc | migo
+  double robustness = 1.4;          ///< migo: the Ms it designs to
+  double response_time_s = 0.0;     ///< migo: the response time (0: fastest)
+  double max_ms = 2.0;              ///< the design's Ms on the model at most this (> 1)
+  double max_overshoot_pct = 60.0;  ///< the verification step's overshoot at most this
+  bool IsValid(std::string* error) const;
+};
+
+/// A closed-loop step with the designed gains: its evaluation, the horizon it
+/// ran and its JSON.
+struct StepRun {
+  evaluation::Evaluation evaluation;
+  double horizon_s = 0.0;
+  nlohmann::json json;
+};
+/// Runs (or finds) the verification step of `gains`; `pu_s` is the
+/// estimated ultimate period, to size it. A failed Status: no step (the
+/// verdict says why, the previous gains stay).
+using StepRunner = std::function<Status(const PidGains& gains, double pu_s, StepRun* run)>;
+
+/// {"experiment", "estimates"} of an experiment.
+nlohmann::json ExperimentJson(const autotune::ExperimentSummary& x);
+nlohmann::json EstimatesJson(const autotune::ExperimentSummary& x);
+
+/// The whole object for experiment `x` run with `previous` gains: experiment,
+/// estimates, design, verification (by `step`), adopted, verdict, gains (the
+/// adopted or the previous ones), previous_gains. *adopted says whether the
+/// design was adopted. `say` gets progress lines (may be empty).
+nlohmann::json AutotuneJson(const autotune::ExperimentSummary& x, const PidGains& previous,
+                            const AutotuneDesignOptions& options, const StepRunner& step,
+                            const std::function<void(const std::string&)>& say, bool* adopted);
+
+/// The same from the log at `path`: its relay episode (`episode_id`, or 0 for
+/// the last one) analysed again, the design made again, the verification the
+/// first later episode that ran the designed gains. Adds "backend": "log",
+/// "log" and "episode_ids". kInvalidInput for an unreadable log or no such
+/// relay episode; kRunnerFailed for an incomplete episode or a relay that is
+/// not the logged one.
+Status AutotuneLogJson(const std::string& path, int64_t episode_id, const AutotuneDesignOptions& options,
+                       const std::function<void(const std::string&)>& say, nlohmann::json* result,
+                       bool* adopted);
+
+}  // namespace pidlab::results

@@ -1,0 +1,260 @@
+// The result object of pidlab autotune (autotune_json.h).
+
+#include "pidlab/results/autotune_json.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "pidlab/replay/log_reader.h"
+#include "pidlab/replay/replay.h"
+#include "pidlab/results/results_json.h"
+#include "pidlab/results/tune_run.h"
+
+namespace pidlab::results {
+namespace {
+
+using autotune::ExperimentSummary;
+using nlohmann::json;
+
+std::string Num(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+bool AutotuneDesignOptions::IsValid(std::string* error) const {
+  std::string e;
+  if (method != "amigo" && method != "simc" && method != "migo")
+    e = "method '" + method + "' is not amigo, simc or migo";
+  else if (!(max_ms > 1.0) || !std::isfinite(max_ms))
+    e = "max Ms " + Num(max_ms) + " must be > 1 and finite";
+  else if (!(max_overshoot_pct >= 0.0))
+    e = "max overshoot " + Num(max_overshoot_pct) + " % must be >= 0";
+  else if (!(robustness > 1.0) || !std::isfinite(robustness))
+    e = "robustness " + Num(robustness) + " must be > 1 and finite";
+  else if (!(response_time_s >= 0.0) || !std::isfinite(response_time_s))
+    e = "response time " + Num(response_time_s) + " s must be >= 0 and finite";
+  else
+    return true;
+  if (error) *error = e;
+  return false;
+}
+
+json ExperimentJson(const ExperimentSummary& x) {
+  json e;
+  e["end"] = ToString(x.end);
+  e["why"] = x.why;
+  e["episodes"] = x.episodes;
+  e["u0"] = JsonNumber(x.u0);
+  e["y0"] = JsonNumber(x.y0);
+  e["noise_sigma"] = JsonNumber(x.noise_sigma);
+  e["hysteresis"] = JsonNumber(x.hysteresis);
+  e["d_high"] = JsonNumber(x.d_high);
+  e["d_low"] = JsonNumber(x.d_low);
+  e["relay_start_s"] = JsonNumber(x.relay_start_s);
+  e["end_s"] = JsonNumber(x.end_s);
+  e["horizon_s"] = JsonNumber(x.horizon_s);
+  e["restarts"] = x.restarts;
+  e["load_changes_s"] = x.load_changes_s;
+  json cycles = json::array();
+  for (const RelayCycle& c : x.cycles)
+    cycles.push_back({{"start_s", c.start_s},
+                      {"t_on_s", c.t_on_s},
+                      {"t_off_s", c.t_off_s},
+                      {"e_max", c.e_max},
+                      {"e_min", c.e_min},
+                      {"integral_e", c.integral_e},
+                      {"integral_on_e", c.integral_on_e}});
+  e["cycles"] = cycles;
+  return e;
+}
+
+json EstimatesJson(const ExperimentSummary& x) {
+  const autotune::RelayEstimates& r = x.estimates;
+  if (x.end != RelayPhase::kDone) return nullptr;
+  json e;
+  e["converged"] = r.converged;
+  e["cycles"] = r.cycles;
+  e["period_s"] = JsonNumber(r.period_s);
+  e["period_ci_s"] = JsonNumber(r.period_ci_s);
+  e["amplitude"] = JsonNumber(r.amplitude);
+  e["amplitude_ci"] = JsonNumber(r.amplitude_ci);
+  e["ku_describing_function"] = JsonNumber(r.ku_describing_function);
+  e["model_found"] = r.model_found;
+  e["message"] = r.message;
+  if (r.model_found) {
+    e["ku"] = JsonNumber(r.ku);
+    e["ku_ci"] = JsonNumber(r.ku_ci);
+    e["pu_s"] = JsonNumber(r.pu_s);
+    e["pu_ci_s"] = JsonNumber(r.pu_ci_s);
+    e["model"] = {{"kind", r.model.integrating ? "ipdt" : "fopdt"},
+                  {"gain", r.model.gain},
+                  {"time_constant_s", r.model.time_constant_s},
+                  {"delay_s", r.model.delay_s},
+                  {"gain_ci", JsonNumber(r.gain_ci)},
+                  {"time_constant_ci_s", JsonNumber(r.time_constant_ci_s)},
+                  {"delay_ci_s", JsonNumber(r.delay_ci_s)},
+                  {"from", r.model_from}};
+  }
+  return e;
+}
+
+namespace {
+
+// The design on the model and its verification; false with *verdict.
+bool DesignAndVerify(const ExperimentSummary& x, const AutotuneDesignOptions& o, const StepRunner& step,
+                     const std::function<void(const std::string&)>& say, json* out, PidGains* adopted,
+                     std::string* verdict) {
+  const autotune::FopdtModel& m = x.estimates.model;
+  json spec = {{"num", {m.gain}},
+               {"delay", m.delay_s},
+               {"method", o.method},
+               {"robustness", o.robustness},
+               {"response_time", o.response_time_s}};
+  spec["den"] = m.integrating ? json::array({1.0, 0.0}) : json::array({m.time_constant_s, 1.0});
+  json design;
+  const Status designed = TuneSpecJson(spec, nullptr, &design);
+  if (!designed.ok()) {
+    *verdict = "no design on the identified model: " + designed.message();
+    (*out)["design"] = {{"spec", spec}, {"error", designed.message()}};
+    return false;
+  }
+  const json& g = design["gains"];
+  const PidGains gains{g.value("kp", 0.0), g.value("ki", 0.0), g.value("kd", 0.0), g.value("tf", 0.0)};
+  const double ms = design["robustness"].is_object() && design["robustness"]["ms"].is_number()
+                        ? design["robustness"]["ms"].get<double>()
+                        : std::numeric_limits<double>::infinity();
+  (*out)["design"] = {{"method", o.method},
+                      {"spec", spec},
+                      {"gains", design["gains"]},
+                      {"ms", JsonNumber(ms)},
+                      {"robustness", design["robustness"]},
+                      {"stable", design["stable"]}};
+  if (say)
+    say("design (" + o.method + " on the identified model): kp " + Num(gains.kp) + ", ki " + Num(gains.ki) +
+        ", kd " + Num(gains.kd) + ", Ms " + Num(ms));
+  if (!(ms <= o.max_ms) || !design.value("stable", false)) {
+    *verdict = "the design's Ms on the identified model is " + Num(ms) + ", above the bound " + Num(o.max_ms);
+    return false;
+  }
+  StepRun run;
+  if (const Status st = step(gains, x.estimates.pu_s, &run); !st.ok()) {
+    *verdict = st.message();
+    return false;
+  }
+  const evaluation::Evaluation& ev = run.evaluation;
+  const double overshoot = ev.step.overshoot_pct, settling = ev.step.settling_time_s;
+  const bool settled = std::isfinite(ev.iae) && std::isfinite(settling) && settling < run.horizon_s;
+  const bool calm = overshoot <= o.max_overshoot_pct;
+  (*out)["verification"] = {{"iae", JsonNumber(ev.iae)},
+                            {"overshoot_pct", JsonNumber(overshoot)},
+                            {"settling_time_s", JsonNumber(settling)},
+                            {"horizon_s", run.horizon_s},
+                            {"settled", settled},
+                            {"overshoot_ok", calm},
+                            {"evaluation", run.json}};
+  if (say)
+    say("  step: IAE " + Num(ev.iae) + ", overshoot " + Num(overshoot) + " %, settling " + Num(settling) +
+        " s");
+  if (!settled) {
+    *verdict = "the step with the new gains did not settle within " + Num(run.horizon_s) + " s";
+    return false;
+  }
+  if (!calm) {
+    *verdict =
+        "the step overshoots " + Num(overshoot) + " %, above the bound " + Num(o.max_overshoot_pct) + " %";
+    return false;
+  }
+  *adopted = gains;
+  *verdict = "adopted: " + o.method + " on the identified model, Ms " + Num(ms) + ", verified by a step";
+  return true;
+}
+
+}  // namespace
+
+json AutotuneJson(const ExperimentSummary& x, const PidGains& previous, const AutotuneDesignOptions& options,
+                  const StepRunner& step, const std::function<void(const std::string&)>& say, bool* adopted) {
+  json out;
+  out["previous_gains"] = ToJson(previous);
+  out["experiment"] = ExperimentJson(x);
+  out["estimates"] = EstimatesJson(x);
+  PidGains gains = previous;
+  bool ok = false;
+  std::string verdict;
+  if (x.end != RelayPhase::kDone)
+    verdict = "the relay did not converge: " + x.why;
+  else if (!x.estimates.model_found)
+    verdict = "no model from the cycles: " + x.estimates.message;
+  else
+    ok = DesignAndVerify(x, options, step, say, &out, &gains, &verdict);
+  out["adopted"] = ok;
+  out["verdict"] = verdict;
+  out["gains"] = ToJson(gains);
+  *adopted = ok;
+  return out;
+}
+
+Status AutotuneLogJson(const std::string& path, int64_t episode_id, const AutotuneDesignOptions& options,
+                       const std::function<void(const std::string&)>& say, json* result, bool* adopted) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::InvalidInput(error);
+  replay::LogContents log;
+  if (const Status st = replay::ReadLog(path, replay::ReadOptions{}, &log); !st.ok())
+    return Status::InvalidInput("log '" + path + "': " + st.message());
+  long index = -1;
+  for (std::size_t i = 0; i < log.episodes.size(); ++i) {
+    const replay::Episode& e = log.episodes[i];
+    if (e.has_config && e.spec.relay && (episode_id == 0 || e.episode_id == episode_id))
+      index = static_cast<long>(i);
+  }
+  if (index < 0)
+    return Status::InvalidInput("log '" + path + "': " +
+                                (episode_id == 0
+                                     ? std::string("no relay episode in it")
+                                     : "no relay episode " + std::to_string(episode_id) + " in it"));
+  const replay::Episode& e = log.episodes[static_cast<std::size_t>(index)];
+  if (!e.Complete())
+    return Status::RunnerFailed("relay episode " + std::to_string(e.episode_id) +
+                                " is incomplete in the log: " + e.CompletenessNote());
+  autotune::ExperimentOptions xo;
+  xo.relay = e.spec.relay_tune;
+  xo.previous = e.spec.gains;
+  xo.pid = PidOptionsAt(e.spec.pid, e.spec.dt_s);
+  std::vector<autotune::RelaySample> samples;
+  samples.reserve(static_cast<std::size_t>(e.total_steps));
+  for (long k = 0; k < e.total_steps; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    samples.push_back({static_cast<double>(k) * e.spec.dt_s, e.spec.reference, e.y[i], e.u[i]});
+  }
+  autotune::ExperimentSummary x;
+  if (const Status st = autotune::AnalyzeRelayRecord(xo, std::move(samples), &x); !st.ok()) return st;
+  x.episodes = 1;
+  autotune::EstimateFromRecord(xo, &x, say);
+  // The verification: the first later episode that ran these gains.
+  const StepRunner step = [&](const PidGains& gains, double, StepRun* run) {
+    for (std::size_t i = static_cast<std::size_t>(index) + 1; i < log.episodes.size(); ++i) {
+      const replay::Episode& s = log.episodes[i];
+      if (!s.has_config || s.spec.relay || s.spec.gains.kp != gains.kp || s.spec.gains.ki != gains.ki ||
+          s.spec.gains.kd != gains.kd)
+        continue;
+      if (const Status st = replay::EvaluateEpisode(s, &run->evaluation); !st.ok())
+        return Status::RunnerFailed("the logged verification step cannot be evaluated: " + st.message());
+      run->horizon_s = s.spec.horizon_s;
+      run->json = ToJson(run->evaluation);
+      run->json["episode_id"] = s.episode_id;
+      return Status::Ok();
+    }
+    return Status::RunnerFailed(
+        "the log holds no verification step with these gains after the relay episode");
+  };
+  *result = AutotuneJson(x, e.spec.gains, options, step, say, adopted);
+  (*result)["backend"] = "log";
+  (*result)["log"] = path;
+  (*result)["episode_ids"] = json::array({e.episode_id});
+  return Status::Ok();
+}
+
+}  // namespace pidlab::results
