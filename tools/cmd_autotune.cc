@@ -128,7 +128,7 @@ struct AutotuneCommand {
     o.max_ms = max_ms;
     o.max_overshoot_pct = max_overshoot_pct;
     std::string why;
-    Require(o.IsValid(&why), why);
+    if (!o.IsValid(&why)) throw BadInput(why);
     return o;
   }
 
@@ -159,7 +159,7 @@ struct AutotuneCommand {
     loop.loop = LoopKind::kSampled;
     const PidGains previous{s.gains[0], s.gains[1], s.gains[2]};
     std::string why;
-    Require(GainsAreValid(previous, &why), "--gains: " + why);
+    if (!GainsAreValid(previous, &why)) throw BadInput("--gains: " + why);
     const PidOptions pid = PidOptionsAt(loop.pid, loop.dt_s);
     const double range = pid.output_max - pid.output_min;
     if (amplitude < 0.0)
@@ -170,7 +170,8 @@ struct AutotuneCommand {
       relay.hysteresis = hysteresis;
       relay.noise_multiple = 0.0;
     } else {
-      if (flags.Given("hysteresis")) throw BadInput("--hysteresis must be >= 0");
+      if (flags.Given("hysteresis"))
+        throw BadInput("--hysteresis " + spec::FormatNumber(hysteresis) + " must be >= 0");
       relay.hysteresis = 0.0;
       relay.noise_multiple = 3.0;
     }
@@ -180,7 +181,7 @@ struct AutotuneCommand {
     xo.pid = pid;
     xo.first_window_s = first_window_s;
     xo.max_window_s = max_window_s;
-    Require(xo.IsValid(&why), why);
+    if (!xo.IsValid(&why)) throw BadInput(why);
     const results::AutotuneDesignOptions design = Design();
 
     std::unique_ptr<EpisodeClient> client = lcm.MakeClient();
