@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "pidlab/autotune/experiment.h"
 #include "pidlab/episode_client/episode_client.h"
+#include "pidlab/episode_client/tune_progress.h"
 #include "pidlab/results/autotune_json.h"
 #include "pidlab/results/spec_run.h"
 #include "pidlab/results/tune_run.h"
@@ -237,6 +238,19 @@ struct AutotuneCommand {
     json out = results::AutotuneJson(x, previous, design, step, Say, &adopted);
     out["backend"] = "lcm";
     out["episode_ids"] = client->stats().episode_ids;
+    // The verdict to live watchers (pidlab serve --lcm-url: the Live tab's
+    // tunings): the adopted gains (or the previous ones) and the design's Ms.
+    try {
+      episode_client::TuneProgressPublisher verdict(lcm.ClientOptions(lcm.Url()), 1, "autotune " + method,
+                                                    "Ms on the identified model");
+      const json& ms = out.contains("design") ? out["design"]["ms"] : json(nullptr);
+      const json& g = out["gains"];
+      verdict.Finished(adopted, PidGains{g.value("kp", 0.0), g.value("ki", 0.0), g.value("kd", 0.0)},
+                       ms.is_number() ? ms.get<double>() : std::numeric_limits<double>::infinity(),
+                       static_cast<long>(client->stats().episodes));
+    } catch (const std::exception&) {
+      // A watcher's message never stops the command.
+    }
     return Print(out, adopted);
   }
 

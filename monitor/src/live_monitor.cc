@@ -15,7 +15,18 @@
 #include <pidlab/lcmt_tune_progress.hpp>
 #include <stdexcept>
 
+#include "pidlab/autotune/relay.h"
+#include "pidlab/controller/relay.h"
+#include "pidlab/transport/episode_spec.h"
+
 namespace pidlab::monitor {
+
+// A relay episode followed as its steps arrive (FollowRelay).
+struct RelayFollower {
+  RelayTuneOptions options;
+  std::shared_ptr<RelayTuner> tuner;
+  double dt_s = 0.0, r = 0.0;
+};
 
 bool LiveMonitorOptions::IsValid(std::string* error) const {
   std::string e;
@@ -107,6 +118,20 @@ struct LiveMonitor::State {
     e.info.r = m.reference;
     e.info.dt_s = m.dt_s;
     e.info.total_steps = static_cast<long>(m.total_steps);
+    if (m.controller_mode == "relay") {  // the relay, when the configuration is one a controller runs
+      transport::EpisodeSpec spec;
+      if (transport::ParseEpisodeConfig(m, &spec).ok() && spec.relay) {
+        auto relay = std::make_shared<RelayFollower>();
+        relay->options = spec.relay_tune;
+        relay->tuner =
+            std::make_shared<RelayTuner>(spec.relay_tune, spec.gains, PidOptionsAt(spec.pid, spec.dt_s));
+        relay->dt_s = spec.dt_s;
+        relay->r = spec.reference;
+        e.relay = relay;
+        e.info.relay.active = true;
+        e.info.relay.phase = ToString(RelayPhase::kHold);
+      }
+    }
     const std::size_t size = static_cast<std::size_t>(m.total_steps) + 1;
     const double nan = std::numeric_limits<double>::quiet_NaN();
     e.y.assign(size, nan), e.u.assign(size, nan), e.n.assign(size, nan);
@@ -142,7 +167,51 @@ struct LiveMonitor::State {
       }
     }
     if (m.count > 0) e->info.highest_step = std::max<long>(e->info.highest_step, m.step + m.count - 1);
+    if (e->relay) FollowRelay(e);
     Changed();
+  }
+
+  // Steps the episode's RelayTuner over the steps now received in order and
+  // updates its view; the estimates on each new cycle.
+  static void FollowRelay(EpisodeTrace* e) {
+    RelayFollower& f = *e->relay;
+    RelayView& v = e->info.relay;
+    const std::size_t before = f.tuner->cycles().size();
+    const RelayPhase phase_before = f.tuner->phase();
+    long k = v.steps_followed;
+    for (; k < e->info.total_steps && e->received[static_cast<std::size_t>(k)]; ++k) {
+      const double y = e->y[static_cast<std::size_t>(k)];
+      if (std::isfinite(y)) f.tuner->Step(static_cast<double>(k) * f.dt_s, f.r, y);
+    }
+    v.steps_followed = k;
+    const RelayTuner& t = *f.tuner;
+    v.phase = ToString(t.phase());
+    v.why = t.why();
+    v.u0 = t.u0(), v.y0 = t.y0(), v.noise_sigma = t.noise_sigma(), v.hysteresis = t.hysteresis();
+    v.d_high = t.d_high(), v.d_low = t.d_low();
+    v.cycles = static_cast<int>(t.cycles().size());
+    v.restarts = t.restarts();
+    if (!t.cycles().empty()) {
+      v.last_period_s = t.cycles().back().period_s();
+      v.last_amplitude = t.cycles().back().amplitude();
+    }
+    if ((t.cycles().size() == before && t.phase() == phase_before) || t.cycles().size() < 3) return;
+    autotune::RelayOptions o;
+    o.setpoint = t.y0(), o.u0 = t.u0(), o.d_high = t.d_high(), o.d_low = t.d_low(),
+    o.hysteresis = t.hysteresis();
+    o.settled_cycles = f.options.settled_cycles;
+    o.tolerance = f.options.tolerance;
+    if (!o.IsValid(nullptr)) return;
+    const autotune::RelayEstimates r =
+        autotune::EstimateFromCycles(o, t.cycles(), t.phase() == RelayPhase::kDone, t.noise_sigma());
+    v.estimates = r.model_found;
+    v.converged = r.converged;
+    v.message = r.message;
+    v.period_s = r.period_s, v.period_ci_s = r.period_ci_s;
+    v.ku = r.ku, v.pu_s = r.pu_s, v.ku_describing_function = r.ku_describing_function;
+    v.gain = r.model.gain, v.time_constant_s = r.model.time_constant_s, v.delay_s = r.model.delay_s;
+    v.integrating = r.model.integrating;
+    v.model_from = r.model_from;
   }
 
   void OnSummary(const pidlab::lcmt_episode_summary& m) {

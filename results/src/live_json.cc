@@ -26,6 +26,40 @@ nlohmann::json PacingJson(const transport::PacingProgress& p) {
           {"histogram", p.histogram}};
 }
 
+// A relay episode's relay as the watcher follows it (docs/autotune.md); null
+// for any other episode.
+nlohmann::json RelayJson(const monitor::RelayView& r) {
+  if (!r.active) return nullptr;
+  nlohmann::json j = {{"phase", r.phase},
+                      {"why", r.why},
+                      {"u0", JsonNumber(r.u0)},
+                      {"y0", JsonNumber(r.y0)},
+                      {"noise_sigma", JsonNumber(r.noise_sigma)},
+                      {"hysteresis", JsonNumber(r.hysteresis)},
+                      {"d_high", JsonNumber(r.d_high)},
+                      {"d_low", JsonNumber(r.d_low)},
+                      {"cycles", r.cycles},
+                      {"restarts", r.restarts},
+                      {"last_period_s", JsonNumber(r.last_period_s)},
+                      {"last_amplitude", JsonNumber(r.last_amplitude)},
+                      {"steps_followed", r.steps_followed},
+                      {"estimates", nullptr}};
+  if (r.estimates)
+    j["estimates"] = {{"converged", r.converged},
+                      {"period_s", JsonNumber(r.period_s)},
+                      {"period_ci_s", JsonNumber(r.period_ci_s)},
+                      {"ku", JsonNumber(r.ku)},
+                      {"pu_s", JsonNumber(r.pu_s)},
+                      {"ku_describing_function", JsonNumber(r.ku_describing_function)},
+                      {"model",
+                       {{"kind", r.integrating ? "ipdt" : "fopdt"},
+                        {"gain", JsonNumber(r.gain)},
+                        {"time_constant_s", JsonNumber(r.time_constant_s)},
+                        {"delay_s", JsonNumber(r.delay_s)},
+                        {"from", r.model_from}}}};
+  return j;
+}
+
 nlohmann::json LiveEpisodeJson(const EpisodeInfo& e, int trio) {
   return {{"episode_id", e.episode_id},
           {"trio", trio},
@@ -39,7 +73,8 @@ nlohmann::json LiveEpisodeJson(const EpisodeInfo& e, int trio) {
           {"status", monitor::StatusName(e.status)},
           {"message", e.message},
           {"realtime", e.realtime.paced() ? RealtimeJson(e.realtime) : nlohmann::json(nullptr)},
-          {"pacing", e.pacing ? PacingJson(*e.pacing) : nlohmann::json(nullptr)}};
+          {"pacing", e.pacing ? PacingJson(*e.pacing) : nlohmann::json(nullptr)},
+          {"relay", RelayJson(e.relay)}};
 }
 
 nlohmann::json HealthJson(const MonitorSnapshot& s) {

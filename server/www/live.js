@@ -150,6 +150,39 @@ function renderEpisodes(s) {
   });
 }
 
+// The relay episodes (pidlab autotune, docs/autotune.md): the relay as the
+// server follows it, its cycles and the estimates as they converge; the
+// verdict is the autotune's row among the tunings.
+function renderRelay(s) {
+  const fmt = (v) => (v === null || v === undefined ? '-' : String(+Number(v).toPrecision(4)));
+  const relays = (s.episodes || []).filter((e) => e.relay);
+  $('live-relay-box').classList.toggle('hidden', relays.length === 0);
+  keyedRows($('live-relay').querySelector('tbody'), relays, idText, (e) => {
+    const tr = document.createElement('tr');
+    tr.dataset.episodeId = idText(e);
+    for (const cls of ['relay-phase', 'relay-cycles', '', 'relay-ku', 'relay-model', 'relay-why']) cell(tr, '', cls);
+    return tr;
+  }, (tr, e) => {
+    const r = e.relay;
+    const [phase, cycles, period, ku, model, why] = tr.children;
+    tr.title = 'episode ' + idText(e);
+    setText(phase, r.phase);
+    phase.dataset.phase = r.phase;
+    phase.title = 'operating point u0 ' + fmt(r.u0) + ', y0 ' + fmt(r.y0) + '; hysteresis ' + fmt(r.hysteresis) +
+      ', relay +' + fmt(r.d_high) + ' / -' + fmt(r.d_low) + ', noise sigma ' + fmt(r.noise_sigma);
+    setText(cycles, String(r.cycles) + (r.restarts ? ' (' + r.restarts + ' restart)' : ''));
+    cycles.dataset.cycles = String(r.cycles);
+    setText(period, r.last_period_s === null ? '-' : fmt(r.last_period_s) + ' s');
+    const x = r.estimates;
+    setText(ku, x ? fmt(x.ku) + ', ' + fmt(x.pu_s) + ' s' + (x.converged ? '' : ' (converging)') : '-');
+    if (x) ku.dataset.ku = String(x.ku);
+    setText(model, x ? 'K ' + fmt(x.model.gain) + (x.model.kind === 'fopdt' ? ', T ' + fmt(x.model.time_constant_s) : ' (ipdt)') +
+      ', L ' + fmt(x.model.delay_s) : '-');
+    setText(why, (r.why || '').split(':')[0]);  // the whole line in the title
+    why.title = r.why || '';
+  });
+}
+
 // The tunings over the trio (pidlab tune --backend lcm) with their best so far.
 function renderTunings(s) {
   const fmt = (v) => String(+Number(v).toPrecision(6));
@@ -232,6 +265,7 @@ function onStatus(s) {
   live.dropped_frames = s.dropped_frames;
   $('live-source').textContent = s.lcm_url + ' prefix ' + s.channel_prefix;
   renderEpisodes(s);
+  renderRelay(s);
   renderTunings(s);
   renderHealth(s);
   renderPacing(s);

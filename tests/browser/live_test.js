@@ -222,6 +222,42 @@ async function main() {
       if (wide.length) throw new Error('wider than 1280 px: ' + JSON.stringify(wide));
       return shown.evaluations + ' evaluations (tune --json\'s), best ' + JSON.stringify(shown.gains) + '; every table within 1280 px';
     });
+
+    await step('a relay autotune over the trio: its cycles and Ku on the page equal autotune --json\'s, its verdict among the tunings', async () => {
+      await launchTrio(['--lcm-url', args['lcm-url']],
+        '"$PIDLAB" autotune --backend lcm --lcm-url \'' + args['lcm-url'] + '\' --num 1 --den 1,1 --delay 0.5 --dt 0.001 ' +
+        '--gains 1,1,0 --json > autotune.json');
+      const at = JSON.parse(fs.readFileSync(path.join(args.tmp, 'autotune.json'), 'utf8'));
+      await waitForPage(session, 'no finished relay in #live-relay', 30000,
+        () => document.querySelector('#live-relay tbody tr .relay-phase[data-phase="done"]'));
+      const shown = await page.evaluate(() => {
+        const tr = [...document.querySelectorAll('#live-relay tbody tr')]
+          .find((r) => r.querySelector('.relay-phase').dataset.phase === 'done');
+        return { ku: Number(tr.querySelector('.relay-ku').dataset.ku), cycles: Number(tr.querySelector('.relay-cycles').dataset.cycles),
+          model: tr.querySelector('.relay-model').textContent, why: tr.querySelector('.relay-why').title };
+      });
+      if (!Object.is(shown.ku, at.estimates.ku) || shown.cycles !== at.experiment.cycles.length || shown.why !== at.experiment.why)
+        throw new Error('page ' + JSON.stringify(shown) + ', autotune --json Ku ' + at.estimates.ku + ', ' +
+          at.experiment.cycles.length + ' cycles, ' + at.experiment.why);
+      await waitForPage(session, 'no autotune verdict in #live-tunings', 30000,
+        () => [...document.querySelectorAll('#live-tunings tbody tr')]
+          .some((tr) => tr.textContent.includes('autotune amigo') && tr.querySelector('.status[data-status="done"]')));
+      const verdict = await page.evaluate(() => {
+        const tr = [...document.querySelectorAll('#live-tunings tbody tr')].find((r) => r.textContent.includes('autotune amigo'));
+        return { gains: JSON.parse(tr.querySelector('.best-gains').dataset.gains), ms: Number(tr.querySelector('.best-objective').dataset.value) };
+      });
+      const want = [at.gains.kp, at.gains.ki, at.gains.kd];
+      if (!at.adopted || !want.every((g, i) => Object.is(verdict.gains[i], g)) || !Object.is(verdict.ms, at.design.ms))
+        throw new Error('verdict ' + JSON.stringify(verdict) + ', autotune --json ' + JSON.stringify(want) + ' Ms ' + at.design.ms);
+      await page.setViewport({ width: 1280, height: 800 });
+      const wide = await page.evaluate(() => [...document.querySelectorAll('#view-live table:not(.u-legend)')]
+        .map((e) => ({ id: e.id || e.className, right: e.getBoundingClientRect().right }))
+        .filter((e) => e.right > 1280));
+      await page.screenshot({ path: path.join(args.out, 'live-relay.png') });
+      await page.setViewport({ width: 1400, height: 1000 });
+      if (wide.length) throw new Error('wider than 1280 px: ' + JSON.stringify(wide));
+      return 'Ku ' + shown.ku + ', ' + shown.cycles + ' cycles, ' + shown.model + '; adopted ' + JSON.stringify(verdict.gains) + ', Ms ' + verdict.ms;
+    });
   } else {
     await step('(logs only) a 25 s episode at dt = 1 ms recorded by pidlab launch --log', async () => {
       await launchTrio(['--lcm-url', args['lcm-url'], '--log', log25], '"$PIDLAB" ' + longArgs.map((a) => "'" + a + "'").join(' ') + ' > long.json');

@@ -59,6 +59,27 @@ enum class EpisodeStatus { kRunning, kComplete, kFailed };
 /// "running", "complete", "failed".
 const char* StatusName(EpisodeStatus status);
 
+/// A relay episode (docs/autotune.md) as the watcher follows it: a
+/// RelayTuner stepped over the steps received in order, its cycles, and the
+/// estimates of its latest cycles as they converge (autotune::
+/// EstimateFromCycles, from the second cycle after the approach on).
+struct RelayView {
+  bool active = false;  ///< a relay episode
+  std::string phase;    ///< hold | relay | done | aborted
+  std::string why;      ///< how it ended
+  double u0 = 0.0, y0 = 0.0, noise_sigma = 0.0, hysteresis = 0.0, d_high = 0.0, d_low = 0.0;
+  int cycles = 0, restarts = 0;
+  double last_period_s = std::numeric_limits<double>::quiet_NaN();
+  double last_amplitude = std::numeric_limits<double>::quiet_NaN();
+  long steps_followed = 0;
+  bool estimates = false;  ///< the fields below are set
+  bool converged = false;
+  double period_s = 0.0, period_ci_s = 0.0, ku = 0.0, pu_s = 0.0, ku_describing_function = 0.0;
+  double gain = 0.0, time_constant_s = 0.0, delay_s = 0.0;
+  bool integrating = false;
+  std::string model_from, message;
+};
+
 /// One episode's figures, without its trajectory.
 struct EpisodeInfo {
   int64_t episode_id = 0;
@@ -79,14 +100,18 @@ struct EpisodeInfo {
   transport::RealtimeStats realtime;  // from the SUMMARY (unpaced before it)
   /// The latest lcmt_pacing_progress of the episode.
   std::optional<transport::PacingProgress> pacing;
+  /// A relay episode's relay, as far as its steps have arrived in order.
+  RelayView relay;
 };
 
 /// An episode with its trajectory: y, u, n of steps 0..total_steps, the
 /// chunks' doubles bit for bit, NaN where a step has not arrived.
+struct RelayFollower;  // live_monitor.cc: a relay episode's RelayTuner
 struct EpisodeTrace {
   EpisodeInfo info;
   std::vector<double> y, u, n;
   std::vector<bool> received;
+  std::shared_ptr<RelayFollower> relay;  // a relay episode's, else null
 };
 
 enum class TuningStatus { kRunning, kDone, kFailed };
