@@ -238,6 +238,10 @@ def config_error(m):
         return "derivative-on measurement with setpoint weight c = %r" % m.setpoint_weight_c
     if m.integral not in ("backward-euler", "forward-euler", "trapezoidal"):
         return "integral '%s' unknown" % m.integral[:80]
+    mode = getattr(m, "controller_mode", "")  # "" in the types before the relay autotune
+    if mode not in ("", "pid"):
+        return ("controller mode '%s': this controller runs the PID only (a relay episode, docs/autotune.md, "
+                "needs pidlab-controller or pidlab-controller-c)" % mode[:80])
     return None
 
 

@@ -179,5 +179,16 @@ print(("PASS " if ok else "FAIL ") + "%s: the exported C relay in the trio (%s, 
       "experiment, estimates and gains bit for bit: %s" % (name, x["end"], len(x["cycles"]), x["restarts"], same))
 PY
     done ;;
+  python_refuses)  # examples/python_controller.py runs the PID only: it ignores a relay episode, saying why,
+    # and the autotune ends naming the silent controller, changing nothing
+    url='udpm://239.255.76.67:7667?ttl=0'
+    PYTHONPATH="$python_dir" /usr/bin/python3 "$(dirname "${BASH_SOURCE[0]}")/../../examples/python_controller.py" \
+      --lcm-url "$url" 2>py.err & pc=$!
+    "$bin/pidlab" launch --roles plant,disturbance --lcm-url "$url" -- "$bin/pidlab" autotune --backend lcm \
+      --num 1 --den 1,1 --delay 0.5 --dt 0.001 --max-attempts 1 >out.txt 2>err; rc=$?
+    kill -TERM $pc; wait $pc
+    if [ $rc = 1 ] && grep -q "controller" err && grep -q "controller mode 'relay'" py.err; then
+      echo "PASS the Python controller ignores a relay episode ($(grep -m1 -o "controller mode 'relay'[^)]*)" py.err)); autotune exit 1: $(tail -1 err)"
+    else echo "FAIL python controller and a relay episode: exit $rc, $(tail -1 err) / $(tail -2 py.err)"; fi ;;
   *) echo "FAIL unknown case $case"; exit 1 ;;
 esac
