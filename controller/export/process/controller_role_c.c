@@ -32,7 +32,9 @@
 #include "pidlab_lcmt_plant_output.h"
 #include "pidlab_lcmt_ready.h"
 #include "pidlab_pid.h"
+#ifdef PIDLAB_RELAY /* the relay autotune: pidlab export --autotune's pidlab_relay.c beside the PID */
 #include "pidlab_relay.h"
+#endif
 
 /* transport/transport.h: PLANT_OUTPUT on the base port + 1, CONTROL on + 2. */
 enum { kPlantOutputLane = 1, kControlLane = 2, kLanes = 3 };
@@ -47,7 +49,9 @@ typedef struct {
   int64_t total_steps, expected;
   double reference;
   pidlab_pid pid;
+#ifdef PIDLAB_RELAY
   pidlab_relay relay; /* a relay episode (controller_mode "relay", docs/autotune.md) */
+#endif
   int relay_on;
   pidlab_lcmt_control_command last;
   int have_last;
@@ -118,8 +122,15 @@ static const char *config_error(const pidlab_lcmt_episode_config *m) {
   if (strcmp(m->controller_mode, "") && strcmp(m->controller_mode, "pid") &&
       strcmp(m->controller_mode, "relay"))
     return "controller mode unknown";
+#ifndef PIDLAB_RELAY
+  if (!strcmp(m->controller_mode, "relay"))
+    return "a relay episode: built without the relay (-DPIDLAB_RELAY, pidlab export --autotune's "
+           "pidlab_relay.c)";
+#endif
   return NULL;
 }
+
+#ifdef PIDLAB_RELAY
 
 /* The relay's options as the message carries them (RelayTuneOptions). */
 static void to_relay_config(const pidlab_lcmt_episode_config *m, pidlab_relay_config *r) {
@@ -138,6 +149,7 @@ static void to_relay_config(const pidlab_lcmt_episode_config *m, pidlab_relay_co
   r->max_restarts =
       m->relay_max_restarts < -1 || m->relay_max_restarts > 1000 ? -1 : (int)m->relay_max_restarts;
 }
+#endif
 
 /* The episode's configuration as the exported module's: the setpoint weights
  * b and c as the message carries them (c = 0 is derivative on measurement),
@@ -240,6 +252,7 @@ static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
   if (!error && pidlab_pid_init(&c->pid, &config) != PIDLAB_PID_OK)
     error = "the module refused the configuration";
   c->relay_on = !error && !strcmp(m->controller_mode, "relay");
+#ifdef PIDLAB_RELAY
   if (c->relay_on) {
     pidlab_relay_config relay;
     to_relay_config(m, &relay);
@@ -248,6 +261,7 @@ static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
       c->relay_on = 0;
     }
   }
+#endif
   if (error) {
     ++c->bad_configs;
     fprintf(stderr, "pidlab-controller-c: ignoring configuration of episode %lld: %s\n",
@@ -292,10 +306,13 @@ static void on_output(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
     pidlab_pid_status status = PIDLAB_PID_INVALID_INPUT;
     if (!c->relay_on) {
       status = pidlab_pid_step(&c->pid, c->reference, m->y, &u);
-    } else if (finite(m->y)) { /* the relay: its u, status OK, as pidlab-controller's */
+    }
+#ifdef PIDLAB_RELAY
+    else if (finite(m->y)) { /* the relay: its u, status OK, as pidlab-controller's */
       u = pidlab_relay_step(&c->relay, m->t_s, c->reference, m->y);
       status = PIDLAB_PID_OK;
     }
+#endif
     c->last.episode_id = c->episode_id;
     c->last.step = m->step;
     c->last.t_s = m->t_s;
