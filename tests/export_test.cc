@@ -17,9 +17,11 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "export/compiled_module.h"
 #include "pidlab/controller/pid.h"
+#include "pidlab/controller/relay.h"
 
 namespace pidlab {
 
@@ -508,6 +510,169 @@ TEST(ExportedPid, Q15IsWithin1LsbOfDiscretePidOver100000RandomSteps) {
   EXPECT_EQ(c.outside_limits, 0);
   EXPECT_EQ(c.jumps, 0);
   std::printf("q15: worst |u_q15 - u_double| = %.3g LSB\n", c.worst_lsb);
+}
+
+// ---- The relay autotune (--autotune): the generated pidlab_relay.c against
+// RelayTuner (controller/relay.h) on a simulated process, in double and in
+// q31 and q15 (RelayTuneOptions::q_bits).
+
+/// What the random relay runs found.
+struct RelayComparison {
+  long runs = 0, steps = 0, mismatches = 0, cycles = 0, done = 0, aborted = 0, restarted = 0, no_pid = 0;
+  long cycles_differ = 0, phases_differ = 0;
+  double worst_lsb = 0.0;
+};
+
+RelayComparison RunRelayRandom(Scalar scalar, unsigned seed, int runs) {
+  RelayComparison out;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Controller headroom;  // the module's range analysis: gains up to these
+  headroom.gains = {2.0, 2.0, 0.0};
+  headroom.pid.dt_s = 0.01;
+  headroom.pid.output_min = -2.0;
+  headroom.pid.output_max = 2.0;
+  const GeneratedCode code = [&] {
+    Options o;
+    o.scalar = scalar;
+    o.input_min = -4.0;
+    o.input_max = 4.0;
+    o.autotune = true;
+    return Generate(o, headroom);
+  }();
+  CompiledModule m(code, ShimPath(IsFixed(scalar) ? "shim_fixed.c" : "shim_real.c"));
+  EXPECT_NE(m.relay_step_, nullptr);
+  if (!m.relay_step_) return out;
+  RelayTuneOptions base;
+  if (IsFixed(scalar)) {
+    Options o;
+    o.scalar = scalar;
+    o.input_min = -4.0;
+    o.input_max = 4.0;
+    const FixedScale f = FixedPointScale(o, headroom);
+    base.q_bits = f.bits;
+    base.input_full_scale = f.input_full_scale;
+    base.output_full_scale = f.output_full_scale;
+  }
+  for (int run = 0; run < runs; ++run) {
+    // A FOPDT process K e^(-Ls)/(Ts+1), sometimes noisy, sometimes with a
+    // load step; a PI in place or an open-loop hold; a symmetric or biased
+    // relay, a heat-only range, and guards that sometimes end the test.
+    const double gain = 0.5 + 1.5 * unit(rng), tau = 0.2 + 1.8 * unit(rng), delay = 0.05 + 0.95 * unit(rng);
+    const double noise = unit(rng) < 0.3 ? 0.01 + 0.02 * unit(rng) : 0.0;
+    const bool load_run = unit(rng) < 0.3;  // a load step while the relay runs, and more cycles
+    const bool heat = unit(rng) < 0.25, pid_in_place = unit(rng) < 0.6;
+    Controller c = headroom;
+    c.pid.output_min = heat ? 0.0 : -2.0;
+    c.gains = pid_in_place ? PidGains{0.3 / gain, 0.3 / gain / tau, 0.0} : PidGains{0.0, 0.0, 0.0};
+    RelayTuneOptions r = base;
+    r.hold_s = 1.0 + 3.0 * unit(rng);
+    r.u0 = heat ? 0.5 : 0.0;
+    r.amplitude = 0.2 + 0.4 * unit(rng);
+    r.bias = unit(rng) < 0.5 ? 0.0 : r.amplitude * (0.6 * unit(rng) - 0.3);
+    r.hysteresis = unit(rng) < 0.5 ? 0.0 : 0.01 * unit(rng);
+    r.noise_multiple = 3.0;
+    r.y_limit = unit(rng) < 0.15 ? 0.05 + 0.2 * unit(rng) : std::numeric_limits<double>::infinity();
+    r.settled_cycles = load_run ? 12 : 2 + static_cast<int>(3 * unit(rng));
+    r.tolerance = load_run ? 0.01 : 0.01 + 0.04 * unit(rng);
+    const double load_at = load_run ? r.hold_s + 6.0 * tau + 6.0 * delay : -1.0;
+    const double load = (unit(rng) < 0.5 ? -1.0 : 1.0) * (0.3 + 0.3 * unit(rng)) * r.amplitude * gain;
+    r.timeout_periods = r.settled_cycles + 2.0 + 20.0 * unit(rng);
+    r.max_restarts = static_cast<int>(3 * unit(rng));
+    const double ref = heat ? 0.3 : 0.0;
+    const ShimConfig config = ToShim(c);
+    void* pid = m.new_(&config);
+    const double v[9] = {r.hold_s,         r.u0,      r.amplitude, r.bias,           r.hysteresis,
+                         r.noise_multiple, r.y_limit, r.tolerance, r.timeout_periods};
+    void* relay = pid ? m.relay_new_(pid, v, r.settled_cycles, r.max_restarts) : nullptr;
+    EXPECT_NE(relay, nullptr) << "run " << run;
+    if (!relay) {
+      if (pid) m.free_(pid);
+      continue;
+    }
+    RelayTuner tuner(r, c.gains, c.pid);
+    const double lsb = IsFixed(scalar) ? std::ldexp(base.output_full_scale, -base.q_bits) : 0.0;
+    const int delay_steps = static_cast<int>(std::lround(delay / c.pid.dt_s));
+    std::vector<double> pipe(static_cast<std::size_t>(delay_steps) + 1, heat ? 0.5 : 0.0);
+    double x = heat ? 0.5 * gain : 0.0;
+    const double a = std::exp(-c.pid.dt_s / tau);
+    for (int k = 0; k < 8000; ++k) {
+      const double t = k * c.pid.dt_s;
+      const double y = x + noise * normal(rng) + (load_at >= 0.0 && t >= load_at ? load : 0.0);
+      const double u_dut = m.relay_step_(relay, t, ref, y);
+      const double u_ref = tuner.Step(t, ref, y);
+      ++out.steps;
+      const bool same = lsb == 0.0 ? std::memcmp(&u_dut, &u_ref, sizeof u_dut) == 0
+                                   : std::abs(u_dut - u_ref) <= FixedRelayLsb(base.q_bits) * lsb;
+      if (lsb > 0.0) out.worst_lsb = std::max(out.worst_lsb, std::abs(u_dut - u_ref) / lsb);
+      if (!same && ++out.mismatches <= 3)
+        ADD_FAILURE() << "run " << run << " step " << k << ": the module's u " << u_dut << ", RelayTuner's "
+                      << u_ref << " (phase " << ToString(tuner.phase()) << ")";
+      pipe[static_cast<std::size_t>(k) % pipe.size()] = u_dut;
+      const double u_delayed = pipe[static_cast<std::size_t>(k + 1) % pipe.size()];
+      x = a * x + (1.0 - a) * gain * u_delayed;
+    }
+    ++out.runs;
+    if (m.relay_phase_(relay) != static_cast<int>(tuner.phase())) ++out.phases_differ;
+    out.done += tuner.phase() == RelayPhase::kDone;
+    out.aborted += tuner.phase() == RelayPhase::kAborted;
+    out.restarted += tuner.restarts() > 0;
+    out.no_pid += !pid_in_place;
+    const long n = m.relay_cycle_count_(relay);
+    if (n != static_cast<long>(tuner.cycles().size())) ++out.cycles_differ;
+    for (long i = 0; i < n && i < static_cast<long>(tuner.cycles().size()); ++i) {
+      double got[7];
+      const RelayCycle& e = tuner.cycles()[static_cast<std::size_t>(i)];
+      const double want[7] = {e.start_s, e.t_on_s,     e.t_off_s,      e.e_max,
+                              e.e_min,   e.integral_e, e.integral_on_e};
+      ++out.cycles;
+      if (!m.relay_cycle_(relay, i, got) || std::memcmp(got, want, sizeof got) != 0) ++out.cycles_differ;
+    }
+    m.relay_free_(relay);
+    m.free_(pid);
+  }
+  return out;
+}
+
+void ExpectRelayEqual(const RelayComparison& c, const char* name) {
+  EXPECT_EQ(c.runs, 60);
+  EXPECT_EQ(c.mismatches, 0);
+  EXPECT_EQ(c.phases_differ, 0);
+  EXPECT_EQ(c.cycles_differ, 0);
+  EXPECT_GT(c.done, 10) << "the runs must converge";
+  EXPECT_GT(c.aborted, 3) << "the guards must end some runs";
+  EXPECT_GT(c.restarted, 0) << "a load step must restart some run";
+  EXPECT_GT(c.no_pid, 5);
+  EXPECT_GT(c.cycles, 250);
+  std::printf(
+      "%s relay: %ld runs, %ld steps, %ld done, %ld aborted, %ld restarted, %ld cycles equal; worst "
+      "|u - RelayTuner's| = %.3g LSB\n",
+      name, c.runs, c.steps, c.done, c.aborted, c.restarted, c.cycles, c.worst_lsb);
+}
+
+TEST(ExportedRelay, DoubleEqualsRelayTunerBitForBitOver60RandomProcesses) {
+  ExpectRelayEqual(RunRelayRandom(Scalar::kDouble, 43, 60), "double");
+}
+
+TEST(ExportedRelay, Q31SwitchesWithRelayTunerAndStaysWithin3LsbOver60RandomProcesses) {
+  ExpectRelayEqual(RunRelayRandom(Scalar::kQ31, 4331, 60), "q31");
+}
+
+TEST(ExportedRelay, Q15SwitchesWithRelayTunerAndStaysWithin2LsbOver60RandomProcesses) {
+  ExpectRelayEqual(RunRelayRandom(Scalar::kQ15, 4315, 60), "q15");
+}
+
+TEST(Generate, TheRelayIsRefusedInFloat) {
+  Options o;
+  o.scalar = Scalar::kFloat;
+  o.autotune = true;
+  try {
+    Generate(o, Controller{});
+    ADD_FAILURE() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("float"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/autotune/experiment.h"
+#include "pidlab/controller_export/export.h"
 #include "pidlab/episode_client/episode_client.h"
 #include "pidlab/episode_client/tune_progress.h"
 #include "pidlab/results/autotune_json.h"
@@ -53,6 +54,8 @@ struct AutotuneCommand {
   std::string method = "amigo";
   double max_ms = 2.0;
   double robustness = 1.4, response_time_s = 0.0, max_overshoot_pct = 60.0;
+  std::string scalar = "double";
+  std::vector<double> input_range;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
@@ -97,6 +100,14 @@ struct AutotuneCommand {
         ->capture_default_str();
     app->add_option("--max-restarts", relay.max_restarts, "restarts after a load change")
         ->capture_default_str();
+    app->add_option("--scalar", scalar,
+                    "the controller's relay: double (pidlab-controller's, checked bit for bit), q31 or q15 "
+                    "(pidlab export --autotune --scalar's in pidlab-controller-c: every switch checked, the "
+                    "input within 3 or 2 LSB; needs --input-range and finite --output-limits)")
+        ->capture_default_str();
+    app->add_option("--input-range", input_range,
+                    "fixed point: LO,HI, the --input-range the controller was exported with")
+        ->delimiter(',');
     app->add_option("--relay-time", first_window_s, "the first relay episode's relay window, s")
         ->check(FiniteNumber())
         ->capture_default_str();
@@ -133,6 +144,39 @@ struct AutotuneCommand {
     return o;
   }
 
+  // --scalar q31|q15: the exported fixed-point relay's grids, as pidlab
+  // export scales them.
+  controller_export::Scalar ParseScalar() const {
+    controller_export::Scalar v = controller_export::Scalar::kDouble;
+    if (!controller_export::ParseScalar(scalar, &v) || v == controller_export::Scalar::kFloat)
+      throw BadInput("--scalar " + Quote(scalar) + " is not one of double, q31, q15");
+    if (v == controller_export::Scalar::kDouble && !input_range.empty())
+      throw BadInput("--input-range is for --scalar q31 or q15");
+    if (v != controller_export::Scalar::kDouble && input_range.size() != 2)
+      throw BadInput("--scalar " + scalar + " needs --input-range LO,HI (the export's)");
+    return v;
+  }
+
+  void SetFixedPoint(const PidGains& previous, const PidOptions& pid) {
+    controller_export::Options o;
+    o.scalar = ParseScalar();
+    if (o.scalar == controller_export::Scalar::kDouble) return;
+    o.input_min = input_range[0];
+    o.input_max = input_range[1];
+    controller_export::Controller c;
+    c.gains = previous;
+    c.pid = pid;
+    controller_export::FixedScale scale;
+    try {
+      scale = controller_export::FixedPointScale(o, c);
+    } catch (const std::invalid_argument& e) {
+      throw BadInput(e.what());
+    }
+    relay.q_bits = scale.bits;
+    relay.input_full_scale = scale.input_full_scale;
+    relay.output_full_scale = scale.output_full_scale;
+  }
+
   static void Say(const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); }
 
   int Run() {
@@ -143,7 +187,20 @@ struct AutotuneCommand {
       max_ms = given.count("max_ms") ? unused.bounds.max_ms : 2.0;
       json out;
       bool adopted = false;
-      Require(results::AutotuneLogJson(log_path, episode_id, Design(), Say, &out, &adopted));
+      ParseScalar();  // bad --scalar or --input-range: exit 2 before the log is read
+      const results::FixedPointRelay fixed = [this](const PidGains& previous, const PidOptions& pid,
+                                                    RelayTuneOptions* r) {
+        try {
+          SetFixedPoint(previous, pid);
+        } catch (const std::exception& e) {
+          return Status::InvalidInput(e.what());
+        }
+        r->q_bits = relay.q_bits;
+        r->input_full_scale = relay.input_full_scale;
+        r->output_full_scale = relay.output_full_scale;
+        return Status::Ok();
+      };
+      Require(results::AutotuneLogJson(log_path, episode_id, Design(), Say, &out, &adopted, fixed));
       return Print(out, adopted);
     }
     spec::EvaluateSpec s;
@@ -176,6 +233,7 @@ struct AutotuneCommand {
       relay.hysteresis = 0.0;
       relay.noise_multiple = 3.0;
     }
+    SetFixedPoint(previous, pid);
     ExperimentOptions xo;
     xo.relay = relay;
     xo.previous = previous;

@@ -104,7 +104,8 @@ struct ExportCommand {
     app->add_flag(
         "--autotune", autotune,
         "also write pidlab_relay.h and pidlab_relay.c: the relay autotune's state machine over this PID "
-        "(docs/autotune.md), bit for bit pidlab-controller's; --scalar double only");
+        "(docs/autotune.md): double (bit for bit pidlab-controller's), q31 or q15 (pidlab autotune "
+        "--scalar)");
     app->add_flag("--force", force,
                   "write the module even when the plant's sampled loop at --dt is unstable (it is refused "
                   "otherwise, exit 2)");
@@ -136,9 +137,9 @@ struct ExportCommand {
     o.spec_json = SpecText(spec::ToJson(s));
     o.pidlab_version = PIDLAB_VERSION;
     o.autotune = autotune;
-    if (autotune && o.scalar != Scalar::kDouble)
+    if (autotune && o.scalar == Scalar::kFloat)
       throw BadInput("--autotune with --scalar " + scalar +
-                     ": the relay autotune is exported in double only");
+                     ": the relay autotune is exported in double, q31 and q15");
     return o;
   }
 

@@ -203,7 +203,7 @@ struct ReplayCommand {
     bool evaluated = false;
     nlohmann::json j = results::EvaluatedEpisodeJson(e, &ev, &evaluated);
     const std::string why = evaluated ? "" : j["evaluation_error"].get<std::string>();
-    TableRow(e, evaluated ? Full(ev.iae) : "-", table);
+    TableRow(e, evaluated ? Full(ev.iae) : e.has_config && e.spec.relay ? "relay autotune" : "-", table);
     StreamDetails("plant outputs", e.outputs, table);
     StreamDetails("commands", e.commands, table);
     StreamDetails("disturbance samples", e.disturbances, table);

@@ -18,6 +18,23 @@ std::string Num(double v) {
 
 double Clip(double u, double lo, double hi) { return std::min(std::max(u, lo), hi); }
 
+// Fixed point: floor(x + 0.5) clamped to [lo, hi], as the exported relay's
+// pidlab_relay_round does it.
+std::int64_t RoundClamp(double x, double lo, double hi) {
+  const double r = std::floor(x + 0.5);
+  return static_cast<std::int64_t>(r < lo ? lo : (r > hi ? hi : r));
+}
+
+// The second differences' scale: 2^shift grid units (q31's 2^33 would
+// overflow their squares' sum).
+int DiffShift(int q_bits) { return q_bits > 23 ? q_bits - 23 : 0; }
+
+std::int64_t ShiftRound(std::int64_t d, int shift) {
+  if (shift == 0) return d;
+  const std::int64_t half = std::int64_t{1} << (shift - 1);
+  return d >= 0 ? (d + half) >> shift : -((-d + half) >> shift);
+}
+
 }  // namespace
 
 const char* ToString(RelayPhase phase) {
@@ -58,6 +75,12 @@ bool RelayTuneOptions::IsValid(std::string* error) const {
     os << "timeout " << timeout_periods << " periods must be finite and more than settled cycles + 1";
   else if (max_restarts < 0 || max_restarts > 100)
     os << "max restarts " << max_restarts << " must be in [0, 100]";
+  else if (q_bits != 0 && q_bits != 15 && q_bits != 31)
+    os << "fixed-point bits " << q_bits << " must be 0 (double), 15 or 31";
+  else if (q_bits != 0 && (!(input_full_scale > 0.0) || !std::isfinite(input_full_scale)))
+    os << "input full scale " << input_full_scale << " must be > 0 and finite";
+  else if (q_bits != 0 && (!(output_full_scale > 0.0) || !std::isfinite(output_full_scale)))
+    os << "output full scale " << output_full_scale << " must be > 0 and finite";
   else
     return true;
   if (error) *error = os.str();
@@ -69,7 +92,36 @@ RelayTuner::RelayTuner(const RelayTuneOptions& options, const PidGains& previous
       previous_(previous),
       pid_(previous, pid),
       out_min_(pid.output_min),
-      out_max_(pid.output_max) {}
+      out_max_(pid.output_max) {
+  if (o_.q_bits == 0) return;
+  const int n = o_.q_bits;
+  const double top = std::ldexp(1.0, n);
+  qy_ = std::ldexp(o_.input_full_scale, -n);
+  qu_ = std::ldexp(o_.output_full_scale, -n);
+  hold_steps_ = RoundClamp(o_.hold_s / pid.dt_s, 0.0, 4e18);
+  out_min_q_ = QOut(out_min_);
+  out_max_q_ = QOut(out_max_);
+  hyst_q_ = RoundClamp(std::ldexp(o_.hysteresis / o_.input_full_scale, n), 0.0, top);
+  dh_q_ = RoundClamp(std::ldexp((o_.amplitude + o_.bias) / o_.output_full_scale, n), 0.0, 2.0 * top);
+  dl_q_ = RoundClamp(std::ldexp((o_.amplitude - o_.bias) / o_.output_full_scale, n), 0.0, 2.0 * top);
+  y_limit_q_ = static_cast<std::int64_t>(
+      std::floor(std::min(std::ldexp(o_.y_limit / o_.input_full_scale, n), 4611686018427387904.0)));
+  u0_cfg_q_ = std::min(std::max(QOut(o_.u0), out_min_q_), out_max_q_);
+}
+
+int FixedRelayLsb(int q_bits) { return q_bits == 31 ? 3 : q_bits == 15 ? 2 : 0; }
+
+double RelayTuner::input_tolerance() const { return FixedRelayLsb(o_.q_bits) * qu_; }
+
+std::int64_t RelayTuner::QIn(double v) const {
+  const double top = std::ldexp(1.0, o_.q_bits);
+  return RoundClamp(std::ldexp(v / o_.input_full_scale, o_.q_bits), -top, top - 1.0);
+}
+
+std::int64_t RelayTuner::QOut(double v) const {
+  const double top = std::ldexp(1.0, o_.q_bits);
+  return RoundClamp(std::ldexp(v / o_.output_full_scale, o_.q_bits), -top, top - 1.0);
+}
 
 bool RelayTuner::HasPid() const { return previous_.kp != 0.0 || previous_.ki != 0.0 || previous_.kd != 0.0; }
 
@@ -79,6 +131,9 @@ void RelayTuner::StartHold(double t_s) {
   sum_u_ = sum_y_ = sum_d_ = sum_d2_ = 0.0;
   n_u_ = n_d_ = 0;
   n_prev_ = 0;
+  hold_start_k_ = k_;
+  sum_u_q_ = sum_y_q_ = sum_d_q_ = 0;
+  sum_d2_q_ = 0;
 }
 
 double RelayTuner::After(double r, double y) {
@@ -95,6 +150,7 @@ void RelayTuner::End(RelayPhase phase, double t_s, const std::string& why) {
 }
 
 double RelayTuner::Step(double t_s, double r, double y) {
+  if (o_.q_bits != 0) return FixedStep(t_s, r, y);
   if (first_) {
     first_ = false;
     StartHold(t_s);
@@ -265,6 +321,156 @@ void RelayTuner::OnCycle(const RelayCycle& c, double t_s) {
   End(RelayPhase::kDone, t_s,
       "converged after " + std::to_string(cycles_.size()) + " cycles: period " + Num(period) +
           " s, amplitude " + Num(amplitude));
+}
+
+}  // namespace pidlab
+
+namespace pidlab {
+
+// Fixed point: the exported q31/q15 relay (c_relay_fixed_template.cc) line
+// for line. y and r on the input grid qy_, u on the output grid qu_, time in
+// steps k_; doubles only where the exported relay uses them too, once per
+// hold (its mean u and y, sigma) and once per cycle (the cycle in seconds,
+// OnCycle's tests), with the same operations in the same order.
+double RelayTuner::FixedAfter(double r, double y) {
+  if (!HasPid()) return static_cast<double>(phase_ == RelayPhase::kHold ? u0_cfg_q_ : u0_q_) * qu_;
+  double u = 0.0;
+  pid_.Step(static_cast<double>(QIn(r)) * qy_, static_cast<double>(QIn(y)) * qy_, &u);
+  return static_cast<double>(QOut(u)) * qu_;
+}
+
+double RelayTuner::FixedStep(double t_s, double r, double y) {
+  if (first_) {
+    first_ = false;
+    k_ = 0;
+    StartHold(t_s);
+  } else {
+    ++k_;
+  }
+  const std::int64_t yq = QIn(y);
+  if (phase_ == RelayPhase::kHold && k_ - hold_start_k_ >= hold_steps_) FixedEndHold(t_s, QIn(r), yq);
+  if (phase_ == RelayPhase::kRelay) return FixedRelayStep(t_s, r, yq);
+  if (phase_ != RelayPhase::kHold) return FixedAfter(r, y);
+  const double u = FixedAfter(r, y);
+  if (2 * (k_ - hold_start_k_) >= hold_steps_) {
+    sum_u_q_ += QOut(u);
+    sum_y_q_ += yq;
+    ++n_u_;
+    if (n_prev_ >= 2) {
+      const std::int64_t d = ShiftRound(yq - 2 * y_prev_q_ + y_prev2_q_, DiffShift(o_.q_bits));
+      const auto d2 = static_cast<std::uint64_t>(d * d);
+      sum_d_q_ += d;
+      sum_d2_q_ = d2 > UINT64_MAX - sum_d2_q_ ? UINT64_MAX : sum_d2_q_ + d2;
+      ++n_d_;
+    }
+    y_prev2_q_ = y_prev_q_;
+    y_prev_q_ = yq;
+    ++n_prev_;
+  }
+  return u;
+}
+
+void RelayTuner::FixedEndHold(double t_s, std::int64_t r, std::int64_t y) {
+  const double top = std::ldexp(1.0, o_.q_bits);
+  u0_q_ = HasPid() && n_u_ > 0
+              ? RoundClamp(static_cast<double>(sum_u_q_) / static_cast<double>(n_u_), -top, top - 1.0)
+              : u0_cfg_q_;
+  y0_q_ =
+      n_u_ > 0 ? RoundClamp(static_cast<double>(sum_y_q_) / static_cast<double>(n_u_), -top, top - 1.0) : r;
+  double sigma_d = 0.0;  // in units of 2^shift grid steps
+  if (n_d_ > 1) {
+    const double n = static_cast<double>(n_d_);
+    const double sum = static_cast<double>(sum_d_q_);
+    const double var = (static_cast<double>(sum_d2_q_) - sum * sum / n) / (n - 1.0);
+    sigma_d = var > 0.0 ? std::sqrt(var / 6.0) : 0.0;
+  }
+  const int shift = DiffShift(o_.q_bits);
+  sigma_ = sigma_d * std::ldexp(qy_, shift);
+  eps_q_ = hyst_q_ + RoundClamp(o_.noise_multiple * std::ldexp(sigma_d, shift), 0.0, top);
+  d_high_q_ = std::min(dh_q_, out_max_q_ - u0_q_);
+  d_low_q_ = std::min(dl_q_, u0_q_ - out_min_q_);
+  u0_ = static_cast<double>(u0_q_) * qu_;
+  y0_ = static_cast<double>(y0_q_) * qy_;
+  eps_ = static_cast<double>(eps_q_) * qy_;
+  d_high_ = static_cast<double>(d_high_q_) * qu_;
+  d_low_ = static_cast<double>(d_low_q_) * qu_;
+  if (d_high_q_ <= 0 || d_low_q_ <= 0) {
+    End(RelayPhase::kAborted, t_s,
+        "no room for a relay around u0 = " + Num(u0_) + " within the output range [" + Num(out_min_) + ", " +
+            Num(out_max_) + "]");
+    return;
+  }
+  phase_ = RelayPhase::kRelay;
+  relay_start_s_ = t_s;
+  relay_start_k_ = k_;
+  high_ = y - y0_q_ < 0;
+  e_prev_q_ = y - y0_q_;
+  k_high_ = k_low_ = -1;
+  integral_q_ = 0;
+  cycles_.clear();
+  changes_.clear();
+}
+
+double RelayTuner::FixedRelayStep(double t_s, double r, std::int64_t y) {
+  const std::int64_t e = y - y0_q_;
+  if (k_ > relay_start_k_) {
+    if (!((e < 0 ? -e : e) <= y_limit_q_)) {
+      End(RelayPhase::kAborted, t_s,
+          "y - y0 = " + Num(static_cast<double>(e) * qy_) + " at t = " + Num(t_s) +
+              " s is beyond the limit " + Num(o_.y_limit));
+      return FixedAfter(r, static_cast<double>(y) * qy_);
+    }
+    if (k_high_ >= 0) {
+      integral_q_ += e + e_prev_q_;
+      e_max_q_ = std::max(e_max_q_, e);
+      e_min_q_ = std::min(e_min_q_, e);
+    }
+    if (!high_ && e < -eps_q_) {
+      const bool complete = k_high_ >= 0 && k_low_ > k_high_;
+      const double dt = pid_.options().dt_s;
+      RelayCycle c;
+      if (complete) {
+        c.start_s = static_cast<double>(k_high_) * dt;
+        c.t_on_s = static_cast<double>(k_low_ - k_high_) * dt;
+        c.t_off_s = static_cast<double>(k_ - k_low_) * dt;
+        c.e_max = static_cast<double>(e_max_q_) * qy_;
+        c.e_min = static_cast<double>(e_min_q_) * qy_;
+        c.integral_e = static_cast<double>(integral_q_) * (0.5 * dt * qy_);
+        c.integral_on_e = static_cast<double>(integral_on_q_) * (0.5 * dt * qy_);
+      }
+      const std::int64_t period_k = k_ - k_high_;
+      high_ = true;
+      k_high_ = k_;
+      k_low_ = -1;
+      integral_q_ = 0;
+      e_max_q_ = e_min_q_ = e;
+      if (complete) {
+        const std::size_t before = cycles_.size();
+        OnCycle(c, t_s);
+        if (phase_ != RelayPhase::kRelay) return FixedAfter(r, static_cast<double>(y) * qy_);
+        if (cycles_.size() > before)
+          timeout_q_ =
+              static_cast<std::int64_t>(std::floor(o_.timeout_periods * static_cast<double>(period_k)));
+      }
+    } else if (high_ && e > eps_q_) {
+      high_ = false;
+      if (k_high_ >= 0) {
+        k_low_ = k_;
+        integral_on_q_ = integral_q_;
+      }
+    }
+    if (!cycles_.empty() && k_ - relay_start_k_ > timeout_q_) {
+      const double dt = pid_.options().dt_s;
+      End(RelayPhase::kAborted, t_s,
+          "the oscillation did not converge within " + Num(o_.timeout_periods) + " periods (" +
+              Num(static_cast<double>(timeout_q_) * dt) + " s): " + std::to_string(cycles_.size()) +
+              " cycles, the last periods and amplitudes differ by more than " + Num(100.0 * o_.tolerance) +
+              " %");
+      return FixedAfter(r, static_cast<double>(y) * qy_);
+    }
+  }
+  e_prev_q_ = e;
+  return static_cast<double>(u0_q_ + (high_ ? d_high_q_ : -d_low_q_)) * qu_;
 }
 
 }  // namespace pidlab

@@ -198,7 +198,8 @@ json AutotuneJson(const ExperimentSummary& x, const PidGains& previous, const Au
 }
 
 Status AutotuneLogJson(const std::string& path, int64_t episode_id, const AutotuneDesignOptions& options,
-                       const std::function<void(const std::string&)>& say, json* result, bool* adopted) {
+                       const std::function<void(const std::string&)>& say, json* result, bool* adopted,
+                       const FixedPointRelay& fixed_point) {
   std::string error;
   if (!options.IsValid(&error)) return Status::InvalidInput(error);
   replay::LogContents log;
@@ -223,6 +224,8 @@ Status AutotuneLogJson(const std::string& path, int64_t episode_id, const Autotu
   xo.relay = e.spec.relay_tune;
   xo.previous = e.spec.gains;
   xo.pid = PidOptionsAt(e.spec.pid, e.spec.dt_s);
+  if (fixed_point)
+    if (const Status st = fixed_point(xo.previous, xo.pid, &xo.relay); !st.ok()) return st;
   std::vector<autotune::RelaySample> samples;
   samples.reserve(static_cast<std::size_t>(e.total_steps));
   for (long k = 0; k < e.total_steps; ++k) {

@@ -122,6 +122,16 @@ nlohmann::json RedriveJson(const replay::RedriveResult& r) {
 nlohmann::json EvaluatedEpisodeJson(const replay::Episode& e, evaluation::Evaluation* evaluation,
                                     bool* evaluated) {
   nlohmann::json j = EpisodeJson(e);
+  if (e.has_config && e.spec.relay) {
+    // A relay experiment is no step response: its IAE would mean nothing.
+    j["controller_mode"] = "relay";
+    j["evaluation"] = nullptr;
+    j["evaluation_error"] =
+        "a relay autotune episode, no step response (pidlab autotune --log analyses it; docs/autotune.md)";
+    if (evaluation) *evaluation = evaluation::Evaluation{};
+    if (evaluated) *evaluated = false;
+    return j;
+  }
   evaluation::Evaluation ev;
   const Status st = replay::EvaluateEpisode(e, &ev);
   const bool ok = st.ok();

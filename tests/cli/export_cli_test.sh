@@ -121,7 +121,7 @@ bad "setpoint weight above 1" "1.5" --gains 1,1,1 --setpoint-weights 1.5,0 --lan
 bad "c = 0.5 with derivative on measurement" "0.5" --gains 1,1,1 --derivative-on measurement \
   --setpoint-weights 1,0.5 --lang c --out x
 bad "unreadable --from" "nothing.json" --from nothing.json --lang c --out x
-bad "--autotune in fixed point" "q31" --gains 1,1,1 --lang c --out x --scalar q31 --input-range -1,1 --autotune
+bad "--autotune in float" "float" --gains 1,1,1 --lang c --out x --scalar float --autotune
 
 # ---- --autotune: the relay autotune beside the PID (docs/autotune.md), strict C99 with both compilers.
 if "$pidlab" export --num 1 --den 1,1 --delay 0.5 --gains 1,1,0 --dt 0.001 --lang c --out relay --autotune \
@@ -133,6 +133,17 @@ if "$pidlab" export --num 1 --den 1,1 --delay 0.5 --gains 1,1,0 --dt 0.001 --lan
     else fail "--autotune: $cc refuses pidlab_relay.c: $(head -c 600 relay/$cc.log)"; fi
   done
 else fail "--autotune: $(cat relay.err)"; fi
+for q in q31 q15; do  # the fixed-point relay over the fixed-point PID (docs/autotune.md)
+  if "$pidlab" export --num 1 --den 1,1 --delay 0.5 --gains 1,1,0 --dt 0.001 --output-limits -2,2 --lang c \
+    --out relay_$q --scalar $q --input-range -2,2 --autotune >relay_$q.out 2>relay_$q.err; then
+    for cc in gcc clang; do
+      if "$cc" "${strict[@]}" -pedantic -c relay_$q/pidlab_relay.c -Irelay_$q -o relay_$q/relay.$cc.o \
+        2>relay_$q/$cc.log; then
+        pass "--autotune --scalar $q: $cc ${strict[*]} -pedantic compiles pidlab_relay.c"
+      else fail "--autotune --scalar $q: $cc refuses pidlab_relay.c: $(head -c 600 relay_$q/$cc.log)"; fi
+    done
+  else fail "--autotune --scalar $q: $(cat relay_$q.err)"; fi
+done
 echo '{"spec": {"plant": "oscillator"}}' >nogains.json
 bad "--from without gains" "gains" --from nogains.json --lang c --out x
 bad "q31 without --input-range" "--input-range" --gains 1,1,1 --output-limits -1,1 --lang c --out x --scalar q31

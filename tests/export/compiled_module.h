@@ -35,12 +35,18 @@ class CompiledModule {
     dir_ = dir_template;
     std::ofstream(dir_ + "/pidlab_pid.h") << code.header;
     std::ofstream(dir_ + "/pidlab_pid.c") << code.source;
+    std::string relay;  // --autotune: the relay and its shim
+    if (!code.relay_source.empty()) {
+      std::ofstream(dir_ + "/pidlab_relay.h") << code.relay_header;
+      std::ofstream(dir_ + "/pidlab_relay.c") << code.relay_source;
+      relay = " " + dir_ + "/pidlab_relay.c " + std::string(PIDLAB_EXPORT_TEST_DIR) + "/shim_relay.c";
+    }
     const std::string so = dir_ + "/module.so";
     const std::string command = std::string(PIDLAB_TEST_CC) +
                                 " -std=c99 -O2 -fPIC -shared -ffp-contract=off -Wall -Wextra -Wconversion "
                                 "-Wsign-conversion -Werror " +
-                                extra_flags + " -I" + dir_ + " " + dir_ + "/pidlab_pid.c " + shim + " -o " +
-                                so + " 2>" + dir_ + "/cc.log";
+                                extra_flags + " -I" + dir_ + " " + dir_ + "/pidlab_pid.c " + shim + relay +
+                                " -lm -o " + so + " 2>" + dir_ + "/cc.log";
     if (std::system(command.c_str()) != 0) {
       std::ifstream log(dir_ + "/cc.log");
       throw std::runtime_error("cc failed: " + command + "\n" +
@@ -62,6 +68,15 @@ class CompiledModule {
     quantize_output_ = reinterpret_cast<double (*)(double)>(dlsym(handle_, "shim_quantize_output"));
     output_lsb_ = reinterpret_cast<double (*)()>(dlsym(handle_, "shim_output_lsb"));
     step_raw_ = reinterpret_cast<int (*)(void*, long, long, long*)>(dlsym(handle_, "shim_step_raw"));
+    // The relay only (shim_relay.c).
+    relay_new_ =
+        reinterpret_cast<void* (*)(void*, const double*, int, int)>(dlsym(handle_, "shim_relay_new"));
+    relay_free_ = reinterpret_cast<void (*)(void*)>(dlsym(handle_, "shim_relay_free"));
+    relay_step_ =
+        reinterpret_cast<double (*)(void*, double, double, double)>(dlsym(handle_, "shim_relay_step"));
+    relay_phase_ = reinterpret_cast<int (*)(void*)>(dlsym(handle_, "shim_relay_phase"));
+    relay_cycle_count_ = reinterpret_cast<long (*)(void*)>(dlsym(handle_, "shim_relay_cycle_count"));
+    relay_cycle_ = reinterpret_cast<int (*)(void*, long, double*)>(dlsym(handle_, "shim_relay_cycle"));
   }
   ~CompiledModule() {
     if (handle_) dlclose(handle_);
@@ -83,6 +98,12 @@ class CompiledModule {
   double (*quantize_output_)(double) = nullptr;
   double (*output_lsb_)() = nullptr;
   int (*step_raw_)(void*, long, long, long*) = nullptr;
+  void* (*relay_new_)(void*, const double*, int, int) = nullptr;
+  void (*relay_free_)(void*) = nullptr;
+  double (*relay_step_)(void*, double, double, double) = nullptr;
+  int (*relay_phase_)(void*) = nullptr;
+  long (*relay_cycle_count_)(void*) = nullptr;
+  int (*relay_cycle_)(void*, long, double*) = nullptr;
 
  private:
   template <typename F>

@@ -5,7 +5,7 @@
 # function, solved here with scipy), the FOPDT parameters against the plant's,
 # and the adopted gains' Ms on the true plant (pidlab evaluate) within the
 # bound. Runs in the private network namespace ctest gives it (unshare -n).
-# usage: autotune_test.sh BIN_DIR CASE [PYTHON_DIR]
+# usage: autotune_test.sh BIN_DIR CASE [PYTHON_DIR [LCM_C_DIR LCM_FIELDS_DIR]]
 set -uo pipefail
 bin=$1 case=$2 python_dir=${3:-}
 . "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
@@ -151,6 +151,20 @@ PY
       pass_line="PASS replay --redrive reproduces the relay episode's and the step's commands bit for bit"
       echo "$pass_line"
     else echo "FAIL replay --redrive: $(grep redrive replay.txt)"; fi
+    # The relay episode is no step: the table says so instead of an IAE, and the JSON names its mode.
+    "$bin/pidlab" replay run.lcmlog --json >replay.json 2>/dev/null || echo "FAIL replay --json"
+    /usr/bin/python3 - <<'PY'
+import json
+eps = json.load(open("replay.json"))["episodes"]
+relay = [e for e in eps if e.get("controller_mode") == "relay"]
+steps = [e for e in eps if e.get("controller_mode") != "relay"]
+ok = len(relay) == 1 and relay[0]["evaluation"] is None and "relay" in relay[0]["evaluation_error"] and \
+     all(e["evaluation"] and e["evaluation"]["iae"] > 0 for e in steps)
+print(("PASS " if ok else "FAIL ") + "replay reports the relay episode as one, with no IAE, and the step's IAE: %s"
+      % [e["evaluation"]["iae"] for e in steps])
+PY
+    if grep -q "relay autotune" replay.txt; then echo "PASS replay's table names the relay episode"
+    else echo "FAIL replay's table: $(head -5 replay.txt)"; fi
     "$bin/pidlab" autotune --log run.lcmlog --episode 42 >/dev/null 2>err; rc=$?
     if [ $rc = 2 ] && grep -q "no relay episode 42" err; then echo "PASS --episode naming no relay episode: exit 2, one line"
     else echo "FAIL --episode 42: exit $rc, $(cat err)"; fi ;;
@@ -178,6 +192,71 @@ ok = len(same) == len(keys) and b["adopted"]
 print(("PASS " if ok else "FAIL ") + "%s: the exported C relay in the trio (%s, %d cycles, %d restart(s)) gives pidlab's "
       "experiment, estimates and gains bit for bit: %s" % (name, x["end"], len(x["cycles"]), x["restarts"], same))
 PY
+    done ;;
+  firmware_fixed)  # the fixed-point relay (pidlab export --autotune --scalar q31|q15) compiled into
+    # pidlab-controller-c and run in the trio. pidlab autotune --scalar checks every switch and every input
+    # (within 3 LSB in q31, 2 in q15); the firmware's own cycles (--print-relay) equal the autotune's bit for
+    # bit; against the double run of the same case the estimates lie within eps = 2 (qy/a + qu/d) + dt/Pu
+    # (relative) and the gains within 3 eps: docs/autotune.md, "In the firmware".
+    lcm_c=$4 fields=$5 src="$(dirname "${BASH_SOURCE[0]}")/../../controller/export/process/controller_role_c.c"
+    url='udpm://239.255.76.67:7667?ttl=0'
+    for f in "$lcm_c"/*.c; do gcc -std=c99 -O2 -w -c "$f" -I"$lcm_c" -o "$(basename "$f" .c).o" || echo "FAIL lcm-gen C: $f"; done
+    for run in "heat 0,2 --num 1 --den 1,1 --delay 0.5 --dt 0.001 --reference 0.2 --output-limits 0,2 --gains 0.5,0.5,0" \
+               "noise -4,4 --num 1 --den 1,1 --delay 0.5 --dt 0.001 --measurement-noise 0.05 --seed 7 --output-limits -4,4 --relay-amplitude 1"; do
+      set -- $run; name=$1 limits=$2; shift 2
+      "$bin/pidlab" launch --isolated -- "$bin/pidlab" autotune --backend lcm --json --method simc "$@" \
+        >"$name.double.json" 2>"$name.double.err" || echo "FAIL $name: autotune in double: $(tail -1 "$name.double.err")"
+      for q in q31 q15; do
+        # The module is exported with the loop's limits and input range (its grids, which autotune --scalar
+        # --input-range reads the same way), for gains up to 2,2,0: it accepts the hold's and the design's.
+        "$bin/pidlab" export --num 1 --den 1,1 --delay 0.5 --gains 2,2,0 --dt 0.001 --output-limits "$limits" --lang c \
+          --out "$name.$q" --scalar $q --input-range -2,2 --autotune >/dev/null 2>"$name.$q.export.err" ||
+          echo "FAIL $name $q: export: $(cat "$name.$q.export.err")"
+        gcc -std=c99 -O2 -Wall -Wextra -Werror -ffp-contract=off -D_POSIX_C_SOURCE=200809L -DPIDLAB_RELAY \
+          -I"$name.$q" -I"$lcm_c" -I"$fields" "$src" "$name.$q/pidlab_pid.c" "$name.$q/pidlab_relay.c" ./*.o \
+          -llcm -lm -o "ctl.$name.$q" 2>"$name.$q.cc.err" || echo "FAIL $name $q: compile: $(head -c 600 "$name.$q.cc.err")"
+        "./ctl.$name.$q" --lcm-url "$url" --print-relay >"$name.$q.ctl" 2>"$name.$q.ctl.err" & pc=$!
+        "$bin/pidlab" launch --roles plant,disturbance --lcm-url "$url" --log "$name.$q.lcmlog" -- "$bin/pidlab" \
+          autotune --backend lcm --json --method simc --scalar $q --input-range -2,2 "$@" >"$name.$q.json" \
+          2>"$name.$q.err" || echo "FAIL $name $q: autotune with the $q firmware: $(tail -1 "$name.$q.err")"
+        kill -TERM $pc; wait $pc
+        # The same from the log alone: every input checked again on the same grids.
+        "$bin/pidlab" autotune --log "$name.$q.lcmlog" --method simc --scalar $q --input-range -2,2 --json \
+          >"$name.$q.log.json" 2>"$name.$q.log.err" || echo "FAIL $name $q: autotune --log: $(tail -1 "$name.$q.log.err")"
+        /usr/bin/python3 - "$name" "$q" "$limits" <<'PY' || echo "FAIL $name $q: the comparison did not complete"
+import json, sys
+name, q = sys.argv[1:3]
+d, f = json.load(open(name + ".double.json")), json.load(open(name + "." + q + ".json"))
+ends = [json.loads(l) for l in open(name + "." + q + ".ctl")]
+ok = True
+def say(good, what):
+    global ok
+    print(("PASS " if good else "FAIL ") + "%s %s: %s" % (name, q, what))
+    ok = ok and good
+x = f["experiment"]
+say(f["adopted"] and x["end"] == "done", "the %s relay converged (%d cycles) and its gains were adopted: %s" % (q, len(x["cycles"]), f["verdict"]))
+mine = [[c[k] for k in ("start_s", "t_on_s", "t_off_s", "e_max", "e_min", "integral_e", "integral_on_e")] for c in x["cycles"]]
+say(bool(ends) and ends[-1]["cycles"] == mine,
+    "the firmware's own %d cycles equal pidlab autotune's bit for bit" % len(ends[-1]["cycles"] if ends else []))
+bits = 31 if q == "q31" else 15
+u_top = max(abs(float(v)) for v in sys.argv[3].split(","))  # U: the limits' power of two (2 and 4 here)
+qy, qu = 2.0 / 2 ** bits, u_top / 2 ** bits  # X = 2 (--input-range -2,2)
+a, dd = f["estimates"]["amplitude"], min(x["d_high"], x["d_low"])
+eps = 2 * (qy / a + qu / dd) + 0.001 / f["estimates"]["period_s"]
+ed, ef = d["estimates"], f["estimates"]
+pairs = [("Ku", ed["ku"], ef["ku"]), ("Pu", ed["period_s"], ef["period_s"])] + \
+        [(k, ed["model"][m], ef["model"][m]) for k, m in (("K", "gain"), ("T", "time_constant_s"), ("L", "delay_s"))]
+worst = max(abs(b - a) / abs(a) for _, a, b in pairs)
+say(worst <= eps, "the estimates within eps = %.3g of the double run's: %s" % (eps, ", ".join("%s %.6g/%.6g" % p for p in pairs)))
+g = [(k, d["gains"][k], f["gains"][k]) for k in ("kp", "ki")]
+gw = max(abs(b - a) / abs(a) for _, a, b in g)
+say(gw <= 3 * eps, "the gains within 3 eps of the double run's (%.3g): %s" % (gw, g))
+l = json.load(open(name + "." + q + ".log.json"))
+say(all(l[k] == f[k] for k in ("estimates", "design", "gains", "adopted")) and l["experiment"]["cycles"] == x["cycles"],
+    "autotune --log --scalar %s recomputes the cycles, estimates, design and gains bit for bit" % q)
+sys.exit(0 if ok else 1)
+PY
+      done
     done ;;
   python_refuses)  # examples/python_controller.py runs the PID only: it ignores a relay episode, saying why,
     # and the autotune ends naming the silent controller, changing nothing

@@ -8,11 +8,19 @@
  * y_k -> u_k once, a resent y_k -> the same u_k again.
  *
  *   pidlab-controller-c [--lcm-url udpm://GROUP:PORT?ttl=N] [--channel-prefix P] [--verbose]
- *                       [--print-configs]
+ *                       [--print-configs] [--print-relay]
  *
  * --print-configs writes every configuration it accepts to stdout as one JSON
  * line, every field of the message by its .lcm name (the X-macro
  * <pidlab/lcmt_episode_config_fields.h>): what this controller saw.
+ * --print-relay writes each relay episode's end to stdout as one JSON line:
+ * the end code and its own cycles (pidlab_relay_cycle_at), each
+ * [start_s, t_on_s, t_off_s, e_max, e_min, integral_e, integral_on_e].
+ *
+ * Built around a fixed-point module (pidlab export --scalar q31|q15, whose
+ * pidlab_pid.h defines PIDLAB_Q_BITS) it rounds r and y to the module's
+ * grid, floor(v 2^bits / X + 0.5) clipped to the integer type, and sends
+ * u = q U 2^-bits (docs/autotune.md, "In the firmware").
  *
  * Not supported: --auth-key (HMAC tags, docs/security.md). */
 #include <lcm/lcm.h>
@@ -53,10 +61,11 @@ typedef struct {
   pidlab_relay relay; /* a relay episode (controller_mode "relay", docs/autotune.md) */
 #endif
   int relay_on;
+  int relay_printed;
   pidlab_lcmt_control_command last;
   int have_last;
   long episodes, commands, foreign, duplicates, bad_configs, conflicts;
-  int print_configs;
+  int print_configs, print_relay;
 } controller;
 
 static volatile sig_atomic_t stop = 0;
@@ -92,6 +101,17 @@ static void ack(controller *c, int64_t episode_id) {
 }
 
 static int finite(double x) { return x - x == 0.0; }
+
+#ifdef PIDLAB_Q_BITS
+/* A value in the loop's units on the module's input grid, and a pidlab_q
+ * output back in the loop's units (RelayTuner's QIn, relay.cc). */
+static pidlab_q to_q_in(double v) {
+  const double top = ldexp(1.0, PIDLAB_Q_BITS),
+               q = floor(ldexp(v / PIDLAB_INPUT_FULL_SCALE, PIDLAB_Q_BITS) + 0.5);
+  return (pidlab_q)(q < -top ? -top : (q > top - 1.0 ? top - 1.0 : q));
+}
+static double from_q_out(pidlab_q u) { return (double)u * ldexp(PIDLAB_OUTPUT_FULL_SCALE, -PIDLAB_Q_BITS); }
+#endif
 
 /* The controller's share of transport::ParseEpisodeConfig: what it uses. */
 static const char *config_error(const pidlab_lcmt_episode_config *m) {
@@ -163,10 +183,15 @@ static void to_config(const pidlab_lcmt_episode_config *m, pidlab_pid_config *p)
   p->setpoint_weight_b = m->setpoint_weight_b;
   p->setpoint_weight_c = m->setpoint_weight_c;
   p->dt_s = m->dt_s;
+#ifdef PIDLAB_Q_BITS /* fixed point: finite limits (init refuses others) */
+  p->output_min = m->output_min;
+  p->output_max = m->output_max;
+#else
   p->has_output_min = finite(m->output_min);
   p->output_min = p->has_output_min ? m->output_min : 0.0;
   p->has_output_max = finite(m->output_max);
   p->output_max = p->has_output_max ? m->output_max : 0.0;
+#endif
   p->anti_windup = !strcmp(m->anti_windup, "none")       ? PIDLAB_ANTI_WINDUP_NONE
                    : !strcmp(m->anti_windup, "clamping") ? PIDLAB_ANTI_WINDUP_CLAMPING
                                                          : PIDLAB_ANTI_WINDUP_BACK_CALCULATION;
@@ -235,6 +260,36 @@ static void print_config(const pidlab_lcmt_episode_config *m) {
   fflush(stdout);
 }
 
+#ifdef PIDLAB_RELAY
+/* The relay's end and its cycles, one JSON line. */
+static void print_relay_end(const controller *c) {
+  long i;
+  printf("{\"episode_id\": %lld, \"phase\": %d, \"end\": %d, \"cycles\": [", (long long)c->episode_id,
+         (int)pidlab_relay_get_phase(&c->relay), (int)pidlab_relay_get_end(&c->relay));
+  for (i = 0; i < pidlab_relay_cycle_count(&c->relay); ++i) {
+    const pidlab_relay_cycle *k = pidlab_relay_cycle_at(&c->relay, i);
+    if (!k) continue;
+    printf("%s[", i ? ", " : "");
+    print_double(k->start_s);
+    fputs(", ", stdout);
+    print_double(k->t_on_s);
+    fputs(", ", stdout);
+    print_double(k->t_off_s);
+    fputs(", ", stdout);
+    print_double(k->e_max);
+    fputs(", ", stdout);
+    print_double(k->e_min);
+    fputs(", ", stdout);
+    print_double(k->integral_e);
+    fputs(", ", stdout);
+    print_double(k->integral_on_e);
+    putchar(']');
+  }
+  fputs("]}\n", stdout);
+  fflush(stdout);
+}
+#endif
+
 static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_lcmt_episode_config *m,
                       void *user) {
   controller *c = (controller *)user;
@@ -274,6 +329,7 @@ static void on_config(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
   c->reference = m->reference;
   c->expected = 0;
   c->have_last = 0;
+  c->relay_printed = 0;
   ++c->episodes;
   if (c->print_configs) print_config(m);
   ack(c, c->episode_id);
@@ -304,13 +360,29 @@ static void on_output(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
   if (m->step == c->expected && m->step < c->total_steps) {
     double u = 0.0; /* INVALID_INPUT: the C++ sends the 0.0 its u was initialised with */
     pidlab_pid_status status = PIDLAB_PID_INVALID_INPUT;
+#ifdef PIDLAB_Q_BITS
+    pidlab_q uq = 0;
+    if (!c->relay_on && finite(m->y)) {
+      status = pidlab_pid_step(&c->pid, to_q_in(c->reference), to_q_in(m->y), &uq);
+      u = from_q_out(uq);
+    }
+#else
     if (!c->relay_on) {
       status = pidlab_pid_step(&c->pid, c->reference, m->y, &u);
     }
+#endif
 #ifdef PIDLAB_RELAY
-    else if (finite(m->y)) { /* the relay: its u, status OK, as pidlab-controller's */
+    else if (c->relay_on && finite(m->y)) { /* the relay: its u, status OK, as pidlab-controller's */
+#ifdef PIDLAB_Q_BITS
+      u = from_q_out(pidlab_relay_step(&c->relay, to_q_in(c->reference), to_q_in(m->y)));
+#else
       u = pidlab_relay_step(&c->relay, m->t_s, c->reference, m->y);
+#endif
       status = PIDLAB_PID_OK;
+      if (c->print_relay && !c->relay_printed && pidlab_relay_get_phase(&c->relay) >= PIDLAB_RELAY_DONE) {
+        print_relay_end(c);
+        c->relay_printed = 1;
+      }
     }
 #endif
     c->last.episode_id = c->episode_id;
@@ -375,15 +447,19 @@ int main(int argc, char **argv) {
       verbose = 1;
     else if (!strcmp(argv[i], "--print-configs"))
       c.print_configs = 1;
+    else if (!strcmp(argv[i], "--print-relay"))
+      c.print_relay = 1;
     else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
       printf(
           "pidlab-controller-c: the trio's controller role in C (docs/export.md)\n"
           "usage: pidlab-controller-c [--lcm-url URL] [--channel-prefix P] [--verbose] [--print-configs]\n"
+          "                           [--print-relay]\n"
           "  --lcm-url URL       udpm://GROUP:PORT?ttl=N (default $PIDLAB_LCM_URL, else "
           "udpm://239.255.76.67:7667?ttl=0)\n"
           "  --channel-prefix P  prefix of every channel (default $PIDLAB_CHANNEL_PREFIX, else PIDLAB_)\n"
           "  --verbose, -v       print the counters when stopped\n"
-          "  --print-configs     print every configuration accepted, one JSON line of every message field\n");
+          "  --print-configs     print every configuration accepted, one JSON line of every message field\n"
+          "  --print-relay       print each relay episode's end and its cycles, one JSON line\n");
       return 0;
     } else {
       fprintf(stderr, "pidlab-controller-c: error: unknown argument '%.80s'\n", argv[i]);

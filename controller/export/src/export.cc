@@ -212,14 +212,29 @@ bool ControllerIsValid(const Controller& c, std::string* error) {
   return false;
 }
 
+FixedScale FixedPointScale(const Options& options, const Controller& controller) {
+  std::string error;
+  if (!options.IsValid(&error) || !ControllerIsValid(controller, &error)) throw std::invalid_argument(error);
+  if (options.scalar != Scalar::kQ31 && options.scalar != Scalar::kQ15)
+    throw std::invalid_argument("--scalar " + ToString(options.scalar) + " is not fixed point (q31, q15)");
+  return internal::Scales(options, controller);
+}
+
 GeneratedCode Generate(const Options& options, const Controller& controller) {
   std::string error;
   if (!options.IsValid(&error) || !ControllerIsValid(controller, &error)) throw std::invalid_argument(error);
-  if (options.autotune && options.scalar != Scalar::kDouble)
-    throw std::invalid_argument("--autotune: the relay autotune is exported in double only, not " +
-                                ToString(options.scalar));
-  if (options.scalar == Scalar::kQ31 || options.scalar == Scalar::kQ15)
-    return internal::GenerateFixed(options, controller, CommentBody(CommentLines(options, controller)));
+  if (options.autotune && options.scalar == Scalar::kFloat)
+    throw std::invalid_argument(
+        "--autotune: the relay autotune is exported in double, q31 and q15, not float");
+  if (options.scalar == Scalar::kQ31 || options.scalar == Scalar::kQ15) {
+    GeneratedCode code =
+        internal::GenerateFixed(options, controller, CommentBody(CommentLines(options, controller)));
+    if (options.autotune) {
+      code.relay_header = internal::kRelayFixedHeader;
+      code.relay_source = internal::kRelayFixedSource;
+    }
+    return code;
+  }
   GeneratedCode code{kRealHeader, kRealSource, "", ""};
   if (options.autotune) {
     code.relay_header = internal::kRelayHeader;

@@ -136,6 +136,11 @@ std::string FixedConfig(const Controller& c) {
 
 }  // namespace
 
+FixedScale Scales(const Options& options, const Controller& controller) {
+  const Scaling s = Scale(options, controller);
+  return FixedScale{s.nio, s.x, s.u};
+}
+
 GeneratedCode GenerateFixed(const Options& options, const Controller& controller,
                             const std::string& comment) {
   const Scaling s = Scale(options, controller);

@@ -13,6 +13,9 @@ extern const char* const kFixedSource;
 // The relay autotune (double, with pidlab_pid.h): pidlab_relay.h, pidlab_relay.c.
 extern const char* const kRelayHeader;
 extern const char* const kRelaySource;
+// The relay autotune in fixed point (q31, q15, with the fixed pidlab_pid.h).
+extern const char* const kRelayFixedHeader;
+extern const char* const kRelayFixedSource;
 
 }  // namespace pidlab::controller_export::internal
 
@@ -25,5 +28,7 @@ namespace pidlab::controller_export::internal {
 /// The fixed-point module (q31, q15): the scalings, the range analysis and
 /// the text. `comment` is the header comment's common part.
 GeneratedCode GenerateFixed(const Options& options, const Controller& controller, const std::string& comment);
+/// Its grids (export.h's FixedPointScale).
+FixedScale Scales(const Options& options, const Controller& controller);
 
 }  // namespace pidlab::controller_export::internal

@@ -45,10 +45,17 @@ Status ReplayRelay(const RelayTuneOptions& relay, const PidGains& previous, cons
       return Status::RunnerFailed("the measurement at t = " + Num(s.t_s) +
                                   " s is not finite: the test stops");
     const double u = tuner->Step(s.t_s, s.r, s.y);
-    if (std::memcmp(&u, &s.u, sizeof u) != 0)
-      return Status::RunnerFailed("step " + std::to_string(k) + " (t = " + Num(s.t_s) +
-                                  " s): the controller put out " + Num(s.u) + ", the relay gives " + Num(u) +
-                                  ": the controller does not run this relay");
+    // Double: bit for bit. Fixed point: within the exported relay's bound
+    // (its previous PID rounds), where a switch at another step differs by
+    // the relay's whole amplitude.
+    const double tolerance = tuner->input_tolerance();
+    if (tolerance == 0.0 ? std::memcmp(&u, &s.u, sizeof u) != 0 : !(std::abs(u - s.u) <= tolerance))
+      return Status::RunnerFailed(
+          "step " + std::to_string(k) + " (t = " + Num(s.t_s) + " s): the controller put out " + Num(s.u) +
+          ", the relay gives " + Num(u) +
+          (tolerance == 0.0 ? std::string() : " (bound " + Num(tolerance) + ")") +
+          ": the controller does not run this relay" +
+          (relay.q_bits == 0 ? std::string() : " in q" + std::to_string(relay.q_bits)));
   }
   return Status::Ok();
 }

@@ -33,6 +33,7 @@
 // Every decision reads only the measurements and the options, so a log of
 // the episode gives the same cycles and the same end.
 
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
@@ -57,9 +58,24 @@ struct RelayTuneOptions {
   double tolerance = 0.02;                                   ///< in (0, 1)
   double timeout_periods = 20.0;                             ///< > settled_cycles + 1
   int max_restarts = 2;                                      ///< >= 0
+  /// Fixed point: the exported q31/q15 relay's arithmetic (docs/autotune.md,
+  /// "In the firmware"). 0: double. 31 or 15: y is rounded to the grid
+  /// input_full_scale 2^-q_bits and u to output_full_scale 2^-q_bits, time
+  /// counts steps, and every decision is the integer one the exported
+  /// fixed-point relay makes; only the previous PID stays in double, so its
+  /// input is the exported one's within kFixedRelayLsb LSB.
+  int q_bits = 0;
+  double input_full_scale = 1.0;   ///< X > 0 (q_bits != 0): the input's full scale
+  double output_full_scale = 1.0;  ///< U > 0 (q_bits != 0): the output's full scale
 
   bool IsValid(std::string* error) const;
 };
+
+/// In fixed point, the exported relay's input and RelayTuner's differ by at
+/// most this many LSB of the output (u0 is the mean of the PID's input over
+/// the hold, each within the PID's test bound: 2 LSB in q31, 1 in q15; its
+/// rounding adds 1). Every switch is at the same step.
+int FixedRelayLsb(int q_bits);
 
 enum class RelayPhase { kHold, kRelay, kDone, kAborted };
 /// hold | relay | done | aborted
@@ -105,6 +121,9 @@ class RelayTuner {
   /// Where load changes restarted the test, s.
   const std::vector<double>& load_changes_s() const { return load_changes_s_; }
   const RelayTuneOptions& options() const { return o_; }
+  /// How far the controller's input may be from Step's: 0 (bit for bit) in
+  /// double, FixedRelayLsb(q_bits) LSB of the output in fixed point.
+  double input_tolerance() const;
 
  private:
   void StartHold(double t_s);
@@ -115,6 +134,14 @@ class RelayTuner {
   void End(RelayPhase phase, double t_s, const std::string& why);
   double After(double r, double y);
   bool HasPid() const;
+  // Fixed point (q_bits != 0): the same machine in the exported relay's
+  // integers (relay.cc, "Fixed point").
+  double FixedStep(double t_s, double r, double y);
+  void FixedEndHold(double t_s, std::int64_t r, std::int64_t y);
+  double FixedRelayStep(double t_s, double r, std::int64_t y);
+  double FixedAfter(double r, double y);
+  std::int64_t QIn(double v) const;
+  std::int64_t QOut(double v) const;
 
   RelayTuneOptions o_;
   PidGains previous_;
@@ -139,6 +166,15 @@ class RelayTuner {
   std::vector<double> load_changes_s_;
   double end_s_ = -1.0;
   std::string why_;
+  // Fixed point: steps, and values in grid units.
+  double qy_ = 0.0, qu_ = 0.0;
+  std::int64_t k_ = 0, hold_steps_ = 0, hold_start_k_ = 0, out_min_q_ = 0, out_max_q_ = 0;
+  std::int64_t hyst_q_ = 0, dh_q_ = 0, dl_q_ = 0, y_limit_q_ = 0, u0_cfg_q_ = 0;
+  std::int64_t sum_u_q_ = 0, sum_y_q_ = 0, sum_d_q_ = 0, y_prev_q_ = 0, y_prev2_q_ = 0;
+  std::uint64_t sum_d2_q_ = 0;
+  std::int64_t u0_q_ = 0, y0_q_ = 0, eps_q_ = 0, d_high_q_ = 0, d_low_q_ = 0, relay_start_k_ = 0;
+  std::int64_t e_prev_q_ = 0, k_high_ = -1, k_low_ = -1, e_max_q_ = 0, e_min_q_ = 0, integral_q_ = 0,
+               integral_on_q_ = 0, timeout_q_ = 0;
 };
 
 }  // namespace pidlab

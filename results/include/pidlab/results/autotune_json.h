@@ -55,9 +55,13 @@ nlohmann::json AutotuneJson(const autotune::ExperimentSummary& x, const PidGains
 /// first later episode that ran the designed gains. Adds "backend": "log",
 /// "log" and "episode_ids". kInvalidInput for an unreadable log or no such
 /// relay episode; kRunnerFailed for an incomplete episode or a relay that is
-/// not the logged one.
+/// not the logged one. `fixed_point`, when given, sets the relay's
+/// fixed-point grids (RelayTuneOptions::q_bits) for the loop the episode ran:
+/// a log of an exported q31/q15 relay (`pidlab autotune --log --scalar`).
+using FixedPointRelay =
+    std::function<Status(const PidGains& previous, const PidOptions& pid, RelayTuneOptions* relay)>;
 Status AutotuneLogJson(const std::string& path, int64_t episode_id, const AutotuneDesignOptions& options,
                        const std::function<void(const std::string&)>& say, nlohmann::json* result,
-                       bool* adopted);
+                       bool* adopted, const FixedPointRelay& fixed_point = {});
 
 }  // namespace pidlab::results

@@ -66,7 +66,7 @@ struct Options {
   std::string loop_check;
   /// Also the relay autotune (`--autotune`, docs/autotune.md): pidlab_relay.h
   /// and pidlab_relay.c, controller/relay.h's RelayTuner over this PID.
-  /// Double only.
+  /// Double, q31 and q15 (RelayTuneOptions::q_bits); not float.
   bool autotune = false;
 
   /// False with *error naming the field, its value and the rule broken.
@@ -85,6 +85,17 @@ struct GeneratedCode {
 /// invalid options or an invalid controller (gains, PID options, weights, or
 /// fixed point that cannot represent them).
 GeneratedCode Generate(const Options& options, const Controller& controller);
+
+/// Fixed point's grids (q31, q15): y = q input_full_scale 2^-bits, u = q
+/// output_full_scale 2^-bits, as Generate scales them. Throws
+/// std::invalid_argument as Generate does for a controller fixed point
+/// cannot hold.
+struct FixedScale {
+  int bits = 31;
+  double input_full_scale = 1.0;
+  double output_full_scale = 1.0;
+};
+FixedScale FixedPointScale(const Options& options, const Controller& controller);
 
 /// Checks the controller as Generate does; false with *error.
 bool ControllerIsValid(const Controller& controller, std::string* error);
