@@ -29,7 +29,7 @@ level = {
     'pidlab_autotune': 2,
     'pidlab_role_main': 3, 'pidlab_plant_roles': 3, 'pidlab_controller_role': 3, 'pidlab_analysis': 3,
     'pidlab_monitor': 3,
-    'pidlab_tune': 4, 'pidlab_identify': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4,
+    'pidlab_tune': 4, 'pidlab_identify': 4, 'pidlab_episode_client': 4, 'pidlab_log_reader': 4, 'pidlab_pil': 4,
     'pidlab_tuner': 5, 'pidlab_results': 5, 'pidlab_identify_json': 6, 'pidlab_replay': 5, 'pidlab_launcher': 5,
     'pidlab_report': 6, 'pidlab_replay_json': 6, 'pidlab_autotune_json': 6, 'pidlab_live_json': 7, 'pidlab_figures': 6, 'pidlab_cli': 7,
     'pidlab': 8, 'pidlab_python': 8,
@@ -74,11 +74,12 @@ for exe in ('pidlab-plant', 'pidlab-controller', 'pidlab-disturbance'):
 header_level = {'io': 2, 'spec': 1, 'plant_sim': 1, 'controller': 0, 'optim': 1, 'plot': 3, 'server': 2, 'transport': 2, 'evaluation': 2, 'controller_export': 2,
                 'autotune': 2,
                 'analysis': 3, 'monitor': 3, 'tune': 4, 'identify': 4, 'episode_client': 4, 'replay': 4, 'results': 5, 'launcher': 5, 'report': 6,
+                'pil': 4,
                 'figures': 6}
 lib_dirs = {'io': 2, 'spec': 1, 'server': 2, 'transport': 2, 'tuner/optim': 1, 'tuner/evaluation': 2, 'tuner/analysis': 3, 'monitor': 3,
             'tuner/autotune': 2,
             'tuner/tune': 4, 'tuner/identify': 4, 'tuner/episode_client': 4, 'replay': 5, 'launcher': 5,
-            'plot': 3, 'results': 5, 'report': 6, 'figures': 6}
+            'plot': 3, 'results': 5, 'report': 6, 'figures': 6, 'controller/pil': 4}
 for d, lv in lib_dirs.items():
     for root, _, files in os.walk(os.path.join(src, d)):
         for f in files:

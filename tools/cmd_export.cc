@@ -12,6 +12,7 @@
 #include "export_spec.h"
 #include "pidlab/controller_export/export.h"
 #include "pidlab/evaluation/closed_loop.h"
+#include "pidlab/pil/firmware.h"
 #include "pidlab/spec/loop_spec.h"
 #include "pidlab/tune/problem.h"
 
@@ -78,6 +79,7 @@ struct ExportCommand {
   bool autotune = false;
   std::vector<double> input_range;
   bool force = false;
+  std::string pil_core;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
@@ -106,6 +108,10 @@ struct ExportCommand {
         "also write pidlab_relay.h and pidlab_relay.c: the relay autotune's state machine over this PID "
         "(docs/autotune.md): double (bit for bit pidlab-controller's), q31 or q15 (pidlab autotune "
         "--scalar)");
+    app->add_option("--pil", pil_core,
+                    "also build the module into a firmware for an emulated Cortex-M (processor in the loop, "
+                    "docs/pil.md): m3 (QEMU mps2-an385) or m4f (mps2-an386); writes OUT/pil.elf and "
+                    "OUT/pil.json; needs scripts/install-deps.sh --pil");
     app->add_flag("--force", force,
                   "write the module even when the plant's sampled loop at --dt is unstable (it is refused "
                   "otherwise, exit 2)");
@@ -157,6 +163,11 @@ struct ExportCommand {
 
   int Run() {
     if (lang != "c") throw BadInput("--lang " + Quote(lang) + " is not supported (c is)");
+    pil::Core core = pil::Core::kM3;
+    if (!pil_core.empty() && !pil::ParseCore(pil_core, &core))
+      throw BadInput("--pil " + Quote(pil_core) + " is not m3 or m4f");
+    if (!pil_core.empty() && autotune)
+      throw BadInput("--pil with --autotune: the PIL firmware runs the PID only");
     if (!from.empty() && flags.Given("spec")) throw BadInput("--from and --spec: give one");
     spec::EvaluateSpec s;
     if (!from.empty()) LoadResult(from, &s);
@@ -192,6 +203,28 @@ struct ExportCommand {
     }
     Require(io::WriteFiles({{header, code.header}, {source, code.source}}));
     std::cout << "wrote " << header << " and " << source << " (" << scalar << ")\n";
+    if (!pil_core.empty()) return BuildPil(code, core);
+    return 0;
+  }
+
+  // --pil: the firmware beside the module, and pil.json for pidlab launch
+  // --controller pil:OUT and pidlab-controller-pil.
+  int BuildPil(const GeneratedCode& code, pil::Core core) const {
+    pil::FirmwareBuild build;
+    Require(pil::BuildFirmware(code, core, out, pil::Toolchain{}, &build));
+    const nlohmann::json j = {{"elf", build.elf},
+                              {"core", pil::ToString(core)},
+                              {"machine", pil::QemuMachine(core)},
+                              {"scalar", scalar},
+                              {"text_bytes", build.text},
+                              {"data_bytes", build.data},
+                              {"bss_bytes", build.bss},
+                              {"stack_reserved_bytes", build.stack_reserved},
+                              {"command", build.command}};
+    Require(io::WriteFiles({{out + "/pil.json", j.dump(2) + "\n"}}));
+    std::cout << "built " << build.elf << " for " << (core == pil::Core::kM3 ? "Cortex-M3" : "Cortex-M4F")
+              << " (QEMU " << pil::QemuMachine(core) << "): text " << build.text << ", data " << build.data
+              << ", bss " << build.bss << " bytes, stack " << build.stack_reserved << " reserved\n";
     return 0;
   }
 };

@@ -4,7 +4,9 @@
 // everything.
 
 #include <csignal>
+#include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
 #include "cli_common.h"
 #include "commands.h"
@@ -55,6 +57,7 @@ struct LaunchFlags {
   launcher::LaunchOptions options;
   bool isolated = false;
   std::string roles;
+  std::string controller;  // "" | pil:DIR
   int trios = 1;
   std::vector<std::string> command;
 };
@@ -78,12 +81,34 @@ void ResolveRtPriority(launcher::LaunchOptions* o) {
   }
 }
 
+// --controller pil:DIR: the firmware pidlab export --pil built in DIR
+// (its pil.json names the image and the core) as the controller role.
+void SetPilController(const std::string& text, launcher::LaunchOptions* o) {
+  if (text.rfind("pil:", 0) != 0 || text.size() == 4)
+    throw BadInput("--controller " + Quote(text) + " is not pil:DIR (a folder of pidlab export --pil)");
+  const std::string dir = text.substr(4), path = dir + "/pil.json";
+  std::ifstream in(path);
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const std::exception&) {
+    j = nullptr;
+  }
+  if (!j.is_object() || !j.contains("elf") || !j.contains("core") || !j["elf"].is_string() ||
+      !j["core"].is_string())
+    throw BadInput("--controller " + Quote(text) + ": '" + path +
+                   "' is missing or not pidlab export --pil's pil.json");
+  o->controller_program = "pidlab-controller-pil";
+  o->controller_args = {"--firmware", j["elf"].get<std::string>(), "--core", j["core"].get<std::string>()};
+}
+
 // Starts the trios, runs COMMAND against them and stops everything.
 int RunLaunch(LaunchFlags* flags, const CLI::Option* roles, const CLI::Option* realtime) {
   std::string error;
   if (realtime->count() > 0 && !transport::RealtimeFactorIsValid(flags->options.realtime_factor, &error))
     throw BadInput(error);
   if (roles->count() > 0) flags->options.roles = SplitRoles(flags->roles);
+  if (!flags->controller.empty()) SetPilController(flags->controller, &flags->options);
   if (g_quiet && flags->options.verbose) throw BadInput("--quiet and --verbose contradict each other");
   if (g_quiet) flags->options.stderr_path = "/dev/null";
   if (!flags->options.IsValid(&error)) throw BadInput(error);
@@ -135,6 +160,10 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
       "PIDLAB_LCM_URL, PIDLAB_CHANNEL_PREFIX and PIDLAB_{PLANT,CONTROLLER,DISTURBANCE}_PID of the roles "
       "started here; with --trios K also PIDLAB_TRIOS, PIDLAB_LCM_URLS (the K URLs) and "
       "PIDLAB_TRIO<i>_{PLANT,CONTROLLER,DISTURBANCE}_PID.");
+  app->add_option(
+      "--controller", flags->controller,
+      "pil:DIR runs the controller role on an emulated Cortex-M: the firmware pidlab export --pil "
+      "built in DIR, under pidlab-controller-pil (docs/pil.md)");
   auto* roles = app->add_option(
       "--roles", flags->roles,
       "the roles to start on this host, comma-separated (default: plant,controller,disturbance); the "

@@ -40,10 +40,12 @@ struct ControllerRole::Episode {
   // own counts are the differences.
   long duplicates_at_start = 0;
   long dropped_at_start = 0;
+  bool refused = false;  // the external PID refused it: unanswered
 };
 
-ControllerRole::ControllerRole(Transport* transport, LogFn log, bool verbose)
-    : Role(transport, "controller", std::move(log), verbose) {
+ControllerRole::ControllerRole(Transport* transport, LogFn log, bool verbose,
+                               std::shared_ptr<ExternalPid> external)
+    : Role(transport, "controller", std::move(log), verbose), external_(std::move(external)) {
   transport_->Subscribe<pidlab::lcmt_plant_output>(
       kPlantOutputChannel, [this](const pidlab::lcmt_plant_output& m) { OnOutput(m); });
 }
@@ -57,6 +59,20 @@ void ControllerRole::StartEpisode(const EpisodeSpec& spec) {
     ep->relay = std::make_unique<RelayTuner>(spec.relay_tune, spec.gains, PidOptionsAt(spec.pid, spec.dt_s));
   ep->duplicates_at_start = counters_.duplicates;
   ep->dropped_at_start = transport_->counters().dropped;
+  if (external_ && !halted_) {
+    bool fatal = true;
+    if (spec.relay) {
+      ep->refused = true;
+      fatal = false;
+      Log("episode " + std::to_string(spec.episode_id) +
+          ": a relay episode, and the firmware in the loop runs the PID only: not answered");
+    } else if (const Status st = external_->Configure(spec, &fatal); !st.ok()) {
+      ep->refused = true;
+      Log("episode " + std::to_string(spec.episode_id) + ": " + st.message() +
+          (fatal ? "" : ": not answered"));
+      halted_ = fatal;
+    }
+  }
   ep_ = std::move(ep);
 }
 
@@ -66,10 +82,18 @@ void ControllerRole::OnOutput(const pidlab::lcmt_plant_output& m) {
     return;
   }
   Episode& e = *ep_;
+  if (e.refused || halted_) return;
   if (m.step == e.expected && m.step < e.spec.total_steps) {
     double u = 0.0;
     PidStatus status = PidStatus::kInvalidInput;
-    if (!e.relay) {
+    if (external_) {
+      if (const Status st = external_->Step(e.spec.reference, m.y, &u, &status); !st.ok()) {
+        Log("episode " + std::to_string(e.spec.episode_id) + " step " + std::to_string(m.step) + ": " +
+            st.message());
+        halted_ = true;
+        return;
+      }
+    } else if (!e.relay) {
       status = e.pid->Step(e.spec.reference, m.y, &u);
     } else if (std::isfinite(m.y)) {
       const RelayPhase before = e.relay->phase();

@@ -176,8 +176,13 @@ void Launcher::StartRoles() {
   for (const std::string& role : AllRoles()) {
     ++seed;  // each role's own drop seed (1, 2, 3), wherever the others run
     if (!Started(options_.roles, role)) continue;
-    std::vector<std::string> args = {options_.bin_dir + "pidlab-" + role, "--lcm-url", url_,
-                                     "--channel-prefix", options_.channel_prefix};
+    const std::string program = role == "controller" && !options_.controller_program.empty()
+                                    ? options_.controller_program
+                                    : "pidlab-" + role;
+    std::vector<std::string> args = {options_.bin_dir + program, "--lcm-url", url_, "--channel-prefix",
+                                     options_.channel_prefix};
+    if (role == "controller")
+      args.insert(args.end(), options_.controller_args.begin(), options_.controller_args.end());
     if (options_.drop_rate > 0.0) {
       std::ostringstream rate;
       rate.precision(17);
@@ -193,8 +198,8 @@ void Launcher::StartRoles() {
     if (options_.EffectiveRtPriority() > 0)  // the whole lockstep loop: a paced plant waits for the others
       args.insert(args.end(), {"--rt-priority", std::to_string(options_.EffectiveRtPriority())});
     if (!options_.auth_key_file.empty()) args.insert(args.end(), {"--auth-key", options_.auth_key_file});
-    roles_[role] = supervisor_->Start("pidlab-" + role, args);
-    if (options_.verbose) Note("started pidlab-" + role + " (pid " + std::to_string(roles_[role]) + ")");
+    roles_[role] = supervisor_->Start(program, args);
+    if (options_.verbose) Note("started " + program + " (pid " + std::to_string(roles_[role]) + ")");
   }
 }
 

@@ -54,6 +54,7 @@ void Role::OnConfig(const pidlab::lcmt_episode_config& m) {
 int ServeRole(Transport* transport, Role* role, const volatile std::sig_atomic_t* stop) {
   while (!*stop) {
     if (transport->WaitAndHandle(role->MaxWait()) < 0) return 1;
+    if (role->Halted()) return 2;
     role->Tick(NowSeconds());
   }
   return 0;

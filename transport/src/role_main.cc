@@ -134,9 +134,11 @@ int Serve(const std::string& program, const RoleFlags& f, const RoleFactory& fac
     if (::write(STDERR_FILENO, text.data(), text.size()) < 0) return;
   };
   std::unique_ptr<Role> role = factory(&transport, log, f.verbose);
+  if (!role) return 1;  // the factory said why
   if (f.verbose) log("serving on " + f.url + " with prefix " + f.transport.channel_prefix);
   const int status = ServeRole(&transport, role.get(), &g_stop);
-  if (status != 0) std::cerr << program << ": failed: LCM receive error\n";
+  if (status == 1) std::cerr << program << ": failed: LCM receive error\n";
+  const int exit_status = status == 0 ? 0 : 1;
   if (f.verbose) {
     const TransportCounters& c = transport.counters();
     log("received " + std::to_string(c.received) + ", dropped " + std::to_string(c.dropped) +
@@ -145,16 +147,19 @@ int Serve(const std::string& program, const RoleFlags& f, const RoleFactory& fac
         std::to_string(role->counters().foreign) + ", conflicts " +
         std::to_string(role->counters().conflicts));
   }
-  return status;
+  return exit_status;
 }
 
 }  // namespace
 
 int RoleMain(int argc, char** argv, const std::string& program, const std::string& description,
-             const RoleFactory& factory, RealtimeFlags* realtime) {
+             const RoleFactory& factory, RealtimeFlags* realtime,
+             const std::function<void(CLI::App*)>& more_flags,
+             const std::function<std::string()>& check_flags) {
   CLI::App app{description, program};
   RoleFlags flags;
   RegisterRoleFlags(&app, &flags, realtime);
+  if (more_flags) more_flags(&app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -163,7 +168,8 @@ int RoleMain(int argc, char** argv, const std::string& program, const std::strin
     std::cerr << program << ": error: " << e.what() << "\n";
     return 2;
   }
-  const std::string error = CheckRoleFlags(&flags, realtime);
+  std::string error = CheckRoleFlags(&flags, realtime);
+  if (error.empty() && check_flags) error = check_flags();
   if (!error.empty()) {
     std::cerr << program << ": error: " << error << "\n";
     return 2;

@@ -367,8 +367,10 @@ static void on_output(const lcm_recv_buf_t *rbuf, const char *ch, const pidlab_l
       u = from_q_out(uq);
     }
 #else
-    if (!c->relay_on) {
-      status = pidlab_pid_step(&c->pid, c->reference, m->y, &u);
+    if (!c->relay_on) { /* double or float: the module's pidlab_real */
+      pidlab_real ur = 0;
+      status = pidlab_pid_step(&c->pid, (pidlab_real)c->reference, (pidlab_real)m->y, &ur);
+      u = (double)ur;
     }
 #endif
 #ifdef PIDLAB_RELAY

@@ -70,6 +70,11 @@ struct LaunchOptions {
   /// passed to the processes with --auth-key and to COMMAND as
   /// $PIDLAB_AUTH_KEY_FILE; the launcher's own messages carry it too.
   std::string auth_key_file;
+  /// The controller role's program in bin_dir (empty: pidlab-controller) and
+  /// the arguments it takes after the common ones: pidlab launch --controller
+  /// pil:DIR runs pidlab-controller-pil --firmware DIR/pil.elf --core C.
+  std::string controller_program;
+  std::vector<std::string> controller_args;
 
   bool IsValid(std::string* error) const;
   std::string EffectiveLcmUrl() const;

@@ -40,6 +40,8 @@ class Role {
   /// The longest a caller may wait before the next Tick.
   virtual double MaxWait() const { return 0.05; }
   const RoleCounters& counters() const { return counters_; }
+  /// True once the role cannot go on (it has said why): ServeRole returns.
+  virtual bool Halted() const { return false; }
   const std::string& role() const { return role_; }
 
  protected:
@@ -62,7 +64,7 @@ class Role {
 };
 
 /// Serves `role` until *stop becomes true (checked between waits). Returns 0,
-/// or 1 on an LCM error.
+/// 1 on an LCM error, or 2 when the role halted (Role::Halted).
 int ServeRole(Transport* transport, Role* role, const volatile std::sig_atomic_t* stop);
 
 }  // namespace pidlab::transport

@@ -8,6 +8,10 @@
 
 #include "pidlab/transport/role.h"
 
+namespace CLI {
+class App;
+}
+
 namespace pidlab::transport {
 
 using RoleFactory = std::function<std::unique_ptr<Role>(Transport* transport, LogFn log, bool verbose)>;
@@ -22,7 +26,14 @@ struct RealtimeFlags {
 /// 1 if LCM cannot start or fails. With `realtime`, the process also takes
 /// --realtime [FACTOR] and --rt-priority N; a refused SCHED_FIFO is said on
 /// stderr once, and the process continues at normal priority.
+///
+/// `more_flags` registers a process's own flags; `check_flags` then returns
+/// "" or the one line of exit 2 naming the bad value (both may be empty).
+/// A factory that returns null has said why on stderr: exit 1. A role that
+/// halts (Role::Halted) has said why: exit 1.
 int RoleMain(int argc, char** argv, const std::string& program, const std::string& description,
-             const RoleFactory& factory, RealtimeFlags* realtime = nullptr);
+             const RoleFactory& factory, RealtimeFlags* realtime = nullptr,
+             const std::function<void(CLI::App*)>& more_flags = {},
+             const std::function<std::string()>& check_flags = {});
 
 }  // namespace pidlab::transport
