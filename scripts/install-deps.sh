@@ -3,7 +3,10 @@
 # lacks, then the page's npm packages (package.json, pinned by package-lock.json:
 # uPlot, embedded in pidlab serve; puppeteer-core, for the browser tests) into
 # node_modules/ with npm ci. Safe to run again: it installs only what is missing.
-#   scripts/install-deps.sh [--no-java]   (--no-java: skip the JDK that tools/lcm-spy needs)
+#   scripts/install-deps.sh [--no-java] [--pil]
+#   --no-java: skip the JDK that tools/lcm-spy needs
+#   --pil: also the processor-in-the-loop toolchain (docs/pil.md): gcc-arm-none-eabi,
+#          libnewlib-arm-none-eabi and qemu-system-arm (about 600 MB installed)
 set -euo pipefail
 
 packages=(
@@ -21,7 +24,8 @@ no_java=0
 for arg in "$@"; do
   case "$arg" in
     --no-java) no_java=1 ;;
-    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    --pil) packages+=(gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm) ;;
+    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
     *) echo "install-deps.sh: error: unknown option '$arg'" >&2; exit 2 ;;
   esac
 done

@@ -17,7 +17,8 @@ case "${1:-}" in
   "") ;;
   *) echo "usage: scripts/test.sh [--fast]" >&2; exit 2 ;;
 esac
-bash scripts/install-deps.sh
+# The full run needs the processor-in-the-loop toolchain too (integration.pil, docs/pil.md).
+if [ "$fast" = 1 ]; then bash scripts/install-deps.sh; else bash scripts/install-deps.sh --pil; fi
 if [ "$fast" = 1 ]; then
   bash scripts/build.sh
   cd build

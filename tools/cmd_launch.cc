@@ -99,7 +99,8 @@ void SetPilController(const std::string& text, launcher::LaunchOptions* o) {
     throw BadInput("--controller " + Quote(text) + ": '" + path +
                    "' is missing or not pidlab export --pil's pil.json");
   o->controller_program = "pidlab-controller-pil";
-  o->controller_args = {"--firmware", j["elf"].get<std::string>(), "--core", j["core"].get<std::string>()};
+  o->controller_args = {"--firmware", j["elf"].get<std::string>(), "--core", j["core"].get<std::string>(),
+                        "--report",   dir + "/pil_report.json"};
 }
 
 // Starts the trios, runs COMMAND against them and stops everything.

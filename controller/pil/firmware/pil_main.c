@@ -83,10 +83,27 @@ static void configure(const uint8_t *p) {
   send(PIL_ACK, (const uint8_t *)&status, 4);
 }
 
+#ifdef PIL_FAULT
+/* Test builds only (PIDLAB_PIL_CFLAGS="-DPIL_FAULT=1|2 -DPIL_FAULT_STEP=N"):
+ * at step N, 1 sends a wrong frame, 2 stalls. */
+static unsigned long pil_steps;
+#endif
+
 static void step(const uint8_t *p) {
   uint8_t out[13];
   uint32_t t0, t1;
   pidlab_pid_status status;
+#ifdef PIL_FAULT
+  if (++pil_steps == PIL_FAULT_STEP) {
+#if PIL_FAULT == 1
+    put_byte(0x00);
+    put_byte(0x13);
+#else
+    for (;;) {
+    }
+#endif
+  }
+#endif
 #ifdef PIDLAB_Q_BITS
   int64_t r64, y64, u64;
   pidlab_q r, y, u = 0;

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -41,6 +42,12 @@ uint16_t Crc16(const uint8_t* p, std::size_t n, uint16_t crc) {
       crc = static_cast<uint16_t>((crc & 0x8000U) ? (crc << 1) ^ 0x1021U : crc << 1);
   }
   return crc;
+}
+
+std::string Seconds(double s) {
+  std::ostringstream os;
+  os << s;
+  return os.str();
 }
 
 double Now() {
@@ -140,13 +147,18 @@ Status BuildFirmware(const controller_export::GeneratedCode& code, Core core, co
     if (const Status st = WriteText(dir + "/" + name, text); !st.ok()) return st;
   const std::string cpu = core == Core::kM3 ? "-mcpu=cortex-m3 -mthumb -mfloat-abi=soft"
                                             : "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16";
-  const std::string d = Quote(dir);
-  build->elf = dir + "/pil.elf";
+  char resolved[PATH_MAX];
+  const std::string absolute = realpath(dir.c_str(), resolved) ? std::string(resolved) : dir;
+  const std::string d = Quote(absolute);
+  build->elf = absolute + "/pil.elf";
   build->command = toolchain.gcc + " " + cpu +
                    " -std=c99 -O2 -ffp-contract=off -ffunction-sections -fdata-sections -Wall -Wextra "
                    "-nostartfiles --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections -T " +
                    d + "/pil_link.ld -I" + d + " " + d + "/pil_startup.c " + d + "/pil_main.c " + d +
                    "/pidlab_pid.c -lm -o " + Quote(build->elf);
+  // Extra flags for test builds (integration.pil's faults: -DPIL_FAULT=...).
+  if (const char* extra = std::getenv("PIDLAB_PIL_CFLAGS"); extra && *extra)
+    build->command += " " + std::string(extra);
   const std::string log = dir + "/build.log";
   if (std::system((build->command + " >" + Quote(log) + " 2>&1").c_str()) != 0)
     return Status::RunnerFailed("arm-none-eabi-gcc failed (" + log + "): " + LastLine(ReadText(log)));
@@ -170,7 +182,7 @@ Status BuildFirmware(const controller_export::GeneratedCode& code, Core core, co
 
 Status Firmware::Boot(const Options& options, std::unique_ptr<Firmware>* out) {
   if (!(options.deadline_s > 0.0) || !std::isfinite(options.deadline_s))
-    return Status::InvalidInput("the PIL deadline " + std::to_string(options.deadline_s) +
+    return Status::InvalidInput("the PIL deadline " + Seconds(options.deadline_s) +
                                 " s must be > 0 and finite");
   if (const std::string missing = options.toolchain.Missing(); !missing.empty())
     return Status::RunnerFailed(missing);
@@ -306,8 +318,8 @@ Status Firmware::ReadExact(uint8_t* p, std::size_t n, double deadline) {
     if (errno != EAGAIN && errno != EINTR) return Exited("an answer");
     const double left = deadline - Now();
     if (left <= 0.0)
-      return Status::RunnerFailed("the firmware did not answer within the " +
-                                  std::to_string(options_.deadline_s) + " s deadline (stalled or faulted)");
+      return Status::RunnerFailed("the firmware did not answer within the " + Seconds(options_.deadline_s) +
+                                  " s deadline (stalled or faulted)");
     pollfd fd{from_fw_, POLLIN, 0};
     poll(&fd, 1, static_cast<int>(std::ceil(left * 1000.0)));
   }
