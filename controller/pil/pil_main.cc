@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "pidlab/controller/controller_role.h"
 #include "pidlab/pil/pil_role.h"
@@ -32,12 +33,17 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app->add_option("--report", report, "at exit, write the steps' cost and the stack as JSON to this file");
   };
+  const auto num = [](double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  };
   const auto check = [&]() -> std::string {
     if (!pil::ParseCore(core_text, &core)) return "--core '" + core_text + "' is not m3 or m4f";
     if (!(deadline_s > 0.0) || !std::isfinite(deadline_s))
-      return "--deadline " + std::to_string(deadline_s) + " must be > 0 and finite";
+      return "--deadline " + num(deadline_s) + " must be > 0 and finite";
     if (!(core_clock_hz >= 0.0) || !std::isfinite(core_clock_hz))
-      return "--core-clock-hz " + std::to_string(core_clock_hz) + " must be >= 0 and finite";
+      return "--core-clock-hz " + num(core_clock_hz) + " must be >= 0 and finite";
     return "";
   };
   const int status = transport::RoleMain(
@@ -56,7 +62,7 @@ int main(int argc, char** argv) {
         if (verbose)
           log("firmware " + elf + " booted on " + pil::QemuMachine(core) + ": " +
               controller_export::ToString(fw->info().scalar));
-        firmware = std::make_shared<pil::FirmwarePid>(std::move(fw), core_clock_hz);
+        firmware = std::make_shared<pil::FirmwarePid>(std::move(fw), core_clock_hz, log);
         return std::make_unique<controller::ControllerRole>(t, log, verbose, firmware);
       },
       nullptr, flags, check);

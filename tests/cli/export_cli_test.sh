@@ -122,6 +122,26 @@ bad "c = 0.5 with derivative on measurement" "0.5" --gains 1,1,1 --derivative-on
   --setpoint-weights 1,0.5 --lang c --out x
 bad "unreadable --from" "nothing.json" --from nothing.json --lang c --out x
 bad "--autotune in float" "float" --gains 1,1,1 --lang c --out x --scalar float --autotune
+bad "an unknown PIL core" "m7" --gains 1,1,1 --lang c --out x --pil m7
+bad "--pil with --autotune" "--autotune" --gains 1,1,1 --lang c --out x --pil m3 --autotune
+
+# ---- --pil's front doors (docs/pil.md): bad values are exit 2 and one line, before anything starts.
+pil_bad() {  # pil_bad WHAT NEEDLE COMMAND...
+  local what=$1 needle=$2 status=0
+  shift 2
+  "$@" >bad.out 2>bad.err || status=$?
+  if [[ $status -ne 2 ]]; then fail "$what: exit $status, expected 2 ($(head -c 300 bad.err))"
+  elif ! why=$(only_line_ok bad.err "$needle"); then fail "$what: $why"
+  else pass "$what: exit 2: $(cat bad.err)"; fi
+}
+ctl_pil="$(dirname "$pidlab")/pidlab-controller-pil"
+pil_bad "pidlab-controller-pil without --firmware" "--firmware" "$ctl_pil" --core m3
+pil_bad "pidlab-controller-pil on an unknown core" "m7" "$ctl_pil" --firmware x.elf --core m7
+pil_bad "pidlab-controller-pil with a deadline of 0" "deadline" "$ctl_pil" --firmware x.elf --deadline 0
+pil_bad "launch --controller that is not pil:DIR" "foo" "$pidlab" launch --controller foo -- true
+pil_bad "launch --controller pil: a folder without pil.json" "pil.json" "$pidlab" launch --controller pil:nowhere -- true
+if "$ctl_pil" --help | grep -q -- "--core-clock-hz"; then pass "pidlab-controller-pil --help names --core-clock-hz"
+else fail "pidlab-controller-pil --help"; fi
 
 # ---- --autotune: the relay autotune beside the PID (docs/autotune.md), strict C99 with both compilers.
 if "$pidlab" export --num 1 --den 1,1 --delay 0.5 --gains 1,1,0 --dt 0.001 --lang c --out relay --autotune \

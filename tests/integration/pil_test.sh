@@ -68,6 +68,26 @@ PY
   done
 done
 
+# The deadline check: the stepper's q31 step on the M3 at 25 MHz fits its 100 us dt; at 5 MHz it does not,
+# and the bridge says so once and counts the steps over (pidlab-controller-pil --core-clock-hz).
+for hz in 25e6 5e6; do
+  "$bin/pidlab-controller-pil" --lcm-url "$url" --firmware "$PWD/pil.stepper.q31.m3/pil.elf" --core m3 \
+    --core-clock-hz $hz --report "deadline.$hz.json" 2>"deadline.$hz.err" & pc=$!
+  "$bin/pidlab" launch --roles plant,disturbance --lcm-url "$url" -- "$bin/pidlab" evaluate --backend lcm \
+    --loop sampled ${plant_flags[stepper]} >/dev/null 2>&1 || echo "FAIL the deadline run at $hz Hz"
+  kill -TERM $pc; wait $pc
+done
+/usr/bin/python3 - <<'PY'
+import json
+fit, slow = json.load(open("deadline.25e6.json"))["deadline"], json.load(open("deadline.5e6.json"))["deadline"]
+line = open("deadline.5e6.err").read().strip().splitlines()
+said = [l for l in line if "deadline:" in l]
+ok = fit["steps_over_dt"] == 0 and fit["worst_fraction_of_dt"] < 1 and slow["steps_over_dt"] == 5000 and len(said) == 1 \
+     and not any("deadline:" in l for l in open("deadline.25e6.err"))
+print(("PASS " if ok else "FAIL ") + "the deadline check: at 25 MHz the worst step takes %.2f of dt, at 5 MHz %d of 5000 "
+      "steps are over, said once: %s" % (fit["worst_fraction_of_dt"], slow["steps_over_dt"], said[0].split(": ", 1)[1] if said else None))
+PY
+
 # A damaged, a stalled and a killed firmware: one line naming it, the trio stopped, nothing left behind.
 fault() {  # fault NAME NEEDLE [CFLAGS]
   local name=$1 needle=$2 cflags=${3:-}

@@ -4,11 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace pidlab::pil {
 
-FirmwarePid::FirmwarePid(std::unique_ptr<Firmware> firmware, double core_clock_hz)
-    : firmware_(std::move(firmware)) {
+FirmwarePid::FirmwarePid(std::unique_ptr<Firmware> firmware, double core_clock_hz, transport::LogFn log)
+    : firmware_(std::move(firmware)), log_(std::move(log)) {
   cost_.core_clock_hz = core_clock_hz;
 }
 
@@ -53,7 +54,13 @@ Status FirmwarePid::Step(double r, double y, double* u, PidStatus* status) {
   if (cost_.core_clock_hz > 0.0 && dt_s_ > 0.0) {
     const double fraction = static_cast<double>(instructions) / cost_.core_clock_hz / dt_s_;
     cost_.worst_fraction_of_dt = std::max(cost_.worst_fraction_of_dt, fraction);
-    if (fraction > 1.0) ++cost_.over_deadline;
+    if (fraction > 1.0 && ++cost_.over_deadline == 1 && log_) {
+      std::ostringstream os;
+      os << "deadline: step " << cost_.steps - 1 << " took " << instructions << " instructions, "
+         << 1e6 * static_cast<double>(instructions) / cost_.core_clock_hz << " us at "
+         << cost_.core_clock_hz / 1e6 << " MHz (one a cycle, emulated), over dt = " << 1e6 * dt_s_ << " us";
+      log_(os.str());
+    }
   }
   return Status::Ok();
 }

@@ -27,7 +27,8 @@ struct StepCost {
 
 class FirmwarePid : public controller::ExternalPid {
  public:
-  FirmwarePid(std::unique_ptr<Firmware> firmware, double core_clock_hz);
+  /// `log` gets one line at the first step over the deadline (may be empty).
+  FirmwarePid(std::unique_ptr<Firmware> firmware, double core_clock_hz, transport::LogFn log = {});
   Status Configure(const transport::EpisodeSpec& spec, bool* fatal) override;
   Status Step(double r, double y, double* u, PidStatus* status) override;
   const StepCost& cost() const { return cost_; }
@@ -36,6 +37,7 @@ class FirmwarePid : public controller::ExternalPid {
  private:
   std::unique_ptr<Firmware> firmware_;
   StepCost cost_;
+  transport::LogFn log_;
   double dt_s_ = 0.0;
   double sum_instructions_ = 0.0;
 };
