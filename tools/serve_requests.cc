@@ -120,6 +120,7 @@ server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
   if (IsLiveRequest(type)) return AnswerLive(live, type, request, connection);
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
   if (type == "export") return Export(request);
+  if (type == "pil_cost") return AnswerPilCost(request, connection);
   if (type == "tune") return AnswerTune(request, connection);
   if (type == "tune_cancel") return AnswerTuneCancel(connection);
   if (type == "identify") return AnswerIdentify(request, connection);
@@ -131,8 +132,8 @@ server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
   return {
       400,
       {{"error", "request type '" + type +
-                     "' is not one of evaluate, fields, paper_designs, export, tune, tune_cancel, identify, "
-                     "identify_cancel, log_open, log_episode"}}};
+                     "' is not one of evaluate, fields, paper_designs, export, pil_cost, tune, tune_cancel, "
+                     "identify, identify_cancel, log_open, log_episode"}}};
 }
 
 }  // namespace pidlab::cli

@@ -47,6 +47,12 @@ bool CancelConnectionJob(const std::shared_ptr<server::Connection>& connection, 
 server::Reply AnswerIdentify(const nlohmann::json& request,
                              const std::shared_ptr<server::Connection>& connection);
 
+/// pil_cost (serve_pil.cc): the design's controller on the emulated
+/// Cortex-M3 and M4F in every scalar, its cost per step, stack and size, on a
+/// thread; the table is posted on `connection` (docs/pil.md).
+server::Reply AnswerPilCost(const nlohmann::json& request,
+                            const std::shared_ptr<server::Connection>& connection);
+
 /// The paper's published gains (Tables II-VI, the report's built-in
 /// data/paper_tables.csv): [{table, plant, method, disturbance_amplitude,
 /// gains: [kp, ki, kd]}].

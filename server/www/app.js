@@ -348,9 +348,11 @@ function resetPlant(fields) {
   pidlab.pinned = [];
   pidlab.trioOverlay = null;
   pidlab.lastTune = null;
-  if (views.design) { views.design.sampled = null; views.design.export = null; views.design.resetKnob(); }
+  if (views.design) { views.design.sampled = null; views.design.export = null; views.design.pil = null; views.design.resetKnob(); }
   $('fw-dt').value = '';
   $('fw-verdict').textContent = '';
+  $('fw-pil-status').textContent = '';
+  $('fw-pil-table').classList.add('hidden');
   for (const id of ['fw-download-c', 'fw-download-h']) $(id).classList.add('hidden');
   renderPinned();
   rebuildPlots();

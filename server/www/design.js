@@ -282,6 +282,39 @@ async function firmware() {
   return design.export;
 }
 
+// The exported design on the emulated Cortex-M3 and M4F in every scalar
+// (the pil_cost request, docs/pil.md): instructions per step, stack, size.
+async function pilCost() {
+  if (!design.export) await firmware();
+  const s = design.export.spec;
+  $('fw-pil-status').textContent = 'building and running the firmware for 4 scalars on 2 cores under QEMU ...';
+  let reply;
+  try {
+    reply = await app.ask({ type: 'pil_cost', spec: s });
+    if (reply.error) throw new Error(reply.error);
+  } catch (e) {
+    $('fw-pil-status').textContent = 'no PIL costs: ' + e.message;
+    throw e;
+  }
+  design.pil = { spec: s, rows: reply.rows };
+  const body = $('fw-pil-table').querySelector('tbody');
+  body.textContent = '';
+  for (const r of reply.rows) {
+    const tr = document.createElement('tr');
+    const cells = r.error ? [r.scalar, r.core, 'not built: ' + r.error, '', '', '']
+      : [r.scalar, r.core === 'm3' ? 'Cortex-M3' : 'Cortex-M4F', Math.round(r.instructions_mean) + ' (' + r.instructions_max + ')',
+        r.stack_bytes, r.text_bytes, r.data_bss_bytes];
+    for (const c of cells) { const td = document.createElement('td'); td.textContent = String(c); tr.appendChild(td); }
+    body.appendChild(tr);
+  }
+  $('fw-pil-table').classList.remove('hidden');
+  $('fw-pil-status').textContent = 'emulated, not silicon timing: ' + reply.emulated + '; the first ' +
+    (reply.rows.find((r) => r.steps) || {}).steps + ' steps of the loop at dt = ' + design.export.dt + ' s; fixed point over r, y in [' +
+    reply.input_range.map(app.fmt).join(', ') + ']' + (reply.fixed_point_output_limits
+    ? ' and, the design having no output limits, u in [' + reply.fixed_point_output_limits.map(app.fmt).join(', ') + ']' : '');
+  return design.pil;
+}
+
 // A dt a tenth of the design's fastest time (1/crossover), rounded down to
 // 1, 2 or 5 times a power of ten: the default the box offers.
 export function suggestDt(result) {
@@ -295,10 +328,10 @@ export function suggestDt(result) {
 export function initDesign(context) {
   app = context;
   design = window.pidlab.design = {
-    upload: null, fit: null, fitCharts: [], sampled: null, export: null,
+    upload: null, fit: null, fitCharts: [], sampled: null, export: null, pil: null,
     knob: { fastestTime: 0, robustnessMoved: false, running: null, pending: false, last: null, error: null,
       designs: new Map(), generation: 0, ahead: -1, ready: false },
-    uploadCsv, identify, acceptModel, knobDesign, firmware, resetKnob, onIdentifyProgress: identifyProgress,
+    uploadCsv, identify, acceptModel, knobDesign, firmware, pilCost, resetKnob, onIdentifyProgress: identifyProgress,
   };
   $('data-file').addEventListener('change', () => {
     const f = $('data-file').files[0];
@@ -325,6 +358,7 @@ export function initDesign(context) {
   });
   $('knob-design').addEventListener('click', () => knobDesign().catch(() => {}));
   $('fw-check').addEventListener('click', () => firmware().catch((e) => app.setStatus('firmware: ' + e.message)));
+  $('fw-pil').addEventListener('click', () => pilCost().catch((e) => app.setStatus('PIL: ' + e.message)));
   showKnob();
   return design;
 }

@@ -202,6 +202,21 @@ async function main() {
     return 'dt ' + dt + ' s: ' + ex.loop_check.verdict;
   });
 
+  await step('5b. the exported design on the emulated Cortex-M3 and M4F in every scalar: cost per step, stack, size (docs/pil.md)', async () => {
+    await page.click('#fw-pil');
+    await waitForPage(session, 'no PIL costs', 180000, () => !!window.pidlab.design.pil ||
+      /no PIL costs/.test(document.getElementById('fw-pil-status').textContent));
+    const got = await page.evaluate(() => ({ pil: window.pidlab.design.pil, status: document.getElementById('fw-pil-status').textContent,
+      rows: document.querySelectorAll('#fw-pil-table:not(.hidden) tbody tr').length }));
+    if (!got.pil) throw new Error(got.status);
+    const rows = got.pil.rows;
+    const bad = rows.filter((r) => r.error || !(r.instructions_mean >= 40 && r.instructions_mean <= r.instructions_max && r.stack_bytes > 0 && r.text_bytes > 0));
+    if (rows.length !== 8 || got.rows !== 8 || bad.length) throw new Error(got.rows + ' rows drawn; ' + JSON.stringify(bad.length ? bad : rows));
+    const mean = (scalar, core) => rows.find((r) => r.scalar === scalar && r.core === core).instructions_mean;
+    if (!(mean('float', 'm4f') < mean('float', 'm3'))) throw new Error('float on the M4F FPU is not cheaper than soft float on the M3');
+    return rows.map((r) => r.scalar + '/' + r.core + ' ' + Math.round(r.instructions_mean)).join(', ') + ' instructions per step';
+  });
+
   // Switching the plant resets what belongs to the plant; the knob's design
   // for the stepper motor and for a thermal plant equals pidlab tune's.
   const designFor = async (what, setPlant) => {
