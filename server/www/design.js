@@ -302,7 +302,7 @@ async function pilCost() {
   for (const r of reply.rows) {
     const tr = document.createElement('tr');
     const cells = r.error ? [r.scalar, r.core, 'not built: ' + r.error, '', '', '']
-      : [r.scalar, r.core === 'm3' ? 'Cortex-M3' : 'Cortex-M4F', Math.round(r.instructions_mean) + ' (' + r.instructions_max + ')',
+      : [r.scalar, r.core === 'm3' ? 'M3' : 'M4F', Math.round(r.instructions_mean) + ' (' + r.instructions_max + ')',
         r.stack_bytes, r.text_bytes, r.data_bss_bytes];
     for (const c of cells) { const td = document.createElement('td'); td.textContent = String(c); tr.appendChild(td); }
     body.appendChild(tr);
