@@ -1,8 +1,10 @@
 """Slow clients and deep JSON against a running `pidlab serve` on 127.0.0.1
-(tests/hostile/serve_slow_test.sh): SLOW connections that each send one byte
-of a request header every 2 s, reopened when the server closes them (as an
-attacker would); meanwhile /api/health and the page must answer within 1 s,
-CHECKS times. Then request bodies and WebSocket messages nested 30 000 deep
+(tests/hostile/serve_slow_test.sh): SLOW connections from 127.0.0.1 that each
+send one byte of a request header every 2 s, reopened when the server closes
+them (as an attacker would), far over the per-address cap; and 48 more, 16
+from each of 127.0.0.3, .4 and .5, which fill the global cap with them.
+Meanwhile /api/health and the page, asked from 127.0.0.2 (a user at an
+address of its own), must answer within 1 s, CHECKS times. Then request bodies and WebSocket messages nested 30 000 deep
 (under the 64 KiB bound: refused by the depth check, 400) and 100 000 deep
 (over it: 413, and the WebSocket closed), /api/health answering after each.
 Prints 'ok ...' lines, and 'FAIL ...' on any failure; runs at most about
@@ -24,14 +26,16 @@ def fail(msg):
 
 
 class Loris:
-    """One slow connection: a header byte per tick; reopened once closed."""
-    def __init__(self):
+    """One slow connection from `source`: a header byte per tick; reopened
+    once closed."""
+    def __init__(self, source):
+        self.source = source
         self.opened = 0
         self.closed_by_server = 0
         self.open()
 
     def open(self):
-        self.s = socket.create_connection(('127.0.0.1', port), timeout=5)
+        self.s = socket.create_connection(('127.0.0.1', port), timeout=5, source_address=(self.source, 0))
         self.s.setblocking(False)
         self.sent = 0
         self.opened += 1
@@ -67,10 +71,11 @@ def trickle(lorises, stop):
 
 
 def timed_get(path):
-    """(status, seconds) of GET path on a fresh connection, at most 1 s."""
+    """(status, seconds) of GET path on a fresh connection from 127.0.0.2, at
+    most 1 s."""
     start = time.monotonic()
     try:
-        s = socket.create_connection(('127.0.0.1', port), timeout=1.0)
+        s = socket.create_connection(('127.0.0.1', port), timeout=1.0, source_address=('127.0.0.2', 0))
         s.sendall(b'GET %s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nConnection: close\r\n\r\n' % (path.encode(), port))
         data = b''
         while True:
@@ -118,7 +123,8 @@ def health_after(what):
 
 
 # (a) The slow connections, opened at once and trickling.
-lorises = [Loris() for _ in range(slow_count)]
+lorises = [Loris('127.0.0.1') for _ in range(slow_count)]
+lorises += [Loris('127.0.0.%d' % (3 + i // 16)) for i in range(48)]
 stop = threading.Event()
 thread = threading.Thread(target=trickle, args=(lorises, stop), daemon=True)
 thread.start()
@@ -131,14 +137,14 @@ for i in range(checks):
         status, seconds = timed_get(path)
         worst = max(worst, seconds)
         if status != needle or seconds > 1.0:
-            fail('GET %s with %d slow connections: status %d in %.3f s (check %d)' % (path, slow_count, status,
+            fail('GET %s with %d + 48 slow connections: status %d in %.3f s (check %d)' % (path, slow_count, status,
                                                                                       seconds, i + 1))
 stop.set()
 thread.join()
 opened = sum(l.opened for l in lorises)
 closed = sum(l.closed_by_server for l in lorises)
-print('ok   %d checks of /api/health and / with %d slow connections trickling: slowest %.3f s; the server '
-      'closed %d of %d slow connections it accepted' % (checks, slow_count, worst, closed, opened), flush=True)
+print('ok   %d checks of /api/health and / with %d + 48 slow connections trickling: slowest %.3f s; the '
+      'server closed %d of %d slow connections it accepted' % (checks, slow_count, worst, closed, opened), flush=True)
 if closed == 0:
     fail('the server closed none of %d slow connections: they hold every slot' % opened)
 for l in lorises:

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Slow clients and deep JSON against `pidlab serve` (docs/workbench.md, "Safe
 # to leave running"), in a private network namespace of its own, on
-# 127.0.0.1 only: 64 connections that each send one header byte every 2 s
-# (reopened when closed) must not keep /api/health and the page from
-# answering within 1 s; requests nested 30 000 and 100 000 deep, over HTTP
+# 127.0.0.1 only: 64 connections from 127.0.0.1 that each send one header
+# byte every 2 s (reopened when closed), and 48 more from three other
+# addresses that fill the global cap, must not keep /api/health and the page
+# from answering a user at 127.0.0.2 within 1 s; requests nested 30 000 and 100 000 deep, over HTTP
 # and the WebSocket, are refused and the server keeps answering; SIGTERM
 # stops it with status 0. Bounded: about 30 s.
 #   serve_slow_test.sh PIDLAB_BINARY
