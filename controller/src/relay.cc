@@ -149,6 +149,13 @@ void RelayTuner::End(RelayPhase phase, double t_s, const std::string& why) {
   why_ = why;
 }
 
+void RelayTuner::EndTimedOut(double t_s, double timeout_s) {
+  End(RelayPhase::kAborted, t_s,
+      "the oscillation did not converge within " + Num(o_.timeout_periods) + " periods (" + Num(timeout_s) +
+          " s): " + std::to_string(cycles_.size()) +
+          " cycles, the last periods and amplitudes differ by more than " + Num(100.0 * o_.tolerance) + " %");
+}
+
 double RelayTuner::Step(double t_s, double r, double y) {
   if (o_.q_bits != 0) return FixedStep(t_s, r, y);
   if (first_) {
@@ -249,11 +256,7 @@ double RelayTuner::RelayStep(double t_s, double r, double y) {
       }
     }
     if (!cycles_.empty() && t_s - relay_start_s_ > o_.timeout_periods * cycles_.back().period_s()) {
-      End(RelayPhase::kAborted, t_s,
-          "the oscillation did not converge within " + Num(o_.timeout_periods) + " periods (" +
-              Num(o_.timeout_periods * cycles_.back().period_s()) + " s): " + std::to_string(cycles_.size()) +
-              " cycles, the last periods and amplitudes differ by more than " + Num(100.0 * o_.tolerance) +
-              " %");
+      EndTimedOut(t_s, o_.timeout_periods * cycles_.back().period_s());
       return After(r, y);
     }
   }
@@ -460,12 +463,7 @@ double RelayTuner::FixedRelayStep(double t_s, double r, std::int64_t y) {
       }
     }
     if (!cycles_.empty() && k_ - relay_start_k_ > timeout_q_) {
-      const double dt = pid_.options().dt_s;
-      End(RelayPhase::kAborted, t_s,
-          "the oscillation did not converge within " + Num(o_.timeout_periods) + " periods (" +
-              Num(static_cast<double>(timeout_q_) * dt) + " s): " + std::to_string(cycles_.size()) +
-              " cycles, the last periods and amplitudes differ by more than " + Num(100.0 * o_.tolerance) +
-              " %");
+      EndTimedOut(t_s, static_cast<double>(timeout_q_) * pid_.options().dt_s);
       return FixedAfter(r, static_cast<double>(y) * qy_);
     }
   }

@@ -101,18 +101,12 @@ fi
 # ---- --help, and bad input: exit 2, one line naming the value.
 help=$("$pidlab" export --help) && [[ $help == *--scalar* && $help == *--from* ]] &&
   pass "--help names --scalar and --from" || fail "--help: $help"
-bad() {
-  local what=$1 needle=$2 status=0
+bad_cmd() {  # bad_cmd WHAT NEEDLE COMMAND...
+  local what=$1 needle=$2 said
   shift 2
-  "$pidlab" export "$@" >bad.out 2>bad.err || status=$?
-  if [[ $status -ne 2 ]]; then
-    fail "$what: exit $status, expected 2 ($(head -c 300 bad.err))"
-  elif ! why=$(only_line_ok bad.err "$needle"); then
-    fail "$what: $why"
-  else
-    pass "$what: exit 2: $(cat bad.err)"
-  fi
+  if said=$(bad_input_ok "$needle" "$@"); then pass "$what: $said"; else fail "$what: $said"; fi
 }
+bad() { bad_cmd "$1" "$2" "$pidlab" export "${@:3}"; }  # bad WHAT NEEDLE ARGS...
 bad "unknown scalar" "q7" --gains 1,1,1 --lang c --out x --scalar q7
 bad "unknown language" "rust" --gains 1,1,1 --lang rust --out x
 bad "no gains" "--gains" --lang c --out x
@@ -126,20 +120,12 @@ bad "an unknown PIL core" "m7" --gains 1,1,1 --lang c --out x --pil m7
 bad "--pil with --autotune" "--autotune" --gains 1,1,1 --lang c --out x --pil m3 --autotune
 
 # ---- --pil's front doors (docs/pil.md): bad values are exit 2 and one line, before anything starts.
-pil_bad() {  # pil_bad WHAT NEEDLE COMMAND...
-  local what=$1 needle=$2 status=0
-  shift 2
-  "$@" >bad.out 2>bad.err || status=$?
-  if [[ $status -ne 2 ]]; then fail "$what: exit $status, expected 2 ($(head -c 300 bad.err))"
-  elif ! why=$(only_line_ok bad.err "$needle"); then fail "$what: $why"
-  else pass "$what: exit 2: $(cat bad.err)"; fi
-}
 ctl_pil="$(dirname "$pidlab")/pidlab-controller-pil"
-pil_bad "pidlab-controller-pil without --firmware" "--firmware" "$ctl_pil" --core m3
-pil_bad "pidlab-controller-pil on an unknown core" "m7" "$ctl_pil" --firmware x.elf --core m7
-pil_bad "pidlab-controller-pil with a deadline of 0" "deadline" "$ctl_pil" --firmware x.elf --deadline 0
-pil_bad "launch --controller that is not pil:DIR" "foo" "$pidlab" launch --controller foo -- true
-pil_bad "launch --controller pil: a folder without pil.json" "pil.json" "$pidlab" launch --controller pil:nowhere -- true
+bad_cmd "pidlab-controller-pil without --firmware" "--firmware" "$ctl_pil" --core m3
+bad_cmd "pidlab-controller-pil on an unknown core" "m7" "$ctl_pil" --firmware x.elf --core m7
+bad_cmd "pidlab-controller-pil with a deadline of 0" "deadline" "$ctl_pil" --firmware x.elf --deadline 0
+bad_cmd "launch --controller that is not pil:DIR" "foo" "$pidlab" launch --controller foo -- true
+bad_cmd "launch --controller pil: a folder without pil.json" "pil.json" "$pidlab" launch --controller pil:nowhere -- true
 if "$ctl_pil" --help | grep -q -- "--core-clock-hz"; then pass "pidlab-controller-pil --help names --core-clock-hz"
 else fail "pidlab-controller-pil --help"; fi
 

@@ -40,3 +40,26 @@ only_line_ok() {
   fi
   final_line_ok "$file" "$needle"
 }
+
+# bad_input_ok NEEDLE COMMAND...: COMMAND exits 2, prints nothing on stdout,
+#   and its stderr is one line naming NEEDLE (only_line_ok). Prints "exit 2:"
+#   and that line and returns 0; else prints the reason and returns 1. Leaves
+#   the command's stdout and stderr in ./bad.out and ./bad.err.
+bad_input_ok() {
+  local needle=$1 status=0 why
+  shift
+  "$@" >bad.out 2>bad.err || status=$?
+  if ((status != 2)); then
+    echo "exit $status, expected 2 ($(head -c 300 bad.err))"
+    return 1
+  fi
+  if ! why=$(only_line_ok bad.err "$needle"); then
+    echo "$why"
+    return 1
+  fi
+  if [[ -s bad.out ]]; then
+    echo "bad input wrote to stdout: $(head -c 200 bad.out)"
+    return 1
+  fi
+  echo "exit 2: $(cat bad.err)"
+}

@@ -132,6 +132,8 @@ class RelayTuner {
   void OnCycle(const RelayCycle& c, double t_s);
   double Tolerance(const RelayCycle& c) const;
   void End(RelayPhase phase, double t_s, const std::string& why);
+  // Ends the relay as aborted: no convergence within `timeout_s`.
+  void EndTimedOut(double t_s, double timeout_s);
   double After(double r, double y);
   bool HasPid() const;
   // Fixed point (q_bits != 0): the same machine in the exported relay's
