@@ -265,9 +265,11 @@ double OnIntegral(double k, double t, double l, double eps, double dh, double dl
   return before + k * dh * d + (e_min - k * dh) * t * (1.0 - std::exp(-d / t));
 }
 
-}  // namespace
-
-Status FopdtFromTimes(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
+// The static gain of a first-order process under relay `o` from one cycle:
+// the integral of e over the mean output, both fits' first step. Refuses
+// invalid options, a cycle whose mean output is zero (a symmetric relay, or
+// an integrating process) and a gain that is not positive.
+Status FirstOrderGain(const RelayOptions& o, const RelayCycle& c, double* k) {
   std::string error;
   if (!o.IsValid(&error)) return Status::InvalidInput(error);
   const double dh = o.d_high, dl = o.d_low;
@@ -276,10 +278,19 @@ Status FopdtFromTimes(const RelayOptions& o, const RelayCycle& c, FopdtModel* mo
     return Status::InvalidInput(
         "the relay's mean output over a cycle is zero (a symmetric relay, or an integrating process): a "
         "first-order process's gain cannot be identified; make d_low differ from d_high");
-  const double k = c.integral_e / mean_v;
-  if (!(k > 0.0) || !std::isfinite(k))
-    return Status::InvalidInput("the identified gain " + Number(k) +
+  *k = c.integral_e / mean_v;
+  if (!(*k > 0.0) || !std::isfinite(*k))
+    return Status::InvalidInput("the identified gain " + Number(*k) +
                                 " is not positive (the relay is reverse acting: a process of positive gain)");
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status FopdtFromTimes(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
+  double k = 0.0;
+  if (Status s = FirstOrderGain(o, c, &k); !s.ok()) return s;
+  const double dh = o.d_high, dl = o.d_low;
   // The level eps_eff the relay really switched at: noise on y crosses the
   // band before the process does, so eps_eff < eps. It is the one whose
   // model gives the measured integral over the part at +d_high.
@@ -395,18 +406,9 @@ Status IntegratingFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtMod
 }
 
 Status FopdtFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
-  std::string error;
-  if (!o.IsValid(&error)) return Status::InvalidInput(error);
+  double k = 0.0;
+  if (Status s = FirstOrderGain(o, c, &k); !s.ok()) return s;
   const double eps = o.hysteresis, dh = o.d_high, dl = o.d_low;
-  const double mean_v = dh * c.t_on_s - dl * c.t_off_s;
-  if (!(std::abs(mean_v) > 1e-6 * (dh * c.t_on_s + dl * c.t_off_s)))
-    return Status::InvalidInput(
-        "the relay's mean output over a cycle is zero (a symmetric relay, or an integrating process): a "
-        "first-order process's gain cannot be identified; make d_low differ from d_high");
-  const double k = c.integral_e / mean_v;
-  if (!(k > 0.0) || !std::isfinite(k))
-    return Status::InvalidInput("the identified gain " + Number(k) +
-                                " is not positive (the relay is reverse acting: a process of positive gain)");
   const double kh = k * dh, kl = k * dl;
   const double e1 = (kh - c.e_max) / (kh - eps), e2 = (kl + c.e_min) / (kl - eps);
   const double big_e = 0.5 * (e1 + e2);  // e^(-L/T) from either extreme
