@@ -13,7 +13,6 @@
 #include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/autotune/experiment.h"
-#include "pidlab/controller_export/export.h"
 #include "pidlab/episode_client/episode_client.h"
 #include "pidlab/episode_client/tune_progress.h"
 #include "pidlab/results/autotune_json.h"
@@ -34,28 +33,17 @@ using pidlab::spec::NameStyle;
 namespace pidlab::cli {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 // A multiple of `step` at least `x`.
 double CeilTo(double x, double step) { return std::ceil(x / step - 1e-9) * step; }
 
 struct AutotuneCommand {
-  SpecFlags flags;
+  SpecFlags flags;           // the loop: plant, PID options, the previous gains
+  SpecFlags autotune_flags;  // the relay and the design (spec/autotune_spec.h)
   bool json_out = false;
   std::string backend = "lcm";
   LcmFlags lcm;
-  RelayTuneOptions relay;
   std::string log_path;
   int64_t episode_id = 0;
-  double amplitude = 0.0;  // 0: from the output range
-  std::string bias_text;   // "": amplitude / 3
-  double hysteresis = -1.0;
-  double first_window_s = 60.0, max_window_s = 7200.0;
-  std::string method = "amigo";
-  double max_ms = 2.0;
-  double robustness = 1.4, response_time_s = 0.0, max_overshoot_pct = 60.0;
-  std::string scalar = "double";
-  std::vector<double> input_range;
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
@@ -66,62 +54,12 @@ struct AutotuneCommand {
         "before the gains are adopted (docs/autotune.md). Run under `pidlab launch`.");
     spec::EvaluateSpec defaults;
     defaults.gains = {0.0, 0.0, 0.0};
-    defaults.bounds.max_ms =
-        2.0;  // --max-ms: adopt only a design with Ms on the identified model at most this
+    // --max-ms: adopt only a design with Ms on the identified model at most this.
+    defaults.bounds.max_ms = results::AutotuneDesignOptions{}.max_ms;
     flags.Register(app, defaults);
+    autotune_flags.Register(app, spec::AutotuneSpec{}, false);
     app->add_option("--backend", backend, "lcm: the relay episodes run over a running trio (pidlab launch)")
         ->check(CLI::IsMember({"lcm"}))
-        ->capture_default_str();
-    app->add_option("--relay-amplitude", amplitude,
-                    "relay amplitude d (units of u) > 0; default 20 % of the output range, 1 if unlimited")
-        ->check(FiniteNumber());
-    app->add_option("--relay-bias", bias_text,
-                    "relay bias b, |b| < d: +d+b above, -(d-b) below the operating point's input; default "
-                    "d/3 (an asymmetric relay, which identifies a FOPDT model); 0 is the symmetric relay");
-    app->add_option("--hysteresis", hysteresis,
-                    "relay hysteresis eps (units of y) >= 0; default 3 sigma of the noise the hold measures")
-        ->check(FiniteNumber());
-    app->add_option("--hold", relay.hold_s,
-                    "the hold before the relay, s (the operating point and the noise)")
-        ->check(FiniteNumber())
-        ->capture_default_str();
-    app->add_option("--u0", relay.u0, "the open-loop hold's input (when --gains are 0,0,0)")
-        ->check(FiniteNumber())
-        ->capture_default_str();
-    app->add_option("--y-limit", relay.y_limit,
-                    "stop the relay when |y - y0| (from the operating point) exceeds this (default: none)")
-        ->check(NumberOrInfinity());
-    app->add_option("--settled-cycles", relay.settled_cycles,
-                    "converged when this many cycles' periods and amplitudes agree")
-        ->capture_default_str();
-    app->add_option("--tolerance", relay.tolerance, "their relative agreement")->capture_default_str();
-    app->add_option("--timeout-periods", relay.timeout_periods,
-                    "stop the relay if it has not converged within this many of its own periods")
-        ->capture_default_str();
-    app->add_option("--max-restarts", relay.max_restarts, "restarts after a load change")
-        ->capture_default_str();
-    app->add_option("--scalar", scalar,
-                    "the controller's relay: double (pidlab-controller's, checked bit for bit), q31 or q15 "
-                    "(pidlab export --autotune --scalar's in pidlab-controller-c: every switch checked, the "
-                    "input within 3 or 2 LSB; needs --input-range and finite --output-limits)")
-        ->capture_default_str();
-    app->add_option("--input-range", input_range,
-                    "fixed point: LO,HI, the --input-range the controller was exported with")
-        ->delimiter(',');
-    app->add_option("--relay-time", first_window_s, "the first relay episode's relay window, s")
-        ->check(FiniteNumber())
-        ->capture_default_str();
-    app->add_option("--max-time", max_window_s, "the longest relay window, s")
-        ->check(FiniteNumber())
-        ->capture_default_str();
-    app->add_option("--method", method, "the design on the identified model: amigo, simc or migo (pidlab's)")
-        ->check(CLI::IsMember({"amigo", "simc", "migo"}))
-        ->capture_default_str();
-    app->add_option("--robustness", robustness, "migo: the Ms bound it designs to")->capture_default_str();
-    app->add_option("--response-time", response_time_s, "migo: the response time it designs to (0: fastest)")
-        ->capture_default_str();
-    app->add_option("--max-overshoot", max_overshoot_pct,
-                    "adopt only gains whose step on the trio overshoots at most this, %")
         ->capture_default_str();
     app->add_option("--log", log_path,
                     "recompute from a log instead (pidlab launch --log): its relay episode's record analysed "
@@ -132,83 +70,31 @@ struct AutotuneCommand {
     return [this] { return Run(); };
   }
 
-  results::AutotuneDesignOptions Design() const {
-    results::AutotuneDesignOptions o;
-    o.method = method;
-    o.robustness = robustness;
-    o.response_time_s = response_time_s;
-    o.max_ms = max_ms;
-    o.max_overshoot_pct = max_overshoot_pct;
-    std::string why;
-    if (!o.IsValid(&why)) throw BadInput(why);
-    return o;
-  }
-
-  // --scalar q31|q15: the exported fixed-point relay's grids, as pidlab
-  // export scales them.
-  controller_export::Scalar ParseScalar() const {
-    controller_export::Scalar v = controller_export::Scalar::kDouble;
-    if (!controller_export::ParseScalar(scalar, &v) || v == controller_export::Scalar::kFloat)
-      throw BadInput("--scalar " + Quote(scalar) + " is not one of double, q31, q15");
-    if (v == controller_export::Scalar::kDouble && !input_range.empty())
-      throw BadInput("--input-range is for --scalar q31 or q15");
-    if (v != controller_export::Scalar::kDouble && input_range.size() != 2)
-      throw BadInput("--scalar " + scalar + " needs --input-range LO,HI (the export's)");
-    return v;
-  }
-
-  void SetFixedPoint(const PidGains& previous, const PidOptions& pid) {
-    controller_export::Options o;
-    o.scalar = ParseScalar();
-    if (o.scalar == controller_export::Scalar::kDouble) return;
-    o.input_min = input_range[0];
-    o.input_max = input_range[1];
-    controller_export::Controller c;
-    c.gains = previous;
-    c.pid = pid;
-    controller_export::FixedScale scale;
-    try {
-      scale = controller_export::FixedPointScale(o, c);
-    } catch (const std::invalid_argument& e) {
-      throw BadInput(e.what());
-    }
-    relay.q_bits = scale.bits;
-    relay.input_full_scale = scale.input_full_scale;
-    relay.output_full_scale = scale.output_full_scale;
-  }
-
   static void Say(const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); }
 
   int Run() {
-    if (!log_path.empty()) {
-      spec::EvaluateSpec unused;
-      std::set<std::string> given;
-      flags.Apply(&unused, &given);
-      max_ms = given.count("max_ms") ? unused.bounds.max_ms : 2.0;
-      json out;
-      bool adopted = false;
-      ParseScalar();  // bad --scalar or --input-range: exit 2 before the log is read
-      const results::FixedPointRelay fixed = [this](const PidGains& previous, const PidOptions& pid,
-                                                    RelayTuneOptions* r) {
-        try {
-          SetFixedPoint(previous, pid);
-        } catch (const std::exception& e) {
-          return Status::InvalidInput(e.what());
-        }
-        r->q_bits = relay.q_bits;
-        r->input_full_scale = relay.input_full_scale;
-        r->output_full_scale = relay.output_full_scale;
-        return Status::Ok();
-      };
-      Require(results::AutotuneLogJson(log_path, episode_id, Design(), Say, &out, &adopted, fixed));
-      return Print(out, adopted);
-    }
+    spec::AutotuneSpec a;
+    std::set<std::string> a_given;
+    autotune_flags.Apply(&a, &a_given);
     spec::EvaluateSpec s;
     s.gains = {0.0, 0.0, 0.0};
-    s.bounds.max_ms = 2.0;
+    s.bounds.max_ms = results::AutotuneDesignOptions{}.max_ms;
     std::set<std::string> given;
     flags.Apply(&s, &given);
-    max_ms = s.bounds.max_ms;
+    if (!log_path.empty()) {
+      // Bad --scalar or --input-range: exit 2 before the log is read.
+      Require(results::CheckAutotuneScalar(a, NameStyle::kFlag));
+      results::AutotuneDesignOptions design;
+      Require(results::BuildAutotuneDesign(a, s.bounds.max_ms, NameStyle::kFlag, &design));
+      const results::FixedPointRelay fixed = [&a](const PidGains& previous, const PidOptions& pid,
+                                                  RelayTuneOptions* r) {
+        return results::AutotuneFixedPoint(a, previous, pid, NameStyle::kFlag, r);
+      };
+      json out;
+      bool adopted = false;
+      Require(results::AutotuneLogJson(log_path, episode_id, design, Say, &out, &adopted, fixed));
+      return Print(out, adopted);
+    }
     if (s.gains.size() != 3) throw BadInput("--gains needs KP,KI,KD");
     s.loop.loop = "sampled";
     Plant plant;
@@ -219,29 +105,11 @@ struct AutotuneCommand {
     std::string why;
     if (!GainsAreValid(previous, &why)) throw BadInput("--gains: " + why);
     const PidOptions pid = PidOptionsAt(loop.pid, loop.dt_s);
-    const double range = pid.output_max - pid.output_min;
-    if (amplitude < 0.0)
-      throw BadInput("--relay-amplitude " + Quote(std::to_string(amplitude)) + " must be > 0");
-    relay.amplitude = amplitude > 0.0 ? amplitude : std::isfinite(range) ? 0.2 * range : 1.0;
-    relay.bias = bias_text.empty() ? relay.amplitude / 3.0 : ParseDouble(bias_text, "--relay-bias");
-    if (hysteresis >= 0.0) {
-      relay.hysteresis = hysteresis;
-      relay.noise_multiple = 0.0;
-    } else {
-      if (flags.Given("hysteresis"))
-        throw BadInput("--hysteresis " + spec::FormatNumber(hysteresis) + " must be >= 0");
-      relay.hysteresis = 0.0;
-      relay.noise_multiple = 3.0;
-    }
-    SetFixedPoint(previous, pid);
-    ExperimentOptions xo;
-    xo.relay = relay;
-    xo.previous = previous;
-    xo.pid = pid;
-    xo.first_window_s = first_window_s;
-    xo.max_window_s = max_window_s;
-    if (!xo.IsValid(&why)) throw BadInput(why);
-    const results::AutotuneDesignOptions design = Design();
+    results::AutotuneRun autotune_run;
+    Require(
+        results::BuildAutotune(a, a_given, previous, pid, s.bounds.max_ms, NameStyle::kFlag, &autotune_run));
+    const ExperimentOptions& xo = autotune_run.experiment;
+    const results::AutotuneDesignOptions& design = autotune_run.design;
 
     std::unique_ptr<EpisodeClient> client = lcm.MakeClient();
     const auto runner = [&](const RelayTuneOptions& r, double horizon_s, std::vector<RelaySample>* out) {
@@ -299,8 +167,8 @@ struct AutotuneCommand {
     // The verdict to live watchers (pidlab serve --lcm-url: the Live tab's
     // tunings): the adopted gains (or the previous ones) and the design's Ms.
     try {
-      episode_client::TuneProgressPublisher verdict(lcm.ClientOptions(lcm.Url()), 1, "autotune " + method,
-                                                    "Ms on the identified model");
+      episode_client::TuneProgressPublisher verdict(
+          lcm.ClientOptions(lcm.Url()), 1, "autotune " + design.method, "Ms on the identified model");
       const json& ms = out.contains("design") ? out["design"]["ms"] : json(nullptr);
       const json& g = out["gains"];
       verdict.Finished(adopted, PidGains{g.value("kp", 0.0), g.value("ki", 0.0), g.value("kd", 0.0)},

@@ -121,6 +121,7 @@ PY
     "$bin/pidlab" launch --isolated --log run.lcmlog -- "$bin/pidlab" autotune --backend lcm --num 1 --den 1,1 \
       --delay 0.5 --dt 0.001 --gains 1,1,0 --json >live.json 2>err || echo "FAIL autotune: $(tail -1 err)"
     "$bin/pidlab" autotune --log run.lcmlog --json >fromlog.json 2>err || echo "FAIL autotune --log: $(tail -1 err)"
+    "$bin/pidlab" autotune --log run.lcmlog --method simc --max-overshoot 80 --json >simc.json 2>err
     /usr/bin/python3 - <<'PY'
 import json
 a, b = json.load(open("live.json")), json.load(open("fromlog.json"))
@@ -140,6 +141,15 @@ b = json.load(open("fromlog.json"))
 ok = r == b and r["adopted"] and r["estimates"]["model"]["kind"] == "fopdt"
 print(("PASS " if ok else "FAIL ") + "pidlab.autotune(log) returns the object of autotune --log --json: Ku %r, gains %r"
       % (r["estimates"]["ku"], r["gains"]))
+# The keywords are the flags' fields: another design from the same relay.
+r = pidlab.autotune("run.lcmlog", method="simc", max_overshoot=80)
+c = json.load(open("simc.json"))
+# The log holds no verification step of the simc gains: not adopted, the previous gains stay.
+ok = (r == c and r["design"] != b["design"] and r["estimates"] == b["estimates"] and not r["adopted"]
+      and r["gains"] == r["previous_gains"])
+print(("PASS " if ok else "FAIL ") + "pidlab.autotune(log, method='simc', max_overshoot=80) equals autotune --log "
+      "--method simc --max-overshoot 80: the same estimates, another design (%s), not adopted: %s"
+      % (r["design"].get("method"), r["verdict"]))
 try:
     pidlab.autotune("run.lcmlog", episode=42)
     print("FAIL pidlab.autotune(episode=42) raised nothing")

@@ -264,6 +264,37 @@ class Spec(unittest.TestCase):
             pidlab.evaluate("oscillator", (1, 2, 3), horizon="long")
 
 
+class Autotune(unittest.TestCase):
+    """pidlab.autotune's keywords are the autotune spec's fields, the flags of
+    `pidlab autotune` (spec/autotune_spec.h): one list for both. (The run
+    itself, from a log, is integration.autotune.log's.)"""
+
+    def test_every_field_is_a_flag_of_the_command_and_a_keyword_that_reaches_the_spec(self):
+        fields = pidlab.spec_fields("autotune")
+        self.assertGreaterEqual(len(fields), 18)
+        help_text = subprocess.run([PIDLAB, "autotune", "--help"], check=True, capture_output=True,
+                                   text=True).stdout
+        for f in fields:
+            with self.subTest(key=f["key"]):
+                self.assertEqual(f["flag"], "--" + f["key"].replace("_", "-"))
+                self.assertIn(f["flag"] + " ", help_text)
+                spec = pidlab.read_spec("autotune", **{f["key"]: f["example"]})
+                self.assertEqual(spec[f["key"]], f["example"])
+                self.assertNotEqual(f["default"], f["example"])
+
+    def test_a_bad_keyword_value_is_named_before_the_log_is_read(self):
+        with self.assertRaisesRegex(ValueError, "method 'pso'"):
+            pidlab.autotune("no.lcmlog", method="pso")
+        with self.assertRaisesRegex(ValueError, "^scalar 'q7' is not one of double, q31, q15"):
+            pidlab.autotune("no.lcmlog", scalar="q7")
+        with self.assertRaisesRegex(ValueError, "needs input_range LO,HI"):
+            pidlab.autotune("no.lcmlog", scalar="q15")
+        with self.assertRaisesRegex(TypeError, "methd"):
+            pidlab.autotune("no.lcmlog", methd="simc")
+        with self.assertRaisesRegex(ValueError, "no.lcmlog"):
+            pidlab.autotune("no.lcmlog", method="simc")
+
+
 class Identify(unittest.TestCase):
     """pidlab.identify on numpy arrays against `pidlab identify --csv --json` of the same record."""
 

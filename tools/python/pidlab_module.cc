@@ -242,13 +242,19 @@ PYBIND11_MODULE(_pidlab, m) {
           ReadKwargs("read_spec", py::dict(kwargs), &s, &given);
           return ToPython(pidlab::spec::ToJson(s));
         }
-        if (which != "tune") Bad("read_spec: '" + which + "' must be evaluate or tune");
+        if (which == "autotune") {
+          pidlab::spec::AutotuneSpec s;
+          ReadKwargs("read_spec", py::dict(kwargs), &s, &given);
+          return ToPython(pidlab::spec::ToJson(s));
+        }
+        if (which != "tune") Bad("read_spec: '" + which + "' must be evaluate, tune or autotune");
         pidlab::spec::TuningSpec s;
         ReadKwargs("read_spec", py::dict(kwargs), &s, &given);
         pidlab::tune::ResolveTuningSpec(&s, given);
         return ToPython(pidlab::spec::ToJson(s));
       },
-      "read_spec(which, **spec): the spec evaluate or tune would read from these keywords (defaults filled "
+      "read_spec(which, **spec): the spec evaluate, tune or autotune would read from these keywords "
+      "(defaults filled "
       "in, "
       "tune's robust preset resolved), as the dict every result carries under 'spec'; nothing is run or "
       "validated.",
@@ -258,38 +264,46 @@ PYBIND11_MODULE(_pidlab, m) {
       [](const std::string& which) {
         if (which == "evaluate") return FieldTable<pidlab::spec::EvaluateSpec>();
         if (which == "tune") return FieldTable<pidlab::spec::TuningSpec>();
-        Bad("spec_fields: '" + which + "' must be evaluate or tune");
+        if (which == "autotune") return FieldTable<pidlab::spec::AutotuneSpec>();
+        Bad("spec_fields: '" + which + "' must be evaluate, tune or autotune");
       },
-      "The fields of evaluate's or tune's spec: key (the keyword), flag, help, unit, default, example, and "
+      "The fields of evaluate's, tune's or autotune's spec: key (the keyword), flag, help, unit, default, "
+      "example, and "
       "whether it travels to the trio (episode).",
       py::arg("which") = "evaluate");
   m.def(
       "autotune",
-      [](const std::string& log, int64_t episode, const std::string& method, double robustness,
-         double response_time, double max_ms, double max_overshoot) {
-        pidlab::results::AutotuneDesignOptions o;
-        o.method = method;
-        o.robustness = robustness;
-        o.response_time_s = response_time;
-        o.max_ms = max_ms;
-        o.max_overshoot_pct = max_overshoot;
+      [](const std::string& log, int64_t episode, double max_ms, py::kwargs kwargs) {
+        pidlab::spec::AutotuneSpec a;
+        std::set<std::string> given;
+        ReadKwargs("autotune", py::dict(kwargs), &a, &given);
+        using pidlab::spec::NameStyle;
+        const auto check = [](const pidlab::Status& st) {
+          if (st.code() == pidlab::StatusCode::kInvalidInput) Bad(st.message());
+          if (!st.ok()) throw std::runtime_error(st.message());
+        };
+        check(pidlab::results::CheckAutotuneScalar(a, NameStyle::kKey));
+        pidlab::results::AutotuneDesignOptions design;
+        check(pidlab::results::BuildAutotuneDesign(a, max_ms, NameStyle::kKey, &design));
+        const pidlab::results::FixedPointRelay fixed = [&a](const pidlab::PidGains& previous,
+                                                            const pidlab::PidOptions& pid,
+                                                            pidlab::RelayTuneOptions* r) {
+          return pidlab::results::AutotuneFixedPoint(a, previous, pid, NameStyle::kKey, r);
+        };
         nlohmann::json out;
         bool adopted = false;
-        const pidlab::Status st = pidlab::results::AutotuneLogJson(log, episode, o, nullptr, &out, &adopted);
-        if (st.code() == pidlab::StatusCode::kInvalidInput) Bad(st.message());
-        if (!st.ok()) throw std::runtime_error(st.message());
+        check(pidlab::results::AutotuneLogJson(log, episode, design, nullptr, &out, &adopted, fixed));
         return ToPython(out);
       },
-      "autotune(log, episode=0, method='amigo', robustness=1.4, response_time=0, max_ms=2, "
-      "max_overshoot=60): "
-      "the relay autotune of a logged run (pidlab launch --log ... -- pidlab autotune --backend lcm) "
-      "recomputed "
-      "from the log alone, as `pidlab autotune --log LOG --json` (docs/autotune.md): the experiment, the "
-      "estimates "
-      "with their intervals, the model, the design, the verification step found in the log, adopted, verdict "
-      "and "
-      "gains. ValueError for an unreadable log or no relay episode in it.",
-      py::arg("log"), py::arg("episode") = 0, py::arg("method") = "amigo", py::arg("robustness") = 1.4,
-      py::arg("response_time") = 0.0, py::arg("max_ms") = 2.0, py::arg("max_overshoot") = 60.0);
+      "autotune(log, episode=0, max_ms=2, **spec): the relay autotune of a logged run (pidlab launch --log "
+      "... -- pidlab autotune --backend lcm) recomputed from the log alone, as `pidlab autotune --log LOG "
+      "--json` (docs/autotune.md): the experiment, the estimates with their intervals, the model, the "
+      "design, "
+      "the verification step found in the log, adopted, verdict and gains. The keywords are the autotune "
+      "spec's fields (spec_fields('autotune')); from a log, the design's (method, robustness, response_time, "
+      "max_overshoot) and the fixed-point check's (scalar, input_range) count, the relay is the log's. "
+      "ValueError for an unreadable log, no relay episode in it or a bad keyword value.",
+      py::arg("log"), py::arg("episode") = 0,
+      py::arg("max_ms") = pidlab::results::AutotuneDesignOptions{}.max_ms);
   DefineIdentify(m);
 }

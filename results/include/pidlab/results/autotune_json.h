@@ -8,10 +8,13 @@
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 
 #include "pidlab/autotune/experiment.h"
 #include "pidlab/evaluation/evaluation.h"
+#include "pidlab/spec/autotune_spec.h"
+#include "pidlab/spec/field.h"
 #include "pidlab/spec/status.h"
 
 namespace pidlab::results {
@@ -25,6 +28,35 @@ struct AutotuneDesignOptions {
   double max_overshoot_pct = 60.0;  ///< the verification step's overshoot at most this
   bool IsValid(std::string* error) const;
 };
+
+/// What an autotune spec asks for (spec/autotune_spec.h): the relay
+/// experiment and the design on its model.
+struct AutotuneRun {
+  autotune::ExperimentOptions experiment;
+  AutotuneDesignOptions design;
+};
+
+/// The one function that turns an autotune spec into a run, for the loop's
+/// PID `pid` with the `previous` gains the hold runs: the relay sized from
+/// the output range where the spec leaves it (20 %, 1 if unlimited; the bias
+/// d/3; the hysteresis 3 sigma of the hold's noise unless given, and a
+/// negative one `given` is refused), its fixed-point grids for scalar q31 or
+/// q15 (AutotuneFixedPoint), the windows, and the design with the loop's Ms
+/// bound `max_ms`. kInvalidInput names the bad field as `style` does.
+Status BuildAutotune(const spec::AutotuneSpec& spec, const std::set<std::string>& given,
+                     const PidGains& previous, const PidOptions& pid, double max_ms, spec::NameStyle style,
+                     AutotuneRun* run);
+/// The design alone (a log's recomputation: the relay is the log's).
+Status BuildAutotuneDesign(const spec::AutotuneSpec& spec, double max_ms, spec::NameStyle style,
+                           AutotuneDesignOptions* design);
+/// Checks scalar and input_range alone (double, or q31/q15 with LO,HI), so
+/// that a command refuses them before it reads a log or starts a trio.
+Status CheckAutotuneScalar(const spec::AutotuneSpec& spec, spec::NameStyle style);
+/// For scalar q31 or q15, the exported relay's grids (pidlab export
+/// --autotune --scalar with the spec's input_range, for `previous` on
+/// `pid`) set in *relay; nothing for double.
+Status AutotuneFixedPoint(const spec::AutotuneSpec& spec, const PidGains& previous, const PidOptions& pid,
+                          spec::NameStyle style, RelayTuneOptions* relay);
 
 /// A closed-loop step with the designed gains: its evaluation, the horizon it
 /// ran and its JSON.
