@@ -1,0 +1,127 @@
+#pragma once
+// `tune --method optimal` (docs/tuning.md, "The design engine"): the PI or
+// PID with a first-order derivative filter that minimises the integrated
+// absolute error of a unit load step at the plant input,
+//
+//   minimise   \int_0^inf |y_L(t)| dt        (r = 0, a unit step d at u)
+//   subject to ||S||inf <= Ms,  ||T||inf <= Mt,  ||C S||inf <= noise gain,
+//              Td = kd/kp <= the plant's dominant time constant,
+//              the closed loop strictly stable,
+//
+// on the exact continuous loop, the plant's dead time included (JuliaSimControl's
+// autotuning problem; Grimholt and Skogestad, J. Process Control 70, 2018).
+// Then a second stage shapes the setpoint response: the weights b, c in
+// [0, 1]^2 with the smallest setpoint \int|e|dt whose overshoot is within a
+// target; they cannot move the load response.
+//
+// The load response is simulated on a uniform grid whose step divides the
+// dead time: the plant and the controller are discretised exactly (matrix
+// exponentials), and the delayed controller output is linear between samples,
+// so the error is second order in the step (about 1e-5 of the IAE here).
+// The peaks are taken on the design's frequency grid, bounded above where the
+// grid is too coarse for the delay's phase; the result is then checked by
+// the exact analysis (AnalyzeLoop) and its gain scaled back until that meets
+// the bounds too.
+//
+// The knobs move along the optimal front, the designs of every Ms bound:
+// a response time T (or a gain crossover W = 2/T) is reached by the Ms bound
+// whose optimal design crosses over at W, so slower always means a lower Ms
+// and a larger load IAE.
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "pidlab/controller/pid.h"
+#include "pidlab/plant_sim/plants.h"
+#include "pidlab/spec/status.h"
+
+namespace pidlab::tune {
+
+/// The Ms range of the optimal front (`--response-time` and `--crossover`
+/// move along it when `--robustness` is not given).
+inline constexpr double kFrontMinMs = 1.1;
+inline constexpr double kFrontMaxMs = 2.0;
+/// The derivative filter's N = Td / tf is searched in [kDesignMinFilterRatio,
+/// kDesignMaxFilterRatio].
+inline constexpr double kDesignMinFilterRatio = 2.0;
+inline constexpr double kDesignMaxFilterRatio = 50.0;
+/// The default setpoint overshoot target of the second stage (%).
+inline constexpr double kDesignDefaultOvershootPct = 10.0;
+
+struct DesignOptions {
+  /// Bound on ||S||inf, in (1, 4].
+  double max_ms = 1.4;
+  /// Bound on ||T||inf, >= 1; NaN: the same as max_ms.
+  double max_mt = std::numeric_limits<double>::quiet_NaN();
+  /// Bound on the noise gain ||C S||inf (> 0; +inf: none).
+  double max_noise_gain = std::numeric_limits<double>::infinity();
+  /// PI only (kd = 0).
+  bool pi = false;
+  /// 0, or the gain crossover (rad/s) to reach by moving along the front:
+  /// the Ms bound in [kFrontMinMs, max_ms] whose design crosses over there.
+  double crossover_rad_s = 0.0;
+  /// The largest derivative time Td = kd / kp (s); 0: the plant's dominant
+  /// time constant (DominantTimeConstant).
+  double max_td_s = 0.0;
+  /// The setpoint stage's overshoot target (%), >= 0; +inf: no target (the
+  /// weights of the smallest setpoint IAE).
+  double max_overshoot_pct = kDesignDefaultOvershootPct;
+
+  /// Names the field, its value and the rule broken.
+  bool IsValid(std::string* error) const;
+  /// max_mt, or max_ms when NaN.
+  double Mt() const;
+};
+
+/// One design of the engine.
+struct DesignSummary {
+  /// kp, ki, kd and the filter tf.
+  PidGains gains;
+  /// The setpoint weights b, c of the second stage.
+  double b = 1.0, c = 1.0;
+  /// \int|y|dt of the unit load step, and of the setpoint error 1 - y with
+  /// the weights found; the setpoint step's overshoot (%) with them, and
+  /// with b = c = 1.
+  double load_iae = std::numeric_limits<double>::infinity();
+  double setpoint_iae = std::numeric_limits<double>::infinity();
+  double overshoot_pct = 0.0, overshoot_unit_weights_pct = 0.0;
+  /// The setpoint stage met its overshoot target (false: the smallest
+  /// overshoot b and c reach, said in `setpoint_note`).
+  bool overshoot_met = true;
+  std::string setpoint_note;
+  /// The exact analysis of the loop (AnalyzeLoop): Ms, Mt, the noise gain,
+  /// the highest gain crossover (rad/s) and the phase margin (deg).
+  double ms = 0.0, mt = 0.0, noise_gain = 0.0, crossover_rad_s = 0.0, phase_margin_deg = 0.0;
+  /// The response time 2 / crossover (s), the one the knob moves.
+  double response_time_s = 0.0;
+  /// The Ms bound the design ran under (max_ms, or the front's point for a
+  /// crossover), and the bounds as given.
+  double ms_bound = 0.0, mt_bound = 0.0, noise_gain_bound = 0.0, td_bound_s = 0.0;
+  /// The constraints within 1 % of their bound at the optimum: "ms", "mt",
+  /// "noise_gain", "td".
+  std::vector<std::string> active;
+  /// Candidates evaluated (each a load-step simulation).
+  int evaluations = 0;
+  /// One line: the engine, the bounds, the gains and the load IAE.
+  std::string message;
+};
+
+/// The plant's dominant time constant: its slowest stable pole off the
+/// origin (s); where it has none, its slowest characteristic time (PlantTimes).
+double DominantTimeConstant(const Plant& plant);
+
+/// The design on `plant` (linear, strictly proper or proper, its dead time
+/// included). kInvalidInput naming the cause: invalid options, a nonlinear
+/// plant, a reverse-acting plant (negative gain: not designed yet), no
+/// stable loop that meets the bounds, or a crossover outside the front's
+/// reachable range (the range named).
+Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSummary* summary);
+
+/// The unit load step's \int|y|dt of `gains` on the continuous loop of
+/// `plant` (dead time included), by the engine's simulation; +inf when the
+/// response does not settle (an unstable loop). Independent of the
+/// evaluation library's, for cross-checks.
+double DesignLoadIae(const Plant& plant, const PidGains& gains);
+
+}  // namespace pidlab::tune

@@ -1,0 +1,219 @@
+// The design engine (design.h): bounds, the exact check, the front and the
+// setpoint stage around the optimisation of design_engine.cc.
+
+#include "pidlab/tune/design.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "design_engine.h"
+#include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/spec/field.h"
+#include "pidlab/tune/migo.h"
+
+namespace pidlab::tune {
+
+using spec::FormatNumber;
+
+bool DesignOptions::IsValid(std::string* error) const {
+  std::ostringstream os;
+  if (!(max_ms > 1.0 && max_ms <= 4.0))
+    os << "robustness " << FormatNumber(max_ms) << " is not an Ms bound in (1, 4]";
+  else if (!std::isnan(max_mt) && !(max_mt >= 1.0))
+    os << "max_mt " << FormatNumber(max_mt) << " must be >= 1";
+  else if (!(max_noise_gain > 0.0))
+    os << "max_noise_gain " << FormatNumber(max_noise_gain) << " must be > 0 (inf: none)";
+  else if (!(crossover_rad_s >= 0.0) || !std::isfinite(crossover_rad_s))
+    os << "crossover " << FormatNumber(crossover_rad_s) << " must be >= 0 and finite (rad/s)";
+  else if (!(max_td_s >= 0.0))
+    os << "max_td " << FormatNumber(max_td_s) << " must be >= 0 (s)";
+  else if (!(max_overshoot_pct >= 0.0))
+    os << "max_overshoot " << FormatNumber(max_overshoot_pct) << " must be >= 0 (%)";
+  if (os.str().empty()) return true;
+  if (error) *error = os.str();
+  return false;
+}
+
+double DesignOptions::Mt() const { return std::isnan(max_mt) ? max_ms : max_mt; }
+
+double DominantTimeConstant(const Plant& plant) {
+  double slowest = 0.0;
+  for (const std::complex<double>& p : PolynomialRoots(plant.tf.den))
+    if (p.real() < 0.0 && std::abs(p) > 1e-12) slowest = std::max(slowest, -1.0 / p.real());
+  if (slowest > 0.0) return slowest;
+  double fastest = 0.0;
+  PlantTimes(plant, &fastest, &slowest);
+  return slowest;
+}
+
+namespace {
+
+// The exact analysis of the continuous loop of g.
+bool Analyse(const Plant& plant, const PidGains& g, analysis::LoopAnalysis* a) {
+  return analysis::AnalyzeLoop(plant, g, evaluation::LoopOptions{}, analysis::LoopAnalysisOptions{}, a)
+             .ok() &&
+         a->stable;
+}
+
+bool Meets(const analysis::LoopAnalysis& a, const design::Bounds& b) {
+  constexpr double kTolerance = 1.0 + 1e-3;
+  return a.ms <= b.ms * kTolerance && a.mt <= b.mt * kTolerance && a.noise_gain <= b.noise_gain * kTolerance;
+}
+
+PidGains Scaled(PidGains g, double f) {
+  g.kp *= f;
+  g.ki *= f;
+  g.kd *= f;
+  return g;
+}
+
+// The grid's optimum checked by the exact analysis: where the exact peaks
+// break a bound (the grid missed a sliver of a peak), the loop gain is
+// scaled back until they do not. False when no scale gives a stable loop.
+bool ExactlyWithin(const Plant& plant, const design::Engine& engine, const design::Bounds& b,
+                   design::Optimum* o, analysis::LoopAnalysis* a) {
+  if (Analyse(plant, o->gains, a) && Meets(*a, b)) return true;
+  double lo = 0.5, hi = 1.0;
+  analysis::LoopAnalysis at;
+  while (!(Analyse(plant, Scaled(o->gains, lo), &at) && Meets(at, b))) {
+    hi = lo;
+    lo *= 0.5;
+    if (lo < 1e-3) return false;
+  }
+  for (int i = 0; i < 14; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    (Analyse(plant, Scaled(o->gains, mid), &at) && Meets(at, b) ? lo : hi) = mid;
+  }
+  o->gains = Scaled(o->gains, lo);
+  o->load_iae = engine.LoadIae(o->gains);
+  return Analyse(plant, o->gains, a) && std::isfinite(o->load_iae);
+}
+
+// One point of the front: the optimum at Ms bound ms, checked exactly.
+bool FrontPoint(const Plant& plant, const design::Engine& engine, design::Bounds b, double ms,
+                const Eigen::VectorXd& warm, design::Optimum* o, analysis::LoopAnalysis* a) {
+  b.ms = ms;
+  return engine.Optimize(b, warm, o) && ExactlyWithin(plant, engine, b, o, a);
+}
+
+double HighestCrossover(const analysis::LoopAnalysis& a) {
+  return a.gain_crossovers_rad_s.empty() ? 0.0 : a.gain_crossovers_rad_s.back();
+}
+
+// The front's point whose crossover is `w`: bisection on the Ms bound in
+// [kFrontMinMs, ms_cap]. kInvalidInput naming the reachable range.
+Status OnTheFront(const Plant& plant, const design::Engine& engine, const design::Bounds& b, double w,
+                  design::Optimum* o, analysis::LoopAnalysis* a, double* ms_bound) {
+  design::Optimum lo_o, hi_o;
+  analysis::LoopAnalysis lo_a, hi_a;
+  double lo = kFrontMinMs, hi = b.ms;
+  if (!FrontPoint(plant, engine, b, hi, Eigen::VectorXd(), &hi_o, &hi_a) ||
+      !FrontPoint(plant, engine, b, lo, hi_o.shape, &lo_o, &lo_a))
+    return Status::InvalidInput("optimal: no stable loop on the front of plant " + plant.name);
+  const double w_lo = HighestCrossover(lo_a), w_hi = HighestCrossover(hi_a);
+  if (w < w_lo * 0.98 || w > w_hi * 1.02) {
+    std::ostringstream os;
+    os << "crossover " << FormatNumber(w) << " rad/s (response time " << FormatNumber(2.0 / w)
+       << " s) is outside what plant " << plant.name << " reaches on the optimal front, Ms "
+       << FormatNumber(kFrontMinMs) << " to " << FormatNumber(b.ms) << ": " << FormatNumber(w_lo) << " to "
+       << FormatNumber(w_hi) << " rad/s (response time " << FormatNumber(2.0 / w_hi) << " to "
+       << FormatNumber(2.0 / w_lo) << " s)";
+    return Status::InvalidInput(os.str());
+  }
+  *o = std::abs(w - w_lo) < std::abs(w - w_hi) ? lo_o : hi_o;
+  *a = std::abs(w - w_lo) < std::abs(w - w_hi) ? lo_a : hi_a;
+  *ms_bound = std::abs(w - w_lo) < std::abs(w - w_hi) ? lo : hi;
+  for (int i = 0; i < 30 && std::abs(HighestCrossover(*a) / w - 1.0) > 0.005; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    design::Optimum m;
+    analysis::LoopAnalysis ma;
+    if (!FrontPoint(plant, engine, b, mid, o->shape, &m, &ma)) break;
+    (HighestCrossover(ma) < w ? lo : hi) = mid;
+    *o = m, *a = ma, *ms_bound = mid;
+  }
+  return Status::Ok();
+}
+
+std::vector<std::string> ActiveBounds(const analysis::LoopAnalysis& a, const design::Bounds& b,
+                                      const PidGains& g) {
+  std::vector<std::string> active;
+  if (a.ms >= 0.99 * b.ms) active.push_back("ms");
+  if (a.mt >= 0.99 * b.mt) active.push_back("mt");
+  if (std::isfinite(b.noise_gain) && a.noise_gain >= 0.99 * b.noise_gain) active.push_back("noise_gain");
+  if (g.kd > 0.0 && g.kd / g.kp >= 0.99 * b.td_max_s) active.push_back("td");
+  return active;
+}
+
+}  // namespace
+
+namespace design {
+void SetpointStage(const Engine& engine, double max_overshoot_pct, DesignSummary* s);
+}  // namespace design
+
+Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSummary* summary) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::InvalidInput(error);
+  if (plant.nonlinear)
+    return Status::InvalidInput("optimal designs on a linear plant: it does not take plant " + plant.name +
+                                " (use its linearisation, plant stepper)");
+  const double dc = plant.tf.DcGain();
+  if (dc < 0.0 || (std::isinf(dc) && plant.tf.num.back() * plant.tf.den[plant.tf.den.size() - 2] < 0.0))
+    return Status::InvalidInput(
+        "optimal: plant " + plant.name +
+        " acts in reverse (negative gain), which the design engine does not take yet");
+  const design::Engine engine(plant, options.pi);
+  design::Bounds b;
+  b.ms = options.max_ms;
+  b.mt = options.Mt();
+  b.noise_gain = options.max_noise_gain;
+  b.td_max_s = options.max_td_s > 0.0 ? options.max_td_s : DominantTimeConstant(plant);
+  b.crossover_cap = engine.SpeedCap();
+  design::Optimum o;
+  analysis::LoopAnalysis a;
+  double ms_bound = b.ms;
+  if (options.crossover_rad_s > 0.0) {
+    if (const Status st = OnTheFront(plant, engine, b, options.crossover_rad_s, &o, &a, &ms_bound); !st.ok())
+      return st;
+  } else if (!FrontPoint(plant, engine, b, b.ms, Eigen::VectorXd(), &o, &a)) {
+    std::ostringstream os;
+    os << "optimal: no stable " << (options.pi ? "PI" : "PID") << " meets Ms <= " << FormatNumber(b.ms)
+       << ", Mt <= " << FormatNumber(b.mt) << " and noise gain <= " << FormatNumber(b.noise_gain)
+       << " on plant " << plant.name << ": raise --robustness or --max-noise-gain";
+    return Status::InvalidInput(os.str());
+  }
+  DesignSummary s;
+  s.gains = o.gains;
+  s.load_iae = o.load_iae;
+  s.ms = a.ms;
+  s.mt = a.mt;
+  s.noise_gain = a.noise_gain;
+  s.crossover_rad_s = HighestCrossover(a);
+  s.response_time_s = s.crossover_rad_s > 0.0 ? 2.0 / s.crossover_rad_s : 0.0;
+  s.phase_margin_deg = a.phase_margin_deg;
+  s.ms_bound = ms_bound;
+  s.mt_bound = b.mt;
+  s.noise_gain_bound = b.noise_gain;
+  s.td_bound_s = b.td_max_s;
+  b.ms = ms_bound;
+  s.active = ActiveBounds(a, b, s.gains);
+  s.evaluations = o.evaluations;
+  design::SetpointStage(engine, options.max_overshoot_pct, &s);
+  std::ostringstream os;
+  os << "optimal: the least load \u222b|e|dt with Ms <= " << FormatNumber(ms_bound)
+     << ", Mt <= " << FormatNumber(b.mt) << ", noise gain <= " << FormatNumber(b.noise_gain)
+     << (options.pi ? std::string(" (PI)") : ", Td <= " + FormatNumber(b.td_max_s) + " s") << ": kp "
+     << FormatNumber(s.gains.kp) << ", ki " << FormatNumber(s.gains.ki) << ", kd " << FormatNumber(s.gains.kd)
+     << ", tf " << FormatNumber(s.gains.tf) << ", load \u222b|e|dt " << FormatNumber(s.load_iae) << ", Ms "
+     << FormatNumber(s.ms) << ", crossover " << FormatNumber(s.crossover_rad_s) << " rad/s";
+  s.message = os.str();
+  *summary = s;
+  return Status::Ok();
+}
+
+double DesignLoadIae(const Plant& plant, const PidGains& gains) {
+  const design::Engine engine(plant, gains.kd == 0.0);
+  return engine.LoadIae(gains);
+}
+
+}  // namespace pidlab::tune

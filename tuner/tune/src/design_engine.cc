@@ -1,0 +1,301 @@
+// The design engine's optimisation for one set of bounds (design_engine.h).
+//
+// The gains are searched as a shape, (log Ti, log Td, log N) with Ti = kp/ki,
+// Td = kd/kp and tf = Td/N (PI: log Ti), and a loop gain kp: for each shape
+// the largest kp whose loop meets the bounds on the frequency grid, because
+// the load IAE falls as the loop gets faster until a bound stops it. Where
+// that is not so (a loose bound), a fourth coordinate lowers kp below it.
+// Nelder-Mead runs from the shapes of the SIMC and AMIGO rules and of a
+// generic start, and the best is polished once more.
+
+#include "design_engine.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pidlab/optim/nelder_mead.h"
+#include "pidlab/tune/migo.h"
+#include "pidlab/tune/tuning_rules.h"
+
+namespace pidlab::tune::design {
+
+using cd = std::complex<double>;
+
+namespace {
+
+constexpr double kPointsPerDecade = 50.0;
+// Samples of the load response per radian of the first estimate of the
+// crossover: about 190 per period.
+constexpr double kStepsPerRadian = 30.0;
+// The first estimate's shape on a plant no rule applies to.
+constexpr double kGenericTiFactor = 1.0;
+
+// The rule's shape (Ti, Td, N = 10) where SIMC or AMIGO applies.
+bool RuleShape(const Plant& plant, TuningRule rule, bool pi, Eigen::VectorXd* shape) {
+  TuningRuleResult r;
+  if (!ApplyTuningRule(plant, rule, pi ? RuleForm::kPi : RuleForm::kPid, &r).ok()) return false;
+  const PidGains& g = r.gains;
+  if (!(g.kp > 0.0) || !(g.ki > 0.0)) return false;
+  const double ti = g.kp / g.ki;
+  if (pi) {
+    *shape = Eigen::VectorXd::Constant(1, std::log(ti));
+    return true;
+  }
+  const double td = g.kd > 0.0 ? g.kd / g.kp : 0.1 * ti;
+  *shape = Eigen::Vector3d(std::log(ti), std::log(td), std::log(10.0));
+  return true;
+}
+
+}  // namespace
+
+Engine::Engine(const Plant& plant, bool pi) : plant_(plant), pi_(pi), sim_(plant, 1.0) {
+  double fastest = 0.0, slowest = 0.0;
+  PlantTimes(plant, &fastest, &slowest);
+  speed_cap_ = kMigoSpeedCap / fastest;
+  for (const cd& p : PolynomialRoots(plant.tf.den)) {
+    if (std::abs(p) <= 1e-12 * std::max(1.0, 1.0 / fastest))
+      ++origin_poles_;
+    else if (p.real() > 0.0)
+      ++rhp_poles_;
+  }
+  grid_ = MakeFrequencyGrid(plant, 1e-3 / slowest, std::max(300.0 / fastest, 30.0 * speed_cap_),
+                            kPointsPerDecade);
+  // The first estimate of the crossover: the rule's shape (or a PI with Ti
+  // the slowest time) as fast as Ms 1.4 allows.
+  Eigen::VectorXd shape;
+  if (!RuleShape(plant, TuningRule::kAmigo, pi, &shape) && !RuleShape(plant, TuningRule::kSimc, pi, &shape)) {
+    shape = pi ? Eigen::VectorXd::Constant(1, std::log(kGenericTiFactor * slowest))
+               : Eigen::VectorXd(Eigen::Vector3d(std::log(slowest), std::log(0.1 * slowest), std::log(10.0)));
+  }
+  Bounds b;
+  b.ms = b.mt = kMigoDefaultMs;
+  b.noise_gain = std::numeric_limits<double>::infinity();
+  b.crossover_cap = speed_cap_;
+  b.td_max_s = std::numeric_limits<double>::infinity();
+  const double kp = MaxKp(shape, b, 0.0);
+  double wc = kp > 0.0 ? PeaksOf(grid_, ShapeGains(shape, kp)).crossover : 0.0;
+  if (!(wc > 0.0)) wc = 1.0 / slowest;
+  time_s_ = 1.0 / wc;
+  sim_ = LoopSimulator(plant, 1.0 / (kStepsPerRadian * wc));
+  // Sixty periods of the crossover at most, and at least 200 delays.
+  max_steps_ = static_cast<int>(std::ceil(60.0 * 2.0 * M_PI / wc / sim_.Step()));
+  if (plant.delay_s > 0.0)
+    max_steps_ = std::max(max_steps_, static_cast<int>(200.0 * plant.delay_s / sim_.Step()));
+  max_steps_ = std::min(max_steps_, 200000);
+}
+
+PidGains Engine::ShapeGains(const Eigen::VectorXd& shape, double kp) const {
+  PidGains g;
+  g.kp = kp;
+  g.ki = kp / std::exp(shape(0));
+  if (!pi_) {
+    const double td = std::exp(shape(1));
+    g.kd = kp * td;
+    g.tf = td / std::exp(shape(2));
+  }
+  return g;
+}
+
+double Engine::MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double hint) const {
+  // L = kp Ls and C = kp Cs on the grid: one pass per kp.
+  const PidGains unit = ShapeGains(shape, 1.0);
+  const std::size_t n = grid_.w.size();
+  std::vector<cd> ls(n);
+  std::vector<double> cs(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const cd c = ControllerAt(unit, grid_.w[i]);
+    ls[i] = c * grid_.g[i];
+    cs[i] = std::abs(c);
+  }
+  const double c_inf = unit.kp + (unit.kd > 0.0 ? unit.kd / unit.tf : 0.0);
+  const double ms2 = bounds.ms * bounds.ms, mt2 = bounds.mt * bounds.mt;
+  const double nb2 = bounds.noise_gain * bounds.noise_gain;
+  const auto feasible = [&](double kp) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const cd l = kp * ls[i];
+      const double l2 = std::norm(l);
+      if (grid_.w[i] > bounds.crossover_cap && l2 >= 1.0) return false;
+      double d2 = std::norm(1.0 + l);
+      if (grid_.coarse[i]) {
+        const double ml = std::sqrt(l2);
+        if (ml >= 1.0) return false;
+        d2 = (1.0 - ml) * (1.0 - ml);
+      }
+      if (ms2 * d2 < 1.0 || l2 > mt2 * d2 || kp * kp * cs[i] * cs[i] > nb2 * d2) return false;
+    }
+    const double l_inf = kp * c_inf * grid_.g_inf;
+    const double d_inf = std::abs(1.0 + l_inf);
+    return bounds.ms * d_inf >= 1.0 && std::abs(l_inf) <= bounds.mt * d_inf &&
+           kp * c_inf <= bounds.noise_gain * d_inf;
+  };
+  // The Nyquist criterion on the grid: Z = P - (2 D - k pi) / (2 pi)
+  // closed-loop poles in the right half-plane, D the change of arg(1 + L)
+  // from 0+ to infinity, k the poles at the origin (indented to the right)
+  // and P the plant's in the right half-plane. Where the grid is coarse for
+  // the delay, |L| < 1 (feasible), so 1 + L stays right of the axis and the
+  // principal differences are exact.
+  const auto stable = [&](double kp) {
+    double d = 0.0;
+    cd prev = 1.0 + kp * ls[0];
+    for (std::size_t i = 1; i < n; ++i) {
+      const cd next = 1.0 + kp * ls[i];
+      d += std::arg(next / prev);
+      prev = next;
+    }
+    d += std::arg((1.0 + kp * c_inf * grid_.g_inf) / prev);
+    const double z = rhp_poles_ - (2.0 * d - origin_poles_ * M_PI) / (2.0 * M_PI);
+    return std::abs(z) < 0.5;
+  };
+  const auto good = [&](double kp) { return feasible(kp) && stable(kp); };
+  // Down from a gain whose crossover lies far above the cap (never
+  // feasible) by halves to the first feasible one, then bisection: the
+  // largest feasible kp, whichever of the feasible intervals it lies in (an
+  // integral-heavy shape on a lag can be feasible at a small gain, not at a
+  // moderate one, and again at a larger one).
+  (void)hint;
+  std::size_t cap = 0;
+  while (cap + 1 < n && grid_.w[cap] < bounds.crossover_cap) ++cap;
+  double bad = 100.0 / std::max(std::abs(ls[cap]), 1e-300);
+  double kp = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    const double k = bad * 0.5;
+    if (good(k)) {
+      kp = k;
+      break;
+    }
+    bad = k;
+  }
+  if (!(kp > 0.0)) return 0.0;
+  for (int i = 0; i < 14; ++i) {
+    const double mid = std::sqrt(kp * bad);
+    (good(mid) ? kp : bad) = mid;
+  }
+  return kp;
+}
+
+double Engine::LoadIae(const PidGains& g) const {
+  Inputs in;
+  in.load = 1.0;
+  const Response r = sim_.Run(g, in, max_steps_);
+  double peak = 0.0;
+  for (double y : r.y) peak = std::max(peak, std::abs(y));
+  if (r.y.empty() || (!r.settled && !(std::abs(r.y.back()) <= 1e-4 * peak)))
+    return std::numeric_limits<double>::infinity();
+  return IntegralAbs(r.y, 0.0, sim_.Step());
+}
+
+double Engine::Cost(const Eigen::VectorXd& shape, double alpha, const Bounds& bounds, double* kp_hint,
+                    PidGains* gains) const {
+  ++evaluations_;
+  if (!pi_ && std::exp(shape(1)) > bounds.td_max_s * (1.0 + 1e-12)) return HUGE_VAL;
+  const double kp_max = MaxKp(shape, bounds, *kp_hint);
+  if (!(kp_max > 0.0)) return HUGE_VAL;
+  *kp_hint = kp_max;
+  const PidGains g = ShapeGains(shape, kp_max * std::exp(std::min(alpha, 0.0)));
+  if (gains) *gains = g;
+  return LoadIae(g);
+}
+
+std::vector<Eigen::VectorXd> Engine::Starts(const Bounds& bounds) const {
+  std::vector<Eigen::VectorXd> starts;
+  Eigen::VectorXd s;
+  if (RuleShape(plant_, TuningRule::kAmigo, pi_, &s)) starts.push_back(s);
+  if (RuleShape(plant_, TuningRule::kSimc, pi_, &s)) starts.push_back(s);
+  // Generic: Ti from the crossover estimate (a PI's), Td a quarter of it.
+  const double ti = 2.0 * time_s_;
+  if (pi_)
+    starts.push_back(Eigen::VectorXd::Constant(1, std::log(ti)));
+  else
+    starts.push_back(
+        Eigen::Vector3d(std::log(ti), std::log(std::min(0.25 * ti, 0.9 * bounds.td_max_s)), std::log(10.0)));
+  for (Eigen::VectorXd& x : starts)
+    if (!pi_) x(1) = std::min(x(1), std::log(0.9 * bounds.td_max_s));
+  return starts;
+}
+
+bool Engine::Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum* best) const {
+  evaluations_ = 0;
+  const int dims = pi_ ? 1 : 3;
+  optim::Bounds box{Eigen::VectorXd(dims), Eigen::VectorXd(dims)};
+  const double t = time_s_;
+  box.lower(0) = std::log(1e-3 * t);
+  box.upper(0) = std::log(1e4 * t);
+  if (!pi_) {
+    box.lower(1) = std::log(1e-4 * std::min(t, bounds.td_max_s));
+    box.upper(1) = std::log(bounds.td_max_s);
+    box.lower(2) = std::log(kDesignMinFilterRatio);
+    box.upper(2) = std::log(kDesignMaxFilterRatio);
+  }
+  std::vector<Eigen::VectorXd> starts = Starts(bounds);
+  if (warm.size() == dims) starts.insert(starts.begin(), warm);
+  double kp_hint = 0.0;
+  const optim::ObjectiveFunction f = [&](const Eigen::VectorXd& x) {
+    return Cost(x, 0.0, bounds, &kp_hint, nullptr);
+  };
+  optim::OptimizerSummary result;
+  for (const Eigen::VectorXd& x0 : starts) {
+    optim::NelderMeadOptions o;
+    o.x0 = x0.cwiseMax(box.lower).cwiseMin(box.upper);
+    o.initial_step_fraction = 0.03;
+    o.max_evaluations = warm.size() == dims && &x0 != &starts.front() ? 60 : 160;
+    o.x_tolerance = 1e-5;
+    o.f_tolerance = 1e-7;
+    o.restarts_on_convergence = 0;
+    kp_hint = 0.0;
+    optim::OptimizerSummary s;
+    optim::NelderMead(f, box, o, &s);
+    if (s.IsUsable() && s.f < result.f) result = s;
+  }
+  if (!result.IsUsable()) return false;
+  // Polish from the best, with a fresh simplex.
+  {
+    optim::NelderMeadOptions o;
+    o.x0 = result.x;
+    o.initial_step_fraction = 0.01;
+    o.max_evaluations = 120;
+    o.x_tolerance = 1e-6;
+    o.f_tolerance = 1e-9;
+    o.restarts_on_convergence = 1;
+    kp_hint = 0.0;
+    optim::OptimizerSummary s;
+    optim::NelderMead(f, box, o, &s);
+    if (s.IsUsable() && s.f < result.f) result = s;
+  }
+  kp_hint = 0.0;
+  PidGains g;
+  double value = Cost(result.x, 0.0, bounds, &kp_hint, &g);
+  // A bound that is not active: kp below the largest (a fourth coordinate).
+  PidGains lower;
+  double hint = kp_hint;
+  if (Cost(result.x, std::log(0.97), bounds, &hint, &lower) < value) {
+    Eigen::VectorXd x0(dims + 1), lo(dims + 1), hi(dims + 1);
+    x0 << result.x, std::log(0.97);
+    lo << box.lower, -4.0;
+    hi << box.upper, 0.0;
+    const optim::ObjectiveFunction f4 = [&](const Eigen::VectorXd& x) {
+      return Cost(x.head(dims), x(dims), bounds, &kp_hint, nullptr);
+    };
+    optim::NelderMeadOptions o;
+    o.x0 = x0;
+    o.initial_step_fraction = 0.02;
+    o.max_evaluations = 300;
+    o.x_tolerance = 1e-6;
+    o.f_tolerance = 1e-9;
+    optim::OptimizerSummary s;
+    kp_hint = 0.0;
+    optim::NelderMead(f4, optim::Bounds{lo, hi}, o, &s);
+    if (s.IsUsable() && s.f < value) {
+      kp_hint = 0.0;
+      value = Cost(s.x.head(dims), s.x(dims), bounds, &kp_hint, &g);
+      result.x = s.x.head(dims);
+    }
+  }
+  if (!std::isfinite(value)) return false;
+  best->gains = g;
+  best->load_iae = value;
+  best->shape = result.x;
+  best->evaluations = evaluations_;
+  return true;
+}
+
+}  // namespace pidlab::tune::design

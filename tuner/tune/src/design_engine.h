@@ -1,0 +1,68 @@
+#pragma once
+// Internal to the design engine (design.h): the optimisation of the load
+// response under the bounds, for one Ms bound.
+
+#include <Eigen/Dense>
+#include <complex>
+#include <vector>
+
+#include "design_loop.h"
+#include "pidlab/tune/design.h"
+
+namespace pidlab::tune::design {
+
+/// The problem's bounds, as the engine applies them.
+struct Bounds {
+  double ms = 1.4, mt = 1.4, noise_gain = 0.0, td_max_s = 0.0;
+  /// No gain crossover above this (rad/s): a plant that allows any speed
+  /// (no dead time, relative degree 1) gets a loop ten times faster than its
+  /// fastest time, as migo's.
+  double crossover_cap = 0.0;
+};
+
+/// The best gains for one set of bounds.
+struct Optimum {
+  PidGains gains;
+  double load_iae = std::numeric_limits<double>::infinity();
+  /// The shape it was found at (log Ti, log Td, log N; PI: log Ti), to start
+  /// the next design of a front from.
+  Eigen::VectorXd shape;
+  int evaluations = 0;
+};
+
+class Engine {
+ public:
+  Engine(const Plant& plant, bool pi);
+  /// The optimum under `bounds`, from the rules' shapes and `warm` (if not
+  /// empty). False when no shape has a stable loop meeting the bounds.
+  bool Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum* best) const;
+  /// \int|y|dt of the unit load step (+inf when it does not settle).
+  double LoadIae(const PidGains& g) const;
+  const LoopSimulator& Simulator() const { return sim_; }
+  int MaxSteps() const { return max_steps_; }
+  /// The characteristic time the grid and the step came from (s).
+  double Time() const { return time_s_; }
+  double SpeedCap() const { return speed_cap_; }
+
+ private:
+  PidGains ShapeGains(const Eigen::VectorXd& shape, double kp) const;
+  /// The largest kp whose loop meets the bounds on the grid, from `hint`.
+  double MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double hint) const;
+  /// The shape's load IAE at kp = max kp * exp(min(alpha, 0)).
+  double Cost(const Eigen::VectorXd& shape, double alpha, const Bounds& bounds, double* kp_hint,
+              PidGains* gains) const;
+  std::vector<Eigen::VectorXd> Starts(const Bounds& bounds) const;
+
+  const Plant& plant_;
+  bool pi_;
+  double time_s_ = 1.0, speed_cap_ = 0.0;
+  FrequencyGrid grid_;
+  LoopSimulator sim_;
+  int max_steps_ = 20000;
+  // The plant's poles in the right half-plane, and at the origin with the
+  // controller's integrator.
+  int rhp_poles_ = 0, origin_poles_ = 1;
+  mutable int evaluations_ = 0;
+};
+
+}  // namespace pidlab::tune::design
