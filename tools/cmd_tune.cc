@@ -32,6 +32,12 @@ using pidlab::tune::TuneSummary;
 namespace pidlab::cli {
 namespace {
 
+std::string Join(const std::vector<std::string>& v) {
+  std::string out;
+  for (const std::string& s : v) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
 // 100 x, as %g prints it (10, not 10.000000000000002).
 std::string Percent(double fraction) {
   char text[32];
@@ -104,6 +110,9 @@ struct TuneCommand {
       if (o.method == pidlab::tune::TuneMethod::kMigo && o.robustness_phase_margin_deg > 0.0)
         std::cout << "robustness       phase margin >= " << o.robustness_phase_margin_deg
                   << " deg (given): the largest Ms bound whose design keeps it, " << s.migo.ms_bound << "\n";
+      else if (o.method == pidlab::tune::TuneMethod::kOptimal)
+        std::cout << "robustness       Ms <= " << s.design.ms_bound << ": " << t.robustness_reason
+                  << "; noise gain <= " << o.bounds.max_noise_gain << ": " << t.noise_gain_reason << "\n";
       else if (o.method == pidlab::tune::TuneMethod::kMigo && !t.robustness_reason.empty())
         std::cout << "robustness       Ms <= " << o.robustness_ms << ": " << t.robustness_reason << "\n";
     }
@@ -137,12 +146,20 @@ struct TuneCommand {
   static void PrintText(const TuneOptions& o, const TuneSummary& s, const Evaluation& ev,
                         const SearchBox& box, const std::vector<double>& widened_from, double box_upper) {
     std::cout << std::setprecision(6);
-    std::cout << "method           " << ToString(o.method) << " on " << ToString(o.objective) << ", box ["
-              << o.lower << ", " << box_upper << "]^3, seed " << o.seed << "\n";
+    if (o.method == pidlab::tune::TuneMethod::kOptimal)
+      std::cout << "method           optimal (the design engine) on the load integral |e| dt\n";
+    else
+      std::cout << "method           " << ToString(o.method) << " on " << ToString(o.objective) << ", box ["
+                << o.lower << ", " << box_upper << "]^3, seed " << o.seed << "\n";
     if (o.method == pidlab::tune::TuneMethod::kSimc || o.method == pidlab::tune::TuneMethod::kAmigo)
       std::cout << "rule             " << s.tuning_rule.message << "\n";
     if (o.method == pidlab::tune::TuneMethod::kMigo)
       std::cout << "design           " << s.migo.message << "\n";
+    if (o.method == pidlab::tune::TuneMethod::kOptimal && s.stable) {
+      PrintDesign(s);
+      std::cout << "wall time        " << s.wall_time_s << " s\n\n" << FormatEvaluation(ev);
+      return;
+    }
     if (!s.stable) {
       std::cout << "result           " << s.message << "\n";
       return;
@@ -176,7 +193,8 @@ struct TuneCommand {
     if (!widened_from.empty()) {
       std::cout << "box widened      ";
       for (double u : widened_from) std::cout << "[0, " << u << "] -> ";
-      std::cout << "[0, " << box_upper << "]  (the optimum was on the upper edge of a box not given: docs/tuning.md)\n";
+      std::cout << "[0, " << box_upper
+                << "]  (the optimum was on the upper edge of a box not given: docs/tuning.md)\n";
     }
     if (!s.at_bounds.empty()) {
       std::cout << "at bounds        ";
@@ -186,6 +204,17 @@ struct TuneCommand {
     if (o.two_dof || s.two_dof.ran) PrintTwoDof(s.two_dof);
     std::cout << "wall time        " << s.wall_time_s << " s\n\n";
     std::cout << FormatEvaluation(ev);
+  }
+
+  // The design engine's result: its bounds, what was active, the setpoint stage.
+  static void PrintDesign(const TuneSummary& s) {
+    std::cout << "design           " << s.design.message << "\n";
+    std::cout << "active bounds    "
+              << (s.design.active.empty() ? std::string("none") : Join(s.design.active)) << "\n";
+    std::cout << "setpoint         b = " << s.design.b << ", c = " << s.design.c << ": " << s.two_dof.message
+              << "\n";
+    std::cout << "response time    " << s.design.response_time_s << " s (2 / the crossover "
+              << s.design.crossover_rad_s << " rad/s)\n";
   }
 
   static void PrintTwoDof(const pidlab::tune::TwoDofSummary& t) {

@@ -127,6 +127,33 @@ nlohmann::json TwoDofJson(const tune::TwoDofSummary& s) {
 
 namespace {
 
+// TuneJson's "design" (the engine, its bounds and what was active) and
+// the keys: response_time_s, two_dof.setpoint_filter_s.
+void AddDesign(const tune::DesignSummary& d, nlohmann::json* j) {
+  (*j)["design"] = {{"engine", "optimal"},
+                    {"objective", "load integral |e| dt (unit step at the plant input, r = 0)"},
+                    {"load_iae", JsonNumber(d.load_iae)},
+                    {"setpoint_iae", JsonNumber(d.setpoint_iae)},
+                    {"ms_bound", JsonNumber(d.ms_bound)},
+                    {"mt_bound", JsonNumber(d.mt_bound)},
+                    {"noise_gain_bound", JsonNumber(d.noise_gain_bound)},
+                    {"td_bound_s", JsonNumber(d.td_bound_s)},
+                    {"ms", JsonNumber(d.ms)},
+                    {"mt", JsonNumber(d.mt)},
+                    {"noise_gain", JsonNumber(d.noise_gain)},
+                    {"crossover_rad_s", JsonNumber(d.crossover_rad_s)},
+                    {"phase_margin_deg", JsonNumber(d.phase_margin_deg)},
+                    {"active", d.active},
+                    {"overshoot_pct", JsonNumber(d.overshoot_pct)},
+                    {"overshoot_unit_weights_pct", JsonNumber(d.overshoot_unit_weights_pct)},
+                    {"overshoot_met", d.overshoot_met},
+                    {"setpoint_note", d.setpoint_note},
+                    {"evaluations", d.evaluations},
+                    {"message", d.message}};
+  (*j)["response_time_s"] = JsonNumber(d.response_time_s);
+  if (j->contains("two_dof")) (*j)["two_dof"]["setpoint_filter_s"] = 0.0;
+}
+
 // TuneJson's "refine": the Ceres cross-check.
 nlohmann::json RefineJson(const TuneOptions& o, const TuneSummary& s) {
   return {{"ran", s.refine.ran},
@@ -215,6 +242,7 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
   if (o.robust_samples > 0) j["robust_set"] = RobustSetJson(o, s);
   if (s.stable) AddMotor(ev, &j);
   if (o.two_dof || s.two_dof.ran) j["two_dof"] = TwoDofJson(s.two_dof);
+  if (o.method == TuneMethod::kOptimal) AddDesign(s.design, &j);
   if (o.method == TuneMethod::kMigo)
     j["migo"] = {{"robustness", o.robustness_ms},
                  {"phase_margin_deg", o.robustness_phase_margin_deg},
@@ -230,7 +258,10 @@ nlohmann::json TuneJson(const Plant& p, const TuneOptions& o, const TuneSummary&
 }
 
 nlohmann::json TimeScaleJson(const tune::TimeScale& t) {
-  return {{"horizon_s", t.horizon_s}, {"sample_time_s", t.sample_time_s}, {"source", t.source}, {"reason", t.reason}};
+  return {{"horizon_s", t.horizon_s},
+          {"sample_time_s", t.sample_time_s},
+          {"source", t.source},
+          {"reason", t.reason}};
 }
 
 nlohmann::json RobustnessJson(const LoopAnalysis& a, const LoopBounds& bounds) {

@@ -24,6 +24,10 @@ nlohmann::json TuningJson(const tune::TuningProblem& problem, const tune::Tuning
     j["box"]["widened_from"] = result.widened_from;
   }
   if (j.contains("migo")) j["migo"]["robustness_reason"] = t.robustness_reason;
+  if (j.contains("design")) {
+    j["design"]["robustness_reason"] = t.robustness_reason;
+    j["design"]["noise_gain_reason"] = t.noise_gain_reason;
+  }
   return j;
 }
 

@@ -211,6 +211,48 @@ Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSum
   return Status::Ok();
 }
 
+Status DesignMsForPhaseMargin(const Plant& plant, double phase_margin_deg, DesignOptions* options) {
+  const auto margin = [&](double ms, double* pm) {
+    DesignOptions o = *options;
+    o.max_ms = ms;
+    o.crossover_rad_s = 0.0;
+    DesignSummary d;
+    if (!DesignOptimal(plant, o, &d).ok()) return false;
+    *pm = std::isfinite(d.phase_margin_deg) ? d.phase_margin_deg : 180.0;
+    return true;
+  };
+  double lo = 1.05, hi = 4.0, pm = 0.0;
+  if (!margin(lo, &pm) || pm < phase_margin_deg) {
+    std::ostringstream os;
+    os << "optimal: no design keeps a phase margin of " << FormatNumber(phase_margin_deg) << " deg on plant "
+       << plant.name << " (at Ms 1.05 it is " << FormatNumber(pm) << " deg): lower --robustness";
+    return Status::InvalidInput(os.str());
+  }
+  if (margin(hi, &pm) && pm >= phase_margin_deg) lo = hi;
+  for (int i = 0; i < 12 && lo < hi; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    (margin(mid, &pm) && pm >= phase_margin_deg ? lo : hi) = mid;
+  }
+  options->max_ms = lo;
+  return Status::Ok();
+}
+
+double DefaultNoiseGain(const Plant& plant, double ms, bool pi, std::string* why) {
+  MigoOptions o;
+  o.ms = ms;
+  o.pi = pi;
+  MigoDesign d;
+  analysis::LoopAnalysis a;
+  if (plant.nonlinear || !DesignMigo(plant, o, &d).ok() || !Analyse(plant, d.gains, &a) ||
+      !std::isfinite(a.noise_gain)) {
+    *why = "none (migo has no design on this plant)";
+    return std::numeric_limits<double>::infinity();
+  }
+  *why = "migo's noise gain at Ms " + FormatNumber(ms) + ", " + FormatNumber(a.noise_gain) +
+         ": never noisier than the largest-ki design";
+  return a.noise_gain;
+}
+
 double DesignLoadIae(const Plant& plant, const PidGains& gains) {
   const design::Engine engine(plant, gains.kd == 0.0);
   return engine.LoadIae(gains);

@@ -318,8 +318,9 @@ Status MigoMsForPhaseMargin(const Plant& plant, double phase_margin_deg, MigoOpt
   double lo = 1.05, hi = 4.0, pm = 0.0;
   if (!margin(lo, &pm) || pm < phase_margin_deg) {
     std::ostringstream os;
-    os << "migo: no design keeps a phase margin of " << spec::FormatNumber(phase_margin_deg) << " deg on plant "
-       << plant.name << " (at Ms 1.05 it is " << spec::FormatNumber(pm) << " deg): lower --robustness";
+    os << "migo: no design keeps a phase margin of " << spec::FormatNumber(phase_margin_deg)
+       << " deg on plant " << plant.name << " (at Ms 1.05 it is " << spec::FormatNumber(pm)
+       << " deg): lower --robustness";
     return Status::InvalidInput(os.str());
   }
   if (margin(hi, &pm) && pm >= phase_margin_deg) lo = hi;

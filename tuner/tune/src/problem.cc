@@ -298,8 +298,14 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
   // them for migo, which designs with it. The rules' PI has no derivative.
   const bool pi_rule = s->tune.rule == "pi" &&
                        (s->tune.method == "migo" || s->tune.method == "simc" || s->tune.method == "amigo");
-  if (!pi_rule && !kept("derivative_filter") && !kept("derivative_filter_ratio") && !kept("robust") &&
-      (!paper || s->tune.method == "migo")) {
+  // The design engine designs its own filter (N = Td / tf searched).
+  const bool optimal = s->tune.method == "optimal";
+  if (optimal && !kept("derivative_filter") && !kept("derivative_filter_ratio")) {
+    s->loop.derivative_filter_s = 0.0;
+    s->loop.derivative_filter_ratio = 0.0;
+  }
+  if (!pi_rule && !optimal && !kept("derivative_filter") && !kept("derivative_filter_ratio") &&
+      !kept("robust") && (!paper || s->tune.method == "migo")) {
     s->loop.derivative_filter_s = 0.0;
     s->loop.derivative_filter_ratio = kMigoFilterRatio;
   }
@@ -310,7 +316,8 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
         s->loop.horizon_s == defaults.horizon_s && s->loop.sample_time_s == defaults.sample_time_s;
     t.source = eq4 ? "eq. (4)" : "given";
     t.reason = eq4 ? "the paper's eq. (4): n = 25 s, ts = 0.05 s" : "given";
-    t.robustness_reason = kept("robustness") ? "given" : "the default, " + spec::FormatNumber(s->tune.robustness);
+    t.robustness_reason =
+        kept("robustness") ? "given" : "the default, " + spec::FormatNumber(s->tune.robustness);
     return t;
   }
   Plant plant;
@@ -319,12 +326,21 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
     if (timed) t.source = t.reason = "given";
     return t;
   }
-  if (s->tune.method == "migo" && !kept("robustness")) {
+  if ((s->tune.method == "migo" || optimal) && !kept("robustness")) {
     s->tune.robustness = DefaultRobustness(plant, &t.robustness_reason);
   } else {
     t.robustness_reason = "given";
   }
-  const std::string reason = t.robustness_reason;
+  // The engine's noise bound: migo's noise gain at the same Ms, unless given
+  // (inf: none). A phase margin's Ms is not known yet: the default Ms's.
+  if (optimal && !kept("max_noise_gain")) {
+    const double ms =
+        s->tune.robustness > 1.0 && s->tune.robustness <= 4.0 ? s->tune.robustness : kMigoDefaultMs;
+    s->bounds.max_noise_gain = DefaultNoiseGain(plant, ms, s->tune.rule == "pi", &t.noise_gain_reason);
+  } else if (optimal) {
+    t.noise_gain_reason = "given";
+  }
+  const std::string reason = t.robustness_reason, noise_reason = t.noise_gain_reason;
   // (The robust preset's bound on the slowest time constant is a tenth of
   // this horizon: at least the migo design's own.)
   const TimeScale derived = DerivedTimeScale(*s, plant);
@@ -333,13 +349,14 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
     const bool same =
         s->loop.horizon_s == derived.horizon_s && s->loop.sample_time_s == derived.sample_time_s;
     if (!same) t.source = t.reason = "given";
-    if (same) t = TimeScale(derived), t.robustness_reason = reason;
+    if (same) t = TimeScale(derived), t.robustness_reason = reason, t.noise_gain_reason = noise_reason;
     return t;
   }
   s->loop.horizon_s = derived.horizon_s;
   s->loop.sample_time_s = derived.sample_time_s;
   t = derived;
   t.robustness_reason = reason;
+  t.noise_gain_reason = noise_reason;
   return t;
 }
 
@@ -363,6 +380,7 @@ Status BuildTuning(const spec::TuningSpec& s, const BuildOptions& options, Tunin
       !BuildTuneOptions(p.spec, options.style, &p.options, &error) ||
       !BuildLoopFor(p.plant, p.spec.loop, options.style, &p.options.loop, &error))
     return Status::InvalidInput(error);
+  p.options.robustness_given = options.given.count("robustness") > 0;
   const bool sampled = p.options.loop.loop == evaluation::LoopKind::kSampled;
   if (p.plant.nonlinear && !sampled)
     return Status::InvalidInput(

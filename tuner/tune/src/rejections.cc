@@ -30,7 +30,8 @@ struct Rule {
 constexpr std::array<Rule, 6> kBoundRules = {{
     {"Ms ", "above --max-ms", "raise --max-ms, or let migo design under an Ms bound: --method migo"},
     {"Mt ", "above --max-mt", "raise --max-mt"},
-    {"noise gain", "above --max-noise-gain", "raise --max-noise-gain or filter the derivative: --derivative-filter-ratio 10"},
+    {"noise gain", "above --max-noise-gain",
+     "raise --max-noise-gain or filter the derivative: --derivative-filter-ratio 10"},
     {"phase margin", "below --min-phase-margin", "lower --min-phase-margin"},
     {"gain margin", "below --min-gain-margin", "lower --min-gain-margin"},
     {"time constant", "slower than --max-time-constant", "raise --max-time-constant or --horizon"},
@@ -40,10 +41,12 @@ constexpr std::array<Rule, 6> kBoundRules = {{
 // degree 1 with dead time, or the box.
 std::pair<std::string, std::string> Unstable(const Plant& plant, const TuneOptions& options) {
   if (IdealDerivativeMakesLoopNeutral(plant, options) && options.upper > 0.0)
-    return {"not strictly stable (an ideal derivative on a plant of relative degree 1 with dead time makes the "
-            "loop neutral)",
-            "filter the derivative: --derivative-filter-ratio 10, or --method migo"};
-  return {"not strictly stable", "--method migo designs a stable loop; or give a box that holds one: --bounds LO,HI"};
+    return {
+        "not strictly stable (an ideal derivative on a plant of relative degree 1 with dead time makes the "
+        "loop neutral)",
+        "filter the derivative: --derivative-filter-ratio 10, or --method migo"};
+  return {"not strictly stable",
+          "--method migo designs a stable loop; or give a box that holds one: --bounds LO,HI"};
 }
 
 // The first rule `g` breaks, as (what, helps); ("", "") if none.
@@ -95,8 +98,8 @@ std::string ExplainRejections(const Plant& plant, const TuneOptions& options,
   auto most = count.begin();
   for (auto it = count.begin(); it != count.end(); ++it)
     if (it->second > most->second) most = it;
-  return "; " + std::to_string(most->second) + " of " + std::to_string(probes) + " probe points of the box are " +
-         most->first.first + "; what helps: " + most->first.second;
+  return "; " + std::to_string(most->second) + " of " + std::to_string(probes) +
+         " probe points of the box are " + most->first.first + "; what helps: " + most->first.second;
 }
 
 }  // namespace pidlab::tune

@@ -394,7 +394,8 @@ bool BuildSearch(const spec::TuneSpec& t, NameStyle style, TuneOptions* o, std::
     return Bad(
         error,
         name("method") + " " + Quote(t.method) +
-            " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga, pso-gsa, simc, amigo or migo");
+            " must be multi-start, nelder-mead, paper-nm, ziegler-nichols, ga, pso-gsa, simc, amigo, migo or "
+            "optimal");
   if (!evaluation::ParseObjectiveKind(t.objective, &o->objective))
     return Bad(error, name("objective") + " " + Quote(t.objective) +
                           " must be iae, ise, itae, iae-continuous, load-iae or setpoint-load");

@@ -192,6 +192,45 @@ bool MigoSearch(const Plant& plant, const TuneOptions& options,
   return status.ok();
 }
 
+// The design engine (design.h) into summary->design, ->two_dof (its
+// setpoint weights) and ->optimizer. --robustness is the Ms bound (or a
+// phase margin: the largest Ms bound whose design keeps it), --max-mt and
+// --max-noise-gain bound Mt and C S, --response-time T the crossover 2 / T
+// on the front, --max-overshoot the setpoint stage's target (default 10 %).
+bool OptimalSearch(const Plant& plant, const TuneOptions& options,
+                   const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary,
+                   std::string* error) {
+  DesignOptions o;
+  o.max_ms = options.robustness_ms;
+  if (std::isfinite(options.bounds.max_mt)) o.max_mt = options.bounds.max_mt;
+  o.max_noise_gain = options.bounds.max_noise_gain;
+  o.pi = options.rule == RuleForm::kPi;
+  o.crossover_rad_s = options.response_time_s > 0.0 ? 2.0 / options.response_time_s : 0.0;
+  if (o.crossover_rad_s > 0.0 && !options.robustness_given) o.max_ms = kFrontMaxMs;
+  o.max_overshoot_pct =
+      std::isfinite(options.max_overshoot_pct) ? options.max_overshoot_pct : kDesignDefaultOvershootPct;
+  Status status = options.robustness_phase_margin_deg > 0.0
+                      ? DesignMsForPhaseMargin(plant, options.robustness_phase_margin_deg, &o)
+                      : Status::Ok();
+  if (status.ok()) status = DesignOptimal(plant, o, &summary->design);
+  if (!status.ok()) {
+    if (error) *error = status.message();
+    return false;
+  }
+  const DesignSummary& d = summary->design;
+  TwoDofSummary& two = summary->two_dof;
+  two.ran = true;
+  two.b = d.b;
+  two.c = d.c;
+  two.termination = optim::TerminationType::kConverged;
+  two.message = d.setpoint_note.empty() ? "the setpoint overshoot " + spec::FormatNumber(d.overshoot_pct) +
+                                              " % <= " + spec::FormatNumber(o.max_overshoot_pct) +
+                                              " %, the least setpoint integral |e| dt"
+                                        : d.setpoint_note;
+  RuleResult(d.gains, evaluator, d.message, &summary->optimizer);
+  return true;
+}
+
 // Runs options.method on f over the gain box into summary->optimizer
 // (Ziegler-Nichols, SIMC, AMIGO: the rule's gains, evaluated once). False
 // with *error if the rule does not apply.
@@ -264,6 +303,8 @@ bool Search(const Plant& plant, const TuneOptions& options, const optim::Objecti
       return RuleSearch(plant, options, evaluator, summary, error);
     case TuneMethod::kMigo:
       return MigoSearch(plant, options, evaluator, summary, error);
+    case TuneMethod::kOptimal:
+      return OptimalSearch(plant, options, evaluator, summary, error);
   }
   return true;
 }
@@ -410,12 +451,15 @@ bool TuneOrExplain(const Plant& plant, const TuneOptions& options, TuneSummary* 
     return false;
   }
   if (!opt.IsUsable()) {
-    summary->message = "no strictly stable loop found in the box: " + opt.message + ExplainRejections(plant, options, evaluator);
+    summary->message = "no strictly stable loop found in the box: " + opt.message +
+                       ExplainRejections(plant, options, evaluator);
     summary->wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     return true;
   }
   summary->search_gains = {opt.x(0), opt.x(1), opt.x(2)};
+  // The engine designs its own derivative filter.
+  if (options.method == TuneMethod::kOptimal) summary->search_gains.tf = summary->design.gains.tf;
   summary->search_objective = opt.f;
   summary->gains = summary->search_gains;
   summary->objective = summary->search_objective;

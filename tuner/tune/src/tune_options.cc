@@ -34,6 +34,8 @@ bool ParseTuneMethod(const std::string& s, TuneMethod* method) {
     *method = TuneMethod::kAmigo;
   else if (s == "migo")
     *method = TuneMethod::kMigo;
+  else if (s == "optimal")
+    *method = TuneMethod::kOptimal;
   else
     return false;
   return true;
@@ -59,13 +61,15 @@ std::string ToString(TuneMethod method) {
       return "amigo";
     case TuneMethod::kMigo:
       return "migo";
+    case TuneMethod::kOptimal:
+      return "optimal";
   }
   return "multi-start";
 }
 
 bool IsTuningRule(TuneMethod method) {
   return method == TuneMethod::kZieglerNichols || method == TuneMethod::kSimc ||
-         method == TuneMethod::kAmigo || method == TuneMethod::kMigo;
+         method == TuneMethod::kAmigo || method == TuneMethod::kMigo || method == TuneMethod::kOptimal;
 }
 
 std::string ToString(RefineTermination termination) {
@@ -184,6 +188,7 @@ int TuneOptions::EvaluationBudget() const {
     case TuneMethod::kSimc:
     case TuneMethod::kAmigo:
     case TuneMethod::kMigo:
+    case TuneMethod::kOptimal:
       break;
   }
   return 1;

@@ -293,7 +293,8 @@ struct TuneSpec {
         {"method",
          "multi-start (Sobol' design + Nelder-Mead polish) | nelder-mead | paper-nm | ziegler-nichols | ga | "
          "pso-gsa | simc | amigo (tuning rules on a reduced model) | migo (the largest ki under an Ms "
-         "bound). Not given: migo, unless a flag asks for a search (an objective, a box, a budget, a step "
+         "bound) | optimal (the design engine: the least load integral |e| dt under Ms, Mt and noise-gain "
+         "bounds, docs/tuning.md). Not given: migo, unless a flag asks for a search (an objective, a box, a budget, a step "
          "or robustness bound, robust, the sampled loop) or the plant is the nonlinear stepper: then "
          "multi-start (docs/tuning.md, \"Any plant\")",
          "", kNone, R"("nelder-mead")"},

@@ -118,6 +118,19 @@ double DominantTimeConstant(const Plant& plant);
 /// reachable range (the range named).
 Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSummary* summary);
 
+/// `--robustness` as a phase margin (deg, in [20, 80]): the largest Ms
+/// bound in [1.05, 4] whose design (with *options otherwise) keeps it
+/// (bisection, 12 designs), into options->max_ms. kInvalidInput naming the
+/// margin when even Ms 1.05 does not keep it.
+Status DesignMsForPhaseMargin(const Plant& plant, double phase_margin_deg, DesignOptions* options);
+
+/// The default noise-gain bound of `tune --method optimal` at Ms bound `ms`:
+/// the noise gain of migo's design at that bound (the largest ki, tf = Td /
+/// 10), so that the engine's design is never noisier than it and, since
+/// migo's gains meet every bound, rejects a load step at least as well.
+/// +inf where migo has no design; *why says so in one clause.
+double DefaultNoiseGain(const Plant& plant, double ms, bool pi, std::string* why);
+
 /// The unit load step's \int|y|dt of `gains` on the continuous loop of
 /// `plant` (dead time included), by the engine's simulation; +inf when the
 /// response does not settle (an unstable loop). Independent of the

@@ -96,8 +96,8 @@ Status MigoSetpointWeights(const Plant& plant, const evaluation::LoopOptions& lo
 /// than kMigoMaxOvershootAtZeroB, the overshoot comes from the integral
 /// action itself: the bound is tightened in steps of 0.05 (down to 1.2) and
 /// the design's message says so. (tune --method migo.)
-Status DesignMigoForSetpoint(const Plant& plant, const evaluation::LoopOptions& loop, const MigoOptions& options,
-                             MigoDesign* design, TwoDofSummary* two_dof);
+Status DesignMigoForSetpoint(const Plant& plant, const evaluation::LoopOptions& loop,
+                             const MigoOptions& options, MigoDesign* design, TwoDofSummary* two_dof);
 
 /// `--robustness` as a phase margin: the range it takes (deg); an Ms bound is
 /// in (1, 4], so the two never meet.
@@ -119,6 +119,8 @@ struct TimeScale {
   std::string reason;
   /// migo: where its Ms bound came from ("given", or SIMC's Ms on the plant).
   std::string robustness_reason;
+  /// optimal: where its noise-gain bound came from ("given", or migo's).
+  std::string noise_gain_reason;
 };
 
 /// The horizon and sample spacing a loop with closed-loop time constants

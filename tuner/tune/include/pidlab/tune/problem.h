@@ -166,8 +166,8 @@ bool IsPaperPlant(const spec::PlantSpec& p);
 /// - with no `method` given and nothing
 ///   that asks for a search (an objective, a box, budgets, step or
 ///   robustness bounds, `robust`, a robust set, the sampled loop), the
-///   method migo (the nonlinear stepper: multi-start); with no derivative filter given (nor `robust`), a PID of any
-///   method gets derivative_filter_ratio 10 (on the paper's plants, migo's);
+///   method migo (the nonlinear stepper: multi-start); with no derivative filter given (nor `robust`), a PID
+///   of any method gets derivative_filter_ratio 10 (on the paper's plants, migo's);
 /// - with neither `horizon` nor `sample_time` given, on a plant other than
 ///   the paper's, the time scale of the migo design's closed loop
 ///   (LoopTimeScale; the plant's own times where migo does not apply); on a

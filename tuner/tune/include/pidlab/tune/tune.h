@@ -16,6 +16,7 @@
 #include "pidlab/optim/multi_start.h"
 #include "pidlab/optim/optimizer.h"
 #include "pidlab/spec/status.h"
+#include "pidlab/tune/design.h"
 #include "pidlab/tune/migo.h"
 #include "pidlab/tune/tuning_rules.h"
 #include "pidlab/tune/two_dof.h"
@@ -36,15 +37,17 @@ enum class TuneMethod {
   kZieglerNichols,
   kGeneticAlgorithm,
   kPsoGsa,
-  kSimc,   // Skogestad's SIMC rule on a reduced model (tuning_rules.h)
-  kAmigo,  // Astrom and Hagglund's AMIGO rule on a reduced model (tuning_rules.h)
-  kMigo,   // the largest ki under an Ms bound, on the frequency response (migo.h)
+  kSimc,     // Skogestad's SIMC rule on a reduced model (tuning_rules.h)
+  kAmigo,    // Astrom and Hagglund's AMIGO rule on a reduced model (tuning_rules.h)
+  kMigo,     // the largest ki under an Ms bound, on the frequency response (migo.h)
+  kOptimal,  // the design engine: the least load IAE under Ms, Mt and noise bounds (design.h)
 };
-/// multi-start | nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa | simc | amigo | migo
+/// multi-start | nelder-mead | paper-nm | ziegler-nichols | ga | pso-gsa | simc | amigo | migo | optimal
 bool ParseTuneMethod(const std::string& s, TuneMethod* method);
 std::string ToString(TuneMethod method);
 /// True for the methods that compute their gains by a rule and evaluate them
-/// once (ziegler-nichols, simc, amigo): no search, no Ceres cross-check.
+/// once (ziegler-nichols, simc, amigo, migo, optimal): no search over the
+/// box, no Ceres cross-check.
 bool IsTuningRule(TuneMethod method);
 
 /// The multi-start's defaults (docs/optimisers.md, "MultiStart"): the design
@@ -146,6 +149,10 @@ struct TuneOptions {
   double robustness_phase_margin_deg = 0.0;
   double response_time_s = 0.0;
   double migo_max_overshoot_pct = 20.0;
+  /// optimal: robustness_ms was given (a response time then moves along
+  /// the front below it), not the plant's default (the front up to
+  /// kFrontMaxMs).
+  bool robustness_given = false;
   /// simc: the closed-loop time constant tau_c (s); 0: tau_c = theta.
   double tau_c_s = 0.0;
   /// Runs independent evaluations at the same time (e.g. one thread per LCM
@@ -277,6 +284,7 @@ struct TuneSummary {
   ZieglerNicholsResult ziegler_nichols;  // ziegler-nichols only
   TuningRuleResult tuning_rule;          // simc and amigo only: the model and the rule's controller
   MigoDesign migo;                       // migo only: the design's peaks and crossover
+  DesignSummary design;                  // optimal only: the engine's design and its bounds
   RefineSummary refine;
   /// With a robust set (TuneOptions::robust_samples > 0): its size (nominal
   /// plus the valid draws), the draws whose parameters gave no valid plant

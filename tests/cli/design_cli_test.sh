@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# pidlab tune --method optimal (docs/tuning.md, "The design engine"): the
+# documented commands, the issue's JSON keys, MATLAB's pidtune on 1/(s+1)^3,
+# the knobs met, and a crossover out of reach refused (exit 2, one line).
+set -uo pipefail
+source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
+pidlab="$1"
+pass=0; fail=0
+check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+
+# The tank of the issue, as docs/tuning.md runs it.
+"$pidlab" tune --num 0.8 --den 1200,130,1 --delay 150 --method optimal --json > "$tmp/tank.json" 2>"$tmp/err"
+check "the tank's default design exits 0" "[ $? -eq 0 ]"
+"$pidlab" tune --num 0.8 --den 1200,130,1 --delay 150 --method amigo --json > "$tmp/amigo.json" 2>"$tmp/err"
+check "the tank: the engine's keys, its bounds met, and a load IAE below AMIGO's at no larger Ms" \
+  "/usr/bin/python3 - \"$tmp/tank.json\" \"$tmp/amigo.json\" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1])); a = json.load(open(sys.argv[2]))
+d = j['design']
+assert j['method'] == 'optimal' and d['engine'] == 'optimal', d
+g = j['gains']
+assert g['tf'] > 0 and g['kd'] > 0, g
+b, c = j['two_dof']['setpoint_weights']
+assert 0 <= b <= 1 and 0 <= c <= 1 and j['two_dof']['setpoint_filter_s'] == 0
+r = j['robustness']
+assert r['ms'] <= d['ms_bound'] * 1.001 and r['noise_gain'] <= d['noise_gain_bound'] * 1.001, (r['ms'], d)
+assert abs(j['response_time_s'] - 2 / d['crossover_rad_s']) < 1e-9 * j['response_time_s']
+assert j['overshoot_pct'] <= 10.0, j['overshoot_pct']
+assert 'migo' in d['noise_gain_reason'] and d['robustness_reason'], d
+assert j['spec']['method'] == 'optimal' and j['spec']['derivative_filter_ratio'] == 0
+# AMIGO's PID on the same plant: its load response (eq. 4 sum x ts) is worse.
+ts = j['time_scale']['sample_time_s']
+assert j['load_iae'] * ts < a['load_iae'] * a['time_scale']['sample_time_s'], (j['load_iae'], a['load_iae'])
+PY"
+
+# MATLAB's documented pidtune(1/(s+1)^3, 'PIDF', 1): load integral |e| dt 1.015 at
+# Ms 1.39 and noise gain 199; its PI 2.203 at Ms 1.629.
+"$pidlab" tune --num 1 --den 1,3,3,1 --method optimal --robustness 1.39 --max-noise-gain 199 --json \
+  > "$tmp/pidf.json" 2>"$tmp/err"
+check "1/(s+1)^3 at MATLAB's PIDF's Ms and noise gain exits 0" "[ $? -eq 0 ]"
+"$pidlab" tune --num 1 --den 1,3,3,1 --method optimal --robustness 1.629 --rule pi --max-noise-gain inf --json \
+  > "$tmp/pi.json" 2>"$tmp/err"
+check "its PI exits 0" "[ $? -eq 0 ]"
+check "both reject a load step better than MATLAB's, within the same bounds" \
+  "/usr/bin/python3 - \"$tmp/pidf.json\" \"$tmp/pi.json\" <<'PY'
+import json, sys
+f = json.load(open(sys.argv[1])); p = json.load(open(sys.argv[2]))
+assert f['design']['load_iae'] <= 1.015 and f['robustness']['ms'] <= 1.39 * 1.001, f['design']
+assert f['robustness']['noise_gain'] <= 199 * 1.001, f['robustness']['noise_gain']
+assert p['design']['load_iae'] <= 2.203 and p['robustness']['ms'] <= 1.629 * 1.001 and p['gains']['kd'] == 0
+PY"
+
+# The knobs: --crossover 1 within 2 %, a phase margin within 1 %.
+"$pidlab" tune --num 1 --den 1,3,3,1 --method optimal --crossover 1 --json > "$tmp/wc.json" 2>"$tmp/err"
+check "--crossover 1 exits 0" "[ $? -eq 0 ]"
+"$pidlab" tune --num 1 --den 1,3,3,1 --method optimal --robustness 60 --json > "$tmp/pm.json" 2>"$tmp/err"
+check "--robustness 60 exits 0" "[ $? -eq 0 ]"
+check "the crossover within 2 % and the phase margin within 1 %" \
+  "/usr/bin/python3 - \"$tmp/wc.json\" \"$tmp/pm.json\" <<'PY'
+import json, sys
+w = json.load(open(sys.argv[1])); m = json.load(open(sys.argv[2]))
+assert abs(w['design']['crossover_rad_s'] - 1) <= 0.02, w['design']['crossover_rad_s']
+assert abs(m['robustness']['phase_margin_deg'] - 60) <= 0.6, m['robustness']['phase_margin_deg']
+PY"
+
+# A crossover the front does not reach: exit 2, one line naming the range.
+"$pidlab" tune --num 1 --den 1,3,3,1 --method optimal --response-time 400 > "$tmp/out" 2>"$tmp/err"
+check "a response time out of reach exits 2" "[ $? -eq 2 ]"
+check "... in one line naming the reachable range" \
+  "only_line_ok \"$tmp/err\" 'response time 400 s) is outside what plant' && grep -q 'rad/s (response time' \"$tmp/err\""
+check "... with nothing on stdout" "[ ! -s \"$tmp/out\" ]"
+
+# A reverse-acting plant: refused by the engine in one line (exit 2).
+"$pidlab" tune --num -19 --den 2,1 --delay 0.5 --method optimal > "$tmp/out" 2>"$tmp/err"
+check "a reverse-acting plant exits 2 in one line saying so" \
+  "[ $? -eq 2 ] && only_line_ok \"$tmp/err\" 'acts in reverse'"
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
