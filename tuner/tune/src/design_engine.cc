@@ -48,7 +48,8 @@ bool RuleShape(const Plant& plant, TuningRule rule, bool pi, Eigen::VectorXd* sh
 
 }  // namespace
 
-Engine::Engine(const Plant& plant, bool pi) : plant_(plant), pi_(pi), sim_(plant, 1.0) {
+Engine::Engine(const Plant& plant, bool pi, double min_tf_s, double crossover_hint)
+    : plant_(plant), pi_(pi), min_tf_s_(min_tf_s), sim_(plant, 1.0) {
   double fastest = 0.0, slowest = 0.0;
   PlantTimes(plant, &fastest, &slowest);
   speed_cap_ = kMigoSpeedCap / fastest;
@@ -73,7 +74,9 @@ Engine::Engine(const Plant& plant, bool pi) : plant_(plant), pi_(pi), sim_(plant
   b.crossover_cap = speed_cap_;
   b.td_max_s = std::numeric_limits<double>::infinity();
   const double kp = MaxKp(shape, b, 0.0);
-  double wc = kp > 0.0 ? PeaksOf(grid_, ShapeGains(shape, kp)).crossover : 0.0;
+  double wc = crossover_hint > 0.0 ? crossover_hint
+              : kp > 0.0           ? PeaksOf(grid_, ShapeGains(shape, kp)).crossover
+                                   : 0.0;
   if (!(wc > 0.0)) wc = 1.0 / slowest;
   time_s_ = 1.0 / wc;
   sim_ = LoopSimulator(plant, 1.0 / (kStepsPerRadian * wc));
@@ -84,6 +87,12 @@ Engine::Engine(const Plant& plant, bool pi) : plant_(plant), pi_(pi), sim_(plant
   max_steps_ = std::min(max_steps_, 200000);
 }
 
+Eigen::VectorXd Engine::ShapeOf(const PidGains& g) const {
+  if (pi_) return Eigen::VectorXd::Constant(1, std::log(g.kp / g.ki));
+  const double td = g.kd / g.kp;
+  return Eigen::Vector3d(std::log(g.kp / g.ki), std::log(td), std::log(td / g.tf));
+}
+
 PidGains Engine::ShapeGains(const Eigen::VectorXd& shape, double kp) const {
   PidGains g;
   g.kp = kp;
@@ -91,84 +100,135 @@ PidGains Engine::ShapeGains(const Eigen::VectorXd& shape, double kp) const {
   if (!pi_) {
     const double td = std::exp(shape(1));
     g.kd = kp * td;
-    g.tf = td / std::exp(shape(2));
+    g.tf = std::max(td / std::exp(shape(2)), min_tf_s_);
   }
   return g;
 }
 
-double Engine::MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double hint) const {
-  // L = kp Ls and C = kp Cs on the grid: one pass per kp.
-  const PidGains unit = ShapeGains(shape, 1.0);
-  const std::size_t n = grid_.w.size();
-  std::vector<cd> ls(n);
-  std::vector<double> cs(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const cd c = ControllerAt(unit, grid_.w[i]);
-    ls[i] = c * grid_.g[i];
-    cs[i] = std::abs(c);
-  }
-  const double c_inf = unit.kp + (unit.kd > 0.0 ? unit.kd / unit.tf : 0.0);
-  const double ms2 = bounds.ms * bounds.ms, mt2 = bounds.mt * bounds.mt;
-  const double nb2 = bounds.noise_gain * bounds.noise_gain;
-  const auto feasible = [&](double kp) {
+namespace {
+
+// One shape's loop on the grid at any gain: L = kp Ls, C = kp Cs.
+class GainScan {
+ public:
+  GainScan(const FrequencyGrid& grid, const PidGains& unit, const Bounds& bounds, int rhp_poles,
+           int origin_poles)
+      : grid_(grid), b_(bounds), rhp_(rhp_poles), origin_(origin_poles) {
+    const std::size_t n = grid.w.size();
+    ls_.resize(n);
+    cs_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
-      const cd l = kp * ls[i];
-      const double l2 = std::norm(l);
-      if (grid_.w[i] > bounds.crossover_cap && l2 >= 1.0) return false;
-      double d2 = std::norm(1.0 + l);
-      if (grid_.coarse[i]) {
-        const double ml = std::sqrt(l2);
-        if (ml >= 1.0) return false;
-        d2 = (1.0 - ml) * (1.0 - ml);
-      }
-      if (ms2 * d2 < 1.0 || l2 > mt2 * d2 || kp * kp * cs[i] * cs[i] > nb2 * d2) return false;
+      const cd c = ControllerAt(unit, grid.w[i]);
+      ls_[i] = c * grid.g[i];
+      cs_[i] = std::abs(c);
     }
-    const double l_inf = kp * c_inf * grid_.g_inf;
-    const double d_inf = std::abs(1.0 + l_inf);
-    return bounds.ms * d_inf >= 1.0 && std::abs(l_inf) <= bounds.mt * d_inf &&
-           kp * c_inf <= bounds.noise_gain * d_inf;
-  };
+    c_inf_ = unit.kp + (unit.kd > 0.0 ? unit.kd / unit.tf : 0.0);
+    while (cap_ + 1 < n && grid.w[cap_] < bounds.crossover_cap) ++cap_;
+  }
+
+  // A gain above which the loop crosses over beyond the cap.
+  double Top() const { return 2.0 / std::max(std::abs(ls_[cap_]), 1e-300); }
+
+  // The largest peak over its bound (<= 1: the bounds are met); 2 for a
+  // crossover beyond the cap or |L| >= 1 where the grid is coarse.
+  double Violation(double kp) const {
+    double v = 0.0;
+    for (std::size_t i = 0; i < ls_.size(); ++i) {
+      const cd l = kp * ls_[i];
+      const double ml = std::abs(l);
+      if (grid_.w[i] > b_.crossover_cap && ml >= 1.0) return 2.0;
+      double d = std::abs(1.0 + l);
+      if (grid_.coarse[i]) {
+        if (ml >= 1.0) return 2.0;
+        d = 1.0 - ml;
+      }
+      v = std::max({v, 1.0 / (b_.ms * d), ml / (b_.mt * d), kp * cs_[i] / (b_.noise_gain * d)});
+    }
+    const double l_inf = kp * c_inf_ * grid_.g_inf, d_inf = std::abs(1.0 + l_inf);
+    return std::max(
+        {v, 1.0 / (b_.ms * d_inf), std::abs(l_inf) / (b_.mt * d_inf), kp * c_inf_ / (b_.noise_gain * d_inf)});
+  }
+
   // The Nyquist criterion on the grid: Z = P - (2 D - k pi) / (2 pi)
   // closed-loop poles in the right half-plane, D the change of arg(1 + L)
   // from 0+ to infinity, k the poles at the origin (indented to the right)
   // and P the plant's in the right half-plane. Where the grid is coarse for
   // the delay, |L| < 1 (feasible), so 1 + L stays right of the axis and the
   // principal differences are exact.
-  const auto stable = [&](double kp) {
+  bool Stable(double kp) const {
     double d = 0.0;
-    cd prev = 1.0 + kp * ls[0];
-    for (std::size_t i = 1; i < n; ++i) {
-      const cd next = 1.0 + kp * ls[i];
+    cd prev = 1.0 + kp * ls_[0];
+    for (std::size_t i = 1; i < ls_.size(); ++i) {
+      const cd next = 1.0 + kp * ls_[i];
       d += std::arg(next / prev);
       prev = next;
     }
-    d += std::arg((1.0 + kp * c_inf * grid_.g_inf) / prev);
-    const double z = rhp_poles_ - (2.0 * d - origin_poles_ * M_PI) / (2.0 * M_PI);
-    return std::abs(z) < 0.5;
-  };
-  const auto good = [&](double kp) { return feasible(kp) && stable(kp); };
-  // Down from a gain whose crossover lies far above the cap (never
-  // feasible) by halves to the first feasible one, then bisection: the
-  // largest feasible kp, whichever of the feasible intervals it lies in (an
-  // integral-heavy shape on a lag can be feasible at a small gain, not at a
-  // moderate one, and again at a larger one).
+    d += std::arg((1.0 + kp * c_inf_ * grid_.g_inf) / prev);
+    return std::abs(rhp_ - (2.0 * d - origin_ * M_PI) / (2.0 * M_PI)) < 0.5;
+  }
+
+  bool Good(double kp) const { return Violation(kp) <= 1.0 && Stable(kp); }
+
+ private:
+  const FrequencyGrid& grid_;
+  Bounds b_;
+  int rhp_, origin_;
+  std::vector<cd> ls_;
+  std::vector<double> cs_;
+  double c_inf_ = 0.0;
+  std::size_t cap_ = 0;
+};
+
+// The least violation in (lo, hi) by golden sections on log kp.
+double LeastViolation(const GainScan& scan, double lo, double hi, double* at) {
+  constexpr double kGolden = 0.6180339887498949;
+  double a = std::log(lo), b = std::log(hi);
+  double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a);
+  double f1 = scan.Violation(std::exp(x1)), f2 = scan.Violation(std::exp(x2));
+  for (int i = 0; i < 24; ++i) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, x1 = b - kGolden * (b - a), f1 = scan.Violation(std::exp(x1));
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + kGolden * (b - a), f2 = scan.Violation(std::exp(x2));
+    }
+  }
+  *at = std::exp(f1 < f2 ? x1 : x2);
+  return std::min(f1, f2);
+}
+
+}  // namespace
+
+double Engine::MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double hint) const {
   (void)hint;
-  std::size_t cap = 0;
-  while (cap + 1 < n && grid_.w[cap] < bounds.crossover_cap) ++cap;
-  double bad = 100.0 / std::max(std::abs(ls[cap]), 1e-300);
-  double kp = 0.0;
+  const GainScan scan(grid_, ShapeGains(shape, 1.0), bounds, rhp_poles_, origin_poles_);
+  // Down from a gain whose crossover lies beyond the cap, by 1.25 over 19
+  // decades, to the first gain that meets the bounds with a stable loop;
+  // then bisection up to the edge: the largest such gain, whichever band of
+  // gains it lies in (an integral-heavy shape on a lag can be feasible at a
+  // small gain, not at a moderate one, and again at a larger one). A band
+  // narrower than a step (a conditionally stable loop, an integrating
+  // plant's) shows as a dip of the violation: the dips under 1.3 are
+  // searched, highest gain first.
+  constexpr double kStep = 1.25;
+  double kp = 0.0, bad = scan.Top();
+  std::vector<double> k, v;
   for (int i = 0; i < 200; ++i) {
-    const double k = bad * 0.5;
-    if (good(k)) {
-      kp = k;
+    k.push_back(bad / kStep);
+    v.push_back(scan.Violation(k.back()));
+    if (v.back() <= 1.0 && scan.Stable(k.back())) {
+      kp = k.back();
       break;
     }
-    bad = k;
+    bad = k.back();
+  }
+  for (std::size_t i = 1; !(kp > 0.0) && i + 1 < v.size(); ++i) {
+    if (!(v[i] <= v[i - 1] && v[i] <= v[i + 1] && v[i] < 1.3)) continue;
+    double at = 0.0;
+    if (LeastViolation(scan, k[i + 1], k[i - 1], &at) <= 1.0 && scan.Stable(at)) kp = at, bad = k[i - 1];
   }
   if (!(kp > 0.0)) return 0.0;
   for (int i = 0; i < 14; ++i) {
     const double mid = std::sqrt(kp * bad);
-    (good(mid) ? kp : bad) = mid;
+    (scan.Good(mid) ? kp : bad) = mid;
   }
   return kp;
 }
@@ -201,13 +261,15 @@ std::vector<Eigen::VectorXd> Engine::Starts(const Bounds& bounds) const {
   Eigen::VectorXd s;
   if (RuleShape(plant_, TuningRule::kAmigo, pi_, &s)) starts.push_back(s);
   if (RuleShape(plant_, TuningRule::kSimc, pi_, &s)) starts.push_back(s);
-  // Generic: Ti from the crossover estimate (a PI's), Td a quarter of it.
-  const double ti = 2.0 * time_s_;
-  if (pi_)
-    starts.push_back(Eigen::VectorXd::Constant(1, std::log(ti)));
-  else
-    starts.push_back(
-        Eigen::Vector3d(std::log(ti), std::log(std::min(0.25 * ti, 0.9 * bounds.td_max_s)), std::log(10.0)));
+  // Generic: Ti from the crossover estimate (a PI's and four times it), Td
+  // a quarter of it.
+  for (const double ti : {2.0 * time_s_, 8.0 * time_s_}) {
+    if (pi_)
+      starts.push_back(Eigen::VectorXd::Constant(1, std::log(ti)));
+    else
+      starts.push_back(Eigen::Vector3d(std::log(ti), std::log(std::min(0.25 * ti, 0.9 * bounds.td_max_s)),
+                                       std::log(10.0)));
+  }
   for (Eigen::VectorXd& x : starts)
     if (!pi_) x(1) = std::min(x(1), std::log(0.9 * bounds.td_max_s));
   return starts;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "design_loop.h"
+#include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/tune/design.h"
 
 namespace pidlab::tune::design {
@@ -14,6 +15,9 @@ namespace pidlab::tune::design {
 /// The problem's bounds, as the engine applies them.
 struct Bounds {
   double ms = 1.4, mt = 1.4, noise_gain = 0.0, td_max_s = 0.0;
+  /// The loop the exact analysis checks the bounds on (continuous, or the
+  /// sampled loop at its dt).
+  evaluation::LoopOptions loop;
   /// No gain crossover above this (rad/s): a plant that allows any speed
   /// (no dead time, relative degree 1) gets a loop ten times faster than its
   /// fastest time, as migo's.
@@ -32,21 +36,31 @@ struct Optimum {
 
 class Engine {
  public:
-  Engine(const Plant& plant, bool pi);
+  /// `min_tf_s`: the derivative filter's least time constant (the sampled
+  /// loop's dt; 0 continuous).
+  /// `crossover_hint`: the crossover (rad/s) the grid step is chosen for;
+  /// 0: estimated from the rules' shapes.
+  Engine(const Plant& plant, bool pi, double min_tf_s = 0.0, double crossover_hint = 0.0);
   /// The optimum under `bounds`, from the rules' shapes and `warm` (if not
   /// empty). False when no shape has a stable loop meeting the bounds.
   bool Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum* best) const;
   /// \int|y|dt of the unit load step (+inf when it does not settle).
   double LoadIae(const PidGains& g) const;
+  /// The shape of gains (kp, ki > 0; a PID's kd, tf > 0), to start from.
+  Eigen::VectorXd ShapeOf(const PidGains& g) const;
   const LoopSimulator& Simulator() const { return sim_; }
   int MaxSteps() const { return max_steps_; }
   /// The characteristic time the grid and the step came from (s).
   double Time() const { return time_s_; }
+  /// The crossover the step was chosen for (rad/s).
+  double Crossover() const { return 1.0 / time_s_; }
   double SpeedCap() const { return speed_cap_; }
 
  private:
   PidGains ShapeGains(const Eigen::VectorXd& shape, double kp) const;
   /// The largest kp whose loop meets the bounds on the grid, from `hint`.
+  /// The largest kp whose loop meets the bounds on the grid (`hint`: the
+  /// last shape's, 0: none).
   double MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double hint) const;
   /// The shape's load IAE at kp = max kp * exp(min(alpha, 0)).
   double Cost(const Eigen::VectorXd& shape, double alpha, const Bounds& bounds, double* kp_hint,
@@ -55,7 +69,7 @@ class Engine {
 
   const Plant& plant_;
   bool pi_;
-  double time_s_ = 1.0, speed_cap_ = 0.0;
+  double time_s_ = 1.0, speed_cap_ = 0.0, min_tf_s_ = 0.0;
   FrequencyGrid grid_;
   LoopSimulator sim_;
   int max_steps_ = 20000;

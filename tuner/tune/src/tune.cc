@@ -201,6 +201,7 @@ bool OptimalSearch(const Plant& plant, const TuneOptions& options,
                    const evaluation::ObjectiveEvaluator& evaluator, TuneSummary* summary,
                    std::string* error) {
   DesignOptions o;
+  o.loop = options.loop;
   o.max_ms = options.robustness_ms;
   if (std::isfinite(options.bounds.max_mt)) o.max_mt = options.bounds.max_mt;
   o.max_noise_gain = options.bounds.max_noise_gain;

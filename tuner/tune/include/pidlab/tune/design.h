@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "pidlab/controller/pid.h"
+#include "pidlab/evaluation/closed_loop.h"
 #include "pidlab/plant_sim/plants.h"
 #include "pidlab/spec/status.h"
 
@@ -67,6 +68,11 @@ struct DesignOptions {
   /// The setpoint stage's overshoot target (%), >= 0; +inf: no target (the
   /// weights of the smallest setpoint IAE).
   double max_overshoot_pct = kDesignDefaultOvershootPct;
+  /// The loop designed for: continuous (default), or the sampled loop at
+  /// loop.dt_s (the ZOH plant and the discrete PID the trio and the exported
+  /// C run): designed with the hold's half sample of delay, tf >= dt, and
+  /// its bounds met by the sampled loop's exact analysis.
+  evaluation::LoopOptions loop;
 
   /// Names the field, its value and the rule broken.
   bool IsValid(std::string* error) const;
