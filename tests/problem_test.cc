@@ -246,7 +246,7 @@ TEST(RunTuning, GivesTheBitsOfTheStepsChainedByHand) {
   EXPECT_TRUE(SameBits(dut.evaluation.y, ev.y));
 }
 
-TEST(BuildTuning, EveryFieldTaggedSearchAsksForASearchAndNoneGivenIsMigo) {
+TEST(BuildTuning, EveryFieldTaggedSearchButTheEnginesBoundsAsksForASearchAndNoneGivenIsTheEngine) {
   const nlohmann::json plant = {{"plant", "custom"}, {"num", {1}}, {"den", {10, 1}}, {"delay", 2}};
   const auto method_of = [](const nlohmann::json& j, std::string* method) {
     spec::TuningSpec s;
@@ -260,7 +260,9 @@ TEST(BuildTuning, EveryFieldTaggedSearchAsksForASearchAndNoneGivenIsMigo) {
   };
   std::string method;
   ASSERT_TRUE(method_of(plant, &method).ok());
-  EXPECT_EQ(method, "migo");
+  EXPECT_EQ(method, "optimal");
+  // The bounds the design engine takes itself keep it.
+  const std::set<std::string> engine_takes = {"max_ms", "max_mt", "max_noise_gain", "max_overshoot"};
   int tagged = 0;
   for (const spec::FieldEntry& e : spec::Fields<spec::TuningSpec>()) {
     if (!e.field.Has(spec::kSearch)) continue;
@@ -269,7 +271,10 @@ TEST(BuildTuning, EveryFieldTaggedSearchAsksForASearchAndNoneGivenIsMigo) {
     j[e.field.key] = nlohmann::json::parse(e.field.example);
     const Status built = method_of(j, &method);
     ASSERT_TRUE(built.ok()) << e.field.key << ": " << built.message();
-    EXPECT_NE(method, "migo") << e.field.key << " given: a search";
+    if (engine_takes.count(e.field.key) > 0)
+      EXPECT_EQ(method, "optimal") << e.field.key << " given: the engine takes it";
+    else
+      EXPECT_EQ(method, "multi-start") << e.field.key << " given: a search";
   }
   EXPECT_EQ(tagged, 21);
 }

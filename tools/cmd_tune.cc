@@ -55,9 +55,12 @@ struct TuneCommand {
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
-        "Tune PID gains on the paper's objective (IAE of the unit-step response, eq. 4) by a multi-start "
-        "from a space-filling design (default), Nelder-Mead or a baseline, rejecting every loop that is not "
-        "strictly stable, then cross-check with Ceres.");
+        "Tune PID gains. On a linear plant the default is the design engine (--method optimal): the least "
+        "integral |e| dt of a unit load step under Ms, Mt and noise-gain bounds, on the exact loop with its "
+        "dead time, then setpoint weights for at most 10 % overshoot (docs/tuning.md, \"The design "
+        "engine\"). A flag that asks for a search (an objective, a box, a budget, a margin, --robust, the "
+        "sampled loop) runs the multi-start on the paper's objective (IAE of the unit step, eq. 4) with a "
+        "Ceres cross-check, as --method multi-start, nelder-mead, paper-nm or a baseline do.");
     // The tuner's acceptance margin is 0.01 (spec::LoopSpec::ForTuning, docs/tuning.md).
     flags.Register(app, spec::TuningSpec{});
     app->add_option("--backend", backend, "local (in-process) or lcm (episodes over a running trio)")
@@ -107,6 +110,8 @@ struct TuneCommand {
       const pidlab::tune::TimeScale& t = problem.time_scale;
       std::cout << "time scale       n = " << t.horizon_s << " s, ts = " << t.sample_time_s << " s ("
                 << t.source << "): " << t.reason << "\n";
+      if (!t.method_reason.empty() && t.method_reason != "given")
+        std::cout << "method chosen    " << ToString(o.method) << ": " << t.method_reason << "\n";
       if (o.method == pidlab::tune::TuneMethod::kMigo && o.robustness_phase_margin_deg > 0.0)
         std::cout << "robustness       phase margin >= " << o.robustness_phase_margin_deg
                   << " deg (given): the largest Ms bound whose design keeps it, " << s.migo.ms_bound << "\n";

@@ -28,6 +28,7 @@ nlohmann::json TuningJson(const tune::TuningProblem& problem, const tune::Tuning
     j["design"]["robustness_reason"] = t.robustness_reason;
     j["design"]["noise_gain_reason"] = t.noise_gain_reason;
   }
+  {}
   return j;
 }
 

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Any plant, one command (docs/tuning.md, "Any plant: the MIGO design"): the
-# section's commands as written, and on the newcomer's plants the default tune
-# is migo, with a filter, a stable loop settled within a time scale taken from
-# the plant, Ms within its bound (SIMC's, within [1.4, 1.6]), overshoot at most
-# 30 %, a load integral below SIMC's at an Ms no higher; the knobs move the
-# design; the paper's plants keep eq. (4) and the multi-start; bad knob values
-# exit 2 with one line.
+# Any plant, one command (docs/tuning.md, "Any plant"): the section's commands
+# as written, and on the newcomer's plants the default tune is the design
+# engine (method optimal), with its own filter, a stable loop settled within a
+# time scale taken from the plant, Ms within its bound (SIMC's, within
+# [1.4, 1.6]), overshoot at most 10 %, a load integral below SIMC's at an Ms
+# no higher; migo's knobs move its design; the paper's plants keep eq. (4) and
+# a budget asks for the multi-start; bad knob values exit 2 with one line.
 #   any_plant_cli_test.sh PIDLAB_BINARY TUNING_MD
 set -uo pipefail
 source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
@@ -32,19 +32,22 @@ verify() {  # name, json, simc json or ''
   /usr/bin/python3 - "$2" "$3" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
-assert j['method'] == 'migo', j['method']
+assert j['method'] == 'optimal', j['method']
 assert j['stable'] is True, 'unstable'
 g = j['gains']
-assert g['kd'] > 0 and abs(g['tf'] - g['kd'] / (10 * g['kp'])) < 1e-12 * g['tf'], g
+assert g['kd'] > 0 and g['tf'] > 0, g
 ms = j['robustness']['ms']
-bound = j['migo']['robustness']
-assert 1.4 <= bound <= 1.6 and 1.1 <= ms <= bound * (1 + 1e-3), (ms, bound)
-assert j['overshoot_pct'] <= 30, j['overshoot_pct']
+bound = j['design']['ms_bound']
+assert 1.4 <= bound <= 1.6 and 0.99 * bound <= ms <= bound * (1 + 1e-3), (ms, bound)
+# At most 10 %, or (a lag-dominant plant, whose integral action overshoots
+# by itself) the least b and c reach, said so, within a point of it.
+d = j['design']
+assert j['overshoot_pct'] <= 10 + 1e-6 or (not d['overshoot_met'] and 'setpoint filter' in d['setpoint_note'] and j['overshoot_pct'] <= 11), (j['overshoot_pct'], d['setpoint_note'])
 t = j['time_scale']
 assert t['source'] == 'plant' and t['horizon_s'] == j['spec']['horizon'] and t['sample_time_s'] == j['spec']['sample_time'], t
 assert j['settling_time_s'] < t['horizon_s'] / 2, (j['settling_time_s'], t)
 b, c = j['two_dof']['setpoint_weights']
-assert c == 0 and 0 <= b <= 1 and j['migo']['setpoint_weight_b'] == b, j['two_dof']
+assert 0 <= c <= 1 and 0 <= b <= 1 and j['two_dof']['setpoint_filter_s'] == 0, j['two_dof']
 if sys.argv[2]:
     s = json.load(open(sys.argv[2]))
     s_ms = s['robustness']['ms']
@@ -60,7 +63,7 @@ for case in "fopdt|--num 1 --den 10,1 --delay 2" "thermal|--num 2 --den 60,1 --d
   n=$(/usr/bin/python3 -c "import json;s=json.load(open('$name.json'))['spec'];print(s['horizon'],s['sample_time'])")
   # shellcheck disable=SC2086
   "$pidlab" tune $flags --method simc --rule pi --horizon ${n% *} --sample-time ${n#* } --json > $name.simc.json
-  check "$name: migo, filtered, stable, Ms within SIMC's bound, overshoot <= 30 %, settled, load below SIMC's" \
+  check "$name: the engine, filtered, stable, Ms at SIMC's bound, overshoot <= 10 % or said, settled, load below SIMC's" \
     "verify $name $name.json $name.simc.json"
   # shellcheck disable=SC2086
   "$pidlab" tune --spec $name.json --json > $name.again.json
@@ -74,25 +77,26 @@ done
 # ---- export --from takes the design's setpoint weights with its gains, at a dt
 # where the loop is stable.
 "$pidlab" export --from fopdt.json --dt 0.01 --lang c --out fw > export.out 2> export.err
-check "export --from the design: its gains and b, c = 0 in the C, the loop checked stable at dt" "/usr/bin/python3 - <<'PY'
+check "export --from the design: its gains and b, c in the C, the loop checked stable at dt" "/usr/bin/python3 - <<'PY'
 import json, re
 j = json.load(open('fopdt.json'))
 c = open('fw/pidlab_pid.c').read()
 h = open('fw/pidlab_pid.h').read()
-b = j['two_dof']['setpoint_weights'][0]
+b, cw = j['two_dof']['setpoint_weights']
 assert 'Loop at dt: the sampled loop of plant custom is stable' in h, h[:2000]
 m = re.search(r'Tuned: kp ([^,]+), ki ([^,]+), kd ([^,]+), tf ([^ ]+) s, b ([^,]+), c ([^,]+),', h)
-assert m and abs(float(m.group(5)) - b) < 1e-6 * max(1, b) and float(m.group(6)) == 0, m and m.groups()
+assert m and abs(float(m.group(5)) - b) < 1e-5 * max(1, b) and abs(float(m.group(6)) - cw) < 1e-5, m and m.groups()
 assert abs(float(m.group(1)) - j['gains']['kp']) < 1e-5 * j['gains']['kp'], m.groups()
 PY"
 
-# ---- The knobs: a tighter bound is slower and more robust; a response time
-# slows the crossover to 2/T.
-"$pidlab" tune --num 1 --den 10,1 --delay 2 --robustness 1.3 --json > tight.json
-"$pidlab" tune --num 1 --den 10,1 --delay 2 --response-time 20 --json > slow.json
+# ---- migo's knobs: a tighter bound is slower and more robust; a response time
+# slows the crossover to 2/T (the engine's: tests/cli/design_cli_test.sh).
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method migo --json > migo.json
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method migo --robustness 1.3 --json > tight.json
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method migo --response-time 20 --json > slow.json
 check "--robustness 1.3: Ms <= 1.3, and a smaller ki than the default" "/usr/bin/python3 - <<'PY'
 import json
-d, t = json.load(open('fopdt.json')), json.load(open('tight.json'))
+d, t = json.load(open('migo.json')), json.load(open('tight.json'))
 assert t['robustness']['ms'] <= 1.3 * (1 + 1e-3) and t['gains']['ki'] < d['gains']['ki'], (t['robustness']['ms'], t['gains'])
 assert t['migo']['robustness_reason'] == 'given', t['migo']
 PY"
@@ -129,26 +133,26 @@ j = json.load(open('paper.json'))
 assert j['method'] == 'multi-start' and j['spec']['horizon'] == 25 and j['spec']['sample_time'] == 0.05, j['spec']
 assert j['time_scale']['source'] == 'eq. (4)', j['time_scale']
 PY"
-# The newcomer's `tune --plant stepper`: migo on eq. (4), off the box's edge,
-# and its load IAE far below the multi-start's on the paper's objective.
+# The newcomer's `tune --plant stepper`: the engine on eq. (4), off the box's
+# edge, and its load IAE far below the multi-start's on the paper's objective.
 "$pidlab" tune --plant stepper --json > stepper.json
 "$pidlab" tune --plant stepper --method multi-start --json > stepper_ms.json
-check "tune --plant stepper: migo, not on the box's edge, Ms <= 1.4, overshoot <= 30 %" "/usr/bin/python3 - <<'PY'
+check "tune --plant stepper: the engine, not on the box's edge, Ms <= 1.4, overshoot <= 10 %" "/usr/bin/python3 - <<'PY'
 import json
 j = json.load(open('stepper.json'))
 m = json.load(open('stepper_ms.json'))
-assert j['method'] == 'migo' and j['time_scale']['source'] == 'eq. (4)', (j['method'], j['time_scale'])
-assert j['migo']['robustness_reason'].startswith('the default'), j['migo']
+assert j['method'] == 'optimal' and j['time_scale']['source'] == 'eq. (4)', (j['method'], j['time_scale'])
+assert j['design']['robustness_reason'].startswith('the default'), j['design']
 assert not j.get('at_bounds'), j.get('at_bounds')
 assert m['at_bounds'], m.get('at_bounds')  # the paper's objective ends on ki = 30
 assert j['robustness']['ms'] <= 1.4 + 1e-3, j['robustness']
-assert j['overshoot_pct'] <= 30, j['overshoot_pct']
+assert j['overshoot_pct'] <= 10 + 1e-6, j['overshoot_pct']
 assert j['load_iae'] < m['load_iae'] / 10, (j['load_iae'], m['load_iae'])
 PY"
 
 # ---- One knob, two words: a phase margin; a crossover is a response time.
-"$pidlab" tune --num 1 --den 10,1 --delay 2 --robustness 60 --json > pm60.json
-"$pidlab" tune --num 1 --den 10,1 --delay 2 --robustness 45 --json > pm45.json
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method migo --robustness 60 --json > pm60.json
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method migo --robustness 45 --json > pm45.json
 check "--robustness 60: a phase margin of at least 60 deg, less robust at 45" "/usr/bin/python3 - <<'PY'
 import json
 a, b = json.load(open('pm60.json')), json.load(open('pm45.json'))
@@ -156,8 +160,8 @@ assert a['migo']['phase_margin_deg'] == 60 and a['robustness']['phase_margin_deg
 assert 1.05 <= a['migo']['ms_bound'] < b['migo']['ms_bound'] <= 4, (a['migo'], b['migo'])
 assert b['robustness']['phase_margin_deg'] >= 45 - 0.5 and a['gains']['ki'] < b['gains']['ki'], (a['gains'], b['gains'])
 PY"
-"$pidlab" tune --num 1 --den 10,1 --delay 2 --crossover 0.1 --json > w.json
-"$pidlab" tune --num 1 --den 10,1 --delay 2 --response-time 20 --json > t.json
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method migo --crossover 0.1 --json > w.json
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --method migo --response-time 20 --json > t.json
 check "--crossover 0.1 is --response-time 20" "/usr/bin/python3 - <<'PY'
 import json
 w, t = json.load(open('w.json')), json.load(open('t.json'))

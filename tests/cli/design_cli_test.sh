@@ -4,10 +4,23 @@
 # the knobs met, and a crossover out of reach refused (exit 2, one line).
 set -uo pipefail
 source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
-pidlab="$1"
+#   design_cli_test.sh PIDLAB_BINARY TUNING_MD
+pidlab=$(realpath -- "$1")
+doc=$(realpath -- "$2")
 pass=0; fail=0
 check() { if eval "$2"; then echo "ok   $1"; pass=$((pass+1)); else echo "FAIL $1"; fail=$((fail+1)); fi; }
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+
+# ---- docs/tuning.md's "The design engine" commands as written (pidlab on PATH).
+mkdir "$tmp/bin" && ln -s "$pidlab" "$tmp/bin/pidlab"
+awk '/^## The design engine/{on=1} /^## Any plant/{on=0} on' "$doc" |
+  awk '/^```sh$/{on=1; next} /^```$/{on=0} on' >"$tmp/commands.sh"
+check "the section has its five commands" "[ \$(grep -c '^pidlab tune' \"$tmp/commands.sh\") -eq 5 ]"
+i=0
+while IFS= read -r line; do
+  i=$((i + 1))
+  check "docs: $line" "PATH=\"$tmp/bin:\$PATH\" bash -c '$line' > \"$tmp/doc$i.out\" 2> \"$tmp/doc$i.err\""
+done < <(grep '^pidlab ' "$tmp/commands.sh")
 
 # The tank of the issue, as docs/tuning.md runs it.
 "$pidlab" tune --num 0.8 --den 1200,130,1 --delay 150 --method optimal --json > "$tmp/tank.json" 2>"$tmp/err"
@@ -27,7 +40,7 @@ r = j['robustness']
 assert r['ms'] <= d['ms_bound'] * 1.001 and r['noise_gain'] <= d['noise_gain_bound'] * 1.001, (r['ms'], d)
 assert abs(j['response_time_s'] - 2 / d['crossover_rad_s']) < 1e-9 * j['response_time_s']
 assert j['overshoot_pct'] <= 10.0, j['overshoot_pct']
-assert 'migo' in d['noise_gain_reason'] and d['robustness_reason'], d
+assert 'ultimate gain Ku = 2.377' in d['noise_gain_reason'] and d['robustness_reason'], d
 assert j['spec']['method'] == 'optimal' and j['spec']['derivative_filter_ratio'] == 0
 # AMIGO's PID on the same plant: its load response (eq. 4 sum x ts) is worse.
 ts = j['time_scale']['sample_time_s']
@@ -50,6 +63,14 @@ assert f['design']['load_iae'] <= 1.015 and f['robustness']['ms'] <= 1.39 * 1.00
 assert f['robustness']['noise_gain'] <= 199 * 1.001, f['robustness']['noise_gain']
 assert p['design']['load_iae'] <= 2.203 and p['robustness']['ms'] <= 1.629 * 1.001 and p['gains']['kd'] == 0
 PY"
+
+# The README's command: the default is the engine, the bounds given taken.
+"$pidlab" tune --num 1 --den 1,3,3,1 --robustness 1.39 --max-noise-gain 199 > "$tmp/readme.txt" 2>"$tmp/err"
+check "the README's default tune runs the engine under the bounds given" \
+  "grep -q '^method  *optimal (the design engine)' \"$tmp/readme.txt\" && grep -q 'Ms <= 1.39, Mt <= 1.39, noise gain <= 199' \"$tmp/readme.txt\""
+"$pidlab" tune --num 1 --den 10,1 --delay 2 --max-iter 50 > "$tmp/search.txt" 2>"$tmp/err"
+check "a budget asks for the search, and one line says so" \
+  "[ \$(grep -c \"^method chosen  *multi-start: 'max_iter' asks for the search\" \"$tmp/search.txt\") -eq 1 ]"
 
 # The knobs: --crossover 1 within 2 %, a phase margin within 1 %.
 "$pidlab" tune --num 1 --den 1,3,3,1 --method optimal --crossover 1 --json > "$tmp/wc.json" 2>"$tmp/err"

@@ -149,7 +149,8 @@ bad "measurement noise on the continuous loop" "--measurement-noise 0.01: noise 
   evaluate --plant linear --gains 1,1,1 --measurement-noise 0.01
 bad "measurement noise in tune" "--measurement-noise 0.01: tune does not take measurement noise" \
   tune --plant linear --loop sampled --measurement-noise 0.01
-bad "tune sampled --dt 1e-5 (5000 x 2.5e6 steps)" "5e9" tune --plant stepper --loop sampled --dt 1e-5
+bad "tune sampled --dt 1e-5 (5000 x 2.5e6 steps)" "5e9" tune --plant stepper --loop sampled --dt 1e-5 \
+  --method multi-start
 bad "tune --max-evals 1e8 (1e8 x 501 samples)" "5e9" tune --plant linear --max-evals 100000000
 bad "tune square period 1e-3 (5000 x 5e4 switches)" "5e9" \
   tune --plant stepper --method multi-start --disturbance-amplitude 1 --disturbance-period 1e-3

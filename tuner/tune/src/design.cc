@@ -55,10 +55,6 @@ bool Analyse(const Plant& plant, const PidGains& g, const evaluation::LoopOption
   return analysis::AnalyzeLoop(plant, g, loop, analysis::LoopAnalysisOptions{}, a).ok() && a->stable;
 }
 
-bool Analyse(const Plant& plant, const PidGains& g, analysis::LoopAnalysis* a) {
-  return Analyse(plant, g, evaluation::LoopOptions{}, a);
-}
-
 bool Meets(const analysis::LoopAnalysis& a, const design::Bounds& b) {
   constexpr double kTolerance = 1.0 + 1e-3;
   return a.ms <= b.ms * kTolerance && a.mt <= b.mt * kTolerance && a.noise_gain <= b.noise_gain * kTolerance;
@@ -77,12 +73,14 @@ PidGains Scaled(PidGains g, double f) {
 bool ExactlyWithin(const Plant& plant, const design::Engine& engine, const design::Bounds& b,
                    design::Optimum* o, analysis::LoopAnalysis* a) {
   if (Analyse(plant, o->gains, b.loop, a) && Meets(*a, b)) return true;
-  double lo = 0.5, hi = 1.0;
+  // By 3 % steps down to half the gain, so as to stay in the design's band
+  // of gains (a larger step can land in a slower band below it).
+  double lo = 0.97, hi = 1.0;
   analysis::LoopAnalysis at;
   while (!(Analyse(plant, Scaled(o->gains, lo), b.loop, &at) && Meets(at, b))) {
     hi = lo;
-    lo *= 0.5;
-    if (lo < 1e-3) return false;
+    lo *= 0.97;
+    if (lo < 0.5) return false;
   }
   for (int i = 0; i < 14; ++i) {
     const double mid = std::sqrt(lo * hi);
@@ -110,13 +108,19 @@ bool FrontPoint(const Plant& plant, const design::Engine& engine, design::Bounds
 bool SampledPoint(const Plant& plant, const design::Engine& engine, const design::Bounds& b, double ms,
                   Eigen::VectorXd warm, design::Optimum* o, analysis::LoopAnalysis* a) {
   double design_ms = ms;
-  for (int i = 0; i < 5; ++i) {
-    if (!FrontPoint(plant, engine, b, design_ms, warm, o, a, ms)) return false;
+  bool found = false;
+  for (int i = 0; i < 8; ++i) {
+    if (!FrontPoint(plant, engine, b, design_ms, warm, o, a, ms)) {
+      // The sampled loop's peaks are above the design's: a tighter bound.
+      design_ms = 1.0 + 0.9 * (design_ms - 1.0);
+      continue;
+    }
+    found = true;
     if (a->ms >= 0.99 * ms) return true;
     warm = o->shape;
     design_ms = std::clamp(design_ms * ms / a->ms, 1.0 + 1e-3, 4.0);
   }
-  return true;
+  return found;
 }
 
 double HighestCrossover(const analysis::LoopAnalysis& a) {
@@ -174,6 +178,53 @@ void SetpointStage(const Engine& engine, double max_overshoot_pct, DesignSummary
 }  // namespace design
 
 namespace {
+
+// The setpoint step's overshoot with the weights of s, by the evaluation
+// library's exact response and stepinfo (NaN where it cannot tell).
+double ExactOvershoot(const Plant& plant, const DesignSummary& s, evaluation::LoopOptions loop) {
+  loop.pid.setpoint_weight_b = s.b;
+  loop.pid.setpoint_weight_c = s.c;
+  loop.disturbance = DisturbanceOptions{};
+  loop.derivative_filter_ratio = 0.0;
+  loop.pid.derivative_filter_s = 0.0;
+  const double horizon = 40.0 * s.response_time_s + 20.0 * plant.delay_s;
+  const bool sampled = loop.loop == evaluation::LoopKind::kSampled;
+  const double spacing =
+      sampled ? std::max(1.0, std::round(horizon / 4000.0 / loop.dt_s)) * loop.dt_s : horizon / 4000.0;
+  loop.sample_time_s = spacing;
+  loop.horizon_s = std::ceil(horizon / spacing) * spacing;
+  evaluation::EvaluateOptions what;
+  what.compute_iae_continuous = false;
+  evaluation::Evaluation ev;
+  if (!evaluation::Evaluate(plant, s.gains, loop, what, &ev).ok() || !ev.step.valid)
+    return std::numeric_limits<double>::quiet_NaN();
+  return ev.step.overshoot_pct;
+}
+
+// The setpoint stage, its overshoot checked on the exact response: where
+// the samples' peak fell short of it, the stage runs again aiming lower by
+// the difference and a half (at most eight times).
+void ShapeSetpoint(const Plant& plant, const design::Engine& engine, const DesignOptions& options,
+                   DesignSummary* s) {
+  const double target = options.max_overshoot_pct;
+  double aim = target;
+  for (int i = 0; i < 8; ++i) {
+    design::SetpointStage(engine, aim, s);
+    const double exact = ExactOvershoot(plant, *s, options.loop);
+    if (std::isnan(exact)) return;
+    s->overshoot_pct = exact;
+    s->overshoot_met = exact <= target + 1e-9;
+    if (s->overshoot_met || !std::isfinite(target) || aim <= 0.0) break;
+    aim = std::max(0.0, aim - 1.5 * (exact - target) - 0.05);
+  }
+  if (s->overshoot_met) s->setpoint_note.clear();
+  if (!s->overshoot_met)
+    s->setpoint_note =
+        "the setpoint overshoot target " + FormatNumber(target) + " % is not met: b " + FormatNumber(s->b) +
+        ", c " + FormatNumber(s->c) + " reach " + FormatNumber(s->overshoot_pct) +
+        " % at the least (the integral action's own overshoot: a setpoint filter would be needed)";
+}
+
 // The design with one engine (its grid and step).
 Status DesignOn(const Plant& plant, const design::Engine& engine, const DesignOptions& options, bool sampled,
                 const DesignSummary* previous, DesignSummary* summary);
@@ -191,10 +242,19 @@ Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSum
         "optimal: plant " + plant.name +
         " acts in reverse (negative gain), which the design engine does not take yet");
   // The sampled loop: the plant with the zero-order hold's half sample of
-  // delay, the derivative filter no faster than dt, checked on the sampled loop.
+  // delay as a lag 1 / (dt s / 2 + 1) (a delay of a few microseconds would
+  // cost the simulation millions of steps), the derivative filter no faster
+  // than dt, checked on the sampled loop.
   const bool sampled = options.loop.loop == evaluation::LoopKind::kSampled;
   Plant design_plant = plant;
-  if (sampled) design_plant.delay_s += 0.5 * options.loop.dt_s;
+  if (sampled) {
+    std::vector<double> den(design_plant.tf.den.size() + 1, 0.0);
+    for (std::size_t i = 0; i < design_plant.tf.den.size(); ++i) {
+      den[i] += 0.5 * options.loop.dt_s * design_plant.tf.den[i];
+      den[i + 1] += design_plant.tf.den[i];
+    }
+    design_plant.tf.den = den;
+  }
   // The grid's step is chosen for the crossover of migo's design at the same
   // bound (the largest ki: a little slower than the engine's), which is also
   // a start (its gains meet every bound); where migo has none, for the
@@ -225,7 +285,10 @@ Status DesignOn(const Plant& plant, const design::Engine& engine, const DesignOp
                 const DesignSummary* previous, DesignSummary* summary) {
   const Eigen::VectorXd warm = previous ? engine.ShapeOf(previous->gains) : Eigen::VectorXd();
   design::Bounds b;
+  // Checked for strict stability as evaluate is (the tuner's search margin
+  // of 0.01 is for candidates the objective cannot see).
   b.loop = options.loop;
+  b.loop.stability_margin = evaluation::LoopOptions{}.stability_margin;
   b.ms = options.max_ms;
   b.mt = options.Mt();
   b.noise_gain = options.max_noise_gain;
@@ -261,7 +324,7 @@ Status DesignOn(const Plant& plant, const design::Engine& engine, const DesignOp
   b.ms = ms_bound;
   s.active = ActiveBounds(a, b, s.gains);
   s.evaluations = o.evaluations;
-  design::SetpointStage(engine, options.max_overshoot_pct, &s);
+  ShapeSetpoint(plant, engine, options, &s);
   std::ostringstream os;
   os << "optimal: the least load \u222b|e|dt with Ms <= " << FormatNumber(ms_bound)
      << ", Mt <= " << FormatNumber(b.mt) << ", noise gain <= " << FormatNumber(b.noise_gain)
@@ -302,20 +365,59 @@ Status DesignMsForPhaseMargin(const Plant& plant, double phase_margin_deg, Desig
   return Status::Ok();
 }
 
-double DefaultNoiseGain(const Plant& plant, double ms, bool pi, std::string* why) {
-  MigoOptions o;
-  o.ms = ms;
-  o.pi = pi;
-  MigoDesign d;
-  analysis::LoopAnalysis a;
-  if (plant.nonlinear || !DesignMigo(plant, o, &d).ok() || !Analyse(plant, d.gains, &a) ||
-      !std::isfinite(a.noise_gain)) {
-    *why = "none (migo has no design on this plant)";
+double UltimateGain(const Plant& plant, double* w180) {
+  // The phase, continuous by construction: each root's angle and -wL.
+  const std::vector<std::complex<double>> zeros = PolynomialRoots(plant.tf.num);
+  const std::vector<std::complex<double>> poles = PolynomialRoots(plant.tf.den);
+  const auto phase = [&](double w) {
+    double ph = -w * plant.delay_s;
+    const std::complex<double> s(0.0, w);
+    for (const auto& z : zeros) ph += std::arg(s - z);
+    for (const auto& p : poles) ph -= std::arg(s - p);
+    return ph;
+  };
+  const auto gain = [&](double w) {
+    const std::complex<double> s(0.0, w);
+    std::complex<double> num = 0.0, den = 0.0;
+    for (double c : plant.tf.num) num = num * s + c;
+    for (double c : plant.tf.den) den = den * s + c;
+    return std::abs(num / den);
+  };
+  double fastest = 0.0, slowest = 0.0;
+  PlantTimes(plant, &fastest, &slowest);
+  const double lo = std::log(1e-4 / slowest), hi = std::log(1e4 / fastest);
+  constexpr int kPoints = 2000;
+  double prev_w = std::exp(lo), prev = phase(prev_w);
+  for (int i = 1; i <= kPoints; ++i) {
+    const double w = std::exp(lo + (hi - lo) * i / kPoints), ph = phase(w);
+    // Strictly past -180 deg: a pole on the axis (an oscillator's) jumps
+    // to -180 deg exactly, at an infinite gain.
+    if (prev > -M_PI && ph < -M_PI - 1e-9) {
+      double a = prev_w, b = w;
+      for (int k = 0; k < 60; ++k) {
+        const double m = std::sqrt(a * b);
+        (phase(m) > -M_PI ? a : b) = m;
+      }
+      *w180 = std::sqrt(a * b);
+      return 1.0 / gain(*w180);
+    }
+    prev_w = w, prev = ph;
+  }
+  *w180 = 0.0;
+  return std::numeric_limits<double>::infinity();
+}
+
+double DefaultNoiseGain(const Plant& plant, std::string* why) {
+  double w180 = 0.0;
+  const double ku = plant.nonlinear ? std::numeric_limits<double>::infinity() : UltimateGain(plant, &w180);
+  if (!std::isfinite(ku)) {
+    *why = "none: the plant's phase never reaches -180 deg, so it has no ultimate gain to scale by";
     return std::numeric_limits<double>::infinity();
   }
-  *why = "migo's noise gain at Ms " + FormatNumber(ms) + ", " + FormatNumber(a.noise_gain) +
-         ": never noisier than the largest-ki design";
-  return a.noise_gain;
+  *why = FormatNumber(kDefaultNoiseGainPerUltimateGain) + " x the ultimate gain Ku = " + FormatNumber(ku) +
+         " (at " + FormatNumber(w180) +
+         " rad/s): Ziegler-Nichols' PID, 0.6 Ku with the usual N = 10, has 6.6 Ku";
+  return kDefaultNoiseGainPerUltimateGain * ku;
 }
 
 double DesignLoadIae(const Plant& plant, const PidGains& gains) {

@@ -24,6 +24,8 @@ using cd = std::complex<double>;
 namespace {
 
 constexpr double kPointsPerDecade = 50.0;
+// The cost of a shape no gain makes feasible, times 1 + its least violation.
+constexpr double kInfeasible = 1e200;
 // Samples of the load response per radian of the first estimate of the
 // crossover: about 190 per period.
 constexpr double kStepsPerRadian = 30.0;
@@ -111,8 +113,8 @@ namespace {
 class GainScan {
  public:
   GainScan(const FrequencyGrid& grid, const PidGains& unit, const Bounds& bounds, int rhp_poles,
-           int origin_poles)
-      : grid_(grid), b_(bounds), rhp_(rhp_poles), origin_(origin_poles) {
+           int origin_poles, const Plant* rational)
+      : grid_(grid), b_(bounds), rhp_(rhp_poles), origin_(origin_poles), rational_(rational), unit_(unit) {
     const std::size_t n = grid.w.size();
     ls_.resize(n);
     cs_.resize(n);
@@ -155,6 +157,7 @@ class GainScan {
   // the delay, |L| < 1 (feasible), so 1 + L stays right of the axis and the
   // principal differences are exact.
   bool Stable(double kp) const {
+    if (rational_) return RationalStable(kp);
     double d = 0.0;
     cd prev = 1.0 + kp * ls_[0];
     for (std::size_t i = 1; i < ls_.size(); ++i) {
@@ -169,6 +172,31 @@ class GainScan {
   bool Good(double kp) const { return Violation(kp) <= 1.0 && Stable(kp); }
 
  private:
+  // Without dead time, the closed loop's poles themselves: the roots of
+  // den s (1 + tf s) + num ((kp s + ki)(1 + tf s) + kd s^2), which a grid
+  // cannot miss at a lightly damped resonance.
+  bool RationalStable(double kp) const {
+    const PidGains g{kp * unit_.kp, kp * unit_.ki, kp * unit_.kd, unit_.tf};
+    const bool filter = g.kd > 0.0;
+    const std::vector<double> c = filter ? std::vector<double>{g.kp * g.tf + g.kd, g.kp + g.ki * g.tf, g.ki}
+                                         : std::vector<double>{g.kp, g.ki};
+    const std::vector<double> s =
+        filter ? std::vector<double>{g.tf, 1.0, 0.0} : std::vector<double>{1.0, 0.0};
+    std::vector<double> p = Multiply(rational_->tf.den, s);
+    const std::vector<double> q = Multiply(rational_->tf.num, c);
+    for (std::size_t i = 0; i < q.size(); ++i) p[p.size() - q.size() + i] += q[i];
+    while (p.size() > 1 && p.front() == 0.0) p.erase(p.begin());
+    for (const cd& r : PolynomialRoots(p))
+      if (!(r.real() < 0.0)) return false;
+    return true;
+  }
+  static std::vector<double> Multiply(const std::vector<double>& a, const std::vector<double>& b) {
+    std::vector<double> r(a.size() + b.size() - 1, 0.0);
+    for (std::size_t i = 0; i < a.size(); ++i)
+      for (std::size_t j = 0; j < b.size(); ++j) r[i + j] += a[i] * b[j];
+    return r;
+  }
+
   const FrequencyGrid& grid_;
   Bounds b_;
   int rhp_, origin_;
@@ -176,6 +204,8 @@ class GainScan {
   std::vector<double> cs_;
   double c_inf_ = 0.0;
   std::size_t cap_ = 0;
+  const Plant* rational_;
+  PidGains unit_;
 };
 
 // The least violation in (lo, hi) by golden sections on log kp.
@@ -197,9 +227,11 @@ double LeastViolation(const GainScan& scan, double lo, double hi, double* at) {
 
 }  // namespace
 
-double Engine::MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double hint) const {
+double Engine::MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double hint,
+                     double* least_violation) const {
   (void)hint;
-  const GainScan scan(grid_, ShapeGains(shape, 1.0), bounds, rhp_poles_, origin_poles_);
+  const GainScan scan(grid_, ShapeGains(shape, 1.0), bounds, rhp_poles_, origin_poles_,
+                      plant_.delay_s > 0.0 ? nullptr : &plant_);
   // Down from a gain whose crossover lies beyond the cap, by 1.25 over 19
   // decades, to the first gain that meets the bounds with a stable loop;
   // then bisection up to the edge: the largest such gain, whichever band of
@@ -225,7 +257,10 @@ double Engine::MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double 
     double at = 0.0;
     if (LeastViolation(scan, k[i + 1], k[i - 1], &at) <= 1.0 && scan.Stable(at)) kp = at, bad = k[i - 1];
   }
-  if (!(kp > 0.0)) return 0.0;
+  if (!(kp > 0.0)) {
+    if (least_violation) *least_violation = *std::min_element(v.begin(), v.end());
+    return 0.0;
+  }
   for (int i = 0; i < 14; ++i) {
     const double mid = std::sqrt(kp * bad);
     (scan.Good(mid) ? kp : bad) = mid;
@@ -248,8 +283,11 @@ double Engine::Cost(const Eigen::VectorXd& shape, double alpha, const Bounds& bo
                     PidGains* gains) const {
   ++evaluations_;
   if (!pi_ && std::exp(shape(1)) > bounds.td_max_s * (1.0 + 1e-12)) return HUGE_VAL;
-  const double kp_max = MaxKp(shape, bounds, *kp_hint);
-  if (!(kp_max > 0.0)) return HUGE_VAL;
+  double least = HUGE_VAL;
+  const double kp_max = MaxKp(shape, bounds, *kp_hint, &least);
+  // A shape with no feasible gain: a value above every feasible one that
+  // falls as the shape nears feasibility, so the simplex can walk out of it.
+  if (!(kp_max > 0.0)) return std::isfinite(least) ? kInfeasible * (1.0 + least) : HUGE_VAL;
   *kp_hint = kp_max;
   const PidGains g = ShapeGains(shape, kp_max * std::exp(std::min(alpha, 0.0)));
   if (gains) *gains = g;
@@ -306,7 +344,7 @@ bool Engine::Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum
     kp_hint = 0.0;
     optim::OptimizerSummary s;
     optim::NelderMead(f, box, o, &s);
-    if (s.IsUsable() && s.f < result.f) result = s;
+    if (s.IsUsable() && s.f < kInfeasible && s.f < result.f) result = s;
   }
   if (!result.IsUsable()) return false;
   // Polish from the best, with a fresh simplex.
@@ -321,7 +359,7 @@ bool Engine::Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum
     kp_hint = 0.0;
     optim::OptimizerSummary s;
     optim::NelderMead(f, box, o, &s);
-    if (s.IsUsable() && s.f < result.f) result = s;
+    if (s.IsUsable() && s.f < kInfeasible && s.f < result.f) result = s;
   }
   kp_hint = 0.0;
   PidGains g;
@@ -346,13 +384,13 @@ bool Engine::Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum
     optim::OptimizerSummary s;
     kp_hint = 0.0;
     optim::NelderMead(f4, optim::Bounds{lo, hi}, o, &s);
-    if (s.IsUsable() && s.f < value) {
+    if (s.IsUsable() && s.f < kInfeasible && s.f < value) {
       kp_hint = 0.0;
       value = Cost(s.x.head(dims), s.x(dims), bounds, &kp_hint, &g);
       result.x = s.x.head(dims);
     }
   }
-  if (!std::isfinite(value)) return false;
+  if (!(value < kInfeasible)) return false;
   best->gains = g;
   best->load_iae = value;
   best->shape = result.x;

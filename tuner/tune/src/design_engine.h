@@ -61,7 +61,10 @@ class Engine {
   /// The largest kp whose loop meets the bounds on the grid, from `hint`.
   /// The largest kp whose loop meets the bounds on the grid (`hint`: the
   /// last shape's, 0: none).
-  double MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double hint) const;
+  /// 0 when none, with *least_violation (may be null) the least of the
+  /// peaks' ratios to their bounds seen.
+  double MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double hint,
+               double* least_violation = nullptr) const;
   /// The shape's load IAE at kp = max kp * exp(min(alpha, 0)).
   double Cost(const Eigen::VectorXd& shape, double alpha, const Bounds& bounds, double* kp_hint,
               PidGains* gains) const;

@@ -270,46 +270,112 @@ double DefaultRobustness(const Plant& plant, std::string* why) {
   return ms;
 }
 
-// A spec that says how to search (a field tagged kSearch: an objective, a
-// box, budgets, step or robustness bounds, the robust preset or set) or runs
-// the sampled loop asks for the search, not for migo's frequency-domain design.
-bool AsksForASearch(const spec::TuningSpec& s, const std::set<std::string>& given) {
-  static const std::vector<spec::FieldEntry> fields = spec::Fields<spec::TuningSpec>();
-  for (const spec::FieldEntry& e : fields)
-    if (e.field.Has(spec::kSearch) && given.count(e.field.key) > 0) return true;
-  return s.loop.loop == "sampled";
+// The bounds the design engine takes itself (max_ms as its --robustness).
+bool EngineTakes(const std::string& key) {
+  return key == "max_ms" || key == "max_mt" || key == "max_noise_gain" || key == "max_overshoot";
 }
 
+// A spec that says how to search (a field tagged kSearch other than the
+// bounds the engine takes: an objective, a box, budgets, a margin, a
+// settling or time-constant bound, the robust preset or set), or runs the
+// sampled loop (on the caller's runner the trio's episodes are the point;
+// in process the engine designs it when asked, --method optimal), asks for
+// the search, not for the design engine. Returns why ("" for no):
+// the flag or key that asked, as `given` names it.
+std::string AsksForASearch(const spec::TuningSpec& s, const std::set<std::string>& given, bool runner) {
+  static const std::vector<spec::FieldEntry> fields = spec::Fields<spec::TuningSpec>();
+  for (const spec::FieldEntry& e : fields)
+    if (e.field.Has(spec::kSearch) && given.count(e.field.key) > 0 && !EngineTakes(e.field.key))
+      return e.field.key;
+  if (s.loop.loop == "sampled") return runner ? "backend" : "loop";
+  return "";
+}
+
+// The engine's noise bound: DefaultNoiseGain, unless given (inf: none).
+void ResolveNoiseGain(spec::TuningSpec* s, const std::set<std::string>& given, TimeScale* t) {
+  Plant plant;
+  if (given.count("max_noise_gain") > 0 || !BuildPlant(s->plant, NameStyle::kKey, &plant, nullptr)) {
+    t->noise_gain_reason = "given";
+    return;
+  }
+  s->bounds.max_noise_gain = DefaultNoiseGain(plant, &t->noise_gain_reason);
+}
+
+// The method, and why (t->method_reason): the design engine unless one is
+// given, the plant is the nonlinear stepper, or a flag asks for a search.
+void ResolveMethod(spec::TuningSpec* s, const std::set<std::string>& given, bool runner, TimeScale* t) {
+  const auto kept = [&given](const char* key) { return given.count(key) > 0; };
+  const std::string search = AsksForASearch(*s, given, runner);
+  if (kept("method")) {
+    t->method_reason = "given";
+  } else if (s->plant.plant == "stepper_nonlinear") {
+    t->method_reason = "the nonlinear stepper is tuned by the search on the paper's objective";
+  } else if (!search.empty()) {
+    t->method_reason =
+        search == "backend" ? "the trio's episodes tune the sampled loop: the search on the paper's objective"
+        : search == "loop"
+            ? "the sampled loop is tuned by the search on the paper's objective (--method optimal: the "
+              "design "
+              "engine designs it, the ZOH plant and the discrete PID)"
+            : "'" + search +
+                  "' asks for the search on the paper's objective (the design engine takes --robustness, "
+                  "--max-ms, --max-mt, --max-noise-gain and --max-overshoot)";
+  } else {
+    s->tune.method = "optimal";
+    t->method_reason = "the default: the design engine";
+  }
+  // The engine's Ms bound from --max-ms where --robustness is not given.
+  if (s->tune.method == "optimal" && kept("max_ms") && !kept("robustness") && std::isfinite(s->bounds.max_ms))
+    s->tune.robustness = s->bounds.max_ms;
+}
+
+// A filtered derivative (tf = kd / (10 kp)) unless one is given: off the
+// paper's plants for every method (an ideal derivative has an unbounded
+// noise gain, and on relative degree 1 with dead time a neutral loop); on
+// them for migo, which designs with it. The rules' PI has no derivative,
+// and the design engine designs its own filter (N = Td / tf searched).
+void ResolveFilter(spec::TuningSpec* s, const std::set<std::string>& given, bool paper) {
+  const auto kept = [&given](const char* key) { return given.count(key) > 0; };
+  if (kept("derivative_filter") || kept("derivative_filter_ratio")) return;
+  if (s->tune.method == "optimal") {
+    s->loop.derivative_filter_s = 0.0;
+    s->loop.derivative_filter_ratio = 0.0;
+    return;
+  }
+  const bool pi_rule = s->tune.rule == "pi" &&
+                       (s->tune.method == "migo" || s->tune.method == "simc" || s->tune.method == "amigo");
+  if (!pi_rule && !kept("robust") && (!paper || s->tune.method == "migo")) {
+    s->loop.derivative_filter_s = 0.0;
+    s->loop.derivative_filter_ratio = kMigoFilterRatio;
+  }
+}
+
+// The reasons a time scale carries besides its own.
+struct Reasons {
+  std::string robustness, noise_gain, method;
+  explicit Reasons(const TimeScale& t)
+      : robustness(t.robustness_reason), noise_gain(t.noise_gain_reason), method(t.method_reason) {}
+  TimeScale Into(TimeScale t) const {
+    t.robustness_reason = robustness;
+    t.noise_gain_reason = noise_gain;
+    t.method_reason = method;
+    return t;
+  }
+};
+
 // Method, filter and time scale from the plant.
-TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>& given) {
+TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>& given, bool runner) {
   const auto kept = [&given](const char* key) { return given.count(key) > 0; };
   TimeScale t;
   t.horizon_s = s->loop.horizon_s;
   t.sample_time_s = s->loop.sample_time_s;
   const bool paper = IsPaperPlant(s->plant);
   const bool timed = kept("horizon") || kept("sample_time");
-  // migo designs on a transfer function: the nonlinear stepper keeps the
-  // multi-start.
-  if (!kept("method") && !AsksForASearch(*s, given) && s->plant.plant != "stepper_nonlinear")
-    s->tune.method = "migo";
-  // A filtered derivative (tf = kd / (10 kp)) unless one is given: off the
-  // paper's plants for every method (an ideal derivative has an unbounded
-  // noise gain, and on relative degree 1 with dead time a neutral loop); on
-  // them for migo, which designs with it. The rules' PI has no derivative.
-  const bool pi_rule = s->tune.rule == "pi" &&
-                       (s->tune.method == "migo" || s->tune.method == "simc" || s->tune.method == "amigo");
-  // The design engine designs its own filter (N = Td / tf searched).
+  ResolveMethod(s, given, runner, &t);
+  ResolveFilter(s, given, paper);
   const bool optimal = s->tune.method == "optimal";
-  if (optimal && !kept("derivative_filter") && !kept("derivative_filter_ratio")) {
-    s->loop.derivative_filter_s = 0.0;
-    s->loop.derivative_filter_ratio = 0.0;
-  }
-  if (!pi_rule && !optimal && !kept("derivative_filter") && !kept("derivative_filter_ratio") &&
-      !kept("robust") && (!paper || s->tune.method == "migo")) {
-    s->loop.derivative_filter_s = 0.0;
-    s->loop.derivative_filter_ratio = kMigoFilterRatio;
-  }
   if (paper) {
+    if (optimal) ResolveNoiseGain(s, given, &t);
     // Given as eq. (4) has them (a result's echo): eq. (4) still.
     const spec::LoopSpec defaults;
     const bool eq4 =
@@ -326,21 +392,13 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
     if (timed) t.source = t.reason = "given";
     return t;
   }
-  if ((s->tune.method == "migo" || optimal) && !kept("robustness")) {
+  if ((s->tune.method == "migo" || optimal) && !kept("robustness") && !kept("max_ms")) {
     s->tune.robustness = DefaultRobustness(plant, &t.robustness_reason);
   } else {
     t.robustness_reason = "given";
   }
-  // The engine's noise bound: migo's noise gain at the same Ms, unless given
-  // (inf: none). A phase margin's Ms is not known yet: the default Ms's.
-  if (optimal && !kept("max_noise_gain")) {
-    const double ms =
-        s->tune.robustness > 1.0 && s->tune.robustness <= 4.0 ? s->tune.robustness : kMigoDefaultMs;
-    s->bounds.max_noise_gain = DefaultNoiseGain(plant, ms, s->tune.rule == "pi", &t.noise_gain_reason);
-  } else if (optimal) {
-    t.noise_gain_reason = "given";
-  }
-  const std::string reason = t.robustness_reason, noise_reason = t.noise_gain_reason;
+  if (optimal) ResolveNoiseGain(s, given, &t);
+  const Reasons reasons(t);
   // (The robust preset's bound on the slowest time constant is a tenth of
   // this horizon: at least the migo design's own.)
   const TimeScale derived = DerivedTimeScale(*s, plant);
@@ -349,21 +407,18 @@ TimeScale ResolvePlantDefaults(spec::TuningSpec* s, const std::set<std::string>&
     const bool same =
         s->loop.horizon_s == derived.horizon_s && s->loop.sample_time_s == derived.sample_time_s;
     if (!same) t.source = t.reason = "given";
-    if (same) t = TimeScale(derived), t.robustness_reason = reason, t.noise_gain_reason = noise_reason;
-    return t;
+    return same ? reasons.Into(derived) : t;
   }
   s->loop.horizon_s = derived.horizon_s;
   s->loop.sample_time_s = derived.sample_time_s;
-  t = derived;
-  t.robustness_reason = reason;
-  t.noise_gain_reason = noise_reason;
-  return t;
+  return reasons.Into(derived);
 }
 
 }  // namespace
 
-SearchBox ResolveTuningSpec(spec::TuningSpec* s, const std::set<std::string>& given, TimeScale* time_scale) {
-  const TimeScale t = ResolvePlantDefaults(s, given);
+SearchBox ResolveTuningSpec(spec::TuningSpec* s, const std::set<std::string>& given, TimeScale* time_scale,
+                            Backend backend) {
+  const TimeScale t = ResolvePlantDefaults(s, given, backend == Backend::kRunner);
   if (time_scale) *time_scale = t;
   ResolveRobustPreset(s, given);
   return ResolveSearchBox(s, given);
@@ -374,7 +429,7 @@ Status BuildTuning(const spec::TuningSpec& s, const BuildOptions& options, Tunin
   TuningProblem p;
   p.spec = s;
   p.spec.plant.Normalize();
-  p.box = ResolveTuningSpec(&p.spec, options.given, &p.time_scale);
+  p.box = ResolveTuningSpec(&p.spec, options.given, &p.time_scale, options.backend);
   std::string error;
   if (!BuildPlant(p.spec.plant, options.style, &p.plant, &error) ||
       !BuildTuneOptions(p.spec, options.style, &p.options, &error) ||

@@ -130,12 +130,18 @@ Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSum
 /// margin when even Ms 1.05 does not keep it.
 Status DesignMsForPhaseMargin(const Plant& plant, double phase_margin_deg, DesignOptions* options);
 
-/// The default noise-gain bound of `tune --method optimal` at Ms bound `ms`:
-/// the noise gain of migo's design at that bound (the largest ki, tf = Td /
-/// 10), so that the engine's design is never noisier than it and, since
-/// migo's gains meet every bound, rejects a load step at least as well.
-/// +inf where migo has no design; *why says so in one clause.
-double DefaultNoiseGain(const Plant& plant, double ms, bool pi, std::string* why);
+/// The default noise-gain bound of the design engine, per unit of the
+/// plant's ultimate gain (docs/tuning.md, "The design engine").
+inline constexpr double kDefaultNoiseGainPerUltimateGain = 10.0;
+
+/// The plant's ultimate gain Ku = 1 / |G(j w180)| at the lowest frequency
+/// w180 (into *w180) where its phase, dead time included, reaches -180 deg;
+/// +inf (w180 = 0) where it never does.
+double UltimateGain(const Plant& plant, double* w180);
+
+/// The default noise-gain bound: kDefaultNoiseGainPerUltimateGain x Ku
+/// (+inf where the plant has no ultimate gain); *why says so in one clause.
+double DefaultNoiseGain(const Plant& plant, std::string* why);
 
 /// The unit load step's \int|y|dt of `gains` on the continuous loop of
 /// `plant` (dead time included), by the engine's simulation; +inf when the

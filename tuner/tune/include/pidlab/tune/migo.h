@@ -121,6 +121,9 @@ struct TimeScale {
   std::string robustness_reason;
   /// optimal: where its noise-gain bound came from ("given", or migo's).
   std::string noise_gain_reason;
+  /// Why the method is what it is: "given", the default (the design engine),
+  /// or the flag that asked for the search instead, in one clause.
+  std::string method_reason;
 };
 
 /// The horizon and sample spacing a loop with closed-loop time constants

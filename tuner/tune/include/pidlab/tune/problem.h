@@ -163,11 +163,18 @@ bool IsPaperPlant(const spec::PlantSpec& p);
 
 /// Resolves what a tuning spec leaves to the plant and the preset, in this
 /// order (docs/tuning.md, "Any plant"):
-/// - with no `method` given and nothing
-///   that asks for a search (an objective, a box, budgets, step or
-///   robustness bounds, `robust`, a robust set, the sampled loop), the
-///   method migo (the nonlinear stepper: multi-start); with no derivative filter given (nor `robust`), a PID
-///   of any method gets derivative_filter_ratio 10 (on the paper's plants, migo's);
+/// - with no `method` given and nothing that asks for a search (an
+///   objective, a box, budgets, a margin, a settling or time-constant bound,
+///   `robust`, a robust set, the sampled loop on the caller's runner), the
+///   design engine, method optimal (the nonlinear stepper: multi-start),
+///   with max_ms as its robustness where that is not given; TimeScale's
+///   method_reason says which and why;
+/// - with no derivative filter given (nor `robust`), a PID of any method
+///   but optimal (which designs its own) gets derivative_filter_ratio 10 (on
+///   the paper's plants, migo's only);
+/// - optimal and migo: with no robustness given, SIMC's Ms on the plant
+///   (DefaultRobustness); optimal: with no max_noise_gain given, migo's
+///   noise gain at that Ms (DefaultNoiseGain);
 /// - with neither `horizon` nor `sample_time` given, on a plant other than
 ///   the paper's, the time scale of the migo design's closed loop
 ///   (LoopTimeScale; the plant's own times where migo does not apply); on a
@@ -181,7 +188,7 @@ bool IsPaperPlant(const spec::PlantSpec& p);
 /// Returns the box and its source; *time_scale (may be null) the time scale
 /// and its source.
 SearchBox ResolveTuningSpec(spec::TuningSpec* s, const std::set<std::string>& given,
-                            TimeScale* time_scale = nullptr);
+                            TimeScale* time_scale = nullptr, Backend backend = Backend::kInProcess);
 
 /// A tuning spec resolved, built and checked.
 struct TuningProblem {
