@@ -54,9 +54,9 @@ Status AutotuneFixedPoint(const spec::AutotuneSpec& s, const PidGains& previous,
 
 Status BuildAutotuneDesign(const spec::AutotuneSpec& s, double max_ms, NameStyle style,
                            AutotuneDesignOptions* design) {
-  if (s.method != "amigo" && s.method != "simc" && s.method != "migo")
+  if (s.method != "amigo" && s.method != "simc" && s.method != "migo" && s.method != "optimal")
     return Status::InvalidInput(DisplayName("method", style) + " " + Quote(s.method) +
-                                " is not amigo, simc or migo");
+                                " is not amigo, simc, migo or optimal");
   AutotuneDesignOptions o;
   o.method = s.method;
   o.robustness = s.robustness;

@@ -27,8 +27,8 @@ std::string Num(double v) {
 
 bool AutotuneDesignOptions::IsValid(std::string* error) const {
   std::string e;
-  if (method != "amigo" && method != "simc" && method != "migo")
-    e = "method '" + method + "' is not amigo, simc or migo";
+  if (method != "amigo" && method != "simc" && method != "migo" && method != "optimal")
+    e = "method '" + method + "' is not amigo, simc, migo or optimal";
   else if (!(max_ms > 1.0) || !std::isfinite(max_ms))
     e = "max Ms " + Num(max_ms) + " must be > 1 and finite";
   else if (!(max_overshoot_pct >= 0.0))

@@ -21,7 +21,7 @@ namespace pidlab::results {
 
 /// The design on the identified model and what adopting it takes.
 struct AutotuneDesignOptions {
-  std::string method = "amigo";     ///< amigo | simc | migo
+  std::string method = "amigo";     ///< amigo | simc | migo | optimal
   double robustness = 1.4;          ///< migo: the Ms it designs to
   double response_time_s = 0.0;     ///< migo: the response time (0: fastest)
   double max_ms = 2.0;              ///< the design's Ms on the model at most this (> 1)

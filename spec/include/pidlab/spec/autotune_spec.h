@@ -76,8 +76,9 @@ struct AutotuneSpec {
              &input_range);
     a->Visit({"relay_time", "the first relay episode's relay window", "s", kNone, "30"}, &relay_time_s);
     a->Visit({"max_time", "the longest relay window", "s", kNone, "600"}, &max_time_s);
-    a->Visit({"method", "the design on the identified model: amigo, simc or migo (pidlab's)", "", kNone,
-              R"("simc")"},
+    a->Visit({"method",
+              "the design on the identified model: amigo, simc, migo or optimal (pidlab's design engine)", "",
+              kNone, R"("simc")"},
              &method);
     a->Visit({"robustness", "migo: the Ms bound it designs to", "", kNone, "1.6"}, &robustness);
     a->Visit({"response_time", "migo: the response time it designs to (0: fastest)", "s", kNone, "5"},
