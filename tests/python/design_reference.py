@@ -214,108 +214,135 @@ class Window:
         return self.h * np.sum(np.abs(y)), y
 
 
-def tail_fraction(y, h, iae, frac=0.25):
-    """The share of the IAE in the last `frac` of the window."""
-    k = int(len(y) * (1.0 - frac))
-    return h * np.sum(np.abs(y[k:])) / max(iae, 1e-300)
-
-
-def settle_time(y, h, iae, rel=1e-7):
-    """The time after which the remaining int |y| is below rel * IAE."""
-    tail = np.cumsum(np.abs(y[::-1]))[::-1] * h
-    idx = np.nonzero(tail > rel * iae)[0]
-    return (idx[-1] + 1) * h if len(idx) else h
-
-
 # --------------------------------------------------------------------------
 # Frequency grids, peaks and stability.
 
 
-def freq_grid(plant, noise_bound, w_ref, n_log=2400, lin_per_ripple=60, max_lin=20000):
-    """The grid the peaks are taken on (rad/s, increasing)."""
-    fast, slow = plant.time_scales()
-    w_lo = min(1e-4 * w_ref, 1e-3 / slow)
-    # Where Gn |G(jw)| falls below 0.05 for good (|L| <= 0.053 beyond: |S|,
-    # |T| far below any bound), at least 30 x w_ref.
-    wide = np.logspace(math.log10(w_ref), math.log10(w_ref) + 8, 4000)
-    gn = noise_bound if np.isfinite(noise_bound) else 1e6
-    mag = gn * np.abs(plant.g(1j * wide))
-    above = np.nonzero(mag >= 0.05)[0]
-    w_nb = wide[above[-1]] if len(above) else w_ref
-    w_nb = max(w_nb, 30.0 * w_ref)
-    w_hi = 1e3 * w_nb
-    grid = [np.logspace(math.log10(w_lo), math.log10(w_hi), n_log)]
-    # Linear: near the crossover, and (the delay's ripple) up to w_nb.
-    step = w_ref / 200.0
-    if plant.delay > 0:
-        step = min(step, 2.0 * np.pi / plant.delay / lin_per_ripple)
-    top = min(w_nb * 1.2, step * max_lin)
-    grid.append(np.arange(step, top, step))
-    # Finer around the crossover region.
-    grid.append(np.linspace(0.05 * w_ref, 5.0 * w_ref, 1500))
-    w = np.unique(np.concatenate(grid))
-    return w
+class Grid:
+    """The frequencies (rad/s) the peaks are taken on.
+
+    `exact`: 1 + L(jw) itself, on a log grid from eps (the Nyquist
+    indentation's radius) and, with a dead time, a linear grid of spacing
+    2 pi / (L k) (k points per ripple of e^(-jwL)) up to w_env, plus a linear
+    grid around the plant's phase crossover w_ref. `env` (dead time only): a
+    log grid from w_env up, where the delay's phase turns through pi in a few
+    per cent of w, so the peak over each ripple is the envelope over the phase
+    of L: |S| <= 1/(1-|L|), |T| <= |L|/(1-|L|), |C S| <= |C|/(1-|L|) (tight
+    there; |L| < 1 is required there, a stable loop has it). The top is where
+    Gn |G(jw)| < 1e-6 (|C| <= about Gn), at least 1e4 w_ref."""
+
+    def __init__(self, plant, noise, w_ref, dense=False):
+        fast, slow = plant.time_scales()
+        self.eps = 1e-4 * min(w_ref, 1.0 / slow)
+        gn = noise if np.isfinite(noise) else 1e6
+        wide = np.logspace(math.log10(w_ref), math.log10(w_ref) + 10, 5000)
+        above = np.nonzero(gn * np.abs(plant.g(1j * wide)) >= 1e-6)[0]
+        w_hi = max(wide[above[-1]] if len(above) else w_ref, 1e4 * w_ref)
+        per_decade = 400 if dense else 50
+        near = np.linspace(0.02 * w_ref, 5.0 * w_ref, 2000 if dense else 200)
+        if plant.delay > 0:
+            ripples = 2000.0 if dense else 60.0
+            w_env = min(max(ripples / plant.delay, 20.0 * w_ref), w_hi)
+            step = 2.0 * np.pi / plant.delay / (60.0 if dense else 30.0)
+            lin = np.arange(step, w_env, step)
+        else:
+            w_env = w_hi
+            lin = np.zeros(0)
+        logx = np.logspace(math.log10(self.eps), math.log10(w_env),
+                           max(int(per_decade * math.log10(w_env / self.eps)), 50))
+        self.exact = np.unique(np.concatenate([logx, lin, near[near < w_env]]))
+        if w_env < w_hi:
+            self.env = np.logspace(math.log10(w_env), math.log10(w_hi),
+                                   max(int(per_decade * math.log10(w_hi / w_env)), 10))[1:]
+        else:
+            self.env = np.zeros(0)
+
+    def with_points(self, extra):
+        """A copy with more exact points (those below the envelope's start)."""
+        g = Grid.__new__(Grid)
+        g.eps, g.env = self.eps, self.env
+        top = self.exact[-1]
+        extra = np.asarray([v for v in extra if 0 < v < top])
+        g.exact = np.unique(np.concatenate([self.exact, extra, extra * (1 - 1e-4), extra * (1 + 1e-4)]))
+        return g
 
 
-def winding_unstable(c_fn, plant, w, eps=None):
+def winding_unstable(c_fn, plant, grid):
     """The number of closed-loop poles in the closed right half plane by the
-    Nyquist criterion, on the grid w (rad/s) and an indentation of radius
-    eps = w[0] around s = 0 (to the right). Returns (count, ok), ok false when
-    the grid is too coarse to unwrap the phase reliably."""
-    eps = w[0] if eps is None else eps
+    Nyquist criterion: the change of arg(1 + L) along the imaginary axis, up
+    from -j inf to j inf, indented to the right of s = 0 by a half circle of
+    radius eps, and back by the right half plane's big half circle (where
+    L -> 0) is -2 pi Z (the plants are open-loop stable but for poles at the
+    origin, which the indentation leaves out). Taken on the exact grid; past
+    it, in the envelope grid, |L| < 0.9 is required (so 1 + L stays in the
+    right half plane: no more turns). Returns (Z, ok), ok false when the grid
+    is too coarse to unwrap the phase or |L| is not small beyond it."""
     phi = np.linspace(-np.pi / 2, np.pi / 2, 181)
-    s_semi = eps * np.exp(1j * phi)
+    s_semi = grid.eps * np.exp(1j * phi)
     f_semi = 1.0 + c_fn(s_semi) * plant.g(s_semi)
-    s_up = 1j * w
+    s_up = 1j * grid.exact
     f_up = 1.0 + c_fn(s_up) * plant.g(s_up)
     a_semi = np.unwrap(np.angle(f_semi))
     a_up = np.unwrap(np.angle(f_up))
-    d_up = np.diff(np.angle(f_up))
-    d_up = (d_up + np.pi) % (2 * np.pi) - np.pi
-    ok = np.max(np.abs(d_up)) < 0.75 * np.pi and np.max(np.abs(np.diff(a_semi))) < 0.75 * np.pi
-    # From j w_max to j inf: 1 + L -> 1 (|L| small there, checked).
-    lw = np.abs(f_up[-1] - 1.0)
-    ok = ok and lw < 0.5
-    delta_upper = (a_up[-1] - a_up[0]) + (0.0 - np.angle(f_up[-1]))
-    # Semicircle ends at s = j eps, where the upper axis starts: phases agree
-    # mod 2 pi; use the semicircle's own change.
+    steps = np.abs(np.diff(a_up))
+    ok = len(steps) == 0 or np.max(steps) < 0.75 * np.pi
+    ok = ok and np.max(np.abs(np.diff(a_semi))) < 0.75 * np.pi
+    if len(grid.env):
+        s_env = 1j * grid.env
+        ok = ok and np.max(np.abs(c_fn(s_env) * plant.g(s_env))) < 0.9
+    else:
+        ok = ok and abs(f_up[-1] - 1.0) < 0.9
+    # j w_top -> j inf: 1 + L -> 1 inside the right half plane.
+    delta_upper = (a_up[-1] - a_up[0]) - np.angle(f_up[-1])
     total = (a_semi[-1] - a_semi[0]) + 2.0 * delta_upper
     z = -total / (2.0 * np.pi)
-    return int(round(z)), ok and abs(z - round(z)) < 0.05
+    return int(round(z)), bool(ok and abs(z - round(z)) < 0.05)
 
 
-def peaks_on_grid(g, plant, w):
-    s = 1j * w
-    c = c_of_gains(g, s)
-    l = c * plant.g(s)
-    sens = 1.0 / (1.0 + l)
-    return np.abs(sens), np.abs(l * sens), np.abs(c * sens)
-
-
-def refine_peak(fn, w, vals):
-    """The largest value of fn (of one w > 0) near the grid's local maxima."""
+def refine_peak(fn, w, vals, most=25):
+    """The largest value of fn (of one w > 0) near the grid's local maxima
+    (the `most` highest within 3 % of the top), by a bounded scalar search
+    in log w between the neighbours."""
+    n = len(w)
+    if n == 0:
+        return -math.inf, math.nan
     best = float(np.max(vals))
     best_w = float(w[int(np.argmax(vals))])
-    n = len(w)
-    cand = [i for i in range(n) if (i == 0 or vals[i] >= vals[i - 1]) and (i == n - 1 or vals[i] >= vals[i + 1])]
+    inner = (vals[1:-1] >= vals[:-2]) & (vals[1:-1] >= vals[2:])
+    cand = list(np.nonzero(inner)[0] + 1)
+    if n > 1 and vals[0] >= vals[1]:
+        cand.append(0)
+    if n > 1 and vals[-1] >= vals[-2]:
+        cand.append(n - 1)
     cand = [i for i in cand if vals[i] >= 0.97 * best]
-    for i in cand:
+    cand.sort(key=lambda i: -vals[i])
+    for i in cand[:most]:
         lo = math.log(w[max(i - 1, 0)])
         hi = math.log(w[min(i + 1, n - 1)])
         if hi <= lo:
             continue
         r = optimize.minimize_scalar(lambda lw: -fn(math.exp(lw)), bounds=(lo, hi), method="bounded",
-                                     options=dict(xatol=1e-10 * max(1.0, abs(lo))))
+                                     options=dict(xatol=1e-9))
         if -r.fun > best:
             best, best_w = -r.fun, math.exp(r.x)
     return best, best_w
 
 
 # --------------------------------------------------------------------------
-# The analysis of one design (used on pidlab's gains and on the optimum).
+# The problem: the analysis of one design, and the optimum.
+
+
+def window_holds(az):
+    """|z| = |y e^(-sigma t)| on a window has died out by its end: the last
+    tenth's median below 1e-5 of its largest, and the last 3 % below 1e-4."""
+    n = len(az)
+    top = np.max(az)
+    return np.median(az[int(0.9 * n):]) <= 1e-5 * top and np.max(az[int(0.97 * n):]) <= 1e-4 * top
 
 
 class Problem:
+    VIOLATION_TOL = 1e-5
+
     def __init__(self, plant, ms=1.59, mt=None, noise=np.inf, pi=False, td_max=None):
         self.plant = plant
         self.ms = float(ms)
@@ -327,8 +354,8 @@ class Problem:
         w180 = plant.phase_crossover()
         fast, slow = plant.time_scales()
         self.w_ref = w180 if w180 is not None else 1.0 / fast
-        self.grid = freq_grid(plant, self.noise, self.w_ref)
-        self.dense = freq_grid(plant, self.noise, self.w_ref, n_log=8000, lin_per_ripple=200, max_lin=80000)
+        self.grid = Grid(plant, self.noise, self.w_ref)
+        self.dense = Grid(plant, self.noise, self.w_ref, dense=True)
         self._windows = {}
         self.evaluations = 0
 
@@ -341,40 +368,47 @@ class Problem:
             self._windows[key] = Window(self.plant, T, n)
         return self._windows[key]
 
-    def fit_window(self, g, T=None, n=1 << 15, rel=1e-7):
-        """A window (T, n) that holds the response of g: the tail beyond T
-        at most rel of the IAE and T at most 2.2 x the settling time (for
-        the resolution)."""
+    def fit_window(self, g, T=None, n=1 << 15):
+        """A window (T, n) that holds the load response of g: judged on
+        z = y e^(-sigma t) (the transform's own output, its small noise floor
+        from the truncation at the Nyquist frequency not amplified), the last
+        tenth of the window below 1e-5 of max |z| and the response's end (the
+        last |z| above that) in [0.3, 0.6] of T, for the resolution."""
         if T is None:
-            fast, slow = self.plant.time_scales()
-            T = 60.0 * (self.plant.delay + 2.0 / self.w_ref) + 0.0
-        for _ in range(40):
+            T = 60.0 * (self.plant.delay + 2.0 / self.w_ref)
+        for _ in range(60):
             win = self.window(T, n)
-            iae, y = win.iae_of_gains(g)
-            if not np.all(np.isfinite(y)):
+            z = win.y_of_c(c_of_gains(g, win.s)) / win.growth
+            if not np.all(np.isfinite(z)):
                 return None
-            ts = settle_time(y, win.h, iae, rel)
-            if ts > 0.55 * T:
+            az = np.abs(z)
+            thr = 1e-5 * np.max(az)
+            if not window_holds(az):
                 T *= 2.0
                 continue
-            if ts < 0.2 * T and T > 1e-6:
-                T = max(ts / 0.45, 1e-9)
+            above = np.nonzero(az > thr)[0]
+            end = (above[-1] + 1) * win.h if len(above) else win.h
+            if end < 0.3 * T:
+                T = max(end / 0.45, 1e-9)
+                continue
+            if end > 0.6 * T:
+                T *= 1.5
                 continue
             return T, n
         return T, n
 
-    def iae(self, g, T=None, check=True):
-        """The load IAE of g, on a fitted window, converged in T and n:
-        (iae, info)."""
-        fit = self.fit_window(g, T)
+    def iae(self, g, check=True):
+        """The load IAE of g on a fitted window, with the relative changes on
+        a window twice as long and on four times the samples: (iae, info)."""
+        fit = self.fit_window(g)
         if fit is None:
             return math.inf, {}
         T, n = fit
-        iae1, y = self.window(T, n).iae_of_gains(g)
+        iae1, _ = self.window(T, n).iae_of_gains(g)
         info = dict(window_s=T, samples=n)
         if check:
-            iae2, _ = self.window(2.0 * T, 2 * n).iae_of_gains(g)  # longer, same step
-            iae3, _ = self.window(T, 4 * n).iae_of_gains(g)  # finer
+            iae2, _ = self.window(2.0 * T, 2 * n).iae_of_gains(g)
+            iae3, _ = self.window(T, 4 * n).iae_of_gains(g)
             info["change_longer"] = abs(iae2 - iae1) / iae1
             info["change_finer"] = abs(iae3 - iae1) / iae1
             iae1 = iae3
@@ -382,82 +416,117 @@ class Problem:
 
     # -- the peaks ------------------------------------------------------
     def peaks(self, g, grid=None):
-        w = self.dense if grid is None else grid
-        a_s, a_t, a_n = peaks_on_grid(g, self.plant, w)
+        grid = self.dense if grid is None else grid
         p = self.plant
 
+        def parts(wv):
+            s = 1j * wv
+            c = c_of_gains(g, s)
+            return c, c * p.g(s)
+
         def s_at(wv):
-            l = c_of_gains(g, 1j * wv) * p.g(1j * wv)
+            c, l = parts(wv)
             return abs(1.0 / (1.0 + l))
 
         def t_at(wv):
-            l = c_of_gains(g, 1j * wv) * p.g(1j * wv)
+            c, l = parts(wv)
             return abs(l / (1.0 + l))
 
         def n_at(wv):
-            c = c_of_gains(g, 1j * wv)
-            return abs(c / (1.0 + c * p.g(1j * wv)))
+            c, l = parts(wv)
+            return abs(c / (1.0 + l))
 
-        ms, ws = refine_peak(s_at, w, a_s)
-        mt, wt = refine_peak(t_at, w, a_t)
-        mn, wn = refine_peak(n_at, w, a_n)
-        cinf = c_inf(g)
-        if cinf > mn:
-            mn, wn = cinf, math.inf
-        unstable, ok = winding_unstable(lambda s: c_of_gains(g, s), p, w)
-        return dict(ms=ms, ms_rad_s=ws, mt=mt, mt_rad_s=wt, noise_gain=mn, noise_rad_s=wn,
-                    unstable_poles=unstable, nyquist_ok=bool(ok), stable=bool(ok and unstable == 0))
+        c, l = parts(grid.exact)
+        out = {}
+        for name, fn, vals in (("ms", s_at, np.abs(1.0 / (1.0 + l))), ("mt", t_at, np.abs(l / (1.0 + l))),
+                               ("noise_gain", n_at, np.abs(c / (1.0 + l)))):
+            out[name], out[name + "_rad_s"] = refine_peak(fn, grid.exact, vals)
+        if len(grid.env):
+            c, l = parts(grid.env)
+            al = np.abs(l)
+            gap = np.maximum(1.0 - al, 1e-300)
+            for name, vals in (("ms", 1.0 / gap), ("mt", al / gap), ("noise_gain", np.abs(c) / gap)):
+                i = int(np.argmax(vals))
+                if vals[i] > out[name]:
+                    out[name], out[name + "_rad_s"] = float(vals[i]), float(grid.env[i])
+        if c_inf(g) > out["noise_gain"]:
+            out["noise_gain"], out["noise_gain_rad_s"] = c_inf(g), math.inf
+        unstable, ok = winding_unstable(lambda s: c_of_gains(g, s), p, grid)
+        out.update(unstable_poles=unstable, nyquist_ok=ok, stable=bool(ok and unstable == 0))
+        return out
 
-    def analyse(self, g):
+    def analyse(self, g, with_iae=True):
         out = self.peaks(g)
         out["td"] = g["kd"] / g["kp"] if g["kd"] != 0.0 else 0.0
         out["n"] = out["td"] / g["tf"] if g["kd"] != 0.0 and g["tf"] > 0 else math.inf
-        if out["stable"]:
+        out["td_bound"] = self.td_max
+        if with_iae and out["stable"]:
             out["iae"], out["iae_info"] = self.iae(g)
-        else:
+        elif with_iae:
             out["iae"], out["iae_info"] = math.inf, {}
         return out
 
+    def violations(self, a):
+        """The relative excess over each bound (<= 0: met)."""
+        v = dict(ms=a["ms"] / self.ms - 1.0, mt=a["mt"] / self.mt - 1.0,
+                 noise_gain=a["noise_gain"] / self.noise - 1.0)
+        if a["td"] > 0:
+            v.update(td=a["td"] / self.td_max - 1.0, n_max=a["n"] / self.n_max - 1.0,
+                     n_min=self.n_min / a["n"] - 1.0)
+        v["stable"] = 0.0 if a["stable"] else math.inf
+        return v
+
     def violation(self, a):
-        """The largest relative excess over a bound (<= 0: all met)."""
-        v = [a["ms"] / self.ms - 1.0, a["mt"] / self.mt - 1.0, a["noise_gain"] / self.noise - 1.0]
-        if not self.pi and a["td"] > 0:
-            v += [a["td"] / self.td_max - 1.0, a["n"] / self.n_max - 1.0, self.n_min / a["n"] - 1.0]
-        if not a["stable"]:
-            v.append(math.inf)
-        return max(v)
+        return max(self.violations(a).values())
 
     # -- the constraint set on a grid ----------------------------------
-    def constraints(self, x, w):
-        """(values, jacobian) of the peak constraints at the grid w, every one
-        >= 0 when met: log bound - log |.|, and the high-frequency |C|."""
-        s = 1j * w
+    def constraints(self, x, grid):
+        """(values, jacobian) of the peak constraints on the grid, every one
+        >= 0 when met: log bound - log |.| on the exact grid, the envelopes
+        and |L| <= 0.5 on the envelope grid, and log Gn - log |C(j inf)|."""
+        vals, jac = [], []
+        lms, lmt = math.log(self.ms), math.log(self.mt)
+        lgn = math.log(self.noise) if np.isfinite(self.noise) else None
+        s = 1j * grid.exact
         c, dc = c_and_grad(x, s, self.pi)
         p = self.plant.g(s)
         l = c * p
         f = 1.0 + l
-        dl = dc * p[None, :]
-        dlogf = np.real(dl / f[None, :])  # d log|1+L|
-        dlogl = np.real(dc / c[None, :])  # d log|L| = d log|C|
-        vals = [math.log(self.ms) + np.log(np.abs(f)),
-                math.log(self.mt) - np.log(np.abs(l)) + np.log(np.abs(f))]
-        jac = [dlogf.T, (dlogf - dlogl).T]
-        if np.isfinite(self.noise):
-            vals.append(math.log(self.noise) - np.log(np.abs(c)) + np.log(np.abs(f)))
-            jac.append((dlogf - dlogl).T)
+        dlogf = np.real(dc * p[None, :] / f[None, :]).T  # d log|1+L|
+        dlogc = np.real(dc / c[None, :]).T  # d log|C| = d log|L|
+        logf = np.log(np.abs(f))
+        vals += [lms + logf, lmt - np.log(np.abs(l)) + logf]
+        jac += [dlogf, dlogf - dlogc]
+        if lgn is not None:
+            vals.append(lgn - np.log(np.abs(c)) + logf)
+            jac.append(dlogf - dlogc)
+        if len(grid.env):
+            s = 1j * grid.env
+            c, dc = c_and_grad(x, s, self.pi)
+            al = np.abs(c * self.plant.g(s))
+            dlogc = np.real(dc / c[None, :]).T
+            gap = np.maximum(1.0 - al, 1e-12)
+            loggap = np.log(gap)
+            dloggap = -(al / gap)[:, None] * dlogc
+            vals += [lms + loggap, lmt - np.log(al) + loggap, math.log(0.5) - np.log(al)]
+            jac += [dloggap, dloggap - dlogc, -dlogc]
+            if lgn is not None:
+                vals.append(lgn - np.log(np.abs(c)) + loggap)
+                jac.append(dloggap - dlogc)
+        if lgn is not None:
             # |C(j inf)| = kp (1 + N) (PID), kp (PI).
             if self.pi:
-                vals.append(np.array([math.log(self.noise) - x[0]]))
+                vals.append(np.array([lgn - x[0]]))
                 jac.append(np.array([[-1.0, 0.0]]))
             else:
                 nn = math.exp(x[3])
-                vals.append(np.array([math.log(self.noise) - x[0] - math.log1p(nn)]))
+                vals.append(np.array([lgn - x[0] - math.log1p(nn)]))
                 jac.append(np.array([[-1.0, 0.0, 0.0, -nn / (1.0 + nn)]]))
         return np.concatenate(vals), np.vstack(jac)
 
-    def stable_x(self, x, w):
+    def stable_x(self, x, grid):
         g = gains_of(x, self.pi)
-        unstable, ok = winding_unstable(lambda s: c_of_gains(g, s), self.plant, w)
+        unstable, ok = winding_unstable(lambda s: c_of_gains(g, s), self.plant, grid)
         return ok and unstable == 0
 
     def bounds(self):
@@ -469,16 +538,14 @@ class Problem:
     # -- starts -------------------------------------------------------
     def fopdt(self):
         """(K, T, L) of a first-order-plus-dead-time model by the method of
-        moments/areas (Astrom & Hagglund): Tar = A0/K, T = e A1/K."""
+        areas (Astrom & Hagglund): Tar = A0/K from the moments, T = e A1/K
+        with A1 the area under the step response up to Tar."""
         p = self.plant
         K = p.static_gain()
-        num_asc = p.num[::-1]
-        den_asc = p.den[::-1]
+        num_asc, den_asc = p.num[::-1], p.den[::-1]
         tar = p.delay + den_asc[1] / den_asc[0] - (num_asc[1] / num_asc[0] if len(num_asc) > 1 else 0.0)
-        sys_ = signal.lti(p.num, p.den)
         t = np.linspace(0.0, max(tar - p.delay, 1e-9), 4001)
-        _, ystep = signal.step(sys_, T=t)
-        # A1 = int_0^Tar y(t) dt, the delayed step response.
+        _, ystep = signal.step(signal.lti(p.num, p.den), T=t)
         a1 = np.trapz(ystep, t)
         T = max(math.e * a1 / K, 1e-6 * tar)
         L = max(tar - T, 1e-3 * tar)
@@ -492,82 +559,71 @@ class Problem:
             kv = p.static_gain()
             den = p.den_reduced
             lag = den[-2] / den[-1] if len(den) > 1 else 0.0
-            L = p.delay + lag  # e^(-sL)/(s(1+T1 s)) ~ e^(-s(L+T1))/s
-            L = max(L, 1e-3)
+            L = max(p.delay + lag, 1e-3)  # e^(-sL)/(s(1+T1 s)) ~ e^(-s(L+T1))/s
             kp = 0.45 / (kv * L)
-            ti = 8.0 * L
-            td = 0.5 * L
-            return kp, kp / ti, td
+            return kp, kp / (8.0 * L), 0.5 * L
         K, T, L = self.fopdt()
         kp = (0.2 + 0.45 * T / L) / K
         ti = (0.4 * L + 0.8 * T) / (L + 0.1 * T) * L
         td = 0.5 * L * T / (0.3 * L + T)
         return kp, kp / ti, td
 
-    def feasible_on(self, x, w):
-        vals, _ = self.constraints(x, w)
-        return np.min(vals) >= 0.0 and self.stable_x(x, w)
+    def feasible_on(self, x, grid):
+        vals, _ = self.constraints(x, grid)
+        return np.min(vals) >= 0.0 and self.stable_x(x, grid)
 
     def scale_to_bounds(self, x):
         """Shift log kp and log ki together (Td, N kept) to the largest gain
-        that meets the constraints on the grid and is stable."""
+        that meets the constraints on the grid and is stable (bisection)."""
         x = np.array(x, float)
 
         def ok(a):
             y = x.copy()
-            y[0] += a
-            y[1] += a
+            y[:2] += a
             return self.feasible_on(y, self.grid)
 
-        lo, hi = -30.0, 0.0
         if ok(0.0):
-            lo = 0.0
-            hi = 0.5
+            lo, hi = 0.0, 0.25
             while ok(hi) and hi < 30:
                 lo, hi = hi, hi * 2.0
         else:
-            hi = 0.0
-            lo = -0.5
+            hi, lo = 0.0, -0.25
             while not ok(lo) and lo > -30:
                 hi, lo = lo, lo * 2.0
             if not ok(lo):
                 return None
-        for _ in range(40):
+        while hi - lo > 1e-4:
             mid = 0.5 * (lo + hi)
-            if ok(mid):
-                lo = mid
-            else:
-                hi = mid
-            if hi - lo < 1e-7:
-                break
+            lo, hi = (mid, hi) if ok(mid) else (lo, mid)
         y = x.copy()
-        y[0] += lo
-        y[1] += lo
+        y[:2] += lo
         return y
 
     def starts(self):
+        """Deterministic starts: AMIGO's gains and other shapes around them
+        (ki/kp, Td, N), each scaled to meet the bounds on the grid."""
         kp, ki, td = self.amigo_shape()
         if self.pi:
-            shapes = [(kp, ki), (kp, 2.0 * ki), (kp, 0.5 * ki), (kp, 4.0 * ki)]
-            xs = [np.log(sh) for sh in shapes]
+            xs = [np.log([kp, ki * f]) for f in (1.0, 2.0, 0.5, 4.0)]
         else:
-            xs = []
             td_a = min(td, self.td_max)
-            for tdf, nn, kif in ((1.0, 10.0, 1.0), (0.3, 5.0, 1.5), (3.0, 20.0, 1.0), (1.0, 40.0, 0.5),
-                                 (0.1, 3.0, 2.0)):
-                tdv = min(td_a * tdf, self.td_max)
-                xs.append(np.log([kp, ki * kif, tdv, nn]))
+            xs = [np.log([kp, ki * kif, min(td_a * tdf, self.td_max), nn])
+                  for tdf, nn, kif in ((1.0, 10.0, 1.0), (0.3, 5.0, 1.5), (3.0, 20.0, 1.0), (1.0, 40.0, 0.5),
+                                       (0.1, 3.0, 2.0), (1e3, 50.0, 1.0), (1.0, 50.0, 3.0))]
         out = []
         for x in xs:
+            x = np.clip(x, [b[0] for b in self.bounds()], [b[1] for b in self.bounds()])
             y = self.scale_to_bounds(x)
             if y is not None:
                 out.append(y)
         return out
 
     # -- the optimisation -----------------------------------------------
-    def solve_from(self, x0, win, w, maxiter=120):
-        """SLSQP from x0 with the window win and the constraint grid w.
-        Returns the best feasible (on w) stable x seen, and its IAE."""
+    def solve_from(self, x0, win, grid, maxiter=100):
+        """SLSQP from x0 with the window win and the constraint grid. The
+        best x seen that meets the constraints on the grid, is stable and
+        whose response the window holds (window_holds), and its IAE on win
+        (None, inf: none seen)."""
         best = [None, math.inf]
         cache = {}
 
@@ -575,87 +631,95 @@ class Problem:
             key = x.tobytes()
             if key not in cache:
                 self.evaluations += 1
-                cv, cj = self.constraints(x, w)
-                stable = self.stable_x(x, w)
+                cv, cj = self.constraints(x, grid)
+                stable = self.stable_x(x, grid)
                 if stable:
-                    iae, grad, _ = win.iae_and_grad(x, self.pi)
+                    iae, grad, y = win.iae_and_grad(x, self.pi)
                     f, fg = math.log(iae), grad / iae
-                else:
-                    iae, f, fg = math.inf, 50.0, np.zeros_like(x)
+                    held = window_holds(np.abs(y / win.growth))
+                else:  # a wall the line search backs off from
+                    iae, f, fg, held = math.inf, 50.0, np.zeros_like(x), False
                 cache.clear()
-                cache[key] = (f, fg, cv, cj, stable, iae)
-                if stable and np.min(cv) >= -1e-9 and iae < best[1]:
+                cache[key] = (f, fg, cv, cj)
+                if held and np.min(cv) >= -1e-9 and iae < best[1]:
                     best[0], best[1] = x.copy(), iae
             return cache[key]
 
-        lb = np.array([b[0] for b in self.bounds()])
-        ub = np.array([b[1] for b in self.bounds()])
-        x0 = np.clip(np.asarray(x0, float), lb, ub)
+        bnds = self.bounds()
+        x0 = np.clip(np.asarray(x0, float), [b[0] for b in bnds], [b[1] for b in bnds])
         ev(x0)
-        try:
-            optimize.minimize(lambda x: ev(x)[0], x0, jac=lambda x: ev(x)[1], method="SLSQP",
-                              bounds=self.bounds(),
-                              constraints=[dict(type="ineq", fun=lambda x: ev(x)[2], jac=lambda x: ev(x)[3])],
-                              options=dict(maxiter=maxiter, ftol=1e-10))
-        except (ValueError, FloatingPointError):
-            pass
+        with np.errstate(all="ignore"):
+            try:
+                optimize.minimize(lambda x: ev(x)[0], x0, jac=lambda x: ev(x)[1], method="SLSQP", bounds=bnds,
+                                  constraints=[dict(type="ineq", fun=lambda x: ev(x)[2], jac=lambda x: ev(x)[3])],
+                                  options=dict(maxiter=maxiter, ftol=1e-10))
+            except (ValueError, FloatingPointError, np.linalg.LinAlgError):
+                pass
         return best[0], best[1]
 
+    def run(self, x0, grid, maxiter=100, rounds=4):
+        """solve_from on the window fitted to the response of x0, then again
+        from its result on the window fitted to that, until the window stays
+        (within 20 %). Returns (x, IAE on the result's own fitted window) or
+        (None, inf)."""
+        x, fit = np.asarray(x0, float), self.fit_window(gains_of(x0, self.pi))
+        if fit is None:
+            return None, math.inf
+        found = None
+        for _ in range(rounds):
+            x2, _ = self.solve_from(x, self.window(*fit), grid, maxiter)
+            if x2 is None:
+                break
+            found = x = x2
+            fit2 = self.fit_window(gains_of(x, self.pi), fit[0])
+            if fit2 is None:
+                return None, math.inf
+            if abs(math.log(fit2[0] / fit[0])) <= 0.2:
+                break
+            fit = fit2
+        if found is None:
+            return None, math.inf
+        return found, self.iae(gains_of(found, self.pi), check=False)[0]
+
     def optimise(self, extra_starts=(), verbose=False):
-        """The reference optimum: dict(gains, iae, analysis, ...)."""
+        """The reference optimum: dict(gains, x, iae, analysis, starts,
+        evaluations), or None when no start meets the bounds."""
         starts = [np.asarray(x, float) for x in extra_starts] + self.starts()
-        if not starts:
-            return None
-        # The window, from the first start's response.
         results = []
         for x0 in starts:
-            g0 = gains_of(x0, self.pi)
-            fit = self.fit_window(g0)
-            if fit is None:
-                continue
-            win = self.window(*fit)
-            x, v = self.solve_from(x0, win, self.grid)
-            if x is None:
-                continue
-            # Re-fit the window at the optimum and polish once on it.
-            fit2 = self.fit_window(gains_of(x, self.pi), fit[0])
-            if fit2 is not None and abs(math.log(fit2[0] / fit[0])) > 0.3:
-                x2, v2 = self.solve_from(x, self.window(*fit2), self.grid)
-                if x2 is not None:
-                    x, v = x2, v2
-            results.append((v, x))
+            x, v = self.run(x0, self.grid)
+            if x is not None:
+                results.append((v, x))
             if verbose:
-                print("  start", np.exp(x0), "->", gains_of(x, self.pi), v, file=sys.stderr)
+                print("  start", gains_of(x0, self.pi), "->", x is not None and gains_of(x, self.pi), v,
+                      file=sys.stderr)
         if not results:
             return None
         results.sort(key=lambda r: r[0])
         v, x = results[0]
-        # Exchange: the refined peaks' frequencies join the grid, and re-solve.
+        # Exchange: the dense analysis's peak frequencies join the grid.
         grid = self.grid
         for _ in range(3):
             g = gains_of(x, self.pi)
-            a = self.peaks(g)
-            if self.violation(dict(a, td=g["kd"] / g["kp"] if g["kd"] else 0.0,
-                                   n=(g["kd"] / g["kp"] / g["tf"]) if g["kd"] else math.inf)) <= 1e-6:
+            a = self.analyse(g, with_iae=False)
+            if self.violation(a) <= self.VIOLATION_TOL:
                 break
-            extra = [a[k] for k in ("ms_rad_s", "mt_rad_s", "noise_rad_s") if np.isfinite(a[k])]
-            grid = np.unique(np.concatenate([grid, extra, np.array(extra) * (1 - 1e-4), np.array(extra) * (1 + 1e-4)]))
-            fit = self.fit_window(g)
-            x2, v2 = self.solve_from(x, self.window(*fit), grid, maxiter=40)
+            grid = grid.with_points([a[k] for k in ("ms_rad_s", "mt_rad_s", "noise_gain_rad_s")
+                                     if np.isfinite(a[k])])
+            x2, v2 = self.run(x, grid, maxiter=50)
             if x2 is not None:
                 x, v = x2, v2
-        # Scale back until the refined peaks meet the bounds.
+        # Scale back (all gains x f) until the dense analysis meets the bounds.
         g = gains_of(x, self.pi)
-        a = self.analyse(g)
+        a = self.analyse(g, with_iae=False)
         f = 1.0
-        while self.violation(a) > 1e-6 and f > 0.5:
-            f *= 0.999
-            gs = dict(g, kp=g["kp"] * f, ki=g["ki"] * f, kd=g["kd"] * f)
-            a = self.analyse(gs)
-            if self.violation(a) <= 1e-6:
-                g = gs
-                break
-        return dict(gains=g, iae=a["iae"], analysis=a, evaluations=self.evaluations)
+        while self.violation(a) > self.VIOLATION_TOL and f > 0.5:
+            f *= 0.9995
+            g = dict(gains_of(x, self.pi))
+            g.update(kp=g["kp"] * f, ki=g["ki"] * f, kd=g["kd"] * f)
+            a = self.analyse(g, with_iae=False)
+        a = self.analyse(g)
+        return dict(gains=g, iae=a["iae"], analysis=a, starts=len(starts), evaluations=self.evaluations)
 
 
 def main(argv):
