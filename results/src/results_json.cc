@@ -148,6 +148,7 @@ void AddDesign(const tune::DesignSummary& d, nlohmann::json* j) {
                     {"overshoot_unit_weights_pct", JsonNumber(d.overshoot_unit_weights_pct)},
                     {"overshoot_met", d.overshoot_met},
                     {"setpoint_note", d.setpoint_note},
+                    {"front_note", d.front_note},
                     {"evaluations", d.evaluations},
                     {"message", d.message}};
   (*j)["response_time_s"] = JsonNumber(d.response_time_s);

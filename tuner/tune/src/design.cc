@@ -130,7 +130,7 @@ double HighestCrossover(const analysis::LoopAnalysis& a) {
 // The front's point whose crossover is `w`: bisection on the Ms bound in
 // [kFrontMinMs, ms_cap]. kInvalidInput naming the reachable range.
 Status OnTheFront(const Plant& plant, const design::Engine& engine, const design::Bounds& b, double w,
-                  design::Optimum* o, analysis::LoopAnalysis* a, double* ms_bound) {
+                  design::Optimum* o, analysis::LoopAnalysis* a, double* ms_bound, std::string* note) {
   design::Optimum lo_o, hi_o;
   analysis::LoopAnalysis lo_a, hi_a;
   double lo = kFrontMinMs, hi = b.ms;
@@ -150,13 +150,23 @@ Status OnTheFront(const Plant& plant, const design::Engine& engine, const design
   *o = std::abs(w - w_lo) < std::abs(w - w_hi) ? lo_o : hi_o;
   *a = std::abs(w - w_lo) < std::abs(w - w_hi) ? lo_a : hi_a;
   *ms_bound = std::abs(w - w_lo) < std::abs(w - w_hi) ? lo : hi;
-  for (int i = 0; i < 30 && std::abs(HighestCrossover(*a) / w - 1.0) > 0.005; ++i) {
+  for (int i = 0; i < 30 && std::abs(HighestCrossover(*a) / w - 1.0) > 0.005 && hi - lo > 1e-4; ++i) {
     const double mid = 0.5 * (lo + hi);
     design::Optimum m;
     analysis::LoopAnalysis ma;
     if (!FrontPoint(plant, engine, b, mid, o->shape, &m, &ma)) break;
     (HighestCrossover(ma) < w ? lo : hi) = mid;
-    *o = m, *a = ma, *ms_bound = mid;
+    if (std::abs(HighestCrossover(ma) / w - 1.0) < std::abs(HighestCrossover(*a) / w - 1.0))
+      *o = m, *a = ma, *ms_bound = mid;
+  }
+  // The front can jump (another optimum takes over between two bounds):
+  // the nearest point, said so.
+  if (std::abs(HighestCrossover(*a) / w - 1.0) > 0.01) {
+    std::ostringstream os;
+    os << "the optimal front jumps past crossover " << FormatNumber(w) << " rad/s near Ms "
+       << FormatNumber(*ms_bound) << ": the nearest design crosses over at "
+       << FormatNumber(HighestCrossover(*a)) << " rad/s";
+    *note = os.str();
   }
   return Status::Ok();
 }
@@ -297,8 +307,11 @@ Status DesignOn(const Plant& plant, const design::Engine& engine, const DesignOp
   design::Optimum o;
   analysis::LoopAnalysis a;
   double ms_bound = b.ms;
+  std::string front_note;
   if (options.crossover_rad_s > 0.0) {
-    if (const Status st = OnTheFront(plant, engine, b, options.crossover_rad_s, &o, &a, &ms_bound); !st.ok())
+    if (const Status st =
+            OnTheFront(plant, engine, b, options.crossover_rad_s, &o, &a, &ms_bound, &front_note);
+        !st.ok())
       return st;
   } else if (sampled ? !SampledPoint(plant, engine, b, b.ms, warm, &o, &a)
                      : !FrontPoint(plant, engine, b, b.ms, warm, &o, &a)) {
@@ -318,6 +331,7 @@ Status DesignOn(const Plant& plant, const design::Engine& engine, const DesignOp
   s.response_time_s = s.crossover_rad_s > 0.0 ? 2.0 / s.crossover_rad_s : 0.0;
   s.phase_margin_deg = a.phase_margin_deg;
   s.ms_bound = ms_bound;
+  s.front_note = front_note;
   s.mt_bound = b.mt;
   s.noise_gain_bound = b.noise_gain;
   s.td_bound_s = b.td_max_s;

@@ -107,6 +107,9 @@ struct DesignSummary {
   /// The constraints within 1 % of their bound at the optimum: "ms", "mt",
   /// "noise_gain", "td".
   std::vector<std::string> active;
+  /// A crossover asked for that the front does not reach within 1 % (it
+  /// jumps there: another optimum takes over): the nearest design, said so.
+  std::string front_note;
   /// Candidates evaluated (each a load-step simulation).
   int evaluations = 0;
   /// One line: the engine, the bounds, the gains and the load IAE.
