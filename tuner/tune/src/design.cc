@@ -220,11 +220,13 @@ void ShapeSetpoint(const Plant& plant, const design::Engine& engine, const Desig
   double aim = target;
   for (int i = 0; i < 8; ++i) {
     design::SetpointStage(engine, aim, s);
+    // The stage's own least overshoot is above its aim: no lower aim helps.
+    const bool reachable = s->overshoot_met;
     const double exact = ExactOvershoot(plant, *s, options.loop);
     if (std::isnan(exact)) return;
     s->overshoot_pct = exact;
     s->overshoot_met = exact <= target + 1e-9;
-    if (s->overshoot_met || !std::isfinite(target) || aim <= 0.0) break;
+    if (s->overshoot_met || !reachable || !std::isfinite(target) || aim <= 0.0) break;
     aim = std::max(0.0, aim - 1.5 * (exact - target) - 0.05);
   }
   if (s->overshoot_met) s->setpoint_note.clear();
