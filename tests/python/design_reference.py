@@ -20,27 +20,41 @@ bisection on kp). Here everything is done in the frequency domain:
   y(t_k) e^(-sigma t_k) = (1/T) sum_n Y(sigma + j w_n) e^(j w_n t_k), w_n =
   2 pi n / T, which is exactly the periodised y(t) e^(-sigma t) (Poisson's
   summation formula) truncated at the Nyquist frequency. The dead time is the
-  exact e^(-sL) of the transform. T is chosen per design so that the tail
-  past T is negligible (checked), sigma = 4 / T damps what wraps around; the
-  IAE is the rectangle (periodic trapezoid) sum of |y_k|. Its gradient in the
-  parameters is exact for that sum: dY = -P^2 S^2 dC / s, one more FFT each.
-* Ms, Mt and the noise gain on a frequency grid (a log grid plus a linear
-  grid up to where Gn |G(jw)| < 0.05, spacing a 60th of the delay's ripple
-  2 pi / L), with the analytic high-frequency limit of |C S| (kp + kd/tf)
-  added, each local maximum refined by a bounded scalar search for the
-  reported peaks.
+  exact e^(-sL) of the transform. The window T is fitted to each design (the
+  response died out by 0.6 T, checked), sigma = 4 / T damps what wraps
+  around; the IAE is the rectangle (periodic trapezoid) sum of |y_k|, 2^15
+  samples (the search: 2^14), reported on 4 x 2^15 with the changes on a
+  window twice as long and on 4x the samples (about 1e-6 here; against
+  scipy.signal.step of the rational loop without dead time, 1e-9). Its
+  gradient in the parameters is exact for that sum (dY = -Y P S dC, by the
+  adjoint of the inverse FFT: one more FFT).
+* Ms, Mt and the noise gain on a frequency grid (Grid): 1 + L itself on a
+  log grid, a linear grid around the plant's phase crossover and, with a
+  dead time, a linear grid resolving the ripple of e^(-jwL) (30 points per
+  2 pi / L; 60 for the reported peaks) up to 60/L (2000/L); above that,
+  where the phase of e^(-jwL) turns through 2 pi in a few per cent of w, the
+  envelope over that phase (|S| <= 1/(1-|L|), ...), tight there. The
+  high-frequency limit of |C S| (kp + kd/tf) is a constraint of its own; the
+  reported peaks refine each local maximum by a bounded scalar search.
 * Stability by the Nyquist criterion: the winding of 1 + C P around 0 along
   the imaginary axis (indented to the right of the integrators at s = 0),
   unwrapped on the grid; the plants taken are open-loop stable apart from
-  poles at the origin, so the closed loop is stable iff the winding is 0.
+  poles at the origin, so the closed loop is stable iff the winding is 0
+  (and |L| < 0.9 where the grid uses the envelope).
 * The optimum by scipy's SLSQP in x = log(kp, ki, Td, N) (PI: log(kp, ki))
   with the peaks at every grid point as smooth inequality constraints
   (log M - log|S(j w_i)| >= 0, ...; analytic Jacobians), Td and N as box
-  bounds, from several deterministic starts (the AMIGO rule's gains on a
-  first-order-plus-dead-time model from the plant's moments, and other
-  shapes, each scaled to meet the bounds); then an exchange step adds the
-  refined peak frequencies to the grid and re-solves, and the best design is
-  scaled back (gains x c <= 1) until the refined peaks meet the bounds.
+  bounds, from seven deterministic starts (the AMIGO rule's PID on a
+  first-order-plus-dead-time model by the method of areas, or on an
+  integrator-plus-dead-time model, and six other shapes of ki/kp, Td and N,
+  each scaled in gain to meet the bounds), plus any given (the test passes
+  the optimum at the other noise bound); each start is scouted for 25
+  iterations, the best two polished to convergence, every SLSQP run redone
+  on the window of its result until the window stays. Then an exchange step
+  adds the dense grid's peak frequencies to the grid and re-solves, and the
+  design is scaled back (all gains x f < 1) until the dense analysis meets
+  the bounds within 1e-5. Checked against 40 random starts on 21 of the
+  test's cases: the same optimum within 0.02 %.
 
 Usage:
   design_reference.py --num 1 --den 1,3,3,1 [--delay 0] --ms 1.59 --noise 25 [--pi]
@@ -53,12 +67,10 @@ import argparse
 import json
 import math
 import sys
+import warnings
 
 import numpy as np
 from scipy import optimize, signal
-
-SQRT_EPS = 1e-12
-
 
 # --------------------------------------------------------------------------
 # The plant.
@@ -97,8 +109,8 @@ class Plant:
         tcs = [-1.0 / p.real for p in self.poles if p.real < 0.0 and abs(p) > 1e-12]
         if tcs:
             return max(tcs)
-        # No stable pole: the delay (the only time the plant has).
-        return max(self.delay, 1.0)
+        # No stable pole: the slowest of its times (the delay, the zeros').
+        return self.time_scales()[1]
 
     def time_scales(self):
         """(fast, slow): the fastest and slowest of the delay and the poles'
@@ -192,6 +204,8 @@ class Window:
         self.t = np.arange(self.n) * self.h
         self.growth = np.exp(self.sigma * self.t)
         self.scale = self.n / self.T
+        self.adjoint_weights = np.full(self.n // 2 + 1, 2.0)
+        self.adjoint_weights[0] = self.adjoint_weights[-1] = 1.0
 
     def y_of_c(self, c):
         return self.y_of_transform(self.p / (1.0 + c * self.p) / self.s)
@@ -200,13 +214,19 @@ class Window:
         return np.fft.irfft(yt, n=self.n, axis=-1) * self.scale * self.growth
 
     def iae_and_grad(self, x, pi):
+        """The IAE h sum |y_k| and its gradient in x (exact for the sum):
+        with dY_i = -Y P S dC/dx_i and y = a irfft(Y) (a = scale x growth),
+        dIAE_i = h sum_k sign(y_k) a_k irfft(dY_i)_k, by the adjoint of the
+        inverse real FFT: (1/n) Re sum_m c_m dY_i,m conj(W_m), W = rfft(w),
+        w = h a sign(y), c_m = 2 but 1 at m = 0 and n/2."""
         c, dc = c_and_grad(x, self.s, pi)
         sens = 1.0 / (1.0 + c * self.p)
         yt = self.p * sens / self.s
         y = self.y_of_transform(yt)
         iae = self.h * np.sum(np.abs(y))
-        dy = self.y_of_transform(-(yt * self.p * sens)[None, :] * dc)
-        grad = self.h * (dy @ np.sign(y))
+        wt = np.fft.rfft(self.h * self.scale * self.growth * np.sign(y))
+        wt *= self.adjoint_weights
+        grad = np.real((-(yt * self.p * sens)[None, :] * dc) @ np.conj(wt)) / self.n
         return iae, grad, y
 
     def iae_of_gains(self, g):
@@ -256,14 +276,23 @@ class Grid:
                                    max(int(per_decade * math.log10(w_hi / w_env)), 10))[1:]
         else:
             self.env = np.zeros(0)
+        self._plant_values(plant)
 
-    def with_points(self, extra):
+    def _plant_values(self, plant):
+        """The plant's G(s) e^(-sL) on the grid, once."""
+        self.s_semi = self.eps * np.exp(1j * np.linspace(-np.pi / 2, np.pi / 2, 181))
+        self.p_semi = plant.g(self.s_semi)
+        self.s_exact, self.s_env = 1j * self.exact, 1j * self.env
+        self.p_exact, self.p_env = plant.g(self.s_exact), plant.g(self.s_env)
+
+    def with_points(self, plant, extra):
         """A copy with more exact points (those below the envelope's start)."""
         g = Grid.__new__(Grid)
         g.eps, g.env = self.eps, self.env
         top = self.exact[-1]
         extra = np.asarray([v for v in extra if 0 < v < top])
         g.exact = np.unique(np.concatenate([self.exact, extra, extra * (1 - 1e-4), extra * (1 + 1e-4)]))
+        g._plant_values(plant)
         return g
 
 
@@ -277,19 +306,15 @@ def winding_unstable(c_fn, plant, grid):
     it, in the envelope grid, |L| < 0.9 is required (so 1 + L stays in the
     right half plane: no more turns). Returns (Z, ok), ok false when the grid
     is too coarse to unwrap the phase or |L| is not small beyond it."""
-    phi = np.linspace(-np.pi / 2, np.pi / 2, 181)
-    s_semi = grid.eps * np.exp(1j * phi)
-    f_semi = 1.0 + c_fn(s_semi) * plant.g(s_semi)
-    s_up = 1j * grid.exact
-    f_up = 1.0 + c_fn(s_up) * plant.g(s_up)
+    f_semi = 1.0 + c_fn(grid.s_semi) * grid.p_semi
+    f_up = 1.0 + c_fn(grid.s_exact) * grid.p_exact
     a_semi = np.unwrap(np.angle(f_semi))
     a_up = np.unwrap(np.angle(f_up))
     steps = np.abs(np.diff(a_up))
     ok = len(steps) == 0 or np.max(steps) < 0.75 * np.pi
     ok = ok and np.max(np.abs(np.diff(a_semi))) < 0.75 * np.pi
     if len(grid.env):
-        s_env = 1j * grid.env
-        ok = ok and np.max(np.abs(c_fn(s_env) * plant.g(s_env))) < 0.9
+        ok = ok and np.max(np.abs(c_fn(grid.s_env) * grid.p_env)) < 0.9
     else:
         ok = ok and abs(f_up[-1] - 1.0) < 0.9
     # j w_top -> j inf: 1 + L -> 1 inside the right half plane.
@@ -342,6 +367,8 @@ def window_holds(az):
 
 class Problem:
     VIOLATION_TOL = 1e-5
+    SEARCH_N = 1 << 14  # samples of the search's windows (the reported IAE: 4 x 2^15)
+    SCOUT_ITER = 25  # SLSQP iterations from each start before the best two are polished
 
     def __init__(self, plant, ms=1.59, mt=None, noise=np.inf, pi=False, td_max=None):
         self.plant = plant
@@ -362,11 +389,11 @@ class Problem:
     # -- the load response ---------------------------------------------
     def window(self, T, n):
         key = (round(math.log(T), 9), n)
-        if key not in self._windows:
-            if len(self._windows) > 6:
-                self._windows.clear()
-            self._windows[key] = Window(self.plant, T, n)
-        return self._windows[key]
+        win = self._windows.pop(key, None) or Window(self.plant, T, n)
+        self._windows[key] = win  # the most recent last
+        while len(self._windows) > 24:
+            self._windows.pop(next(iter(self._windows)))
+        return win
 
     def fit_window(self, g, T=None, n=1 << 15):
         """A window (T, n) that holds the load response of g: judged on
@@ -436,14 +463,15 @@ class Problem:
             c, l = parts(wv)
             return abs(c / (1.0 + l))
 
-        c, l = parts(grid.exact)
+        c = c_of_gains(g, grid.s_exact)
+        l = c * grid.p_exact
         out = {}
         for name, fn, vals in (("ms", s_at, np.abs(1.0 / (1.0 + l))), ("mt", t_at, np.abs(l / (1.0 + l))),
                                ("noise_gain", n_at, np.abs(c / (1.0 + l)))):
             out[name], out[name + "_rad_s"] = refine_peak(fn, grid.exact, vals)
         if len(grid.env):
-            c, l = parts(grid.env)
-            al = np.abs(l)
+            c = c_of_gains(g, grid.s_env)
+            al = np.abs(c * grid.p_env)
             gap = np.maximum(1.0 - al, 1e-300)
             for name, vals in (("ms", 1.0 / gap), ("mt", al / gap), ("noise_gain", np.abs(c) / gap)):
                 i = int(np.argmax(vals))
@@ -487,9 +515,8 @@ class Problem:
         vals, jac = [], []
         lms, lmt = math.log(self.ms), math.log(self.mt)
         lgn = math.log(self.noise) if np.isfinite(self.noise) else None
-        s = 1j * grid.exact
-        c, dc = c_and_grad(x, s, self.pi)
-        p = self.plant.g(s)
+        c, dc = c_and_grad(x, grid.s_exact, self.pi)
+        p = grid.p_exact
         l = c * p
         f = 1.0 + l
         dlogf = np.real(dc * p[None, :] / f[None, :]).T  # d log|1+L|
@@ -501,9 +528,8 @@ class Problem:
             vals.append(lgn - np.log(np.abs(c)) + logf)
             jac.append(dlogf - dlogc)
         if len(grid.env):
-            s = 1j * grid.env
-            c, dc = c_and_grad(x, s, self.pi)
-            al = np.abs(c * self.plant.g(s))
+            c, dc = c_and_grad(x, grid.s_env, self.pi)
+            al = np.abs(c * grid.p_env)
             dlogc = np.real(dc / c[None, :]).T
             gap = np.maximum(1.0 - al, 1e-12)
             loggap = np.log(gap)
@@ -648,7 +674,8 @@ class Problem:
         bnds = self.bounds()
         x0 = np.clip(np.asarray(x0, float), [b[0] for b in bnds], [b[1] for b in bnds])
         ev(x0)
-        with np.errstate(all="ignore"):
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # SLSQP's "clipping to bounds"
             try:
                 optimize.minimize(lambda x: ev(x)[0], x0, jac=lambda x: ev(x)[1], method="SLSQP", bounds=bnds,
                                   constraints=[dict(type="ineq", fun=lambda x: ev(x)[2], jac=lambda x: ev(x)[3])],
@@ -662,7 +689,7 @@ class Problem:
         from its result on the window fitted to that, until the window stays
         (within 20 %). Returns (x, IAE on the result's own fitted window) or
         (None, inf)."""
-        x, fit = np.asarray(x0, float), self.fit_window(gains_of(x0, self.pi))
+        x, fit = np.asarray(x0, float), self.fit_window(gains_of(x0, self.pi), n=self.SEARCH_N)
         if fit is None:
             return None, math.inf
         found = None
@@ -671,7 +698,7 @@ class Problem:
             if x2 is None:
                 break
             found = x = x2
-            fit2 = self.fit_window(gains_of(x, self.pi), fit[0])
+            fit2 = self.fit_window(gains_of(x, self.pi), fit[0], n=self.SEARCH_N)
             if fit2 is None:
                 return None, math.inf
             if abs(math.log(fit2[0] / fit[0])) <= 0.2:
@@ -682,17 +709,32 @@ class Problem:
         return found, self.iae(gains_of(found, self.pi), check=False)[0]
 
     def optimise(self, extra_starts=(), verbose=False):
-        """The reference optimum: dict(gains, x, iae, analysis, starts,
+        """The reference optimum: dict(gains, iae, analysis, starts,
         evaluations), or None when no start meets the bounds."""
         starts = [np.asarray(x, float) for x in extra_starts] + self.starts()
-        results = []
+        # Scout from every start, then polish the best two distinct ones.
+        scouts = []
         for x0 in starts:
-            x, v = self.run(x0, self.grid)
+            x, v = self.run(x0, self.grid, maxiter=self.SCOUT_ITER, rounds=2)
             if x is not None:
-                results.append((v, x))
+                scouts.append((v, x))
             if verbose:
                 print("  start", gains_of(x0, self.pi), "->", x is not None and gains_of(x, self.pi), v,
                       file=sys.stderr)
+        scouts.sort(key=lambda r: r[0])
+        chosen = []
+        for v, x in scouts:
+            if all(np.max(np.abs(x - y)) > 1e-3 for _, y in chosen):
+                chosen.append((v, x))
+            if len(chosen) == 2:
+                break
+        results = []
+        for v0, x0 in chosen:
+            x, v = self.run(x0, self.grid)
+            results.append((v, x) if x is not None and v <= v0 else (v0, x0))
+            if verbose:
+                print("  polish", gains_of(x0, self.pi), v0, "->", gains_of(results[-1][1], self.pi),
+                      results[-1][0], file=sys.stderr)
         if not results:
             return None
         results.sort(key=lambda r: r[0])
@@ -704,7 +746,7 @@ class Problem:
             a = self.analyse(g, with_iae=False)
             if self.violation(a) <= self.VIOLATION_TOL:
                 break
-            grid = grid.with_points([a[k] for k in ("ms_rad_s", "mt_rad_s", "noise_gain_rad_s")
+            grid = grid.with_points(self.plant, [a[k] for k in ("ms_rad_s", "mt_rad_s", "noise_gain_rad_s")
                                      if np.isfinite(a[k])])
             x2, v2 = self.run(x, grid, maxiter=50)
             if x2 is not None:

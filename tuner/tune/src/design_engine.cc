@@ -252,10 +252,16 @@ double Engine::MaxKp(const Eigen::VectorXd& shape, const Bounds& bounds, double 
     }
     bad = k.back();
   }
-  for (std::size_t i = 1; !(kp > 0.0) && i + 1 < v.size(); ++i) {
+  // The dips above the first feasible gain too (its band may be a slower
+  // one below a narrow faster band: the corner where Ms and Mt meet).
+  const std::size_t scanned = v.size();
+  for (std::size_t i = 1; i + 1 < scanned; ++i) {
     if (!(v[i] <= v[i - 1] && v[i] <= v[i + 1] && v[i] < 1.3)) continue;
     double at = 0.0;
-    if (LeastViolation(scan, k[i + 1], k[i - 1], &at) <= 1.0 && scan.Stable(at)) kp = at, bad = k[i - 1];
+    if (LeastViolation(scan, k[i + 1], k[i - 1], &at) <= 1.0 && scan.Stable(at) && at > kp) {
+      kp = at, bad = k[i - 1];
+      break;
+    }
   }
   if (!(kp > 0.0)) {
     if (least_violation) *least_violation = *std::min_element(v.begin(), v.end());
