@@ -9,6 +9,7 @@
 
 #include "design_engine.h"
 #include "pidlab/analysis/loop_analysis.h"
+#include "pidlab/evaluation/evaluation.h"
 #include "pidlab/spec/field.h"
 #include "pidlab/tune/migo.h"
 
