@@ -157,7 +157,7 @@ async function knobDesign() {
     const dt = suggestDt(result);  // the firmware's dt offered for this design
     if (dt) $('fw-dt').value = dt;
     showKnob();
-    $('knob-status').textContent = 'pidlab tune ' + Object.entries(knobValues()).map(([a, b]) => '--' + a.replace('_', '-') + ' ' + b).join(' ');
+    $('knob-status').textContent = 'pidlab tune --method migo ' + Object.entries(knobValues()).map(([a, b]) => '--' + a.replace('_', '-') + ' ' + b).join(' ');
     return result;
   }).catch((e) => {
     if (!known && /migo/.test(e.message)) k.designs.set(key, { error: e.message });  // migo's refusal of this position

@@ -118,6 +118,7 @@ async function main() {
   };
   const compareWithTune = (got) => {
     const flags = ['tune', '--plant', got.spec.plant, '--json'];
+    if (got.spec.method) flags.push('--method', got.spec.method);  // the page's knobs: migo
     if (got.spec.plant === 'custom') flags.push('--num', got.spec.num.join(','), '--den', got.spec.den.join(','));
     if (got.spec.delay) flags.push('--delay', String(got.spec.delay));
     if (got.spec.response_time) flags.push('--response-time', String(got.spec.response_time));
