@@ -240,7 +240,7 @@ MotorGainSet PaperSet(const PidGains& paper_nm) {
 
 // `pidlab tune --plant stepper_motor --method multi-start --seed <seed>`'s
 // options: the paper's objective and box, asked for explicitly (the default
-// method on eq. (3) is migo since wave 4).
+// method on eq. (3) is the design engine, optimal, since issue 57).
 TuneOptions Eq3TuneOptions(bool quick, std::uint64_t seed) {
   TuneOptions d;
   d.seed = seed;
@@ -261,7 +261,7 @@ bool DefaultSet(const Plant& eq3, const TuneOptions& d, std::uint64_t seed, Moto
   set->origin = "`pidlab tune --plant stepper_motor --method multi-start --seed " + std::to_string(seed) +
                 "` (" + ToString(d.method) +
                 " on eq. (3), the paper's continuous loop and objective, asked for explicitly: the default "
-                "method is migo; IAE " +
+                "method is the design engine, optimal; IAE " +
                 Num(ds.objective, 6) + ").";
   return true;
 }

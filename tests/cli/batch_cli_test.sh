@@ -61,7 +61,7 @@ PY"
 # The search box of a custom plant: (s + 1)^3 has AMIGO's FOPDT T = L = 1.5,
 # kp = 0.65, so the box is [0, 6.5]; the spec echoes it and runs again to the
 # same numbers; --bounds overrides it. (The box is the searching methods': a custom
-# plant's default method is migo, which searches no box.)
+# plant's default method is the design engine, which searches no box.)
 "$pidlab" tune --num 1 --den 1,3,3,1 --method multi-start --max-evals 200 --json > "$tmp/box.json"
 check "tune on (s + 1)^3 takes the box [0, 6.5] from the plant and echoes it" "python3 - $tmp/box.json <<'PY'
 import json, sys

@@ -14,6 +14,7 @@
 #include <cmath>
 
 #include "pidlab/optim/nelder_mead.h"
+#include "pidlab/plant_sim/polynomial.h"
 #include "pidlab/tune/migo.h"
 #include "pidlab/tune/tuning_rules.h"
 
@@ -182,19 +183,13 @@ class GainScan {
                                          : std::vector<double>{g.kp, g.ki};
     const std::vector<double> s =
         filter ? std::vector<double>{g.tf, 1.0, 0.0} : std::vector<double>{1.0, 0.0};
-    std::vector<double> p = Multiply(rational_->tf.den, s);
-    const std::vector<double> q = Multiply(rational_->tf.num, c);
+    std::vector<double> p = PolynomialProduct(rational_->tf.den, s);
+    const std::vector<double> q = PolynomialProduct(rational_->tf.num, c);
     for (std::size_t i = 0; i < q.size(); ++i) p[p.size() - q.size() + i] += q[i];
     while (p.size() > 1 && p.front() == 0.0) p.erase(p.begin());
     for (const cd& r : PolynomialRoots(p))
       if (!(r.real() < 0.0)) return false;
     return true;
-  }
-  static std::vector<double> Multiply(const std::vector<double>& a, const std::vector<double>& b) {
-    std::vector<double> r(a.size() + b.size() - 1, 0.0);
-    for (std::size_t i = 0; i < a.size(); ++i)
-      for (std::size_t j = 0; j < b.size(); ++j) r[i + j] += a[i] * b[j];
-    return r;
   }
 
   const FrequencyGrid& grid_;
