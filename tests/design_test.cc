@@ -208,11 +208,30 @@ TEST(Design, ANoiseBoundIsHonouredAndCostsLoadIae) {
   EXPECT_NE(std::find(bound.active.begin(), bound.active.end(), "noise_gain"), bound.active.end());
 }
 
-TEST(Design, RefusesAReverseActingPlantANonlinearOneAndBadOptionsInOneLine) {
+TEST(Design, AReverseActingPlantGetsTheNegatedGainsOfItsMirrorWithTheSameLoop) {
+  const Plant reverse = MakeTf("reverse", {-19.0}, {2.0, 1.0}, 0.5);
+  const Plant mirror = MakeTf("mirror", {19.0}, {2.0, 1.0}, 0.5);
+  const DesignSummary r = DesignOrDie(reverse, DesignOptions{});
+  const DesignSummary m = DesignOrDie(mirror, DesignOptions{});
+  EXPECT_TRUE(r.reverse_acting);
+  EXPECT_FALSE(m.reverse_acting);
+  EXPECT_NE(r.message.find("acts in reverse"), std::string::npos) << r.message;
+  EXPECT_EQ(r.gains.kp, -m.gains.kp);
+  EXPECT_EQ(r.gains.ki, -m.gains.ki);
+  EXPECT_EQ(r.gains.kd, -m.gains.kd);
+  EXPECT_EQ(r.gains.tf, m.gains.tf);
+  EXPECT_LT(r.gains.kp, 0.0);
+  // The exact analysis of the reverse loop is the mirror's.
+  const analysis::LoopAnalysis a = Analyse(reverse, r.gains), b = Analyse(mirror, m.gains);
+  EXPECT_TRUE(a.stable);
+  EXPECT_NEAR(a.ms, b.ms, 1e-12);
+  EXPECT_NEAR(a.noise_gain, b.noise_gain, 1e-9 * b.noise_gain);
+  EXPECT_NEAR(LibraryLoadIae(reverse, r.gains, 60.0, 6000), LibraryLoadIae(mirror, m.gains, 60.0, 6000), 1e-9);
+}
+
+TEST(Design, RefusesANonlinearPlantAndBadOptionsInOneLine) {
   DesignSummary s;
-  Status st = DesignOptimal(MakeTf("reverse", {-19.0}, {2.0, 1.0}, 0.5), DesignOptions{}, &s);
-  ASSERT_FALSE(st.ok());
-  EXPECT_NE(st.message().find("acts in reverse"), std::string::npos);
+  Status st = Status::Ok();
   DesignOptions bad;
   bad.max_ms = 0.9;
   st = DesignOptimal(Cube(), bad, &s);

@@ -409,10 +409,24 @@ std::string GenerateError(const Options& o, const Controller& c) {
   return "";
 }
 
-TEST(Generate, ThrowsNamingANegativeGain) {
+TEST(Generate, ThrowsNamingGainsThatDifferInSign) {
   Controller c;
   c.gains.kp = -2.0;
+  c.gains.ki = 1.0;
   EXPECT_NE(GenerateError(Options{}, c).find("kp = -2"), std::string::npos) << GenerateError(Options{}, c);
+}
+
+TEST(Generate, TakesAReverseActingPidInDoubleAndRefusesItInFixedPointInOneLine) {
+  Controller c;
+  c.gains = {-2.0, -1.0, -0.1, 0.01};
+  c.pid.output_min = -1.0;
+  c.pid.output_max = 1.0;
+  EXPECT_EQ(GenerateError(Options{}, c), "");
+  Options q;
+  q.scalar = Scalar::kQ31;
+  const std::string e = GenerateError(q, c);
+  EXPECT_NE(e.find("reverse-acting"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
 
 TEST(Generate, ThrowsNamingASetpointWeightOutsideZeroOne) {

@@ -289,10 +289,40 @@ TEST(PidOptions, RejectsAZeroBackCalculationGain) {
   EXPECT_NE(error.find("back-calculation gain 0"), std::string::npos) << error;
 }
 
-TEST(PidGains, RejectsANegativeKp) {
+TEST(PidGains, RejectsGainsThatDifferInSign) {
   std::string error;
-  EXPECT_FALSE(GainsAreValid({-1.0, 0.0, 0.0}, &error));
+  EXPECT_FALSE(GainsAreValid({-1.0, 0.5, 0.0}, &error));
   EXPECT_NE(error.find("kp = -1"), std::string::npos) << error;
+  EXPECT_NE(error.find("differ in sign"), std::string::npos) << error;
+}
+
+TEST(PidGains, AcceptsGainsAllAtMostZeroForAReverseActingPlant) {
+  std::string error;
+  EXPECT_TRUE(GainsAreValid({-1.0, -0.5, -0.1, 0.01}, &error)) << error;
+  EXPECT_TRUE(GainsAreReverse({-1.0, 0.0, 0.0}));
+  EXPECT_FALSE(GainsAreReverse({1.0, 0.0, 0.0}));
+  EXPECT_FALSE(GainsAreValid({-1.0, -0.5, -0.1, -0.01}, &error));
+  EXPECT_NE(error.find("tf"), std::string::npos) << error;
+}
+
+TEST(DiscretePid, AReverseActingPidOnANegatedErrorGivesTheNegatedOutputBitForBitUnderClamping) {
+  // The mirror: gains -g on the error e give -(u of gains g on e), with the
+  // clamping anti-windup's choices the same under mirrored limits.
+  PidOptions o = Options(0.01);
+  o.output_min = -0.4;
+  o.output_max = 0.4;
+  o.anti_windup = AntiWindup::kClamping;
+  o.derivative_filter_s = 0.02;
+  DiscretePid<double> direct({2.0, 3.0, 0.1}, o), reverse({-2.0, -3.0, -0.1}, o);
+  int saturated = 0;
+  for (int k = 0; k < 400; ++k) {
+    const double y = 0.3 * std::sin(0.05 * k) + (k > 200 ? 0.5 : 0.0);
+    double u = 0.0, v = 0.0;
+    ASSERT_EQ(direct.Step(1.0, y, &u), reverse.Step(1.0, y, &v)) << "step " << k;
+    ASSERT_EQ(v, -u) << "step " << k;
+    saturated += std::fabs(u) == 0.4;
+  }
+  EXPECT_GT(saturated, 10);
 }
 
 TEST(PidGains, RejectsANanKi) {

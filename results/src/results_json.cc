@@ -149,6 +149,10 @@ void AddDesign(const tune::DesignSummary& d, nlohmann::json* j) {
                     {"overshoot_met", d.overshoot_met},
                     {"setpoint_note", d.setpoint_note},
                     {"front_note", d.front_note},
+                    {"reverse_acting", d.reverse_acting},
+                    {"reverse_note", d.reverse_acting ? "the loop acts in reverse: the plant's gain is negative, "
+                                                        "so are kp, ki and kd (u = kp e + ...)"
+                                                      : ""},
                     {"evaluations", d.evaluations},
                     {"message", d.message}};
   (*j)["response_time_s"] = JsonNumber(d.response_time_s);

@@ -1,8 +1,8 @@
 // The tuning app's path on the Design tab (docs/workbench.md, "From data to
 // C"): a step-test CSV uploaded and fitted (the identify request: `pidlab
 // identify`'s code and JSON), the model accepted as the plant, the design's
-// two knobs (response time and robustness: `pidlab tune`'s migo with
-// --response-time and --robustness) and the firmware at a chosen dt (the
+// two knobs (the design engine's front and its Ms bound: `pidlab tune
+// --robustness`) and the firmware at a chosen dt (the
 // sampled loop beside the continuous one, the export request's check, the
 // .c and .h to download). Every number is the server's; the page only draws.
 
@@ -102,26 +102,33 @@ function acceptModel() {
   return knobDesign();
 }
 
-// ---- The two knobs: migo's --response-time and --robustness.
-// Response time: the slider is log10 of T over [T0, 30 T0], T0 = 2/wc of the
-// fastest design the bound allows; its right end is "as fast as allowed" (0).
-const kSlowest = 30;
-// The response-time knob's positions: 0, 1/kKnobSteps, ..., 1 (index.html's step).
+// ---- The two knobs, on the design engine (`pidlab tune`, docs/tuning.md):
+// the robustness knob is the Ms bound R (until moved, the plant's default,
+// which the first design reports); the response knob moves along the
+// engine's optimal front, the design at each Ms bound from kFrontMinMs
+// (slowest) to R (fastest), so slower always means a lower Ms and a larger
+// load IAE. A position is one design: `pidlab tune --robustness MS`.
+const kFrontMinMs = 1.1;
+// The response knob's positions: 0, 1/kKnobSteps, ..., 1 (index.html's step).
 const kKnobSteps = 50;
 function knobValues(at) {
   const k = design.knob;
   const speed = at === undefined ? Number($('knob-speed').value) : at;  // 0 slowest .. 1 fastest
-  const robust = Number($('knob-robustness').value);
+  const bound = k.robustnessMoved ? Number($('knob-robustness').value) : k.defaultMs;
   const values = {};
-  if (speed < 1 && k.fastestTime > 0) values.response_time = Number((k.fastestTime * Math.pow(kSlowest, 1 - speed)).toPrecision(3));
-  if (k.robustnessMoved) values.robustness = Number(robust.toFixed(2));
+  if (speed < 1 && bound > kFrontMinMs) values.robustness = Number((kFrontMinMs + speed * (bound - kFrontMinMs)).toFixed(3));
+  else if (k.robustnessMoved) values.robustness = Number(bound.toFixed(2));
   return values;
 }
 
 function showKnob() {
+  const k = design.knob;
   const v = knobValues();
-  $('knob-speed-value').textContent = v.response_time ? 'T = ' + app.fmt(v.response_time) + ' s' : 'fastest';
-  $('knob-robustness-value').textContent = v.robustness ? 'Ms \u2264 ' + v.robustness : 'default (SIMC\u2019s Ms)';
+  const last = k.last && k.last.spec.robustness === v.robustness ? k.last.result : null;
+  const t = last && last.response_time_s > 0 ? ', T = ' + app.fmt(last.response_time_s) + ' s' : '';
+  $('knob-speed-value').textContent = (v.robustness && Number($('knob-speed').value) < 1 ? 'Ms \u2264 ' + v.robustness : 'fastest') + t;
+  $('knob-robustness-value').textContent = k.robustnessMoved ? 'Ms \u2264 ' + Number($('knob-robustness').value).toFixed(2)
+    : 'default (SIMC\u2019s Ms' + (k.defaultMs > 0 ? ', ' + k.defaultMs.toFixed(3) : '') + ')';
 }
 
 // The tuning spec of the current plant with the knobs' values (the
@@ -129,8 +136,8 @@ function showKnob() {
 function knobSpec(at) {
   const s = app.spec();
   for (const k of ['gains', 'monte_carlo', 'spread', 'derivative_filter', 'setpoint_weights', 'max_ms', 'max_mt', 'max_noise_gain',
-    'min_phase_margin', 'loop', 'dt']) delete s[k];
-  s.method = 'migo';
+    'min_phase_margin', 'loop', 'dt', 'response_time']) delete s[k];
+  s.method = 'optimal';
   Object.assign(s, knobValues(at));
   return s;
 }
@@ -151,16 +158,18 @@ async function knobDesign() {
   k.running = designed.then((result) => {
     k.designs.set(key, { result });
     k.last = { spec: s, result };
-    const m = result.migo || {};
-    if (!s.response_time && m.crossover_rad_s > 0) k.fastestTime = 2 / m.crossover_rad_s;
-    if (!k.robustnessMoved && m.ms_bound > 0) $('knob-robustness').value = m.ms_bound;
+    const d = result.design || {};
+    if (!s.robustness && d.ms_bound > 0) {
+      k.defaultMs = d.ms_bound;
+      if (!k.robustnessMoved) $('knob-robustness').value = d.ms_bound;
+    }
     const dt = suggestDt(result);  // the firmware's dt offered for this design
     if (dt) $('fw-dt').value = dt;
     showKnob();
-    $('knob-status').textContent = 'pidlab tune --method migo ' + Object.entries(knobValues()).map(([a, b]) => '--' + a.replace('_', '-') + ' ' + b).join(' ');
+    $('knob-status').textContent = 'pidlab tune ' + Object.entries(knobValues()).map(([a, b]) => '--' + a.replace('_', '-') + ' ' + b).join(' ');
     return result;
   }).catch((e) => {
-    if (!known && /migo/.test(e.message)) k.designs.set(key, { error: e.message });  // migo's refusal of this position
+    if (!known && /optimal/.test(e.message)) k.designs.set(key, { error: e.message });  // the engine's refusal of this position
     k.error = { spec: s, message: e.message };
     $('knob-status').textContent = 'design: ' + e.message;
     throw e;
@@ -179,7 +188,7 @@ async function knobDesign() {
 // robustness move starts over (the generation).
 async function designAhead() {
   const k = design.knob;
-  if (!(k.fastestTime > 0) || k.ahead === k.generation) return;
+  if (!(k.defaultMs > 0) || k.ahead === k.generation) return;
   const generation = k.ahead = k.generation;
   const robustness = $('knob-robustness').value;
   const current = Number($('knob-speed').value);
@@ -201,7 +210,7 @@ async function designAhead() {
         try {
           known = { result: (await app.backgroundAsk({ type: 'tune', spec: s })).result };
         } catch (e) {
-          if (!/migo/.test(e.message)) throw e;
+          if (!/optimal/.test(e.message)) throw e;
           known = { error: e.message };
         }
         if (stale()) break;
@@ -231,7 +240,7 @@ function resetKnob() {
   k.designs.clear();
   k.ready = false;
   $('knob-ahead').textContent = '';
-  Object.assign(k, { fastestTime: 0, robustnessMoved: false, last: null });
+  Object.assign(k, { defaultMs: 0, robustnessMoved: false, last: null });
   $('knob-speed').value = 1;
   $('knob-robustness').value = 1.4;
   showKnob();
@@ -329,7 +338,7 @@ export function initDesign(context) {
   app = context;
   design = window.pidlab.design = {
     upload: null, fit: null, fitCharts: [], sampled: null, export: null, pil: null,
-    knob: { fastestTime: 0, robustnessMoved: false, running: null, pending: false, last: null, error: null,
+    knob: { defaultMs: 0, robustnessMoved: false, running: null, pending: false, last: null, error: null,
       designs: new Map(), generation: 0, ahead: -1, ready: false },
     uploadCsv, identify, acceptModel, knobDesign, firmware, pilCost, resetKnob, onIdentifyProgress: identifyProgress,
   };

@@ -241,9 +241,9 @@ async function main() {
           at.experiment.cycles.length + ' cycles, ' + at.experiment.why);
       await waitForPage(session, 'no autotune verdict in #live-tunings', 30000,
         () => [...document.querySelectorAll('#live-tunings tbody tr')]
-          .some((tr) => tr.textContent.includes('autotune amigo') && tr.querySelector('.status[data-status="done"]')));
+          .some((tr) => tr.textContent.includes('autotune optimal') && tr.querySelector('.status[data-status="done"]')));
       const verdict = await page.evaluate(() => {
-        const tr = [...document.querySelectorAll('#live-tunings tbody tr')].find((r) => r.textContent.includes('autotune amigo'));
+        const tr = [...document.querySelectorAll('#live-tunings tbody tr')].find((r) => r.textContent.includes('autotune optimal'));
         return { gains: JSON.parse(tr.querySelector('.best-gains').dataset.gains), ms: Number(tr.querySelector('.best-objective').dataset.value) };
       });
       const want = [at.gains.kp, at.gains.ki, at.gains.kd];

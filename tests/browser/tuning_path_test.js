@@ -118,7 +118,7 @@ async function main() {
   };
   const compareWithTune = (got) => {
     const flags = ['tune', '--plant', got.spec.plant, '--json'];
-    if (got.spec.method) flags.push('--method', got.spec.method);  // the page's knobs: migo
+    if (got.spec.method) flags.push('--method', got.spec.method);  // the page's knobs: optimal
     if (got.spec.plant === 'custom') flags.push('--num', got.spec.num.join(','), '--den', got.spec.den.join(','));
     if (got.spec.delay) flags.push('--delay', String(got.spec.delay));
     if (got.spec.response_time) flags.push('--response-time', String(got.spec.response_time));
@@ -136,8 +136,9 @@ async function main() {
     return compareWithTune(got);
   });
 
-  await step('4. the response-time knob, then the robustness knob: the gains of pidlab tune with the same knobs (1e-12)', async () => {
+  await step('4. the response knob, then the robustness knob: the gains of pidlab tune at the front\'s Ms bound (1e-12)', async () => {
     const moved = [];
+    const fastest = await page.evaluate(() => window.pidlab.design.knob.last.result);
     for (const [id, value] of [['knob-speed', '0.5'], ['knob-robustness', '1.3']]) {
       await page.evaluate((id, value) => {
         const r = document.getElementById(id);
@@ -145,8 +146,12 @@ async function main() {
         r.dispatchEvent(new Event('input', { bubbles: true }));
       }, id, value);
       const got = await knobGains('no design for ' + id + ' = ' + value);
-      if (id === 'knob-speed' && !got.spec.response_time) throw new Error('the response-time knob set no response_time');
-      if (id === 'knob-robustness' && got.spec.robustness !== 1.3) throw new Error('robustness ' + got.spec.robustness);
+      // Halfway along the front from Ms 1.1 to the bound: the default's, then 1.3.
+      const bound = id === 'knob-speed' ? fastest.design.ms_bound : 1.3;
+      const want = Number((1.1 + 0.5 * (bound - 1.1)).toFixed(3));
+      if (got.spec.robustness !== want) throw new Error(id + ' = ' + value + ': robustness ' + got.spec.robustness + ', not ' + want);
+      if (id === 'knob-speed' && !(got.result.response_time_s > fastest.response_time_s && got.result.design.load_iae > fastest.design.load_iae))
+        throw new Error('the slower position is not slower: T ' + got.result.response_time_s + ' against ' + fastest.response_time_s);
       moved.push(compareWithTune(got));
     }
     await shot('knob');
@@ -171,7 +176,8 @@ async function main() {
         window.pidlab.lastResult && window.pidlab.lastResult.gains.kp === window.pidlab.design.knob.last.result.gains.kp);
       const t = await page.evaluate(() => window.pidlab.timings[window.pidlab.timings.length - 1]);
       if (!t.kept) throw new Error('the move to ' + value + ' sent a request: ' + JSON.stringify(t));
-      if (got.spec.robustness !== 1.3) throw new Error('designed ahead at robustness ' + got.spec.robustness);
+      const want = Number((1.1 + Number(value) * 0.2).toFixed(3));
+      if (got.spec.robustness !== want) throw new Error('designed ahead at robustness ' + got.spec.robustness + ', not ' + want);
       moved.push(compareWithTune(got) + ' (drawn ' + (t.drawn_ms - t.sent_ms).toFixed(1) + ' ms after the input)');
     }
     return 'ready ' + ((Date.now() - started) / 1000).toFixed(1) + ' s after the robustness move; ' + moved.join('; ');

@@ -37,7 +37,7 @@ bad "a tolerance of 2" "tolerance 2" --num 1 --den 1,1 --tolerance 2
 bad "a negative hold" "hold -1" --num 1 --den 1,1 --hold -1
 bad "a longest window below the first" "window 1 s" --num 1 --den 1,1 --max-time 1
 bad "an Ms bound of 1" "1" --num 1 --den 1,1 --max-ms 1
-bad "negative previous gains" "-1" --num 1 --den 1,1 --gains -1,0,0
+bad "previous gains that differ in sign" "-1" --num 1 --den 1,1 --gains -1,1,0
 bad "an unknown scalar" "q7" --num 1 --den 1,1 --scalar q7
 bad "the relay in float" "float" --num 1 --den 1,1 --scalar float
 bad "fixed point without an input range" "--input-range" --num 1 --den 1,1 --output-limits -2,2 --scalar q31

@@ -15,12 +15,25 @@ tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 mkdir "$tmp/bin" && ln -s "$pidlab" "$tmp/bin/pidlab"
 awk '/^## The design engine/{on=1} /^## Any plant/{on=0} on' "$doc" |
   awk '/^```sh$/{on=1; next} /^```$/{on=0} on' >"$tmp/commands.sh"
-check "the section has its five commands" "[ \$(grep -c '^pidlab tune' \"$tmp/commands.sh\") -eq 5 ]"
+check "the section has its seven commands" "[ \$(grep -c '^pidlab tune' \"$tmp/commands.sh\") -eq 7 ]"
 i=0
 while IFS= read -r line; do
   i=$((i + 1))
   check "docs: $line" "PATH=\"$tmp/bin:\$PATH\" bash -c '$line' > \"$tmp/doc$i.out\" 2> \"$tmp/doc$i.err\""
 done < <(grep '^pidlab ' "$tmp/commands.sh")
+
+# The sampled motor (docs' sixth command): the engine by default, the
+# sampled loop's Ms within 1 % of 1.4.
+check "the sampled loop at dt 0.002: the design engine by default, Ms within 1 % of 1.4" \
+  "/usr/bin/python3 -c \"import json; j=json.load(open('$tmp/doc6.out')); assert j['method']=='optimal' and j['design']['engine']=='optimal', j['method']; assert j['loop']=='sampled' and j['robustness']['loop']=='sampled', j['loop']; assert abs(j['robustness']['ms']/1.4-1)<=0.01, j['robustness']['ms']\""
+# The reverse-acting P1D (the seventh): gains all <= 0, said in one note,
+# the mirror's gains with their sign turned.
+"$pidlab" tune --num 19 --den 2,1 --delay 0.5 --json > "$tmp/mirror.json" 2>/dev/null
+check "a reverse-acting plant gets the mirror's gains with the sign turned, and the note" \
+  "/usr/bin/python3 -c \"import json; r=json.load(open('$tmp/doc7.out')); m=json.load(open('$tmp/mirror.json')); d=r['design']; assert d['reverse_acting'] and 'acts in reverse' in d['reverse_note']; assert all(r['gains'][k]==-m['gains'][k] for k in ('kp','ki','kd')) and r['gains']['tf']==m['gains']['tf'] and r['gains']['kp']<0, (r['gains'], m['gains']); assert r['robustness']['ms']==m['robustness']['ms'], (r['robustness']['ms'], m['robustness']['ms'])\""
+PATH="$tmp/bin:$PATH" pidlab tune --num -19 --den 2,1 --delay 0.5 > "$tmp/reverse.txt" 2>&1
+check "its text output says the loop acts in reverse in one note line" \
+  "[ \$(grep -c '^note .*acts in reverse' \"$tmp/reverse.txt\") -eq 1 ]"
 
 # The tank of the issue, as docs/tuning.md runs it.
 "$pidlab" tune --num 0.8 --den 1200,130,1 --delay 150 --method optimal --json > "$tmp/tank.json" 2>"$tmp/err"
@@ -92,10 +105,10 @@ check "... in one line naming the reachable range" \
   "only_line_ok \"$tmp/err\" 'response time 400 s) is outside what plant' && grep -q 'rad/s (response time' \"$tmp/err\""
 check "... with nothing on stdout" "[ ! -s \"$tmp/out\" ]"
 
-# A reverse-acting plant: refused by the engine in one line (exit 2).
-"$pidlab" tune --num -19 --den 2,1 --delay 0.5 --method optimal > "$tmp/out" 2>"$tmp/err"
-check "a reverse-acting plant exits 2 in one line saying so" \
-  "[ $? -eq 2 ] && only_line_ok \"$tmp/err\" 'acts in reverse'"
+# Gains that differ in sign: refused in one line (exit 2).
+"$pidlab" evaluate --num -19 --den 2,1 --delay 0.5 --gains -1,0.5,0 > "$tmp/out" 2>"$tmp/err"
+check "gains that differ in sign exit 2 in one line saying so" \
+  "[ $? -eq 2 ] && only_line_ok \"$tmp/err\" 'differ in sign'"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

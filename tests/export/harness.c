@@ -71,9 +71,14 @@ static void run(pidlab_pid *pid) {
     /* the plant y' = -y + u, explicit Euler at the controller's period */
     y = y + (double)pid->config.dt_s * (FROM_VALUE_OUT(u) - y);
   }
-  check(pidlab_pid_set_gains(pid, (parameter)-1, (parameter)0, (parameter)0, (parameter)0) ==
+  check(pidlab_pid_set_gains(pid, (parameter)-1, (parameter)1, (parameter)0, (parameter)0) ==
             PIDLAB_PID_INVALID_CONFIG,
-        "negative kp refused", k);
+        "gains that differ in sign refused", k);
+#ifndef PIDLAB_Q_BITS
+  /* double and float: a reverse-acting PID's gains, all <= 0, are taken */
+  check(pidlab_pid_set_gains(pid, (parameter)-1, (parameter)-0.5, (parameter)0, (parameter)0) == PIDLAB_PID_OK,
+        "gains all <= 0 (reverse acting) taken", k);
+#endif
   check(pidlab_pid_set_sample_time(pid, (parameter)0) == PIDLAB_PID_INVALID_CONFIG, "dt = 0 refused", k);
 #ifdef PIDLAB_Q_BITS
   {

@@ -102,6 +102,22 @@ run_case twodof_double_integrator -- --plant double_integrator --gains 8,3,2 --s
 run_case twodof_stepper -- --plant stepper_motor --gains 2.6685,30,0.095 --setpoint-weights 0.8,0 \
   --output-limits -5,5 --anti-windup back-calculation --derivative-filter 0.002
 
+# 2d. A reverse-acting plant (a negative gain) under the PID with gains all
+#     <= 0 that `pidlab tune` gives it, saturating under clamping: the C
+#     controller and the C++ trio carry the sign, and the loop is the mirror
+#     of the direct-acting one (-G with -C: y and the IAE bit for bit, u negated).
+run_case reverse -- --num -19 --den 2,1 --gains -0.9,-1.2,-0.03 --derivative-filter 0.0084 \
+  --output-limits -0.1,0.1 --anti-windup clamping
+"$pidlab" launch --lcm-url "$url" -- pidlab evaluate --backend lcm --loop sampled --horizon 2 --num -19 --den 2,1 \
+  --gains -0.9,-1.2,-0.03 --derivative-filter 0.0084 --output-limits -0.1,0.1 --anti-windup clamping --json \
+  --trajectory-csv reverse.cpp.csv >reverse.cpp.json 2>reverse.cpp.err
+check "reverse: the C++ trio gives the same trajectory and IAE" \
+  "same reverse reverse.c.json reverse.c.csv reverse.cpp.json reverse.cpp.csv"
+"$pidlab" evaluate --loop sampled --horizon 2 --num 19 --den 2,1 --gains 0.9,1.2,0.03 --derivative-filter 0.0084 \
+  --output-limits -0.1,0.1 --anti-windup clamping --json --trajectory-csv direct.csv >direct.json
+check "reverse: the mirror of the direct-acting loop, y and IAE bit for bit, u negated, saturated" \
+  "python3 -c \"import csv,json,sys; a=list(csv.DictReader(open('reverse.c.csv'))); b=list(csv.DictReader(open('direct.csv'))); ok=json.load(open('reverse.c.json'))['iae']==json.load(open('direct.json'))['iae'] and len(a)==len(b) and all(x['y']==y['y'] and float(x['u'])==-float(y['u']) for x,y in zip(a,b)) and max(abs(float(x['u'])) for x in a)==0.1; sys.exit(not ok)\""
+
 # 3. Loss: the plant and the disturbance throw 5 % of what they receive away,
 #    so the plant resends y_k and the controller must repeat u_k.
 run_case loss --drop-rate 0.05 -- --plant oscillator --gains 2,1,1.5

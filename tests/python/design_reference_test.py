@@ -22,9 +22,9 @@ For each case, with the reference's code:
     same way) is at most 1.03 x the reference optimum's under the same bounds.
 
 The reference's own IAEs must be converged (within 1e-4 on a window twice
-as long and on 4x the samples). A plant pidlab refuses as reverse-acting
-(exit 2, "acts in reverse"; its two bounds then 3 and 30 x the ultimate gain
-of |G|) is printed as "refused" and counted neither way. One line per case
+as long and on 4x the samples). A reverse-acting plant (a negative gain) must get gains all <= 0 and
+design.reverse_acting: the reference then designs for -G, and pidlab's
+gains, their sign turned, are checked against it (the same loop). One line per case
 (plant, G, pidlab's design.load_iae, the reference optimum's IAE, pidlab's
 gains' IAE by the reference, their ratio to the optimum's, both Ms), failing
 ones starting "FAIL: ", and last `N passed, M failed`; exit 1 on any
@@ -108,15 +108,6 @@ def run_pidlab(pidlab, num, den, delay, noise=None, pi=False):
     return p.returncode, out, p.stderr.strip()
 
 
-def ultimate_gain(num, den, delay):
-    """1 / |G(j w180)| of the plant, its sign turned to direct action."""
-    plant = ref.Plant(num, den, delay)
-    if plant.static_gain() < 0:
-        plant = ref.Plant([-v for v in num], den, delay)
-    w = plant.phase_crossover()
-    return 1.0 / abs(plant.g(1j * w)) if w else 10.0
-
-
 def check_case(pidlab, name, plant, num, den, delay, g, pi, previous):
     """One case at noise bound g: (verdict line, passed, the reference
     optimum's x or None, the IAE ratio pidlab / reference or NaN)."""
@@ -125,8 +116,16 @@ def check_case(pidlab, name, plant, num, den, delay, g, pi, previous):
     if code != 0 or j is None:
         return "FAIL: %-18s %10.4g pidlab exit %d: %s" % (label, g, code, err), False, None, math.nan
     problems = []
-    prob = ref.Problem(plant, MS, noise=g, pi=pi)
     gains = {k: float(j["gains"][k]) for k in ("kp", "ki", "kd", "tf")}
+    if plant.static_gain() < 0:
+        # Reverse acting: the loop of -G under -C is the loop of G under C.
+        if not (j["design"].get("reverse_acting") and all(gains[k] <= 0 for k in ("kp", "ki", "kd"))):
+            problems.append("a reverse-acting plant with gains %s, reverse_acting %s"
+                            % (gains, j["design"].get("reverse_acting")))
+        for k in ("kp", "ki", "kd"):
+            gains[k] = -gains[k]
+        plant = ref.Plant([-v for v in num], den, delay)
+    prob = ref.Problem(plant, MS, noise=g, pi=pi)
     if pi and gains["kd"] != 0.0:
         problems.append("a PI with kd %g" % gains["kd"])
     a = prob.analyse(gains)
@@ -173,7 +172,7 @@ def main(argv):
         return 2
     pidlab = argv[1]
     t0 = time.time()
-    passed = failed = refused = 0
+    passed = failed = 0
     ratios = []
     print("%-18s %10s %12s %12s %12s %8s %7s %7s  %s" % ("plant", "G", "pidlab IAE", "ref IAE", "pidlab(ref)",
                                                        "ratio", "Ms", "ref Ms", "verdict"))
@@ -182,20 +181,6 @@ def main(argv):
     for name, num, den, delay, pi in cases:
         plant = ref.Plant(num, den, delay)
         code, base, err = run_pidlab(pidlab, num, den, delay, None, pi)
-        if code == 2 and "acts in reverse" in err:
-            # Refused: both bounds (from the plant's ultimate gain, since
-            # pidlab gives no default here) must be refused the same way.
-            ku = ultimate_gain(num, den, delay)
-            for g in (3.0 * ku, 30.0 * ku):
-                c2, _, e2 = run_pidlab(pidlab, num, den, delay, g, pi)
-                if c2 == 2 and "acts in reverse" in e2:
-                    refused += 1
-                    print("%-18s %10.4g %12s %12s %12s %8s %7s %7s  refused (exit 2: %s)"
-                          % (name, g, "-", "-", "-", "-", "-", "-", e2.splitlines()[-1][:90]))
-                else:
-                    failed += 1
-                    print("FAIL: %-18s %10.4g exit %d, not the reverse-acting refusal: %s" % (name, g, c2, e2))
-            continue
         if code != 0 or base is None:
             failed += 1
             print("FAIL: %-18s the default design: exit %d: %s" % (name, code, err))
@@ -218,8 +203,8 @@ def main(argv):
             print(line)
             sys.stdout.flush()
     if ratios:
-        print("ratio pidlab / reference: min %.4f, median %.4f, max %.4f over %d cases; %d refused; %.1f s"
-              % (min(ratios), float(np.median(ratios)), max(ratios), len(ratios), refused, time.time() - t0))
+        print("ratio pidlab / reference: min %.4f, median %.4f, max %.4f over %d cases; %.1f s"
+              % (min(ratios), float(np.median(ratios)), max(ratios), len(ratios), time.time() - t0))
     print("%d passed, %d failed" % (passed, failed))
     return 1 if failed else 0
 

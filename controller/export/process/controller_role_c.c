@@ -116,9 +116,12 @@ static double from_q_out(pidlab_q u) { return (double)u * ldexp(PIDLAB_OUTPUT_FU
 /* The controller's share of transport::ParseEpisodeConfig: what it uses. */
 static const char *config_error(const pidlab_lcmt_episode_config *m) {
   if (m->episode_id == 0) return "episode id 0";
-  if (!(finite(m->kp) && m->kp >= 0 && m->kp <= MAX_GAIN && finite(m->ki) && m->ki >= 0 &&
-        m->ki <= MAX_GAIN && finite(m->kd) && m->kd >= 0 && m->kd <= MAX_GAIN))
-    return "a gain is not finite, >= 0 and at most 1e12";
+  if (!(finite(m->kp) && fabs(m->kp) <= MAX_GAIN && finite(m->ki) && fabs(m->ki) <= MAX_GAIN && finite(m->kd) &&
+        fabs(m->kd) <= MAX_GAIN))
+    return "a gain is not finite and at most 1e12 in size";
+  /* One sign: all >= 0 (direct acting) or all <= 0 (reverse acting). */
+  if (!((m->kp >= 0 && m->ki >= 0 && m->kd >= 0) || (m->kp <= 0 && m->ki <= 0 && m->kd <= 0)))
+    return "the gains differ in sign";
   if (!finite(m->reference)) return "reference not finite";
   if (!(finite(m->dt_s) && m->dt_s > 0)) return "dt not positive and finite";
   if (m->total_steps < 1 || m->total_steps > MAX_EPISODE_STEPS) return "total steps out of [1, 5e7]";

@@ -126,9 +126,13 @@ static int pidlab_is_finite(pidlab_real x) { return x - x == PIDLAB_ZERO; }
 
 static int pidlab_in_unit(pidlab_real x) { return x >= PIDLAB_ZERO && x <= PIDLAB_ONE; }
 
+/* kp, ki and kd share one sign: all >= 0 (direct acting) or all <= 0 (a
+ * reverse-acting plant's PID). */
 static int pidlab_gains_valid(pidlab_real kp, pidlab_real ki, pidlab_real kd, pidlab_real tf) {
-  return pidlab_is_finite(kp) && kp >= PIDLAB_ZERO && pidlab_is_finite(ki) && ki >= PIDLAB_ZERO &&
-         pidlab_is_finite(kd) && kd >= PIDLAB_ZERO && pidlab_is_finite(tf) && tf >= PIDLAB_ZERO;
+  const int direct = kp >= PIDLAB_ZERO && ki >= PIDLAB_ZERO && kd >= PIDLAB_ZERO;
+  const int reverse = kp <= PIDLAB_ZERO && ki <= PIDLAB_ZERO && kd <= PIDLAB_ZERO;
+  return pidlab_is_finite(kp) && pidlab_is_finite(ki) && pidlab_is_finite(kd) && (direct || reverse) &&
+         pidlab_is_finite(tf) && tf >= PIDLAB_ZERO;
 }
 
 static int pidlab_config_valid(const pidlab_pid_config *c) {
@@ -230,8 +234,10 @@ pidlab_pid_status pidlab_pid_step(pidlab_pid *pid, pidlab_real r, pidlab_real y,
     if (saturated) {
       if (c->anti_windup == PIDLAB_ANTI_WINDUP_CLAMPING) {
         /* Integrate only if the error pulls the output back inside. */
-        const int pushes_further = (c->has_output_max && unsaturated > c->output_max && e > PIDLAB_ZERO) ||
-                                   (c->has_output_min && unsaturated < c->output_min && e < PIDLAB_ZERO);
+        /* (The integral moves u the way ki e does: against e where reverse acting.) */
+        const pidlab_real pull = c->ki < PIDLAB_ZERO ? -e : e;
+        const int pushes_further = (c->has_output_max && unsaturated > c->output_max && pull > PIDLAB_ZERO) ||
+                                   (c->has_output_min && unsaturated < c->output_min && pull < PIDLAB_ZERO);
         if (pushes_further) {
           integral = pid->integral;
           integral_lo = pid->integral_lo;

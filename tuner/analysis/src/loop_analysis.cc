@@ -269,7 +269,7 @@ bool AnalyzeDelayedLoop(const Plant& plant, const PidGains& g, const evaluation:
   SetMargins(r, c, a);
   SetPeaks(r, w, pts, true, ao, a);
   if (std::isinf(a->noise_gain))
-    a->noise_gain_note = g.kd > 0.0 && !(g.tf > 0.0) ? "ideal derivative: unbounded" : "unbounded";
+    a->noise_gain_note = g.kd != 0.0 && !(g.tf > 0.0) ? "ideal derivative: unbounded" : "unbounded";
   return true;
 }
 
@@ -332,7 +332,7 @@ bool AnalyzeLoopOrExplain(const Plant& plant, const PidGains& typed_gains,
   SetMargins(*m.response, FindCrossings(*m.response, w, pts), &a);
   SetPeaks(*m.response, w, pts, continuous, ao, &a);
   if (std::isinf(a.noise_gain)) {
-    a.noise_gain_note = g.kd > 0.0 && !(g.tf > 0.0) ? "ideal derivative: unbounded" : "unbounded";
+    a.noise_gain_note = g.kd != 0.0 && !(g.tf > 0.0) ? "ideal derivative: unbounded" : "unbounded";
   }
   return true;
 }

@@ -170,7 +170,7 @@ bool ContinuousLoopMeetsBounds(const TransferFunction& plant, const PidGains& g,
                                const evaluation::Stability& stability, const LoopBounds& bounds) {
   if (!stability.stable) return false;
   if (SlowestTimeConstant(stability.poles) > bounds.max_time_constant_s) return false;
-  const bool ideal_derivative = g.kd > 0.0 && !(g.tf > 0.0);
+  const bool ideal_derivative = g.kd != 0.0 && !(g.tf > 0.0);
   if (std::isfinite(bounds.max_noise_gain) && ideal_derivative) return false;  // unbounded
   const ContinuousResponse r(plant, g);
   std::vector<double> special = SpecialFrequencies(stability.poles);

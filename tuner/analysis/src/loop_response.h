@@ -69,7 +69,7 @@ class SampledResponse : public Response {
     const double tf = EffectiveDerivativeFilter(g, o), dt = o.dt_s;
     const double a = tf / (tf + dt), b = g.kd / (tf + dt);
     Polynomial num{g.kp}, den{1.0};
-    if (g.ki > 0.0) {
+    if (g.ki != 0.0) {
       Polynomial inum;
       switch (o.integral) {
         case IntegralMethod::kBackwardEuler:
@@ -85,7 +85,7 @@ class SampledResponse : public Response {
       num = Add(Mul(num, {1.0, -1.0}), inum);
       den = {1.0, -1.0};
     }
-    if (g.kd > 0.0) {
+    if (g.kd != 0.0) {
       num = Add(Mul(num, {1.0, -a}), Mul(Mul({b}, {1.0, -1.0}), den));
       den = Mul(den, {1.0, -a});
     }

@@ -218,7 +218,7 @@ namespace {
 
 // DelayedLoopIsRetarded() with the refusal's message in *error.
 bool DelayedLoopIsRetardedOrExplain(const TransferFunction& tf, const PidGains& g, std::string* error) {
-  if (!(g.kd > 0.0) || g.tf > 0.0 || tf.RelativeDegree() >= 2) return true;
+  if (g.kd == 0.0 || g.tf > 0.0 || tf.RelativeDegree() >= 2) return true;
   if (error) {
     std::ostringstream os;
     os << "kd " << g.kd << " with no derivative filter on a plant of relative degree 1 and a dead time makes "

@@ -49,7 +49,7 @@ std::vector<double> OpenLoopFrequencies(const ContinuousResponse& r) {
 
 void ContinuousPidPolynomials(const PidGains& g, std::vector<double>* num, std::vector<double>* den) {
   using frequency::Polynomial;
-  const bool d = g.kd > 0.0, filtered = d && g.tf > 0.0, integral = g.ki > 0.0;
+  const bool d = g.kd != 0.0, filtered = d && g.tf > 0.0, integral = g.ki != 0.0;
   if (filtered) {
     // (kp + kd/tf) - (kd/tf)/(tf s + 1) + ki/s over s (tf s + 1).
     *num = integral ? Polynomial{g.kp * g.tf + g.kd, g.kp + g.ki * g.tf, g.ki}

@@ -17,6 +17,9 @@ namespace pidlab::tune {
 
 using spec::FormatNumber;
 
+// The sampled loop's highest crossover, per unit of the sample rate 1/dt.
+constexpr double kSampledCrossoverPerRate = 0.5;
+
 bool DesignOptions::IsValid(std::string* error) const {
   std::ostringstream os;
   if (!(max_ms > 1.0 && max_ms <= 4.0))
@@ -61,6 +64,11 @@ bool Meets(const analysis::LoopAnalysis& a, const design::Bounds& b) {
   return a.ms <= b.ms * kTolerance && a.mt <= b.mt * kTolerance && a.noise_gain <= b.noise_gain * kTolerance;
 }
 
+// The largest ratio of a peak to its bound.
+double Excess(const analysis::LoopAnalysis& a, const design::Bounds& b) {
+  return std::max({a.ms / b.ms, a.mt / b.mt, a.noise_gain / b.noise_gain});
+}
+
 PidGains Scaled(PidGains g, double f) {
   g.kp *= f;
   g.ki *= f;
@@ -73,12 +81,17 @@ PidGains Scaled(PidGains g, double f) {
 // scaled back until they do not. False when no scale gives a stable loop.
 bool ExactlyWithin(const Plant& plant, const design::Engine& engine, const design::Bounds& b,
                    design::Optimum* o, analysis::LoopAnalysis* a) {
-  if (Analyse(plant, o->gains, b.loop, a) && Meets(*a, b)) return true;
+  bool stable = Analyse(plant, o->gains, b.loop, a);
+  if (stable && Meets(*a, b)) return true;
   // By 3 % steps down to half the gain, so as to stay in the design's band
-  // of gains (a larger step can land in a slower band below it).
-  double lo = 0.97, hi = 1.0;
+  // of gains (a larger step can land in a slower band below it); given up
+  // where a step raises the excess (an integrating plant's Mt rises as the
+  // gain falls).
+  double lo = 0.97, hi = 1.0, excess = stable ? Excess(*a, b) : HUGE_VAL;
   analysis::LoopAnalysis at;
-  while (!(Analyse(plant, Scaled(o->gains, lo), b.loop, &at) && Meets(at, b))) {
+  while (!((stable = Analyse(plant, Scaled(o->gains, lo), b.loop, &at)) && Meets(at, b))) {
+    if (stable && Excess(at, b) > excess) return false;
+    if (stable) excess = Excess(at, b);
     hi = lo;
     lo *= 0.97;
     if (lo < 0.5) return false;
@@ -92,36 +105,79 @@ bool ExactlyWithin(const Plant& plant, const design::Engine& engine, const desig
   return Analyse(plant, o->gains, b.loop, a) && std::isfinite(o->load_iae);
 }
 
-// One point of the front: the optimum at Ms bound ms, checked exactly
-// (against `check_ms`, ms where not given).
-bool FrontPoint(const Plant& plant, const design::Engine& engine, design::Bounds b, double ms,
-                const Eigen::VectorXd& warm, design::Optimum* o, analysis::LoopAnalysis* a,
-                double check_ms = 0.0) {
-  b.ms = ms;
-  if (!engine.Optimize(b, warm, o)) return false;
-  b.ms = check_ms > 0.0 ? check_ms : ms;
-  return ExactlyWithin(plant, engine, b, o, a);
+// A design bound corrected by the exact peak it gave against the peak
+// wanted: (bound - 1) scaled by (wanted - 1) / (peak - 1), within [1.001, 4].
+double Corrected(double bound, double wanted, double peak) {
+  const double f = (wanted - 1.0) / std::max(peak - 1.0, 1e-6);
+  return std::clamp(1.0 + (bound - 1.0) * f, 1.0 + 1e-3, 4.0);
 }
 
-// The sampled loop's point at Ms bound `ms`: the engine designs on the
-// plant with the hold's half sample of delay, and its bound is corrected
-// until the sampled loop's exact Ms is within 1 % of `ms` (at most 5 times).
-bool SampledPoint(const Plant& plant, const design::Engine& engine, const design::Bounds& b, double ms,
-                  Eigen::VectorXd warm, design::Optimum* o, analysis::LoopAnalysis* a) {
-  double design_ms = ms;
+// The design's bounds tightened after an optimum whose exact peaks broke
+// `check`: by the peaks' excess (a little more), or by a tenth where the
+// loop is not stable.
+void Tighten(const Plant& plant, const design::Bounds& check, const design::Optimum& failed,
+             design::Bounds* design) {
+  analysis::LoopAnalysis at;
+  if (Analyse(plant, failed.gains, check.loop, &at)) {
+    design->ms = Corrected(design->ms, check.ms, std::max(at.ms, check.ms) * 1.002);
+    design->mt = Corrected(design->mt, check.mt, std::max(at.mt, check.mt) * 1.002);
+  } else {
+    design->ms = 1.0 + 0.9 * (design->ms - 1.0);
+    design->mt = 1.0 + 0.9 * (design->mt - 1.0);
+  }
+}
+
+// The point at Ms bound `ms` with the design's bounds corrected until the
+// exact peaks meet them, the active one within 1 % (at most 8 designs): the
+// sampled loop's (the engine designs on the plant with the hold's half
+// sample of delay), or a continuous one the grid's peaks missed where
+// scaling the gain back cannot help (an integrating plant's Mt, which rises
+// as the gain falls).
+bool CorrectedPoint(const Plant& plant, const design::Engine& engine, const design::Bounds& check,
+                    design::Bounds design, Eigen::VectorXd warm, design::Optimum* o, analysis::LoopAnalysis* a) {
   bool found = false;
   for (int i = 0; i < 8; ++i) {
-    if (!FrontPoint(plant, engine, b, design_ms, warm, o, a, ms)) {
-      // The sampled loop's peaks are above the design's: a tighter bound.
-      design_ms = 1.0 + 0.9 * (design_ms - 1.0);
+    design::Optimum trial;
+    analysis::LoopAnalysis at;
+    if (!engine.Optimize(design, warm, &trial)) {
+      design.ms = 1.0 + 0.9 * (design.ms - 1.0);
+      design.mt = 1.0 + 0.9 * (design.mt - 1.0);
       continue;
     }
+    if (!ExactlyWithin(plant, engine, check, &trial, &at)) {
+      Tighten(plant, check, trial, &design);
+      warm = trial.shape;
+      continue;
+    }
+    if (!found || trial.load_iae < o->load_iae) {
+      *o = trial;
+      *a = at;
+    }
     found = true;
-    if (a->ms >= 0.99 * ms) return true;
-    warm = o->shape;
-    design_ms = std::clamp(design_ms * ms / a->ms, 1.0 + 1e-3, 4.0);
+    if (at.ms >= 0.99 * check.ms || at.mt >= 0.99 * check.mt) return true;
+    warm = trial.shape;
+    design.ms = Corrected(design.ms, check.ms, at.ms);
+    design.mt = Corrected(design.mt, check.mt, at.mt);
   }
   return found;
+}
+
+// The sampled loop's point at Ms bound ms.
+bool SampledPoint(const Plant& plant, const design::Engine& engine, design::Bounds b, double ms,
+                  const Eigen::VectorXd& warm, design::Optimum* o, analysis::LoopAnalysis* a) {
+  b.ms = ms;
+  return CorrectedPoint(plant, engine, b, b, warm, o, a);
+}
+
+// One point of the front: the optimum at Ms bound ms, checked exactly.
+bool FrontPoint(const Plant& plant, const design::Engine& engine, design::Bounds b, double ms,
+                const Eigen::VectorXd& warm, design::Optimum* o, analysis::LoopAnalysis* a) {
+  b.ms = ms;
+  if (!engine.Optimize(b, warm, o)) return false;
+  if (ExactlyWithin(plant, engine, b, o, a)) return true;
+  design::Bounds design = b;
+  Tighten(plant, b, *o, &design);
+  return CorrectedPoint(plant, engine, b, design, o->shape, o, a);
 }
 
 double HighestCrossover(const analysis::LoopAnalysis& a) {
@@ -249,11 +305,23 @@ Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSum
   if (plant.nonlinear)
     return Status::InvalidInput("optimal designs on a linear plant: it does not take plant " + plant.name +
                                 " (use its linearisation, plant stepper)");
+  // A reverse-acting plant (negative gain) is designed as -G, and the
+  // gains change sign: the same loop, the same peaks and responses.
   const double dc = plant.tf.DcGain();
-  if (dc < 0.0 || (std::isinf(dc) && plant.tf.num.back() * plant.tf.den[plant.tf.den.size() - 2] < 0.0))
-    return Status::InvalidInput(
-        "optimal: plant " + plant.name +
-        " acts in reverse (negative gain), which the design engine does not take yet");
+  const bool reverse =
+      dc < 0.0 || (std::isinf(dc) && plant.tf.num.back() * plant.tf.den[plant.tf.den.size() - 2] < 0.0);
+  if (reverse) {
+    Plant forward = plant;
+    for (double& n : forward.tf.num) n = -n;
+    const Status st = DesignOptimal(forward, options, summary);
+    if (!st.ok()) return st;
+    summary->gains.kp = -summary->gains.kp;
+    summary->gains.ki = -summary->gains.ki;
+    summary->gains.kd = -summary->gains.kd;
+    summary->reverse_acting = true;
+    summary->message += "; the loop acts in reverse (the plant's gain is negative): so do the gains";
+    return st;
+  }
   // The sampled loop: the plant with the zero-order hold's half sample of
   // delay as a lag 1 / (dt s / 2 + 1) (a delay of a few microseconds would
   // cost the simulation millions of steps), the derivative filter no faster
@@ -281,8 +349,16 @@ Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSum
   double hint = has_migo ? migo.crossover_rad_s : 0.0;
   DesignSummary previous;
   if (has_migo) previous.gains = migo.gains;
+  // The sampled loop's crossover: migo's cap on the plant itself, and at
+  // most kSampledCrossoverPerRate / dt (the hold's lag there is 14 deg).
+  double cap = 0.0;
+  if (sampled) {
+    double fastest = 0.0, slowest = 0.0;
+    PlantTimes(plant, &fastest, &slowest);
+    cap = std::min(kMigoSpeedCap / fastest, kSampledCrossoverPerRate / options.loop.dt_s);
+  }
   for (int pass = 0; pass < 3; ++pass) {
-    const design::Engine engine(design_plant, options.pi, sampled ? options.loop.dt_s : 0.0, hint);
+    const design::Engine engine(design_plant, options.pi, sampled ? options.loop.dt_s : 0.0, hint, cap);
     const bool warm = has_migo || pass > 0;
     const Status st = DesignOn(plant, engine, options, sampled, warm ? &previous : nullptr, summary);
     if (!st.ok() || !(summary->crossover_rad_s > 3.0 * engine.Crossover())) return st;

@@ -51,12 +51,19 @@ bool RuleShape(const Plant& plant, TuningRule rule, bool pi, Eigen::VectorXd* sh
 
 }  // namespace
 
-Engine::Engine(const Plant& plant, bool pi, double min_tf_s, double crossover_hint)
+Engine::Engine(const Plant& plant, bool pi, double min_tf_s, double crossover_hint, double speed_cap)
     : plant_(plant), pi_(pi), min_tf_s_(min_tf_s), sim_(plant, 1.0) {
   double fastest = 0.0, slowest = 0.0;
   PlantTimes(plant, &fastest, &slowest);
-  speed_cap_ = kMigoSpeedCap / fastest;
-  for (const cd& p : PolynomialRoots(plant.tf.den)) {
+  speed_cap_ = speed_cap > 0.0 ? speed_cap : kMigoSpeedCap / fastest;
+  // The poles at the origin exactly (the denominator's trailing zeros; their
+  // computed roots scatter by the square root of the precision), then the rest.
+  std::vector<double> den = plant.tf.den;
+  while (den.size() > 1 && den.back() == 0.0) {
+    den.pop_back();
+    ++origin_poles_;
+  }
+  for (const cd& p : PolynomialRoots(den)) {
     if (std::abs(p) <= 1e-12 * std::max(1.0, 1.0 / fastest))
       ++origin_poles_;
     else if (p.real() > 0.0)
@@ -81,6 +88,7 @@ Engine::Engine(const Plant& plant, bool pi, double min_tf_s, double crossover_hi
               : kp > 0.0           ? PeaksOf(grid_, ShapeGains(shape, kp)).crossover
                                    : 0.0;
   if (!(wc > 0.0)) wc = 1.0 / slowest;
+  wc = std::min(wc, speed_cap_);
   time_s_ = 1.0 / wc;
   sim_ = LoopSimulator(plant, 1.0 / (kStepsPerRadian * wc));
   // Sixty periods of the crossover at most, and at least 200 delays.

@@ -40,7 +40,10 @@ class Engine {
   /// loop's dt; 0 continuous).
   /// `crossover_hint`: the crossover (rad/s) the grid step is chosen for;
   /// 0: estimated from the rules' shapes.
-  Engine(const Plant& plant, bool pi, double min_tf_s = 0.0, double crossover_hint = 0.0);
+  /// `speed_cap`: the highest crossover allowed (rad/s); 0: migo's,
+  /// kMigoSpeedCap over the plant's fastest time.
+  Engine(const Plant& plant, bool pi, double min_tf_s = 0.0, double crossover_hint = 0.0,
+         double speed_cap = 0.0);
   /// The optimum under `bounds`, from the rules' shapes and `warm` (if not
   /// empty). False when no shape has a stable loop meeting the bounds.
   bool Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum* best) const;

@@ -253,7 +253,11 @@ TimeScale DerivedTimeScale(const spec::TuningSpec& s, const Plant& plant) {
 // migo's default bound: SIMC's (tau_c = L) Ms on the plant, with the
 // derivative filter migo uses, clamped to [kMigoMinDefaultMs,
 // kMigoMaxDefaultMs]; kMigoMaxDefaultMs where SIMC does not apply.
-double DefaultRobustness(const Plant& plant, std::string* why) {
+double DefaultRobustness(const Plant& given, std::string* why) {
+  // A reverse-acting plant's as -G's (the design engine designs it so).
+  Plant plant = given;
+  if (plant.tf.DcGain() < 0.0)
+    for (double& n : plant.tf.num) n = -n;
   TuningRuleResult simc;
   analysis::LoopAnalysis a;
   evaluation::LoopOptions loop;
@@ -287,7 +291,7 @@ std::string AsksForASearch(const spec::TuningSpec& s, const std::set<std::string
   for (const spec::FieldEntry& e : fields)
     if (e.field.Has(spec::kSearch) && given.count(e.field.key) > 0 && !EngineTakes(e.field.key))
       return e.field.key;
-  if (s.loop.loop == "sampled") return runner ? "backend" : "loop";
+  if (s.loop.loop == "sampled" && runner) return "backend";
   return "";
 }
 
@@ -313,16 +317,14 @@ void ResolveMethod(spec::TuningSpec* s, const std::set<std::string>& given, bool
   } else if (!search.empty()) {
     t->method_reason =
         search == "backend" ? "the trio's episodes tune the sampled loop: the search on the paper's objective"
-        : search == "loop"
-            ? "the sampled loop is tuned by the search on the paper's objective (--method optimal: the "
-              "design "
-              "engine designs it, the ZOH plant and the discrete PID)"
             : "'" + search +
                   "' asks for the search on the paper's objective (the design engine takes --robustness, "
                   "--max-ms, --max-mt, --max-noise-gain and --max-overshoot)";
   } else {
     s->tune.method = "optimal";
-    t->method_reason = "the default: the design engine";
+    t->method_reason = s->loop.loop == "sampled"
+                           ? "the default: the design engine, on the sampled loop (the ZOH plant and the discrete PID)"
+                           : "the default: the design engine";
   }
   // The engine's Ms bound from --max-ms where --robustness is not given.
   if (s->tune.method == "optimal" && kept("max_ms") && !kept("robustness") && std::isfinite(s->bounds.max_ms))

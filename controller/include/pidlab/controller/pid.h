@@ -55,25 +55,42 @@ using PidGains = PidGainsT<double>;
 /// limits"): larger gains only overflow the closed loop's matrices.
 inline constexpr double kMaxGain = 1e12;
 
-/// Gains (and the filter time constant tf, s) must be finite, >= 0 and at
-/// most kMaxGain (the paper's search box is [0, 30]^3).
+/// Gains (and the filter time constant tf, s) must be finite and at most
+/// kMaxGain in size (the paper's search box is [0, 30]^3); tf >= 0. kp, ki
+/// and kd share one sign: all >= 0 (direct acting), or all <= 0, the PID of
+/// a reverse-acting plant (a negative gain: u = -|kp| e - ...).
 inline bool GainsAreValid(const PidGains& g, std::string* error) {
   const std::pair<const char*, double> f[] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}, {"tf", g.tf}};
   for (const auto& [name, v] : f) {
-    if (!std::isfinite(v) || v < 0.0 || v > kMaxGain) {
+    const bool tf = name[0] == 't';
+    if (!std::isfinite(v) || std::fabs(v) > kMaxGain || (tf && v < 0.0)) {
       if (error) {
         std::ostringstream os;
-        if (name[0] == 't')
+        if (tf)
           os << "derivative filter " << v << " s (tf) must be finite, >= 0 and at most " << kMaxGain;
         else
-          os << "gain " << name << " = " << v << " must be finite, >= 0 and at most " << kMaxGain;
+          os << "gain " << name << " = " << v << " must be finite and at most " << kMaxGain << " in size";
         *error = os.str();
       }
       return false;
     }
   }
+  const bool positive = g.kp > 0.0 || g.ki > 0.0 || g.kd > 0.0;
+  const bool negative = g.kp < 0.0 || g.ki < 0.0 || g.kd < 0.0;
+  if (positive && negative) {
+    if (error) {
+      std::ostringstream os;
+      os << "gains kp = " << g.kp << ", ki = " << g.ki << ", kd = " << g.kd
+         << " differ in sign: all must be >= 0 (direct acting) or all <= 0 (reverse acting)";
+      *error = os.str();
+    }
+    return false;
+  }
   return true;
 }
+
+/// True where the gains are those of a reverse-acting loop (all <= 0, one < 0).
+inline bool GainsAreReverse(const PidGains& g) { return g.kp < 0.0 || g.ki < 0.0 || g.kd < 0.0; }
 
 /// The spec's derivative_on (kept for the flag and for logs): kError is
 /// setpoint weight c = 1, kMeasurement c = 0 (SetpointWeightC).
@@ -202,8 +219,10 @@ class DiscretePid {
     if (saturated) {
       if (options_.anti_windup == AntiWindup::kClamping) {
         // Integrate only if the error pulls the output back inside the limits.
-        const bool pushes_further = (ToValue(unsaturated) > options_.output_max && ToValue(e) > 0.0) ||
-                                    (ToValue(unsaturated) < options_.output_min && ToValue(e) < 0.0);
+        // (The integral moves u the way ki e does: against e where reverse acting.)
+        const double pull = ToValue(gains_.ki) < 0.0 ? -ToValue(e) : ToValue(e);
+        const bool pushes_further = (ToValue(unsaturated) > options_.output_max && pull > 0.0) ||
+                                    (ToValue(unsaturated) < options_.output_min && pull < 0.0);
         if (pushes_further) integral = integral_;
       } else if (options_.anti_windup == AntiWindup::kBackCalculation) {
         integral += T(options_.back_calculation_gain * dt) * (out - unsaturated);

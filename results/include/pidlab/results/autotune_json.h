@@ -21,9 +21,9 @@ namespace pidlab::results {
 
 /// The design on the identified model and what adopting it takes.
 struct AutotuneDesignOptions {
-  std::string method = "amigo";     ///< amigo | simc | migo | optimal
-  double robustness = 1.4;          ///< migo: the Ms it designs to
-  double response_time_s = 0.0;     ///< migo: the response time (0: fastest)
+  std::string method = "optimal";   ///< optimal | amigo | simc | migo
+  double robustness = 1.4;          ///< optimal, migo: the Ms they design to
+  double response_time_s = 0.0;     ///< optimal, migo: the response time (0: fastest)
   double max_ms = 2.0;              ///< the design's Ms on the model at most this (> 1)
   double max_overshoot_pct = 60.0;  ///< the verification step's overshoot at most this
   bool IsValid(std::string* error) const;

@@ -31,7 +31,7 @@ struct AutotuneSpec {
   std::string scalar = "double";
   std::vector<double> input_range;  // fixed point: LO,HI
   double relay_time_s = 60.0, max_time_s = 7200.0;
-  std::string method = "amigo";
+  std::string method = "optimal";
   double robustness = 1.4, response_time_s = 0.0, max_overshoot_pct = 60.0;
 
   template <typename Archive>
@@ -77,11 +77,11 @@ struct AutotuneSpec {
     a->Visit({"relay_time", "the first relay episode's relay window", "s", kNone, "30"}, &relay_time_s);
     a->Visit({"max_time", "the longest relay window", "s", kNone, "600"}, &max_time_s);
     a->Visit({"method",
-              "the design on the identified model: amigo, simc, migo or optimal (pidlab's design engine)", "",
+              "the design on the identified model: optimal (pidlab's design engine, the default), amigo, simc or migo", "",
               kNone, R"("simc")"},
              &method);
-    a->Visit({"robustness", "migo: the Ms bound it designs to", "", kNone, "1.6"}, &robustness);
-    a->Visit({"response_time", "migo: the response time it designs to (0: fastest)", "s", kNone, "5"},
+    a->Visit({"robustness", "optimal and migo: the Ms bound they design to", "", kNone, "1.6"}, &robustness);
+    a->Visit({"response_time", "optimal and migo: the response time they design to (0: the fastest at the Ms bound)", "s", kNone, "5"},
              &response_time_s);
     a->Visit({"max_overshoot", "adopt only gains whose step on the trio overshoots at most this, %", "",
               kNone, "30"},

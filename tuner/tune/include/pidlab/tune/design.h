@@ -110,6 +110,9 @@ struct DesignSummary {
   /// A crossover asked for that the front does not reach within 1 % (it
   /// jumps there: another optimum takes over): the nearest design, said so.
   std::string front_note;
+  /// The plant acts in reverse (a negative gain): designed as -G, the gains
+  /// all <= 0 (said in `message`).
+  bool reverse_acting = false;
   /// Candidates evaluated (each a load-step simulation).
   int evaluations = 0;
   /// One line: the engine, the bounds, the gains and the load IAE.
@@ -121,10 +124,10 @@ struct DesignSummary {
 double DominantTimeConstant(const Plant& plant);
 
 /// The design on `plant` (linear, strictly proper or proper, its dead time
-/// included). kInvalidInput naming the cause: invalid options, a nonlinear
-/// plant, a reverse-acting plant (negative gain: not designed yet), no
-/// stable loop that meets the bounds, or a crossover outside the front's
-/// reachable range (the range named).
+/// included; a reverse-acting plant gets gains <= 0). kInvalidInput naming
+/// the cause: invalid options, a nonlinear plant, no stable loop that meets
+/// the bounds, or a crossover outside the front's reachable range (the
+/// range named).
 Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSummary* summary);
 
 /// `--robustness` as a phase margin (deg, in [20, 80]): the largest Ms
