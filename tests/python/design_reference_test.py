@@ -26,7 +26,8 @@ as long and on 4x the samples). A reverse-acting plant (a negative gain) must ge
 design.reverse_acting: the reference then designs for -G, and pidlab's
 gains, their sign turned, are checked against it (the same loop). One line per case
 (plant, G, pidlab's design.load_iae, the reference optimum's IAE, pidlab's
-gains' IAE by the reference, their ratio to the optimum's, both Ms), failing
+gains' IAE by the reference, their ratio to the optimum's, both Ms, and
+pidlab's wall time for the design, s: bench/design_bench.sh tabulates them), failing
 ones starting "FAIL: ", and last `N passed, M failed`; exit 1 on any
 failure. Deterministic (no random starts); about 100 s of CPU.
 
@@ -159,8 +160,8 @@ def check_case(pidlab, name, plant, num, den, delay, g, pi, previous):
                 "noise %.5g); reference kp %.10g ki %.10g kd %.10g tf %.10g (Ms %.5g Mt %.5g noise %.5g)"
                 % (100 * (ratio - 1), gains["kp"], gains["ki"], gains["kd"], gains["tf"], a["ms"], a["mt"],
                    a["noise_gain"], og["kp"], og["ki"], og["kd"], og["tf"], oa["ms"], oa["mt"], oa["noise_gain"]))
-    line = "%-18s %10.4g %12.6g %12.6g %12.6g %8.4f %7.4f %7.4f" % (label, g, iae_p, iae_r, iae_pr, ratio, a["ms"],
-                                                                  ms_r)
+    line = "%-18s %10.4g %12.6g %12.6g %12.6g %8.4f %7.4f %7.4f %7.3f" % (
+        label, g, iae_p, iae_r, iae_pr, ratio, a["ms"], ms_r, float(j.get("wall_time_s", math.nan)))
     if problems:
         return "FAIL: " + line + "  " + "; ".join(problems), False, x_ref, ratio
     return line + "  ok", True, x_ref, ratio
@@ -174,8 +175,8 @@ def main(argv):
     t0 = time.time()
     passed = failed = 0
     ratios = []
-    print("%-18s %10s %12s %12s %12s %8s %7s %7s  %s" % ("plant", "G", "pidlab IAE", "ref IAE", "pidlab(ref)",
-                                                       "ratio", "Ms", "ref Ms", "verdict"))
+    print("%-18s %10s %12s %12s %12s %8s %7s %7s %7s  %s" % ("plant", "G", "pidlab IAE", "ref IAE", "pidlab(ref)",
+                                                           "ratio", "Ms", "ref Ms", "time", "verdict"))
     cases = [(name, num, den, delay, False) for name, num, den, delay in plants()]
     cases += [(name, num, den, delay, True) for name, num, den, delay in plants() if name in PI_PLANTS]
     for name, num, den, delay, pi in cases:
