@@ -154,7 +154,7 @@ class Reference {
   double LastP() const { return gains_.kp * (1.0 * prev_r_ - prev_y_); }
   void Remember(double r, double y) {
     jump_bound_ = std::fabs(gains_.kp * (r - y) - LastP()) +
-                  gains_.ki * options_.dt_s * (std::fabs(r - y) + std::fabs(prev_r_ - prev_y_)) +
+                  std::fabs(gains_.ki) * options_.dt_s * (std::fabs(r - y) + std::fabs(prev_r_ - prev_y_)) +
                   std::fabs(Derivative(pid_.get()) - last_d_);
     last_d_ = Derivative(pid_.get());
     term_scale_ =
@@ -252,6 +252,10 @@ struct Comparison {
   double worst_relative = 0.0;       // to Scale(u, peak)
   double worst_relative_to_u = 0.0;  // to Scale(u, no peak)
   double worst_lsb = 0.0;            // fixed point: |u_q - u| in LSB of the output
+  // Reverse-acting runs: the gains all <= 0, a tenth of the gain changes
+  // turning the direction (counted).
+  bool reverse = false;
+  long direction_changes = 0;
 };
 
 /// Scale of the output for a relative error: the largest of |u|, the
@@ -277,9 +281,14 @@ void RandomEvent(std::mt19937* rng, const CompiledModule& m, void* dut, Referenc
   const double what = unit(*rng);
   if (what < 0.3) {
     PidGains g = ref->gains();
-    g.kp = 10.0 * unit(*rng);
-    g.ki = 20.0 * unit(*rng);
-    g.kd = unit(*rng);
+    double sign = GainsAreReverse(g) ? -1.0 : 1.0;
+    if (out->reverse && unit(*rng) < 0.1) {
+      sign = -sign;
+      ++out->direction_changes;
+    }
+    g.kp = sign * 10.0 * unit(*rng);
+    g.ki = sign * 20.0 * unit(*rng);
+    g.kd = sign * unit(*rng);
     g.tf = unit(*rng) < 0.3 ? 0.0 : 0.001 + 0.1 * unit(*rng);
     if (m.quantize_input_) g.kd *= 100.0 * ref->options().dt_s;
     const int status = m.set_gains_(dut, g.kp, g.ki, g.kd, g.tf);
@@ -315,10 +324,11 @@ void RandomEvent(std::mt19937* rng, const CompiledModule& m, void* dut, Referenc
 /// `steps` random steps of the compiled module against the reference.
 /// exact: compare bits; else the relative error's worst case.
 Comparison RunRandom(Scalar scalar, std::uint32_t seed, int controllers, int steps_each,
-                     double lsb_tolerance = 0.0) {
+                     double lsb_tolerance = 0.0, bool reverse = false) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   Comparison out;
+  out.reverse = reverse;
   // A double or float module takes every gain and option at run time
   // (shim_new), so one compiled module serves every random controller; a
   // fixed-point module is compiled for each, its Q formats coming from that
@@ -330,6 +340,7 @@ Comparison RunRandom(Scalar scalar, std::uint32_t seed, int controllers, int ste
       // A derivative the fixed-point range analysis takes (kd/dt <= 100).
       c.gains.kd *= 100.0 * c.pid.dt_s;
     }
+    if (reverse) c.gains = {-c.gains.kp, -c.gains.ki, -c.gains.kd, c.gains.tf};
     std::unique_ptr<CompiledModule>& slot = IsFixed(scalar) ? own : shared;
     if (!slot || IsFixed(scalar))
       slot = std::make_unique<CompiledModule>(Code(scalar, c),
@@ -416,7 +427,7 @@ TEST(Generate, ThrowsNamingGainsThatDifferInSign) {
   EXPECT_NE(GenerateError(Options{}, c).find("kp = -2"), std::string::npos) << GenerateError(Options{}, c);
 }
 
-TEST(Generate, TakesAReverseActingPidInDoubleAndRefusesItInFixedPointInOneLine) {
+TEST(Generate, TakesAReverseActingPidInDoubleAndInFixedPointWithTheSameRangeAnalysis) {
   Controller c;
   c.gains = {-2.0, -1.0, -0.1, 0.01};
   c.pid.output_min = -1.0;
@@ -424,9 +435,12 @@ TEST(Generate, TakesAReverseActingPidInDoubleAndRefusesItInFixedPointInOneLine) 
   EXPECT_EQ(GenerateError(Options{}, c), "");
   Options q;
   q.scalar = Scalar::kQ31;
-  const std::string e = GenerateError(q, c);
-  EXPECT_NE(e.find("reverse-acting"), std::string::npos) << e;
-  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  EXPECT_EQ(GenerateError(q, c), "");
+  Controller direct = c;
+  direct.gains = {2.0, 1.0, 0.1, 0.01};
+  const FixedScale r = FixedPointScale(q, c), d = FixedPointScale(q, direct);
+  EXPECT_EQ(r.input_full_scale, d.input_full_scale);
+  EXPECT_EQ(r.output_full_scale, d.output_full_scale);
 }
 
 TEST(Generate, ThrowsNamingASetpointWeightOutsideZeroOne) {
@@ -514,6 +528,26 @@ TEST(ExportedPid, Q31IsWithin2LsbOfDiscretePidOver100000RandomSteps) {
   EXPECT_EQ(c.jumps, 0);
   std::printf("q31: worst |u_q31 - u_double| = %.3g LSB; %ld saturated steps, %ld changes\n", c.worst_lsb,
               c.saturated, c.changes);
+}
+
+TEST(ExportedPid, AReverseActingPidInDoubleEqualsDiscretePidBitForBitAndTurnsDirectionWithoutABump) {
+  const Comparison c = RunRandom(Scalar::kDouble, 20261202, 20, 5000, 0.0, true);
+  EXPECT_EQ(c.steps, 100000);
+  EXPECT_EQ(c.mismatches, 0);
+  EXPECT_EQ(c.outside_limits, 0);
+  EXPECT_GT(c.saturated, 1000);
+  EXPECT_GT(c.direction_changes, 5);
+  EXPECT_EQ(c.jumps, 0);
+}
+
+TEST(ExportedPid, AReverseActingPidInQ31IsWithin2LsbOfDiscretePidAndTurnsDirectionWithoutABump) {
+  const Comparison c = RunRandom(Scalar::kQ31, 3102, 20, 5000, 2.0, true);
+  EXPECT_EQ(c.steps, 100000);
+  EXPECT_EQ(c.mismatches, 0) << "worst " << c.worst_lsb << " LSB";
+  EXPECT_EQ(c.outside_limits, 0);
+  EXPECT_GT(c.saturated, 1000);
+  EXPECT_GT(c.direction_changes, 5);
+  EXPECT_EQ(c.jumps, 0);
 }
 
 TEST(ExportedPid, Q15IsWithin1LsbOfDiscretePidOver100000RandomSteps) {

@@ -75,6 +75,9 @@ typedef struct {
   int64_t prev_error, prev_r, prev_y; /* input units (2^-31 of the input full scale) */
   int manual;
   int64_t manual_output;
+  /* Gains all <= 0 (a reverse-acting plant's): run as the PID of |gains| on
+   * -r and -y, the same u; the inputs kept above are the negated ones. */
+  int reverse;
 } pidlab_pid;
 
 extern const pidlab_pid_config pidlab_pid_tuned;
@@ -194,18 +197,24 @@ static int pidlab_finite(double x) { return x - x == 0.0; }
 
 /* The worst case of |p| + |D| + |u| of a configuration, in the loop's output
  * units: what the range analysis bounds. */
+static double pidlab_abs(double x) { return x < 0.0 ? -x : x; }
+
 static double pidlab_worst_case(const pidlab_pid_config *c) {
   const double limit = c->output_max > -c->output_min ? c->output_max : -c->output_min;
-  return c->kp * (c->setpoint_weight_b + 1.0) * PIDLAB_INPUT_RANGE_REAL + c->kd * (1.0 + c->setpoint_weight_c) * PIDLAB_INPUT_SPAN_REAL / c->dt_s +
-         limit;
+  return pidlab_abs(c->kp) * (c->setpoint_weight_b + 1.0) * PIDLAB_INPUT_RANGE_REAL +
+         pidlab_abs(c->kd) * (1.0 + c->setpoint_weight_c) * PIDLAB_INPUT_SPAN_REAL / c->dt_s + limit;
 }
+
+/* Gains all <= 0 with one < 0: a reverse-acting loop. */
+static int pidlab_reverse(const pidlab_pid_config *c) { return c->kp < 0.0 || c->ki < 0.0 || c->kd < 0.0; }
 
 static int pidlab_unit(double x) { return x >= 0.0 && x <= 1.0; }
 
 static int pidlab_config_valid(const pidlab_pid_config *c) {
-  if (!(pidlab_finite(c->kp) && c->kp >= 0.0 && pidlab_finite(c->ki) && c->ki >= 0.0 && pidlab_finite(c->kd) &&
-        c->kd >= 0.0 && pidlab_finite(c->tf) && c->tf >= 0.0))
+  /* kp, ki, kd share one sign: all >= 0, or all <= 0 (reverse acting) */
+  if (!(pidlab_finite(c->kp) && pidlab_finite(c->ki) && pidlab_finite(c->kd) && pidlab_finite(c->tf) && c->tf >= 0.0))
     return 0;
+  if (!((c->kp >= 0.0 && c->ki >= 0.0 && c->kd >= 0.0) || (c->kp <= 0.0 && c->ki <= 0.0 && c->kd <= 0.0))) return 0;
   if (!pidlab_unit(c->setpoint_weight_b) || !pidlab_unit(c->setpoint_weight_c) || !pidlab_finite(c->dt_s) || !(c->dt_s > 0.0)) return 0;
   if (!pidlab_finite(c->output_min) || !pidlab_finite(c->output_max) || !(c->output_min < c->output_max)) return 0;
   if (c->output_max > PIDLAB_OUTPUT_FULL_SCALE || c->output_min < -PIDLAB_OUTPUT_FULL_SCALE) return 0;
@@ -219,9 +228,10 @@ static int pidlab_config_valid(const pidlab_pid_config *c) {
 /* The integer coefficients of a valid configuration; 0 if one does not fit. */
 static int pidlab_coefficients(const pidlab_pid_config *c, pidlab_pid *pid) {
   const double a = PIDLAB_ACC_PER_INPUT_REAL;
-  return pidlab_encode(c->kp * a, &pid->kp) && pidlab_encode(c->ki * c->dt_s * a, &pid->ki_dt) &&
-         pidlab_encode(c->ki * (c->dt_s * 0.5) * a, &pid->ki_half_dt) &&
-         pidlab_encode(c->kd / (c->tf + c->dt_s) * a, &pid->kd_k) &&
+  const double kp = pidlab_abs(c->kp), ki = pidlab_abs(c->ki), kd = pidlab_abs(c->kd);
+  return pidlab_encode(kp * a, &pid->kp) && pidlab_encode(ki * c->dt_s * a, &pid->ki_dt) &&
+         pidlab_encode(ki * (c->dt_s * 0.5) * a, &pid->ki_half_dt) &&
+         pidlab_encode(kd / (c->tf + c->dt_s) * a, &pid->kd_k) &&
          pidlab_encode(c->dt_s / (c->tf + c->dt_s), &pid->pole_g) &&
          pidlab_encode(c->back_calculation_gain * c->dt_s, &pid->aw) && pidlab_encode(c->setpoint_weight_b, &pid->b) &&
          pidlab_encode(c->setpoint_weight_c, &pid->c);
@@ -233,6 +243,14 @@ static int pidlab_apply(pidlab_pid *pid, const pidlab_pid_config *config) {
   if (!pidlab_config_valid(config)) return 0;
   next.config = *config;
   if (!pidlab_coefficients(config, &next)) return 0;
+  if (pidlab_reverse(config) != next.reverse) {
+    /* The inputs kept change sign with the direction; the integral and the
+     * derivative are in u's units, the same either way. */
+    next.prev_error = -next.prev_error;
+    next.prev_r = -next.prev_r;
+    next.prev_y = -next.prev_y;
+    next.reverse = pidlab_reverse(config);
+  }
   next.output_min = pidlab_round_to_int64(config->output_min * PIDLAB_ACC_ONE_REAL);
   next.output_max = pidlab_round_to_int64(config->output_max * PIDLAB_ACC_ONE_REAL);
   *pid = next;
@@ -248,6 +266,7 @@ static int64_t pidlab_limit_integral(int64_t i) { return pidlab_clamp(i, -PIDLAB
 pidlab_pid_status pidlab_pid_init(pidlab_pid *pid, const pidlab_pid_config *config) {
   pidlab_pid next;
   pidlab_pid_reset(&next);
+  next.reverse = 0;
   if (!pidlab_apply(&next, config)) return PIDLAB_PID_INVALID_CONFIG;
   *pid = next;
   return PIDLAB_PID_OK;
@@ -280,7 +299,8 @@ static pidlab_q pidlab_output(int64_t acc) {
 
 pidlab_pid_status pidlab_pid_step(pidlab_pid *pid, pidlab_q r_q, pidlab_q y_q, pidlab_q *u) {
   const pidlab_pid_config *c = &pid->config;
-  const int64_t r = pidlab_input(r_q), y = pidlab_input(y_q);
+  const int64_t r = pid->reverse ? -pidlab_input(r_q) : pidlab_input(r_q);
+  const int64_t y = pid->reverse ? -pidlab_input(y_q) : pidlab_input(y_q);
   const int64_t e = r - y;
   const int64_t p = pidlab_mul(pidlab_mul(r, pid->b) - y, pid->kp);
   int64_t integral = pid->integral, d, unsaturated, out, delta_signal;

@@ -227,10 +227,6 @@ GeneratedCode Generate(const Options& options, const Controller& controller) {
     throw std::invalid_argument(
         "--autotune: the relay autotune is exported in double, q31 and q15, not float");
   if (options.scalar == Scalar::kQ31 || options.scalar == Scalar::kQ15) {
-    if (GainsAreReverse(controller.gains))
-      throw std::invalid_argument("--scalar " + ToString(options.scalar) +
-                                  ": the fixed-point PID takes gains >= 0; a reverse-acting PID (negative "
-                                  "gains) is exported in double or float");
     GeneratedCode code =
         internal::GenerateFixed(options, controller, CommentBody(CommentLines(options, controller)));
     if (options.autotune) {

@@ -72,8 +72,8 @@ Scaling Scale(const Options& o, const Controller& c) {
   s.u = PowerOfTwoAtLeast(s.u_limit);
   const double tf = EffectiveDerivativeFilter(c.gains, c.pid);
   (void)tf;
-  s.p_max = c.gains.kp * (c.setpoint_weight_b + 1.0) * s.range;
-  s.d_max = c.gains.kd * (1.0 + c.setpoint_weight_c) * s.span / c.pid.dt_s;
+  s.p_max = std::fabs(c.gains.kp) * (c.setpoint_weight_b + 1.0) * s.range;
+  s.d_max = std::fabs(c.gains.kd) * (1.0 + c.setpoint_weight_c) * s.span / c.pid.dt_s;
   s.worst = s.p_max + s.d_max + s.u_limit;
   s.worst_max = 2.0 * s.worst;
   s.guard = std::min(30, 32 - static_cast<int>(std::ceil(std::log2(8.0 * s.worst_max / s.u))));

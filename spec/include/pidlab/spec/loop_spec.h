@@ -400,7 +400,7 @@ struct EvaluateSpec {
   template <typename Archive>
   void Serialize(Archive* a) {
     plant.Serialize(a);
-    a->Visit({"gains", "KP,KI,KD (each finite and >= 0)", "", kEpisode, "[2, 1, 1.5]"}, &gains);
+    a->Visit({"gains", "KP,KI,KD (finite; all >= 0, or all <= 0 for a reverse-acting plant)", "", kEpisode, "[2, 1, 1.5]"}, &gains);
     loop.Serialize(a);
     bounds.Serialize(a);
     a->Visit(
