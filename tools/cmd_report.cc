@@ -75,11 +75,8 @@ struct ReportCommand {
           !st.ok())
         throw std::runtime_error(st.message());
     } else {
-      if (!std::filesystem::is_regular_file(options.paper_tables))
-        throw BadInput("paper tables not found: " + Quote(options.paper_tables) +
-                       " (use --paper-tables FILE)");
       if (const Status st = report::ReadPaperTables(options.paper_tables, &paper); !st.ok())
-        throw BadInput(st.message());
+        throw BadInput("--paper-tables " + st.message());
     }
     report::ReportData data;
     if (const Status st = report::ComputeReport(options, paper, &data); !st.ok())
