@@ -13,7 +13,6 @@
 #include <map>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <sstream>
 
 #include "pidlab/spec/json.h"
@@ -32,7 +31,7 @@ using Response = http::response<http::string_body>;
 using internal::PathOf;
 using internal::PercentDecoded;
 using internal::QueryValue;
-using internal::SameSecret;
+using internal::JsonLibraryWords;
 
 bool IsUpload(const Request& req) {
   return req.method() == http::verb::post && PathOf(std::string(req.target())) == "/api/upload";
@@ -44,13 +43,6 @@ constexpr std::chrono::seconds kBodyTimeout{30};
 // WebSocket replies waiting beyond this many bytes: the session stops reading
 // requests until they are written (a client that sends and never reads).
 constexpr std::size_t kMaxQueuedReplyBytes = 1 << 20;
-
-// The JSON library's words for a mistake without its "[json.exception.type_error.302] ".
-std::string JsonLibraryWords(const nlohmann::json::exception& e) {
-  const std::string what = e.what();
-  const std::size_t end = what.find("] ");
-  return what.rfind("[json.exception.", 0) == 0 && end != std::string::npos ? what.substr(end + 2) : what;
-}
 
 Response JsonResponse(const Request& req, http::status status, const nlohmann::json& body) {
   Response res{status, req.version()};
@@ -84,17 +76,14 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     ++(counters.*field);
   }
 
-  // Whether a new connection from `address` may open, after closing the
-  // connection idle longest where a cap is reached (that address's own
-  // first, then any).
+  // Whether a new connection from `address` may open (slots.h: the
+  // connections idle longest closed for it where a cap is reached).
   bool MakeRoom(const std::string& address) {
-    const auto evict = [this](const std::string* of) {
-      if (!slots.EvictIdleLongest(of)) return false;
-      Count(&ServerCounters::evicted);
-      return true;
-    };
-    if (slots.Count(&address) >= options.max_connections_per_address && !evict(&address)) return false;
-    return slots.Count(nullptr) < options.max_connections || evict(nullptr);
+    int evicted = 0;
+    const bool room =
+        slots.MakeRoom(address, options.max_connections_per_address, options.max_connections, &evicted);
+    for (; evicted > 0; --evicted) Count(&ServerCounters::evicted);
+    return room;
   }
 
   // The request bodies held in memory at once, every connection's together.
@@ -102,27 +91,14 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     return std::max({options.max_bodies_bytes, options.max_upload_bytes, options.max_body_bytes});
   }
 
-  // Why `req` may not be served (token, host, origin), or empty.
+  // Why `req` may not be served (token, host, origin), or empty (url.h).
   std::pair<http::status, std::string> Refusal(const Request& req) const {
-    if (!options.token.empty()) {
-      std::string given = QueryValue(std::string(req.target()), "token");
-      const std::string auth(req[http::field::authorization]);
-      if (given.empty() && auth.rfind("Bearer ", 0) == 0) given = auth.substr(7);
-      if (!SameSecret(given, options.token)) return {http::status::unauthorized, "a valid token is required"};
-    }
-    const std::string host(req[http::field::host]);
-    const std::string suffix = ":" + std::to_string(port);
-    std::set<std::string> hosts = {"127.0.0.1" + suffix, "localhost" + suffix, "[::1]" + suffix};
-    hosts.insert((options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind) +
-                 suffix);
-    // Bound to every address: any Host, as the token guards it.
-    const bool any = options.bind == "0.0.0.0" || options.bind == "::";
-    if (!any && hosts.count(host) == 0)
-      return {http::status::forbidden, "Host '" + host + "' is not this server"};
     const auto origin = req.find(http::field::origin);
-    if (origin != req.end() && std::string(origin->value()) != "http://" + host)
-      return {http::status::forbidden, "Origin '" + std::string(origin->value()) + "' is not this server's"};
-    return {http::status::ok, ""};
+    const std::string origin_text = origin == req.end() ? "" : std::string(origin->value());
+    const auto [status, why] = internal::Refusal(
+        options, port, std::string(req.target()), std::string(req[http::field::authorization]),
+        std::string(req[http::field::host]), origin == req.end() ? nullptr : &origin_text);
+    return {static_cast<http::status>(status), why};
   }
 
   // One request object through the handler: the reply's status and body.
@@ -144,7 +120,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     } catch (const nlohmann::json::exception& e) {
       // A field of the wrong JSON type ({"type": 5}): the request's mistake.
       Count(&ServerCounters::malformed);
-      reply = {400, {{"error", "the request is not of the expected form: " + JsonLibraryWords(e)}}};
+      reply = {400, {{"error", "the request is not of the expected form: " + JsonLibraryWords(e.what())}}};
     } catch (const std::exception& e) {
       reply = {500, {{"error", std::string("the server failed: ") + e.what()}}};
     }
@@ -236,10 +212,12 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
     timeout.keep_alive_pings = true;
     ws_.set_option(timeout);
     ws_.read_message_max(server_->options.max_message_bytes);
-    // Closed for a new connection when it is the one idle longest.
-    server_->slots.Idle(slot_, [weak = weak_from_this()] {
+    // Closed for a new connection when it is the one idle longest, and when the server stops.
+    const auto close = [weak = weak_from_this()] {
       if (auto self = weak.lock()) self->Evict();
-    });
+    };
+    server_->slots.Idle(slot_, close);
+    server_->slots.OnStop(slot_, close);
     ws_.async_accept(req, beast::bind_front_handler(&WebSocketSession::OnAccept, shared_from_this()));
   }
 
@@ -367,7 +345,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   ~HttpSession() {
     if (slot_) server_->slots.Close(slot_);
   }
-  void Run() { Read(); }
+  void Run() {
+    server_->slots.OnStop(slot_, [weak = weak_from_this()] {
+      beast::error_code ignored;
+      if (auto self = weak.lock()) self->stream_.socket().close(ignored);
+    });
+    Read();
+  }
 
  private:
   void Read() {
@@ -586,7 +570,16 @@ Status Server::Start() {
 
 int Server::port() const { return impl_->port; }
 
-void Server::Run() { impl_->io.run(); }
+void Server::Run() {
+  impl_->io.run();
+  // Stopped: every connection is closed and its handlers run to their end,
+  // so that no session (each holds the Impl) is left holding the server.
+  beast::error_code ignored;
+  impl_->acceptor.close(ignored);
+  impl_->slots.CloseAll();
+  impl_->io.restart();
+  impl_->io.run_for(std::chrono::seconds(2));
+}
 
 void Server::Stop() { impl_->io.stop(); }
 

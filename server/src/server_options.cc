@@ -1,9 +1,11 @@
-// ServerOptions::IsValid, IsLoopback and the text helpers of url.h.
+// ServerOptions::IsValid, IsLoopback, and the request checks and text helpers of url.h.
 
 #include <boost/asio/ip/address.hpp>
 #include <cctype>
+#include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "pidlab/server/server.h"
 #include "url.h"
@@ -46,6 +48,30 @@ bool SameSecret(const std::string& a, const std::string& b) {
   unsigned char diff = 0;
   for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
   return diff == 0;
+}
+
+std::pair<int, std::string> Refusal(const ServerOptions& options, int port, const std::string& target,
+                                    const std::string& authorization, const std::string& host,
+                                    const std::string* origin) {
+  if (!options.token.empty()) {
+    std::string given = QueryValue(target, "token");
+    if (given.empty() && authorization.rfind("Bearer ", 0) == 0) given = authorization.substr(7);
+    if (!SameSecret(given, options.token)) return {401, "a valid token is required"};
+  }
+  const std::string suffix = ":" + std::to_string(port);
+  std::set<std::string> hosts = {"127.0.0.1" + suffix, "localhost" + suffix, "[::1]" + suffix};
+  hosts.insert((options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind) +
+               suffix);
+  // Bound to every address: any Host, as the token guards it.
+  const bool any = options.bind == "0.0.0.0" || options.bind == "::";
+  if (!any && hosts.count(host) == 0) return {403, "Host '" + host + "' is not this server"};
+  if (origin && *origin != "http://" + host) return {403, "Origin '" + *origin + "' is not this server's"};
+  return {200, ""};
+}
+
+std::string JsonLibraryWords(const std::string& what) {
+  const std::size_t end = what.find("] ");
+  return what.rfind("[json.exception.", 0) == 0 && end != std::string::npos ? what.substr(end + 2) : what;
 }
 
 }  // namespace internal

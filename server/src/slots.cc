@@ -3,6 +3,7 @@
 #include "slots.h"
 
 #include <utility>
+#include <vector>
 
 namespace pidlab::server::internal {
 
@@ -35,6 +36,18 @@ void Slots::Busy(Id id) {
   if (e != entries_.end()) e->second.close = nullptr;
 }
 
+void Slots::OnStop(Id id, std::function<void()> close) {
+  const auto e = entries_.find(id);
+  if (e != entries_.end()) e->second.stop = std::move(close);
+}
+
+void Slots::CloseAll() {
+  std::vector<std::function<void()>> stops;
+  for (auto& [id, e] : entries_)
+    if (e.stop) stops.push_back(std::move(e.stop));
+  for (const auto& stop : stops) stop();
+}
+
 int Slots::Count(const std::string* address) const {
   if (!address) return static_cast<int>(entries_.size());
   int n = 0;
@@ -54,6 +67,16 @@ bool Slots::EvictIdleLongest(const std::string* address) {
   entries_.erase(oldest);
   close();
   return true;
+}
+
+bool Slots::MakeRoom(const std::string& address, int per_address_cap, int cap, int* evicted) {
+  const auto evict = [this, evicted](const std::string* of) {
+    if (!EvictIdleLongest(of)) return false;
+    ++*evicted;
+    return true;
+  };
+  if (Count(&address) >= per_address_cap && !evict(&address)) return false;
+  return Count(nullptr) < cap || evict(nullptr);
 }
 
 bool Slots::HoldBody(Id id, std::size_t bytes, std::size_t budget) {

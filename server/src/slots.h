@@ -35,11 +35,20 @@ class Slots {
   void Touch(Id id);
   /// `id` is answering a request: never closed for a new one until Idle().
   void Busy(Id id);
+  /// How to close `id` whatever it is doing, when the server stops.
+  void OnStop(Id id, std::function<void()> close);
+  /// Closes every connection (the server has stopped): their handlers then
+  /// end, and with them the sessions that hold the server.
+  void CloseAll();
   /// The connections open, of `address` only if not null.
   int Count(const std::string* address) const;
   /// Closes the connection (of `address` if not null) idle longest and frees
   /// its slot now; false if none is idle.
   bool EvictIdleLongest(const std::string* address);
+  /// Whether a new connection from `address` may open under the caps (of one
+  /// address, of all), after closing the connection idle longest where one
+  /// is reached (that address's own first); how many were closed in *evicted.
+  bool MakeRoom(const std::string& address, int per_address_cap, int cap, int* evicted);
   /// Holds `bytes` of request body for `id` if every body held stays within
   /// `budget` bytes; false, and nothing held, if not.
   bool HoldBody(Id id, std::size_t bytes, std::size_t budget);
@@ -53,6 +62,7 @@ class Slots {
     std::string address;
     Clock::time_point since;
     std::function<void()> close;  // set while idle
+    std::function<void()> stop;   // closes it whatever it is doing
     std::size_t body_bytes = 0;
   };
   std::map<Id, Entry> entries_;
