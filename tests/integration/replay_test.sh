@@ -171,12 +171,25 @@ fi
 # ---- an altered command ----
 "$tamper" run.lcmlog altered.lcmlog alter-command 1234 || fail "tamper alter-command"
 status=0
-"$pidlab" replay altered.lcmlog --episode "$id" --redrive >altered.txt 2>&1 || status=$?
+"$pidlab" replay altered.lcmlog --episode "$id" --redrive >altered.txt 2>altered.err || status=$?
 if [[ $status -eq 1 ]] && grep -q "redrive: FAILED, first mismatch at step 1234 " altered.txt &&
-   grep -q "logged u = .*, recomputed u = " altered.txt; then
-  pass "--redrive points at the altered command (step 1234) with both values"
+   grep -q "logged u = .*, recomputed u = " altered.txt && [[ $(wc -l <altered.err) -eq 1 ]] &&
+   grep -q "^pidlab replay: .*--redrive: 1 of 1 episodes did not reproduce; episode $id: first mismatch at step 1234 " altered.err; then
+  pass "--redrive points at the altered command (step 1234) with both values, and says why in one line"
 else
-  fail "--redrive on the altered log (status $status): $(cat altered.txt)"
+  fail "--redrive on the altered log (status $status): $(cat altered.txt altered.err)"
+fi
+
+# ---- one forged event of an episode whose configuration is in no log ----
+"$tamper" run.lcmlog orphan.lcmlog inject-orphan || fail "tamper inject-orphan"
+status=0
+"$pidlab" replay orphan.lcmlog --redrive >orphan.txt 2>orphan.err || status=$?
+real=$(grep -c "redrive: OK, all .* reproduced bit for bit" orphan.txt)
+if [[ $status -eq 0 ]] && [[ $real -ge 1 ]] && [[ $real -eq $(grep -c "redrive: OK" redrive.txt) ]] &&
+   grep -q "redrive: SKIPPED, episode 987654321 has no configuration in the log" orphan.txt && [[ ! -s orphan.err ]]; then
+  pass "--redrive with an orphan event: the $real real episode(s) reproduce (exit 0), the orphan is named and skipped"
+else
+  fail "--redrive with an orphan event (status $status): $(cat orphan.txt orphan.err | head -20)"
 fi
 
 # ---- redrive against a live controller (started alone in this namespace) ----
