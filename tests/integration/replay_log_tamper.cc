@@ -6,8 +6,9 @@
 //                                                 the trio's URL does not hear: the chunks carry u)
 //   replay_log_tamper IN OUT inject-garbage       foreign, unknown-type and undecodable events
 //                                                 between the events of the episode
-//   replay_log_tamper IN OUT inject-orphan        one forged plant output of episode 987654321,
-//                                                 whose configuration is in no log (an orphan)
+//   replay_log_tamper IN OUT inject-orphan        one forged plant output of each of the episodes
+//                                                 987654321..3, whose configuration is in no log
+//                                                 (orphans)
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -92,10 +93,12 @@ int main(int argc, char** argv) {
     Put(&out, *ev, &num);
     pidlab::lcmt_plant_output output;
     if (mode == "inject-orphan" && !orphaned && output.decode(ev->data, 0, ev->datalen) == ev->datalen) {
-      output.episode_id = 987654321;
-      std::vector<uint8_t> buf(static_cast<std::size_t>(output.getEncodedSize()));
-      output.encode(buf.data(), 0, static_cast<int>(buf.size()));
-      PutBytes(&out, ev->channel, buf, &num);
+      for (int64_t id : {987654321, 987654322, 987654323}) {
+        output.episode_id = id;
+        std::vector<uint8_t> buf(static_cast<std::size_t>(output.getEncodedSize()));
+        output.encode(buf.data(), 0, static_cast<int>(buf.size()));
+        PutBytes(&out, ev->channel, buf, &num);
+      }
       orphaned = true;
     }
     if (mode == "inject-garbage" && events % 50 == 0) {
