@@ -6,8 +6,8 @@
 # must exit 1 with one line naming "No space left on device" and the path,
 # and leave the folder exactly as it was: the old files, byte for byte, and
 # no temporary. Then export's directory-in-the-way and read-only-old-file
-# cases, and plot over a read-only old PNG (exit 2, one line): non-zero,
-# nothing written.
+# cases, plot over a read-only old PNG and report over a read-only old
+# report.md (exit 2, one line, at once): non-zero, nothing written.
 # usage: full_disk_test.sh PIDLAB_BINARY
 set -uo pipefail
 pidlab=$(realpath -- "${1:?usage: full_disk_test.sh PIDLAB_BINARY}")
@@ -119,6 +119,19 @@ if [ "$rc" -eq 2 ] && [ "$ro_before" = "$ro_after" ] && [ "$(cat plot_ro/evaluat
   pass "plot over a read-only old PNG: exit 2, '$(cat err)', the folder as it was"
 else
   fail "plot over a read-only old PNG: exit $rc, $(cat err), $(ls -A plot_ro)"
+fi
+
+# report over a read-only old report.md: refused before the tunings (under
+# 2 s, exit 2, one line), the old file kept.
+mkdir -p report_ro && echo "old report" > report_ro/report.md && chmod 0444 report_ro/report.md
+rc=0; start=$(date +%s%N)
+"$pidlab" report --quick --no-figures --out report_ro >out 2>err || rc=$?
+ms=$((($(date +%s%N) - start) / 1000000))
+if [ "$rc" -eq 2 ] && [ "$ms" -lt 2000 ] && [ "$(cat report_ro/report.md)" = "old report" ] &&
+   [ "$(ls -A report_ro)" = "report.md" ] && only_line_ok err "read-only" >/dev/null; then
+  pass "report over a read-only old report.md: exit 2 in $ms ms, '$(cat err)', nothing written"
+else
+  fail "report over a read-only old report.md: exit $rc in $ms ms, $(cat err), $(ls -A report_ro)"
 fi
 
 echo "full_disk_test: $passed passed checks, $failed failed"
