@@ -249,7 +249,8 @@ TEST(Server, ClosesAWebSocketThatDoesNotAnswerItsPing) {
   char chunk[256];
   beast::error_code ec;
   while (!ec) bytes.append(chunk, socket.read_some(net::buffer(chunk), ec));
-  const double closed_after_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double closed_after_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_GE(bytes.size(), 2u);
   EXPECT_EQ(static_cast<unsigned char>(bytes[0]), 0x89) << "the first frame is not a ping";
   EXPECT_GE(closed_after_s, 0.35);

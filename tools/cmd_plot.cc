@@ -69,7 +69,8 @@ struct PlotCommand {
     PlotSpec ps;
     std::set<std::string> given;
     flags.Apply(&ps, &given);
-    if (name.empty()) name = log_path.empty() ? "evaluation" : std::filesystem::path(log_path).stem().string();
+    if (name.empty())
+      name = log_path.empty() ? "evaluation" : std::filesystem::path(log_path).stem().string();
     if (name.empty() || name.find('/') != std::string::npos)
       throw BadInput("--name " + Quote(name) + " must be a plain file name stem");
     if (!log_path.empty())
@@ -96,7 +97,8 @@ struct PlotCommand {
     if (!report.empty()) std::cerr << report;
   }
 
-  void FigureOfEvaluation(const PlotSpec& ps, const std::set<std::string>& given, plot::Figure* figure) const {
+  void FigureOfEvaluation(const PlotSpec& ps, const std::set<std::string>& given,
+                          plot::Figure* figure) const {
     if (!episodes.empty()) throw BadInput("--episode needs --log");
     if (gains.empty()) throw BadInput("--gains is required (or --log FILE)");
     Plant p;
@@ -124,7 +126,9 @@ struct PlotCommand {
     figure->output_path = stage->path() + "/" + name + ".png";
     figure->data_dir = stage->path() + "/" + name + "_data";
     if (std::string error; !figure->IsValid(&error)) throw BadInput(error);
-    const auto unstaged = [&stage](const Status& st) { return Status(st.code(), stage->Unstaged(st.message())); };
+    const auto unstaged = [&stage](const Status& st) {
+      return Status(st.code(), stage->Unstaged(st.message()));
+    };
     Require(unstaged(plot::DrawPng(*figure)));
     // The script kept beside the data draws to the figure's own path, not the stage's.
     const std::string script = figure->data_dir + "/figure.gp";
@@ -132,7 +136,8 @@ struct PlotCommand {
     Require(unstaged(io::ReadFile(script, 1 << 20, &text)));
     Require(unstaged(io::WriteFile(script, stage->Unstaged(text))));
     Require(unstaged(stage->Commit()));
-    std::cout << out_dir + "/" + name + ".png" << "\n";
+    std::cout << out_dir + "/" + name + ".png"
+              << "\n";
     return 0;
   }
 };

@@ -58,7 +58,8 @@ struct ReportCommand {
     PrepareOutputDir(out_dir, "--out");  // an unwritable folder is bad input (exit 2), before the work
     // So is a read-only old report.md (or trio.log), found now and not after the tunings.
     for (const char* file : {"report.md", "trio.log"})
-      if (const Status st = io::CheckWritableTarget((std::filesystem::path(out_dir) / file).string()); !st.ok())
+      if (const Status st = io::CheckWritableTarget((std::filesystem::path(out_dir) / file).string());
+          !st.ok())
         throw BadInput("--out " + st.message());
     std::unique_ptr<io::StagedFolder> stage;
     Require(io::StagedFolder::Create(out_dir, &stage));

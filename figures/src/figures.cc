@@ -32,7 +32,8 @@ class EpisodeNotes {
  public:
   // `singular` and `plural` follow the episode(s): "not plotted: ...".
   void Add(long episode_id, const std::string& singular, const std::string& plural) {
-    auto at = std::find_if(notes_.begin(), notes_.end(), [&](const Note& n) { return n.singular == singular; });
+    auto at =
+        std::find_if(notes_.begin(), notes_.end(), [&](const Note& n) { return n.singular == singular; });
     if (at == notes_.end()) at = notes_.insert(notes_.end(), Note{singular, plural, {}});
     at->ids.push_back(episode_id);
   }
@@ -45,7 +46,8 @@ class EpisodeNotes {
       }
       constexpr std::size_t kNamed = 5;
       std::string ids;
-      for (std::size_t i = 0; i < std::min(n.ids.size(), kNamed); ++i) ids += (i ? ", " : "") + std::to_string(n.ids[i]);
+      for (std::size_t i = 0; i < std::min(n.ids.size(), kNamed); ++i)
+        ids += (i ? ", " : "") + std::to_string(n.ids[i]);
       if (n.ids.size() > kNamed) ids += " and " + std::to_string(n.ids.size() - kNamed) + " more";
       out += "note: " + std::to_string(n.ids.size()) + " episodes (" + ids + ") " + n.plural + "\n";
     }

@@ -28,10 +28,10 @@ namespace net = boost::asio;
 using tcp = net::ip::tcp;
 using Request = http::request<http::string_body>;
 using Response = http::response<http::string_body>;
+using internal::JsonLibraryWords;
 using internal::PathOf;
 using internal::PercentDecoded;
 using internal::QueryValue;
-using internal::JsonLibraryWords;
 
 bool IsUpload(const Request& req) {
   return req.method() == http::verb::post && PathOf(std::string(req.target())) == "/api/upload";
@@ -411,14 +411,17 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   // in the server's budget; answers 413 and returns false when that is spent.
   bool HoldBody() {
     const auto length = parser_->content_length();
-    const std::size_t bytes = length ? static_cast<std::size_t>(*length) : parser_->chunked() ? BodyLimit() : 0;
+    const std::size_t bytes = length               ? static_cast<std::size_t>(*length)
+                              : parser_->chunked() ? BodyLimit()
+                                                   : 0;
     const std::size_t budget = server_->BodyBudget();
     if (bytes == 0 || server_->slots.HoldBody(slot_, bytes, budget)) return true;
     server_->Count(&ServerCounters::http_requests);
     server_->Count(&ServerCounters::over_budget);
     Refuse(http::status::payload_too_large,
-           "the server holds " + std::to_string(server_->slots.body_bytes() >> 20) + " MiB of request bodies, " +
-               "within " + std::to_string(budget >> 20) + " MiB for all: send it again once an upload has finished");
+           "the server holds " + std::to_string(server_->slots.body_bytes() >> 20) +
+               " MiB of request bodies, " + "within " + std::to_string(budget >> 20) +
+               " MiB for all: send it again once an upload has finished");
     return false;
   }
 

@@ -42,7 +42,8 @@ void PutBytes(lcm::LogFile* out, const std::string& channel, std::vector<uint8_t
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: replay_log_tamper IN OUT alter-command STEP | inject-garbage | inject-orphan\n");
+    std::fprintf(stderr,
+                 "usage: replay_log_tamper IN OUT alter-command STEP | inject-garbage | inject-orphan\n");
     return 2;
   }
   const std::string mode = argv[3];
