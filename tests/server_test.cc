@@ -46,6 +46,9 @@ class Served {
     if (!handler)
       handler = [padding](const nlohmann::json&) { return Reply{200, {{"ok", true}, {"padding", padding}}}; };
     dut_ = std::make_unique<Server>(options, std::move(handler), std::vector<Asset>{});
+    dut_->SetUploadHandler([](const std::string&, const std::string& body) {
+      return Reply{200, {{"bytes", body.size()}}};
+    });
     std::string error;
     EXPECT_TRUE(IsOk(dut_->Start()));
     thread_ = std::thread([this] { dut_->Run(); });
@@ -275,20 +278,36 @@ TEST(Server, EvictsAConnectionTricklingItsBodyToAdmitANewOne) {
   EXPECT_EQ(served.counters().evicted, 1);
 }
 
-TEST(Server, RefusesABodyThatWouldPassTheBudgetOfEveryBodyInMemory) {
+// Status and body of POST /api/upload with `body`, on a fresh connection.
+std::pair<int, std::string> PostUpload(const Served& served, const std::string& body) {
+  Client client(served);
+  http::request<http::string_body> req{http::verb::post, "/api/upload?name=a.lcmlog", 11};
+  req.set(http::field::host, client.host());
+  req.body() = body;
+  req.prepare_payload();
+  http::write(client.socket(), req);
+  http::response<http::string_body> res;
+  beast::flat_buffer buffer;
+  beast::error_code ec;
+  http::read(client.socket(), buffer, res, ec);
+  return {ec ? -1 : res.result_int(), res.body()};
+}
+
+TEST(Server, RefusesAnUploadThatWouldPassTheBudgetOfEveryUploadInMemory) {
   ServerOptions options;
-  options.max_body_bytes = 4096;
   options.max_upload_bytes = 4096;
   options.max_bodies_bytes = 6000;
   Served served(options);
   Client holding(served);
-  holding.Send("POST /api/request HTTP/1.1\r\nHost: " + holding.host() + "\r\nContent-Length: 4000\r\n\r\n{");
+  holding.Send("POST /api/upload?name=b.lcmlog HTTP/1.1\r\nHost: " + holding.host() +
+               "\r\nContent-Length: 4000\r\n\r\nLCM");
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  const auto [status, body] = PostRequest(served, "{\"x\":\"" + std::string(3000, 'x') + "\"}");
+  const auto [status, body] = PostUpload(served, std::string(3000, 'x'));
   EXPECT_EQ(status, 413);
-  EXPECT_NE(body.find("request bodies"), std::string::npos) << body;
+  EXPECT_NE(body.find("MiB of uploads"), std::string::npos) << body;
   EXPECT_EQ(served.counters().over_budget, 1);
-  EXPECT_EQ(PostRequest(served, "{}").first, 200);  // a small body still fits
+  EXPECT_EQ(PostRequest(served, "{\"x\":\"" + std::string(3000, 'x') + "\"}").first, 200);  // not an upload
+  EXPECT_EQ(PostUpload(served, std::string(1000, 'x')).first, 200);                         // still fits
 }
 
 TEST(Server, AnswersAFieldOfTheWrongJsonTypeWith400AndOneLine) {

@@ -86,10 +86,9 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     return room;
   }
 
-  // The request bodies held in memory at once, every connection's together.
-  std::size_t BodyBudget() const {
-    return std::max({options.max_bodies_bytes, options.max_upload_bytes, options.max_body_bytes});
-  }
+  // The upload bodies held in memory at once, every connection's together
+  // (other bodies are at most max_body_bytes on each of max_connections).
+  std::size_t BodyBudget() const { return std::max(options.max_bodies_bytes, options.max_upload_bytes); }
 
   // Why `req` may not be served (token, host, origin), or empty (url.h).
   std::pair<http::status, std::string> Refusal(const Request& req) const {
@@ -407,9 +406,12 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
                      beast::bind_front_handler(&HttpSession::OnRead, shared_from_this()));
   }
 
-  // Holds the body's bytes (its Content-Length, or its limit when chunked)
+  // Holds an upload's bytes (its Content-Length, or its limit when chunked)
   // in the server's budget; answers 413 and returns false when that is spent.
+  // A request's own body (64 KiB at most) always fits: uploads cannot crowd
+  // out the page's requests.
   bool HoldBody() {
+    if (!IsUpload(parser_->get())) return true;
     const auto length = parser_->content_length();
     const std::size_t bytes = length               ? static_cast<std::size_t>(*length)
                               : parser_->chunked() ? BodyLimit()
@@ -418,10 +420,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     if (bytes == 0 || server_->slots.HoldBody(slot_, bytes, budget)) return true;
     server_->Count(&ServerCounters::http_requests);
     server_->Count(&ServerCounters::over_budget);
-    Refuse(http::status::payload_too_large,
-           "the server holds " + std::to_string(server_->slots.body_bytes() >> 20) +
-               " MiB of request bodies, " + "within " + std::to_string(budget >> 20) +
-               " MiB for all: send it again once an upload has finished");
+    Refuse(http::status::payload_too_large, "the server holds " +
+                                                std::to_string(server_->slots.body_bytes() >> 20) +
+                                                " MiB of uploads, within " + std::to_string(budget >> 20) +
+                                                " MiB for all: send it again once an upload has finished");
     return false;
   }
 

@@ -67,7 +67,7 @@ stored = codes.count(200)
 for status, body in results:
     if status not in (200, 413):
         fail('an upload got %d: %r' % (status, body[:200]))
-    elif status == 413 and (b'\n' in body.strip() or b'request bodies' not in body):
+    elif status == 413 and (b'\n' in body.strip() or b'MiB of uploads' not in body):
         fail('a refused upload does not say why in one line: %r' % body[:200])
 if stored < 1:
     fail('none of %d concurrent uploads was stored: %s' % (UPLOADS, codes))

@@ -18,7 +18,7 @@
 //    address's) are at their cap, the one idle longest (waiting for a header,
 //    trickling a body, a quiet WebSocket) is closed to admit the new one (a
 //    slow loris loses its slot, not the next client);
-//  - the request bodies held in memory at once are bounded in total
+//  - the uploads held in memory at once are bounded in total
 //    (`max_bodies_bytes`): one that would pass it gets 413 on its header;
 //  - request JSON nested deeper than 64 levels is refused (400) before it is
 //    parsed;
@@ -54,9 +54,10 @@ struct ServerOptions {
   std::size_t max_message_bytes = 64 * 1024;
   /// The body of POST /api/upload (a log); 413 above.
   std::size_t max_upload_bytes = 64 * 1024 * 1024;
-  /// Request bodies held in memory at once, every connection's together
-  /// (at least max_upload_bytes): a body that would pass it is refused with
-  /// 413 on its header, before it is read.
+  /// Upload bodies held in memory at once, every connection's together (at
+  /// least max_upload_bytes): an upload that would pass it is refused with
+  /// 413 on its header, before it is read. Other bodies are bounded by
+  /// max_body_bytes on each of max_connections (4 MiB in all by default).
   std::size_t max_bodies_bytes = 64 * 1024 * 1024;
   /// Connections open at once. A new one beyond it closes the connection
   /// idle longest: one waiting for its request header, trickling its body,
@@ -139,7 +140,7 @@ struct ServerCounters {
   long malformed = 0;        // 400, 413, 431 and WebSocket messages that are not JSON objects
   long dropped_replies = 0;  // replaced by a newer one for a slow client
   long evicted = 0;          // closed while idle (the one idle longest), to admit a new connection
-  long over_budget = 0;      // 413: the request bodies in memory at their total limit
+  long over_budget = 0;      // 413: the uploads in memory at their total limit
   long turned_away = 0;      // closed on accept: every slot held by connections that may not be evicted
 };
 
