@@ -1,6 +1,7 @@
 #include "pidlab/server/server.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
@@ -493,9 +494,19 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
                       });
   }
 
+  // After the last reply: what the client still sends (an oversized body's
+  // rest) is dropped for up to 1 s, so that it reads the reply, not a reset.
   void Close() {
     beast::error_code ignored;
     stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+    stream_.expires_after(std::chrono::seconds(1));
+    Drain();
+  }
+  void Drain() {
+    stream_.async_read_some(net::buffer(drained_),
+                            [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                              if (!ec) self->Drain();
+                            });
   }
 
   // Closed while waiting for its request header, to admit a new connection.
@@ -509,6 +520,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::shared_ptr<Server::Impl> server_;
   Server::Impl::Slots::Id slot_;
   bool evicted_ = false;
+  std::array<char, 4096> drained_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
 };
@@ -536,14 +548,6 @@ void Accept(std::shared_ptr<Server::Impl> server) {
 }
 
 }  // namespace
-
-Server::Server(ServerOptions options, Handler handler, std::vector<Asset> assets)
-    : Server(std::move(options),
-             ConnectionHandler([handler = std::move(handler)](const nlohmann::json& request,
-                                                              const std::shared_ptr<Connection>&) {
-               return handler(request);
-             }),
-             std::move(assets)) {}
 
 Server::Server(ServerOptions options, ConnectionHandler handler, std::vector<Asset> assets)
     : impl_(std::make_shared<Impl>()) {

@@ -1,7 +1,9 @@
-// ServerOptions::IsValid, IsLoopback, and the request checks and text helpers of url.h.
+// ServerOptions::IsValid, IsLoopback, the request checks and text helpers of
+// url.h, and the Server constructor for a plain Handler.
 
 #include <boost/asio/ip/address.hpp>
 #include <cctype>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string>
@@ -109,5 +111,14 @@ bool ServerOptions::IsValid(std::string* error) const {
   if (error) *error = e;
   return e.empty();
 }
+
+// The plain handler's constructor: the connection handler's, without the connection.
+Server::Server(ServerOptions options, Handler handler, std::vector<Asset> assets)
+    : Server(std::move(options),
+             ConnectionHandler([handler = std::move(handler)](const nlohmann::json& request,
+                                                              const std::shared_ptr<Connection>&) {
+               return handler(request);
+             }),
+             std::move(assets)) {}
 
 }  // namespace pidlab::server
