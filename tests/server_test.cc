@@ -1,7 +1,9 @@
 // The workbench server (pidlab::server) on 127.0.0.1 with a handler of the
-// test's own: slots that a slow client cannot hold against a new one, the
-// request-header deadline, the JSON depth bound, and every WebSocket reply
-// delivered in order to a client that reads late.
+// test's own: slots that a slow client, a trickling body or a quiet
+// WebSocket cannot hold against a new one, the request-header deadline, the
+// WebSocket's ping, the budget of bodies in memory, the JSON depth bound, a
+// field of the wrong type, and every WebSocket reply delivered in order to a
+// client that reads late.
 
 #include "pidlab/server/server.h"
 
@@ -19,6 +21,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "test_status.h"
@@ -36,14 +39,16 @@ using tcp = net::ip::tcp;
 // fixture ends. Its handler answers {"ok": true} and `padding_bytes` of 'x'.
 class Served {
  public:
-  explicit Served(ServerOptions options, std::size_t padding_bytes = 0) {
+  explicit Served(ServerOptions options, std::size_t padding_bytes = 0, Handler handler = nullptr) {
     options.bind = "127.0.0.1";
     options.port = 0;
     const std::string padding(padding_bytes, 'x');
-    dut_ = std::make_unique<Server>(options, Handler([padding](const nlohmann::json&) {
-                                      return Reply{200, {{"ok", true}, {"padding", padding}}};
-                                    }),
-                                    std::vector<Asset>{});
+    if (!handler)
+      handler = [padding](const nlohmann::json&) { return Reply{200, {{"ok", true}, {"padding", padding}}}; };
+    dut_ = std::make_unique<Server>(options, std::move(handler), std::vector<Asset>{});
+    dut_->SetUploadHandler([](const std::string&, const std::string& body) {
+      return Reply{200, {{"bytes", body.size()}}};
+    });
     std::string error;
     EXPECT_TRUE(IsOk(dut_->Start()));
     thread_ = std::thread([this] { dut_->Run(); });
@@ -195,28 +200,127 @@ TEST(Server, CapsTheConnectionsOfOneAddressBelowTheGlobalCap) {
   EXPECT_EQ(other->ReadStatus(), 200);
 }
 
-TEST(Server, NeverEvictsAWebSocketAndTurnsAwayANewConnectionWhenNoneWaits) {
+// A WebSocket client of the served port from `source`, its handshake done.
+std::unique_ptr<websocket::stream<tcp::socket>> OpenWebSocket(net::io_context* io, const Served& served,
+                                                              const std::string& source = "127.0.0.1") {
+  auto ws = std::make_unique<websocket::stream<tcp::socket>>(*io);
+  ws->next_layer().open(tcp::v4());
+  ws->next_layer().bind({net::ip::make_address(source), 0});
+  ws->next_layer().connect({net::ip::make_address("127.0.0.1"), static_cast<unsigned short>(served.port())});
+  ws->handshake(served.host(), "/ws");
+  return ws;
+}
+
+int AskId(websocket::stream<tcp::socket>* ws, int id) {
+  ws->write(net::buffer(nlohmann::json{{"id", id}}.dump()));
+  beast::flat_buffer buffer;
+  ws->read(buffer);
+  return nlohmann::json::parse(beast::buffers_to_string(buffer.data()))["id"].get<int>();
+}
+
+TEST(Server, EvictsTheWebSocketIdleLongestWhenEverySlotIsTaken) {
   ServerOptions options;
   options.max_connections = 2;
   options.max_connections_per_address = 2;
   Served served(options);
   net::io_context io;
-  std::vector<std::unique_ptr<websocket::stream<tcp::socket>>> sockets;
-  for (int i = 0; i < 2; ++i) {
-    auto ws = std::make_unique<websocket::stream<tcp::socket>>(io);
-    ws->next_layer().connect(
-        {net::ip::make_address("127.0.0.1"), static_cast<unsigned short>(served.port())});
-    ws->handshake(served.host(), "/ws");
-    sockets.push_back(std::move(ws));
-  }
-  Client refused(served);
-  EXPECT_TRUE(refused.ClosedByServer());
-  EXPECT_EQ(served.counters().turned_away, 1);
-  EXPECT_EQ(served.counters().evicted, 0);
-  sockets[0]->write(net::buffer(std::string("{\"id\":7}")));
+  auto quiet = OpenWebSocket(&io, served);
+  auto talking = OpenWebSocket(&io, served);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_EQ(AskId(talking.get(), 7), 7);  // its idle time starts again
+  Client fresh(served);
+  EXPECT_EQ(fresh.Get("/api/health"), 200);
   beast::flat_buffer buffer;
-  sockets[0]->read(buffer);
-  EXPECT_EQ(nlohmann::json::parse(beast::buffers_to_string(buffer.data()))["id"], 7);
+  beast::error_code ec;
+  quiet->read(buffer, ec);
+  EXPECT_TRUE(ec) << "the quiet WebSocket is still open";
+  EXPECT_EQ(AskId(talking.get(), 8), 8);
+  EXPECT_EQ(served.counters().evicted, 1);
+  EXPECT_EQ(served.counters().turned_away, 0);
+}
+
+TEST(Server, ClosesAWebSocketThatDoesNotAnswerItsPing) {
+  ServerOptions options;
+  options.websocket_idle_timeout_s = 0.4;
+  Served served(options);
+  net::io_context io;
+  // A raw socket after the handshake: it never reads, so it never answers a ping.
+  auto ws = OpenWebSocket(&io, served);
+  tcp::socket& socket = ws->next_layer();
+  const auto start = std::chrono::steady_clock::now();
+  std::string bytes;
+  char chunk[256];
+  beast::error_code ec;
+  while (!ec) bytes.append(chunk, socket.read_some(net::buffer(chunk), ec));
+  const double closed_after_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_GE(bytes.size(), 2u);
+  EXPECT_EQ(static_cast<unsigned char>(bytes[0]), 0x89) << "the first frame is not a ping";
+  EXPECT_GE(closed_after_s, 0.35);
+  EXPECT_LT(closed_after_s, 3.0);
+}
+
+TEST(Server, EvictsAConnectionTricklingItsBodyToAdmitANewOne) {
+  ServerOptions options;
+  options.max_connections = 2;
+  options.max_connections_per_address = 2;
+  Served served(options);
+  std::vector<std::unique_ptr<Client>> slow;
+  for (int i = 0; i < 2; ++i) {
+    slow.push_back(std::make_unique<Client>(served));
+    slow.back()->Send("POST /api/request HTTP/1.1\r\nHost: " + slow.back()->host() +
+                      "\r\nContent-Length: 100\r\n\r\n{\"a\":");
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  Client fresh(served, "127.0.0.2");
+  EXPECT_EQ(fresh.Get("/api/health"), 200);
+  EXPECT_TRUE(slow[0]->ClosedByServer());
+  EXPECT_EQ(served.counters().evicted, 1);
+}
+
+// Status and body of POST /api/upload with `body`, on a fresh connection.
+std::pair<int, std::string> PostUpload(const Served& served, const std::string& body) {
+  Client client(served);
+  http::request<http::string_body> req{http::verb::post, "/api/upload?name=a.lcmlog", 11};
+  req.set(http::field::host, client.host());
+  req.body() = body;
+  req.prepare_payload();
+  http::write(client.socket(), req);
+  http::response<http::string_body> res;
+  beast::flat_buffer buffer;
+  beast::error_code ec;
+  http::read(client.socket(), buffer, res, ec);
+  return {ec ? -1 : res.result_int(), res.body()};
+}
+
+TEST(Server, RefusesAnUploadThatWouldPassTheBudgetOfEveryUploadInMemory) {
+  ServerOptions options;
+  options.max_upload_bytes = 4096;
+  options.max_bodies_bytes = 6000;
+  Served served(options);
+  Client holding(served);
+  holding.Send("POST /api/upload?name=b.lcmlog HTTP/1.1\r\nHost: " + holding.host() +
+               "\r\nContent-Length: 4000\r\n\r\nLCM");
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const auto [status, body] = PostUpload(served, std::string(3000, 'x'));
+  EXPECT_EQ(status, 413);
+  EXPECT_NE(body.find("MiB of uploads"), std::string::npos) << body;
+  EXPECT_EQ(served.counters().over_budget, 1);
+  EXPECT_EQ(PostRequest(served, "{\"x\":\"" + std::string(3000, 'x') + "\"}").first, 200);  // not an upload
+  EXPECT_EQ(PostUpload(served, std::string(1000, 'x')).first, 200);                         // still fits
+}
+
+TEST(Server, AnswersAFieldOfTheWrongJsonTypeWith400AndOneLine) {
+  Served served(ServerOptions{}, 0, [](const nlohmann::json& request) {
+    return Reply{200, {{"type", request.value("type", std::string())}}};
+  });
+  for (const std::string body : {"{\"type\":5}", "{\"type\":null}", "{\"type\":[]}", "{\"type\":{}}"}) {
+    const auto [status, reply] = PostRequest(served, body);
+    EXPECT_EQ(status, 400) << body;
+    EXPECT_EQ(reply.find("json.exception"), std::string::npos) << reply;
+    EXPECT_EQ(reply.find('\n'), std::string::npos) << reply;
+  }
+  EXPECT_EQ(PostRequest(served, "{\"type\":\"fields\"}").first, 200);
 }
 
 TEST(Server, RefusesJsonNestedDeeperThan64LevelsBeforeParsingIt) {

@@ -121,6 +121,13 @@ nlohmann::json SpecFlags::ReadSpecFile() const {
   return j;
 }
 
+Status SpecFlags::Named(const Status& status) const {
+  if (status.ok() || spec_file_.empty() || status.code() != StatusCode::kInvalidInput) return status;
+  const std::string prefix = "--spec " + Quote(spec_file_) + ": ";
+  if (status.message().rfind(prefix, 0) == 0) return status;
+  return Status(status.code(), prefix + status.message());
+}
+
 void SpecFlags::ThrowSpecFileError(const std::string& why) const {
   throw BadInput("--spec " + Quote(spec_file_) + ": " + why);
 }

@@ -64,6 +64,11 @@ class SpecFlags {
   /// True when the flag of `key` was on the command line.
   bool Given(const std::string& key) const;
 
+  /// `status` naming the --spec file when one was given: a rule the spec
+  /// breaks (kInvalidInput) found after Apply, when the spec is built, says
+  /// which file it came from ("--spec 'loop.json': horizon ...").
+  Status Named(const Status& status) const;
+
  private:
   struct Registrar {
     SpecFlags* self;

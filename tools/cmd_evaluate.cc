@@ -67,7 +67,7 @@ struct EvaluateCommand {
     build.backend = backend == "lcm" ? tune::Backend::kRunner : tune::Backend::kInProcess;
     flags.Apply(&s, &build.given);
     tune::EvaluationProblem problem;
-    Require(tune::BuildEvaluation(s, build, &problem));
+    Require(flags.Named(tune::BuildEvaluation(s, build, &problem)));
     const LoopOptions& options = problem.loop;
     tune::EvaluationRunOptions run;
     run.what.record_trajectory = !trajectory_csv.empty();

@@ -121,7 +121,7 @@ struct ExportCommand {
   Controller BuildController(const spec::EvaluateSpec& s) const {
     std::string error;
     Controller c;
-    Require(ExportController(s, NameStyle::kFlag, &c, &error), error);
+    if (!ExportController(s, NameStyle::kFlag, &c, &error)) Require(flags.Named(Status::InvalidInput(error)));
     return c;
   }
 
@@ -153,7 +153,7 @@ struct ExportCommand {
   // unless --force, which writes it with a warning.
   void CheckLoop(const spec::EvaluateSpec& s, Options* options) const {
     tune::SampledControllerCheck check;
-    Require(tune::CheckSampledController(s, NameStyle::kFlag, &check));
+    Require(flags.Named(tune::CheckSampledController(s, NameStyle::kFlag, &check)));
     options->loop_check = check.verdict;
     if (check.stable) return;
     if (!force) throw BadInput(check.verdict);

@@ -4,12 +4,12 @@
 // everything.
 
 #include <csignal>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
 #include "commands.h"
+#include "pidlab/io/files.h"
 #include "pidlab/launcher/launcher.h"
 #include "pidlab/transport/pacing.h"
 
@@ -87,13 +87,10 @@ void SetPilController(const std::string& text, launcher::LaunchOptions* o) {
   if (text.rfind("pil:", 0) != 0 || text.size() == 4)
     throw BadInput("--controller " + Quote(text) + " is not pil:DIR (a folder of pidlab export --pil)");
   const std::string dir = text.substr(4), path = dir + "/pil.json";
-  std::ifstream in(path);
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const std::exception&) {
-    j = nullptr;
-  }
+  std::string bytes;
+  if (const Status st = io::ReadFile(path, kMaxSpecFileBytes, &bytes); !st.ok())
+    throw BadInput("--controller " + Quote(text) + ": " + st.message());
+  const nlohmann::json j = nlohmann::json::parse(bytes, nullptr, false);
   if (!j.is_object() || !j.contains("elf") || !j.contains("core") || !j["elf"].is_string() ||
       !j["core"].is_string())
     throw BadInput("--controller " + Quote(text) + ": '" + path +

@@ -4,12 +4,15 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <memory>
+#include <set>
 #include <sstream>
 
 #include "cli_common.h"
 #include "cli_spec.h"
 #include "commands.h"
 #include "pidlab/figures/figures.h"
+#include "pidlab/io/files.h"
 #include "pidlab/plot/loop_figure.h"
 #include "pidlab/tune/problem.h"
 #include "pidlab/tune/time_scale.h"
@@ -63,47 +66,78 @@ struct PlotCommand {
     plot::Figure figure;
     figure.width_px = width_px;
     figure.height_px = height_px;
-    std::string error;
     PlotSpec ps;
     std::set<std::string> given;
     flags.Apply(&ps, &given);
-    if (!log_path.empty()) {
-      if (!gains.empty() || flags.Given("plant") || flags.Given("num"))
-        throw BadInput("--log cannot be combined with --plant/--gains (the log carries its own)");
-      PrepareOutputDir(out_dir, "--out");  // bad input before any work
-      std::string report;
-      if (const Status st = figures::LogFigure(log_path, episodes, &figure, &report); !st.ok())
-        throw BadInput(st.message());
-      if (!report.empty()) std::cerr << report;
-      if (name.empty()) name = std::filesystem::path(log_path).stem().string();
-    } else {
-      if (!episodes.empty()) throw BadInput("--episode needs --log");
-      if (gains.empty()) throw BadInput("--gains is required (or --log FILE)");
-      Plant p;
-      LoopOptions options;
-      std::vector<PidGains> sets;
-      for (const auto& g : gains) sets.push_back(ParseGains(g));
-      // Framed for the loop: with neither --horizon nor --sample-time, the
-      // closed loops' time scale, on every plant (tune/time_scale.h).
-      Require(tune::BuildFigureLoop(ps.plant, ps.loop, sets, given, NameStyle::kFlag, &p, &options));
-      const long points = options.loop == LoopKind::kSampled ? options.TotalSteps() : options.NumSamples();
-      if (static_cast<double>(points) * static_cast<double>(sets.size()) > kMaxRecordedPoints)
-        throw BadInput(
-            std::to_string(sets.size()) + " curve(s) of " + std::to_string(points) +
-            " points each are more than 1e7 points: use a coarser --dt or --sample-time, a shorter "
-            "--horizon or fewer --gains");
-      PrepareOutputDir(out_dir, "--out");  // bad input before any work
-      if (const Status st = figures::EvaluationFigure(p, sets, options, &figure); !st.ok())
-        throw BadInput(st.message());
-      if (name.empty()) name = "evaluation";
-    }
+    if (name.empty())
+      name = log_path.empty() ? "evaluation" : std::filesystem::path(log_path).stem().string();
     if (name.empty() || name.find('/') != std::string::npos)
       throw BadInput("--name " + Quote(name) + " must be a plain file name stem");
-    figure.output_path = out_dir + "/" + name + ".png";
-    figure.data_dir = out_dir + "/" + name + "_data";
-    if (!figure.IsValid(&error)) throw BadInput(error);
-    Require(plot::DrawPng(figure));
-    std::cout << figure.output_path << "\n";
+    if (!log_path.empty())
+      FigureOfLog(&figure);
+    else
+      FigureOfEvaluation(ps, given, &figure);
+    return Draw(&figure);
+  }
+
+  // Bad input (the folder, an old PNG that cannot be replaced) before any work.
+  void CheckOutput() const {
+    PrepareOutputDir(out_dir, "--out");
+    if (const Status st = io::CheckWritableTarget(out_dir + "/" + name + ".png"); !st.ok())
+      throw BadInput("--out " + st.message());
+  }
+
+  void FigureOfLog(plot::Figure* figure) const {
+    if (!gains.empty() || flags.Given("plant") || flags.Given("num"))
+      throw BadInput("--log cannot be combined with --plant/--gains (the log carries its own)");
+    CheckOutput();
+    std::string report;
+    if (const Status st = figures::LogFigure(log_path, episodes, figure, &report); !st.ok())
+      throw BadInput(st.message());
+    if (!report.empty()) std::cerr << report;
+  }
+
+  void FigureOfEvaluation(const PlotSpec& ps, const std::set<std::string>& given,
+                          plot::Figure* figure) const {
+    if (!episodes.empty()) throw BadInput("--episode needs --log");
+    if (gains.empty()) throw BadInput("--gains is required (or --log FILE)");
+    Plant p;
+    LoopOptions options;
+    std::vector<PidGains> sets;
+    for (const auto& g : gains) sets.push_back(ParseGains(g));
+    // Framed for the loop: with neither --horizon nor --sample-time, the
+    // closed loops' time scale, on every plant (tune/time_scale.h).
+    Require(tune::BuildFigureLoop(ps.plant, ps.loop, sets, given, NameStyle::kFlag, &p, &options));
+    const long points = options.loop == LoopKind::kSampled ? options.TotalSteps() : options.NumSamples();
+    if (static_cast<double>(points) * static_cast<double>(sets.size()) > kMaxRecordedPoints)
+      throw BadInput(std::to_string(sets.size()) + " curve(s) of " + std::to_string(points) +
+                     " points each are more than 1e7 points: use a coarser --dt or --sample-time, a shorter "
+                     "--horizon or fewer --gains");
+    CheckOutput();
+    if (const Status st = figures::EvaluationFigure(p, sets, options, figure); !st.ok())
+      throw BadInput(st.message());
+  }
+
+  // The PNG and its data drawn into a stage inside --out and moved in only
+  // when all of them are complete: a full disk leaves the folder as it was.
+  int Draw(plot::Figure* figure) const {
+    std::unique_ptr<io::StagedFolder> stage;
+    Require(io::StagedFolder::Create(out_dir, &stage));
+    figure->output_path = stage->path() + "/" + name + ".png";
+    figure->data_dir = stage->path() + "/" + name + "_data";
+    if (std::string error; !figure->IsValid(&error)) throw BadInput(error);
+    const auto unstaged = [&stage](const Status& st) {
+      return Status(st.code(), stage->Unstaged(st.message()));
+    };
+    Require(unstaged(plot::DrawPng(*figure)));
+    // The script kept beside the data draws to the figure's own path, not the stage's.
+    const std::string script = figure->data_dir + "/figure.gp";
+    std::string text;
+    Require(unstaged(io::ReadFile(script, 1 << 20, &text)));
+    Require(unstaged(io::WriteFile(script, stage->Unstaged(text))));
+    Require(unstaged(stage->Commit()));
+    std::cout << out_dir + "/" + name + ".png"
+              << "\n";
     return 0;
   }
 };

@@ -12,6 +12,9 @@
 #include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_ready.hpp>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "cli_common.h"
 #include "commands.h"
@@ -104,9 +107,9 @@ struct ReplayCommand {
     nlohmann::json out = results::LogJson(log, log_path);
     std::ostringstream table;
     TableHeader(log, &table);
-    int status = 0;
+    std::vector<std::string> failed;  // --redrive: "episode ID: why", one per episode that did not reproduce
     for (const replay::Episode* e : selected) {
-      if (!ReportEpisode(*e, &out["episodes"], &table)) status = 1;
+      ReportEpisode(*e, &out["episodes"], &table, &failed);
       if (csv_file) WriteCsv(*e, csv_file.get());
     }
     if (csv_file) Require(csv_file->Commit());  // whole, or the old file stays
@@ -118,7 +121,13 @@ struct ReplayCommand {
     } else {
       std::cout << table.str();
     }
-    return status;
+    if (!failed.empty()) {
+      std::cout.flush();
+      // One line on stderr: how many, and the first one's reason.
+      throw std::runtime_error("--redrive: " + std::to_string(failed.size()) + " of " +
+                               std::to_string(redriven_) + " episodes did not reproduce; " + failed.front());
+    }
+    return 0;
   }
 
   replay::LogContents ReadTheLog() const {
@@ -197,8 +206,9 @@ struct ReplayCommand {
   // ---- One episode: evaluation, table row and details, JSON, redrive
 
   // Appends the episode's JSON to *episodes_json and its lines to *table;
-  // false if --redrive found a mismatch.
-  bool ReportEpisode(const replay::Episode& e, nlohmann::json* episodes_json, std::ostream* table) const {
+  // with --redrive, a line to *failed if it did not reproduce.
+  void ReportEpisode(const replay::Episode& e, nlohmann::json* episodes_json, std::ostream* table,
+                     std::vector<std::string>* failed) {
     Evaluation ev;
     bool evaluated = false;
     nlohmann::json j = results::EvaluatedEpisodeJson(e, &ev, &evaluated);
@@ -211,21 +221,31 @@ struct ReplayCommand {
       *table << "    episode FAILED live: " << FromLog(e.summary_message) << "\n";
     if (e.realtime.paced()) *table << "    " << transport::DescribeRealtime(e.realtime) << "\n";
     if (!evaluated && e.has_config && e.Complete()) *table << "    not evaluated: " << FromLog(why) << "\n";
-    const bool ok = !redrive || RedriveEpisode(e, &j, table);
+    if (redrive) RedriveEpisode(e, &j, table, failed);
     episodes_json->push_back(j);
-    return ok;
   }
 
   // ---- --redrive
 
-  // Re-drives the episode in process or against the live controller; false
-  // on a mismatch.
-  bool RedriveEpisode(const replay::Episode& e, nlohmann::json* j, std::ostream* table) const {
+  // Re-drives the episode in process or against the live controller; a
+  // mismatch is named in *failed. Events of an episode whose configuration
+  // is not in the log (an orphan, or a stranger's forgery) cannot be
+  // re-driven: the episode is named and skipped, not a failure.
+  void RedriveEpisode(const replay::Episode& e, nlohmann::json* j, std::ostream* table,
+                      std::vector<std::string>* failed) {
+    if (!e.has_config) {
+      const std::string why = "no configuration in the log (" + FromLog(e.CompletenessNote()) + ")";
+      (*j)["redrive"] = {{"ok", nullptr}, {"skipped", true}, {"message", "skipped: " + why}};
+      *table << "    redrive: SKIPPED, episode " << e.episode_id << " has " << why << "\n";
+      return;
+    }
+    ++redriven_;
     const replay::RedriveResult r = backend == "lcm" ? RedriveLive(e) : replay::Redrive(e);
     (*j)["redrive"] = results::RedriveJson(r);
     *table << "    redrive: " << (r.ok ? "OK, " : "FAILED, ") << FromLog(r.message) << "\n";
-    return r.ok;
+    if (!r.ok) failed->push_back("episode " + std::to_string(e.episode_id) + ": " + FromLog(r.message));
   }
+  long redriven_ = 0;  // episodes --redrive re-drove (not the skipped)
 
   // ---- CSV
 

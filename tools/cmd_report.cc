@@ -56,6 +56,11 @@ struct ReportCommand {
     // written into a stage inside --out and moved into place only when all
     // are complete: a failure leaves the folder as it was.
     PrepareOutputDir(out_dir, "--out");  // an unwritable folder is bad input (exit 2), before the work
+    // So is a read-only old report.md (or trio.log), found now and not after the tunings.
+    for (const char* file : {"report.md", "trio.log"})
+      if (const Status st = io::CheckWritableTarget((std::filesystem::path(out_dir) / file).string());
+          !st.ok())
+        throw BadInput("--out " + st.message());
     std::unique_ptr<io::StagedFolder> stage;
     Require(io::StagedFolder::Create(out_dir, &stage));
     options.out_dir = stage->path();
@@ -75,11 +80,8 @@ struct ReportCommand {
           !st.ok())
         throw std::runtime_error(st.message());
     } else {
-      if (!std::filesystem::is_regular_file(options.paper_tables))
-        throw BadInput("paper tables not found: " + Quote(options.paper_tables) +
-                       " (use --paper-tables FILE)");
       if (const Status st = report::ReadPaperTables(options.paper_tables, &paper); !st.ok())
-        throw BadInput(st.message());
+        throw BadInput("--paper-tables " + st.message());
     }
     report::ReportData data;
     if (const Status st = report::ComputeReport(options, paper, &data); !st.ok())

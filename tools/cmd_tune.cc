@@ -78,7 +78,7 @@ struct TuneCommand {
     build.backend = backend == "lcm" ? tune::Backend::kRunner : tune::Backend::kInProcess;
     flags.Apply(&ts, &build.given);
     tune::TuningProblem problem;
-    Require(tune::BuildTuning(ts, build, &problem));
+    Require(flags.Named(tune::BuildTuning(ts, build, &problem)));
     CheckOutputFile(trace, "--trace");  // before the search, not after it
     const TuneOptions& o = problem.options;
     tune::TuningRunOptions run;

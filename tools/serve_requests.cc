@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "pidlab/results/spec_run.h"
+#include "pidlab/spec/field.h"
 #include "serve_live.h"
 #include "serve_logs.h"
 #ifndef PIDLAB_HOSTILE_COMMANDS_ONLY
@@ -111,6 +112,9 @@ nlohmann::json PaperDesigns() {
 server::Reply AnswerWorkbenchRequest(const nlohmann::json& request,
                                      const std::shared_ptr<server::Connection>& connection,
                                      LiveService* live) {
+  const auto type_field = request.find("type");
+  if (type_field != request.end() && !type_field->is_string())
+    return {400, {{"error", "request type " + spec::Truncate(type_field->dump()) + " must be a string"}}};
   const std::string type = request.value("type", std::string());
   if (type == "fields") return {200, {{"type", "fields"}, {"fields", results::EvaluateSpecFields()}}};
   if (type == "paper_designs") return {200, {{"type", "paper_designs"}, {"designs", PaperDesigns()}}};

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "pidlab/plot/loop_figure.h"
 #include "pidlab/replay/replay.h"
@@ -23,6 +25,42 @@ std::string GainsLabel(const PidGains& g) {
   os << std::setprecision(6) << "kp=" << g.kp << " ki=" << g.ki << " kd=" << g.kd;
   return os.str();
 }
+
+// Notes on the episodes of a log, one line per distinct note: a damaged log
+// with 29 episodes of the same damage says so once, naming the episodes.
+class EpisodeNotes {
+ public:
+  // `singular` and `plural` follow the episode(s): "not plotted: ...".
+  void Add(long episode_id, const std::string& singular, const std::string& plural) {
+    auto at =
+        std::find_if(notes_.begin(), notes_.end(), [&](const Note& n) { return n.singular == singular; });
+    if (at == notes_.end()) at = notes_.insert(notes_.end(), Note{singular, plural, {}});
+    at->ids.push_back(episode_id);
+  }
+  std::string Lines() const {
+    std::string out;
+    for (const Note& n : notes_) {
+      if (n.ids.size() == 1) {
+        out += "note: episode " + std::to_string(n.ids[0]) + " " + n.singular + "\n";
+        continue;
+      }
+      constexpr std::size_t kNamed = 5;
+      std::string ids;
+      for (std::size_t i = 0; i < std::min(n.ids.size(), kNamed); ++i)
+        ids += (i ? ", " : "") + std::to_string(n.ids[i]);
+      if (n.ids.size() > kNamed) ids += " and " + std::to_string(n.ids.size() - kNamed) + " more";
+      out += "note: " + std::to_string(n.ids.size()) + " episodes (" + ids + ") " + n.plural + "\n";
+    }
+    return out;
+  }
+
+ private:
+  struct Note {
+    std::string singular, plural;
+    std::vector<long> ids;
+  };
+  std::vector<Note> notes_;
+};
 
 }  // namespace
 
@@ -80,7 +118,13 @@ Status LogFigure(const std::string& log_path, const std::vector<long>& episodes,
                  std::string* report) {
   replay::LogContents log;
   if (Status st = replay::ReadLog(log_path, replay::ReadOptions{}, &log); !st.ok()) return st;
-  for (const auto& n : log.notes) *report += "note: " + n + "\n";
+  std::vector<std::string> said;  // the log's own notes, each once
+  for (const auto& n : log.notes) {
+    if (std::find(said.begin(), said.end(), n) != said.end()) continue;
+    said.push_back(n);
+    *report += "note: " + n + "\n";
+  }
+  EpisodeNotes notes;
   std::vector<plot::LoopTrace> traces;
   std::string plant_name;
   bool mixed_plants = false;
@@ -95,13 +139,12 @@ Status LogFigure(const std::string& log_path, const std::vector<long>& episodes,
     if (!episodes.empty() && std::find(episodes.begin(), episodes.end(), e.episode_id) == episodes.end())
       continue;
     if (!e.has_config) {
-      *report +=
-          "note: episode " + std::to_string(e.episode_id) + " not plotted: " + e.CompletenessNote() + "\n";
+      notes.Add(e.episode_id, "not plotted: " + e.CompletenessNote(), "not plotted: " + e.CompletenessNote());
       continue;
     }
     if (!e.Complete())
-      *report += "note: episode " + std::to_string(e.episode_id) +
-                 " has gaps (drawn as breaks): " + e.CompletenessNote() + "\n";
+      notes.Add(e.episode_id, "has gaps (drawn as breaks): " + e.CompletenessNote(),
+                "have gaps (drawn as breaks): " + e.CompletenessNote());
     plot::LoopTrace tr;
     std::ostringstream name;
     name << "episode " << e.episode_id << ": " << GainsLabel(e.spec.gains);
@@ -127,6 +170,7 @@ Status LogFigure(const std::string& log_path, const std::vector<long>& episodes,
     plant_name = e.spec.plant.name;
     traces.push_back(std::move(tr));
   }
+  *report += notes.Lines();
   if (traces.empty()) {
     return Status::InvalidInput("no episode with a configuration to plot in " + log_path);
   }

@@ -359,13 +359,34 @@ Status StagedFolder::Commit() {
   return Status::Ok();
 }
 
-Status ReadFile(const std::string& path, std::size_t max_bytes, std::string* text) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return Status::InvalidInput(Quoted(path) + " cannot be read: " + std::strerror(errno));
+Status OpenRegularFile(const std::string& path, int* fd) {
+  // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer,
+  // and a device's open may wait too; a regular file ignores the flag.
+  const int opened = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (opened < 0) return Status::InvalidInput(Quoted(path) + " cannot be read: " + std::strerror(errno));
   struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
+  if (::fstat(opened, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(opened);
     return Status::InvalidInput(Quoted(path) + " is not a regular file");
+  }
+  const int flags = ::fcntl(opened, F_GETFL);
+  if (flags < 0 || ::fcntl(opened, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+    const int saved = errno;
+    ::close(opened);
+    return IoError("cannot read", path, saved);
+  }
+  *fd = opened;
+  return Status::Ok();
+}
+
+Status ReadFile(const std::string& path, std::size_t max_bytes, std::string* text) {
+  int fd = -1;
+  if (Status s = OpenRegularFile(path, &fd); !s.ok()) return s;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    const int saved = errno;
+    ::close(fd);
+    return IoError("cannot read", path, saved);
   }
   if (static_cast<unsigned long long>(st.st_size) > max_bytes) {
     ::close(fd);

@@ -8,6 +8,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "pidlab/io/files.h"
+
 namespace pidlab::replay {
 namespace {
 
@@ -42,16 +44,14 @@ Status EventReader::Open(const std::string& path) {
   if (fd_ >= 0) {
     return Status::IoFailed("log '" + path + "': this reader already has a file open");
   }
+  // A FIFO or a device is refused before anything waits on it.
+  if (Status s = io::OpenRegularFile(path, &fd_); !s.ok()) {
+    fd_ = -1;
+    return Status(s.code(), "log " + s.message());
+  }
   struct stat st {};
-  if (stat(path.c_str(), &st) != 0) {
-    return Status::IoFailed("log '" + path + "' cannot be opened: " + std::strerror(errno));
-  }
-  if (!S_ISREG(st.st_mode)) {
-    return Status::IoFailed("log '" + path + "' is not a regular file");
-  }
-  fd_ = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd_ < 0 || fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
-    return Status::IoFailed("log '" + path + "' cannot be opened as an LCM log");
+  if (fstat(fd_, &st) != 0) {
+    return Status::IoFailed("log '" + path + "' cannot be opened as an LCM log: " + std::strerror(errno));
   }
   // Only what the file holds now: a logger may still be appending.
   file_bytes_ = static_cast<long long>(st.st_size);

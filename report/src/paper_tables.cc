@@ -1,17 +1,20 @@
 // Reading paper_tables.csv: see ReadPaperTables in report.h.
 
 #include <cstddef>
-#include <fstream>
 #include <map>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "pidlab/io/files.h"
 #include "pidlab/report/report.h"
 
 namespace pidlab::report {
 namespace {
+
+// Far more than the paper's tables (under 2 KiB) will ever hold.
+constexpr std::size_t kMaxPaperTablesBytes = 1 << 20;
 
 std::string Trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r\n");
@@ -101,28 +104,11 @@ PaperRow ParseRow(const std::vector<std::string>& cells, const Columns& col, con
 
 }  // namespace
 
-namespace {
-
-// ReadPaperTables() with the refusal's message in *error.
-bool ReadPaperTablesOrExplain(const std::string& path, std::vector<PaperRow>* rows, std::string* error) {
-  std::ifstream file(path);
-  if (!file) {
-    *error = "cannot read the paper's tables at " + path;
-    return false;
-  }
-  std::ostringstream text;
-  text << file.rdbuf();
-  const Status st = ParsePaperTables(text.str(), path, rows);
-  if (!st.ok()) *error = st.message();
-  return st.ok();
-}
-
-}  // namespace
-
 Status ReadPaperTables(const std::string& path, std::vector<PaperRow>* rows) {
-  std::string why;
-  if (!ReadPaperTablesOrExplain(path, rows, &why)) return Status::InvalidInput(why);
-  return Status::Ok();
+  // A FIFO or a folder is refused before anything waits on it.
+  std::string text;
+  if (const Status st = io::ReadFile(path, kMaxPaperTablesBytes, &text); !st.ok()) return st;
+  return ParsePaperTables(text, path, rows);
 }
 
 namespace {

@@ -1,6 +1,7 @@
 #include "pidlab/server/server.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
@@ -13,10 +14,10 @@
 #include <map>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <sstream>
 
 #include "pidlab/spec/json.h"
+#include "slots.h"
 #include "url.h"
 
 namespace pidlab::server {
@@ -28,10 +29,10 @@ namespace net = boost::asio;
 using tcp = net::ip::tcp;
 using Request = http::request<http::string_body>;
 using Response = http::response<http::string_body>;
+using internal::JsonLibraryWords;
 using internal::PathOf;
 using internal::PercentDecoded;
 using internal::QueryValue;
-using internal::SameSecret;
 
 bool IsUpload(const Request& req) {
   return req.method() == http::verb::post && PathOf(std::string(req.target())) == "/api/upload";
@@ -57,63 +58,8 @@ Response JsonResponse(const Request& req, http::status status, const nlohmann::j
 }  // namespace
 
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
-  // The open connections, each with its client's address; those waiting for
-  // a request header, with the time they started waiting and how to close
-  // them. Touched on the server's thread only.
-  class Slots {
-   public:
-    using Id = std::uint64_t;
-    using Clock = std::chrono::steady_clock;
-
-    Id Open(const std::string& address) {
-      entries_[++last_].address = address;
-      return last_;
-    }
-    void Close(Id id) { entries_.erase(id); }
-    // From now on `id` waits for a request header; `close` ends it.
-    void Waiting(Id id, std::function<void()> close) {
-      const auto e = entries_.find(id);
-      if (e == entries_.end()) return;
-      e->second.since = Clock::now();
-      e->second.close = std::move(close);
-    }
-    // `id` has its header (or is a WebSocket): never evicted.
-    void Busy(Id id) {
-      const auto e = entries_.find(id);
-      if (e != entries_.end()) e->second.close = nullptr;
-    }
-    // The connections open, of `address` only if not null.
-    int Count(const std::string* address) const {
-      if (!address) return static_cast<int>(entries_.size());
-      int n = 0;
-      for (const auto& [id, e] : entries_) n += e.address == *address;
-      return n;
-    }
-    // Closes the connection (of `address` if not null) that has waited
-    // longest for its request header, and frees its slot now; false if none
-    // waits.
-    bool EvictLongestWaiting(const std::string* address) {
-      auto oldest = entries_.end();
-      for (auto e = entries_.begin(); e != entries_.end(); ++e)
-        if (e->second.close && (!address || e->second.address == *address) &&
-            (oldest == entries_.end() || e->second.since < oldest->second.since))
-          oldest = e;
-      if (oldest == entries_.end()) return false;
-      const std::function<void()> close = std::move(oldest->second.close);
-      entries_.erase(oldest);
-      close();
-      return true;
-    }
-
-   private:
-    struct Entry {
-      std::string address;
-      Clock::time_point since;
-      std::function<void()> close;  // set while waiting for a request header
-    };
-    std::map<Id, Entry> entries_;
-    Id last_ = 0;
-  };
+  // Every connection and body held in memory: one budget (slots.h).
+  using Slots = internal::Slots;
 
   ServerOptions options;
   ConnectionHandler handler;
@@ -131,39 +77,28 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     ++(counters.*field);
   }
 
-  // Whether a new connection from `address` may open, after evicting the
-  // connection waiting longest for its header where a cap is reached.
+  // Whether a new connection from `address` may open (slots.h: the
+  // connections idle longest closed for it where a cap is reached).
   bool MakeRoom(const std::string& address) {
-    const auto evict = [this](const std::string* of) {
-      if (!slots.EvictLongestWaiting(of)) return false;
-      Count(&ServerCounters::evicted);
-      return true;
-    };
-    if (slots.Count(&address) >= options.max_connections_per_address && !evict(&address)) return false;
-    return slots.Count(nullptr) < options.max_connections || evict(nullptr);
+    int evicted = 0;
+    const bool room =
+        slots.MakeRoom(address, options.max_connections_per_address, options.max_connections, &evicted);
+    for (; evicted > 0; --evicted) Count(&ServerCounters::evicted);
+    return room;
   }
 
-  // Why `req` may not be served (token, host, origin), or empty.
+  // The upload bodies held in memory at once, every connection's together
+  // (other bodies are at most max_body_bytes on each of max_connections).
+  std::size_t BodyBudget() const { return std::max(options.max_bodies_bytes, options.max_upload_bytes); }
+
+  // Why `req` may not be served (token, host, origin), or empty (url.h).
   std::pair<http::status, std::string> Refusal(const Request& req) const {
-    if (!options.token.empty()) {
-      std::string given = QueryValue(std::string(req.target()), "token");
-      const std::string auth(req[http::field::authorization]);
-      if (given.empty() && auth.rfind("Bearer ", 0) == 0) given = auth.substr(7);
-      if (!SameSecret(given, options.token)) return {http::status::unauthorized, "a valid token is required"};
-    }
-    const std::string host(req[http::field::host]);
-    const std::string suffix = ":" + std::to_string(port);
-    std::set<std::string> hosts = {"127.0.0.1" + suffix, "localhost" + suffix, "[::1]" + suffix};
-    hosts.insert((options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind) +
-                 suffix);
-    // Bound to every address: any Host, as the token guards it.
-    const bool any = options.bind == "0.0.0.0" || options.bind == "::";
-    if (!any && hosts.count(host) == 0)
-      return {http::status::forbidden, "Host '" + host + "' is not this server"};
     const auto origin = req.find(http::field::origin);
-    if (origin != req.end() && std::string(origin->value()) != "http://" + host)
-      return {http::status::forbidden, "Origin '" + std::string(origin->value()) + "' is not this server's"};
-    return {http::status::ok, ""};
+    const std::string origin_text = origin == req.end() ? "" : std::string(origin->value());
+    const auto [status, why] = internal::Refusal(
+        options, port, std::string(req.target()), std::string(req[http::field::authorization]),
+        std::string(req[http::field::host]), origin == req.end() ? nullptr : &origin_text);
+    return {static_cast<http::status>(status), why};
   }
 
   // One request object through the handler: the reply's status and body.
@@ -182,6 +117,10 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     Reply reply;
     try {
       reply = handler(request, connection);
+    } catch (const nlohmann::json::exception& e) {
+      // A field of the wrong JSON type ({"type": 5}): the request's mistake.
+      Count(&ServerCounters::malformed);
+      reply = {400, {{"error", "the request is not of the expected form: " + JsonLibraryWords(e.what())}}};
     } catch (const std::exception& e) {
       reply = {500, {{"error", std::string("the server failed: ") + e.what()}}};
     }
@@ -265,14 +204,30 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
 
   void Run(Request req) {
     connection_ = std::make_shared<SessionConnection>(ws_.get_executor(), weak_from_this());
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    // Pinged after half the idle timeout without a byte from the client,
+    // closed at the whole: a page answers pings, a dead peer does not.
+    auto timeout = websocket::stream_base::timeout::suggested(beast::role_type::server);
+    timeout.idle_timeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(server_->options.websocket_idle_timeout_s));
+    timeout.keep_alive_pings = true;
+    ws_.set_option(timeout);
     ws_.read_message_max(server_->options.max_message_bytes);
+    // Closed for a new connection when it is the one idle longest, and when the server stops.
+    const auto close = [weak = weak_from_this()] {
+      if (auto self = weak.lock()) self->Evict();
+    };
+    server_->slots.Idle(slot_, close);
+    server_->slots.OnStop(slot_, close);
     ws_.async_accept(req, beast::bind_front_handler(&WebSocketSession::OnAccept, shared_from_this()));
   }
 
  private:
   void OnAccept(beast::error_code ec) {
     if (!ec) Read();
+  }
+  void Evict() {
+    beast::error_code ignored;
+    beast::get_lowest_layer(ws_).socket().close(ignored);
   }
   void Read() {
     ws_.async_read(buffer_, beast::bind_front_handler(&WebSocketSession::OnRead, shared_from_this()));
@@ -285,6 +240,7 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
       return;                      // closed, too big or broken: the session ends
     }
     server_->Count(&ServerCounters::websocket_messages);
+    server_->slots.Touch(slot_);
     const std::string text = beast::buffers_to_string(buffer_.data());
     buffer_.consume(buffer_.size());
     const Reply reply = server_->Answer(text, connection_);
@@ -331,6 +287,7 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
   void OnWrite(beast::error_code ec, std::size_t) {
     writing_ = false;
     if (ec) return;
+    server_->slots.Touch(slot_);
     Outgoing next;
     if (!ordered_.empty()) {
       next = std::move(ordered_.front());
@@ -388,12 +345,20 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   ~HttpSession() {
     if (slot_) server_->slots.Close(slot_);
   }
-  void Run() { Read(); }
+  void Run() {
+    server_->slots.OnStop(slot_, [weak = weak_from_this()] {
+      beast::error_code ignored;
+      if (auto self = weak.lock()) self->stream_.socket().close(ignored);
+    });
+    Read();
+  }
 
  private:
   void Read() {
-    // Until the header is complete this connection may be closed for a new one.
-    server_->slots.Waiting(slot_, [weak = weak_from_this()] {
+    // The previous request's body is gone; until this one's header and body
+    // are in, the connection may be closed for a new one.
+    server_->slots.ReleaseBody(slot_);
+    server_->slots.Idle(slot_, [weak = weak_from_this()] {
       if (auto self = weak.lock()) self->Evict();
     });
     parser_.emplace();
@@ -408,33 +373,65 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   }
 
   // An upload gets its own body limit, and is refused on its headers (token,
-  // Host, Origin) before its body is read.
+  // Host, Origin) before its body is read; every body is held in the
+  // server's budget before it is read (413 when that is spent).
   void OnHeader(beast::error_code ec, std::size_t) {
     if (evicted_) return;  // its slot went to a newer connection
-    server_->slots.Busy(slot_);
-    if (!ec) stream_.expires_after(kBodyTimeout);
-    if (!ec && IsUpload(parser_->get())) {
+    if (ec) {
+      OnRead(ec, 0);
+      return;
+    }
+    stream_.expires_after(kBodyTimeout);
+    server_->slots.Touch(slot_);  // idle from now while the body trickles
+    if (IsUpload(parser_->get())) {
       const auto [status, why] = server_->Refusal(parser_->get());
       if (status != http::status::ok) {
         server_->Count(&ServerCounters::http_requests);
         server_->Count(&ServerCounters::refused);
-        Response res = JsonResponse(parser_->get(), status, {{"error", why}});
-        res.keep_alive(false);
-        Write(std::move(res));
+        Refuse(status, why);
         return;
       }
-      parser_->body_limit(server_->options.max_upload_bytes);
-    } else if (!ec) {
-      parser_->body_limit(server_->options.max_body_bytes);
-      const auto length = parser_->content_length();
-      if (length && *length > server_->options.max_body_bytes) ec = http::error::body_limit;
     }
-    if (ec || parser_->is_done()) {
+    parser_->body_limit(BodyLimit());
+    const auto length = parser_->content_length();
+    if (length && *length > BodyLimit()) {
+      OnRead(http::error::body_limit, 0);
+      return;
+    }
+    if (!HoldBody()) return;
+    if (parser_->is_done()) {
       OnRead(ec, 0);
       return;
     }
     http::async_read(stream_, buffer_, *parser_,
                      beast::bind_front_handler(&HttpSession::OnRead, shared_from_this()));
+  }
+
+  // Holds an upload's bytes (its Content-Length, or its limit when chunked)
+  // in the server's budget; answers 413 and returns false when that is spent.
+  // A request's own body (64 KiB at most) always fits: uploads cannot crowd
+  // out the page's requests.
+  bool HoldBody() {
+    if (!IsUpload(parser_->get())) return true;
+    const auto length = parser_->content_length();
+    const std::size_t bytes = length               ? static_cast<std::size_t>(*length)
+                              : parser_->chunked() ? BodyLimit()
+                                                   : 0;
+    const std::size_t budget = server_->BodyBudget();
+    if (bytes == 0 || server_->slots.HoldBody(slot_, bytes, budget)) return true;
+    server_->Count(&ServerCounters::http_requests);
+    server_->Count(&ServerCounters::over_budget);
+    Refuse(http::status::payload_too_large, "the server holds " +
+                                                std::to_string(server_->slots.body_bytes() >> 20) +
+                                                " MiB of uploads, within " + std::to_string(budget >> 20) +
+                                                " MiB for all: send it again once an upload has finished");
+    return false;
+  }
+
+  void Refuse(http::status status, const std::string& why) {
+    Response res = JsonResponse(parser_->get(), status, {{"error", why}});
+    res.keep_alive(false);
+    Write(std::move(res));
   }
 
   void OnRead(beast::error_code ec, std::size_t) {
@@ -486,6 +483,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   }
 
   void Write(Response res) {
+    server_->slots.Busy(slot_);  // answering: not closed for a new connection
     auto shared = std::make_shared<Response>(std::move(res));
     http::async_write(stream_, *shared,
                       [self = shared_from_this(), shared](beast::error_code ec, std::size_t) {
@@ -496,9 +494,19 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
                       });
   }
 
+  // After the last reply: what the client still sends (an oversized body's
+  // rest) is dropped for up to 1 s, so that it reads the reply, not a reset.
   void Close() {
     beast::error_code ignored;
     stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+    stream_.expires_after(std::chrono::seconds(1));
+    Drain();
+  }
+  void Drain() {
+    stream_.async_read_some(net::buffer(drained_),
+                            [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                              if (!ec) self->Drain();
+                            });
   }
 
   // Closed while waiting for its request header, to admit a new connection.
@@ -512,6 +520,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::shared_ptr<Server::Impl> server_;
   Server::Impl::Slots::Id slot_;
   bool evicted_ = false;
+  std::array<char, 4096> drained_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
 };
@@ -539,14 +548,6 @@ void Accept(std::shared_ptr<Server::Impl> server) {
 }
 
 }  // namespace
-
-Server::Server(ServerOptions options, Handler handler, std::vector<Asset> assets)
-    : Server(std::move(options),
-             ConnectionHandler([handler = std::move(handler)](const nlohmann::json& request,
-                                                              const std::shared_ptr<Connection>&) {
-               return handler(request);
-             }),
-             std::move(assets)) {}
 
 Server::Server(ServerOptions options, ConnectionHandler handler, std::vector<Asset> assets)
     : impl_(std::make_shared<Impl>()) {
@@ -578,7 +579,16 @@ Status Server::Start() {
 
 int Server::port() const { return impl_->port; }
 
-void Server::Run() { impl_->io.run(); }
+void Server::Run() {
+  impl_->io.run();
+  // Stopped: every connection is closed and its handlers run to their end,
+  // so that no session (each holds the Impl) is left holding the server.
+  beast::error_code ignored;
+  impl_->acceptor.close(ignored);
+  impl_->slots.CloseAll();
+  impl_->io.restart();
+  impl_->io.run_for(std::chrono::seconds(2));
+}
 
 void Server::Stop() { impl_->io.stop(); }
 

@@ -1,9 +1,13 @@
-// ServerOptions::IsValid, IsLoopback and the text helpers of url.h.
+// ServerOptions::IsValid, IsLoopback, the request checks and text helpers of
+// url.h, and the Server constructor for a plain Handler.
 
 #include <boost/asio/ip/address.hpp>
 #include <cctype>
+#include <memory>
+#include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "pidlab/server/server.h"
 #include "url.h"
@@ -48,6 +52,30 @@ bool SameSecret(const std::string& a, const std::string& b) {
   return diff == 0;
 }
 
+std::pair<int, std::string> Refusal(const ServerOptions& options, int port, const std::string& target,
+                                    const std::string& authorization, const std::string& host,
+                                    const std::string* origin) {
+  if (!options.token.empty()) {
+    std::string given = QueryValue(target, "token");
+    if (given.empty() && authorization.rfind("Bearer ", 0) == 0) given = authorization.substr(7);
+    if (!SameSecret(given, options.token)) return {401, "a valid token is required"};
+  }
+  const std::string suffix = ":" + std::to_string(port);
+  std::set<std::string> hosts = {"127.0.0.1" + suffix, "localhost" + suffix, "[::1]" + suffix};
+  hosts.insert((options.bind.find(':') != std::string::npos ? "[" + options.bind + "]" : options.bind) +
+               suffix);
+  // Bound to every address: any Host, as the token guards it.
+  const bool any = options.bind == "0.0.0.0" || options.bind == "::";
+  if (!any && hosts.count(host) == 0) return {403, "Host '" + host + "' is not this server"};
+  if (origin && *origin != "http://" + host) return {403, "Origin '" + *origin + "' is not this server's"};
+  return {200, ""};
+}
+
+std::string JsonLibraryWords(const std::string& what) {
+  const std::size_t end = what.find("] ");
+  return what.rfind("[json.exception.", 0) == 0 && end != std::string::npos ? what.substr(end + 2) : what;
+}
+
 }  // namespace internal
 
 bool IsLoopback(const std::string& address) {
@@ -76,8 +104,21 @@ bool ServerOptions::IsValid(std::string* error) const {
         std::to_string(max_connections);
   else if (!(header_timeout_s >= 0.1 && header_timeout_s <= 600))
     e = "header_timeout_s " + std::to_string(header_timeout_s) + " must be in 0.1..600";
+  else if (!(websocket_idle_timeout_s >= 0.1 && websocket_idle_timeout_s <= 3600))
+    e = "websocket_idle_timeout_s " + std::to_string(websocket_idle_timeout_s) + " must be in 0.1..3600";
+  else if (max_bodies_bytes < 1024)
+    e = "max_bodies_bytes " + std::to_string(max_bodies_bytes) + " must be at least 1024";
   if (error) *error = e;
   return e.empty();
 }
+
+// The plain handler's constructor: the connection handler's, without the connection.
+Server::Server(ServerOptions options, Handler handler, std::vector<Asset> assets)
+    : Server(std::move(options),
+             ConnectionHandler([handler = std::move(handler)](const nlohmann::json& request,
+                                                              const std::shared_ptr<Connection>&) {
+               return handler(request);
+             }),
+             std::move(assets)) {}
 
 }  // namespace pidlab::server

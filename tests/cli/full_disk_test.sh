@@ -2,11 +2,12 @@
 # Whole or nothing on a full disk (docs/security.md): a small tmpfs, mounted
 # in a private mount namespace this script makes (unshare -m), holds an old
 # version of every output, and is then filled. export, identify --out,
-# evaluate --samples-csv and --trajectory-csv and report each
+# evaluate --samples-csv and --trajectory-csv, plot --out and report each
 # must exit 1 with one line naming "No space left on device" and the path,
 # and leave the folder exactly as it was: the old files, byte for byte, and
 # no temporary. Then export's directory-in-the-way and read-only-old-file
-# cases: non-zero, nothing written.
+# cases, plot over a read-only old PNG and report over a read-only old
+# report.md (exit 2, one line, at once): non-zero, nothing written.
 # usage: full_disk_test.sh PIDLAB_BINARY
 set -uo pipefail
 pidlab=$(realpath -- "${1:?usage: full_disk_test.sh PIDLAB_BINARY}")
@@ -35,8 +36,9 @@ PY
 
 mkdir full
 mount -t tmpfs -o size=256k,mode=0755 tmpfs full || { echo "FAIL: cannot mount a tmpfs (root is needed)"; exit 1; }
-mkdir -p full/export full/report
-for f in export/pidlab_pid.h export/pidlab_pid.c model.json samples.csv trajectory.csv replay.csv report/report.md; do
+mkdir -p full/export full/report full/plot/evaluation_data
+for f in export/pidlab_pid.h export/pidlab_pid.c model.json samples.csv trajectory.csv replay.csv report/report.md \
+         plot/evaluation.png plot/evaluation_data/p0_s0.dat; do
   echo "old $f" > "full/$f"
 done
 snapshot() { (cd full && find . -path ./filler -prune -o -print0 | sort -z | xargs -0 ls -ld --time-style=+ | awk '{$6=""; print}'; find . -type f ! -name filler -print0 | sort -z | xargs -0 sha256sum); }
@@ -72,6 +74,8 @@ expect_full "evaluate --samples-csv" "full/samples.csv" \
   "$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --samples-csv full/samples.csv
 expect_full "evaluate --trajectory-csv" "full/trajectory.csv" \
   "$pidlab" evaluate --plant double_integrator --gains 3.9,0.06,4.9 --loop sampled --trajectory-csv full/trajectory.csv
+expect_full "plot --out" "full/plot" \
+  "$pidlab" plot --plant double_integrator --gains 3.9,0.06,4.9 --out full/plot
 expect_full "report" "full/report" \
   "$pidlab" report --quick --out full/report
 
@@ -102,6 +106,32 @@ if [ "$rc" -ne 0 ] && [ ! -e read_only/pidlab_pid.c ] && [ "$(cat read_only/pidl
   pass "export over a read-only old header: exit $rc, '$(cat err)', nothing written"
 else
   fail "export over a read-only old header: exit $rc, $(cat err), $(ls -A read_only)"
+fi
+
+# plot over a read-only old PNG: refused before any work (exit 2, one line),
+# the folder exactly as it was (no data files, no stage).
+mkdir -p plot_ro && echo "old png" > plot_ro/evaluation.png && chmod 0444 plot_ro/evaluation.png
+ro_before=$(cd plot_ro && find . -print0 | sort -z | xargs -0 ls -ld --time-style=+ | awk '{$6=""; print}' | grep -v ' \.$')
+rc=0; "$pidlab" plot --plant double_integrator --gains 3.9,0.06,4.9 --out plot_ro >out 2>err || rc=$?
+ro_after=$(cd plot_ro && find . -print0 | sort -z | xargs -0 ls -ld --time-style=+ | awk '{$6=""; print}' | grep -v ' \.$')
+if [ "$rc" -eq 2 ] && [ "$ro_before" = "$ro_after" ] && [ "$(cat plot_ro/evaluation.png)" = "old png" ] &&
+   only_line_ok err "read-only" >/dev/null && grep -qF "plot_ro/evaluation.png" err; then
+  pass "plot over a read-only old PNG: exit 2, '$(cat err)', the folder as it was"
+else
+  fail "plot over a read-only old PNG: exit $rc, $(cat err), $(ls -A plot_ro)"
+fi
+
+# report over a read-only old report.md: refused before the tunings (under
+# 2 s, exit 2, one line), the old file kept.
+mkdir -p report_ro && echo "old report" > report_ro/report.md && chmod 0444 report_ro/report.md
+rc=0; start=$(date +%s%N)
+"$pidlab" report --quick --no-figures --out report_ro >out 2>err || rc=$?
+ms=$((($(date +%s%N) - start) / 1000000))
+if [ "$rc" -eq 2 ] && [ "$ms" -lt 2000 ] && [ "$(cat report_ro/report.md)" = "old report" ] &&
+   [ "$(ls -A report_ro)" = "report.md" ] && only_line_ok err "read-only" >/dev/null; then
+  pass "report over a read-only old report.md: exit 2 in $ms ms, '$(cat err)', nothing written"
+else
+  fail "report over a read-only old report.md: exit $rc in $ms ms, $(cat err), $(ls -A report_ro)"
 fi
 
 echo "full_disk_test: $passed passed checks, $failed failed"

@@ -57,15 +57,22 @@ class WebSocket:
         return data
 
     def recv(self):
-        """(opcode, payload) of the next message, its fragments joined."""
+        """(opcode, payload) of the next message, its fragments joined. A
+        ping is answered with its pong, as a browser does (the server closes a
+        WebSocket that stays silent through its ping), and not returned."""
         opcode, payload = None, b''
         while True:
             b0, b1 = self._exact(2)
             n = b1 & 0x7f
             if n == 126: n = struct.unpack('>H', self._exact(2))[0]
             elif n == 127: n = struct.unpack('>Q', self._exact(8))[0]
+            data = self._exact(n)
+            if b0 & 0x0f == 9:
+                self.send(data, opcode=10)
+                continue
+            if b0 & 0x0f == 10: continue
             if opcode is None: opcode = b0 & 0x0f
-            payload += self._exact(n)
+            payload += data
             if b0 & 0x80: return opcode, payload
 
     def ask(self, obj):

@@ -126,6 +126,19 @@ bad "no gains" "--gains is required" '{"plant": "oscillator"}'
 "$pidlab" evaluate --spec missing.json >/dev/null 2>bad.err
 if [[ $? -eq 2 ]] && why=$(only_line_ok bad.err "missing.json"); then pass "a missing spec file is bad input naming it"
 else fail "missing spec file: ${why:-}"; fi
+# A rule broken only when the spec is built (evaluate, tune, export): the
+# line names the file as well as the value.
+built() {  # built NAME NEEDLE COMMAND_AND_FLAGS... (the spec in built.json)
+  local name=$1 needle=$2 why=""; shift 2
+  "$pidlab" "$@" --spec built.json >/dev/null 2>bad.err
+  local status=$?
+  if [[ $status -eq 2 ]] && why=$(only_line_ok bad.err "--spec 'built.json': ") && grep -qF -- "$needle" bad.err
+  then pass "a spec that does not build names the file ($name): $(cat bad.err)"
+  else fail "a spec that does not build ($name): exit $status, ${why:-$(cat bad.err)}"; fi
+}
+printf '%s' '{"plant": "double_integrator", "gains": [3.9, 0.06, 4.9], "loop": "sampled", "sample_time": 0.0155, "horizon": 10}' >built.json
+built "evaluate" "whole multiple of the sample time" evaluate
+built "export" "whole multiple of the sample time" export --lang c --out built_export
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -1,6 +1,10 @@
 """Hostile input against a running `pidlab serve` (tests/hostile/serve_hostile_test.sh):
 seeded malformed HTTP requests and WebSocket frames, the server's health checked
-every 500 cases. Prints one line per class and 'FAIL ...' on any failure."""
+every 500 cases. A user's mistake must never be a 500: every HTTP reply read
+is counted by status, and one class sends JSON objects of every request type
+whose fields have the wrong JSON type ({"type": 5}, a spec that is an array,
+an id that is an object). Prints one line per class and 'FAIL ...' on any
+failure."""
 import json, os, random, socket, struct, sys, time
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..', 'cli'))
 from serve_client import http, WebSocket
@@ -31,9 +35,44 @@ def raw(data, read=True):
             if not chunk: break
             reply += chunk
         s.close()
-        return reply.split(b'\r\n', 1)[0]
+        line = reply.split(b'\r\n', 1)[0]
+        parts = line.split(b' ')
+        if len(parts) > 1 and parts[1].isdigit():
+            statuses[int(parts[1])] = statuses.get(int(parts[1]), 0) + 1
+            if parts[1].startswith(b'5'):
+                fail('HTTP %s for %r: %r' % (parts[1].decode(), data[:200], reply.split(b'\r\n\r\n', 1)[-1][:200]))
+        return line
     except (ConnectionError, socket.timeout, OSError):
         return b''
+
+
+statuses = {}
+TYPES = ['evaluate', 'fields', 'paper_designs', 'export', 'pil_cost', 'tune', 'tune_cancel', 'identify',
+         'identify_cancel', 'log_open', 'log_episode', 'server_info', 'live_subscribe', 'live_unsubscribe',
+         'live_select', 'live_data', 'run_on_trio']
+FIELDS = ['type', 'spec', 'series', 'id', 'force', 'log_id', 'path', 'index', 'upload_id', 'model', 'name',
+          'episode', 'options', 'gains', 'plant', 'monte_carlo']
+
+
+def any_json(depth=0):
+    """A random JSON value of any type."""
+    k = rng.randrange(9 if depth < 3 else 6)
+    if k == 0: return None
+    if k == 1: return rng.choice([True, False])
+    if k == 2: return rng.choice([0, -1, 5, 2 ** 63, -2 ** 70, 1e308, -0.0, 3.5])
+    if k == 3: return rng.choice(['', 'x', 'evaluate', '\u0000', 'a' * 300, '../etc/passwd'])
+    if k == 4: return []
+    if k == 5: return {}
+    if k == 6: return [any_json(depth + 1) for _ in range(rng.randint(1, 3))]
+    return {rng.choice(FIELDS + ['num', 'den', 'dt']): any_json(depth + 1) for _ in range(rng.randint(1, 3))}
+
+
+def typed_request():
+    """A request object of a real type (or none), its fields of random JSON types."""
+    r = {}
+    if rng.random() < 0.9: r['type'] = rng.choice(TYPES) if rng.random() < 0.8 else any_json()
+    for _ in range(rng.randint(0, 4)): r[rng.choice(FIELDS)] = any_json()
+    return r
 
 
 def mutate(data):
@@ -50,7 +89,11 @@ def mutate(data):
 
 
 def http_case(i):
-    kind = i % 6
+    kind = i % 7
+    if kind == 6:
+        body = json.dumps(typed_request()).encode()
+        raw(VALID % (port, len(body)) + body)
+        return
     if kind == 0:
         data = bytes(rng.randrange(256) for _ in range(rng.randint(1, 2048)))
     elif kind == 1:
@@ -124,7 +167,10 @@ http_cases = count // 2
 for i in range(http_cases):
     http_case(i)
     if (i + 1) % 500 == 0: healthy('%d malformed HTTP requests' % (i + 1))
-print('ok   %d malformed HTTP requests' % http_cases, flush=True)
+print('ok   %d malformed HTTP requests; replies read by status: %s' % (
+    http_cases, ', '.join('%d: %d' % kv for kv in sorted(statuses.items()))), flush=True)
+if sum(n for code, n in statuses.items() if code >= 500):
+    fail('%d of the replies were 5xx' % sum(n for code, n in statuses.items() if code >= 500))
 frames = 0
 while frames < count - http_cases:
     frames += ws_case(rng.randint(1, 40))

@@ -6,8 +6,9 @@
 # nest 60000 deep; frames with bad opcodes, no mask, 2^63-byte lengths,
 # interleaved fragments), the server's answer to a valid evaluate checked
 # every 500; it must still answer at the end and stop with status 0. With
-# FUZZ (a script beside this one, serve_identify_fuzz.py), that script's
-# cases instead, the server given a --log-dir so that it takes uploads.
+# FUZZ (a script beside this one: serve_identify_fuzz.py, serve_uploads.py),
+# that script's cases instead, the server given a --log-dir so that it takes
+# uploads (and its pid in PIDLAB_SERVER_PID).
 #   serve_hostile_test.sh BIN_DIR COUNT SEED [FUZZ]
 set -uo pipefail
 bindir=$1 count=$2 seed=$3 fuzz=${4:-serve_fuzz.py}
@@ -19,6 +20,7 @@ logs=()
 [ "$fuzz" = serve_fuzz.py ] || logs=(--log-dir "$tmp")
 "$bindir/pidlab" serve --port 0 "${logs[@]}" > "$tmp/out" 2> "$tmp/err" &
 server=$!
+export PIDLAB_SERVER_PID=$server  # for a script that reads the server's memory (serve_uploads.py)
 for _ in $(seq 200); do grep -q '^pidlab serve: http' "$tmp/out" && break; sleep 0.05; done
 port=$(sed -nE 's#^pidlab serve: http://[^/]*:([0-9]+)/.*#\1#p' "$tmp/out")
 [ -n "$port" ] || { echo "FAIL: the server did not start"; cat "$tmp/err"; exit 1; }

@@ -7,8 +7,9 @@ Meanwhile /api/health and the page, asked from 127.0.0.2 (a user at an
 address of its own), must answer within 1 s, CHECKS times. Then request bodies and WebSocket messages nested 30 000 deep
 (under the 64 KiB bound: refused by the depth check, 400) and 100 000 deep
 (over it: 413, and the WebSocket closed), /api/health answering after each.
-Prints 'ok ...' lines, and 'FAIL ...' on any failure; runs at most about
-2 * CHECKS + 10 s.
+Then 64 idle WebSockets and 64 slow bodies, 16 of each from every one of
+127.0.1.1..4: /api/health answers within 1 s, 4 of 4 times. Prints 'ok ...'
+lines, and 'FAIL ...' on any failure; runs at most about 2 * CHECKS + 20 s.
   serve_slow.py PORT SLOW CHECKS"""
 import json, os, select, socket, struct, sys, threading, time
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..', 'cli'))
@@ -149,6 +150,80 @@ if closed == 0:
     fail('the server closed none of %d slow connections: they hold every slot' % opened)
 for l in lorises:
     l.s.close()
+
+# (b2) 64 idle WebSockets that never read (so never answer a ping) and 64
+# POSTs whose bodies trickle a byte every 2 s, 16 of each from every one of
+# 127.0.1.1..4 (past the per-address cap of 16 without ever reaching it), each
+# reopened once the server closes it: /api/health from 127.0.0.2 still
+# answers within 1 s, CHECKS_IDLE times.
+class Idler:
+    """A WebSocket that never reads, or a POST whose body never ends, from
+    `source`; reopened once closed."""
+    def __init__(self, source, kind):
+        self.source, self.kind = source, kind
+        self.opened = self.closed_by_server = 0
+        self.open()
+
+    def open(self):
+        self.s = socket.create_connection(('127.0.0.1', port), timeout=5, source_address=(self.source, 0))
+        if self.kind == 'ws':
+            self.s.sendall(b'GET /ws HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n'
+                           b'Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n' % port)
+        else:
+            self.s.sendall(b'POST /api/request HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nContent-Type: application/json\r\n'
+                           b'Content-Length: 60000\r\n\r\n{' % port)
+        self.s.setblocking(False)
+        self.opened += 1
+
+    def tick(self):
+        alive = True
+        try:
+            r, _, _ = select.select([self.s], [], [], 0)
+            # Read and dropped: the handshake's reply and the server's pings,
+            # never answered.
+            if r: alive = self.s.recv(65536) != b''
+            if alive and self.kind == 'body': self.s.send(b' ')
+        except OSError:
+            alive = False
+        if not alive:
+            self.closed_by_server += 1
+            self.s.close()
+            self.open()
+
+
+def hold(idlers, stop):
+    while not stop.wait(2.0):
+        for x in idlers:
+            try:
+                x.tick()
+            except OSError as e:
+                fail('reopening an idle connection: %s' % e)
+                return
+
+
+checks_idle = 4
+idlers = [Idler('127.0.1.%d' % (1 + i % 4), kind) for kind in ('ws', 'body') for i in range(64)]
+stop = threading.Event()
+thread = threading.Thread(target=hold, args=(idlers, stop), daemon=True)
+thread.start()
+worst = 0.0
+for i in range(checks_idle):
+    time.sleep(1.0)
+    status, seconds = timed_get('/api/health')
+    worst = max(worst, seconds)
+    if status != 200 or seconds > 1.0:
+        fail('GET /api/health with 64 idle WebSockets and 64 slow bodies from 127.0.1.1-4: status %d in '
+             '%.3f s (check %d)' % (status, seconds, i + 1))
+stop.set()
+thread.join()
+opened = sum(x.opened for x in idlers)
+closed = sum(x.closed_by_server for x in idlers)
+print('ok   %d checks of /api/health with 64 idle WebSockets and 64 slow bodies from 127.0.1.1-4: slowest '
+      '%.3f s; the server closed %d of the %d it accepted' % (checks_idle, worst, closed, opened), flush=True)
+if closed == 0:
+    fail('the server closed none of %d idle connections: they hold every slot' % opened)
+for x in idlers:
+    x.s.close()
 
 # (c) Deep nesting, as the request body and as a WebSocket message.
 status, body = post(deep(30000))

@@ -4,9 +4,11 @@
 # 127.0.0.1 only: 64 connections from 127.0.0.1 that each send one header
 # byte every 2 s (reopened when closed), and 48 more from three other
 # addresses that fill the global cap, must not keep /api/health and the page
-# from answering a user at 127.0.0.2 within 1 s; requests nested 30 000 and 100 000 deep, over HTTP
+# from answering a user at 127.0.0.2 within 1 s; nor may 64 WebSockets that
+# never answer a ping and 64 POSTs trickling their bodies, 16 of each from
+# every one of 127.0.1.1-4 (4 of 4 checks within 1 s); requests nested 30 000 and 100 000 deep, over HTTP
 # and the WebSocket, are refused and the server keeps answering; SIGTERM
-# stops it with status 0. Bounded: about 30 s.
+# stops it with status 0. Bounded: about 40 s.
 #   serve_slow_test.sh PIDLAB_BINARY
 set -uo pipefail
 if [[ $# -ne 1 ]]; then

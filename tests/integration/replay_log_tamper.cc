@@ -6,12 +6,16 @@
 //                                                 the trio's URL does not hear: the chunks carry u)
 //   replay_log_tamper IN OUT inject-garbage       foreign, unknown-type and undecodable events
 //                                                 between the events of the episode
+//   replay_log_tamper IN OUT inject-orphan        one forged plant output of each of the episodes
+//                                                 987654321..3, whose configuration is in no log
+//                                                 (orphans)
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <lcm/lcm-cpp.hpp>
 #include <pidlab/lcmt_control_command.hpp>
 #include <pidlab/lcmt_episode_config.hpp>
+#include <pidlab/lcmt_plant_output.hpp>
 #include <pidlab/lcmt_trajectory_chunk.hpp>
 #include <random>
 #include <string>
@@ -38,7 +42,8 @@ void PutBytes(lcm::LogFile* out, const std::string& channel, std::vector<uint8_t
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: replay_log_tamper IN OUT alter-command STEP | inject-garbage\n");
+    std::fprintf(stderr,
+                 "usage: replay_log_tamper IN OUT alter-command STEP | inject-garbage | inject-orphan\n");
     return 2;
   }
   const std::string mode = argv[3];
@@ -52,6 +57,7 @@ int main(int argc, char** argv) {
   std::mt19937 rng(11);
   int64_t num = 0, disturbed_episode = 0;
   long altered = 0, events = 0;
+  bool orphaned = false;
   for (const lcm::LogEvent* ev; (ev = in.readNextEvent()) != nullptr;) {
     ++events;
     if (ev->channel.size() >= 14 && ev->channel.substr(ev->channel.size() - 14) == "EPISODE_CONFIG") {
@@ -86,6 +92,16 @@ int main(int argc, char** argv) {
       continue;
     }
     Put(&out, *ev, &num);
+    pidlab::lcmt_plant_output output;
+    if (mode == "inject-orphan" && !orphaned && output.decode(ev->data, 0, ev->datalen) == ev->datalen) {
+      for (int64_t id : {987654321, 987654322, 987654323}) {
+        output.episode_id = id;
+        std::vector<uint8_t> buf(static_cast<std::size_t>(output.getEncodedSize()));
+        output.encode(buf.data(), 0, static_cast<int>(buf.size()));
+        PutBytes(&out, ev->channel, buf, &num);
+      }
+      orphaned = true;
+    }
     if (mode == "inject-garbage" && events % 50 == 0) {
       std::vector<uint8_t> junk(40);
       for (auto& b : junk) b = static_cast<uint8_t>(rng());
@@ -93,6 +109,10 @@ int main(int argc, char** argv) {
       PutBytes(&out, "PIDLAB_CONTROL", junk, &num);               // unknown fingerprint
       PutBytes(&out, "PIDLAB_PLANT_OUTPUT", {0x00, 0x01}, &num);  // too short to be anything
     }
+  }
+  if (mode == "inject-orphan" && !orphaned) {
+    std::fprintf(stderr, "replay_log_tamper: no plant output to forge an orphan from\n");
+    return 1;
   }
   if (mode == "alter-command" && altered == 0) {
     std::fprintf(stderr, "replay_log_tamper: no command of step %ld found\n", step);

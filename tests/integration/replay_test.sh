@@ -171,12 +171,34 @@ fi
 # ---- an altered command ----
 "$tamper" run.lcmlog altered.lcmlog alter-command 1234 || fail "tamper alter-command"
 status=0
-"$pidlab" replay altered.lcmlog --episode "$id" --redrive >altered.txt 2>&1 || status=$?
+"$pidlab" replay altered.lcmlog --episode "$id" --redrive >altered.txt 2>altered.err || status=$?
 if [[ $status -eq 1 ]] && grep -q "redrive: FAILED, first mismatch at step 1234 " altered.txt &&
-   grep -q "logged u = .*, recomputed u = " altered.txt; then
-  pass "--redrive points at the altered command (step 1234) with both values"
+   grep -q "logged u = .*, recomputed u = " altered.txt && [[ $(wc -l <altered.err) -eq 1 ]] &&
+   grep -q "^pidlab replay: .*--redrive: 1 of 1 episodes did not reproduce; episode $id: first mismatch at step 1234 " altered.err; then
+  pass "--redrive points at the altered command (step 1234) with both values, and says why in one line"
 else
-  fail "--redrive on the altered log (status $status): $(cat altered.txt)"
+  fail "--redrive on the altered log (status $status): $(cat altered.txt altered.err)"
+fi
+
+# ---- forged events of three episodes whose configuration is in no log ----
+"$tamper" run.lcmlog orphan.lcmlog inject-orphan || fail "tamper inject-orphan"
+status=0
+"$pidlab" replay orphan.lcmlog --redrive >orphan.txt 2>orphan.err || status=$?
+real=$(grep -c "redrive: OK, all .* reproduced bit for bit" orphan.txt)
+if [[ $status -eq 0 ]] && [[ $real -ge 1 ]] && [[ $real -eq $(grep -c "redrive: OK" redrive.txt) ]] &&
+   grep -q "redrive: SKIPPED, episode 987654321 has no configuration in the log" orphan.txt && [[ ! -s orphan.err ]]; then
+  pass "--redrive with orphan events: the $real real episode(s) reproduce (exit 0), each orphan is named and skipped"
+else
+  fail "--redrive with orphan events (status $status): $(cat orphan.txt orphan.err | head -20)"
+fi
+status=0
+"$pidlab" plot --log orphan.lcmlog --out plot_orphans >/dev/null 2>plot_orphans.err || status=$?
+if [[ $status -eq 0 ]] && [[ $(grep -c "not plotted" plot_orphans.err) -eq 1 ]] &&
+   grep -q "^note: 3 episodes (987654321, 987654322, 987654323) not plotted: no episode configuration" plot_orphans.err &&
+   [[ $(sort plot_orphans.err | uniq -d | wc -l) -eq 0 ]]; then
+  pass "plot --log with three orphans: one line per distinct note, naming the three"
+else
+  fail "plot --log with three orphans (status $status): $(head -c 600 plot_orphans.err)"
 fi
 
 # ---- redrive against a live controller (started alone in this namespace) ----

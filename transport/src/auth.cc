@@ -1,10 +1,13 @@
 #include "pidlab/transport/auth.h"
 
+#include <fcntl.h>
 #include <sodium.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <vector>
 
@@ -33,14 +36,28 @@ bool LoadAuthKeyOrExplain(const std::string& path, AuthKey* key, std::string* er
     return false;
   };
   if (!SodiumReady()) return fail("libsodium could not be initialised");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail("cannot be read");
+  // Opened without blocking and checked before a byte is read, as
+  // io::OpenRegularFile does (transport sits beside io, not above it): a
+  // FIFO would otherwise wait for a writer for ever.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) return fail("cannot be read");
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return fail("is not a regular file");
+  }
   std::vector<char> bytes;
   char buf[4096];
-  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
-    bytes.insert(bytes.end(), buf, buf + in.gcount());
-    if (bytes.size() > (std::size_t{1} << 20)) return fail("is larger than 1 MiB");
+  for (ssize_t n; (n = ::read(fd, buf, sizeof buf)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 || bytes.size() + static_cast<std::size_t>(n) > (std::size_t{1} << 20)) {
+      ::close(fd);
+      sodium_memzero(bytes.data(), bytes.size());
+      return fail(n < 0 ? "cannot be read" : "is larger than 1 MiB");
+    }
+    bytes.insert(bytes.end(), buf, buf + n);
   }
+  ::close(fd);
   if (bytes.size() < kMinAuthKeyFileBytes)
     return fail("holds " + std::to_string(bytes.size()) + " bytes, at least " +
                 std::to_string(kMinAuthKeyFileBytes) + " are needed (head -c 32 /dev/urandom > FILE)");

@@ -104,6 +104,12 @@ class StagedFolder {
   bool committed_ = false;
 };
 
+/// `path` opened for reading into *fd (the caller closes it), refused before
+/// anything is read when it is not a regular file: a FIFO, a device or a
+/// folder is kInvalidInput ("'F' is not a regular file") at once, never a
+/// wait for a writer. Every reader of a file a user names opens it here.
+Status OpenRegularFile(const std::string& path, int* fd);
+
 /// The whole of `path`, at most `max_bytes` (kInvalidInput beyond, and for a
 /// file that cannot be opened or is not a regular file, naming the errno's
 /// words).

@@ -56,8 +56,9 @@ class EventReader {
   EventReader(const EventReader&) = delete;
   EventReader& operator=(const EventReader&) = delete;
 
-  /// Opens the log at `path` (a regular file; once per reader). A failed
-  /// Status (kIoFailed), a line naming the path, if it cannot be opened.
+  /// Opens the log at `path` (a regular file; once per reader) with
+  /// io::OpenRegularFile: a FIFO or a folder is refused at once. A failed
+  /// Status (kInvalidInput), a line naming the path, if it cannot be opened.
   Status Open(const std::string& path);
 
   /// Called for every stretch of bytes skipped while looking for the next

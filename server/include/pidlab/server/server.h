@@ -12,10 +12,14 @@
 //  - headers, bodies and WebSocket messages are bounded (431, 413, close
 //    1009); a malformed request gets 400 and its connection closes; the
 //    server keeps serving;
-//  - a request header must be complete within `header_timeout_s`; when the
-//    connections (all, or one address's) are at their cap, the one that has
-//    waited longest for its request header is closed to admit the new one
-//    (a slow loris loses its slot, not the next client);
+//  - a request header must be complete within `header_timeout_s`, its body
+//    within 30 s, and a WebSocket that does not answer a ping within
+//    `websocket_idle_timeout_s` is closed; when the connections (all, or one
+//    address's) are at their cap, the one idle longest (waiting for a header,
+//    trickling a body, a quiet WebSocket) is closed to admit the new one (a
+//    slow loris loses its slot, not the next client);
+//  - the uploads held in memory at once are bounded in total
+//    (`max_bodies_bytes`): one that would pass it gets 413 on its header;
 //  - request JSON nested deeper than 64 levels is refused (400) before it is
 //    parsed;
 //  - every reply to a WebSocket request is sent, in order; only the
@@ -50,10 +54,15 @@ struct ServerOptions {
   std::size_t max_message_bytes = 64 * 1024;
   /// The body of POST /api/upload (a log); 413 above.
   std::size_t max_upload_bytes = 64 * 1024 * 1024;
+  /// Upload bodies held in memory at once, every connection's together (at
+  /// least max_upload_bytes): an upload that would pass it is refused with
+  /// 413 on its header, before it is read. Other bodies are bounded by
+  /// max_body_bytes on each of max_connections (4 MiB in all by default).
+  std::size_t max_bodies_bytes = 64 * 1024 * 1024;
   /// Connections open at once. A new one beyond it closes the connection
-  /// that has waited longest for its request header (an established
-  /// WebSocket or a request being read or answered is never closed so); with
-  /// none to close, the new one is closed on accept.
+  /// idle longest: one waiting for its request header, trickling its body,
+  /// or a WebSocket since its last message (only a connection being answered
+  /// is never closed so); with none to close, the new one is closed on accept.
   int max_connections = 64;
   /// Connections open at once from one client address, 1..max_connections;
   /// the same rule as max_connections among that address's connections.
@@ -61,6 +70,9 @@ struct ServerOptions {
   /// Seconds from a connection's accept (or its previous reply) to a complete
   /// request header, 0.1..600; the connection is closed after it.
   double header_timeout_s = 5.0;
+  /// Seconds a WebSocket may go without a byte from its client, 0.1..3600:
+  /// it is pinged after half of them and closed after all of them.
+  double websocket_idle_timeout_s = 60.0;
 
   /// Names the field, its value and the rule on failure.
   bool IsValid(std::string* error) const;
@@ -127,7 +139,8 @@ struct ServerCounters {
   long refused = 0;          // 401 and 403
   long malformed = 0;        // 400, 413, 431 and WebSocket messages that are not JSON objects
   long dropped_replies = 0;  // replaced by a newer one for a slow client
-  long evicted = 0;          // closed before their request header was complete, to admit a new connection
+  long evicted = 0;          // closed while idle (the one idle longest), to admit a new connection
+  long over_budget = 0;      // 413: the uploads in memory at their total limit
   long turned_away = 0;      // closed on accept: every slot held by connections that may not be evicted
 };
 
