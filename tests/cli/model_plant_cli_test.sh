@@ -128,6 +128,13 @@ write('badnumber.json', lambda j: j['parameters']['Kp'].update(value='x'))
 write('badkind.json', lambda j: j.update(model='p3d'))
 write('badshape.json', lambda j: j['covariance'].update(matrix=[[1, 0], [0, 1]]))
 write('badmodel.json', lambda j: j['parameters']['Tp1'].update(value=-1))
+# The parameters and the transfer function must agree (issue 59): an edited
+# Kp (zero, subnormal, ten times), Tp1 or Td, or an edited delay, is refused.
+for name, v in (('kp0', 0.0), ('kpsub', 5e-324), ('kp50', 10 * good['parameters']['Kp']['value'])):
+    write(name + '.json', lambda j, v=v: j['parameters']['Kp'].update(value=v))
+write('tp1.json', lambda j: j['parameters']['Tp1'].update(value=2 * good['parameters']['Tp1']['value']))
+write('td.json', lambda j: j['parameters']['Td'].update(value=good['parameters']['Td']['value'] + 1))
+write('delay.json', lambda j: j['transfer_function'].update(delay_s=good['transfer_function']['delay_s'] + 1))
 PY
 for case in "missing.json|cannot be read" \
             "notjson.json|is not valid JSON" \
@@ -135,7 +142,13 @@ for case in "missing.json|cannot be read" \
             "badnumber.json|\"parameters.Kp.value\" \"x\" is not a number" \
             "badkind.json|\"model\" \"p3d\" must be p1d|p2d|p2du|p1di" \
             "badshape.json|\"covariance.matrix\" must be 3 x 3 (Kp, Tp1, Td)" \
-            "badmodel.json|is not a valid p1d model: Tp1 -1 s must be > 0"; do
+            "badmodel.json|is not a valid p1d model: Tp1 -1 s must be > 0" \
+            "kp0.json|\"transfer_function.num\" disagrees with \"parameters\"" \
+            "kpsub.json|\"transfer_function.num\" disagrees with \"parameters\"" \
+            "kp50.json|\"transfer_function.num\" disagrees with \"parameters\"" \
+            "tp1.json|\"transfer_function.num\" disagrees with \"parameters\"" \
+            "td.json|\"transfer_function.delay_s\"" \
+            "delay.json|disagrees with \"parameters.Td\""; do
   file=${case%%|*} needle=${case#*|}
   pidlab evaluate --model "$file" "${G[@]}" > out 2> err
   check "evaluate --model $file exits 2 with one line naming '$needle'" \

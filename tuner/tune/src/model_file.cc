@@ -2,13 +2,18 @@
 
 #include "pidlab/tune/model_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "pidlab/io/files.h"
+#include "pidlab/plant_sim/process_model.h"
+#include "pidlab/spec/field.h"
 #include "pidlab/spec/json.h"
 
 namespace pidlab::tune {
@@ -159,6 +164,55 @@ bool IsModelPlant(const std::string& plant, std::string* path) {
 namespace {
 
 // ReadModelFile() with the refusal's message in *error.
+// The parameters' transfer function and delay against the file's (both
+// scaled by their denominators' leading coefficient), to 1e-9 of the
+// largest coefficient: a file whose parameters were edited, or whose
+// transfer function was, is refused naming the field that disagrees.
+bool ParametersGiveTheTf(const ProcessModelUncertainty& m, const Plant& file, std::string* error) {
+  const plant_sim::ProcessModel model = plant_sim::ModelFromValues(m.kind, m.values, m.poles, m.zeros);
+  const TransferFunction want = model.ToTransferFunction();
+  const auto scaled = [](const std::vector<double>& v, double by) {
+    std::vector<double> out;
+    bool leading = true;
+    for (double x : v) {
+      if (leading && x == 0.0) continue;
+      leading = false;
+      out.push_back(x / by);
+    }
+    if (out.empty()) out.push_back(0.0);
+    return out;
+  };
+  const auto list = [](const std::vector<double>& v) {
+    std::string t = "[";
+    for (std::size_t i = 0; i < v.size(); ++i) t += (i ? ", " : "") + spec::FormatNumber(v[i]);
+    return t + "]";
+  };
+  const auto lead = [](const std::vector<double>& den) {
+    for (double x : den)
+      if (x != 0.0) return x;
+    return 1.0;
+  };
+  const std::pair<const char*, std::pair<std::vector<double>, std::vector<double>>> parts[] = {
+      {"num", {scaled(file.tf.num, lead(file.tf.den)), scaled(want.num, lead(want.den))}},
+      {"den", {scaled(file.tf.den, lead(file.tf.den)), scaled(want.den, lead(want.den))}}};
+  for (const auto& [name, pair] : parts) {
+    const auto& [got, from] = pair;
+    double size = 0.0;
+    for (double x : from) size = std::max(size, std::fabs(x));
+    bool same = got.size() == from.size();
+    for (std::size_t i = 0; same && i < got.size(); ++i) same = std::fabs(got[i] - from[i]) <= 1e-9 * size;
+    if (!same)
+      return FileBad(error, std::string("\"transfer_function.") + name + "\" disagrees with \"parameters\" (a " +
+                                plant_sim::ToString(m.kind) + " model whose parameters give " + name + " " +
+                                list(from) + " against " + list(got) +
+                                ", both over the denominator's leading coefficient)");
+  }
+  if (std::fabs(file.delay_s - model.delay_s()) > 1e-9 * std::max(1.0, model.delay_s()))
+    return FileBad(error, "\"transfer_function.delay_s\" " + spec::FormatNumber(file.delay_s) +
+                              " disagrees with \"parameters.Td\" " + spec::FormatNumber(model.delay_s()));
+  return true;
+}
+
 bool ReadModelFileOrExplain(const std::string& path, Plant* plant, std::string* error) {
   std::string text;
   nlohmann::json j;
@@ -185,6 +239,7 @@ bool ReadModelFileOrExplain(const std::string& path, Plant* plant, std::string* 
   if (!Number(*delay, "transfer_function.delay_s", &p.delay_s, error)) return false;
   if (p.delay_s < 0.0)
     return FileBad(error, "\"transfer_function.delay_s\" " + spec::FormatNumber(p.delay_s) + " must be >= 0");
+  if (!ParametersGiveTheTf(*m, p, error)) return false;
   p.name = kModelPlantName;
   p.model = std::move(m);
   *plant = std::move(p);
