@@ -226,7 +226,8 @@ TEST(Design, AReverseActingPlantGetsTheNegatedGainsOfItsMirrorWithTheSameLoop) {
   EXPECT_TRUE(a.stable);
   EXPECT_NEAR(a.ms, b.ms, 1e-12);
   EXPECT_NEAR(a.noise_gain, b.noise_gain, 1e-9 * b.noise_gain);
-  EXPECT_NEAR(LibraryLoadIae(reverse, r.gains, 60.0, 6000), LibraryLoadIae(mirror, m.gains, 60.0, 6000), 1e-9);
+  EXPECT_NEAR(LibraryLoadIae(reverse, r.gains, 60.0, 6000), LibraryLoadIae(mirror, m.gains, 60.0, 6000),
+              1e-9);
 }
 
 TEST(Design, RefusesANonlinearPlantAndBadOptionsInOneLine) {

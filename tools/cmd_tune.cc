@@ -221,7 +221,8 @@ struct TuneCommand {
     std::cout << "response time    " << s.design.response_time_s << " s (2 / the crossover "
               << s.design.crossover_rad_s << " rad/s)\n";
     if (s.design.reverse_acting)
-      std::cout << "note             the loop acts in reverse: the plant's gain is negative, so are kp, ki and kd\n";
+      std::cout << "note             the loop acts in reverse: the plant's gain is negative, so are kp, ki "
+                   "and kd\n";
   }
 
   static void PrintTwoDof(const pidlab::tune::TwoDofSummary& t) {

@@ -134,7 +134,8 @@ void Tighten(const Plant& plant, const design::Bounds& check, const design::Opti
 // scaling the gain back cannot help (an integrating plant's Mt, which rises
 // as the gain falls).
 bool CorrectedPoint(const Plant& plant, const design::Engine& engine, const design::Bounds& check,
-                    design::Bounds design, Eigen::VectorXd warm, design::Optimum* o, analysis::LoopAnalysis* a) {
+                    design::Bounds design, Eigen::VectorXd warm, design::Optimum* o,
+                    analysis::LoopAnalysis* a) {
   bool found = false;
   for (int i = 0; i < 8; ++i) {
     design::Optimum trial;

@@ -202,10 +202,10 @@ bool ParametersGiveTheTf(const ProcessModelUncertainty& m, const Plant& file, st
     bool same = got.size() == from.size();
     for (std::size_t i = 0; same && i < got.size(); ++i) same = std::fabs(got[i] - from[i]) <= 1e-9 * size;
     if (!same)
-      return FileBad(error, std::string("\"transfer_function.") + name + "\" disagrees with \"parameters\" (a " +
-                                plant_sim::ToString(m.kind) + " model whose parameters give " + name + " " +
-                                list(from) + " against " + list(got) +
-                                ", both over the denominator's leading coefficient)");
+      return FileBad(error, std::string("\"transfer_function.") + name +
+                                "\" disagrees with \"parameters\" (a " + plant_sim::ToString(m.kind) +
+                                " model whose parameters give " + name + " " + list(from) + " against " +
+                                list(got) + ", both over the denominator's leading coefficient)");
   }
   if (std::fabs(file.delay_s - model.delay_s()) > 1e-9 * std::max(1.0, model.delay_s()))
     return FileBad(error, "\"transfer_function.delay_s\" " + spec::FormatNumber(file.delay_s) +

@@ -316,15 +316,17 @@ void ResolveMethod(spec::TuningSpec* s, const std::set<std::string>& given, bool
     t->method_reason = "the nonlinear stepper is tuned by the search on the paper's objective";
   } else if (!search.empty()) {
     t->method_reason =
-        search == "backend" ? "the trio's episodes tune the sampled loop: the search on the paper's objective"
+        search == "backend"
+            ? "the trio's episodes tune the sampled loop: the search on the paper's objective"
             : "'" + search +
                   "' asks for the search on the paper's objective (the design engine takes --robustness, "
                   "--max-ms, --max-mt, --max-noise-gain and --max-overshoot)";
   } else {
     s->tune.method = "optimal";
-    t->method_reason = s->loop.loop == "sampled"
-                           ? "the default: the design engine, on the sampled loop (the ZOH plant and the discrete PID)"
-                           : "the default: the design engine";
+    t->method_reason =
+        s->loop.loop == "sampled"
+            ? "the default: the design engine, on the sampled loop (the ZOH plant and the discrete PID)"
+            : "the default: the design engine";
   }
   // The engine's Ms bound from --max-ms where --robustness is not given.
   if (s->tune.method == "optimal" && kept("max_ms") && !kept("robustness") && std::isfinite(s->bounds.max_ms))
