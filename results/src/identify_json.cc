@@ -150,19 +150,29 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
 
 Status RunIdentify(const identify::IdentifyData& data, const std::string& model,
                    const identify::IdentifyOptions& options, IdentifyRun* run) {
-  if (model == "auto") {
-    identify::AutoResult& a = run->automatic;
-    if (Status st = identify::IdentifyAuto(data, options, &a); !st.ok()) return st;
-    run->result = a.candidates[static_cast<std::size_t>(a.chosen)].result;
-    run->json = IdentifyAutoJson(a);
-    return Status::Ok();
-  }
   identify::ProcessModelKind kind = identify::ProcessModelKind::kP1D;
-  if (!identify::Parse(model, &kind))
+  if (model != "auto" && !identify::Parse(model, &kind))
     return Status::InvalidInput("model '" + model + "' must be one of " + identify::ProcessModelKindNames() +
                                 "|auto");
-  if (Status st = identify::Identify(data, kind, options, &run->result); !st.ok()) return st;
-  run->json = IdentifyResultJson(run->result);
+  if (Status st = identify::DecimateRecord(data, options.max_samples, options.intersample, &run->data,
+                                           &run->decimation);
+      !st.ok())
+    return st;
+  const identify::Decimation& d = run->decimation;
+  const nlohmann::json decimation = {{"factor", d.factor},
+                                     {"samples_read", d.samples_read},
+                                     {"samples", d.samples},
+                                     {"max_samples", d.max_samples}};
+  if (model == "auto") {
+    identify::AutoResult& a = run->automatic;
+    if (Status st = identify::IdentifyAuto(run->data, options, &a); !st.ok()) return st;
+    run->result = a.candidates[static_cast<std::size_t>(a.chosen)].result;
+    run->json = IdentifyAutoJson(a);
+  } else {
+    if (Status st = identify::Identify(run->data, kind, options, &run->result); !st.ok()) return st;
+    run->json = IdentifyResultJson(run->result);
+  }
+  run->json["decimation"] = decimation;
   return Status::Ok();
 }
 
