@@ -5,7 +5,8 @@
 # 59 sets; the bench has the figures), decimated by 20 to 10000 samples,
 # saying so on stderr at once with its progress, in the text and in the
 # JSON; the gain, time constant and delay within 3 % of the truth. Under
-# --quiet stderr is empty; a bad --max-samples exits 2 with one line.
+# --quiet stderr is empty; a bad --max-samples exits 2 with one line; a
+# time constant too short for the decimated record is warned of.
 set -uo pipefail
 source "$(dirname -- "$0")/stderr_shape.sh"  # only_line_ok: the one-line stderr rule
 pidlab="$1"
@@ -58,6 +59,23 @@ check "the JSON's decimation is {factor 20, 200000 read, 10000 fitted}; Kp, Tp1,
 "$pidlab" identify --csv long.csv --model p1d --max-samples 5 > /dev/null 2> bad
 check "--max-samples 5 exits 2 with one line naming the limit" \
   "[ $? -eq 2 ] && only_line_ok bad '--max-samples 5 must be in [100, 10000000]'"
+
+# Tp1 = 0.03 s at dt = 1 ms, decimated by 20 to 0.02 s: the fit warns that
+# Tp1 is under two of the decimated intervals.
+/usr/bin/python3 - <<'PY'
+import math, random
+rng, kp, tau, dt, rows = random.Random(5), 2.0, 0.03, 0.001, 20000
+a, y = math.exp(-dt / tau), 0.0
+with open('fast.csv', 'w') as f:
+    f.write('t,u,y\n')
+    for k in range(rows):
+        u = 1.0 if (k // 500) % 2 else 0.0
+        f.write('%.3f,%g,%.6f\n' % (k * dt, u, y + rng.gauss(0.0, 0.02)))
+        y = a * y + kp * (1.0 - a) * u
+PY
+"$pidlab" identify --csv fast.csv --model p1d --u0 0 --max-samples 1000 > /dev/null 2> fast_err
+check "a time constant under two decimated intervals is warned of, naming the factor and the limit" \
+  "[ $? -eq 0 ] && grep -q '^warning: Tp1 = .* s is under two intervals (0.02 s) of the record decimated by 20 from 20000 samples: .*max_samples (1000)' fast_err"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -43,7 +43,8 @@ struct IdentifyRun {
 /// "auto" (every process kind, the lowest AIC kept; tf needs
 /// options.poles), decimated first when longer than options.max_samples
 /// (json "decimation" {factor, samples_read, samples, max_samples}, factor
-/// 1 when not). kInvalidInput names a bad model or record; the fit's
+/// 1 when not; a time constant under two decimated intervals is added to
+/// the warnings). kInvalidInput names a bad model or record; the fit's
 /// own failures keep their code. The command line and the page's identify
 /// request both run it.
 Status RunIdentify(const identify::IdentifyData& data, const std::string& model,
