@@ -87,9 +87,9 @@ inline constexpr double kDownweightedBelow = 0.5;
 /// The most starts a fit takes (IdentifyOptions::starts).
 inline constexpr int kMaxStarts = 1000;
 /// The default and the range of IdentifyOptions::max_samples: a fit's time
-/// grows with the samples (about 0.6 ms each for P1D's 17 starts on one
-/// core, bench/identify_bench.sh), so a record longer than the limit is
-/// decimated first (DecimateRecord) or refused.
+/// grows with the samples (at 10000, about 0.6 s for P1D and 20 s for P2DU
+/// or P2DZ on this project's 2 shared cores: bench/identify_long_bench.sh),
+/// so a longer record is decimated first (DecimateRecord) or refused.
 inline constexpr std::size_t kDefaultMaxSamples = 10000;
 inline constexpr std::size_t kMinMaxSamples = 100;
 inline constexpr std::size_t kMaxMaxSamples = 10000000;
