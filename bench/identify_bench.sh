@@ -50,7 +50,9 @@ with tempfile.TemporaryDirectory() as tmp:
     pidlab_cpu = []
     for _ in range(repeats):
         before = children_cpu()
-        out = subprocess.run([pidlab, "identify", "--csv", path, "--model", "p2d", "--json"], capture_output=True,
+        # The whole record, however long (--max-samples: not decimated, as scipy fits it).
+        out = subprocess.run([pidlab, "identify", "--csv", path, "--model", "p2d", "--json",
+                              "--max-samples", str(max(samples, 100))], capture_output=True,
                              text=True, check=True)
         pidlab_cpu.append(children_cpu() - before)
     j = json.loads(out.stdout)

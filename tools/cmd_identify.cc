@@ -132,6 +132,15 @@ std::string RestAndLossLines(const IdentifyResult& r) {
   return os.str();
 }
 
+// "record decimated by 20 ...": one line when the record was longer than
+// --max-samples, else nothing.
+std::string DecimationLine(const identify::Decimation& d) {
+  if (d.factor == 1) return "";
+  return "record decimated by " + std::to_string(d.factor) + ": " + std::to_string(d.samples_read) +
+         " samples to " + std::to_string(d.samples) + " (--max-samples " + std::to_string(d.max_samples) +
+         "), u and y averaged over each interval\n";
+}
+
 std::string WhitenessLine(const identify::Whiteness& w) {
   std::ostringstream os;
   os << "residuals: Ljung-Box Q " << Num(w.ljung_box_q, 5) << " over " << w.lags
@@ -201,10 +210,17 @@ struct IdentifyCommand {
     app->add_option("--loss-scale", loss_scale_text,
                     "with --loss huber or cauchy: the scale a in units of y, > 0 (default: 1.345 or 2.385 "
                     "robust standard deviations, 1.4826 MAD, of the l2 fit's residuals)");
+    app->add_option("--max-samples", options.max_samples,
+                    "the most samples a fit takes, " + std::to_string(identify::kMinMaxSamples) + ".." +
+                        std::to_string(identify::kMaxMaxSamples) +
+                        ": a longer record is decimated by the least integer factor that fits, u and y "
+                        "averaged over each interval (said on stderr and in the output)")
+        ->capture_default_str();
     app->add_flag("--json", json, "print one JSON object");
     app->add_flag("--quiet", quiet,
                   "no progress lines (on a terminal, a fit that runs beyond 3 s says on stderr, once a "
-                  "second, the model, the starts done and the best cost so far)");
+                  "second, the model, the starts done and the best cost so far; a record beyond "
+                  "--max-samples says so, and its progress, wherever stderr goes)");
     app->add_option("--out", out,
                     "also write the JSON object to this file (a model file for --plant model:FILE)");
     app->add_option("--plot", plot_path,
@@ -214,20 +230,36 @@ struct IdentifyCommand {
 
   mutable long chosen_episode = 0;
 
-  // After 3 s, at most once a second: "pidlab identify: p2d: 9 of 17 starts,
-  // best cost 12.5 (4 s)" on stderr.
-  static std::function<void(identify::ProcessModelKind, int, int, double)> ProgressPrinter() {
+  // After 3 s (from the first start when `at_once`: a long record), at most
+  // once a second: "pidlab identify: p2d: 9 of 17 starts, best cost 12.5
+  // (4 s)" on stderr.
+  static std::function<void(identify::ProcessModelKind, int, int, double)> ProgressPrinter(bool at_once) {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    auto last = std::make_shared<Clock::time_point>(start);
-    return [start, last](identify::ProcessModelKind kind, int done, int total, double best) {
+    auto last = std::make_shared<Clock::time_point>(start - std::chrono::seconds(at_once ? 1 : 0));
+    const auto wait = std::chrono::seconds(at_once ? 0 : 3);
+    return [start, last, wait](identify::ProcessModelKind kind, int done, int total, double best) {
       const auto now = Clock::now();
-      if (now - start < std::chrono::seconds(3) || now - *last < std::chrono::seconds(1)) return;
+      if (now - start < wait || now - *last < std::chrono::seconds(1)) return;
       *last = now;
       std::cerr << "pidlab identify: " << identify::ToString(kind) << ": " << done << " of " << total
                 << " starts, best cost " << Num(best, 6) << " ("
                 << std::chrono::duration_cast<std::chrono::seconds>(now - start).count() << " s)\n";
     };
+  }
+
+  // Progress on a terminal, or for a record beyond --max-samples (its
+  // decimation said at once); otherwise a log or a test's captured stderr
+  // keeps its one line (README, "Exit status and limits").
+  void ShowProgress(std::size_t samples) {
+    const bool long_record = samples > options.max_samples;
+    if (quiet) return;
+    if (long_record)
+      std::cerr << "pidlab identify: " << samples << " samples, more than --max-samples "
+                << options.max_samples << ": decimated by "
+                << identify::DecimationFactor(samples, options.max_samples)
+                << " (an anti-alias average) before the fit\n";
+    if (long_record || ::isatty(STDERR_FILENO)) options.progress = ProgressPrinter(long_record);
   }
 
   identify::IdentifyData ReadData() const {
@@ -358,9 +390,7 @@ struct IdentifyCommand {
       if (std::isnan(options.u0)) options.u0 = 0.0;
       if (std::isnan(options.y0)) options.y0 = 0.0;
     }
-    // On a terminal only: a log or a test's captured stderr keeps its one
-    // line (README, "Exit status and limits").
-    if (!quiet && ::isatty(STDERR_FILENO)) options.progress = ProgressPrinter();
+    ShowProgress(data.y.size());
     results::IdentifyRun run;
     const Status status = results::RunIdentify(data, automatic ? "auto" : model, options, &run);
     if (status.code() == StatusCode::kInvalidInput) throw BadInput(Source() + ": " + status.message());
@@ -392,14 +422,15 @@ struct IdentifyCommand {
     if (!plot_path.empty()) {
       plot::Figure figure;
       std::string error;
-      if (const Status st = figures::IdentifyFigure(data, result, &figure); !st.ok())
+      if (const Status st = figures::IdentifyFigure(run.data, result, &figure); !st.ok())
         throw std::runtime_error(st.message());
       figure.output_path = plot_path;
       Require(plot::DrawPng(figure));
     }
     for (const std::string& w : result.warnings) std::cerr << "warning: " << w << "\n";
     std::cout << (json ? j.dump() + "\n"
-                       : header + Table(result) + RestAndLossLines(result) + WhitenessLine(result.whiteness));
+                       : header + DecimationLine(run.decimation) + Table(result) + RestAndLossLines(result) +
+                             WhitenessLine(result.whiteness));
     return 0;
   }
 };

@@ -1,7 +1,8 @@
 // The page's identify and identify_cancel requests (docs/workbench.md, "Data
 // and model"): a process model fitted on a thread of its own, as `pidlab
 // identify --model MODEL --json` fits it (results::RunIdentify, the same
-// record readers), with its progress at most ten times a second. The
+// record readers, a record beyond max_samples decimated), with its progress
+// at most ten times a second, cancelled within one solver iteration. The
 // result carries the fit's curves and the path of a model file written in
 // the uploads' directory: the plant "model:PATH" of the page's next specs.
 
@@ -155,7 +156,7 @@ nlohmann::json Fit(const Record& record, const std::string& model, const identif
   if (path.empty()) return {{"type", "identify_result"}, {"error", error}};
   return {{"type", "identify_result"},
           {"result", run.json},
-          {"fit", results::IdentifyFitSeries(record.data, run.result)},
+          {"fit", results::IdentifyFitSeries(run.data, run.result)},
           {"plant", std::string(tune::kModelPlantPrefix) + path}};
 }
 
@@ -163,8 +164,12 @@ void RunFit(std::shared_ptr<ConnectionJob> job, std::shared_ptr<server::Connecti
             std::string model, identify::IdentifyOptions options, nlohmann::json id) {
   nlohmann::json reply;
   options.progress = ProgressPoster(job, out, id);
+  // Asked at every iteration of every solve: a cancel stops the fit within
+  // one iteration (a record is at most options.max_samples long).
+  options.cancelled = [job, out] { return job->cancel || out->closed(); };
   try {
     reply = Fit(record, model, options);
+    if (job->cancel || out->closed()) throw Cancelled{};
   } catch (const Cancelled&) {
     reply = {{"type", "identify_cancelled"}, {"error", "the fit was cancelled"}};
   } catch (const std::exception& e) {

@@ -1,6 +1,8 @@
 #include "pidlab/results/identify_json.h"
 
 #include <Eigen/Dense>
+#include <sstream>
+#include <string>
 
 #include "pidlab/plant_sim/transfer_function.h"
 #include "pidlab/results/results_json.h"
@@ -42,6 +44,22 @@ nlohmann::json OperatingPointJson(const identify::IdentifyResult& r) {
     hypotheses.push_back(hj);
   }
   return {{"u0", JsonNumber(r.u0)}, {"source", r.u0_source}, {"hypotheses", hypotheses}};
+}
+
+// A record decimated by q sees its dynamics at q times the interval: a time
+// constant under two of those intervals is said in a warning (fit a shorter
+// stretch at full rate, or raise the limit).
+void WarnIfTooCoarse(const identify::Decimation& d, identify::IdentifyResult* r) {
+  if (d.factor == 1) return;
+  for (std::size_t i = 0; i < r->names.size() && i < r->values.size(); ++i) {
+    const std::string& name = r->names[i];
+    if ((name != "Tp1" && name != "Tp2" && name != "Tw") || !(r->values[i] < 2.0 * r->dt_s)) continue;
+    std::ostringstream os;
+    os << name << " = " << r->values[i] << " s is under two intervals (" << r->dt_s
+       << " s) of the record decimated by " << d.factor << " from " << d.samples_read
+       << " samples: fit a shorter stretch at full rate or raise max_samples (" << d.max_samples << ")";
+    r->warnings.push_back(os.str());
+  }
 }
 
 }  // namespace
@@ -150,19 +168,31 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
 
 Status RunIdentify(const identify::IdentifyData& data, const std::string& model,
                    const identify::IdentifyOptions& options, IdentifyRun* run) {
-  if (model == "auto") {
-    identify::AutoResult& a = run->automatic;
-    if (Status st = identify::IdentifyAuto(data, options, &a); !st.ok()) return st;
-    run->result = a.candidates[static_cast<std::size_t>(a.chosen)].result;
-    run->json = IdentifyAutoJson(a);
-    return Status::Ok();
-  }
   identify::ProcessModelKind kind = identify::ProcessModelKind::kP1D;
-  if (!identify::Parse(model, &kind))
+  if (model != "auto" && !identify::Parse(model, &kind))
     return Status::InvalidInput("model '" + model + "' must be one of " + identify::ProcessModelKindNames() +
                                 "|auto");
-  if (Status st = identify::Identify(data, kind, options, &run->result); !st.ok()) return st;
-  run->json = IdentifyResultJson(run->result);
+  if (Status st = identify::DecimateRecord(data, options.max_samples, options.intersample, &run->data,
+                                           &run->decimation);
+      !st.ok())
+    return st;
+  const identify::Decimation& d = run->decimation;
+  const nlohmann::json decimation = {{"factor", d.factor},
+                                     {"samples_read", d.samples_read},
+                                     {"samples", d.samples},
+                                     {"max_samples", d.max_samples}};
+  if (model == "auto") {
+    identify::AutoResult& a = run->automatic;
+    if (Status st = identify::IdentifyAuto(run->data, options, &a); !st.ok()) return st;
+    WarnIfTooCoarse(d, &a.candidates[static_cast<std::size_t>(a.chosen)].result);
+    run->result = a.candidates[static_cast<std::size_t>(a.chosen)].result;
+    run->json = IdentifyAutoJson(a);
+  } else {
+    if (Status st = identify::Identify(run->data, kind, options, &run->result); !st.ok()) return st;
+    WarnIfTooCoarse(d, &run->result);
+    run->json = IdentifyResultJson(run->result);
+  }
+  run->json["decimation"] = decimation;
   return Status::Ok();
 }
 

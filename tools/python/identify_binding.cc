@@ -62,11 +62,12 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
                       int starts, std::uint64_t seed, const py::object& u0, const py::object& y0,
                       const py::object& poles, const py::object& zeros, const std::string& intersample,
                       const std::string& initial_condition, const std::string& loss,
-                      const py::object& loss_scale) {
+                      const py::object& loss_scale, std::size_t max_samples) {
   identify::IdentifyData data{Column(t, "t"), Column(u, "u"), Column(y, "y")};
   identify::IdentifyOptions options;
   options.starts = starts;
   options.seed = seed;
+  options.max_samples = max_samples;
   if (py::isinstance<py::str>(u0)) {
     if (u0.cast<std::string>() != "estimate")
       throw py::value_error("identify: u0 = '" + u0.cast<std::string>() +
@@ -86,27 +87,18 @@ py::object IdentifyPy(const py::object& t, const py::object& u, const py::object
     throw py::value_error("identify: loss = '" + loss + "' must be 'l2', 'huber' or 'cauchy'");
   if (!loss_scale.is_none()) options.loss_scale = loss_scale.cast<double>();
   if (std::string error; !options.IsValid(&error)) throw py::value_error("identify: " + error);
+  identify::ProcessModelKind kind = identify::ProcessModelKind::kP1D;
+  if (model != "auto" && !identify::Parse(model, &kind))
+    throw py::value_error("identify: model = '" + model + "' must be one of " +
+                          identify::ProcessModelKindNames() + "|auto");
+  // As `pidlab identify` fits it: a record beyond max_samples decimated first.
+  results::IdentifyRun run;
   Status status;
-  nlohmann::json j;
-  if (model == "auto") {
-    identify::AutoResult result;
-    {
-      py::gil_scoped_release release;
-      status = identify::IdentifyAuto(data, options, &result);
-    }
-    if (status.ok()) j = results::IdentifyAutoJson(result);
-  } else {
-    identify::ProcessModelKind kind = identify::ProcessModelKind::kP1D;
-    if (!identify::Parse(model, &kind))
-      throw py::value_error("identify: model = '" + model + "' must be one of " +
-                            identify::ProcessModelKindNames() + "|auto");
-    identify::IdentifyResult result;
-    {
-      py::gil_scoped_release release;
-      status = identify::Identify(data, kind, options, &result);
-    }
-    if (status.ok()) j = results::IdentifyResultJson(result);
+  {
+    py::gil_scoped_release release;
+    status = results::RunIdentify(data, model, options, &run);
   }
+  const nlohmann::json& j = run.json;
   if (status.code() == StatusCode::kInvalidInput) throw py::value_error("identify: " + status.message());
   if (!status.ok()) throw std::runtime_error("identify: " + status.message());
   return ToDict(j);
@@ -118,7 +110,7 @@ void DefineIdentify(py::module_& m) {
   m.def(
       "identify", &IdentifyPy,
       "identify(t, u, y, model='p1d', starts=16, seed=0, u0=None, y0=None, poles=None, zeros=None, "
-      "intersample='zoh', initial_condition='zero', loss='l2', loss_scale=None): fits a "
+      "intersample='zoh', initial_condition='zero', loss='l2', loss_scale=None, max_samples=10000): fits a "
       "process model (p1d, p2d, p2du, p1di, p2dz, or auto to choose among them by AIC) or a general "
       "transfer function (model='tf' with poles=N in 1..6 and zeros=M in 0..N-1, default 0) to the record "
       "t (s, uniform or not), u, y (lists or numpy arrays) and returns the dict of `pidlab identify "
@@ -128,12 +120,14 @@ void DefineIdentify(py::module_& m) {
       "fitted too). intersample: "
       "'zoh' (held) or 'foh' (linear between samples); initial_condition: 'zero', 'steady-state' or "
       "'estimate', as the CLI's --intersample and --initial-condition; loss: 'l2', 'huber' or 'cauchy' "
-      "with loss_scale (None: derived from the l2 fit's residuals), as --loss and --loss-scale. Bad data or "
+      "with loss_scale (None: derived from the l2 fit's residuals), as --loss and --loss-scale; a record "
+      "longer than max_samples is decimated as --max-samples says (the dict's 'decimation'). Bad data or "
       "arguments raise ValueError naming the reason (docs/identify.md).",
       py::arg("t"), py::arg("u"), py::arg("y"), py::kw_only(), py::arg("model") = "p1d",
       py::arg("starts") = 16, py::arg("seed") = 0, py::arg("u0") = py::none(), py::arg("y0") = py::none(),
       py::arg("poles") = py::none(), py::arg("zeros") = py::none(), py::arg("intersample") = "zoh",
-      py::arg("initial_condition") = "zero", py::arg("loss") = "l2", py::arg("loss_scale") = py::none());
+      py::arg("initial_condition") = "zero", py::arg("loss") = "l2", py::arg("loss_scale") = py::none(),
+      py::arg("max_samples") = identify::kDefaultMaxSamples);
 }
 
 }  // namespace pidlab::python

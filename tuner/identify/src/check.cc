@@ -91,6 +91,9 @@ bool IdentifyOptions::IsValid(std::string* error) const {
     e = "loss_scale = " + CheckedNumber(loss_scale) + " must be a number in (0, 1e12] (units of y)";
   else if (!std::isnan(loss_scale) && loss == Loss::kL2)
     e = "loss_scale = " + CheckedNumber(loss_scale) + " applies to the losses huber and cauchy, not l2";
+  else if (max_samples < kMinMaxSamples || max_samples > kMaxMaxSamples)
+    e = "max_samples = " + std::to_string(max_samples) + " must be in [" + std::to_string(kMinMaxSamples) +
+        ", " + std::to_string(kMaxMaxSamples) + "]";
   if (error) *error = e;
   return e.empty();
 }

@@ -158,6 +158,22 @@ void SetGainByLeastSquares(const Record& record, std::vector<double>* theta) {
   }
 }
 
+namespace {
+
+// Ends a solve at its next iteration once the options' cancelled() says so.
+class CancelCallback : public ceres::IterationCallback {
+ public:
+  explicit CancelCallback(const IdentifyOptions& options) : options_(options) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return options_.cancelled && options_.cancelled() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const IdentifyOptions& options_;
+};
+
+}  // namespace
+
 // One start's fit; the final cost, or infinity if Ceres failed.
 double FitFrom(const Record& record, const IdentifyOptions& options, std::vector<double>* theta) {
   ceres::Problem problem;
@@ -170,6 +186,8 @@ double FitFrom(const Record& record, const IdentifyOptions& options, std::vector
   solver.parameter_tolerance = 1e-13;
   solver.logging_type = ceres::SILENT;
   solver.num_threads = 1;
+  CancelCallback cancel(options);
+  solver.callbacks.push_back(&cancel);
   ceres::Solver::Summary summary;
   // A TF's start may walk to the edge of stability, where a central
   // difference fails and Ceres stops with FAILURE, logged through glog as an
@@ -178,7 +196,8 @@ double FitFrom(const Record& record, const IdentifyOptions& options, std::vector
   FLAGS_minloglevel = google::GLOG_FATAL;
   ceres::Solve(solver, &problem, &summary);
   FLAGS_minloglevel = log_level;
-  if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost))
+  if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE ||
+      !std::isfinite(summary.final_cost))
     return std::numeric_limits<double>::infinity();
   return summary.final_cost;
 }
@@ -198,12 +217,15 @@ double FitHolding(const Record& record, const IdentifyOptions& options, const st
   solver.parameter_tolerance = 1e-10;
   solver.logging_type = ceres::SILENT;
   solver.num_threads = 1;
+  CancelCallback cancel(options);
+  solver.callbacks.push_back(&cancel);
   ceres::Solver::Summary summary;
   const int log_level = FLAGS_minloglevel;
   FLAGS_minloglevel = google::GLOG_FATAL;
   ceres::Solve(solver, &problem, &summary);
   FLAGS_minloglevel = log_level;
-  if (summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost))
+  if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE ||
+      !std::isfinite(summary.final_cost))
     return std::numeric_limits<double>::infinity();
   return summary.final_cost;
 }

@@ -255,9 +255,11 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
     total += *arx_used ? 1 : 0;
     if (*arx_used) fit(theta, false);
   }
-  for (const std::vector<double>& theta : nested) fit(theta, true);
-  for (int s = 0; s < options.starts; ++s) fit(StartPoint(record, sobol, s), false);
-  return best;
+  const auto stop = [&] { return options.cancelled && options.cancelled(); };
+  for (const std::vector<double>& theta : nested)
+    if (!stop()) fit(theta, true);
+  for (int s = 0; s < options.starts && !stop(); ++s) fit(StartPoint(record, sobol, s), false);
+  return stop() ? std::vector<double>{} : best;
 }
 
 // Starts at the optimum `inner` of the model that `record`'s kind contains,
@@ -369,6 +371,10 @@ Status MakeRecord(const IdentifyData& data, ProcessModelKind kind, const Identif
   if (!shape.ok()) return shape;
   record->poles = options.poles;
   record->zeros = options.zeros;
+  if (data.y.size() > options.max_samples)
+    return Status::InvalidInput("the record has " + std::to_string(data.y.size()) +
+                                " samples, more than max_samples = " + std::to_string(options.max_samples) +
+                                ": decimate it (DecimateRecord) or raise the limit");
   Sampling sampling;
   const Status status = CheckData(data, &sampling);
   if (!status.ok()) return status;
@@ -469,6 +475,7 @@ Status FitKind(const IdentifyData& data, ProcessModelKind kind, const IdentifyOp
   }
   result->nested_starts = static_cast<int>(nested.size());
   std::vector<double> theta = MultiStart(record, options, nested, &result->start_costs, &result->arx_start);
+  if (options.cancelled && options.cancelled()) return Status::RunnerFailed("cancelled");
   if (theta.empty())
     return Status::RunnerFailed(
         "no start of the fit converged: " + std::to_string(options.starts) + " starts (seed " +

@@ -33,11 +33,18 @@ struct IdentifyRun {
   identify::IdentifyResult result;
   /// "auto": every candidate (empty otherwise).
   identify::AutoResult automatic;
+  /// The record fitted (the given one, or it decimated to
+  /// options.max_samples: identify::DecimateRecord) and how it was shortened.
+  identify::IdentifyData data;
+  identify::Decimation decimation;
 };
 
 /// Fits `data` with `model`, one of identify::ProcessModelKindNames() or
 /// "auto" (every process kind, the lowest AIC kept; tf needs
-/// options.poles). kInvalidInput names a bad model or record; the fit's
+/// options.poles), decimated first when longer than options.max_samples
+/// (json "decimation" {factor, samples_read, samples, max_samples}, factor
+/// 1 when not; a time constant under two decimated intervals is added to
+/// the warnings). kInvalidInput names a bad model or record; the fit's
 /// own failures keep their code. The command line and the page's identify
 /// request both run it.
 Status RunIdentify(const identify::IdentifyData& data, const std::string& model,

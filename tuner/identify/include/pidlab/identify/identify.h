@@ -7,6 +7,7 @@
 // from a zero state (or a steady or estimated one: InitialCondition). Ceres fits from several starts and
 // keeps the best. docs/identify.md, "Identifying a model from a CSV".
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -85,6 +86,13 @@ inline constexpr double kDownweightedBelow = 0.5;
 
 /// The most starts a fit takes (IdentifyOptions::starts).
 inline constexpr int kMaxStarts = 1000;
+/// The default and the range of IdentifyOptions::max_samples: a fit's time
+/// grows with the samples (at 10000, about 0.6 s for P1D and 20 s for P2DU
+/// or P2DZ on this project's 2 shared cores: bench/identify_long_bench.sh),
+/// so a longer record is decimated first (DecimateRecord) or refused.
+inline constexpr std::size_t kDefaultMaxSamples = 10000;
+inline constexpr std::size_t kMinMaxSamples = 100;
+inline constexpr std::size_t kMaxMaxSamples = 10000000;
 
 struct IdentifyOptions {
   /// Starts of the multi-start design (Sobol' points over the time constants,
@@ -145,6 +153,14 @@ struct IdentifyOptions {
   /// the best cost so far. Empty: nothing is called. A front end shows
   /// progress with it; the library prints nothing.
   std::function<void(ProcessModelKind kind, int done, int total, double best_cost)> progress;
+  /// Asked before every start and at every iteration of every solve (on the
+  /// caller's thread); true stops the fit, which returns kRunnerFailed
+  /// "cancelled". Empty: never cancelled. The page's identify_cancel.
+  std::function<bool()> cancelled;
+  /// The most samples a record may have, in [kMinMaxSamples, kMaxMaxSamples]:
+  /// Identify refuses a longer one naming the limit; front ends decimate it
+  /// to fit first (DecimateRecord).
+  std::size_t max_samples = kDefaultMaxSamples;
 
   /// Names the field, its value and the rule on failure.
   bool IsValid(std::string* error) const;
@@ -264,6 +280,30 @@ struct AutoResult {
 /// its line in the file where `rows` gives each sample's (ReadCsvData), else
 /// its index. Sets *sampling.
 Status CheckData(const IdentifyData& data, Sampling* sampling, const std::vector<long>* rows = nullptr);
+/// How DecimateRecord shortened a record: factor 1 when it was within the
+/// limit (the record unchanged).
+struct Decimation {
+  int factor = 1;
+  std::size_t samples_read = 0;  // before
+  std::size_t samples = 0;       // after
+  std::size_t max_samples = 0;   // the limit applied
+};
+
+/// `data` (checked by CheckData) into *out, decimated by the least integer
+/// factor q that leaves at most max_samples samples: sample k of *out is
+/// sample k q of `data` in time, u its average over [t_kq, t_(k+1)q)
+/// weighted by time (a held input's integral kept; with kFoh, a sampled
+/// continuous input, the centred average as y's), y the average of the
+/// samples centred on t_kq (at most q of them, symmetric, so no shift): an
+/// anti-alias average. Sound while the dynamics are slow against q dt
+/// (docs/identify.md, "Long records"). kInvalidInput naming the limit when
+/// max_samples is out of [kMinMaxSamples, kMaxMaxSamples].
+Status DecimateRecord(const IdentifyData& data, std::size_t max_samples, Intersample hold, IdentifyData* out,
+                      Decimation* decimation);
+/// The factor DecimateRecord takes: the least integer q with ceil(samples /
+/// q) <= max_samples (1 within the limit).
+std::size_t DecimationFactor(std::size_t samples, std::size_t max_samples);
+
 /// kInvalidInput unless y varies beyond 12 digits of its magnitude: a flat
 /// record holds no response to fit (Identify checks it after CheckData and
 /// the model's own conditions, before any start).
