@@ -1,5 +1,6 @@
 #include "pidlab/report/identify_section.h"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <filesystem>
@@ -176,6 +177,9 @@ bool ComputeIdentifySectionOrExplain(bool quick, std::uint64_t seed, IdentifySec
     if (!RunExperiment(&s, error)) return false;
     identify::IdentifyOptions options;
     options.u0 = 0.0, options.y0 = 0.0;  // the motor starts at rest at its holding point, as a log's
+    // The whole record, as the report's figures were fitted (30 000 samples,
+    // over the interactive limit that would decimate it).
+    options.max_samples = std::max(options.max_samples, s.data.t.size());
     const Status status = identify::Identify(s.data, plant_sim::ProcessModelKind::kP2DU, options, &s.fit);
     if (!status.ok()) {
       *error = "identify: " + status.message();
