@@ -149,7 +149,7 @@ class DiscretePid:
     OK, SATURATED, INVALID_INPUT = 0, 1, 2
 
     def __init__(self, kp, ki, kd, dt_s, derivative_filter_s, output_min, output_max, anti_windup,
-                 back_calculation_gain, setpoint_weight_b, setpoint_weight_c, integral):
+                 back_calculation_gain, setpoint_weight_b, setpoint_weight_c, integral, setpoint_filter_s=0.0):
         self.kp, self.ki, self.kd = kp, ki, kd
         self.dt = dt_s
         self.tf = derivative_filter_s
@@ -158,6 +158,8 @@ class DiscretePid:
         self.back_calculation_gain = back_calculation_gain
         self.b, self.c = setpoint_weight_b, setpoint_weight_c  # the 2-DOF PID's setpoint weights
         self.integral_method = integral
+        self.tr = setpoint_filter_s  # the setpoint filter r / (tr s + 1); 0 = none
+        self.filtered_r = 0.0
         self.integral = 0.0
         self.derivative = 0.0
         self.prev_error = 0.0
@@ -168,6 +170,9 @@ class DiscretePid:
         if not (math.isfinite(r) and math.isfinite(y)):
             return self.INVALID_INPUT, None
         dt = self.dt
+        if self.tr > 0.0:  # the setpoint filter's f_k in r's place
+            self.filtered_r += dt / (self.tr + dt) * (r - self.filtered_r)
+            r = self.filtered_r
         e = r - y
         p = self.kp * (self.b * r - y)
         integral = self.integral
@@ -234,6 +239,9 @@ def config_error(m):
         v = getattr(m, name)
         if not (math.isfinite(v) and 0.0 <= v <= 1.0):
             return "setpoint weight %s = %r must be finite and in [0, 1]" % (name[-1], v)
+    tr = getattr(m, "setpoint_filter_s", 0.0)  # 0 in the types before the setpoint filter
+    if not (math.isfinite(tr) and tr >= 0.0):
+        return "setpoint filter %r s must be >= 0 and finite" % tr
     if m.derivative_on == "measurement" and m.setpoint_weight_c != 0.0:
         return "derivative-on measurement with setpoint weight c = %r" % m.setpoint_weight_c
     if m.integral not in ("backward-euler", "forward-euler", "trapezoidal"):
@@ -253,7 +261,8 @@ class Episode:
         self.pid = DiscretePid(config.kp, config.ki, config.kd, config.dt_s, config.derivative_filter_s,
                                config.output_min, config.output_max, config.anti_windup,
                                config.back_calculation_gain, config.setpoint_weight_b,
-                               config.setpoint_weight_c, config.integral)
+                               config.setpoint_weight_c, config.integral,
+                               getattr(config, "setpoint_filter_s", 0.0))
         self.expected = 0  # the next step to compute
         self.last = None  # the last command sent (an lcmt_control_command)
 

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -194,6 +195,39 @@ TEST(Design, TheSetpointStageMeetsTheOvershootTargetWithoutMovingTheLoad) {
     ASSERT_TRUE(evaluation::Evaluate(plant, s.gains, lo, evaluation::EvaluateOptions{}, &ev).ok());
     EXPECT_NEAR(ev.step.overshoot_pct, s.overshoot_pct, 0.5) << plant.name;
   }
+}
+
+// Where b = c = 0 still overshoots (the integral action's own overshoot on a
+// lag-dominant FOPDT, 10.9 % at Ms 1.6), a setpoint filter joins the
+// weights; the load response is the same design's.
+TEST(Design, TheSetpointStageAddsAFilterWhereNoWeightsMeetTheTarget) {
+  const Plant fopdt = MakeTf("fopdt L/T=0.1", {1.0}, {1.0, 1.0}, 0.1);
+  DesignOptions o;
+  o.max_ms = 1.6;  // the default tune's bound for it (DefaultRobustness)
+  o.max_noise_gain = 163.506;
+  const DesignSummary s = DesignOrDie(fopdt, o);
+  EXPECT_TRUE(s.overshoot_met) << s.setpoint_note;
+  EXPECT_GT(s.setpoint_filter_s, 0.0);
+  EXPECT_LE(s.overshoot_pct, 10.0 + 1e-9);
+  evaluation::LoopOptions lo;
+  lo.pid.setpoint_weight_b = s.b;
+  lo.pid.setpoint_weight_c = s.c;
+  lo.pid.setpoint_filter_s = s.setpoint_filter_s;
+  lo.horizon_s = 40.0 * s.response_time_s + 20.0 * fopdt.delay_s + 12.0 * s.setpoint_filter_s;
+  lo.sample_time_s = lo.horizon_s / 4000.0;
+  evaluation::Evaluation ev;
+  ASSERT_TRUE(evaluation::Evaluate(fopdt, s.gains, lo, evaluation::EvaluateOptions{}, &ev).ok());
+  EXPECT_LE(ev.step.overshoot_pct, 10.0 + 1e-6);
+  std::printf("fopdt L/T=0.1: b %.4g, c %.4g, tr %.4g s, overshoot %.4g %% (weights alone: >= 10.9 %%)\n",
+              s.b, s.c, s.setpoint_filter_s, ev.step.overshoot_pct);
+  DesignOptions unbounded = o;
+  unbounded.max_overshoot_pct = HUGE_VAL;
+  const DesignSummary unshaped = DesignOrDie(fopdt, unbounded);
+  EXPECT_EQ(unshaped.setpoint_filter_s, 0.0);
+  EXPECT_EQ(unshaped.load_iae, s.load_iae);
+  EXPECT_EQ(unshaped.gains.kp, s.gains.kp);
+  // Where the weights can, no filter.
+  EXPECT_EQ(DesignOrDie(Cube(), o).setpoint_filter_s, 0.0);
 }
 
 TEST(Design, ANoiseBoundIsHonouredAndCostsLoadIae) {

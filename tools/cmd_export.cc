@@ -62,6 +62,10 @@ void LoadResult(const std::string& path, spec::EvaluateSpec* s) {
     if (!w.is_array() || w.size() != 2 || !w[0].is_number() || !w[1].is_number())
       throw BadInput("--from " + Quote(path) + ": two_dof.setpoint_weights is not two numbers");
     s->loop.setpoint_weights = {w[0].get<double>(), w[1].get<double>()};
+    const auto& f = j["two_dof"].value("setpoint_filter_s", nlohmann::json(0.0));
+    if (!f.is_number())
+      throw BadInput("--from " + Quote(path) + ": two_dof.setpoint_filter_s is not a number");
+    s->loop.setpoint_filter_s = f.get<double>();
     s->loop.derivative_on = "error";  // c carries it
   }
   s->gains.clear();
@@ -84,7 +88,8 @@ struct ExportCommand {
   std::function<int()> Register(CLI::App* app) {
     app->description(
         "Write the discrete PID of a gain set and a loop (--dt, --output-limits, --anti-windup, "
-        "--integral, --derivative-filter, --derivative-on, --setpoint-weights) as a dependency-free C99 "
+        "--integral, --derivative-filter, --derivative-on, --setpoint-weights, --setpoint-filter) as a "
+        "dependency-free C99 "
         "module, pidlab_pid.h and "
         "pidlab_pid.c in --out: the controller DiscretePid runs, in its operation order (--scalar double: "
         "bit for bit), with manual mode, bumpless transfer and run-time gain and sample-time changes "

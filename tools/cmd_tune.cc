@@ -216,8 +216,9 @@ struct TuneCommand {
     std::cout << "design           " << s.design.message << "\n";
     std::cout << "active bounds    "
               << (s.design.active.empty() ? std::string("none") : Join(s.design.active)) << "\n";
-    std::cout << "setpoint         b = " << s.design.b << ", c = " << s.design.c << ": " << s.two_dof.message
-              << "\n";
+    std::cout << "setpoint         b = " << s.design.b << ", c = " << s.design.c;
+    if (s.design.setpoint_filter_s > 0.0) std::cout << ", filter " << s.design.setpoint_filter_s << " s";
+    std::cout << ": " << s.two_dof.message << "\n";
     std::cout << "response time    " << s.design.response_time_s << " s (2 / the crossover "
               << s.design.crossover_rad_s << " rad/s)\n";
     if (s.design.reverse_acting)

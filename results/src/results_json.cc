@@ -118,6 +118,7 @@ nlohmann::json TwoDofJson(const tune::TwoDofSummary& s) {
   if (!s.ran) return {{"ran", false}, {"message", s.message}};
   return {{"ran", true},
           {"setpoint_weights", {s.b, s.c}},
+          {"setpoint_filter_s", JsonNumber(s.setpoint_filter_s)},
           {"before", TwoDofResponseJson(s.before)},
           {"after", TwoDofResponseJson(s.after)},
           {"evaluations", s.evaluations},
@@ -128,35 +129,36 @@ nlohmann::json TwoDofJson(const tune::TwoDofSummary& s) {
 namespace {
 
 // TuneJson's "design" (the engine, its bounds and what was active) and
-// the keys: response_time_s, two_dof.setpoint_filter_s.
+// response_time_s (the knob's).
 void AddDesign(const tune::DesignSummary& d, nlohmann::json* j) {
-  (*j)["design"] = {{"engine", "optimal"},
-                    {"objective", "load integral |e| dt (unit step at the plant input, r = 0)"},
-                    {"load_iae", JsonNumber(d.load_iae)},
-                    {"setpoint_iae", JsonNumber(d.setpoint_iae)},
-                    {"ms_bound", JsonNumber(d.ms_bound)},
-                    {"mt_bound", JsonNumber(d.mt_bound)},
-                    {"noise_gain_bound", JsonNumber(d.noise_gain_bound)},
-                    {"td_bound_s", JsonNumber(d.td_bound_s)},
-                    {"ms", JsonNumber(d.ms)},
-                    {"mt", JsonNumber(d.mt)},
-                    {"noise_gain", JsonNumber(d.noise_gain)},
-                    {"crossover_rad_s", JsonNumber(d.crossover_rad_s)},
-                    {"phase_margin_deg", JsonNumber(d.phase_margin_deg)},
-                    {"active", d.active},
-                    {"overshoot_pct", JsonNumber(d.overshoot_pct)},
-                    {"overshoot_unit_weights_pct", JsonNumber(d.overshoot_unit_weights_pct)},
-                    {"overshoot_met", d.overshoot_met},
-                    {"setpoint_note", d.setpoint_note},
-                    {"front_note", d.front_note},
-                    {"reverse_acting", d.reverse_acting},
-                    {"reverse_note", d.reverse_acting ? "the loop acts in reverse: the plant's gain is negative, "
-                                                        "so are kp, ki and kd (u = kp e + ...)"
-                                                      : ""},
-                    {"evaluations", d.evaluations},
-                    {"message", d.message}};
+  (*j)["design"] = {
+      {"engine", "optimal"},
+      {"objective", "load integral |e| dt (unit step at the plant input, r = 0)"},
+      {"load_iae", JsonNumber(d.load_iae)},
+      {"setpoint_iae", JsonNumber(d.setpoint_iae)},
+      {"ms_bound", JsonNumber(d.ms_bound)},
+      {"mt_bound", JsonNumber(d.mt_bound)},
+      {"noise_gain_bound", JsonNumber(d.noise_gain_bound)},
+      {"td_bound_s", JsonNumber(d.td_bound_s)},
+      {"ms", JsonNumber(d.ms)},
+      {"mt", JsonNumber(d.mt)},
+      {"noise_gain", JsonNumber(d.noise_gain)},
+      {"crossover_rad_s", JsonNumber(d.crossover_rad_s)},
+      {"phase_margin_deg", JsonNumber(d.phase_margin_deg)},
+      {"active", d.active},
+      {"overshoot_pct", JsonNumber(d.overshoot_pct)},
+      {"overshoot_unit_weights_pct", JsonNumber(d.overshoot_unit_weights_pct)},
+      {"overshoot_met", d.overshoot_met},
+      {"setpoint_filter_s", JsonNumber(d.setpoint_filter_s)},
+      {"setpoint_note", d.setpoint_note},
+      {"front_note", d.front_note},
+      {"reverse_acting", d.reverse_acting},
+      {"reverse_note", d.reverse_acting ? "the loop acts in reverse: the plant's gain is negative, "
+                                          "so are kp, ki and kd (u = kp e + ...)"
+                                        : ""},
+      {"evaluations", d.evaluations},
+      {"message", d.message}};
   (*j)["response_time_s"] = JsonNumber(d.response_time_s);
-  if (j->contains("two_dof")) (*j)["two_dof"]["setpoint_filter_s"] = 0.0;
 }
 
 // TuneJson's "refine": the Ceres cross-check.

@@ -10,13 +10,35 @@ const token = new URLSearchParams(location.search).get('token');
 const plants = ['double_integrator', 'oscillator', 'stepper_motor', 'custom', 'stepper_nonlinear', 'model'];
 // The design: what the form shows. Empty strings are fields left to the spec's defaults.
 const state = {
-  plant: 'double_integrator', num: '1', den: '1,0,0', model: '', delay: '', stepper: '',
-  kp: 3.9, ki: 0.06, kd: 4.9, derivative_filter: '', setpoint_weight_b: '', setpoint_weight_c: '', limit_lo: '', limit_hi: '',
-  loop: 'continuous', dt: '', max_ms: '', max_mt: '', max_noise_gain: '', min_phase_margin: '',
-  monte_carlo: '', spread: '',
+  plant: 'double_integrator',
+  num: '1',
+  den: '1,0,0',
+  model: '',
+  delay: '',
+  stepper: '',
+  kp: 3.9,
+  ki: 0.06,
+  kd: 4.9,
+  derivative_filter: '',
+  setpoint_weight_b: '',
+  setpoint_weight_c: '',
+  setpoint_filter: '',
+  limit_lo: '',
+  limit_hi: '',
+  loop: 'continuous',
+  dt: '',
+  max_ms: '',
+  max_mt: '',
+  max_noise_gain: '',
+  min_phase_margin: '',
+  monte_carlo: '',
+  spread: '',
 };
-const textFields = ['num', 'den', 'model', 'delay', 'stepper', 'derivative_filter', 'setpoint_weight_b', 'setpoint_weight_c',
-  'limit_lo', 'limit_hi', 'dt', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin', 'monte_carlo', 'spread'];
+const textFields = [
+  'num', 'den', 'model', 'delay', 'stepper', 'derivative_filter', 'setpoint_weight_b', 'setpoint_weight_c',
+  'setpoint_filter', 'limit_lo', 'limit_hi', 'dt', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin',
+  'monte_carlo', 'spread'
+];
 const pidlab = window.pidlab = {
   state, lastResult: null, lastSeries: null, plots: {}, rendered: 0, timings: [], pinned: [],
   lastTune: null, paperDesigns: [],
@@ -45,6 +67,7 @@ function spec() {
   if (given(state.derivative_filter)) s.derivative_filter = Number(state.derivative_filter);
   if (given(state.setpoint_weight_b) || given(state.setpoint_weight_c))
     s.setpoint_weights = [given(state.setpoint_weight_b) ? Number(state.setpoint_weight_b) : 1, given(state.setpoint_weight_c) ? Number(state.setpoint_weight_c) : 1];
+  if (given(state.setpoint_filter)) s.setpoint_filter = Number(state.setpoint_filter);
   if (given(state.limit_lo) || given(state.limit_hi))
     s.output_limits = [given(state.limit_lo) ? Number(state.limit_lo) : '-inf', given(state.limit_hi) ? Number(state.limit_hi) : 'inf'];
   for (const k of ['max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin']) if (given(state[k])) s[k] = Number(state[k]);
@@ -139,8 +162,15 @@ function specWith(fields) {
 function tunedFields(r) {
   const g = r.gains;
   const w = r.two_dof && r.two_dof.ran ? r.two_dof.setpoint_weights : null;
-  return { kp: g.kp, ki: g.ki, kd: g.kd, derivative_filter: g.tf > 0 ? g.tf : '',
-    setpoint_weight_b: w ? w[0] : '', setpoint_weight_c: w ? w[1] : '' };
+  return {
+    kp: g.kp,
+    ki: g.ki,
+    kd: g.kd,
+    derivative_filter: g.tf > 0 ? g.tf : '',
+    setpoint_weight_b: w ? w[0] : '',
+    setpoint_weight_c: w ? w[1] : '',
+    setpoint_filter: w && r.two_dof.setpoint_filter_s > 0 ? r.two_dof.setpoint_filter_s : ''
+  };
 }
 
 // A second connection for work done ahead of the user (design.js's knob
@@ -341,8 +371,11 @@ function withoutLoop(s) { const c = { ...s }; delete c.loop; delete c.dt; return
 // weights, the limits, the bounds, the pinned designs, the trio's and the
 // firmware's runs, the knobs. `fields`: the new plant's state fields.
 function resetPlant(fields) {
-  for (const k of ['derivative_filter', 'setpoint_weight_b', 'setpoint_weight_c', 'limit_lo', 'limit_hi', 'max_ms', 'max_mt',
-    'max_noise_gain', 'min_phase_margin', 'monte_carlo', 'spread', 'dt']) state[k] = '';
+  for (const k
+           of ['derivative_filter', 'setpoint_weight_b', 'setpoint_weight_c', 'setpoint_filter', 'limit_lo',
+               'limit_hi', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin', 'monte_carlo', 'spread',
+               'dt'])
+    state[k] = '';
   state.loop = 'continuous';
   Object.assign(state, fields);
   pidlab.pinned = [];

@@ -135,8 +135,10 @@ function showKnob() {
 // response-time knob at `at` when given).
 function knobSpec(at) {
   const s = app.spec();
-  for (const k of ['gains', 'monte_carlo', 'spread', 'derivative_filter', 'setpoint_weights', 'max_ms', 'max_mt', 'max_noise_gain',
-    'min_phase_margin', 'loop', 'dt', 'response_time']) delete s[k];
+  for (const k
+           of ['gains', 'monte_carlo', 'spread', 'derivative_filter', 'setpoint_weights', 'setpoint_filter',
+               'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin', 'loop', 'dt', 'response_time'])
+    delete s[k];
   s.method = 'optimal';
   Object.assign(s, knobValues(at));
   return s;

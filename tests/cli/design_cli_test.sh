@@ -110,5 +110,24 @@ check "... with nothing on stdout" "[ ! -s \"$tmp/out\" ]"
 check "gains that differ in sign exit 2 in one line saying so" \
   "[ $? -eq 2 ] && only_line_ok \"$tmp/err\" 'differ in sign'"
 
+# A lag-dominant FOPDT, whose integral action overshoots 10.9 % by itself:
+# the default tune adds a setpoint filter, its own evaluation (weights and
+# filter) is within 10 %, and export --from carries the filter into the C.
+"$pidlab" tune --num 1 --den 1,1 --delay 0.1 --json > "$tmp/lag.json" 2>"$tmp/err"
+check "a lag-dominant FOPDT: a setpoint filter, the overshoot within 10 % by the tune's own evaluation" \
+  "/usr/bin/python3 -c \"import json; j=json.load(open('$tmp/lag.json')); t=j['two_dof']['setpoint_filter_s']; assert t>0 and t==j['design']['setpoint_filter_s'], t; assert j['overshoot_pct']<=10.0 and j['design']['overshoot_met'], j['overshoot_pct']\""
+"$pidlab" export --from "$tmp/lag.json" --lang c --out "$tmp/lag_c" > /dev/null 2>"$tmp/err"
+check "export --from carries the filter into pidlab_pid_tuned" \
+  "/usr/bin/python3 - \"$tmp/lag.json\" \"$tmp/lag_c/pidlab_pid.c\" <<'PY'
+import json, re, sys
+t = json.load(open(sys.argv[1]))['two_dof']['setpoint_filter_s']
+m = re.search(r'([-+0-9.eE]+), /\\* setpoint_filter_s, s \\*/', open(sys.argv[2]).read())
+assert m and float(m.group(1)) == t, (m and m.group(1), t)
+PY"
+"$pidlab" evaluate --num 1 --den 1,1 --delay 0.1 --gains 6,27,0.26 --derivative-filter 0.002 --setpoint-filter -1 \
+  > "$tmp/out" 2>"$tmp/err"
+check "--setpoint-filter -1 exits 2 in one line naming the value" \
+  "[ $? -eq 2 ] && only_line_ok \"$tmp/err\" 'setpoint-filter -1'"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -23,6 +23,7 @@ struct ShimConfig {
   int anti_windup = 1;
   double back_calculation_gain = 1;
   int integral = 0;
+  double setpoint_filter_s = 0;
 };
 
 class CompiledModule {

@@ -14,6 +14,7 @@ typedef struct {
   int anti_windup;
   double back_calculation_gain;
   int integral;
+  double setpoint_filter_s;
 } shim_config;
 
 static double shim_two_n(void) { return (double)((int64_t)1 << PIDLAB_Q_BITS); }
@@ -53,6 +54,7 @@ void *shim_new(const shim_config *s) {
   c.tf = s->tf;
   c.setpoint_weight_b = s->b;
   c.setpoint_weight_c = s->c;
+  c.setpoint_filter_s = s->setpoint_filter_s;
   c.dt_s = s->dt_s;
   c.output_min = s->output_min;
   c.output_max = s->output_max;

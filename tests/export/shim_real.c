@@ -14,6 +14,7 @@ typedef struct {
   int anti_windup;
   double back_calculation_gain;
   int integral;
+  double setpoint_filter_s;
 } shim_config;
 
 void *shim_new(const shim_config *s) {
@@ -26,6 +27,7 @@ void *shim_new(const shim_config *s) {
   c.tf = (pidlab_real)s->tf;
   c.setpoint_weight_b = (pidlab_real)s->b;
   c.setpoint_weight_c = (pidlab_real)s->c;
+  c.setpoint_filter_s = (pidlab_real)s->setpoint_filter_s;
   c.dt_s = (pidlab_real)s->dt_s;
   c.has_output_min = s->has_output_min;
   c.output_min = (pidlab_real)s->output_min;

@@ -118,6 +118,20 @@ check "reverse: the C++ trio gives the same trajectory and IAE" \
 check "reverse: the mirror of the direct-acting loop, y and IAE bit for bit, u negated, saturated" \
   "python3 -c \"import csv,json,sys; a=list(csv.DictReader(open('reverse.c.csv'))); b=list(csv.DictReader(open('direct.csv'))); ok=json.load(open('reverse.c.json'))['iae']==json.load(open('direct.json'))['iae'] and len(a)==len(b) and all(x['y']==y['y'] and float(x['u'])==-float(y['u']) for x,y in zip(a,b)) and max(abs(float(x['u'])) for x in a)==0.1; sys.exit(not ok)\""
 
+# 2e. The setpoint filter (docs/two_dof.md), carried by the episode's message,
+#     with weights, limits and clamping: the C controller and the C++ trio run
+#     the in-process loop's filter, and it did move the response.
+sf=(--loop sampled --horizon 2 --plant oscillator --gains 2,1,1.5 --setpoint-weights 0.6,0 --output-limits -0.5,0.8
+  --anti-windup clamping --derivative-filter 0.01)
+run_case setpoint_filter -- "${sf[@]:4}" --setpoint-filter 0.4
+"$pidlab" launch --lcm-url "$url" -- pidlab evaluate --backend lcm "${sf[@]}" --setpoint-filter 0.4 --json \
+  --trajectory-csv setpoint_filter.cpp.csv >setpoint_filter.cpp.json 2>setpoint_filter.cpp.err
+check "setpoint_filter: the C++ trio gives the same trajectory and IAE" \
+  "same setpoint_filter setpoint_filter.c.json setpoint_filter.c.csv setpoint_filter.cpp.json setpoint_filter.cpp.csv"
+"$pidlab" evaluate "${sf[@]}" --json >unfiltered.json
+check "setpoint_filter: the filter moved the setpoint response" \
+  "[ \"\$(iae unfiltered.json)\" != \"\$(iae setpoint_filter.c.json)\" ]"
+
 # 3. Loss: the plant and the disturbance throw 5 % of what they receive away,
 #    so the plant resends y_k and the controller must repeat u_k.
 run_case loss --drop-rate 0.05 -- --plant oscillator --gains 2,1,1.5

@@ -55,6 +55,7 @@ void CopyNumbers(EpisodeSpec* s, pidlab::lcmt_episode_config* m, Direction direc
   field(s->pid.back_calculation_gain, m->back_calculation_gain);
   field(s->pid.setpoint_weight_b, m->setpoint_weight_b);
   field(s->pid.setpoint_weight_c, m->setpoint_weight_c);
+  field(s->pid.setpoint_filter_s, m->setpoint_filter_s);
   field(s->dt_s, m->dt_s);
   field(s->sample_time_s, m->sample_time_s);
   field(s->horizon_s, m->horizon_s);

@@ -139,6 +139,7 @@ static const char *config_error(const pidlab_lcmt_episode_config *m) {
   if (!(finite(m->setpoint_weight_b) && m->setpoint_weight_b >= 0 && m->setpoint_weight_b <= 1 &&
         finite(m->setpoint_weight_c) && m->setpoint_weight_c >= 0 && m->setpoint_weight_c <= 1))
     return "setpoint weights not in [0, 1]";
+  if (!(finite(m->setpoint_filter_s) && m->setpoint_filter_s >= 0)) return "setpoint filter not >= 0";
   if (strcmp(m->integral, "backward-euler") && strcmp(m->integral, "forward-euler") &&
       strcmp(m->integral, "trapezoidal"))
     return "integral unknown";
@@ -185,6 +186,7 @@ static void to_config(const pidlab_lcmt_episode_config *m, pidlab_pid_config *p)
   p->tf = m->derivative_filter_s;
   p->setpoint_weight_b = m->setpoint_weight_b;
   p->setpoint_weight_c = m->setpoint_weight_c;
+  p->setpoint_filter_s = m->setpoint_filter_s;
   p->dt_s = m->dt_s;
 #ifdef PIDLAB_Q_BITS /* fixed point: finite limits (init refuses others) */
   p->output_min = m->output_min;

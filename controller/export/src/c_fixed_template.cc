@@ -54,7 +54,9 @@ typedef enum {
  * setters, which turn it into integer coefficients; the step uses no
  * floating point). */
 typedef struct {
-  double kp, ki, kd, tf, setpoint_weight_b, setpoint_weight_c, dt_s;
+  double kp, ki, kd, tf, setpoint_weight_b, setpoint_weight_c;
+  double setpoint_filter_s; /* tr: setpoint filter r/(tr s + 1) before all terms, s, >= 0; 0 = none */
+  double dt_s;
   double output_min, output_max; /* finite, inside +-PIDLAB_OUTPUT_FULL_SCALE */
   pidlab_anti_windup anti_windup;
   double back_calculation_gain;
@@ -69,10 +71,12 @@ typedef struct {
 
 typedef struct {
   pidlab_pid_config config;
-  pidlab_coef kp, ki_dt, ki_half_dt, kd_k, pole_g, aw, b, c;
+  pidlab_coef kp, ki_dt, ki_half_dt, kd_k, pole_g, aw, b, c, filter_g;
   int64_t output_min, output_max; /* in accumulator units */
   int64_t integral, derivative;   /* accumulator units */
   int64_t prev_error, prev_r, prev_y; /* input units (2^-31 of the input full scale) */
+  int filtering;                      /* 1: the setpoint filter runs (tr > 0) */
+  int64_t filtered_r;                 /* its state, in 2^-20 input units */
   int manual;
   int64_t manual_output;
   /* Gains all <= 0 (a reverse-acting plant's): run as the PID of |gains| on
@@ -93,6 +97,9 @@ void pidlab_pid_set_auto(pidlab_pid *pid);
  * the new values' worst case exceeds the range analysis above. */
 pidlab_pid_status pidlab_pid_set_gains(pidlab_pid *pid, double kp, double ki, double kd, double tf);
 pidlab_pid_status pidlab_pid_set_setpoint_weights(pidlab_pid *pid, double b, double c);
+/* The setpoint filter's tr (s, >= 0; 0 = none); switched on, it starts from
+ * the last setpoint the terms saw. */
+pidlab_pid_status pidlab_pid_set_setpoint_filter(pidlab_pid *pid, double tr);
 pidlab_pid_status pidlab_pid_set_sample_time(pidlab_pid *pid, double dt_s);
 
 #ifdef __cplusplus
@@ -138,6 +145,9 @@ static int64_t pidlab_sat_sub(int64_t a, int64_t b) {
 }
 
 static int64_t pidlab_clamp(int64_t x, int64_t lo, int64_t hi) { return x < lo ? lo : (x > hi ? hi : x); }
+
+/* One input unit in the setpoint filter's state units. */
+#define PIDLAB_FILTER_ONE ((int64_t)1 << 20)
 
 /* a m 2^-s, rounded to nearest, saturated: the 128-bit product from four
  * 32x32 -> 64-bit products, in sign and magnitude, so that no negative
@@ -216,6 +226,7 @@ static int pidlab_config_valid(const pidlab_pid_config *c) {
     return 0;
   if (!((c->kp >= 0.0 && c->ki >= 0.0 && c->kd >= 0.0) || (c->kp <= 0.0 && c->ki <= 0.0 && c->kd <= 0.0))) return 0;
   if (!pidlab_unit(c->setpoint_weight_b) || !pidlab_unit(c->setpoint_weight_c) || !pidlab_finite(c->dt_s) || !(c->dt_s > 0.0)) return 0;
+  if (!pidlab_finite(c->setpoint_filter_s) || !(c->setpoint_filter_s >= 0.0)) return 0;
   if (!pidlab_finite(c->output_min) || !pidlab_finite(c->output_max) || !(c->output_min < c->output_max)) return 0;
   if (c->output_max > PIDLAB_OUTPUT_FULL_SCALE || c->output_min < -PIDLAB_OUTPUT_FULL_SCALE) return 0;
   if (!pidlab_finite(c->back_calculation_gain) || !(c->back_calculation_gain > 0.0)) return 0;
@@ -234,7 +245,8 @@ static int pidlab_coefficients(const pidlab_pid_config *c, pidlab_pid *pid) {
          pidlab_encode(kd / (c->tf + c->dt_s) * a, &pid->kd_k) &&
          pidlab_encode(c->dt_s / (c->tf + c->dt_s), &pid->pole_g) &&
          pidlab_encode(c->back_calculation_gain * c->dt_s, &pid->aw) && pidlab_encode(c->setpoint_weight_b, &pid->b) &&
-         pidlab_encode(c->setpoint_weight_c, &pid->c);
+         pidlab_encode(c->setpoint_weight_c, &pid->c) &&
+         pidlab_encode(c->setpoint_filter_s > 0.0 ? c->dt_s / (c->setpoint_filter_s + c->dt_s) : 1.0, &pid->filter_g);
 }
 
 /* A configuration in place of the current one, or nothing changed. */
@@ -249,8 +261,12 @@ static int pidlab_apply(pidlab_pid *pid, const pidlab_pid_config *config) {
     next.prev_error = -next.prev_error;
     next.prev_r = -next.prev_r;
     next.prev_y = -next.prev_y;
+    next.filtered_r = -next.filtered_r;
     next.reverse = pidlab_reverse(config);
   }
+  /* A setpoint filter switched on starts from the setpoint the terms saw last. */
+  if (!next.filtering && config->setpoint_filter_s > 0.0) next.filtered_r = next.prev_r * PIDLAB_FILTER_ONE;
+  next.filtering = config->setpoint_filter_s > 0.0;
   next.output_min = pidlab_round_to_int64(config->output_min * PIDLAB_ACC_ONE_REAL);
   next.output_max = pidlab_round_to_int64(config->output_max * PIDLAB_ACC_ONE_REAL);
   *pid = next;
@@ -267,6 +283,7 @@ pidlab_pid_status pidlab_pid_init(pidlab_pid *pid, const pidlab_pid_config *conf
   pidlab_pid next;
   pidlab_pid_reset(&next);
   next.reverse = 0;
+  next.filtering = 0;
   if (!pidlab_apply(&next, config)) return PIDLAB_PID_INVALID_CONFIG;
   *pid = next;
   return PIDLAB_PID_OK;
@@ -278,6 +295,7 @@ void pidlab_pid_reset(pidlab_pid *pid) {
   pid->prev_error = 0;
   pid->prev_r = 0;
   pid->prev_y = 0;
+  pid->filtered_r = 0;
   pid->manual = 0;
   pid->manual_output = 0;
 }
@@ -299,9 +317,17 @@ static pidlab_q pidlab_output(int64_t acc) {
 
 pidlab_pid_status pidlab_pid_step(pidlab_pid *pid, pidlab_q r_q, pidlab_q y_q, pidlab_q *u) {
   const pidlab_pid_config *c = &pid->config;
-  const int64_t r = pid->reverse ? -pidlab_input(r_q) : pidlab_input(r_q);
+  int64_t r = pid->reverse ? -pidlab_input(r_q) : pidlab_input(r_q);
   const int64_t y = pid->reverse ? -pidlab_input(y_q) : pidlab_input(y_q);
-  const int64_t e = r - y;
+  int64_t e;
+  if (pid->filtering) {
+    /* The setpoint filter f += dt/(tr + dt) (r - f), in r's place; f is kept
+     * 20 bits finer than the inputs, so that its rounding stays below one
+     * input unit. */
+    pid->filtered_r += pidlab_mul(r * PIDLAB_FILTER_ONE - pid->filtered_r, pid->filter_g);
+    r = (pid->filtered_r + (pid->filtered_r < 0 ? -PIDLAB_FILTER_ONE / 2 : PIDLAB_FILTER_ONE / 2)) / PIDLAB_FILTER_ONE;
+  }
+  e = r - y;
   const int64_t p = pidlab_mul(pidlab_mul(r, pid->b) - y, pid->kp);
   int64_t integral = pid->integral, d, unsaturated, out, delta_signal;
   int saturated = 0;
@@ -388,6 +414,12 @@ pidlab_pid_status pidlab_pid_set_setpoint_weights(pidlab_pid *pid, double b, dou
   pidlab_pid_config config = pid->config;
   config.setpoint_weight_b = b;
   config.setpoint_weight_c = c;
+  return pidlab_change(pid, &config);
+}
+
+pidlab_pid_status pidlab_pid_set_setpoint_filter(pidlab_pid *pid, double tr) {
+  pidlab_pid_config config = pid->config;
+  config.setpoint_filter_s = tr;
   return pidlab_change(pid, &config);
 }
 

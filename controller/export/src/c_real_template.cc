@@ -49,6 +49,7 @@ typedef struct {
   pidlab_real tf;   /* derivative filter time constant, s; 0 = unfiltered */
   pidlab_real setpoint_weight_b; /* b: setpoint weight of P, [0, 1] */
   pidlab_real setpoint_weight_c; /* c: setpoint weight of D, [0, 1]; 0 = on measurement */
+  pidlab_real setpoint_filter_s; /* tr: setpoint filter r/(tr s + 1) before all terms, s, >= 0; 0 = none */
   pidlab_real dt_s; /* sample period, s, > 0: call pidlab_pid_step this often */
   int has_output_min; /* 0: no lower limit */
   pidlab_real output_min;
@@ -71,6 +72,7 @@ typedef struct {
   pidlab_real prev_signal;  /* c r_{k-1} - y_{k-1} */
   pidlab_real prev_r;       /* r_{k-1}, for bumpless changes */
   pidlab_real prev_y;       /* y_{k-1} */
+  pidlab_real filtered_r;   /* f_{k-1}, the setpoint filter's state (tr > 0) */
   int manual;               /* 1: the output follows manual_output */
   pidlab_real manual_output;
 } pidlab_pid;
@@ -102,6 +104,10 @@ void pidlab_pid_set_auto(pidlab_pid *pid);
 pidlab_pid_status pidlab_pid_set_gains(pidlab_pid *pid, pidlab_real kp, pidlab_real ki, pidlab_real kd,
                                        pidlab_real tf);
 pidlab_pid_status pidlab_pid_set_setpoint_weights(pidlab_pid *pid, pidlab_real b, pidlab_real c);
+/* The setpoint filter's tr (s, >= 0; 0 = none): it acts from the next
+ * sample, from the filter's present state (switched on: from the last
+ * setpoint the terms saw, so without a bump). */
+pidlab_pid_status pidlab_pid_set_setpoint_filter(pidlab_pid *pid, pidlab_real tr);
 pidlab_pid_status pidlab_pid_set_sample_time(pidlab_pid *pid, pidlab_real dt_s);
 
 #ifdef __cplusplus
@@ -138,6 +144,7 @@ static int pidlab_gains_valid(pidlab_real kp, pidlab_real ki, pidlab_real kd, pi
 static int pidlab_config_valid(const pidlab_pid_config *c) {
   if (!pidlab_gains_valid(c->kp, c->ki, c->kd, c->tf)) return 0;
   if (!pidlab_in_unit(c->setpoint_weight_b) || !pidlab_in_unit(c->setpoint_weight_c)) return 0;
+  if (!pidlab_is_finite(c->setpoint_filter_s) || !(c->setpoint_filter_s >= PIDLAB_ZERO)) return 0;
   if (!pidlab_is_finite(c->dt_s) || !(c->dt_s > PIDLAB_ZERO)) return 0;
   if (c->has_output_min && !pidlab_is_finite(c->output_min)) return 0;
   if (c->has_output_max && !pidlab_is_finite(c->output_max)) return 0;
@@ -186,6 +193,7 @@ void pidlab_pid_reset(pidlab_pid *pid) {
   pid->prev_signal = PIDLAB_ZERO;
   pid->prev_r = PIDLAB_ZERO;
   pid->prev_y = PIDLAB_ZERO;
+  pid->filtered_r = PIDLAB_ZERO;
   pid->manual = 0;
   pid->manual_output = PIDLAB_ZERO;
 }
@@ -195,6 +203,11 @@ pidlab_pid_status pidlab_pid_step(pidlab_pid *pid, pidlab_real r, pidlab_real y,
   pidlab_real e, p, integral, integral_lo, signal, tf, d, unsaturated, out;
   int saturated = 0;
   if (!pidlab_is_finite(r) || !pidlab_is_finite(y)) return PIDLAB_PID_INVALID_INPUT;
+  if (c->setpoint_filter_s > PIDLAB_ZERO) {
+    /* The setpoint filter: f_k = f_{k-1} + dt/(tr + dt) (r_k - f_{k-1}) in r's place. */
+    pid->filtered_r += c->dt_s / (c->setpoint_filter_s + c->dt_s) * (r - pid->filtered_r);
+    r = pid->filtered_r;
+  }
   e = r - y;
   p = c->kp * (c->setpoint_weight_b * r - y);
   integral = pid->integral;
@@ -291,6 +304,14 @@ pidlab_pid_status pidlab_pid_set_setpoint_weights(pidlab_pid *pid, pidlab_real b
   pid->config.setpoint_weight_c = c;
   pidlab_accumulate(&pid->integral, &pid->integral_lo, p_before - pidlab_last_p(pid));
   pid->prev_signal = c * pid->prev_r - pid->prev_y;
+  return PIDLAB_PID_OK;
+}
+
+pidlab_pid_status pidlab_pid_set_setpoint_filter(pidlab_pid *pid, pidlab_real tr) {
+  if (!pidlab_is_finite(tr) || !(tr >= PIDLAB_ZERO)) return PIDLAB_PID_INVALID_CONFIG;
+  /* A filter switched on starts from the setpoint the terms saw last. */
+  if (!(pid->config.setpoint_filter_s > PIDLAB_ZERO)) pid->filtered_r = pid->prev_r;
+  pid->config.setpoint_filter_s = tr;
   return PIDLAB_PID_OK;
 }
 

@@ -102,6 +102,7 @@ std::string RealConfig(const Controller& c, Scalar scalar) {
   s += line(Literal(tf, scalar), "tf, s");
   s += line(Literal(c.setpoint_weight_b, scalar), "setpoint_weight_b");
   s += line(Literal(c.setpoint_weight_c, scalar), "setpoint_weight_c");
+  s += line(Literal(c.pid.setpoint_filter_s, scalar), "setpoint_filter_s, s");
   s += line(Literal(c.pid.dt_s, scalar), "dt_s, s");
   s += line(has_min ? "1" : "0", "has_output_min");
   s += line(Literal(has_min ? c.pid.output_min : 0.0, scalar), "output_min");
@@ -130,6 +131,7 @@ std::vector<std::string> CommentLines(const Options& o, const Controller& c) {
   l.push_back("Plant: " + (o.plant.empty() ? std::string("(not given)") : o.plant));
   l.push_back("");
   l.push_back("The controller, period dt, one pidlab_pid_step per sample k:");
+  l.push_back("  r = f = f + dt/(tr+dt) (r - f)  (the setpoint filter, where tr > 0)");
   l.push_back("  e = r - y");
   l.push_back("  p = kp (b r - y)");
   l.push_back("  I = I + ki dt e_k | ki dt e_{k-1} | ki dt/2 (e_k + e_{k-1})  (integral rule)");
@@ -141,7 +143,8 @@ std::vector<std::string> CommentLines(const Options& o, const Controller& c) {
   l.push_back("");
   l.push_back("Tuned: kp " + Number(c.gains.kp) + ", ki " + Number(c.gains.ki) + ", kd " +
               Number(c.gains.kd) + ", tf " + Number(tf) + " s, b " + Number(c.setpoint_weight_b) + ", c " +
-              Number(c.setpoint_weight_c) + ", dt " + Number(c.pid.dt_s) + " s,");
+              Number(c.setpoint_weight_c) + ", tr " + Number(c.pid.setpoint_filter_s) + " s, dt " +
+              Number(c.pid.dt_s) + " s,");
   l.push_back("  output limits [" + Number(c.pid.output_min) + ", " + Number(c.pid.output_max) +
               "], anti-windup " + ToString(c.pid.anti_windup) + " (back-calculation gain " +
               Number(c.pid.back_calculation_gain) + " 1/s), integral " + ToString(c.pid.integral) + ".");

@@ -127,6 +127,7 @@ std::string FixedConfig(const Controller& c) {
   std::string s;
   s += line(Num(c.gains.kp), "kp") + line(Num(c.gains.ki), "ki, 1/s") + line(Num(c.gains.kd), "kd, s");
   s += line(Num(tf), "tf, s") + line(Num(c.setpoint_weight_b), "b") + line(Num(c.setpoint_weight_c), "c");
+  s += line(Num(c.pid.setpoint_filter_s), "setpoint_filter_s, s");
   s += line(Num(c.pid.dt_s), "dt_s, s") + line(Num(c.pid.output_min), "output_min");
   s += line(Num(c.pid.output_max), "output_max") + line(aw, "anti_windup");
   s += line(Num(c.pid.back_calculation_gain), "back_calculation_gain, 1/s");

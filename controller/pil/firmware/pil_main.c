@@ -79,6 +79,7 @@ static void configure(const uint8_t *p) {
   c.anti_windup = (pidlab_anti_windup)(int)get_double(p + 88);
   c.back_calculation_gain = get_double(p + 96);
   c.integral = (pidlab_integral_rule)(int)get_double(p + 104);
+  c.setpoint_filter_s = get_double(p + 112);
   status = (int32_t)pidlab_pid_init(&pid, &c);
   send(PIL_ACK, (const uint8_t *)&status, 4);
 }
@@ -183,7 +184,7 @@ void pil_main(void) {
       memcpy(info, v, 12);
       memcpy(info + 12, scale, 16);
       send(PIL_INFO, info, 28);
-    } else if (type == PIL_CONFIG && n == 112) {
+    } else if (type == PIL_CONFIG && n == 120) {
       configure(buf);
     } else if (type == PIL_STEP && n == 16) {
       step(buf);

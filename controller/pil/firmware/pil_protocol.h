@@ -14,7 +14,7 @@
 /* bridge -> firmware */
 #define PIL_HELLO 'H' /* empty: answered by PIL_INFO */
 #define PIL_CONFIG \
-  'C' /* 14 doubles: kp ki kd tf b c dt out_min out_max has_min has_max anti_windup aw_gain integral */
+  'C' /* 15 doubles: kp ki kd tf b c dt out_min out_max has_min has_max anti_windup aw_gain integral tr */
 #define PIL_STEP 'S'  /* r, y: two value slots */
 #define PIL_STATS 'T' /* empty: answered by PIL_STATS_REPLY */
 /* firmware -> bridge */

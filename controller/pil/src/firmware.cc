@@ -356,12 +356,12 @@ Status Firmware::Receive(uint8_t want, std::string* payload) {
 Status Firmware::Configure(const PidGains& gains, const PidOptions& pid, double b, double c,
                            int* init_status) {
   std::string p;
-  for (double v :
-       {gains.kp, gains.ki, gains.kd, pid.derivative_filter_s, b, c, pid.dt_s,
-        std::isfinite(pid.output_min) ? pid.output_min : 0.0,
-        std::isfinite(pid.output_max) ? pid.output_max : 0.0, std::isfinite(pid.output_min) ? 1.0 : 0.0,
-        std::isfinite(pid.output_max) ? 1.0 : 0.0, static_cast<double>(static_cast<int>(pid.anti_windup)),
-        pid.back_calculation_gain, static_cast<double>(static_cast<int>(pid.integral))})
+  for (double v : {gains.kp, gains.ki, gains.kd, pid.derivative_filter_s, b, c, pid.dt_s,
+                   std::isfinite(pid.output_min) ? pid.output_min : 0.0,
+                   std::isfinite(pid.output_max) ? pid.output_max : 0.0,
+                   std::isfinite(pid.output_min) ? 1.0 : 0.0, std::isfinite(pid.output_max) ? 1.0 : 0.0,
+                   static_cast<double>(static_cast<int>(pid.anti_windup)), pid.back_calculation_gain,
+                   static_cast<double>(static_cast<int>(pid.integral)), pid.setpoint_filter_s})
     Put(&p, v);
   if (const Status st = Send(kConfig, p); !st.ok()) return st;
   std::string ack;

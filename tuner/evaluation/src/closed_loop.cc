@@ -33,7 +33,7 @@ bool ParseLoopKind(const std::string& s, LoopKind* kind) {
 std::string ToString(LoopKind kind) { return kind == LoopKind::kContinuous ? "continuous" : "sampled"; }
 
 // A field added to these structs must join LoopOptionsKey.
-static_assert(sizeof(PidOptions) == 9 * 8);
+static_assert(sizeof(PidOptions) == 10 * 8);
 static_assert(sizeof(DisturbanceOptions) == 10 * 8);
 static_assert(sizeof(MeasurementNoise) == 3 * 8);
 static_assert(sizeof(EpisodeShape) ==
@@ -65,6 +65,7 @@ std::vector<double> LoopOptionsKey(const LoopOptions& o) {
           static_cast<double>(p.integral),
           p.setpoint_weight_b,
           p.setpoint_weight_c,
+          p.setpoint_filter_s,
           static_cast<double>(d.kind),
           d.amplitude,
           d.period_s,

@@ -112,12 +112,15 @@ bool Run(const DelayedClosedLoop& loop, double ts, int num_samples, long p, long
   const Eigen::Index n = loop.m.rows();
   Mat<N> a = loop.m;
   Eigen::Matrix<double, 1, N> kq = loop.kq;
-  const int ir = loop.exo_index - 1;  // the reference state, held
+  const int ir = loop.reference_index;  // the reference state, held
   if (loop.w0(ir) == 0.0) {
-    // A zero reference (the load response) stays 0: its column goes, so that
-    // the setpoint weights, which only multiply it, leave the rounding alone.
-    a.col(ir).setZero();
-    kq(ir) = 0.0;
+    // A zero reference (the load response) stays 0: its columns go (r's and
+    // the setpoint filter's r_f, which stays 0 too), so that the setpoint
+    // weights, which only multiply them, leave the rounding alone.
+    for (int j = ir; j < loop.exo_index; ++j) {
+      a.col(j).setZero();
+      kq(j) = 0.0;
+    }
   }
   const Mat<N> c = loop.e * kq;
   const double t_end = (num_samples - 1) * ts;

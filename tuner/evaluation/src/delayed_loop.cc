@@ -252,26 +252,36 @@ bool BuildDelayedClosedLoopOrExplain(const TransferFunction& tf, const StateSpac
   const bool filtered = g.tf > 0.0;
   const DisturbanceKind kind = disturbance.options().kind;
   const int exo = kind == DisturbanceKind::kNone ? 0 : (kind == DisturbanceKind::kSine ? 2 : 1);
-  const int iz = n, iv = n + 1, ir = filtered ? n + 2 : n + 1, ie = ir + 1;
+  const int rf = weights.filter_s > 0.0 ? 1 : 0;
+  // is: the setpoint the PID reads, r or the setpoint filter's r_f.
+  const int iz = n, iv = n + 1, ir = filtered ? n + 2 : n + 1, is = ir + rf, ie = is + 1;
   const int size = ie + exo;
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(size, size);
   Eigen::RowVectorXd u = Eigen::RowVectorXd::Zero(size);
   m.topLeftCorner(n, n) = plant.a;
   m.block(iz, 0, 1, n) = -plant.c;
-  m(iz, ir) = 1.0;
+  m(iz, is) = 1.0;
+  if (rf) {  // r_f' = (r - r_f) / tr
+    m(is, ir) = 1.0 / weights.filter_s;
+    m(is, is) = -1.0 / weights.filter_s;
+  }
   if (filtered) {
     // u = kp (b r - C x) + ki z + kf (c r - C x - v), v' = (c r - C x - v) / tf.
     const double kf = g.kd / g.tf;
     u.head(n) = -(g.kp + kf) * plant.c;
     u(iv) = -kf;
-    u(ir) = g.kp * weights.b + kf * weights.c;
+    u(is) = g.kp * weights.b + kf * weights.c;
     m.block(iv, 0, 1, n) = -plant.c / g.tf;
     m(iv, iv) = -1.0 / g.tf;
-    m(iv, ir) = weights.c / g.tf;
+    m(iv, is) = weights.c / g.tf;
   } else {
     // u = kp (b r - C x) + ki z - kd C A x: e' = -C (A x + B p), C B = 0 here.
     u.head(n) = -g.kp * plant.c - g.kd * (plant.c * plant.a);
-    u(ir) = g.kp * weights.b;
+    u(is) = g.kp * weights.b;
+    if (rf) {  // kd c r_f' = kd c (r - r_f) / tr
+      u(ir) += g.kd * weights.c / weights.filter_s;
+      u(is) -= g.kd * weights.c / weights.filter_s;
+    }
   }
   u(iz) = g.ki;
   Eigen::VectorXd w0 = Eigen::VectorXd::Zero(size);
@@ -284,11 +294,12 @@ bool BuildDelayedClosedLoopOrExplain(const TransferFunction& tf, const StateSpac
   out->e.head(n) = plant.b;
   out->w0 = std::move(w0);
   out->impulse = Eigen::VectorXd::Zero(size);
-  if (!filtered) out->impulse.head(n) = g.kd * weights.c * reference * plant.b;
+  if (!filtered && !rf) out->impulse.head(n) = g.kd * weights.c * reference * plant.b;
   out->c = plant.c;
   out->plant_order = n;
   out->exo_size = exo;
   out->exo_index = ie;
+  out->reference_index = ir;
   out->delay_s = delay_s;
   return true;
 }

@@ -185,7 +185,9 @@ bool FastContinuousObjective::Covers(const TransferFunction& tf, const LoopOptio
   // The fast path runs the ideal PID only (tf = 0).
   if (options.derivative_filter_ratio > 0.0 || options.pid.derivative_filter_s != 0.0) return false;
   // and the 1-DOF PID (setpoint weights 1, 1).
-  if (options.pid.setpoint_weight_b != 1.0 || options.pid.setpoint_weight_c != 1.0) return false;
+  if (options.pid.setpoint_weight_b != 1.0 || options.pid.setpoint_weight_c != 1.0 ||
+      options.pid.setpoint_filter_s != 0.0)
+    return false;
   if (!tf.IsValid(nullptr) || tf.RelativeDegree() < 1) return false;
   const int order =
       static_cast<int>(tf.den.size()) - 1 -

@@ -35,6 +35,8 @@ class AdaptiveWalker {
   AdaptiveWalker(const ContinuousClosedLoop<double>& loop, const Disturbance* disturbance,
                  const Stability& stability)
       : loop_(loop), disturbance_(disturbance), poles_(stability.poles) {
+    // The setpoint filter's mode is the response's, not the loop's.
+    if (loop.reference_filter_order) poles_.emplace_back(-loop.reference_filter_rate(), 0.0);
     double fastest = 0.0;
     for (const auto& p : poles_) fastest = std::max(fastest, std::abs(p));
     if (loop.exo_size == 2) fastest = std::max(fastest, ExoFrequency());
@@ -266,9 +268,10 @@ double ObjectiveFromSamples(ObjectiveKind kind, const std::vector<double>& y, do
 double ContinuousFinalValue(const ContinuousClosedLoop<double>& loop) {
   const std::vector<int> live = LiveLoopStates(loop);
   const int n = static_cast<int>(live.size());
-  const int ir = loop.reference_index();
+  // At rest the setpoint filter's r_f is r: its column joins r's.
+  const int ir = loop.reference_index(), is = loop.setpoint_index();
   Eigen::VectorXd rhs(n);
-  for (int i = 0; i < n; ++i) rhs(i) = -loop.m(live[i], ir);
+  for (int i = 0; i < n; ++i) rhs(i) = -loop.m(live[i], ir) - (is != ir ? loop.m(live[i], is) : 0.0);
   const Eigen::VectorXd w = LiveLoopMatrix(loop).partialPivLu().solve(rhs);
   return loop.reference * loop.c.dot(w.head(loop.plant_order));  // the plant's states come first
 }
@@ -285,6 +288,7 @@ StepInfo ContinuousStepInfo(const ContinuousClosedLoop<double>& loop, const Stab
   // Walk until the slowest mode has died out.
   double slowest = kInf;
   for (const auto& p : stability.poles) slowest = std::min(slowest, -p.real());
+  if (y1.reference_filter_order) slowest = std::min(slowest, y1.reference_filter_rate());
   const double t_end = -kDeadExponent / slowest;
   AdaptiveWalker walker(y1, nullptr, stability);
   GridResponse response{y1, walker, {}, {}, {}};

@@ -252,10 +252,11 @@ namespace {
 double ExactOvershoot(const Plant& plant, const DesignSummary& s, evaluation::LoopOptions loop) {
   loop.pid.setpoint_weight_b = s.b;
   loop.pid.setpoint_weight_c = s.c;
+  loop.pid.setpoint_filter_s = s.setpoint_filter_s;
   loop.disturbance = DisturbanceOptions{};
   loop.derivative_filter_ratio = 0.0;
   loop.pid.derivative_filter_s = 0.0;
-  const double horizon = 40.0 * s.response_time_s + 20.0 * plant.delay_s;
+  const double horizon = 40.0 * s.response_time_s + 20.0 * plant.delay_s + 12.0 * s.setpoint_filter_s;
   const bool sampled = loop.loop == evaluation::LoopKind::kSampled;
   const double spacing =
       sampled ? std::max(1.0, std::round(horizon / 4000.0 / loop.dt_s)) * loop.dt_s : horizon / 4000.0;
@@ -291,8 +292,10 @@ void ShapeSetpoint(const Plant& plant, const design::Engine& engine, const Desig
   if (!s->overshoot_met)
     s->setpoint_note =
         "the setpoint overshoot target " + FormatNumber(target) + " % is not met: b " + FormatNumber(s->b) +
-        ", c " + FormatNumber(s->c) + " reach " + FormatNumber(s->overshoot_pct) +
-        " % at the least (the integral action's own overshoot: a setpoint filter would be needed)";
+        ", c " + FormatNumber(s->c) +
+        (s->setpoint_filter_s > 0.0 ? " and the setpoint filter " + FormatNumber(s->setpoint_filter_s) + " s"
+                                    : std::string()) +
+        " reach " + FormatNumber(s->overshoot_pct) + " % at the least";
 }
 
 // The design with one engine (its grid and step).

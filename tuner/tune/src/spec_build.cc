@@ -263,6 +263,10 @@ bool BuildSetpointWeights(const spec::LoopSpec& s, DerivativeOn derivative_on, N
     return Bad(error, value + ": each weight must be finite and in [0, 1]");
   pid->setpoint_weight_b = b;
   pid->setpoint_weight_c = c;
+  if (!(s.setpoint_filter_s >= 0.0) || !std::isfinite(s.setpoint_filter_s))
+    return Bad(error, spec::DisplayName("setpoint_filter", style) + " " +
+                          spec::FormatNumber(s.setpoint_filter_s) + ": must be >= 0 and finite (s)");
+  pid->setpoint_filter_s = s.setpoint_filter_s;
   if (derivative_on == DerivativeOn::kMeasurement) {
     if (c != 0.0 && c != 1.0)
       return Bad(error, value + ": " + spec::DisplayName("derivative_on", style) +

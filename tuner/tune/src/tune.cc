@@ -223,11 +223,15 @@ bool OptimalSearch(const Plant& plant, const TuneOptions& options,
   two.ran = true;
   two.b = d.b;
   two.c = d.c;
+  two.setpoint_filter_s = d.setpoint_filter_s;
   two.termination = optim::TerminationType::kConverged;
-  two.message = d.setpoint_note.empty() ? "the setpoint overshoot " + spec::FormatNumber(d.overshoot_pct) +
-                                              " % <= " + spec::FormatNumber(o.max_overshoot_pct) +
-                                              " %, the least setpoint integral |e| dt"
-                                        : d.setpoint_note;
+  two.message =
+      d.setpoint_note.empty()
+          ? "the setpoint overshoot " + spec::FormatNumber(d.overshoot_pct) +
+                " % <= " + spec::FormatNumber(o.max_overshoot_pct) +
+                " %, the least setpoint integral |e| dt" +
+                (d.setpoint_filter_s > 0.0 ? " (with a setpoint filter: no weights b, c reach it alone)" : "")
+          : d.setpoint_note;
   RuleResult(d.gains, evaluator, d.message, &summary->optimizer);
   return true;
 }

@@ -182,7 +182,10 @@ Status SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
 }
 
 evaluation::LoopOptions WithSetpointWeights(evaluation::LoopOptions loop, const TwoDofSummary& summary) {
-  return summary.ran ? Weighted(loop, summary.b, summary.c) : loop;
+  if (!summary.ran) return loop;
+  loop = Weighted(loop, summary.b, summary.c);
+  loop.pid.setpoint_filter_s = summary.setpoint_filter_s;
+  return loop;
 }
 
 }  // namespace pidlab::tune

@@ -10,9 +10,16 @@
 // proportional and derivative terms,
 //   u = kp (b r - y) + ki/s (r - y) + kd s / (tf s + 1) (c r - y);
 // b = c = 1 is the 1-DOF PID above, c = 0 the derivative on measurement.
+// A first-order setpoint filter of time constant tr > 0
+// (PidOptions::setpoint_filter_s) takes r to r_f = r / (tr s + 1) before all
+// three terms, where the weights alone cannot shape the response (0 = none):
+//   u = kp (b r_f - y) + ki/s (r_f - y) + kd s / (tf s + 1) (c r_f - y).
 //
 // Discrete, period dt, one call per sample k (t_k = k dt), u_k held over
 // [t_k, t_{k+1}):
+//   r_k stands for the filtered f_k where tr > 0 (0: r_k itself):
+//       f_k = f_{k-1} + dt/(tr+dt) (r_k - f_{k-1}), f_{-1} = 0 (at rest),
+//       the backward-Euler image of 1/(tr s + 1), as the derivative's filter
 //   e_k = r_k - y_k
 //   P_k = kp (b r_k - y_k)
 //   I_k = I_{k-1} + ki dt e_k                    (backward Euler, default)
@@ -121,6 +128,10 @@ struct PidOptions {
   /// enters. 1, 1: the 1-DOF PID, bit for bit.
   double setpoint_weight_b = 1.0;  // b
   double setpoint_weight_c = 1.0;  // c
+  /// Time constant tr of the first-order setpoint filter r / (tr s + 1), s,
+  /// finite and >= 0; 0 = none (r enters as it is). Like the weights, it
+  /// changes only how r enters, never the feedback loop.
+  double setpoint_filter_s = 0.0;  // tr
 
   bool IsValid(std::string* error) const {
     std::ostringstream os;
@@ -134,6 +145,8 @@ struct PidOptions {
       os << "setpoint weight b = " << setpoint_weight_b << " must be finite and in [0, 1]";
     else if (!SetpointWeightIsValid(setpoint_weight_c))
       os << "setpoint weight c = " << setpoint_weight_c << " must be finite and in [0, 1]";
+    else if (!(setpoint_filter_s >= 0.0) || !std::isfinite(setpoint_filter_s))
+      os << "setpoint filter " << setpoint_filter_s << " s must be >= 0 and finite";
     else if (anti_windup == AntiWindup::kBackCalculation &&
              (!(back_calculation_gain > 0.0) || !std::isfinite(back_calculation_gain)))
       os << "back-calculation gain " << back_calculation_gain << " must be positive";
@@ -182,10 +195,14 @@ class DiscretePid {
   /// Options must be valid (checked by the caller with IsValid).
   DiscretePid(const PidGainsT<T>& gains, const PidOptions& options) : gains_(gains), options_(options) {}
 
-  PidStatus Step(const T& r, const T& y, T* u) {
+  PidStatus Step(const T& r_in, const T& y, T* u) {
     using std::isfinite;
-    if (!IsFinite(r) || !IsFinite(y)) return PidStatus::kInvalidInput;
+    if (!IsFinite(r_in) || !IsFinite(y)) return PidStatus::kInvalidInput;
     const double dt = options_.dt_s;
+    // The setpoint filter's f_k (tr > 0), or r_k itself.
+    if (options_.setpoint_filter_s > 0.0)
+      filtered_r_ += T(dt) / (T(options_.setpoint_filter_s) + T(dt)) * (r_in - filtered_r_);
+    const T r = options_.setpoint_filter_s > 0.0 ? filtered_r_ : r_in;
     const T e = r - y;
     // The operation order is the exported C's (pidlab export): keep it.
     const T p = gains_.kp * (T(options_.setpoint_weight_b) * r - y);
@@ -242,6 +259,7 @@ class DiscretePid {
     derivative_ = T(0.0);
     prev_error_ = T(0.0);
     prev_signal_ = T(0.0);
+    filtered_r_ = T(0.0);
   }
 
   const PidGainsT<T>& gains() const { return gains_; }
@@ -261,6 +279,7 @@ class DiscretePid {
   T derivative_ = T(0.0);
   T prev_error_ = T(0.0);
   T prev_signal_ = T(0.0);
+  T filtered_r_ = T(0.0);  // the setpoint filter's state f_k (tr > 0)
 };
 
 }  // namespace pidlab

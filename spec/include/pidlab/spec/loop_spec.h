@@ -144,6 +144,9 @@ struct LoopSpec {
   /// The 2-DOF PID's setpoint weights b (proportional), c (derivative), each
   /// in [0, 1] (docs/two_dof.md); 1, 1 = the 1-DOF PID.
   std::pair<double, double> setpoint_weights{1.0, 1.0};
+  /// The first-order setpoint filter r / (Tr s + 1) before all three terms,
+  /// Tr in s (docs/two_dof.md); 0 = none.
+  double setpoint_filter_s = 0.0;
 
   /// The loop a tuning starts from: stability margin 0.01, because with a
   /// margin near zero the search parks poles a hair left of the imaginary
@@ -239,6 +242,12 @@ struct LoopSpec {
               "s/(tf s + 1) (c r - y) (docs/two_dof.md); 1,1 = the 1-DOF PID",
               "", kEpisode, "[0.6, 0]"},
              &setpoint_weights);
+    a->Visit(
+        {"setpoint_filter",
+         "2-DOF PID, both loops: first-order setpoint filter time constant Tr, r_f = r/(Tr s + 1) in r's "
+         "place in all three terms (docs/two_dof.md); 0 = none",
+         "s", kEpisode, "2"},
+        &setpoint_filter_s);
     a->Visit({"integral", "sampled PID: backward-euler|forward-euler|trapezoidal", "", kEpisode,
               R"("trapezoidal")"},
              &integral);

@@ -162,17 +162,22 @@ PidGainsT<T> LoopGains(const PidGainsT<T>& g, const LoopOptions& o) {
 /// The 2-DOF PID's setpoint weights as the continuous loops take them
 /// (PidOptions::setpoint_weight_b, setpoint_weight_c): r enters the
 /// proportional term as b r and the derivative's as c r. They change the loop
-/// from r only, never its poles or the loop from the disturbance.
+/// from r only, never its poles or the loop from the disturbance. A
+/// setpoint filter (filter_s = tr > 0, PidOptions::setpoint_filter_s) puts
+/// r_f = r / (tr s + 1) in r's place in all three terms: one more state after
+/// r's, r_f' = (r - r_f) / tr, outside the loop proper like r itself.
 struct SetpointWeights {
   double b = 1.0;
   double c = 1.0;
+  double filter_s = 0.0;
 };
 inline SetpointWeights SetpointWeightsOf(const PidOptions& o) {
-  return {o.setpoint_weight_b, o.setpoint_weight_c};
+  return {o.setpoint_weight_b, o.setpoint_weight_c, o.setpoint_filter_s};
 }
 
 /// The continuous closed loop as one linear system w' = M w with
-/// w = [x (plant); z = \int e; v (filter, only when tf > 0); r; exo],
+/// w = [x (plant); z = \int e; v (filter, only when tf > 0); r;
+///      r_f (setpoint filter, only when tr > 0); exo],
 /// y = C x. The reference and the
 /// disturbance are states of an exosystem: r' = 0, a piecewise-constant n is
 /// a state with n' = 0 reset at its breakpoints, a sine is (s, c) with
@@ -185,11 +190,19 @@ struct ContinuousClosedLoop {
   int plant_order = 0;
   int filter_order = 0;  // 1 with a derivative filter (tf > 0), else 0
   int exo_size = 0;      // 0 (no disturbance), 1 (piecewise constant), 2 (sine)
+  int reference_filter_order = 0;  // 1 with a setpoint filter (tr > 0), else 0
   Eigen::RowVectorXd c;
   /// States of the loop proper: plant, integral and filter.
   int loop_order() const { return plant_order + 1 + filter_order; }
   int reference_index() const { return loop_order(); }
-  int exo_index() const { return loop_order() + 1; }
+  /// The state the PID reads as its setpoint: r, or r_f where filtered.
+  int setpoint_index() const { return reference_index() + reference_filter_order; }
+  int exo_index() const { return setpoint_index() + 1; }
+  /// 1 / tr, the setpoint filter's rate (0 without one): a mode of the
+  /// setpoint response that is not a pole of the loop.
+  double reference_filter_rate() const {
+    return reference_filter_order ? -ToDouble(m(setpoint_index(), setpoint_index())) : 0.0;
+  }
   T Output(const VectorX<T>& w) const {
     T y = T(0.0);
     for (int i = 0; i < plant_order; ++i) y += c(i) * w(i);
@@ -217,9 +230,17 @@ void SetExosystem(const Disturbance& disturbance, int exo, int ie, MatrixX<T>* m
 /// states), then *out from the loop matrix and initial state.
 template <typename T>
 void FinishClosedLoop(const StateSpace& plant, const Disturbance& disturbance, double reference,
-                      int filter_order, int exo, MatrixX<T> m, VectorX<T> w0, ContinuousClosedLoop<T>* out) {
+                      int filter_order, int exo, MatrixX<T> m, VectorX<T> w0, ContinuousClosedLoop<T>* out,
+                      const SetpointWeights& weights) {
   const int n = plant.order();
-  SetExosystem<T>(disturbance, exo, n + 2 + filter_order, &m, &w0);
+  const int rf = weights.filter_s > 0.0 ? 1 : 0;
+  const int ir = n + 1 + filter_order;
+  if (rf) {  // r_f' = (r - r_f) / tr
+    m(ir + 1, ir) = T(1.0 / weights.filter_s);
+    m(ir + 1, ir + 1) = T(-1.0 / weights.filter_s);
+  }
+  SetExosystem<T>(disturbance, exo, ir + 1 + rf, &m, &w0);
+  out->reference_filter_order = rf;
   out->m = std::move(m);
   out->w0 = std::move(w0);
   out->reference = reference;
@@ -240,8 +261,9 @@ Status BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
   const int n = plant.order();
   const DisturbanceKind kind = disturbance.options().kind;
   const int exo = kind == DisturbanceKind::kNone ? 0 : (kind == DisturbanceKind::kSine ? 2 : 1);
-  const int iz = n, iv = n + 1, ir = n + 2, ie = n + 3;
-  const int size = n + 3 + exo;
+  const int rf = weights.filter_s > 0.0 ? 1 : 0;
+  const int iz = n, iv = n + 1, ir = n + 2, is = ir + rf, ie = is + 1;  // is: the setpoint the PID reads
+  const int size = n + 3 + rf + exo;
   const T kf = g.kd / g.tf;  // the derivative's high-frequency gain
   const T inv_tf = T(1.0) / g.tf;
   MatrixX<T> m = MatrixX<T>::Zero(size, size);
@@ -250,7 +272,7 @@ Status BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
   for (int j = 0; j < n; ++j) u_row(j) = -(g.kp + kf) * plant.c(j);
   u_row(iz) = g.ki;
   u_row(iv) = -kf;
-  u_row(ir) = g.kp * T(weights.b) + kf * T(weights.c);
+  u_row(is) = g.kp * T(weights.b) + kf * T(weights.c);
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < n; ++j) m(i, j) = T(plant.a(i, j));
     for (int j = 0; j < size; ++j) m(i, j) += plant.b(i) * u_row(j);
@@ -260,13 +282,13 @@ Status BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
     m(iz, j) = T(-plant.c(j));
     m(iv, j) = -inv_tf * plant.c(j);
   }
-  m(iz, ir) = T(1.0);
+  m(iz, is) = T(1.0);
   m(iv, iv) = -inv_tf;
-  m(iv, ir) = inv_tf * T(weights.c);  // v' = (c r - C x - v) / tf
+  m(iv, is) = inv_tf * T(weights.c);  // v' = (c r - C x - v) / tf
   VectorX<T> w0 = VectorX<T>::Zero(size);
   w0(ir) = T(reference);
   FinishClosedLoop<T>(plant, disturbance, reference, /*filter_order=*/1, exo, std::move(m), std::move(w0),
-                      out);
+                      out, weights);
   return Status::Ok();
 }
 
@@ -281,6 +303,8 @@ Status BuildFilteredClosedLoop(const StateSpace& plant, const PidGainsT<T>& g, c
 /// no impulse (x(0+) = 0) and no algebraic loop (the plant is strictly proper).
 /// With setpoint weights b, c (2-DOF) r enters as kp b r and kd c r' (the
 /// impulse kd c A), or as (kp b + kf c) r and v' = (c r - C x - v) / tf.
+/// A setpoint filter puts r_f in r's place: kd c r_f' = kd c (r - r_f) / tr
+/// is a state's, so there is no impulse.
 template <typename T>
 Status BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g,
                                  const Disturbance& disturbance, ContinuousClosedLoop<T>* out,
@@ -289,7 +313,8 @@ Status BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g,
   const int n = plant.order();
   const DisturbanceKind kind = disturbance.options().kind;
   const int exo = kind == DisturbanceKind::kNone ? 0 : (kind == DisturbanceKind::kSine ? 2 : 1);
-  const int size = n + 2 + exo;
+  const int rf = weights.filter_s > 0.0 ? 1 : 0;
+  const int size = n + 2 + rf + exo;
   const double cb = plant.c.dot(plant.b);
   const T denom = T(1.0) + g.kd * cb;
   if (std::abs(ToDouble(denom)) < 1e-12) {
@@ -298,12 +323,17 @@ Status BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g,
   const T alpha = T(1.0) / denom;
   const Eigen::RowVectorXd ca = plant.c * plant.a;
   MatrixX<T> m = MatrixX<T>::Zero(size, size);
-  const int iz = n, ir = n + 1, ie = n + 2;
+  const int iz = n, ir = n + 1, is = ir + rf, ie = is + 1;  // is: the setpoint the PID reads
   // u as a row over w.
   VectorX<T> u_row = VectorX<T>::Zero(size);
   for (int j = 0; j < n; ++j) u_row(j) = -alpha * (g.kp * plant.c(j) + g.kd * ca(j));
   u_row(iz) = alpha * g.ki;
-  u_row(ir) = alpha * (g.kp * T(weights.b));
+  u_row(is) = alpha * (g.kp * T(weights.b));
+  if (rf) {  // kd c r_f'
+    const T kick_rate = alpha * g.kd * T(weights.c / weights.filter_s);
+    u_row(ir) += kick_rate;
+    u_row(is) -= kick_rate;
+  }
   if (exo > 0) u_row(ie) = -alpha * g.kd * cb;
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < n; ++j) m(i, j) = T(plant.a(i, j));
@@ -311,12 +341,13 @@ Status BuildContinuousClosedLoop(const StateSpace& plant, const PidGainsT<T>& g,
     if (exo > 0) m(i, ie) += T(plant.b(i));
   }
   for (int j = 0; j < n; ++j) m(iz, j) = T(-plant.c(j));
-  m(iz, ir) = T(1.0);
+  m(iz, is) = T(1.0);
   VectorX<T> w0 = VectorX<T>::Zero(size);
-  for (int i = 0; i < n; ++i) w0(i) = alpha * g.kd * T(weights.c) * (reference * plant.b(i));
+  if (!rf)
+    for (int i = 0; i < n; ++i) w0(i) = alpha * g.kd * T(weights.c) * (reference * plant.b(i));
   w0(ir) = T(reference);
   FinishClosedLoop<T>(plant, disturbance, reference, /*filter_order=*/0, exo, std::move(m), std::move(w0),
-                      out);
+                      out, weights);
   return Status::Ok();
 }
 

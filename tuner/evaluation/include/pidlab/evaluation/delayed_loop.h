@@ -44,6 +44,7 @@ struct DelayedClosedLoop {
   int plant_order = 0;
   int exo_size = 0;
   int exo_index = 0;
+  int reference_index = 0;  // r's state (r_f's, where a setpoint filter runs, follows it)
   double delay_s = 0.0;
   double Output(const Eigen::VectorXd& w) const { return c.dot(w.head(plant_order)); }
 };

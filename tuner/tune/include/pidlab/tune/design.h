@@ -12,7 +12,9 @@
 // autotuning problem; Grimholt and Skogestad, J. Process Control 70, 2018).
 // Then a second stage shapes the setpoint response: the weights b, c in
 // [0, 1]^2 with the smallest setpoint \int|e|dt whose overshoot is within a
-// target; they cannot move the load response.
+// target, and where no weights meet it (the integral action's own
+// overshoot), a first-order setpoint filter r / (tr s + 1) with them; none
+// of them can move the load response.
 //
 // The load response is simulated on a uniform grid whose step divides the
 // dead time: the plant and the controller are discretised exactly (matrix
@@ -84,8 +86,11 @@ struct DesignOptions {
 struct DesignSummary {
   /// kp, ki, kd and the filter tf.
   PidGains gains;
-  /// The setpoint weights b, c of the second stage.
+  /// The setpoint weights b, c of the second stage, and its first-order
+  /// setpoint filter's time constant tr (s; 0 = none), where b and c alone
+  /// cannot meet the overshoot target.
   double b = 1.0, c = 1.0;
+  double setpoint_filter_s = 0.0;
   /// \int|y|dt of the unit load step, and of the setpoint error 1 - y with
   /// the weights found; the setpoint step's overshoot (%) with them, and
   /// with b = c = 1.

@@ -30,6 +30,9 @@ struct TwoDofSummary {
   bool ran = false;
   /// The weights found (the grid's best polished by Nelder-Mead in the box).
   double b = 1.0, c = 1.0;
+  /// The first-order setpoint filter's time constant (s; 0 = none): the
+  /// design engine's, where b and c alone miss the overshoot target.
+  double setpoint_filter_s = 0.0;
   /// With the weights the feedback stage ran with (the loop's, 1, 1 by
   /// default), and with the weights found.
   TwoDofResponse before, after;
@@ -57,7 +60,7 @@ Status SetpointWeightForOvershoot(const Plant& plant, const PidGains& gains,
                                   const evaluation::LoopOptions& loop, double c, double max_overshoot_pct,
                                   TwoDofSummary* summary);
 
-/// `loop` with the weights of `summary` when it ran.
+/// `loop` with the weights (and the setpoint filter) of `summary` when it ran.
 evaluation::LoopOptions WithSetpointWeights(evaluation::LoopOptions loop, const TwoDofSummary& summary);
 
 }  // namespace pidlab::tune
