@@ -450,8 +450,8 @@ TEST_F(LogReaderTest, ASuppliedConfigurationYieldsToALoggedOneAndListsAnEpisodeT
     int64_t num = 0;
     EpisodeWriter{ref}.Write(&log, &num);
   }
-  auto config = transport::MakeEpisodeConfig(
-      MakeEpisodeSpec(42, ref.plant, ref.gains, ref.options, ref.options.disturbance, transport::RecoveryOptions{}));
+  auto config = transport::MakeEpisodeConfig(MakeEpisodeSpec(
+      42, ref.plant, ref.gains, ref.options, ref.options.disturbance, transport::RecoveryOptions{}));
   ReadOptions options;
   options.channel_prefix = "PIDLAB_";
   config.kp += 1.0;  // not what the log holds: the log's own wins, without a note

@@ -358,8 +358,8 @@ Status LogCapture::MergeLanes() {
   }
   inputs.insert(inputs.end(), beside.begin(), beside.end());
   const std::string merged = options_.log_file + ".merging";
-  ok = ok && MergeEventLogsOrExplain(inputs, rebuilt,
-                                     options_.channel_prefix + transport::kPlantOutputChannel, merged, &error);
+  ok = ok && MergeEventLogsOrExplain(
+                 inputs, rebuilt, options_.channel_prefix + transport::kPlantOutputChannel, merged, &error);
   if (ok && std::rename(merged.c_str(), options_.log_file.c_str()) != 0) {
     ok = false;
     error = "cannot rename " + merged + " to " + options_.log_file;
@@ -520,9 +520,9 @@ void LogCapture::Conclude(const std::vector<Gap>& gaps, const std::vector<int64_
   if (summary->status == RepairStatus::kIncomplete) return;
   if (!restored_.empty()) {
     summary->status = RepairStatus::kRepaired;
-    summary->lines.push_back("lcm-logger lost the configuration of episode" +
-                             std::string(restored_.size() == 1 ? " " : "s ") + EpisodeList(summary->restored) +
-                             "; " + options_.log_file + " gets launch's own copy");
+    summary->lines.push_back(
+        "lcm-logger lost the configuration of episode" + std::string(restored_.size() == 1 ? " " : "s ") +
+        EpisodeList(summary->restored) + "; " + options_.log_file + " gets launch's own copy");
   }
   if (summary->republished.empty()) return;
   summary->status = RepairStatus::kRepaired;
