@@ -418,6 +418,59 @@ TEST_F(LogReaderTest, DataWithoutConfigurationIsListedButNotEvaluated) {
   EXPECT_NE(error.find("configuration"), std::string::npos) << error;
 }
 
+TEST_F(LogReaderTest, ASuppliedConfigurationCompletesAnEpisodeWhoseLogLacksIt) {
+  const Reference ref;
+  {
+    lcm::LogFile log(path_, "w");
+    int64_t num = 0;
+    EpisodeWriter w{ref};
+    w.with_config = false;
+    w.Write(&log, &num);
+  }
+  ReadOptions options;
+  options.channel_prefix = "PIDLAB_";
+  options.supplied_configs.push_back(transport::MakeEpisodeConfig(MakeEpisodeSpec(
+      42, ref.plant, ref.gains, ref.options, ref.options.disturbance, transport::RecoveryOptions{})));
+  const LogContents dut = Read(options);
+  ASSERT_EQ(dut.episodes.size(), 1u);
+  const Episode& e = dut.episodes[0];
+  EXPECT_TRUE(e.has_config);
+  EXPECT_TRUE(e.config_supplied);
+  EXPECT_TRUE(e.Complete()) << e.CompletenessNote();
+  EXPECT_EQ(dut.orphan_messages, 0);
+  Evaluation ev;
+  ASSERT_TRUE(IsOk(EvaluateEpisode(e, &ev)));
+  EXPECT_EQ(ev.iae, ref.evaluation.iae);
+}
+
+TEST_F(LogReaderTest, ASuppliedConfigurationYieldsToALoggedOneAndListsAnEpisodeTheLogLacks) {
+  const Reference ref;
+  {
+    lcm::LogFile log(path_, "w");
+    int64_t num = 0;
+    EpisodeWriter{ref}.Write(&log, &num);
+  }
+  auto config = transport::MakeEpisodeConfig(MakeEpisodeSpec(
+      42, ref.plant, ref.gains, ref.options, ref.options.disturbance, transport::RecoveryOptions{}));
+  ReadOptions options;
+  options.channel_prefix = "PIDLAB_";
+  config.kp += 1.0;  // not what the log holds: the log's own wins, without a note
+  options.supplied_configs.push_back(config);
+  config.episode_id = 43;  // nothing of it in the log
+  options.supplied_configs.push_back(config);
+  const LogContents dut = Read(options);
+  ASSERT_EQ(dut.episodes.size(), 2u) << Notes(dut);
+  EXPECT_FALSE(dut.episodes[0].config_supplied);
+  EXPECT_EQ(dut.episodes[0].config.kp, ref.gains.kp);
+  EXPECT_TRUE(dut.episodes[0].Complete()) << dut.episodes[0].CompletenessNote();
+  EXPECT_EQ(Notes(dut).find("more than once"), std::string::npos) << Notes(dut);
+  const Episode& lacking = dut.episodes[1];
+  EXPECT_EQ(lacking.episode_id, 43);
+  EXPECT_TRUE(lacking.config_supplied);
+  ASSERT_EQ(lacking.outputs.missing.size(), 1u);
+  EXPECT_EQ(lacking.outputs.missing[0], std::make_pair(0L, ref.total_steps()));
+}
+
 TEST_F(LogReaderTest, AFileThatIsNotALogIsRefused) {
   {
     std::ofstream f(path_);

@@ -176,7 +176,9 @@ std::function<int()> RegisterLaunch(CLI::App* app) {
                   "the two above); 'pidlab tune --backend lcm' runs its starts on all of them. With --log, "
                   "trio i > 1 logs into FILE.trio<i>")
       ->capture_default_str();
-  app->add_option("--log", o.log_file, "record every message with lcm-logger into this file (overwritten)");
+  app->add_option("--log", o.log_file,
+                  "record every message with lcm-logger into this file (overwritten); after COMMAND, what "
+                  "the logger lost is repaired: steps from the plant, configurations from launch's own copy");
   app->add_flag("--isolated", flags->isolated,
                 "run everything in a private network namespace (root) with multicast over its "
                 "loopback: nothing leaves the machine");

@@ -363,6 +363,11 @@ int Launcher::RunWatching(const std::vector<Launcher*>& trios, const std::vector
       return c && !c->alive ? ExitCodeOf(c->status) : 128 + static_cast<int>(*stop);
     }
     first.transport_->WaitAndHandle(0.02);
+    // Every trio's launcher hears its own trio's episodes (EpisodeWitness):
+    // what the others queued meanwhile is handled now.
+    for (Launcher* trio : trios)
+      for (int i = 0; trio != &first && i < 256 && trio->transport_->WaitAndHandle(0.0) > 0; ++i) {
+      }
   }
 }
 

@@ -81,7 +81,7 @@ long CountSteps(const std::vector<std::pair<long, long>>& ranges) {
 
 LogCapture::LogCapture(const LogCaptureOptions& options, transport::Transport* transport,
                        Supervisor* supervisor)
-    : options_(options), transport_(transport), supervisor_(supervisor) {}
+    : options_(options), transport_(transport), supervisor_(supervisor), witness_(transport) {}
 
 LogCapture::~LogCapture() {
   for (const auto& [pid, files] : loggers_) std::remove(files.stderr_file.c_str());
@@ -156,12 +156,21 @@ void LogCapture::StartLaneLoggers(const std::string& lcm_url) {
   }
 }
 
-std::string LogCapture::DescribeMissing() const {
+replay::ReadOptions LogCapture::ReaderOptions() const {
   replay::ReadOptions read_options;
   read_options.channel_prefix = options_.channel_prefix;
   read_options.auth_key = options_.auth_key;
+  for (const int64_t id : witness_.ended())
+    if (const auto* config = witness_.Config(id)) read_options.supplied_configs.push_back(*config);
+  for (const int64_t id : orphans_with_copy_)
+    if (const auto* config = witness_.Config(id); config && !witness_.Ended(id))
+      read_options.supplied_configs.push_back(*config);
+  return read_options;
+}
+
+std::string LogCapture::DescribeMissing() const {
   replay::LogContents log;
-  if (!replay::ReadLog(options_.log_file, read_options, &log).ok())
+  if (!replay::ReadLog(options_.log_file, ReaderOptions(), &log).ok())
     return options_.log_file + " cannot be read";
   const replay::Episode* first = nullptr;
   long more = 0;
@@ -317,20 +326,18 @@ std::vector<TimedPayload> LogCapture::MissingLaneOutputs(const std::string& lane
   // if y_k is missing. Authenticated runs are left as they are (the rebuilt
   // messages would carry no tag).
   if (options_.auth_key) return {};
-  replay::ReadOptions read_options;
-  read_options.channel_prefix = options_.channel_prefix;
   replay::LogContents log;
-  if (!replay::ReadLog(options_.log_file, read_options, &log).ok()) return {};
+  if (!replay::ReadLog(options_.log_file, ReaderOptions(), &log).ok()) return {};
   return RebuildLaneOutputs(log, lane_file, options_.channel_prefix);
 }
 
 Status LogCapture::MergeLanes() {
   rebuilt_outputs_ = 0;
-  if (lane_loggers_.empty()) return Status::Ok();
+  if (lane_loggers_.empty() && restored_.empty()) return Status::Ok();
   for (const auto& [pid, file] : lane_loggers_)
     if (pid > 0 && !supervisor_->StopChild(pid, SIGINT, 3.0)) supervisor_->StopChild(pid, SIGKILL, 1.0);
-  std::vector<std::string> inputs{options_.log_file};
-  for (const auto& lane : lane_loggers_) inputs.push_back(lane.second);
+  std::vector<std::string> inputs{options_.log_file}, beside;
+  for (const auto& lane : lane_loggers_) beside.push_back(lane.second);
   std::vector<TimedPayload> rebuilt;
   for (const auto& lane : lane_loggers_)
     if (lane.second == options_.log_file + ".lane" + std::to_string(transport::kPlantOutputLane))
@@ -338,24 +345,36 @@ Status LogCapture::MergeLanes() {
   std::stable_sort(rebuilt.begin(), rebuilt.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   rebuilt_outputs_ = static_cast<long>(rebuilt.size());
-  const std::string merged = options_.log_file + ".merging";
   std::string error;
-  bool ok = MergeEventLogsOrExplain(inputs, rebuilt, options_.channel_prefix + transport::kPlantOutputChannel,
-                                    merged, &error);
+  bool ok = true;
+  if (!restored_.empty()) {
+    // launch's copies are one more input, as a lane logger's file is.
+    const std::string configs = options_.log_file + ".configs";
+    const Status written = WriteConfigLog(
+        restored_, options_.channel_prefix + transport::kEpisodeConfigChannel, options_.auth_key, configs);
+    ok = written.ok();
+    if (ok) beside.push_back(configs);
+    error = written.message();
+  }
+  inputs.insert(inputs.end(), beside.begin(), beside.end());
+  const std::string merged = options_.log_file + ".merging";
+  ok = ok && MergeEventLogsOrExplain(
+                 inputs, rebuilt, options_.channel_prefix + transport::kPlantOutputChannel, merged, &error);
   if (ok && std::rename(merged.c_str(), options_.log_file.c_str()) != 0) {
     ok = false;
     error = "cannot rename " + merged + " to " + options_.log_file;
     std::remove(merged.c_str());
   }
   if (ok) {
-    for (const auto& lane : lane_loggers_) std::remove(lane.second.c_str());
-  } else {
+    for (const std::string& file : beside) std::remove(file.c_str());
+  } else if (!beside.empty()) {
     // What the lanes hold exists nowhere else: keep it and say where.
     std::string kept;
-    for (const auto& lane : lane_loggers_) kept += (kept.empty() ? "" : ", ") + lane.second;
+    for (const std::string& file : beside) kept += (kept.empty() ? "" : ", ") + file;
     error += "; kept " + kept;
   }
   lane_loggers_.clear();
+  restored_.clear();
   return ok ? Status::Ok() : Status::IoFailed(error);
 }
 
@@ -386,37 +405,52 @@ bool LogCapture::WaitForMarker(const std::string& what) {
   return false;
 }
 
-bool LogCapture::FindGaps(std::vector<Gap>* gaps, RepairSummary* summary) const {
-  replay::ReadOptions read_options;
-  read_options.channel_prefix = options_.channel_prefix;
-  read_options.auth_key = options_.auth_key;
+bool LogCapture::FindGaps(std::vector<Gap>* gaps, std::vector<int64_t>* lost_configs,
+                          RepairSummary* summary) {
   replay::LogContents log;
-  if (const Status st = replay::ReadLog(options_.log_file, read_options, &log); !st.ok()) {
-    summary->status = RepairStatus::kUnreadable;
-    summary->lines.push_back("cannot read " + options_.log_file + " to check it: " + st.message());
-    return false;
+  for (;;) {
+    if (const Status st = replay::ReadLog(options_.log_file, ReaderOptions(), &log); !st.ok()) {
+      summary->status = RepairStatus::kUnreadable;
+      summary->lines.push_back("cannot read " + options_.log_file + " to check it: " + st.message());
+      return false;
+    }
+    // Data in the log of an episode whose configuration is not there, and
+    // launch heard it: read again with launch's copy (once per episode).
+    bool more = false;
+    for (const replay::Episode& e : log.episodes)
+      if (!e.has_config && e.config_error.empty() && witness_.Config(e.episode_id))
+        more = orphans_with_copy_.insert(e.episode_id).second || more;
+    if (!more) break;
   }
   gaps->clear();
+  lost_configs->clear();
+  restored_.clear();
+  std::set<int64_t> listed;
   long orphans = 0;
   for (const replay::Episode& e : log.episodes) {
+    listed.insert(e.episode_id);
+    if (e.config_supplied) restored_.push_back(e.config);
     if (!e.has_config) {
-      // Steps without a configuration in the log: a stranger's messages, or
-      // an episode whose every configuration copy the logger lost (the
-      // client repeats it until all three roles acknowledge). Either way the
-      // plant cannot resend a configuration, and a stranger must not be able
-      // to make the log fail: noted, not repaired.
-      ++orphans;
+      // The plant ended it: ours, and nothing holds its configuration.
+      // Otherwise steps without a configuration: a stranger's messages,
+      // which must not be able to make the log fail: noted, not repaired.
+      if (witness_.Ended(e.episode_id))
+        lost_configs->push_back(e.episode_id);
+      else
+        ++orphans;
       continue;
     }
     if (e.Complete()) continue;
     if (e.has_summary && e.summary_status == pidlab::lcmt_episode_summary::FAILED) continue;
     gaps->push_back({e.episode_id, MissingSteps(e)});
   }
+  for (const int64_t id : witness_.ended())
+    if (!listed.count(id)) lost_configs->push_back(id);  // nothing of it in the log, no copy here
   if (orphans > 0 && !noted_orphans_) {
     noted_orphans_ = true;
     summary->notes.push_back(std::to_string(orphans) + " episode id(s) in " + options_.log_file +
-                             " have no configuration there (a stranger's messages, or a configuration the "
-                             "logger lost); left as they are (pidlab replay lists them)");
+                             " have no configuration there and were not run by this trio (a stranger's "
+                             "messages); left as they are (pidlab replay lists them)");
   }
   return true;
 }
@@ -468,6 +502,37 @@ void LogCapture::DescribeUnrepaired(const std::vector<Gap>& gaps, RepairSummary*
   }
 }
 
+void LogCapture::Conclude(const std::vector<Gap>& gaps, const std::vector<int64_t>& lost_configs,
+                          RepairSummary* summary) const {
+  for (const auto& config : restored_) summary->restored.push_back(config.episode_id);
+  summary->lost_configs = lost_configs;
+  if (!lost_configs.empty()) {
+    summary->status = RepairStatus::kIncomplete;
+    summary->lines.push_back(options_.log_file + " is incomplete: the configuration of episode" +
+                             (lost_configs.size() == 1 ? " " : "s ") + EpisodeList(lost_configs) +
+                             ", which pidlab-plant ran, is not in it: lcm-logger lost every copy and "
+                             "launch heard none");
+  }
+  if (!gaps.empty()) {
+    summary->status = RepairStatus::kIncomplete;
+    DescribeUnrepaired(gaps, summary);
+  }
+  if (summary->status == RepairStatus::kIncomplete) return;
+  if (!restored_.empty()) {
+    summary->status = RepairStatus::kRepaired;
+    summary->lines.push_back(
+        "lcm-logger lost the configuration of episode" + std::string(restored_.size() == 1 ? " " : "s ") +
+        EpisodeList(summary->restored) + "; " + options_.log_file + " gets launch's own copy");
+  }
+  if (summary->republished.empty()) return;
+  summary->status = RepairStatus::kRepaired;
+  std::ostringstream os;
+  os << "lcm-logger lost messages; repaired " << options_.log_file << " from the plant's trajectory chunks:";
+  for (const auto& [id, n] : summary->republished) os << " episode " << id << " (" << n << " steps)";
+  os << " in " << summary->rounds << " round" << (summary->rounds == 1 ? "" : "s");
+  summary->lines.push_back(os.str());
+}
+
 RepairSummary LogCapture::Repair() {
   if (!listening_) {
     transport_->Subscribe<pidlab::lcmt_trajectory_chunk>(transport::kTrajectoryChannel,
@@ -480,21 +545,10 @@ RepairSummary LogCapture::Repair() {
   for (int round = 0;; ++round) {
     summary.rounds = round;
     std::vector<Gap> gaps;
-    if (!FindGaps(&gaps, &summary)) return summary;
-    if (gaps.empty()) {
-      if (summary.republished.empty()) return summary;
-      summary.status = RepairStatus::kRepaired;
-      std::ostringstream os;
-      os << "lcm-logger lost messages; repaired " << options_.log_file
-         << " from the plant's trajectory chunks:";
-      for (const auto& [id, n] : summary.republished) os << " episode " << id << " (" << n << " steps)";
-      os << " in " << round << " round" << (round == 1 ? "" : "s");
-      summary.lines.push_back(os.str());
-      return summary;
-    }
-    if (round == options_.repair_rounds) {
-      summary.status = RepairStatus::kIncomplete;
-      DescribeUnrepaired(gaps, &summary);
+    std::vector<int64_t> lost_configs;
+    if (!FindGaps(&gaps, &lost_configs, &summary)) return summary;
+    if (gaps.empty() || round == options_.repair_rounds) {
+      Conclude(gaps, lost_configs, &summary);
       return summary;
     }
     AskForGaps(gaps, &summary);

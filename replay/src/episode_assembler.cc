@@ -195,6 +195,13 @@ void EpisodeAssembler::On(const std::string& prefix, const pidlab::lcmt_episode_
     b.episode.config_error = st.message();
 }
 
+void EpisodeAssembler::Supply(const std::string& prefix, const pidlab::lcmt_episode_config& config) {
+  Building& b = EpisodeOf(prefix, config.episode_id);
+  if (b.episode.has_config || !b.episode.config_error.empty()) return;
+  On(prefix, config);
+  b.episode.config_supplied = true;
+}
+
 void EpisodeAssembler::On(const std::string& prefix, const pidlab::lcmt_plant_output& m) {
   EpisodeOf(prefix, m.episode_id).outputs.Add(m.step, {m.y, m.t_s, 0, -1});
 }

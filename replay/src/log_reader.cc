@@ -212,6 +212,8 @@ Status ReadLog(const std::string& path, const ReadOptions& options, LogContents*
   EpisodeAssembler assembler;
   for (LogEvent event; reader.Next(&event);) HandleEvent(table, options, event, &assembler, &tallies, out);
   RecordEnd(reader, out);
+  for (const lcmt_episode_config& config : options.supplied_configs)
+    assembler.Supply(options.channel_prefix, config);
   AssembledEpisodes assembled = assembler.Finish();
   for (const std::string& orphan : assembled.orphans) tallies.orphans.Add(orphan);
   out->notes.insert(out->notes.end(), assembled.notes.begin(), assembled.notes.end());

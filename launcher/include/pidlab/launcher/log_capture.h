@@ -1,7 +1,8 @@
 #pragma once
 // A complete log of the trio's traffic: lcm-logger under supervision, an end
 // marker that proves everything published before it is on disk, and repair of
-// whatever the logger still lost from the plant's trajectory chunks.
+// whatever the logger still lost: steps from the plant's trajectory chunks,
+// configurations from launch's own copies (episode_witness.h).
 
 #include <sys/types.h>
 
@@ -9,10 +10,12 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "pidlab/launcher/episode_witness.h"
 #include "pidlab/launcher/supervisor.h"
 #include "pidlab/replay/log_reader.h"
 #include "pidlab/spec/status.h"
@@ -72,6 +75,11 @@ struct RepairSummary {
   RepairStatus status = RepairStatus::kComplete;
   int rounds = 0;
   std::map<int64_t, long> republished;  // episode -> steps asked for (all rounds)
+  /// Episodes whose configuration the log lacks and launch heard: MergeLanes
+  /// writes launch's copy into the log.
+  std::vector<int64_t> restored;
+  /// Episodes the plant ended whose configuration neither the log nor launch has.
+  std::vector<int64_t> lost_configs;
   /// One line per problem (kIncomplete, kUnreadable) or the repair (kRepaired).
   std::vector<std::string> lines;
   /// Informative lines whatever the status (e.g. episodes without a configuration).
@@ -139,6 +147,9 @@ class LogCapture {
   /// files are kept and named in the message).
   /// Outputs the PLANT_OUTPUT lane's logger lost are rebuilt from the
   /// trajectory chunks (not for authenticated runs); rebuilt_outputs() counts them.
+  /// The configurations Repair found the log lacking are merged in too, from
+  /// launch's copies (via FILE.configs, removed after the merge), with their
+  /// tags in authenticated runs.
   Status MergeLanes();
   long rebuilt_outputs() const { return rebuilt_outputs_; }
 
@@ -151,7 +162,10 @@ class LogCapture {
   /// with the replay reader, asks the plant to republish each missing range
   /// as trajectory chunks, waits until the answers are in the log, and
   /// repeats up to repair_rounds times. Episodes the plant ended with a
-  /// FAILED summary are left as they are.
+  /// FAILED summary are left as they are. An episode the plant ended (its
+  /// SUMMARY heard live) or with data in the log, whose configuration the
+  /// log lacks, takes launch's own copy (MergeLanes writes it into the log)
+  /// and is repaired like the others; without a copy it is incomplete.
   RepairSummary Repair();
 
  private:
@@ -159,8 +173,15 @@ class LogCapture {
     int64_t id;
     std::vector<std::pair<long, long>> ranges;
   };
-  /// Reads the log: the gaps to fill, or false with *summary filled.
-  bool FindGaps(std::vector<Gap>* gaps, RepairSummary* summary) const;
+  /// The replay reader's options for the log: launch's copies of the
+  /// configurations of the episodes the plant ended or the log holds data of.
+  replay::ReadOptions ReaderOptions() const;
+  /// Reads the log: the gaps to fill and the episodes that ran without a
+  /// configuration anywhere, or false with *summary filled.
+  bool FindGaps(std::vector<Gap>* gaps, std::vector<int64_t>* lost_configs, RepairSummary* summary);
+  /// The summary's status and lines once no round is left to run.
+  void Conclude(const std::vector<Gap>& gaps, const std::vector<int64_t>& lost_configs,
+                RepairSummary* summary) const;
   void AskForGaps(const std::vector<Gap>& gaps, RepairSummary* summary);
   /// (timestamp, encoded lcmt_plant_output) for every step of a complete
   /// episode whose PLANT_OUTPUT is not in `lane_file`.
@@ -170,6 +191,10 @@ class LogCapture {
   LogCaptureOptions options_;
   transport::Transport* transport_;
   Supervisor* supervisor_;
+  EpisodeWitness witness_;
+  std::set<int64_t> orphans_with_copy_;  // data in the log, no configuration there, a copy here
+  /// launch's copies of the configurations the log lacks (the last Repair's).
+  std::vector<pidlab::lcmt_episode_config> restored_;
   bool listening_ = false;
   mutable bool noted_orphans_ = false;
   /// The plant's chunks as this process hears them: (episode, first step) -> count.

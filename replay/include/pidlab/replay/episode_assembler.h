@@ -45,6 +45,8 @@ class EpisodeAssembler {
   /// Adds one message of the trio on channel prefix `prefix`. Ready
   /// messages and requests change nothing.
   void Add(const std::string& prefix, const PidlabMessage& message);
+  /// Uses `config` for its episode unless one was added (Episode::config_supplied).
+  void Supply(const std::string& prefix, const pidlab::lcmt_episode_config& config);
 
   /// The episodes. For an episode with a valid configuration, total_steps is
   /// the configuration's and y, u, n, u_input_y, status and has_* hold

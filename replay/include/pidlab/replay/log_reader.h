@@ -48,6 +48,9 @@ struct Episode {
   std::string prefix;  // channel prefix, e.g. "PIDLAB_"
   int64_t episode_id = 0;
   bool has_config = false;
+  /// The configuration is not in the log: it came from
+  /// ReadOptions::supplied_configs.
+  bool config_supplied = false;
   std::string config_error;  // set if a config was logged but is invalid
   transport::EpisodeSpec spec;
   /// The configuration as logged (its first copy), valid or not; meaningful
@@ -84,6 +87,12 @@ struct ReadOptions {
   /// verifies; untagged and badly tagged ones are counted as unauthenticated.
   /// Without a key, tagged messages are used unverified (and counted).
   std::optional<transport::AuthKey> auth_key;
+  /// Configurations known from elsewhere (`pidlab launch --log` keeps a copy
+  /// of each one it heard), on channel_prefix: each is used for its episode
+  /// as if it had been logged after every event, unless the log holds a
+  /// configuration of that episode itself (valid or not). The episode is
+  /// then listed even if the log holds nothing else of it.
+  std::vector<lcmt_episode_config> supplied_configs;
 };
 
 struct LogContents {
