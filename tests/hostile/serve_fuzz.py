@@ -187,26 +187,31 @@ def ws_drain(ws, sent, wait):
 
 
 def ws_frames(rng, frames):
-    """`frames` hostile frames: random bytes, mutated or unmasked requests,
-    bad opcodes, huge lengths, deep nesting, interleaved fragments, and
-    request objects of every type with fields of random JSON types."""
+    """`frames` hostile frames: half of them well-formed text messages that
+    are not valid requests (request objects of every type with fields of
+    random JSON types, mutated specs as UTF-8 text, deep nesting), answered
+    one reply each; half protocol violations (random bytes, unmasked frames,
+    bad opcodes, huge lengths, interleaved fragments), which close the
+    connection."""
     for _ in range(frames):
-        k = rng.randrange(9)
-        if k == 0: yield ws_frame(bytes(rng.randrange(256) for _ in range(rng.randint(0, 200))))
-        elif k == 1: yield ws_frame(mutate(SPEC, rng))
-        elif k == 2: yield ws_frame(b'x', opcode=rng.choice([3, 4, 5, 6, 7, 11, 12, 13, 14, 15]))
-        elif k == 3: yield ws_frame(SPEC, masked=False)
-        elif k == 4: yield ws_frame(b'', length=rng.choice([2 ** 40, 2 ** 63 - 1, 70000]))
-        elif k == 5: yield ws_frame(b'[' * rng.randint(100, 60000))
-        elif k == 6: yield ws_frame(SPEC[:10], fin=False) + ws_frame(b'garbage', opcode=0, fin=rng.random() < 0.5)
-        elif k == 7: yield ws_frame(json.dumps(typed_request(rng)).encode())
+        k = rng.randrange(16)
+        if k < 5: yield ws_frame(json.dumps(typed_request(rng)).encode())
+        elif k < 7: yield ws_frame(mutate(SPEC, rng).decode('utf-8', 'replace').encode())
+        elif k == 7: yield ws_frame(b'[' * rng.randint(100, 60000))
+        elif k == 8: yield ws_frame(bytes(rng.randrange(256) for _ in range(rng.randint(0, 200))))
+        elif k == 9: yield ws_frame(mutate(SPEC, rng))
+        elif k == 10: yield ws_frame(b'x', opcode=rng.choice([3, 4, 5, 6, 7, 11, 12, 13, 14, 15]))
+        elif k == 11: yield ws_frame(SPEC, masked=False)
+        elif k == 12: yield ws_frame(b'', length=rng.choice([2 ** 40, 2 ** 63 - 1, 70000]))
+        elif k == 13: yield ws_frame(SPEC[:10], fin=False) + ws_frame(b'garbage', opcode=0, fin=rng.random() < 0.5)
+        elif k == 14: yield ws_frame(b'{"type": "evaluate", "spec": ' + mutate(SPEC, rng) + b'}')
         else: yield bytes(rng.randrange(256) for _ in range(rng.randint(1, 64)))
 
 
 def ws_case(rng, frames):
-    """One connection, `frames` hostile frames, every reply read (those
-    waiting after each frame, then all until the sentinel's reply or the
-    server's close); the number sent."""
+    """One connection, up to `frames` hostile frames until the server closes
+    it, every reply read (those waiting after each frame, then all until the
+    sentinel's reply or the server's close); the number sent (at least 1)."""
     try:
         ws = WebSocket(port)
     except (ConnectionError, socket.timeout, OSError) as e:
@@ -216,12 +221,13 @@ def ws_case(rng, frames):
         fail('the WebSocket upgrade was refused: %d' % ws.status)
         return 0
     open_ = True
-    sent = b''
+    sent, count = b'', 0
     try:
         for f in ws_frames(rng, frames):
             sent = f
             ws.s.settimeout(2)
             ws.s.sendall(f)
+            count += 1
             open_ = ws_drain(ws, sent, wait=False)
             if not open_: break
         if open_:
@@ -231,7 +237,7 @@ def ws_case(rng, frames):
     except (ConnectionError, socket.timeout, OSError, EOFError):
         ws_count('closed')  # the server closed a connection it was right to close
     ws.s.close()
-    return frames
+    return max(count, 1)
 
 
 def ws_worker(index, frames_wanted, done):
