@@ -154,6 +154,19 @@ TEST(ServerOptions, RefusesAHeaderTimeoutOutsideItsRange) {
   }
 }
 
+TEST(ServerOptions, RefusesABodyTimeoutOutsideItsRange) {
+  ServerOptions options;
+  std::string error;
+  EXPECT_EQ(options.body_timeout_s, 30.0);
+  for (double seconds : {0.0, 0.05, 3601.0, -1.0, std::nan("")}) {
+    options.body_timeout_s = seconds;
+    EXPECT_FALSE(options.IsValid(&error)) << seconds;
+    EXPECT_NE(error.find("body_timeout_s"), std::string::npos) << error;
+  }
+  options.body_timeout_s = 0.1;
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+}
+
 TEST(Server, ClosesAConnectionWhoseHeaderIsNotCompleteInTime) {
   ServerOptions options;
   options.header_timeout_s = 0.3;

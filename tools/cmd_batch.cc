@@ -195,10 +195,6 @@ struct BatchCommand {
 
 }  // namespace
 
-std::function<int()> RegisterBatch(CLI::App* app) {
-  auto command = std::make_shared<BatchCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterBatch(CLI::App* app) { return RegisterCommand<BatchCommand>(app); }
 
 }  // namespace pidlab::cli

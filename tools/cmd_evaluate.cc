@@ -176,10 +176,6 @@ struct EvaluateCommand {
 };
 
 }  // namespace
-std::function<int()> RegisterEvaluate(CLI::App* app) {
-  auto command = std::make_shared<EvaluateCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterEvaluate(CLI::App* app) { return RegisterCommand<EvaluateCommand>(app); }
 
 }  // namespace pidlab::cli

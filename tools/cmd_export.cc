@@ -3,7 +3,6 @@
 
 #include <fstream>
 #include <iostream>
-#include <memory>
 #include <set>
 
 #include "cli_common.h"
@@ -235,10 +234,6 @@ struct ExportCommand {
 };
 
 }  // namespace
-std::function<int()> RegisterExport(CLI::App* app) {
-  auto command = std::make_shared<ExportCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterExport(CLI::App* app) { return RegisterCommand<ExportCommand>(app); }
 
 }  // namespace pidlab::cli

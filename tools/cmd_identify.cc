@@ -437,10 +437,6 @@ struct IdentifyCommand {
 
 }  // namespace
 
-std::function<int()> RegisterIdentify(CLI::App* app) {
-  auto command = std::make_shared<IdentifyCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterIdentify(CLI::App* app) { return RegisterCommand<IdentifyCommand>(app); }
 
 }  // namespace pidlab::cli

@@ -56,10 +56,6 @@ struct LinearizeCommand {
 };
 
 }  // namespace
-std::function<int()> RegisterLinearize(CLI::App* app) {
-  auto command = std::make_shared<LinearizeCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterLinearize(CLI::App* app) { return RegisterCommand<LinearizeCommand>(app); }
 
 }  // namespace pidlab::cli

@@ -143,10 +143,6 @@ struct PlotCommand {
 };
 
 }  // namespace
-std::function<int()> RegisterPlot(CLI::App* app) {
-  auto command = std::make_shared<PlotCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterPlot(CLI::App* app) { return RegisterCommand<PlotCommand>(app); }
 
 }  // namespace pidlab::cli

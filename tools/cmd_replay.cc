@@ -272,10 +272,6 @@ struct ReplayCommand {
 };
 
 }  // namespace
-std::function<int()> RegisterReplay(CLI::App* app) {
-  auto command = std::make_shared<ReplayCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterReplay(CLI::App* app) { return RegisterCommand<ReplayCommand>(app); }
 
 }  // namespace pidlab::cli

@@ -100,10 +100,6 @@ struct ReportCommand {
 };
 
 }  // namespace
-std::function<int()> RegisterReport(CLI::App* app) {
-  auto command = std::make_shared<ReportCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterReport(CLI::App* app) { return RegisterCommand<ReportCommand>(app); }
 
 }  // namespace pidlab::cli

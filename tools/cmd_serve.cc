@@ -14,6 +14,7 @@
 #include "pidlab/episode_client/episode_pool.h"
 #include "pidlab/server/assets.h"
 #include "pidlab/server/server.h"
+#include "pidlab/spec/field.h"
 #include "serve_live.h"
 #include "serve_logs.h"
 #include "serve_requests.h"
@@ -49,6 +50,11 @@ struct ServeCommand {
                     "the directory log_open paths are relative to (default: the current one)");
     app->add_option("--max-upload-mb", max_upload_mb, "largest uploaded log, MiB (1..4096)")
         ->capture_default_str();
+    app->add_option("--body-timeout", options.body_timeout_s,
+                    "seconds a request or upload body may take after its header (0.1..3600): a body that "
+                    "trickles past them is answered 408 and its connection closed")
+        ->check(FiniteNumber())
+        ->capture_default_str();
     app->add_option("--lcm-url", lcm.lcm_url,
                     "watch the trio on this LCM URL, or the trios of several, comma-separated (pidlab launch "
                     "--trios K: $PIDLAB_LCM_URLS): the live scope, episodes on demand on the first "
@@ -64,6 +70,9 @@ struct ServeCommand {
 
   int Run() {
     if (!server::IsLoopback(options.bind)) options.token = RandomToken();
+    if (!(options.body_timeout_s >= 0.1 && options.body_timeout_s <= 3600))
+      throw BadInput("--body-timeout " + spec::FormatNumber(options.body_timeout_s) +
+                     " must be in 0.1..3600 s");
     std::string error;
     if (!options.IsValid(&error)) throw BadInput(error);
     std::unique_ptr<LogStore> logs = ServedLogs();
@@ -148,10 +157,6 @@ struct ServeCommand {
 
 }  // namespace
 
-std::function<int()> RegisterServe(CLI::App* app) {
-  auto command = std::make_shared<ServeCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterServe(CLI::App* app) { return RegisterCommand<ServeCommand>(app); }
 
 }  // namespace pidlab::cli

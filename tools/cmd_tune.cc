@@ -252,10 +252,6 @@ struct TuneCommand {
 };
 
 }  // namespace
-std::function<int()> RegisterTune(CLI::App* app) {
-  auto command = std::make_shared<TuneCommand>();
-  auto action = command->Register(app);
-  return [command, action] { return action(); };
-}
+std::function<int()> RegisterTune(CLI::App* app) { return RegisterCommand<TuneCommand>(app); }
 
 }  // namespace pidlab::cli

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <memory>
 #include <string>
 
 namespace pidlab::cli {
@@ -21,6 +22,15 @@ std::function<int()> RegisterIdentify(CLI::App* app);
 std::function<int()> RegisterServe(CLI::App* app);
 std::function<int()> RegisterExport(CLI::App* app);
 std::function<int()> RegisterVersion(CLI::App* app);
+
+/// The action of a command object T, made here and kept as long as the
+/// action: T::Register(app) registers its flags and returns what runs.
+template <typename T>
+std::function<int()> RegisterCommand(CLI::App* app) {
+  auto command = std::make_shared<T>();
+  auto action = command->Register(app);
+  return [command, action] { return action(); };
+}
 
 /// "pidlab 0.2.0 (commit 4b5211fe12ab)": what `pidlab version` and
 /// `pidlab --version` print.

@@ -6,11 +6,9 @@
 // result carries the fit's curves and the path of a model file written in
 // the uploads' directory: the plant "model:PATH" of the page's next specs.
 
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
-#include <thread>
 
 #include "cli_common.h"
 #include "identify_record.h"
@@ -21,8 +19,6 @@
 
 namespace pidlab::cli {
 namespace {
-
-struct Cancelled {};
 
 server::Reply Bad(const std::string& why) { return {400, {{"error", why}}}; }
 
@@ -130,12 +126,8 @@ bool ReadOptions(const nlohmann::json& request, std::string* model, identify::Id
 
 std::function<void(identify::ProcessModelKind, int, int, double)> ProgressPoster(
     std::shared_ptr<ConnectionJob> job, std::shared_ptr<server::Connection> out, nlohmann::json id) {
-  auto last = std::make_shared<std::chrono::steady_clock::time_point>();
-  return [job, out, id, last](identify::ProcessModelKind kind, int done, int total, double best) {
-    if (job->cancel || out->closed()) throw Cancelled{};
-    const auto now = std::chrono::steady_clock::now();
-    if (now - *last < std::chrono::milliseconds(100)) return;
-    *last = now;
+  return [job, out, id](identify::ProcessModelKind kind, int done, int total, double best) {
+    if (!job->ProgressDue(*out)) return;
     out->Post({{"type", "identify_progress"},
                {"model", identify::ToString(kind)},
                {"done", done},
@@ -160,24 +152,16 @@ nlohmann::json Fit(const Record& record, const std::string& model, const identif
           {"plant", std::string(tune::kModelPlantPrefix) + path}};
 }
 
-void RunFit(std::shared_ptr<ConnectionJob> job, std::shared_ptr<server::Connection> out, Record record,
-            std::string model, identify::IdentifyOptions options, nlohmann::json id) {
-  nlohmann::json reply;
+// The fit on the job's thread: cancelled within one iteration of every
+// solve (a record is at most options.max_samples long).
+nlohmann::json RunFit(const std::shared_ptr<ConnectionJob>& job,
+                      const std::shared_ptr<server::Connection>& out, const Record& record,
+                      const std::string& model, identify::IdentifyOptions options, const nlohmann::json& id) {
   options.progress = ProgressPoster(job, out, id);
-  // Asked at every iteration of every solve: a cancel stops the fit within
-  // one iteration (a record is at most options.max_samples long).
   options.cancelled = [job, out] { return job->cancel || out->closed(); };
-  try {
-    reply = Fit(record, model, options);
-    if (job->cancel || out->closed()) throw Cancelled{};
-  } catch (const Cancelled&) {
-    reply = {{"type", "identify_cancelled"}, {"error", "the fit was cancelled"}};
-  } catch (const std::exception& e) {
-    reply = {{"type", "identify_result"}, {"error", std::string("the fit failed: ") + e.what()}};
-  }
-  reply["id"] = id;
-  job->done = true;
-  out->Post(reply);
+  nlohmann::json reply = Fit(record, model, options);
+  if (job->cancel || out->closed()) throw JobCancelled{};
+  return reply;
 }
 
 }  // namespace
@@ -191,12 +175,12 @@ server::Reply AnswerIdentify(const nlohmann::json& request,
   Record record;
   if (!ReadRecord(request, &record, &error)) return Bad(error);
   if (record.from_log) options.u0 = options.y0 = 0.0;
-  const std::shared_ptr<ConnectionJob> job = StartConnectionJob(connection, "identify", &error);
-  if (!job) return Bad(error);
-  std::thread(RunFit, job, connection, std::move(record), model, options,
-              request.value("id", nlohmann::json(nullptr)))
-      .detach();
-  return {200, nullptr};  // the progress and the result follow on the connection
+  return StartJob(
+      request, connection, {"identify", "identify_result", "fit"},
+      [connection, record = std::move(record), model, options,
+       id = request.value("id", nlohmann::json(nullptr))](const std::shared_ptr<ConnectionJob>& job) {
+        return RunFit(job, connection, record, model, options, id);
+      });
 }
 
 }  // namespace pidlab::cli

@@ -13,7 +13,6 @@
 #include <filesystem>
 #include <memory>
 #include <string>
-#include <thread>
 
 #include "cli_common.h"
 #include "export_spec.h"
@@ -162,19 +161,6 @@ nlohmann::json PilCost(const nlohmann::json& spec_json) {
   return reply;
 }
 
-void RunPilCost(std::shared_ptr<ConnectionJob> job, std::shared_ptr<server::Connection> out,
-                nlohmann::json spec, nlohmann::json id) {
-  nlohmann::json reply;
-  try {
-    reply = PilCost(spec);
-  } catch (const std::exception& e) {
-    reply = {{"type", "pil_cost_result"}, {"error", std::string("the PIL costs failed: ") + e.what()}};
-  }
-  reply["id"] = id;
-  job->done = true;
-  out->Post(reply);
-}
-
 }  // namespace
 
 server::Reply AnswerPilCost(const nlohmann::json& request,
@@ -183,12 +169,8 @@ server::Reply AnswerPilCost(const nlohmann::json& request,
     return {400, {{"error", "pil_cost runs over the WebSocket /ws, which carries its result"}}};
   if (!request.contains("spec") || !request["spec"].is_object())
     return {400, {{"error", "a pil_cost request needs a spec object"}}};
-  std::string error;
-  const std::shared_ptr<ConnectionJob> job = StartConnectionJob(connection, "pil_cost", &error);
-  if (!job) return {400, {{"error", error}}};
-  std::thread(RunPilCost, job, connection, request["spec"], request.value("id", nlohmann::json(nullptr)))
-      .detach();
-  return {200, nullptr};
+  return StartJob(request, connection, {"pil_cost", "pil_cost_result", "PIL costs"},
+                  [spec = request["spec"]](const std::shared_ptr<ConnectionJob>&) { return PilCost(spec); });
 }
 
 }  // namespace pidlab::cli

@@ -4,6 +4,8 @@
 // series), fields, paper_designs. `pidlab serve` passes Answer to the server.
 
 #include <atomic>
+#include <chrono>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -33,13 +35,36 @@ server::Reply AnswerTuneCancel(const std::shared_ptr<server::Connection>& connec
 struct ConnectionJob {
   std::atomic<bool> cancel{false};
   std::atomic<bool> done{false};
+  /// For the job's progress callback, on its thread: throws JobCancelled once
+  /// the job is cancelled or `out` has closed; else whether a progress
+  /// message is due (at most ten a second).
+  bool ProgressDue(const server::Connection& out);
+
+ private:
+  std::chrono::steady_clock::time_point last_progress_;
 };
+/// What a job's progress callback throws to stop it (StartJob answers it).
+struct JobCancelled {};
 /// A new job of `kind` ("tune", "identify") on `connection`, or null with
 /// *refusal set when one of that kind is still running.
 std::shared_ptr<ConnectionJob> StartConnectionJob(const std::shared_ptr<server::Connection>& connection,
                                                   const std::string& kind, std::string* refusal);
 /// Asks the connection's running job of `kind` to stop; false if none runs.
 bool CancelConnectionJob(const std::shared_ptr<server::Connection>& connection, const std::string& kind);
+
+/// How a kind of job names itself in its replies.
+struct JobKind {
+  std::string kind;         // "tune": the request, "tune_cancelled" when cancelled
+  std::string result_type;  // "tune_result": the reply of a job that failed
+  std::string noun;         // "tuning": "the tuning was cancelled", "the tuning failed: ..."
+};
+/// Runs `work` as the connection's job of `kind` on a thread of its own:
+/// {200, null} now (400 while one of that kind runs), and later on
+/// `connection` the reply `work` returns, or one naming its cancellation
+/// (JobCancelled) or its exception, with the request's id.
+server::Reply StartJob(const nlohmann::json& request, const std::shared_ptr<server::Connection>& connection,
+                       const JobKind& kind,
+                       std::function<nlohmann::json(const std::shared_ptr<ConnectionJob>&)> work);
 
 /// identify (serve_identify.cc): fits request["model"] to an uploaded CSV
 /// (upload_id) or an opened log's episode (log_id, index) on a thread, as

@@ -25,16 +25,10 @@ struct ConnectionJobs {
   }
 };
 
-struct Cancelled {};
-
 optim::ProgressCallback ProgressPoster(std::shared_ptr<ConnectionJob> job,
                                        std::shared_ptr<server::Connection> out, nlohmann::json id) {
-  auto last = std::make_shared<std::chrono::steady_clock::time_point>();
-  return [job, out, id, last](const optim::TracePoint& tp) {
-    if (job->cancel || out->closed()) throw Cancelled{};
-    const auto now = std::chrono::steady_clock::now();
-    if (now - *last < std::chrono::milliseconds(100)) return;
-    *last = now;
+  return [job, out, id](const optim::TracePoint& tp) {
+    if (!job->ProgressDue(*out)) return;
     nlohmann::json m = {
         {"type", "tune_progress"}, {"iteration", tp.iteration}, {"evaluations", tp.evaluations}};
     m["best"] = std::isfinite(tp.best_f) ? nlohmann::json(tp.best_f) : nlohmann::json(nullptr);
@@ -43,20 +37,16 @@ optim::ProgressCallback ProgressPoster(std::shared_ptr<ConnectionJob> job,
   };
 }
 
-void RunTuning(std::shared_ptr<ConnectionJob> job, std::shared_ptr<server::Connection> out,
-               nlohmann::json spec, nlohmann::json id) {
+// The job's thread: its reply, or the words of its cancellation or failure.
+void RunJob(std::shared_ptr<ConnectionJob> job, std::shared_ptr<server::Connection> out, JobKind kind,
+            std::function<nlohmann::json(const std::shared_ptr<ConnectionJob>&)> work, nlohmann::json id) {
   nlohmann::json reply;
   try {
-    nlohmann::json result;
-    const Status status = results::TuneSpecJson(spec, ProgressPoster(job, out, id), &result);
-    if (status.ok())
-      reply = {{"type", "tune_result"}, {"result", result}};
-    else
-      reply = {{"type", "tune_result"}, {"error", status.message()}};
-  } catch (const Cancelled&) {
-    reply = {{"type", "tune_cancelled"}, {"error", "the tuning was cancelled"}};
+    reply = work(job);
+  } catch (const JobCancelled&) {
+    reply = {{"type", kind.kind + "_cancelled"}, {"error", "the " + kind.noun + " was cancelled"}};
   } catch (const std::exception& e) {
-    reply = {{"type", "tune_result"}, {"error", std::string("the tuning failed: ") + e.what()}};
+    reply = {{"type", kind.result_type}, {"error", "the " + kind.noun + " failed: " + e.what()}};
   }
   reply["id"] = id;
   job->done = true;
@@ -64,6 +54,25 @@ void RunTuning(std::shared_ptr<ConnectionJob> job, std::shared_ptr<server::Conne
 }
 
 }  // namespace
+
+bool ConnectionJob::ProgressDue(const server::Connection& out) {
+  if (cancel || out.closed()) throw JobCancelled{};
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_progress_ < std::chrono::milliseconds(100)) return false;
+  last_progress_ = now;
+  return true;
+}
+
+server::Reply StartJob(const nlohmann::json& request, const std::shared_ptr<server::Connection>& connection,
+                       const JobKind& kind,
+                       std::function<nlohmann::json(const std::shared_ptr<ConnectionJob>&)> work) {
+  std::string refusal;
+  const std::shared_ptr<ConnectionJob> job = StartConnectionJob(connection, kind.kind, &refusal);
+  if (!job) return {400, {{"error", refusal}}};
+  std::thread(RunJob, job, connection, kind, std::move(work), request.value("id", nlohmann::json(nullptr)))
+      .detach();
+  return {200, nullptr};  // the progress and the result follow on the connection
+}
 
 std::shared_ptr<ConnectionJob> StartConnectionJob(const std::shared_ptr<server::Connection>& connection,
                                                   const std::string& kind, std::string* refusal) {
@@ -95,12 +104,15 @@ server::Reply AnswerTune(const nlohmann::json& request,
   if (!connection) return {400, {{"error", "tune runs over the WebSocket /ws, which carries its progress"}}};
   if (!request.contains("spec") || !request["spec"].is_object())
     return {400, {{"error", "a tune request needs a spec object"}}};
-  std::string refusal;
-  const std::shared_ptr<ConnectionJob> job = StartConnectionJob(connection, "tune", &refusal);
-  if (!job) return {400, {{"error", refusal}}};
-  std::thread(RunTuning, job, connection, request["spec"], request.value("id", nlohmann::json(nullptr)))
-      .detach();
-  return {200, nullptr};  // the progress and the result follow on the connection
+  return StartJob(request, connection, {"tune", "tune_result", "tuning"},
+                  [connection, spec = request["spec"], id = request.value("id", nlohmann::json(nullptr))](
+                      const std::shared_ptr<ConnectionJob>& job) -> nlohmann::json {
+                    nlohmann::json result;
+                    const Status status =
+                        results::TuneSpecJson(spec, ProgressPoster(job, connection, id), &result);
+                    if (!status.ok()) return {{"type", "tune_result"}, {"error", status.message()}};
+                    return {{"type", "tune_result"}, {"result", result}};
+                  });
 }
 
 server::Reply AnswerTuneCancel(const std::shared_ptr<server::Connection>& connection) {

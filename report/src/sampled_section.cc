@@ -103,27 +103,22 @@ bool EvaluateSampledLoops(SampledSection* s, std::string* error) {
   sampled.dt_s = s->dt_s;
   EvaluateOptions what;
   what.compute_iae_continuous = false;
-  Evaluation ev;
-  if (const Status st = Evaluate(stepper, s->gains, sampled, what, &ev); !st.ok()) {
-    if (error) *error = st.message();
-    return false;
-  }
-  FillFromEvaluation(ev, &s->sampled_in_process);
+  // The gains on `loop`, their metrics into *metrics; false with *error.
+  const auto evaluate = [&](const LoopOptions& loop, Metrics* metrics) {
+    Evaluation ev;
+    if (const Status st = Evaluate(stepper, s->gains, loop, what, &ev); !st.ok()) {
+      if (error) *error = st.message();
+      return false;
+    }
+    FillFromEvaluation(ev, metrics);
+    return true;
+  };
+  if (!evaluate(sampled, &s->sampled_in_process)) return false;
   LoopOptions short_horizon = sampled;
   short_horizon.horizon_s = s->trio_horizon_s;
-  Evaluation same_as_trio;
-  if (const Status st = Evaluate(stepper, s->gains, short_horizon, what, &same_as_trio); !st.ok()) {
-    if (error) *error = st.message();
-    return false;
-  }
-  FillFromEvaluation(same_as_trio, &s->sampled_trio_horizon);
+  if (!evaluate(short_horizon, &s->sampled_trio_horizon)) return false;
   sampled.dt_s = s->fine_dt_s;
-  Evaluation fine;
-  if (const Status st = Evaluate(stepper, s->gains, sampled, what, &fine); !st.ok()) {
-    if (error) *error = st.message();
-    return false;
-  }
-  FillFromEvaluation(fine, &s->sampled_fine);
+  if (!evaluate(sampled, &s->sampled_fine)) return false;
   for (const auto& p : PolynomialRoots(stepper.tf.den))
     s->fastest_plant_pole_re = std::min(s->fastest_plant_pole_re, p.real());
   return true;

@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
@@ -16,7 +17,8 @@
 #include <optional>
 #include <sstream>
 
-#include "pidlab/spec/json.h"
+#include "impl.h"
+#include "pidlab/spec/field.h"
 #include "slots.h"
 #include "url.h"
 
@@ -27,151 +29,22 @@ namespace http = beast::http;
 namespace websocket = beast::websocket;
 namespace net = boost::asio;
 using tcp = net::ip::tcp;
-using Request = http::request<http::string_body>;
-using Response = http::response<http::string_body>;
-using internal::JsonLibraryWords;
+using internal::IsUpload;
+using internal::JsonResponse;
 using internal::PathOf;
-using internal::PercentDecoded;
-using internal::QueryValue;
-
-bool IsUpload(const Request& req) {
-  return req.method() == http::verb::post && PathOf(std::string(req.target())) == "/api/upload";
-}
-
-// A request's body after its header: the time it may take.
-constexpr std::chrono::seconds kBodyTimeout{30};
+using internal::Request;
+using internal::Response;
 
 // WebSocket replies waiting beyond this many bytes: the session stops reading
 // requests until they are written (a client that sends and never reads).
 constexpr std::size_t kMaxQueuedReplyBytes = 1 << 20;
 
-Response JsonResponse(const Request& req, http::status status, const nlohmann::json& body) {
-  Response res{status, req.version()};
-  res.set(http::field::content_type, "application/json");
-  res.set(http::field::cache_control, "no-store");
-  res.keep_alive(req.keep_alive() && status != http::status::bad_request);
-  res.body() = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  res.prepare_payload();
-  return res;
+// A reply's write: the time a client that does not read may take.
+constexpr std::chrono::seconds kReplyTimeout{30};
+
+std::chrono::steady_clock::duration Seconds(double s) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(s));
 }
-
-}  // namespace
-
-struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
-  // Every connection and body held in memory: one budget (slots.h).
-  using Slots = internal::Slots;
-
-  ServerOptions options;
-  ConnectionHandler handler;
-  UploadHandler upload_handler;
-  std::vector<Asset> assets;
-  net::io_context io{1};
-  tcp::acceptor acceptor{io};
-  int port = 0;
-  Slots slots;
-  mutable std::mutex counters_mutex;
-  ServerCounters counters;
-
-  void Count(long ServerCounters::*field) {
-    std::lock_guard<std::mutex> lock(counters_mutex);
-    ++(counters.*field);
-  }
-
-  // Whether a new connection from `address` may open (slots.h: the
-  // connections idle longest closed for it where a cap is reached).
-  bool MakeRoom(const std::string& address) {
-    int evicted = 0;
-    const bool room =
-        slots.MakeRoom(address, options.max_connections_per_address, options.max_connections, &evicted);
-    for (; evicted > 0; --evicted) Count(&ServerCounters::evicted);
-    return room;
-  }
-
-  // The upload bodies held in memory at once, every connection's together
-  // (other bodies are at most max_body_bytes on each of max_connections).
-  std::size_t BodyBudget() const { return std::max(options.max_bodies_bytes, options.max_upload_bytes); }
-
-  // Why `req` may not be served (token, host, origin), or empty (url.h).
-  std::pair<http::status, std::string> Refusal(const Request& req) const {
-    const auto origin = req.find(http::field::origin);
-    const std::string origin_text = origin == req.end() ? "" : std::string(origin->value());
-    const auto [status, why] = internal::Refusal(
-        options, port, std::string(req.target()), std::string(req[http::field::authorization]),
-        std::string(req[http::field::host]), origin == req.end() ? nullptr : &origin_text);
-    return {static_cast<http::status>(status), why};
-  }
-
-  // One request object through the handler: the reply's status and body.
-  Reply Answer(const std::string& text, const std::shared_ptr<Connection>& connection = nullptr) {
-    // The one JSON reader of every file and request: nesting beyond
-    // spec::kMaxJsonDepth is refused before any parser runs.
-    if (const Status st = spec::CheckJsonNesting(text, spec::kMaxJsonDepth); !st.ok()) {
-      Count(&ServerCounters::malformed);
-      return {400, {{"error", "the request's JSON " + st.message()}}};
-    }
-    nlohmann::json request;
-    if (!spec::ParseJsonText(text, &request).ok() || !request.is_object()) {
-      Count(&ServerCounters::malformed);
-      return {400, {{"error", "a request must be one JSON object"}}};
-    }
-    Reply reply;
-    try {
-      reply = handler(request, connection);
-    } catch (const nlohmann::json::exception& e) {
-      // A field of the wrong JSON type ({"type": 5}): the request's mistake.
-      Count(&ServerCounters::malformed);
-      reply = {400, {{"error", "the request is not of the expected form: " + JsonLibraryWords(e.what())}}};
-    } catch (const std::exception& e) {
-      reply = {500, {{"error", std::string("the server failed: ") + e.what()}}};
-    }
-    if (request.contains("id") && reply.body.is_object()) reply.body["id"] = request["id"];
-    return reply;
-  }
-
-  Response Upload(const Request& req) {
-    Reply r;
-    try {
-      r = upload_handler(PercentDecoded(QueryValue(std::string(req.target()), "name")), req.body());
-    } catch (const std::exception& e) {
-      r = {500, {{"error", std::string("the server failed: ") + e.what()}}};
-    }
-    if (r.status == 400) Count(&ServerCounters::malformed);
-    return JsonResponse(req, static_cast<http::status>(r.status), r.body);
-  }
-
-  Response Serve(const Request& req) {
-    Count(&ServerCounters::http_requests);
-    const auto [status, why] = Refusal(req);
-    if (status != http::status::ok) {
-      Count(&ServerCounters::refused);
-      return JsonResponse(req, status, {{"error", why}});
-    }
-    const std::string path = PathOf(std::string(req.target()));
-    if (req.method() == http::verb::get) {
-      for (const Asset& a : assets)
-        if (a.path == path) {
-          Response res{http::status::ok, req.version()};
-          res.set(http::field::content_type, a.content_type);
-          res.set("X-Content-Type-Options", "nosniff");
-          res.set("Content-Security-Policy", "default-src 'self'; connect-src 'self'");
-          res.keep_alive(req.keep_alive());
-          res.body() = a.body;
-          res.prepare_payload();
-          return res;
-        }
-      if (path == "/api/health") return JsonResponse(req, http::status::ok, {{"ok", true}});
-      return JsonResponse(req, http::status::not_found, {{"error", "no such path: " + path}});
-    }
-    if (req.method() == http::verb::post && path == "/api/request") {
-      const Reply r = Answer(req.body());
-      return JsonResponse(req, static_cast<http::status>(r.status), r.body);
-    }
-    if (IsUpload(req) && upload_handler) return Upload(req);
-    return JsonResponse(req, http::status::method_not_allowed, {{"error", "method or path not served"}});
-  }
-};
-
-namespace {
 
 class WebSocketSession;
 
@@ -207,8 +80,7 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
     // Pinged after half the idle timeout without a byte from the client,
     // closed at the whole: a page answers pings, a dead peer does not.
     auto timeout = websocket::stream_base::timeout::suggested(beast::role_type::server);
-    timeout.idle_timeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(server_->options.websocket_idle_timeout_s));
+    timeout.idle_timeout = Seconds(server_->options.websocket_idle_timeout_s);
     timeout.keep_alive_pings = true;
     ws_.set_option(timeout);
     ws_.read_message_max(server_->options.max_message_bytes);
@@ -366,8 +238,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     // The larger limit while the headers are parsed (Beast checks a
     // Content-Length against it there); OnHeader sets the request's own.
     parser_->body_limit(std::max(server_->options.max_body_bytes, server_->options.max_upload_bytes));
-    stream_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(server_->options.header_timeout_s)));
+    stream_.expires_after(Seconds(server_->options.header_timeout_s));
     http::async_read_header(stream_, buffer_, *parser_,
                             beast::bind_front_handler(&HttpSession::OnHeader, shared_from_this()));
   }
@@ -381,7 +252,6 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       OnRead(ec, 0);
       return;
     }
-    stream_.expires_after(kBodyTimeout);
     server_->slots.Touch(slot_);  // idle from now while the body trickles
     if (IsUpload(parser_->get())) {
       const auto [status, why] = server_->Refusal(parser_->get());
@@ -403,6 +273,22 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       OnRead(ec, 0);
       return;
     }
+    ReadBody();
+  }
+
+  // The body, complete within body_timeout_s of its header however it
+  // trickles: past it, 408 and the connection closed (OnRead).
+  void ReadBody() {
+    stream_.expires_never();  // the body's deadline is body_timer_'s, which answers
+    reading_body_ = true;
+    body_timer_.expires_after(Seconds(server_->options.body_timeout_s));
+    body_timer_.async_wait([weak = weak_from_this()](beast::error_code ec) {
+      auto self = weak.lock();
+      if (ec || !self || !self->reading_body_) return;
+      self->body_late_ = true;
+      beast::error_code ignored;
+      self->stream_.socket().cancel(ignored);
+    });
     http::async_read(stream_, buffer_, *parser_,
                      beast::bind_front_handler(&HttpSession::OnRead, shared_from_this()));
   }
@@ -435,6 +321,16 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   }
 
   void OnRead(beast::error_code ec, std::size_t) {
+    reading_body_ = false;
+    body_timer_.cancel();
+    if (body_late_ && ec && !evicted_) {
+      body_late_ = false;
+      server_->Count(&ServerCounters::late_bodies);
+      Refuse(http::status::request_timeout, "the body did not arrive within " +
+                                                spec::FormatNumber(server_->options.body_timeout_s) +
+                                                " s of its header (pidlab serve --body-timeout)");
+      return;
+    }
     if (ec == http::error::end_of_stream || ec == beast::error::timeout ||
         ec == net::error::operation_aborted || ec == net::error::connection_reset || ec == net::error::eof) {
       Close();
@@ -484,6 +380,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
   void Write(Response res) {
     server_->slots.Busy(slot_);  // answering: not closed for a new connection
+    stream_.expires_after(kReplyTimeout);
     auto shared = std::make_shared<Response>(std::move(res));
     http::async_write(stream_, *shared,
                       [self = shared_from_this(), shared](beast::error_code ec, std::size_t) {
@@ -520,6 +417,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::shared_ptr<Server::Impl> server_;
   Server::Impl::Slots::Id slot_;
   bool evicted_ = false;
+  net::steady_timer body_timer_{stream_.get_executor()};
+  bool reading_body_ = false;  // the body is being read: body_timer_ may cut it
+  bool body_late_ = false;     // body_timer_ cut it: answered 408
   std::array<char, 4096> drained_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "pidlab/server/server.h"
+#include "pidlab/spec/field.h"
 #include "url.h"
 
 namespace pidlab::server {
@@ -104,6 +105,8 @@ bool ServerOptions::IsValid(std::string* error) const {
         std::to_string(max_connections);
   else if (!(header_timeout_s >= 0.1 && header_timeout_s <= 600))
     e = "header_timeout_s " + std::to_string(header_timeout_s) + " must be in 0.1..600";
+  else if (!(body_timeout_s >= 0.1 && body_timeout_s <= 3600))
+    e = "body_timeout_s " + spec::FormatNumber(body_timeout_s) + " must be in 0.1..3600";
   else if (!(websocket_idle_timeout_s >= 0.1 && websocket_idle_timeout_s <= 3600))
     e = "websocket_idle_timeout_s " + std::to_string(websocket_idle_timeout_s) + " must be in 0.1..3600";
   else if (max_bodies_bytes < 1024)

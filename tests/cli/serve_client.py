@@ -57,8 +57,8 @@ class WebSocket:
         return data
 
     def recv(self):
-        """(opcode, payload) of the next message, its fragments joined. A
-        ping is answered with its pong, as a browser does (the server closes a
+        """(opcode, payload) of the next message, its fragments joined, or
+        (8, code and reason) of a close frame. A ping is answered with its pong, as a browser does (the server closes a
         WebSocket that stays silent through its ping), and not returned."""
         opcode, payload = None, b''
         while True:
@@ -71,6 +71,9 @@ class WebSocket:
                 self.send(data, opcode=10)
                 continue
             if b0 & 0x0f == 10: continue
+            # A close, even amid a message's fragments (the server closing on
+            # a protocol error abandons the message it was sending).
+            if b0 & 0x0f == 8: return 8, data
             if opcode is None: opcode = b0 & 0x0f
             payload += data
             if b0 & 0x80: return opcode, payload

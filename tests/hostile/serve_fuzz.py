@@ -5,7 +5,7 @@ is counted by status, and one class sends JSON objects of every request type
 whose fields have the wrong JSON type ({"type": 5}, a spec that is an array,
 an id that is an object). Prints one line per class and 'FAIL ...' on any
 failure."""
-import json, os, random, socket, struct, sys, time
+import json, os, random, select, socket, struct, sys, threading, time
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..', 'cli'))
 from serve_client import http, WebSocket
 
@@ -17,10 +17,14 @@ VALID = (b'POST /api/request HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nContent-Type: app
 SPEC = json.dumps({'type': 'evaluate', 'spec': {'plant': 'double_integrator', 'gains': [3.9, 0.06, 4.9]}}).encode()
 
 
+fail_lock = threading.Lock()
+
+
 def fail(msg):
     global failures
-    failures += 1
-    print('FAIL ' + msg, flush=True)
+    with fail_lock:
+        failures += 1
+        print('FAIL ' + msg, flush=True)
 
 
 def raw(data, read=True):
@@ -54,7 +58,7 @@ FIELDS = ['type', 'spec', 'series', 'id', 'force', 'log_id', 'path', 'index', 'u
           'episode', 'options', 'gains', 'plant', 'monte_carlo']
 
 
-def any_json(depth=0):
+def any_json(depth=0, rng=rng):
     """A random JSON value of any type."""
     k = rng.randrange(9 if depth < 3 else 6)
     if k == 0: return None
@@ -63,19 +67,19 @@ def any_json(depth=0):
     if k == 3: return rng.choice(['', 'x', 'evaluate', '\u0000', 'a' * 300, '../etc/passwd'])
     if k == 4: return []
     if k == 5: return {}
-    if k == 6: return [any_json(depth + 1) for _ in range(rng.randint(1, 3))]
-    return {rng.choice(FIELDS + ['num', 'den', 'dt']): any_json(depth + 1) for _ in range(rng.randint(1, 3))}
+    if k == 6: return [any_json(depth + 1, rng) for _ in range(rng.randint(1, 3))]
+    return {rng.choice(FIELDS + ['num', 'den', 'dt']): any_json(depth + 1, rng) for _ in range(rng.randint(1, 3))}
 
 
-def typed_request():
+def typed_request(rng=rng):
     """A request object of a real type (or none), its fields of random JSON types."""
     r = {}
-    if rng.random() < 0.9: r['type'] = rng.choice(TYPES) if rng.random() < 0.8 else any_json()
-    for _ in range(rng.randint(0, 4)): r[rng.choice(FIELDS)] = any_json()
+    if rng.random() < 0.9: r['type'] = rng.choice(TYPES) if rng.random() < 0.8 else any_json(0, rng)
+    for _ in range(rng.randint(0, 4)): r[rng.choice(FIELDS)] = any_json(0, rng)
     return r
 
 
-def mutate(data):
+def mutate(data, rng=rng):
     b = bytearray(data)
     for _ in range(rng.randint(1, 8)):
         op = rng.randrange(4)
@@ -128,29 +132,122 @@ def ws_frame(payload, opcode=1, masked=True, fin=True, length=None):
     return head + mask + bytes(b ^ mask[j % 4] for j, b in enumerate(payload))
 
 
-def ws_case(frames):
-    """One connection, `frames` hostile frames; the number sent."""
+# Every WebSocket reply read: a reply is one JSON object, and an internal
+# error (the server's "the server failed: ..." of an exception, its 500) is a
+# failure as an HTTP 500 is. ws_replies counts them by kind.
+ws_replies = {'answer': 0, 'error': 0, 'closed': 0, 'silent': 0}
+ws_lock = threading.Lock()
+SILENT_S = 3.0  # a reply takes milliseconds; no message for this long: the server is waiting
+SENTINEL = json.dumps({'id': 'end of case'})  # answered 400 with its id: the replies before it are in
+
+
+def ws_count(kind):
+    with ws_lock:
+        ws_replies[kind] += 1
+
+
+def ws_reply(opcode, payload, sent):
+    """Checks one message from the server; True for the sentinel's reply."""
+    if opcode == 8: return False  # the close frame: read by ws_drain
+    try:
+        reply = json.loads(payload) if opcode == 1 else None
+    except ValueError:
+        reply = None
+    if not isinstance(reply, dict):
+        fail('a WebSocket reply that is not a JSON object (opcode %d): %r after %r' % (opcode, payload[:200], sent[-200:]))
+        return False
+    if reply.get('id') == 'end of case': return True
+    error = reply.get('error')
+    ws_count('error' if error is not None else 'answer')
+    if isinstance(error, str) and error.startswith('the server failed'):
+        fail('WebSocket internal error %r after %r' % (error[:200], sent[-200:]))
+    return False
+
+
+def ws_drain(ws, sent, wait):
+    """Reads the server's messages: those waiting now, or (wait) until the
+    sentinel's reply or the close. False once the connection has closed."""
+    while True:
+        try:
+            if not wait and not select.select([ws.s], [], [], 0)[0]: return True
+            ws.s.settimeout(SILENT_S)
+            opcode, payload = ws.recv()
+            if opcode == 8:
+                ws_count('closed')
+                return False
+            if ws_reply(opcode, payload, sent) and wait: return True
+        except socket.timeout:
+            # A frame header the server still waits the rest of (random
+            # bytes announcing a length): it neither answers nor closes.
+            ws_count('silent')
+            return False
+        except (ConnectionError, OSError, EOFError):
+            ws_count('closed')
+            return False
+
+
+def ws_frames(rng, frames):
+    """`frames` hostile frames: half of them well-formed text messages that
+    are not valid requests (request objects of every type with fields of
+    random JSON types, mutated specs as UTF-8 text, deep nesting), answered
+    one reply each; half protocol violations (random bytes, unmasked frames,
+    bad opcodes, huge lengths, interleaved fragments), which close the
+    connection."""
+    for _ in range(frames):
+        k = rng.randrange(16)
+        if k < 5: yield ws_frame(json.dumps(typed_request(rng)).encode())
+        elif k < 7: yield ws_frame(mutate(SPEC, rng).decode('utf-8', 'replace').encode())
+        elif k == 7: yield ws_frame(b'[' * rng.randint(100, 60000))
+        elif k == 8: yield ws_frame(bytes(rng.randrange(256) for _ in range(rng.randint(0, 200))))
+        elif k == 9: yield ws_frame(mutate(SPEC, rng))
+        elif k == 10: yield ws_frame(b'x', opcode=rng.choice([3, 4, 5, 6, 7, 11, 12, 13, 14, 15]))
+        elif k == 11: yield ws_frame(SPEC, masked=False)
+        elif k == 12: yield ws_frame(b'', length=rng.choice([2 ** 40, 2 ** 63 - 1, 70000]))
+        elif k == 13: yield ws_frame(SPEC[:10], fin=False) + ws_frame(b'garbage', opcode=0, fin=rng.random() < 0.5)
+        elif k == 14: yield ws_frame(b'{"type": "evaluate", "spec": ' + mutate(SPEC, rng) + b'}')
+        else: yield bytes(rng.randrange(256) for _ in range(rng.randint(1, 64)))
+
+
+def ws_case(rng, frames):
+    """One connection, up to `frames` hostile frames until the server closes
+    it, every reply read (those waiting after each frame, then all until the
+    sentinel's reply or the server's close); the number sent (at least 1)."""
     try:
         ws = WebSocket(port)
-        if ws.status != 101:
-            fail('the WebSocket upgrade was refused: %d' % ws.status)
-            return 0
-        ws.s.settimeout(2)
-        for _ in range(frames):
-            k = rng.randrange(8)
-            if k == 0: f = ws_frame(bytes(rng.randrange(256) for _ in range(rng.randint(0, 200))))
-            elif k == 1: f = ws_frame(mutate(SPEC))
-            elif k == 2: f = ws_frame(b'x', opcode=rng.choice([3, 4, 5, 6, 7, 11, 12, 13, 14, 15]))
-            elif k == 3: f = ws_frame(SPEC, masked=False)
-            elif k == 4: f = ws_frame(b'', length=rng.choice([2 ** 40, 2 ** 63 - 1, 70000]))
-            elif k == 5: f = ws_frame(b'[' * rng.randint(100, 60000))
-            elif k == 6: f = ws_frame(SPEC[:10], fin=False) + ws_frame(b'garbage', opcode=0, fin=rng.random() < 0.5)
-            else: f = bytes(rng.randrange(256) for _ in range(rng.randint(1, 64)))
+    except (ConnectionError, socket.timeout, OSError) as e:
+        fail('the WebSocket could not connect: %r' % e)
+        return 0
+    if ws.status != 101:
+        fail('the WebSocket upgrade was refused: %d' % ws.status)
+        return 0
+    open_ = True
+    sent, count = b'', 0
+    try:
+        for f in ws_frames(rng, frames):
+            sent = f
+            ws.s.settimeout(2)
             ws.s.sendall(f)
-        ws.s.close()
+            count += 1
+            open_ = ws_drain(ws, sent, wait=False)
+            if not open_: break
+        if open_:
+            ws.s.settimeout(2)
+            ws.send(SENTINEL)
+            ws_drain(ws, sent, wait=True)
     except (ConnectionError, socket.timeout, OSError, EOFError):
-        pass  # the server closed a connection it was right to close
-    return frames
+        ws_count('closed')  # the server closed a connection it was right to close
+    ws.s.close()
+    return max(count, 1)
+
+
+def ws_worker(index, frames_wanted, done):
+    """One of WS_CLIENTS concurrent clients (as a page's tabs are), seeded of
+    its own: connections of 1..40 frames until frames_wanted are sent."""
+    rng_k = random.Random(seed * 1000 + index)
+    frames = 0
+    while frames < frames_wanted:
+        frames += ws_case(rng_k, rng_k.randint(1, 40))
+    done[index] = frames
 
 
 def healthy(where):
@@ -171,11 +268,23 @@ print('ok   %d malformed HTTP requests; replies read by status: %s' % (
     http_cases, ', '.join('%d: %d' % kv for kv in sorted(statuses.items()))), flush=True)
 if sum(n for code, n in statuses.items() if code >= 500):
     fail('%d of the replies were 5xx' % sum(n for code, n in statuses.items() if code >= 500))
-frames = 0
-while frames < count - http_cases:
-    frames += ws_case(rng.randint(1, 40))
-    if frames // 500 != (frames - 1) // 500: healthy('%d hostile WebSocket frames' % frames)
-print('ok   %d hostile WebSocket frames' % frames, flush=True)
+WS_CLIENTS = 4
+ws_wanted = count - http_cases
+done = [0] * WS_CLIENTS
+workers = [threading.Thread(target=ws_worker, args=(k, (ws_wanted + k) // WS_CLIENTS, done))
+           for k in range(WS_CLIENTS)]
+for w in workers: w.start()
+# The server's health while the clients send, as a user's page asks it.
+while any(w.is_alive() for w in workers):
+    healthy('hostile WebSocket frames from %d clients at once' % WS_CLIENTS)
+    for w in workers: w.join(timeout=0.5)
+frames = sum(done)
+print('ok   %d hostile WebSocket frames from %d concurrent clients; every reply read: %d answers, %d '
+      'errors (none internal), %d connections closed by the server, %d left waiting for a frame\'s rest' % (
+          frames, WS_CLIENTS, ws_replies['answer'], ws_replies['error'], ws_replies['closed'],
+          ws_replies['silent']), flush=True)
+if ws_replies['answer'] + ws_replies['error'] == 0:
+    fail('no WebSocket reply was read')
 healthy('everything')
 print('%d cases in %.1f s, %d failures' % (http_cases + frames, time.time() - start, failures))
 sys.exit(1 if failures else 0)

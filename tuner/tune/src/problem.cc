@@ -121,7 +121,12 @@ Status BuildFigureLoop(const spec::PlantSpec& plant, const spec::LoopSpec& loop,
                        NameStyle style, Plant* p, evaluation::LoopOptions* options) {
   Plant built;
   evaluation::LoopOptions unframed;
-  if (Status st = BuildPlantInLoop(plant, loop, style, &built, &unframed); !st.ok()) return st;
+  // The plant, in its loop on the sampled grid (a dt that eq. (4)'s spacing
+  // is no multiple of builds, as evaluate builds it); a given horizon or
+  // sample time is checked as given when the framed loop builds.
+  spec::LoopSpec gridded = loop;
+  if (gridded.loop == "sampled") OnSampledGrid(gridded.dt_s, &gridded.sample_time_s, &gridded.horizon_s);
+  if (Status st = BuildPlantInLoop(plant, gridded, style, &built, &unframed); !st.ok()) return st;
   spec::LoopSpec framed = loop;
   ResolveGainsTimeScale(plant, built, gains, given, TimeScaleScope::kFigure, &framed);
   return BuildPlantInLoop(plant, framed, style, p, options);
@@ -136,12 +141,8 @@ Status BuildController(const spec::EvaluateSpec& s, NameStyle style, PidGains* g
   // evaluation's grid is made a multiple of dt, so that a dt the default
   // spacing is no multiple of (1 s against eq. (4)'s 0.05 s) builds.
   spec::LoopSpec loop_spec = s.loop;
-  if (loop_spec.loop == "sampled" && loop_spec.dt_s > 0.0 && std::isfinite(loop_spec.dt_s)) {
-    loop_spec.sample_time_s =
-        loop_spec.dt_s * std::max(1.0, std::round(loop_spec.sample_time_s / loop_spec.dt_s));
-    loop_spec.horizon_s =
-        loop_spec.sample_time_s * std::ceil(loop_spec.horizon_s / loop_spec.sample_time_s - 1e-9);
-  }
+  if (loop_spec.loop == "sampled")
+    OnSampledGrid(loop_spec.dt_s, &loop_spec.sample_time_s, &loop_spec.horizon_s);
   if (!BuildGains(s.gains, style, &g, &error) || !BuildLoopOptions(loop_spec, style, &l, &error))
     return Status::InvalidInput(error);
   *gains = g;
@@ -241,11 +242,7 @@ TimeScale DerivedTimeScale(const spec::TuningSpec& s, const Plant& plant) {
     }
   }
   TimeScale t = LoopTimeScale(fastest, slowest, plant.delay_s);
-  if (s.loop.loop == "sampled" && s.loop.dt_s > 0.0) {
-    const double k = std::max(1.0, std::round(t.sample_time_s / s.loop.dt_s));
-    t.sample_time_s = k * s.loop.dt_s;
-    t.horizon_s = std::ceil(t.horizon_s / t.sample_time_s - 1e-9) * t.sample_time_s;
-  }
+  if (s.loop.loop == "sampled") OnSampledGrid(s.loop.dt_s, &t.sample_time_s, &t.horizon_s);
   t.reason = from + ": " + t.reason;
   return t;
 }

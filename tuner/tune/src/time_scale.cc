@@ -15,8 +15,9 @@ namespace pidlab::tune {
 namespace {
 
 // TimeScaleScope::kFigure's frame of `t` (see there).
+// On the sampled loop (dt_s > 0) the frame stays on its grid (OnSampledGrid).
 TimeScale Framed(const Plant& plant, const std::vector<PidGains>& gains, evaluation::LoopOptions loop,
-                 const TimeScale& t, const KnownEvaluation& known) {
+                 double dt_s, const TimeScale& t, const KnownEvaluation& known) {
   loop.horizon_s = t.horizon_s;
   loop.sample_time_s = t.sample_time_s;
   double settling = 0.0;
@@ -38,12 +39,19 @@ TimeScale Framed(const Plant& plant, const std::vector<PidGains>& gains, evaluat
   TimeScale f = t;
   f.horizon_s = horizon;
   while (f.sample_time_s > horizon / 500.0 && horizon / f.sample_time_s < 20000.0) f.sample_time_s /= 2.0;
+  OnSampledGrid(dt_s, &f.sample_time_s, &f.horizon_s);
   f.reason = "framed for the figure: 3 x the 2 % settling time " + spec::FormatNumber(settling) +
              " s, rounded up, of " + t.reason;
   return f;
 }
 
 }  // namespace
+
+void OnSampledGrid(double dt_s, double* sample_time_s, double* horizon_s) {
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) return;
+  *sample_time_s = dt_s * std::max(1.0, std::round(*sample_time_s / dt_s));
+  *horizon_s = *sample_time_s * std::ceil(*horizon_s / *sample_time_s - 1e-9);
+}
 
 bool KnownEvaluation::Matches(const PidGains& g, const evaluation::LoopOptions& l) const {
   if (!gains || !loop || !evaluation) return false;
@@ -105,12 +113,9 @@ TimeScale ResolveGainsTimeScale(const spec::PlantSpec& plant_spec, const Plant& 
       return t;  // (a loop that does not build is reported by its caller)
   }
   TimeScale derived = GainsTimeScale(plant, gains, options);
-  if (loop->loop == "sampled" && loop->dt_s > 0.0) {
-    const double k = std::max(1.0, std::round(derived.sample_time_s / loop->dt_s));
-    derived.sample_time_s = k * loop->dt_s;
-    derived.horizon_s = std::ceil(derived.horizon_s / derived.sample_time_s - 1e-9) * derived.sample_time_s;
-  }
-  if (scope == TimeScaleScope::kFigure) derived = Framed(plant, gains, options, derived, known);
+  const double dt_s = loop->loop == "sampled" ? loop->dt_s : 0.0;
+  OnSampledGrid(dt_s, &derived.sample_time_s, &derived.horizon_s);
+  if (scope == TimeScaleScope::kFigure) derived = Framed(plant, gains, options, dt_s, derived, known);
   if (timed) {
     // Given as the loop gives them (a result's echo): the loop's still.
     const bool same = loop->horizon_s == derived.horizon_s && loop->sample_time_s == derived.sample_time_s;

@@ -21,6 +21,13 @@ namespace pidlab::tune {
 TimeScale GainsTimeScale(const Plant& plant, const std::vector<PidGains>& gains,
                          const evaluation::LoopOptions& loop);
 
+/// The sampled loop's grid, in one place for every front end (evaluate,
+/// plot, serve, a time scale derived or framed): the spacing a whole
+/// multiple of dt_s, at least dt_s, and the horizon a whole multiple of the
+/// spacing, rounded up. Nothing changes when dt_s is not a positive finite
+/// number (the continuous loop, or a dt its caller refuses).
+void OnSampledGrid(double dt_s, double* sample_time_s, double* horizon_s);
+
 /// Which loops take a derived time scale.
 enum class TimeScaleScope {
   kNotPaper,  ///< every plant but the paper's (evaluate: eq. 4's numbers stay)
