@@ -313,6 +313,10 @@ case $CASE in
       wait $e' 2>"$TMP/launch.err" || { echo "FAIL launch: $(grep -v "^pidlab-" "$TMP/launch.err")"; fail=1; }
     if grep -q "repaired .* from the plant's trajectory chunks" "$TMP/launch.err"; then
       echo "ok   $(grep -o "lcm-logger lost messages.*" "$TMP/launch.err")"
+    elif "$BIN/trio_log_check" "$TMP/run.lcmlog" | grep -q "[1-9][0-9]* from chunks"; then
+      # Under load evaluate's own client can lose the same steps and ask the
+      # plant for them first: the logger logs those chunks, and launch finds no gap.
+      echo "ok   the logger's losses were filled by chunks the trio's own recovery asked for"
     else
       echo "FAIL launch did not report a repair (did stopping the logger lose nothing?)"; fail=1
     fi
