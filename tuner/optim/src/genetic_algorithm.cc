@@ -11,11 +11,6 @@
 namespace pidlab::optim {
 namespace {
 
-using internal::EvaluationBudgetExhausted;
-using internal::Evaluator;
-using internal::FieldError;
-using internal::Rng;
-
 struct Individual {
   Eigen::VectorXd x;
   double f;

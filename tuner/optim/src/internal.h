@@ -168,4 +168,11 @@ bool FieldError(const char* owner, const char* field, const T& value, const char
 }
 
 }  // namespace internal
+
+// The optimisers' own files name these without the prefix.
+using internal::EvaluationBudgetExhausted;
+using internal::Evaluator;
+using internal::FieldError;
+using internal::Rng;
+
 }  // namespace pidlab::optim

@@ -12,10 +12,6 @@
 namespace pidlab::optim {
 namespace {
 
-using internal::EvaluationBudgetExhausted;
-using internal::Evaluator;
-using internal::FieldError;
-
 constexpr int kMaxDesignPoints = 1 << 20;
 constexpr double kMaxWarp = 40.0;
 

@@ -12,11 +12,6 @@
 namespace pidlab::optim {
 namespace {
 
-using internal::EvaluationBudgetExhausted;
-using internal::Evaluator;
-using internal::FieldError;
-using internal::Rng;
-
 struct Coefficients {
   double reflection;   // rho
   double expansion;    // chi

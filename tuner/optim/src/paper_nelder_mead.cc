@@ -9,11 +9,6 @@
 namespace pidlab::optim {
 namespace {
 
-using internal::EvaluationBudgetExhausted;
-using internal::Evaluator;
-using internal::FieldError;
-using internal::Rng;
-
 struct Point {
   Eigen::VectorXd x;
   double f;

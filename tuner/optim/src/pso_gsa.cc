@@ -10,11 +10,6 @@
 namespace pidlab::optim {
 namespace {
 
-using internal::EvaluationBudgetExhausted;
-using internal::Evaluator;
-using internal::FieldError;
-using internal::Rng;
-
 // The swarm in coordinates normalised to the unit box.
 struct Swarm {
   std::vector<Eigen::VectorXd> z;  // positions in [0, 1]^n
