@@ -242,6 +242,28 @@ TEST(Design, ANoiseBoundIsHonouredAndCostsLoadIae) {
   EXPECT_NE(std::find(bound.active.begin(), bound.active.end(), "noise_gain"), bound.active.end());
 }
 
+TEST(Design, ADoubleIntegratorWithAFastLagIsDesignedWithinItsBoundsAndItsUnityGainTime) {
+  // 1/(s^2 (0.005 s + 1)): migo finds no start on it; its lag is not the
+  // plant's dominant time, the double integrator's unity-gain time 1 s is.
+  const Plant plant = MakeTf("lagged double integrator", {1.0}, {0.005, 1.0, 0.0, 0.0}, 0.0);
+  EXPECT_NEAR(DominantTimeConstant(plant), 1.0, 1e-4);
+  double fastest = 0.0, slowest = 0.0;
+  PlantTimes(plant, &fastest, &slowest);
+  EXPECT_DOUBLE_EQ(fastest, 0.005);
+  EXPECT_DOUBLE_EQ(slowest, 0.005);
+  DesignOptions o;
+  o.max_ms = 1.6;
+  const DesignSummary s = DesignOrDie(plant, o);
+  const analysis::LoopAnalysis a = Analyse(plant, s.gains);
+  EXPECT_TRUE(a.stable);
+  EXPECT_LE(a.ms, 1.6 * 1.001);
+  EXPECT_LE(s.gains.kd / s.gains.kp, DominantTimeConstant(plant) * (1 + 1e-9));
+  EXPECT_GT(s.gains.ki, 0.0);
+  // The engine's load IAE is the evaluation library's.
+  const double horizon = 40.0 * s.response_time_s;
+  EXPECT_NEAR(s.load_iae, LibraryLoadIae(plant, s.gains, horizon, 40000), 1e-3 * s.load_iae);
+}
+
 TEST(Design, AReverseActingPlantGetsTheNegatedGainsOfItsMirrorWithTheSameLoop) {
   const Plant reverse = MakeTf("reverse", {-19.0}, {2.0, 1.0}, 0.5);
   const Plant mirror = MakeTf("mirror", {19.0}, {2.0, 1.0}, 0.5);

@@ -43,8 +43,12 @@ double DesignOptions::Mt() const { return std::isnan(max_mt) ? max_ms : max_mt; 
 
 double DominantTimeConstant(const Plant& plant) {
   double slowest = 0.0;
-  for (const std::complex<double>& p : PolynomialRoots(plant.tf.den))
+  int integrators = 0;
+  for (const std::complex<double>& p : RootsOffTheOrigin(plant.tf.den, &integrators))
     if (p.real() < 0.0 && std::abs(p) > 1e-12) slowest = std::max(slowest, -1.0 / p.real());
+  // Two or more integrators dominate any lag: a PID holds them with a
+  // derivative time near the plant's unity-gain time, whatever its lags.
+  if (integrators >= 2) return std::max(slowest, UnityGainTime(plant));
   if (slowest > 0.0) return slowest;
   double fastest = 0.0;
   PlantTimes(plant, &fastest, &slowest);
@@ -298,6 +302,21 @@ void ShapeSetpoint(const Plant& plant, const design::Engine& engine, const Desig
         " reach " + FormatNumber(s->overshoot_pct) + " % at the least";
 }
 
+// migo's design as the engine's start. Where migo finds none on a plant of
+// two or more integrators (their lags take its grid), its design on the
+// integrators alone k / (a s^n) is the start.
+bool MigoStart(const Plant& plant, const MigoOptions& mo, MigoDesign* migo) {
+  if (DesignMigo(plant, mo, migo).ok() && migo->crossover_rad_s > 0.0) return true;
+  int integrators = 0;
+  RootsOffTheOrigin(plant.tf.den, &integrators);
+  if (integrators < 2 || plant.tf.num.back() == 0.0) return false;
+  Plant core = plant;
+  core.tf.num = {plant.tf.num.back()};
+  core.tf.den.assign(integrators + 1, 0.0);
+  core.tf.den[0] = plant.tf.den[plant.tf.den.size() - 1 - integrators];
+  return DesignMigo(core, mo, migo).ok() && migo->crossover_rad_s > 0.0;
+}
+
 // The design with one engine (its grid and step).
 Status DesignOn(const Plant& plant, const design::Engine& engine, const DesignOptions& options, bool sampled,
                 const DesignSummary* previous, DesignSummary* summary);
@@ -349,7 +368,7 @@ Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSum
   mo.ms = std::min(options.max_ms, 4.0);
   mo.pi = options.pi;
   MigoDesign migo;
-  const bool has_migo = DesignMigo(design_plant, mo, &migo).ok() && migo.crossover_rad_s > 0.0;
+  const bool has_migo = MigoStart(design_plant, mo, &migo);
   double hint = has_migo ? migo.crossover_rad_s : 0.0;
   DesignSummary previous;
   if (has_migo) previous.gains = migo.gains;

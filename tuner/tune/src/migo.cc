@@ -282,21 +282,30 @@ bool MigoOptions::IsValid(std::string* error) const {
   return false;
 }
 
+std::vector<cd> RootsOffTheOrigin(std::vector<double> coefficients, int* at_origin) {
+  int n = 0;
+  while (coefficients.size() > 1 && coefficients.back() == 0.0) coefficients.pop_back(), ++n;
+  if (at_origin != nullptr) *at_origin = n;
+  return PolynomialRoots(coefficients);
+}
+
+double UnityGainTime(const Plant& plant) {
+  double lo = -12.0, hi = 12.0;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (std::abs(PlantAt(plant, std::pow(10.0, mid))) > 1.0 ? lo : hi) = mid;
+  }
+  return std::pow(10.0, -0.5 * (lo + hi));
+}
+
 void PlantTimes(const Plant& plant, double* fastest_s, double* slowest_s) {
   std::vector<double> times;
   for (const auto* p : {&plant.tf.num, &plant.tf.den})
-    for (const cd& r : PolynomialRoots(*p))
+    for (const cd& r : RootsOffTheOrigin(*p, nullptr))
       if (std::abs(r) > 1e-12) times.push_back(1.0 / std::abs(r));
   if (plant.delay_s > 0.0) times.push_back(plant.delay_s);
-  if (times.empty()) {
-    // No pole, zero or delay off the origin (k / s^n): the gain crossover.
-    double lo = -12.0, hi = 12.0;
-    for (int i = 0; i < 100; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (std::abs(PlantAt(plant, std::pow(10.0, mid))) > 1.0 ? lo : hi) = mid;
-    }
-    times.push_back(std::pow(10.0, -0.5 * (lo + hi)));
-  }
+  // No pole, zero or delay off the origin (k / s^n): the gain crossover.
+  if (times.empty()) times.push_back(UnityGainTime(plant));
   *fastest_s = *std::min_element(times.begin(), times.end());
   *slowest_s = *std::max_element(times.begin(), times.end());
 }

@@ -16,7 +16,9 @@
 // time. The loop's time scale (the horizon and the sample spacing every
 // result is evaluated on) follows from the design's closed loop.
 
+#include <complex>
 #include <string>
+#include <vector>
 
 #include "pidlab/controller/pid.h"
 #include "pidlab/plant_sim/plants.h"
@@ -139,5 +141,14 @@ double NiceUp(double v);
 /// The plant's characteristic times (s), slowest and fastest, from its poles,
 /// zeros, dead time and gain crossover (never 0 or infinite).
 void PlantTimes(const Plant& plant, double* fastest_s, double* slowest_s);
+
+/// The roots of a polynomial (highest power first) with its exact roots at
+/// the origin (trailing zero coefficients) taken out first, their number
+/// into *at_origin (may be null): root finding scatters a multiple root.
+std::vector<std::complex<double>> RootsOffTheOrigin(std::vector<double> coefficients, int* at_origin);
+
+/// 1 / w at the plant's lowest unity-gain frequency |G(jw)| = 1 (s), by
+/// bisection on a log scale over [1e-12, 1e12] rad/s.
+double UnityGainTime(const Plant& plant);
 
 }  // namespace pidlab::tune
