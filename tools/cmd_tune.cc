@@ -57,10 +57,12 @@ struct TuneCommand {
     app->description(
         "Tune PID gains. On a linear plant the default is the design engine (--method optimal): the least "
         "integral |e| dt of a unit load step under Ms, Mt and noise-gain bounds, on the exact loop with its "
-        "dead time, then setpoint weights for at most 10 % overshoot (docs/tuning.md, \"The design "
-        "engine\"). A flag that asks for a search (an objective, a box, a budget, a margin, --robust, the "
-        "sampled loop) runs the multi-start on the paper's objective (IAE of the unit step, eq. 4) with a "
-        "Ceres cross-check, as --method multi-start, nelder-mead, paper-nm or a baseline do.");
+        "dead time, then setpoint weights b, c (and a setpoint filter where they cannot) for at most 10 % "
+        "overshoot, --max-overshoot (docs/tuning.md, \"The design "
+        "engine\"); --loop sampled --dt D designs the sampled loop at D the same way. A flag that asks for "
+        "a search (an objective, a box, a budget, a margin, --robust, --backend lcm) runs the multi-start "
+        "on the paper's objective (IAE of the unit step, eq. 4) with a Ceres cross-check, as --method "
+        "multi-start, nelder-mead, paper-nm or a baseline do, and the line 'method chosen' says which flag.");
     // The tuner's acceptance margin is 0.01 (spec::LoopSpec::ForTuning, docs/tuning.md).
     flags.Register(app, spec::TuningSpec{});
     app->add_option("--backend", backend, "local (in-process) or lcm (episodes over a running trio)")

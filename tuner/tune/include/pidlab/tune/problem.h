@@ -165,7 +165,8 @@ bool IsPaperPlant(const spec::PlantSpec& p);
 /// order (docs/tuning.md, "Any plant"):
 /// - with no `method` given and nothing that asks for a search (an
 ///   objective, a box, budgets, a margin, a settling or time-constant bound,
-///   `robust`, a robust set, the sampled loop on the caller's runner), the
+///   `robust`, a robust set, the sampled loop on the caller's trio runner;
+///   the sampled loop in process is the engine's too), the
 ///   design engine, method optimal (the nonlinear stepper: multi-start),
 ///   with max_ms as its robustness where that is not given; TimeScale's
 ///   method_reason says which and why;
