@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -141,6 +142,65 @@ TEST(PlotSeries, CommandCancelsTheLoadStepAtSteadyState) {
     // The step response's command settles where the plant holds y = 1: u = den(0)/num(0) = 1.
     EXPECT_NEAR(series["u"].back().get<double>(), 1.0, 1e-3) << loop;
   }
+}
+
+TEST(PlotSeries, TheLoadResponseOfADeadTimeLoopIsDrawnAsTheSampledLoopAtAFinePeriodSeesIt) {
+  // The continuous loop with dead time: series.load_y is filled (its samples
+  // are those the load IAE sums) and agrees with the sampled loop at
+  // dt = 5e-4, an independent computation (ZOH and the discrete PID); u is
+  // not sampled there, and a note says so.
+  const nlohmann::json spec = {{"plant", "custom"},      {"num", {1}},
+                               {"den", {1, 1}},          {"delay", 0.5},
+                               {"gains", {1, 0.8, 0.1}}, {"derivative_filter_ratio", 10},
+                               {"horizon", 20},          {"sample_time", 0.04}};
+  nlohmann::json result;
+  const nlohmann::json series = SeriesOf(spec, &result);
+  ASSERT_TRUE(series["load_y"].is_array()) << series["notes"];
+  ASSERT_EQ(series["load_y"].size(), series["t"].size());
+  EXPECT_TRUE(series["u"].is_null());
+  double sum = 0.0;
+  for (const auto& v : series["load_y"]) sum += std::abs(v.get<double>());
+  EXPECT_NEAR(sum, result["load_iae"].get<double>(), 1e-9 * sum);
+  nlohmann::json sampled = spec;
+  sampled["loop"] = "sampled";
+  sampled["dt"] = 5e-4;
+  const nlohmann::json fine = SeriesOf(sampled);
+  ASSERT_EQ(fine["load_y"].size(), series["load_y"].size());
+  double worst = 0.0;
+  for (std::size_t m = 0; m < fine["load_y"].size(); ++m)
+    worst = std::max(worst, std::abs(fine["load_y"][m].get<double>() - series["load_y"][m].get<double>()));
+  std::printf("dead-time load_y against the sampled loop at dt 5e-4: at most %.3g\n", worst);
+  EXPECT_LT(worst, 5e-4) << "the largest difference from the sampled loop at dt 5e-4";
+  EXPECT_GT(std::abs(series["load_y"][25].get<double>()), 0.1) << "the response has moved by t = 1 s";
+  EXPECT_NEAR(series["load_y"].back().get<double>(), 0.0, 1e-3) << "integral action returns y to 0";
+  // \int y_L dt = 1 / ki with integral action (the final value theorem on
+  // y_L / s), and y_L >= 0 here: the load's \int|e|dt is 1.25 but for the
+  // tail past 20 s.
+  EXPECT_NEAR(result["load_iae_continuous"].get<double>(), 1.0 / 0.8, 1e-4);
+  EXPECT_NEAR(sum * 0.04, result["load_iae_continuous"].get<double>(), 1e-3);
+}
+
+TEST(PlotSeries, TheContinuousLoadIntegralIsMatlabsFigureForItsPidfOnTheThirdOrderLag) {
+  // pidtune's PIDF on 1/(s+1)^3 at wc = 1 (kp 2.72, ki 0.985, kd 1.72, and
+  // its filter Tf = 0.0316 s): MATLAB's documentation gives a load \int|e|dt
+  // of 1.015 (issue 57); the sampled loop has none.
+  nlohmann::json result;
+  SeriesOf({{"plant", "custom"},
+            {"num", {1}},
+            {"den", {1, 3, 3, 1}},
+            {"gains", {2.72, 0.985, 1.72}},
+            {"derivative_filter", 0.0316}},
+           &result);
+  EXPECT_NEAR(result["load_iae_continuous"].get<double>(), 1.015, 1e-3);
+  SeriesOf({{"plant", "custom"},
+            {"num", {1}},
+            {"den", {1, 3, 3, 1}},
+            {"gains", {2.72, 0.985, 1.72}},
+            {"derivative_filter", 0.0316},
+            {"loop", "sampled"},
+            {"dt", 0.01}},
+           &result);
+  EXPECT_TRUE(result["load_iae_continuous"].is_null());
 }
 
 TEST(PlotSeries, MonteCarloBandOfZeroSpreadIsTheNominalResponse) {

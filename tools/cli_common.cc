@@ -409,6 +409,8 @@ std::string FormatEvaluation(const Evaluation& ev) {
   os << "ISE              " << num(ev.ise) << "\n";
   os << "ITAE             " << num(ev.itae) << "\n";
   os << "integral |e| dt  " << num(ev.iae_continuous) << "\n";
+  if (!std::isnan(ev.load_iae_continuous))
+    os << "load |e| dt      " << num(ev.load_iae_continuous) << "   (integral of |y|, the unit load step)\n";
   if (ev.step.valid) {
     os << "rise time        " << num(ev.step.rise_time_s) << " s   (10-90 %, stepinfo)\n";
     os << "overshoot        " << num(ev.step.overshoot_pct) << " %\n";

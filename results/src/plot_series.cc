@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/evaluation/delayed_loop.h"
 #include "pidlab/plant_sim/matrix_exp.h"
 
 namespace pidlab::results {
@@ -62,7 +63,18 @@ void TimeSeries(const Plant& plant, const PidGains& gains, const LoopOptions& op
         load_u.push_back(steps[std::min(m * every, steps.size() - 1)].u);
     }
   } else if (plant.delay_s > 0.0) {
-    notes->push_back("no command or load response for the continuous loop with dead time");
+    // The load response by the evaluation library's delayed loop (the
+    // samples LoadIntegralAbsError sums); the command is not sampled there.
+    evaluation::DelayedClosedLoop load;
+    evaluation::DelayedTrace trace;
+    if (!evaluation::BuildDelayedClosedLoop(plant.tf, Realize(plant.tf), gains, load_step, plant.delay_s, 0.0,
+                                            &load)
+             .ok() ||
+        !evaluation::SampleDelayedLoop(load, load_step, options.sample_time_s, options.NumSamples(), &load_y,
+                                       &trace)
+             .ok())
+      load_y.clear();
+    notes->push_back("no command u for the continuous loop with dead time (the sampled loop's is drawn)");
   } else {
     const StateSpace ss = Realize(plant.tf);
     ContinuousClosedLoop<double> loop, load;

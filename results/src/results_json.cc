@@ -84,6 +84,7 @@ nlohmann::json ToJson(const Evaluation& ev) {
   j["iae_per_unit"] = JsonNumber(ev.iae_per_unit);
   j["iae_undisturbed"] = JsonNumber(ev.iae_undisturbed);
   j["load_iae"] = JsonNumber(ev.load_iae);
+  j["load_iae_continuous"] = JsonNumber(ev.load_iae_continuous);
   j["ise"] = JsonNumber(ev.ise);
   j["itae"] = JsonNumber(ev.itae);
   j["iae_continuous"] = JsonNumber(ev.iae_continuous);

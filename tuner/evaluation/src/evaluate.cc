@@ -184,7 +184,7 @@ void FinishScores(const Plant& plant, const PidGains& gains, const LoopOptions& 
                   const EvaluateOptions& what, Evaluation* ev) {
   if (!ev->stability.stable) {
     ev->iae = ev->ise = ev->itae = ev->iae_continuous = ev->iae_undisturbed = ev->iae_per_unit =
-        ev->load_iae = kInf;
+        ev->load_iae = ev->load_iae_continuous = kInf;
     ev->step.note = "unstable loop: no step metrics";
     return;
   }
@@ -203,12 +203,22 @@ void FinishScores(const Plant& plant, const PidGains& gains, const LoopOptions& 
                                          : nullptr;
   // The load response of a linear plant; a nonlinear plant's is not computed (NaN).
   if (options.loop == LoopKind::kContinuous && plant.delay_s > 0.0) {
-    ev->load_iae = internal::DelayedLoadIae(plant, gains, options);
+    if (what.compute_iae_continuous)
+      ev->load_iae = internal::DelayedLoadIae(plant, gains, options, &ev->load_iae_continuous);
+    else
+      ev->load_iae = internal::DelayedLoadIae(plant, gains, options);
     return;
   }
   ev->load_iae = plant.nonlinear ? std::numeric_limits<double>::quiet_NaN()
                                  : internal::LoadIaeOfStableLoop(Realize(plant.tf), discrete.get(), gains,
                                                                  options, Disturbance(UnitLoadStep()));
+  // The continuous loop's \int|y_L|dt by its exact walker, r = 0.
+  ContinuousClosedLoop<double> load;
+  if (options.loop == LoopKind::kContinuous && what.compute_iae_continuous && !plant.nonlinear &&
+      BuildContinuousClosedLoop<double>(Realize(plant.tf), gains, Disturbance(UnitLoadStep()), &load, 0.0)
+          .ok())
+    ev->load_iae_continuous =
+        ContinuousIntegralAbsError(load, Disturbance(UnitLoadStep()), ev->stability, options.horizon_s);
 }
 
 // Checked, started, stability of the sampled loop: the common head of

@@ -129,6 +129,21 @@ double DelayedLoadIae(const Plant& plant, const PidGains& gains, const LoopOptio
   return std::isfinite(sum) ? sum : kInf;
 }
 
+double DelayedLoadIae(const Plant& plant, const PidGains& gains, const LoopOptions& options,
+                      double* integral) {
+  std::vector<double> y;
+  DelayedTrace trace;
+  trace.record = true;
+  *integral = kInf;
+  if (!Sample(plant, gains, options, Disturbance(UnitLoadStep()), 0.0, DelayedPath::kFast, &y, &trace,
+              nullptr))
+    return kInf;
+  *integral = NodeIntegralAbsError(trace, 0.0);
+  double sum = 0.0;
+  for (double v : y) sum += std::abs(v);
+  return std::isfinite(sum) ? sum : kInf;
+}
+
 double DelayedContinuousObjective(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
                                   double load_weight, const PidGains& gains, DelayedPath path) {
   if (!DelayedLoopIsRetarded(plant.tf, gains).ok()) return kInf;

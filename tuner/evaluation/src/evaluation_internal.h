@@ -41,6 +41,10 @@ Status EvaluateDelayedContinuous(const Plant& plant, const PidGains& loop_gains,
 /// input, delayed with the control),
 double DelayedLoadIae(const Plant& plant, const PidGains& loop_gains, const LoopOptions& options,
                       DelayedPath path = DelayedPath::kFast);
+/// The same run's \int_0^horizon |y_L| dt, by the trapezoids on its nodes
+/// (NodeIntegralAbsError), into *integral; the samples' sum is returned.
+double DelayedLoadIae(const Plant& plant, const PidGains& loop_gains, const LoopOptions& options,
+                      double* integral);
 /// and the tuner's objective: +inf for an unstable or neutral loop.
 double DelayedContinuousObjective(const Plant& plant, const LoopOptions& options, ObjectiveKind kind,
                                   double load_weight, const PidGains& loop_gains,

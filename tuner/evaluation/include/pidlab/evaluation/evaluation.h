@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -58,6 +59,11 @@ struct Evaluation {
   /// IAE of the load response (LoadIntegralAbsError; unit input step, r = 0).
   /// +inf if unstable.
   double load_iae = 0;
+  /// The continuous loop's \int_0^horizon |y_L| dt of that load response
+  /// (the exact walker; with dead time the trapezoids on the delayed loop's
+  /// nodes); NaN for the sampled loop, a nonlinear plant, or when
+  /// compute_iae_continuous or compute_load_iae is off.
+  double load_iae_continuous = std::numeric_limits<double>::quiet_NaN();
   StepInfo step;
   /// stepper_nonlinear only: what the motor did, and whether it lost steps
   /// (at the horizon the rotor is lambda/2 or more from A: it settled at
