@@ -35,6 +35,12 @@ std::int64_t ShiftRound(std::int64_t d, int shift) {
   return d >= 0 ? (d + half) >> shift : -((-d + half) >> shift);
 }
 
+// The abort of a relay with no room around u0 within the output range.
+std::string NoRoom(double u0, double out_min, double out_max) {
+  return "no room for a relay around u0 = " + Num(u0) + " within the output range [" + Num(out_min) + ", " +
+         Num(out_max) + "]";
+}
+
 }  // namespace
 
 const char* ToString(RelayPhase phase) {
@@ -199,9 +205,7 @@ void RelayTuner::EndHold(double t_s, double r, double y) {
   d_high_ = std::min(o_.amplitude + o_.bias, out_max_ - u0_);
   d_low_ = std::min(o_.amplitude - o_.bias, u0_ - out_min_);
   if (!(d_high_ > 0.0) || !(d_low_ > 0.0) || !std::isfinite(u0_)) {
-    End(RelayPhase::kAborted, t_s,
-        "no room for a relay around u0 = " + Num(u0_) + " within the output range [" + Num(out_min_) + ", " +
-            Num(out_max_) + "]");
+    End(RelayPhase::kAborted, t_s, NoRoom(u0_, out_min_, out_max_));
     return;
   }
   phase_ = RelayPhase::kRelay;
@@ -398,9 +402,7 @@ void RelayTuner::FixedEndHold(double t_s, std::int64_t r, std::int64_t y) {
   d_high_ = static_cast<double>(d_high_q_) * qu_;
   d_low_ = static_cast<double>(d_low_q_) * qu_;
   if (d_high_q_ <= 0 || d_low_q_ <= 0) {
-    End(RelayPhase::kAborted, t_s,
-        "no room for a relay around u0 = " + Num(u0_) + " within the output range [" + Num(out_min_) + ", " +
-            Num(out_max_) + "]");
+    End(RelayPhase::kAborted, t_s, NoRoom(u0_, out_min_, out_max_));
     return;
   }
   phase_ = RelayPhase::kRelay;

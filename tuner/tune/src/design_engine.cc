@@ -347,34 +347,28 @@ bool Engine::Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum
     return Cost(x, 0.0, bounds, &kp_hint, nullptr);
   };
   optim::OptimizerSummary result;
-  for (const Eigen::VectorXd& x0 : starts) {
+  // One Nelder-Mead run from x0, kept where it improves on the best.
+  const auto run = [&](const Eigen::VectorXd& x0, double step, int evaluations, double x_tol, double f_tol,
+                       int restarts) {
     optim::NelderMeadOptions o;
-    o.x0 = x0.cwiseMax(box.lower).cwiseMin(box.upper);
-    o.initial_step_fraction = 0.03;
-    o.max_evaluations = warm.size() == dims && &x0 != &starts.front() ? 60 : 160;
-    o.x_tolerance = 1e-5;
-    o.f_tolerance = 1e-7;
-    o.restarts_on_convergence = 0;
+    o.x0 = x0;
+    o.initial_step_fraction = step;
+    o.max_evaluations = evaluations;
+    o.x_tolerance = x_tol;
+    o.f_tolerance = f_tol;
+    o.restarts_on_convergence = restarts;
     kp_hint = 0.0;
     optim::OptimizerSummary s;
     optim::NelderMead(f, box, o, &s);
     if (s.IsUsable() && s.f < kInfeasible && s.f < result.f) result = s;
-  }
+  };
+  for (const Eigen::VectorXd& x0 : starts)
+    run(x0.cwiseMax(box.lower).cwiseMin(box.upper), 0.03,
+        warm.size() == dims && &x0 != &starts.front() ? 60 : 160, 1e-5, 1e-7, 0);
   if (!result.IsUsable()) return false;
   // Polish from the best, with a fresh simplex.
-  {
-    optim::NelderMeadOptions o;
-    o.x0 = result.x;
-    o.initial_step_fraction = 0.01;
-    o.max_evaluations = 120;
-    o.x_tolerance = 1e-6;
-    o.f_tolerance = 1e-9;
-    o.restarts_on_convergence = 1;
-    kp_hint = 0.0;
-    optim::OptimizerSummary s;
-    optim::NelderMead(f, box, o, &s);
-    if (s.IsUsable() && s.f < kInfeasible && s.f < result.f) result = s;
-  }
+  const Eigen::VectorXd from = result.x;
+  run(from, 0.01, 120, 1e-6, 1e-9, 1);
   kp_hint = 0.0;
   PidGains g;
   double value = Cost(result.x, 0.0, bounds, &kp_hint, &g);
