@@ -138,7 +138,8 @@ std::string DecimationLine(const identify::Decimation& d) {
   if (d.factor == 1) return "";
   return "record decimated by " + std::to_string(d.factor) + ": " + std::to_string(d.samples_read) +
          " samples to " + std::to_string(d.samples) + " (--max-samples " + std::to_string(d.max_samples) +
-         "), u and y averaged over each interval\n";
+         "), u and y averaged over each interval; the starts on " + std::to_string(d.start_samples) +
+         " samples, the best refitted on the " + std::to_string(d.samples) + "\n";
 }
 
 std::string WhitenessLine(const identify::Whiteness& w) {
@@ -214,7 +215,9 @@ struct IdentifyCommand {
                     "the most samples a fit takes, " + std::to_string(identify::kMinMaxSamples) + ".." +
                         std::to_string(identify::kMaxMaxSamples) +
                         ": a longer record is decimated by the least integer factor that fits, u and y "
-                        "averaged over each interval (said on stderr and in the output)")
+                        "averaged over each interval, and its starts run on an eighth of the limit (a tf's "
+                        "on a quarter), the best refitted on the decimated record (said on stderr and in "
+                        "the output)")
         ->capture_default_str();
     app->add_flag("--json", json, "print one JSON object");
     app->add_flag("--quiet", quiet,
@@ -258,7 +261,8 @@ struct IdentifyCommand {
       std::cerr << "pidlab identify: " << samples << " samples, more than --max-samples "
                 << options.max_samples << ": decimated by "
                 << identify::DecimationFactor(samples, options.max_samples)
-                << " (an anti-alias average) before the fit\n";
+                << " (an anti-alias average) before the fit, its starts on "
+                << identify::StartSamples(options.max_samples, model == "tf") << " samples\n";
     if (long_record || ::isatty(STDERR_FILENO)) options.progress = ProgressPrinter(long_record);
   }
 

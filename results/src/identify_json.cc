@@ -176,19 +176,24 @@ Status RunIdentify(const identify::IdentifyData& data, const std::string& model,
                                            &run->decimation);
       !st.ok())
     return st;
-  const identify::Decimation& d = run->decimation;
+  identify::Decimation& d = run->decimation;
+  // A decimated record's starts on an eighth of its samples, the best refitted on all.
+  identify::IdentifyOptions fit = options;
+  if (d.factor > 1)
+    fit.start_samples = d.start_samples = identify::StartSamples(d.max_samples, model == "tf");
   const nlohmann::json decimation = {{"factor", d.factor},
                                      {"samples_read", d.samples_read},
                                      {"samples", d.samples},
-                                     {"max_samples", d.max_samples}};
+                                     {"max_samples", d.max_samples},
+                                     {"start_samples", d.start_samples}};
   if (model == "auto") {
     identify::AutoResult& a = run->automatic;
-    if (Status st = identify::IdentifyAuto(run->data, options, &a); !st.ok()) return st;
+    if (Status st = identify::IdentifyAuto(run->data, fit, &a); !st.ok()) return st;
     WarnIfTooCoarse(d, &a.candidates[static_cast<std::size_t>(a.chosen)].result);
     run->result = a.candidates[static_cast<std::size_t>(a.chosen)].result;
     run->json = IdentifyAutoJson(a);
   } else {
-    if (Status st = identify::Identify(run->data, kind, options, &run->result); !st.ok()) return st;
+    if (Status st = identify::Identify(run->data, kind, fit, &run->result); !st.ok()) return st;
     WarnIfTooCoarse(d, &run->result);
     run->json = IdentifyResultJson(run->result);
   }

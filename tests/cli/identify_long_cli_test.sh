@@ -48,12 +48,12 @@ check "--json --quiet exits 0 with an empty stderr" "[ $? -eq 0 ] && [ ! -s quie
 import json, sys
 j = json.load(open(sys.argv[1]))
 d, p = j['decimation'], {k: v['value'] for k, v in j['parameters'].items()}
-ok = d == {'factor': 20, 'samples_read': 200000, 'samples': 10000, 'max_samples': 10000} and j['samples'] == 10000
+ok = d == {'factor': 20, 'samples_read': 200000, 'samples': 10000, 'max_samples': 10000, 'start_samples': 1250} and j['samples'] == 10000
 for name, truth in (('Kp', 2.0), ('Tp1', 40.0), ('Td', 5.0)):
     ok = ok and abs(p[name] - truth) <= 0.03 * truth
 print('ok' if ok else 'no', d, p)
 PY
-check "the JSON's decimation is {factor 20, 200000 read, 10000 fitted}; Kp, Tp1, Td within 3 % ($(cat close))" \
+check "the JSON's decimation is {factor 20, 200000 read, 10000 fitted, starts on 1250}; Kp, Tp1, Td within 3 % ($(cat close))" \
   "grep -q '^ok' close"
 
 "$pidlab" identify --csv long.csv --model p1d --max-samples 5 > /dev/null 2> bad

@@ -94,6 +94,9 @@ bool IdentifyOptions::IsValid(std::string* error) const {
   else if (max_samples < kMinMaxSamples || max_samples > kMaxMaxSamples)
     e = "max_samples = " + std::to_string(max_samples) + " must be in [" + std::to_string(kMinMaxSamples) +
         ", " + std::to_string(kMaxMaxSamples) + "]";
+  else if (start_samples != 0 && (start_samples < kMinMaxSamples || start_samples > kMaxMaxSamples))
+    e = "start_samples = " + std::to_string(start_samples) + " must be 0 or in [" +
+        std::to_string(kMinMaxSamples) + ", " + std::to_string(kMaxMaxSamples) + "]";
   if (error) *error = e;
   return e.empty();
 }

@@ -445,6 +445,73 @@ void Refine(const Record& record, const IdentifyOptions& options, std::vector<do
   result->starts = static_cast<int>(result->start_costs.size());
 }
 
+// A model on a record longer than options.start_samples: the starts
+// (FitKind's, with the seeds) on the record decimated to that many samples,
+// their best refitted on the record itself and refined there. The starts'
+// figures (start_costs, starts, starts_at_best, the ARX and nested starts)
+// are the decimated record's (docs/identify.md, "Long records").
+Status FitFromDecimatedStarts(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
+                              const internal::Seeds& seeds, IdentifyResult* result) {
+  Record record;
+  if (Status s = MakeRecord(data, kind, options, &record, result); !s.ok()) return s;
+  IdentifyData coarse;
+  Decimation decimation;
+  if (Status s = DecimateRecord(data, options.start_samples, options.intersample, &coarse, &decimation);
+      !s.ok())
+    return s;
+  IdentifyOptions coarse_options = options;
+  coarse_options.start_samples = 0;
+  coarse_options.u0 = result->u0;  // the record's: not the decimated record's first sample
+  IdentifyResult screened;
+  if (Status s = internal::FitKind(coarse, kind, coarse_options, seeds, &screened); !s.ok()) return s;
+  // Refitted from the starts' best (and a robust fit's l2 optimum), then,
+  // if that ends above the contained model's optimum, from it too: a bigger
+  // model never ends worse than the one it contains, whatever basin the
+  // decimated record preferred.
+  std::vector<double> theta = SameKindStart(record, screened, result->u0, result->y0);
+  std::vector<double> costs = {FitFrom(record, options, &theta)};
+  std::vector<std::vector<double>> seeded;
+  if (seeds.same_kind) seeded.push_back(SameKindStart(record, *seeds.same_kind, result->u0, result->y0));
+  if (seeds.contained && options.nested_starts && !(costs[0] <= seeds.contained->cost))
+    for (std::vector<double>& start : NestedStarts(record, *seeds.contained, result->u0, result->y0))
+      seeded.push_back(std::move(start));
+  seeded.erase(std::remove_if(seeded.begin(), seeded.end(), [](const auto& v) { return v.empty(); }),
+               seeded.end());
+  if (!seeded.empty()) {
+    IdentifyOptions refit_options = options;
+    refit_options.starts = 0;
+    refit_options.arx_start = false;
+    refit_options.progress = nullptr;  // the starts' progress was shown
+    bool arx_used = false;
+    std::vector<double> seeded_costs;
+    std::vector<double> from_seeds = MultiStart(record, refit_options, seeded, &seeded_costs, &arx_used);
+    if (!from_seeds.empty() && *std::min_element(seeded_costs.begin(), seeded_costs.end()) < costs[0])
+      theta = from_seeds;
+    costs.insert(costs.end(), seeded_costs.begin(), seeded_costs.end());
+  }
+  if (!std::isfinite(*std::min_element(costs.begin(), costs.end()))) theta.clear();
+  if (options.cancelled && options.cancelled()) return Status::RunnerFailed("cancelled");
+  if (theta.empty())
+    return Status::RunnerFailed("the refit of " + std::string(ToString(kind)) + " on all " +
+                                std::to_string(data.y.size()) + " samples, from the best of its starts on " +
+                                std::to_string(coarse.y.size()) + ", ended at a non-finite cost");
+  double best = *std::min_element(costs.begin(), costs.end());
+  result->start_costs = costs;
+  Refine(record, options, &theta, &best, result);
+  result->start_costs = screened.start_costs;
+  result->starts = screened.starts;
+  result->starts_at_best = screened.starts_at_best;
+  result->arx_start = screened.arx_start;
+  result->nested_starts = screened.nested_starts;
+  result->delay_profile_improved = result->delay_profile_improved || screened.delay_profile_improved;
+  result->bounds_refit_improved = result->bounds_refit_improved || screened.bounds_refit_improved;
+  result->seed = options.seed;
+  result->samples = static_cast<int>(data.y.size());
+  result->dt_s = record.dt_s;
+  Summarise(record, data, theta, best, result);
+  return Status::Ok();
+}
+
 }  // namespace
 
 namespace internal {
@@ -464,6 +531,8 @@ bool ContainedKind(ProcessModelKind kind, ProcessModelKind* inner) {
 
 Status FitKind(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
                const Seeds& seeds, IdentifyResult* result) {
+  if (options.start_samples > 0 && data.y.size() > options.start_samples)
+    return FitFromDecimatedStarts(data, kind, options, seeds, result);
   Record record;
   if (Status s = MakeRecord(data, kind, options, &record, result); !s.ok()) return s;
   std::vector<std::vector<double>> nested;

@@ -42,11 +42,13 @@ struct IdentifyRun {
 /// Fits `data` with `model`, one of identify::ProcessModelKindNames() or
 /// "auto" (every process kind, the lowest AIC kept; tf needs
 /// options.poles), decimated first when longer than options.max_samples
-/// (json "decimation" {factor, samples_read, samples, max_samples}, factor
-/// 1 when not; a time constant under two decimated intervals is added to
-/// the warnings). kInvalidInput names a bad model or record; the fit's
-/// own failures keep their code. The command line and the page's identify
-/// request both run it.
+/// (json "decimation" {factor, samples_read, samples, max_samples,
+/// start_samples}, factor 1 and start_samples 0 when not; a decimated
+/// record's starts run on an eighth of max_samples, the best refitted on
+/// the decimated record: IdentifyOptions::start_samples; a time constant
+/// under two decimated intervals is added to the warnings). kInvalidInput
+/// names a bad model or record; the fit's own failures keep their code.
+/// The command line and the page's identify request both run it.
 Status RunIdentify(const identify::IdentifyData& data, const std::string& model,
                    const identify::IdentifyOptions& options, IdentifyRun* run);
 

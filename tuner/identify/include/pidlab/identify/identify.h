@@ -7,6 +7,7 @@
 // from a zero state (or a steady or estimated one: InitialCondition). Ceres fits from several starts and
 // keeps the best. docs/identify.md, "Identifying a model from a CSV".
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -88,11 +89,21 @@ inline constexpr double kDownweightedBelow = 0.5;
 inline constexpr int kMaxStarts = 1000;
 /// The default and the range of IdentifyOptions::max_samples: a fit's time
 /// grows with the samples (at 10000, about 0.6 s for P1D and 20 s for P2DU
-/// or P2DZ on this project's 2 shared cores: bench/identify_long_bench.sh),
-/// so a longer record is decimated first (DecimateRecord) or refused.
+/// or P2DZ on this project's 2 shared cores, when every start runs on all of
+/// them: bench/identify_long_bench.sh), so a longer record is decimated
+/// first (DecimateRecord) or refused.
 inline constexpr std::size_t kDefaultMaxSamples = 10000;
 inline constexpr std::size_t kMinMaxSamples = 100;
 inline constexpr std::size_t kMaxMaxSamples = 10000000;
+/// A record decimated to max_samples has its starts run on an eighth of
+/// them (IdentifyOptions::start_samples), a TF's on a quarter (its
+/// coefficients' starts on an eighth found a worse optimum: docs/identify.md,
+/// "Long records"), at least kMinMaxSamples.
+inline constexpr std::size_t kStartSamplesDivisor = 8;
+inline constexpr std::size_t kTfStartSamplesDivisor = 4;
+inline std::size_t StartSamples(std::size_t max_samples, bool tf = false) {
+  return std::max(kMinMaxSamples, max_samples / (tf ? kTfStartSamplesDivisor : kStartSamplesDivisor));
+}
 
 struct IdentifyOptions {
   /// Starts of the multi-start design (Sobol' points over the time constants,
@@ -161,6 +172,15 @@ struct IdentifyOptions {
   /// Identify refuses a longer one naming the limit; front ends decimate it
   /// to fit first (DecimateRecord).
   std::size_t max_samples = kDefaultMaxSamples;
+  /// 0: the starts run on the record. Else, in [kMinMaxSamples,
+  /// kMaxMaxSamples]: a model's starts (and its contained model's)
+  /// run on a longer record decimated to at most this many samples
+  /// (DecimateRecord), and only their best is refitted on the record itself,
+  /// then refined as usual; starts and start_costs are then the decimated
+  /// record's. RunIdentify sets it to an eighth of max_samples
+  /// (kStartSamplesDivisor) for a record it decimated (docs/identify.md,
+  /// "Long records"); a record within it is fitted as without.
+  std::size_t start_samples = 0;
 
   /// Names the field, its value and the rule on failure.
   bool IsValid(std::string* error) const;
@@ -287,6 +307,9 @@ struct Decimation {
   std::size_t samples_read = 0;  // before
   std::size_t samples = 0;       // after
   std::size_t max_samples = 0;   // the limit applied
+  /// The fit's IdentifyOptions::start_samples that RunIdentify set (an
+  /// eighth of the limit when factor > 1, else 0: the starts on the record).
+  std::size_t start_samples = 0;
 };
 
 /// `data` (checked by CheckData) into *out, decimated by the least integer
