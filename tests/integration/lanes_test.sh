@@ -7,7 +7,8 @@
 # received from the lanes, and the base port's log alone holds none of them.
 # A stock lcm-logger drops beyond 30 queued messages when the machine starves
 # it (docs/logs.md, "Bursts"): a run with steps missing from the lane files is
-# run again, at most 3 times, and said so.
+# run again, at most 3 times, and said so; so is a run whose joined or base log
+# is incomplete (a lost CONTROL, chunk or configuration).
 # Run as: unshare -n bash lanes_test.sh BIN_DIR DOCS_LOGS_MD   (ctest does this)
 set -uo pipefail
 
@@ -51,17 +52,22 @@ for run in 1 2 3; do
     echo "FAIL the recipe exits non-zero: $(grep -v '^pidlab-' recipe.err | tail -3 | tr '\n' '|')"
     exit 1
   fi
-  if ! all=$(counts all.lcmlog) || ! base=$(counts base.lcmlog); then
-    echo "FAIL pidlab replay --json of the recipe's logs: $all / $base"
-    exit 1
+  if ! all=$(counts all.lcmlog 2>&1) || ! base=$(counts base.lcmlog 2>&1); then
+    # A configuration the base logger lost leaves no whole episode to count.
+    echo "note: run $run: pidlab replay --json of the recipe's logs: ${all:-} / ${base:-}; running again"
+    y=? want_y=? u=? want_u=? complete=? base_complete=?
+    continue
   fi
   read -r y want_y u want_u complete <<<"$all"
   read -r base_y _ base_u _ base_complete <<<"$base"
-  if [[ $complete != True || $base_complete != True ]] || ((want_y < 2 || want_u < 1 || base_y != 0 || base_u != 0)); then
-    echo "FAIL the recipe's logs: joined '$all', base port alone '$base' (wanted complete, no y or u on the base port)"
+  # The lanes' routing is wrong (not a loss): y or u on the base port, or no steps.
+  if ((want_y < 2 || want_u < 1 || base_y != 0 || base_u != 0)); then
+    echo "FAIL the recipe's logs: joined '$all', base port alone '$base' (wanted steps, no y or u on the base port)"
     exit 1
   fi
-  if ((y == want_y && u == want_u)); then
+  # A starved stock logger drops datagrams on any port: a lost CONTROL leaves the
+  # joined log incomplete, a lost chunk or configuration the base log; run again.
+  if [[ $complete == True && $base_complete == True ]] && ((y == want_y && u == want_u)); then
     echo "PASS docs/logs.md's recipe, as written: the lanes' loggers hold all $y PLANT_OUTPUTs and $u CONTROLs" \
          "of the episode, the base port's logger none (run $run)"
     grep -q "plant outputs: $y/$want_y received" recipe.out && grep -q "commands: $u/$want_u received" recipe.out ||
@@ -69,7 +75,8 @@ for run in 1 2 3; do
     echo "PASS its pidlab replay all.lcmlog says 'plant outputs: $y/$want_y received', 'commands: $u/$want_u received'"
     exit 0
   fi
-  echo "note: run $run: the lanes' loggers kept $y of $want_y PLANT_OUTPUTs and $u of $want_u CONTROLs; running again"
+  echo "note: run $run: the lanes' loggers kept $y of $want_y PLANT_OUTPUTs and $u of $want_u CONTROLs" \
+       "(joined log complete: $complete, base log complete: $base_complete); running again"
 done
-echo "FAIL the lanes' loggers missed steps in 3 runs (last: $y of $want_y y, $u of $want_u u)"
+echo "FAIL the loggers lost messages in 3 runs (last: $y of $want_y y, $u of $want_u u, complete $complete, base complete $base_complete)"
 exit 1
