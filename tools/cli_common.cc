@@ -427,12 +427,20 @@ std::string FormatEvaluation(const Evaluation& ev) {
   return os.str();
 }
 
-void WriteSamplesCsv(const Evaluation& ev, const std::string& path) {
+void WriteSamplesCsv(const Evaluation& ev, const evaluation::CommandSeries& series, const std::string& path) {
   std::ostringstream f;
-  f << std::setprecision(17) << "t,r,y,e,n\n";
+  f << std::setprecision(17) << "t,r,y,e,n,u,y_load,u_load\n";
+  // A column the loop has none of (the nonlinear motor's load response) is empty.
+  const auto cell = [](const std::vector<double>& v, std::size_t m) {
+    std::ostringstream c;
+    c << std::setprecision(17);
+    if (m < v.size()) c << v[m];
+    return c.str();
+  };
   for (std::size_t m = 0; m < ev.y.size(); ++m)
     f << ev.t[m] << "," << ev.options.reference << "," << ev.y[m] << "," << ev.options.reference - ev.y[m]
-      << "," << ev.n[m] << "\n";
+      << "," << ev.n[m] << "," << cell(series.u, m) << "," << cell(series.load_y, m) << ","
+      << cell(series.load_u, m) << "\n";
   WriteOutputFile(path, f.str());
 }
 

@@ -15,6 +15,7 @@
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/episode_client/episode_client.h"
 #include "pidlab/episode_client/episode_pool.h"
+#include "pidlab/evaluation/command_series.h"
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/io/files.h"
 #include "pidlab/results/replay_json.h"
@@ -136,7 +137,10 @@ using results::ToJson;
 std::string FormatPoles(const std::vector<std::complex<double>>& poles);
 /// Human-readable report of one evaluation.
 std::string FormatEvaluation(const evaluation::Evaluation& ev);
-/// CSV of the sample times: t,r,y,e,n. BadInput if `path` cannot be opened.
-void WriteSamplesCsv(const evaluation::Evaluation& ev, const std::string& path);
+/// CSV of the sample times: t,r,y,e,n and the command and load response,
+/// u,y_load,u_load (evaluation::CommandAndLoadSeries; empty cells where the loop
+/// has none). BadInput if `path` cannot be opened.
+void WriteSamplesCsv(const evaluation::Evaluation& ev, const evaluation::CommandSeries& series,
+                     const std::string& path);
 
 }  // namespace pidlab::cli

@@ -47,7 +47,10 @@ struct EvaluateCommand {
     flags.Register(app, spec::EvaluateSpec{});
     app->add_flag("--json", json,
                   "print one JSON object instead of the table (with the spec it ran, \"spec\")");
-    app->add_option("--samples-csv", samples_csv, "write t,r,y,e,n at the sample times to this CSV file");
+    app->add_option(
+        "--samples-csv", samples_csv,
+        "write t,r,y,e,n,u,y_load,u_load at the sample times to this CSV file (u and the load response "
+        "of a unit step at the plant input)");
     app->add_option("--trajectory-csv", trajectory_csv,
                     "write k,t,r,y,u,n of every step of the sampled loop to this CSV file (%.17g)");
     app->add_option(
@@ -96,7 +99,11 @@ struct EvaluateCommand {
     tune::EvaluationResult result;
     Require(tune::RunEvaluation(problem, run, &result));
     if (tty && result.monte_carlo_ran) std::fprintf(stderr, "\r%40s\r", "");
-    if (!samples_csv.empty()) WriteSamplesCsv(result.evaluation, samples_csv);
+    if (!samples_csv.empty()) {
+      evaluation::CommandSeries series;
+      evaluation::CommandAndLoadSeries(problem.plant, problem.gains, options, result.evaluation, &series);
+      WriteSamplesCsv(result.evaluation, series, samples_csv);
+    }
     if (!trajectory_csv.empty()) WriteTrajectoryCsv(result.evaluation, trajectory_csv);
     Print(problem, result, client.get());
     // -v: the episodes' ids, to find them in a log (pidlab replay --episode).

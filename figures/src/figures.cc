@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/evaluation/command_series.h"
 #include "pidlab/plot/loop_figure.h"
 #include "pidlab/replay/replay.h"
 
@@ -97,6 +98,9 @@ Status EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, 
       tr.n = ev.n;
       tr.r.assign(ev.t.size(), options.reference);
       for (double y : ev.y) tr.e.push_back(options.reference - y);
+      evaluation::CommandSeries series;
+      evaluation::CommandAndLoadSeries(plant, g, options, ev, &series);
+      if (series.u.size() == ev.t.size()) tr.u = std::move(series.u), tr.u_held = false;
     }
     traces.push_back(std::move(tr));
   }
@@ -107,8 +111,9 @@ Status EvaluationFigure(const Plant& plant, const std::vector<PidGains>& gains, 
   if (options.loop == LoopKind::kSampled)
     title << "sampled loop, dt = " << options.dt_s << " s, every step";
   else
-    title << "continuous loop (exact), y, e, n at the sample times ts = " << options.sample_time_s
-          << " s; no sampled u";
+    title << "continuous loop (exact), y, e, n and u at the sample times ts = " << options.sample_time_s
+          << " s"
+          << (options.disturbance.kind != DisturbanceKind::kNone ? " (u of the undisturbed step)" : "");
   if (options.disturbance.kind != DisturbanceKind::kNone)
     title << ", " << ToString(options.disturbance.kind) << " disturbance " << options.disturbance.amplitude;
   return plot::MakeLoopFigure(traces, plot::UnitsOfPlant(plant.name), title.str(), figure);

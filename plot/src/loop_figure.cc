@@ -43,7 +43,8 @@ bool MakeLoopFigureOrExplain(const std::vector<LoopTrace>& traces, const LoopUni
   const std::string x_label = "t [" + units.time + "]";
   Panel py{"step response", x_label, "y [" + units.output + "]", {}};
   Panel pe{"error e = r - y", x_label, "e [" + units.output + "]", {}};
-  Panel pu{"control u (held over each step)", x_label, "u [" + units.command + "]", {}};
+  const bool held = std::any_of(traces.begin(), traces.end(), [](const LoopTrace& tr) { return tr.u_held; });
+  Panel pu{held ? "control u (held over each step)" : "control u", x_label, "u [" + units.command + "]", {}};
   Panel pn{"disturbance n at the plant input", x_label, "n [" + units.command + "]", {}};
   bool reference_drawn = false;
   for (std::size_t i = 0; i < traces.size(); ++i) {
@@ -60,7 +61,8 @@ bool MakeLoopFigureOrExplain(const std::vector<LoopTrace>& traces, const LoopUni
     };
     if (!tr.y.empty()) py.series.push_back({name("output y"), tr.t, tr.y, Style::kLines, color});
     if (!tr.e.empty()) pe.series.push_back({name("error e"), tr.t, tr.e, Style::kLines, color});
-    if (!tr.u.empty()) pu.series.push_back({name("command u"), tr.t, tr.u, Style::kSteps, color});
+    if (!tr.u.empty())
+      pu.series.push_back({name("command u"), tr.t, tr.u, tr.u_held ? Style::kSteps : Style::kLines, color});
     if (!tr.n.empty()) pn.series.push_back({name("disturbance n"), tr.t, tr.n, Style::kSteps, color});
   }
   // The derivative kick kd/dt of the first step dwarfs the rest of u: scale

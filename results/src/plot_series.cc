@@ -6,89 +6,21 @@
 #include <string>
 #include <vector>
 
-#include "pidlab/evaluation/delayed_loop.h"
-#include "pidlab/plant_sim/matrix_exp.h"
-
 namespace pidlab::results {
 namespace {
 using analysis::LoopAnalysis;
 using analysis::LoopFrequencyPoint;
-using evaluation::BuildContinuousClosedLoop;
-using evaluation::ContinuousClosedLoop;
 using evaluation::Evaluation;
 using evaluation::LoopKind;
 using evaluation::LoopOptions;
 
-// y and u of a continuous loop (no breakpoints: no disturbance, or the load
-// step from t = 0) at t = 0, ts, ...: the loop's state propagated by
-// e^{M ts} as SampleContinuousLoop does, and u from the plant's row of
-// w' = M w: B u = x' - A x - B n.
-void ContinuousResponseAndCommand(const StateSpace& ss, const ContinuousClosedLoop<double>& loop, double ts,
-                                  int samples, std::vector<double>* y, std::vector<double>* u) {
-  const Eigen::MatrixXd phi = MatrixExp<double>(Eigen::MatrixXd(loop.m * ts));
-  const int n = loop.plant_order;
-  const double bb = ss.b.squaredNorm();
-  Eigen::VectorXd w = loop.w0, next(w.size());
-  y->clear();
-  u->clear();
-  for (int k = 0; k < samples; ++k) {
-    if (k > 0) {
-      next.noalias() = phi * w;
-      w.swap(next);
-    }
-    const Eigen::VectorXd x = w.head(n);
-    const Eigen::VectorXd dx = (loop.m * w).head(n);
-    const double disturbance = loop.exo_size == 1 ? w(loop.exo_index()) : 0.0;
-    y->push_back(loop.Output(w));
-    u->push_back(ss.b.dot(dx - ss.a * x) / bb - disturbance);
-  }
-}
-
 // The command and the load response of the loop at the sample times.
-void TimeSeries(const Plant& plant, const PidGains& gains, const LoopOptions& options, const Evaluation& ev,
-                nlohmann::json* out, std::vector<std::string>* notes) {
-  std::vector<double> u, load_y, load_u;
-  const Disturbance load_step(evaluation::UnitLoadStep());
-  if (options.loop == LoopKind::kSampled) {
-    const int every = options.StepsPerSample();
-    for (std::size_t m = 0; m < ev.t.size() && !ev.trajectory.empty(); ++m)
-      u.push_back(ev.trajectory[std::min(m * every, ev.trajectory.size() - 1)].u);
-    if (plant.nonlinear) {
-      notes->push_back("no load response for the nonlinear motor");
-    } else {
-      std::vector<evaluation::SampledStep> steps;
-      evaluation::RunSampledLoop<double>(evaluation::SampledPlant(plant, options.dt_s), gains, options.Pid(),
-                                         load_step, options.TotalSteps(), every, &load_y, &steps, 0.0);
-      for (std::size_t m = 0; m < load_y.size(); ++m)
-        load_u.push_back(steps[std::min(m * every, steps.size() - 1)].u);
-    }
-  } else if (plant.delay_s > 0.0) {
-    // The load response by the evaluation library's delayed loop (the
-    // samples LoadIntegralAbsError sums); the command is not sampled there.
-    evaluation::DelayedClosedLoop load;
-    evaluation::DelayedTrace trace;
-    if (!evaluation::BuildDelayedClosedLoop(plant.tf, Realize(plant.tf), gains, load_step, plant.delay_s, 0.0,
-                                            &load)
-             .ok() ||
-        !evaluation::SampleDelayedLoop(load, load_step, options.sample_time_s, options.NumSamples(), &load_y,
-                                       &trace)
-             .ok())
-      load_y.clear();
-    notes->push_back("no command u for the continuous loop with dead time (the sampled loop's is drawn)");
-  } else {
-    const StateSpace ss = Realize(plant.tf);
-    ContinuousClosedLoop<double> loop, load;
-    std::vector<double> y_clean;
-    const Disturbance none{DisturbanceOptions{}};
-    if (BuildContinuousClosedLoop<double>(ss, gains, none, &loop, options.reference,
-                                          evaluation::SetpointWeightsOf(options.pid))
-            .ok())
-      ContinuousResponseAndCommand(ss, loop, options.sample_time_s, options.NumSamples(), &y_clean, &u);
-    if (BuildContinuousClosedLoop<double>(ss, gains, load_step, &load, 0.0).ok())
-      ContinuousResponseAndCommand(ss, load, options.sample_time_s, options.NumSamples(), &load_y, &load_u);
-    if (options.disturbance.kind != DisturbanceKind::kNone)
-      notes->push_back("u is the command of the undisturbed step response");
-  }
+void TimeSeries(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
+                const Evaluation& ev, nlohmann::json* out, std::vector<std::string>* notes) {
+  evaluation::CommandSeries series;
+  evaluation::CommandAndLoadSeries(plant, typed_gains, options, ev, &series);
+  notes->insert(notes->end(), series.notes.begin(), series.notes.end());
+  const std::vector<double>&u = series.u, &load_y = series.load_y, &load_u = series.load_u;
   (*out)["t"] = ev.t;
   (*out)["y"] = ev.y;
   (*out)["u"] = u.empty() ? nlohmann::json(nullptr) : nlohmann::json(u);
@@ -128,10 +60,9 @@ Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const LoopOpt
   if (!(series_options.frequency_points >= 10 && series_options.frequency_points <= 5000))
     return Status::InvalidInput("frequency_points " + std::to_string(series_options.frequency_points) +
                                 " must be in 10..5000");
-  const PidGains gains = evaluation::LoopGains(typed_gains, options);
   std::vector<std::string> notes;
   *series = nlohmann::json::object();
-  TimeSeries(plant, gains, options, evaluation, series, &notes);
+  TimeSeries(plant, typed_gains, options, evaluation, series, &notes);
   const std::vector<double> w = FrequencyGrid(analysis, options, series_options);
   std::vector<LoopFrequencyPoint> response;
   if (const Status st = analysis::LoopFrequencyResponse(plant, typed_gains, options, w, &response); !st.ok())

@@ -1,10 +1,14 @@
 // The workbench page: the design form -> a spec -> the server (WebSocket /ws)
 // -> the JSON of `pidlab evaluate --json` and the plot series, drawn by
 // uPlot (plots.js). The page computes no result itself (docs/workbench.md).
-import { createPlots, destroyPlots, drawPlots } from './plots.js';
-import { initLive, initTrio } from './live.js';
-import { initLogs } from './logs.js';
-import { initDesign, suggestDt } from './design.js';
+import {initDesign, suggestDt} from './design.js';
+import {initFields, initSliders} from './form.js';
+import {initLive, initTrio} from './live.js';
+import {initLogs} from './logs.js';
+import {fmt, showKeyMetrics, showMetrics} from './metrics.js';
+import {initPins} from './pins.js';
+import {createPlots, destroyPlots, drawPlots} from './plots.js';
+import {initTuning} from './tuning.js';
 
 const token = new URLSearchParams(location.search).get('token');
 const plants = ['double_integrator', 'oscillator', 'stepper_motor', 'custom', 'stepper_nonlinear', 'model'];
@@ -33,6 +37,7 @@ const state = {
   min_phase_margin: '',
   monte_carlo: '',
   spread: '',
+  fields: {},  // the generated fields (form.js): key -> text
 };
 const textFields = [
   'num', 'den', 'model', 'delay', 'stepper', 'derivative_filter', 'setpoint_weight_b', 'setpoint_weight_c',
@@ -52,6 +57,13 @@ const waiting = new Map();  // id -> {resolve, reject} of other requests
 const $ = (id) => document.getElementById(id);
 const list = (text) => String(text).split(/[\s,]+/).filter((x) => x !== '').map(Number);
 const given = (v) => v !== '' && v !== null && v !== undefined;
+const pins = initPins({pidlab, state, $, setDesign, rebuildPlots, ask, setStatus});
+pidlab.pin = () => pins.pin();
+const form = initFields({state, $, ask, onChange: send, setStatus});
+pidlab.form = form;
+const sliders = initSliders({state, $, send: () => send()});
+const tuning =
+    initTuning({pidlab, state, $, spec, ask, rawSend, showForm, evaluated, pin: (label) => pins.pin(label)});
 
 // The spec of the current design (docs/spec.md): only the fields the form sets.
 function spec() {
@@ -75,7 +87,7 @@ function spec() {
     s.monte_carlo = Number(state.monte_carlo);
     if (given(state.spread)) s.spread = Number(state.spread);
   }
-  return s;
+  return form.apply(s);
 }
 
 function shellWord(v) {
@@ -226,63 +238,6 @@ function idle() {
   });
 }
 
-function fmt(v) {
-  if (v === null || v === undefined) return '-';
-  if (typeof v === 'boolean') return v ? 'yes' : 'no';
-  if (typeof v !== 'number') return String(v);
-  return Math.abs(v) >= 1e4 || (Math.abs(v) < 1e-3 && v !== 0) ? v.toExponential(4) : String(Number(v.toPrecision(5)));
-}
-
-// [key, label, value, the bound's name in the violations] of a result.
-function metricRows(r) {
-  const rb = r.robustness || {};
-  return [
-    ['iae', 'IAE (eq. 4)', r.iae], ['ise', 'ISE', r.ise], ['itae', 'ITAE', r.itae],
-    ['iae_continuous', 'IAE continuous', r.iae_continuous], ['load_iae', 'load IAE', r.load_iae],
-    ['stable', 'stable', r.stable], ['rise_time', 'rise time s', r.rise_time_s],
-    ['overshoot', 'overshoot %', r.overshoot_pct], ['settling_time', 'settling time s', r.settling_time_s],
-    ['ms', 'Ms', rb.ms, 'Ms'], ['mt', 'Mt', rb.mt, 'Mt'], ['noise_gain', 'noise gain', rb.noise_gain, 'noise gain'],
-    ['phase_margin', 'phase margin deg', rb.phase_margin_deg, 'phase margin'],
-    ['gain_margin', 'gain margin', rb.gain_margin, 'gain margin'], ['delay_margin', 'delay margin s', rb.delay_margin_s],
-    ['time_constant', 'slowest time constant s', rb.slowest_time_constant_s, 'time constant'],
-  ];
-}
-
-function showMetrics(r) {
-  const violations = (r.robustness && r.robustness.violations) || [];
-  const body = document.querySelector('#metrics tbody');
-  body.textContent = '';
-  for (const [key, name, value, bound] of metricRows(r)) {
-    const tr = document.createElement('tr');
-    const th = document.createElement('th'); th.textContent = name;
-    const td = document.createElement('td'); td.id = 'metric-' + key;
-    td.textContent = fmt(value);
-    td.dataset.value = value === undefined ? 'null' : String(value);
-    const broken = violations.filter((v) => (bound && v.toLowerCase().startsWith(bound.toLowerCase())) || v === 'unstable loop');
-    if (broken.length && (bound || key === 'stable')) { td.classList.add('violated'); td.title = broken.join('; '); }
-    tr.append(th, td);
-    body.append(tr);
-  }
-}
-
-// The few numbers an engineer reads first, beside the knobs.
-function showKeyMetrics(r) {
-  const rb = r.robustness || {};
-  const g = r.gains || {};
-  const rows = [['kp, ki, kd', [g.kp, g.ki, g.kd].map(fmt).join(', ')], ['tf s', fmt(g.tf)],
-    ['overshoot %', fmt(r.overshoot_pct)], ['settling s', fmt(r.settling_time_s)], ['load IAE', fmt(r.load_iae)],
-    ['Ms', fmt(rb.ms)], ['phase margin', fmt(rb.phase_margin_deg) + ' deg'], ['stable', fmt(r.stable)]];
-  const body = document.querySelector('#key-metrics tbody');
-  body.textContent = '';
-  for (const [name, text] of rows) {
-    const tr = document.createElement('tr');
-    const th = document.createElement('th'); th.textContent = name;
-    const td = document.createElement('td'); td.textContent = text;
-    tr.append(th, td);
-    body.append(tr);
-  }
-}
-
 function show(reply, sent, reply_ms) {
   pidlab.lastResult = reply.result;
   pidlab.lastSeries = reply.series;
@@ -294,7 +249,7 @@ function show(reply, sent, reply_ms) {
   drawPlots(pidlab.plots, reply.series, pidlab.pinned, pidlab.trioOverlay, sampledOverlay());
   $('spec').textContent = JSON.stringify(reply.result.spec);
   $('command').textContent = pidlab.command();
-  renderDiff();
+  pins.diff();
   queueMicrotask(() => {  // after uPlot's own commit (a microtask queued by setData)
     pidlab.timings.push({ seq: sent.seq, sent_ms: sent.sent_ms, reply_ms, drawn_ms: performance.now(),
       server_ms: sent.kept ? 0 : reply.compute_ms, kept: !!sent.kept });
@@ -310,7 +265,10 @@ function onMessage(reply, arrived_ms) {
     if (pending) { pending = false; send(); }
     return;
   }
-  if (reply.type === 'tune_progress') { tuneProgress(reply); return; }
+  if (reply.type === 'tune_progress') {
+    tuning.progress(reply);
+    return;
+  }
   if (reply.type === 'identify_progress') { views.design.onIdentifyProgress(reply); return; }
   if (views.live.onMessage(reply) || views.trio.onMessage(reply)) {
     if (reply.id === undefined || !waiting.has(reply.id)) return;
@@ -322,42 +280,14 @@ function onMessage(reply, arrived_ms) {
 }
 
 // ---- The form.
-function slider(name) {
-  const row = document.createElement('div');
-  row.className = 'row';
-  const label = document.createElement('label');
-  label.textContent = name; label.htmlFor = name;
-  const range = document.createElement('input');
-  range.type = 'range'; range.min = -3; range.max = 2.5; range.step = 0.001; range.id = name + '-slider';
-  const box = document.createElement('input');
-  box.type = 'number'; box.step = 'any'; box.min = 0; box.id = name;
-  range.addEventListener('input', () => setGain(name, Number(Math.pow(10, Number(range.value)).toPrecision(6)), range));
-  box.addEventListener('change', () => setGain(name, Number(box.value), box));
-  row.append(label, range, box);
-  $('gains').append(row);
-}
-
-function setGain(name, v, from) {
-  state[name] = v;
-  if (from !== $(name)) $(name).value = v;
-  if (from !== $(name + '-slider')) $(name + '-slider').value = v > 0 ? Math.log10(v) : -3;
-  send();
-}
-
 function showForm() {
   $('plant').value = state.plant;
   $('loop').value = state.loop;
   for (const k of textFields) $(k).value = state[k];
-  for (const g of ['kp', 'ki', 'kd']) setGainBoxes(g);
-  for (const k of ['max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin']) if ($(k + '-slider')) syncBoundSlider(k);
+  sliders.sync();
   for (const el of document.querySelectorAll('.plant-custom')) el.classList.toggle('hidden', state.plant !== 'custom');
   for (const el of document.querySelectorAll('.plant-model')) el.classList.toggle('hidden', state.plant !== 'model');
   for (const el of document.querySelectorAll('.plant-stepper')) el.classList.toggle('hidden', !state.plant.startsWith('stepper'));
-}
-
-function setGainBoxes(g) {
-  $(g).value = state[g];
-  $(g + '-slider').value = state[g] > 0 ? Math.log10(state[g]) : -3;
 }
 
 // The firmware's sampled loop, while it belongs to the design drawn.
@@ -377,6 +307,7 @@ function resetPlant(fields) {
                'dt'])
     state[k] = '';
   state.loop = 'continuous';
+  state.fields = {};
   Object.assign(state, fields);
   pidlab.pinned = [];
   pidlab.trioOverlay = null;
@@ -387,7 +318,8 @@ function resetPlant(fields) {
   $('fw-pil-status').textContent = '';
   $('fw-pil-table').classList.add('hidden');
   for (const id of ['fw-download-c', 'fw-download-h']) $(id).classList.add('hidden');
-  renderPinned();
+  pins.render();
+  form.render();
   rebuildPlots();
   showForm();
 }
@@ -421,120 +353,12 @@ function readHash() {
   } catch (e) { setStatus('the URL does not hold a design: ' + e.message); }
 }
 
-// ---- Pins and the paper's designs.
+// ---- The plots, the pins and the paper's designs.
 function rebuildPlots() {
   destroyPlots(pidlab.plots);
   const el = (k) => $('plot-' + k);
   pidlab.plots = createPlots({ step: el('step'), effort: el('effort'), load: el('load'), freq: el('freq'), nyquist: el('nyquist') }, pidlab.pinned);
   if (pidlab.lastSeries) drawPlots(pidlab.plots, pidlab.lastSeries, pidlab.pinned, pidlab.trioOverlay, sampledOverlay());
-}
-
-function pin(label) {
-  if (!pidlab.lastResult) return null;
-  const r = pidlab.lastResult;
-  const g = r.gains;
-  const design = {
-    label: label || 'P' + (pidlab.pinned.length + 1) + ' ' + r.plant + ' ' + [g.kp, g.ki, g.kd].map(fmt).join('/'),
-    spec: r.spec, result: r, series: pidlab.lastSeries,
-  };
-  pidlab.pinned.push(design);
-  renderPinned();
-  rebuildPlots();
-  return design;
-}
-pidlab.pin = () => pin();
-
-function renderPinned() {
-  const listEl = $('pinned-list');
-  listEl.textContent = '';
-  pidlab.pinned.forEach((p, i) => {
-    const div = document.createElement('div');
-    div.className = 'pinned-design';
-    const name = document.createElement('span'); name.textContent = p.label + ' ';
-    const load = document.createElement('button'); load.textContent = 'load';
-    load.addEventListener('click', () => { Object.assign(state, p.state || {}); setDesign({ plant: p.result.plant === 'model' ? state.plant : p.spec.plant, gains: p.spec.gains }); });
-    const drop = document.createElement('button'); drop.textContent = 'unpin';
-    drop.addEventListener('click', () => { pidlab.pinned.splice(i, 1); renderPinned(); rebuildPlots(); });
-    div.append(name, load, drop);
-    listEl.append(div);
-  });
-  renderDiff();
-}
-
-// Metrics of the current design and every pinned one, and the difference.
-function renderDiff() {
-  const table = $('diff-table');
-  table.textContent = '';
-  if (!pidlab.pinned.length || !pidlab.lastResult) return;
-  const head = document.createElement('tr');
-  for (const h of ['metric', 'current', ...pidlab.pinned.map((p) => p.label), ...pidlab.pinned.map((p) => 'current - ' + p.label.split(' ')[0])]) {
-    const th = document.createElement('th'); th.textContent = h; head.append(th);
-  }
-  table.append(head);
-  const rows = metricRows(pidlab.lastResult);
-  const pinnedRows = pidlab.pinned.map((p) => metricRows(p.result));
-  rows.forEach(([key, name, value], i) => {
-    const tr = document.createElement('tr');
-    const cells = [name, fmt(value), ...pinnedRows.map((r) => fmt(r[i][2])),
-      ...pinnedRows.map((r) => (typeof value === 'number' && typeof r[i][2] === 'number' ? fmt(value - r[i][2]) : '-'))];
-    cells.forEach((c, j) => { const td = document.createElement(j ? 'td' : 'th'); td.textContent = c; tr.append(td); });
-    tr.dataset.key = key;
-    table.append(tr);
-  });
-}
-
-async function loadPaperDesigns() {
-  try {
-    const reply = await ask({ type: 'paper_designs' });
-    pidlab.paperDesigns = reply.designs;
-    for (const d of reply.designs) {
-      const b = document.createElement('button');
-      b.className = 'paper-design';
-      b.textContent = 'Table ' + d.table + ' ' + d.plant + ' ' + d.method + (d.disturbance_amplitude ? ' ±' + d.disturbance_amplitude : '');
-      b.addEventListener('click', () => setDesign({ plant: d.plant, gains: d.gains }));
-      $('paper-designs').append(b);
-    }
-  } catch (e) { setStatus('paper designs: ' + e.message); }
-}
-
-// ---- Tuning on the server.
-let tuning = false;
-function tuneProgress(m) {
-  if (!tuning) return;
-  $('tune-status').textContent = 'tuning: ' + m.evaluations + ' evaluations, best objective ' + fmt(m.best);
-}
-
-function tuningSpec(options) {
-  const s = spec();
-  for (const k of ['gains', 'monte_carlo', 'spread']) delete s[k];  // evaluate's keys, not a tuning's
-  if (options.robust) s.robust = true;
-  for (const k of ['method', 'objective', 'bounds', 'max_evals', 'max_iter', 'max_ms', 'max_mt', 'max_noise_gain', 'min_phase_margin', 'refine'])
-    if (options[k] !== undefined) s[k] = options[k];
-  return s;
-}
-
-async function tune(options) {
-  const s = tuningSpec(options || {});
-  $('tune-status').textContent = 'tuning: started';
-  tuning = true;
-  try {
-    const reply = await ask({ type: 'tune', spec: s });
-    tuning = false;
-    pidlab.lastTune = reply.result;
-    const g = reply.result.gains;
-    $('tune-status').textContent = 'tuned: objective ' + fmt(reply.result.objective) + ', gains ' + [g.kp, g.ki, g.kd].map(fmt).join(', ') +
-      (reply.result.refine ? ', Ceres: ' + (reply.result.refine.verdict || JSON.stringify(reply.result.refine)) : '');
-    state.kp = g.kp; state.ki = g.ki; state.kd = g.kd;
-    if (g.tf > 0) state.derivative_filter = g.tf;
-    showForm();
-    await evaluated();
-    pin('tuned ' + (s.robust ? '--robust ' : '') + [g.kp, g.ki, g.kd].map(fmt).join('/'));
-    return reply.result;
-  } catch (e) {
-    tuning = false;
-    $('tune-status').textContent = 'tuning: ' + e.message;
-    throw e;
-  }
 }
 
 // A tuning spec run on the server, its gains, filter and setpoint weights
@@ -560,15 +384,6 @@ function evaluated() {
   });
 }
 
-pidlab.tune = tune;
-pidlab.cancelTune = () => rawSend({ type: 'tune_cancel' });
-
-function formTuneOptions() {
-  const o = { method: $('tune-method').value, objective: $('tune-objective').value };
-  if ($('tune-robust').checked) return { robust: true };
-  return o;
-}
-
 // ---- The design as C (the export request: pidlab export's module, as text).
 async function exportC() {
   const reply = await ask({ type: 'export', spec: spec() });
@@ -590,7 +405,14 @@ function wsUrl() {
 function connect() {
   socket = new WebSocket(wsUrl());
   socket.binaryType = 'arraybuffer';  // the live view's frames (live.js)
-  socket.addEventListener('open', () => { send(); loadPaperDesigns(); serverInfo(); });
+  socket.addEventListener('open', () => {
+    send();
+    pins.loadPaperDesigns();
+    serverInfo();
+    form.load().then(() => {
+      if (Object.keys(state.fields).length) send();
+    });
+  });
   socket.addEventListener('message', (e) => {
     const arrived = performance.now();
     if (e.data instanceof ArrayBuffer) views.live.onFrame(e.data); else onMessage(JSON.parse(e.data), arrived);
@@ -603,7 +425,6 @@ for (const p of plants) {
   o.value = p; o.textContent = p;
   $('plant').append(o);
 }
-for (const name of ['kp', 'ki', 'kd']) slider(name);
 $('plant').addEventListener('change', () => {
   resetPlant({ plant: $('plant').value });
   send();
@@ -617,34 +438,7 @@ for (const k of textFields) {
     send();
   });
 }
-// The bounds also as sliders (linear, or log10 for the noise gain): moving
-// one sets its number box and the bound; an empty box is no bound.
-const boundSliders = { max_ms: [1.05, 4, 0.01, false], max_mt: [1, 4, 0.01, false],
-  max_noise_gain: [-1, 4, 0.01, true], min_phase_margin: [0, 90, 0.5, false] };
-function syncBoundSlider(k) {
-  const [lo, hi, , log] = boundSliders[k];
-  const v = Number(state[k]);
-  const r = $(k + '-slider');
-  if (state[k] === '' || !isFinite(v)) { r.value = lo; return; }
-  r.value = Math.min(hi, Math.max(lo, log ? Math.log10(v) : v));
-}
-for (const [k, [lo, hi, step, log]] of Object.entries(boundSliders)) {
-  const r = document.createElement('input');
-  r.type = 'range'; r.id = k + '-slider'; r.min = lo; r.max = hi; r.step = step;
-  r.title = k + ' (slider)';
-  $(k).after(r);
-  r.addEventListener('input', () => {
-    const x = Number(r.value);
-    state[k] = String(log ? Number(Math.pow(10, x).toPrecision(4)) : x);
-    $(k).value = state[k];
-    send();
-  });
-  $(k).addEventListener('change', () => syncBoundSlider(k));
-  syncBoundSlider(k);
-}
-$('pin-button').addEventListener('click', () => pin());
-$('tune-button').addEventListener('click', () => tune(formTuneOptions()).catch(() => {}));
-$('tune-cancel').addEventListener('click', () => pidlab.cancelTune());
+$('pin-button').addEventListener('click', () => pins.pin());
 $('copy-command').addEventListener('click', () => navigator.clipboard.writeText(pidlab.command()).catch((e) => setStatus('copy: ' + e.message)));
 $('copy-spec').addEventListener('click', () => navigator.clipboard.writeText(JSON.stringify(spec())).catch((e) => setStatus('copy: ' + e.message)));
 $('export-button').addEventListener('click', () => exportC().catch((e) => setStatus('export: ' + e.message)));

@@ -316,16 +316,21 @@ export function drawPlots(plots, series, pinned, trio, sampled) {
   const extraData = { linear: () => [series.linear_y], band: () => [mc.y_max, mc.y_min],
     sampled: () => [heldAt(sampled.t, sampled.y, series.t)], trio: () => [atSampleTimes(trio, series.t)] };
   plots.step.setData([series.t, series.y, ...pin('y'), ...extras.flatMap((k) => extraData[k]())]);
-  // The continuous loop with dead time has no u: the firmware's sampled
-  // loop, when it is drawn, gives it (held between its samples).
+  // u is in every series but the stepper's failed ones; the firmware's
+  // sampled loop, when it is drawn, fills a gap (held between its samples).
   const u = Array.isArray(series.u) ? series.u
     : sampled && Array.isArray(sampled.u) ? heldAt(sampled.t, sampled.u, series.t) : orEmpty(series.u, n);
   const title = (chart, text) => { const el = chart.root.querySelector('.u-title'); if (el) el.textContent = text; };
-  title(plots.effort, Array.isArray(series.u) ? 'Control effort u (step response)'
-    : sampled && Array.isArray(sampled.u) ? 'Control effort u of the sampled loop at the firmware\'s dt'
-      : 'Control effort u: not computed for the continuous loop with dead time (the firmware\'s sampled loop draws it)');
-  title(plots.load, Array.isArray(series.load_y) ? 'Load response y (unit step at the plant input)'
-    : 'Load response: not computed for the continuous loop with dead time');
+  title(
+      plots.effort,
+      Array.isArray(series.u) ? 'Control effort u (step response)' :
+          sampled && Array.isArray(sampled.u) ?
+                                'Control effort u of the sampled loop at the firmware\'s dt' :
+                                'Control effort u: not computed (' + (series.notes || []).join('; ') + ')');
+  title(
+      plots.load,
+      Array.isArray(series.load_y) ? 'Load response y (unit step at the plant input)' :
+                                     'Load response: not computed (' + (series.notes || []).join('; ') + ')');
   plots.effort.setData([series.t, u, ...pin('u')]);
   plots.load.setData([series.t, orEmpty(series.load_y, n), ...pin('load_y')]);
   const m = series.w.length;

@@ -228,6 +228,107 @@ async function main() {
     return 'kp ' + g.kp + ', ki ' + g.ki + ', kd ' + g.kd + ', tf ' + g.tf + '; ' + runs.length + ' CLI runs';
   });
 
+  await step(
+      '(f) a FOPDT and an integrating plant with dead time: the step, u and load plots hold finite points over the horizon, evaluate --samples-csv\'s y, u and y_load (1e-9)',
+      async () => {
+        const details = [];
+        for (const [num, den, delay] of [['1', '1,1', '0.5'], ['0.2', '1,0', '1']]) {
+          const before = await page.evaluate(() => window.pidlab.rendered);
+          await page.evaluate((num, den, delay) => {
+            window.pidlab.resetPlant({plant: 'custom', num, den, delay});
+            Object.assign(window.pidlab.state, {kp: 0.6, ki: 0.15, kd: 0.05, derivative_filter: '0.01'});
+            window.pidlab.setDesign({});
+          }, num, den, delay);
+          await waitForPage(
+              session, 'no redraw of the dead-time plant ' + num + '/' + den, redrawMs,
+              (before) => window.pidlab.rendered > before && window.pidlab.lastResult.spec.delay > 0, before);
+          const shown = await page.evaluate(
+              () => ({
+                spec: window.pidlab.spec(),
+                frame: window.pidlab.lastSeries.time_scale,
+                t: Array.from(window.pidlab.plots.step.data[0]),
+                y: Array.from(window.pidlab.plots.step.data[1]),
+                u: Array.from(window.pidlab.plots.effort.data[1]),
+                load: Array.from(window.pidlab.plots.load.data[1]),
+                titles: Array.from(document.querySelectorAll('.u-title')).map((e) => e.textContent)
+              }));
+          for (const key of ['y', 'u', 'load'])
+            if (!shown[key].length || !shown[key].every(Number.isFinite))
+              throw new Error(key + ' has points that are not finite: ' + shown[key].slice(0, 5));
+          const csv = path.join(args.tmp, 'deadtime' + delay + '.csv');
+          pidlab([
+            'evaluate', '--spec', specFile(shown.spec), '--horizon', String(shown.frame.horizon_s),
+            '--sample-time', String(shown.frame.sample_time_s), '--json', '--samples-csv', csv
+          ]);
+          const samples = readCsv(csv);
+          expectSeries('plots.step.data[1] (y)', shown.y, samples.y, 1e-9);
+          expectSeries('plots.effort.data[1] (u)', shown.u, samples.u, 1e-9);
+          expectSeries('plots.load.data[1] (y_load)', shown.load, samples.y_load, 1e-9);
+          if (shown.titles.some((t) => /not computed/.test(t)))
+            throw new Error('a plot says: ' + shown.titles.join(' | '));
+          details.push(
+              num + '/(' + den + ') e^-' + delay + 's: ' + shown.t.length + ' samples to ' +
+              shown.frame.horizon_s + ' s');
+        }
+        await shot('deadtime');
+        return details.join('; ');
+      });
+
+  await step(
+      '(g) "Every other field" holds one input per field of the fields request the page has no control for; a value set there runs, a bad one is refused naming it',
+      async () => {
+        const got = await page.evaluate(async () => {
+          const reply = await new Promise((resolve) => {
+            const u = new URL(location.href);
+            const ws =
+                new WebSocket((u.protocol === 'https:' ? 'wss:' : 'ws:') + '//' + u.host + '/ws' + u.search);
+            ws.onopen = () => ws.send(JSON.stringify({id: 1, type: 'fields'}));
+            ws.onmessage = (e) => {
+              resolve(JSON.parse(e.data));
+              ws.close();
+            };
+          });
+          const inputs =
+              Array.from(document.querySelectorAll('#fields [data-key]')).map((e) => e.dataset.key);
+          return {all: reply.fields.map((f) => f.key), inputs};
+        });
+        const own = [
+          'plant', 'num', 'den', 'model', 'delay', 'stepper', 'gains', 'derivative_filter',
+          'setpoint_weights', 'setpoint_filter', 'output_limits', 'loop', 'dt', 'max_ms', 'max_mt',
+          'max_noise_gain', 'min_phase_margin', 'monte_carlo', 'spread'
+        ];
+        const want = got.all.filter((k) => !own.includes(k));
+        if (canonical(want) !== canonical(got.inputs))
+          throw new Error('inputs ' + got.inputs.join(',') + ', fields ' + want.join(','));
+        if (!got.inputs.includes('horizon') || !got.inputs.includes('anti_windup'))
+          throw new Error('no horizon or anti_windup input');
+        const set = async (key, value) => {
+          const before = await page.evaluate(() => window.pidlab.rendered);
+          await page.evaluate((key, value) => {
+            const e = document.getElementById('field-' + key);
+            e.value = value;
+            e.dispatchEvent(new Event('change', {bubbles: true}));
+          }, key, value);
+          return before;
+        };
+        const before = await set('horizon', '7');
+        await waitForPage(
+            session, 'no redraw after horizon 7', redrawMs,
+            (before) => window.pidlab.rendered > before && window.pidlab.lastResult.spec.horizon === 7,
+            before);
+        await set('horizon', 'seven');
+        await waitForPage(
+            session, 'no refusal of horizon "seven"', redrawMs,
+            () => /horizon "seven" is not a number/.test(document.getElementById('status').textContent));
+        const back = await set('horizon', '');
+        await waitForPage(
+            session, 'no redraw after the horizon was cleared', redrawMs,
+            (back) => window.pidlab.rendered > back && !('horizon' in window.pidlab.lastResult.spec) ||
+                (window.pidlab.rendered > back && window.pidlab.lastResult.spec.horizon !== 7),
+            back);
+        return want.length + ' generated inputs; horizon 7 ran, "seven" refused, cleared';
+      });
+
   await step('pidlab.timings: one entry per redraw, sent <= reply <= drawn, the server\'s time inside the round trip', async () => {
     const { timings, rendered } = await page.evaluate(() => ({ timings: window.pidlab.timings, rendered: window.pidlab.rendered }));
     if (timings.length !== rendered) throw new Error(timings.length + ' timings for ' + rendered + ' redraws');

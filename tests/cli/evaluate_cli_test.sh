@@ -249,5 +249,36 @@ else
   fail "lost steps report (exit $status)"
 fi
 
+# A dead-time plant: evaluate prints the load \int|e|dt and --samples-csv
+# writes u and the load response (u_load cancels the unit load at the end;
+# u(0+) = kp + kd / tf, the filtered derivative's kick; y_load's sum is the
+# JSON's load_iae).
+status=0
+"$pidlab" evaluate --plant custom --num 1 --den 1,1 --delay 0.5 --gains 1,0.8,0.1 --derivative-filter 0.01 \
+  --horizon 20 --sample-time 0.04 --samples-csv deadtime.csv >deadtime.txt 2>deadtime.err || status=$?
+"$pidlab" evaluate --plant custom --num 1 --den 1,1 --delay 0.5 --gains 1,0.8,0.1 --derivative-filter 0.01 \
+  --horizon 20 --sample-time 0.04 --json >deadtime.json 2>>deadtime.err || status=$?
+if [[ $status -eq 0 ]] && grep -q '^load |e| dt' deadtime.txt && python3 - deadtime.csv deadtime.json <<'PY'
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+j = json.load(open(sys.argv[2]))
+assert list(rows[0]) == ["t", "r", "y", "e", "n", "u", "y_load", "u_load"], list(rows[0])
+assert len(rows) == 501, len(rows)
+u = [float(r["u"]) for r in rows]
+yl = [float(r["y_load"]) for r in rows]
+ul = [float(r["u_load"]) for r in rows]
+assert abs(u[0] - (1 + 0.1 / 0.01)) < 1e-9, u[0]
+assert abs(u[-1] - 1) < 1e-3 and abs(ul[-1] + 1) < 1e-3 and abs(yl[-1]) < 1e-3, (u[-1], ul[-1], yl[-1])
+assert all(abs(y) < 1e-15 for y in yl[:12]) and abs(yl[25]) > 0.1, yl[:30]  # the load reaches y after the 0.5 s delay
+s = sum(abs(y) for y in yl)
+assert abs(s - j["load_iae"]) <= 1e-9 * s, (s, j["load_iae"])
+assert abs(j["load_iae_continuous"] - 1 / 0.8) < 1e-3, j["load_iae_continuous"]
+PY
+then
+  pass "evaluate on a dead-time plant prints the load |e| dt and --samples-csv writes u, y_load and u_load"
+else
+  fail "evaluate on a dead-time plant (exit $status): $(head -c 300 deadtime.err) $(grep load deadtime.txt)"
+fi
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -42,9 +42,18 @@ else
   fail "plot of the sampled loop"
 fi
 
-if "$pidlab" plot --plant oscillator --gains 2,1,1 --out cont >/dev/null &&
-   grep -q "at the sample times" cont/evaluation_data/figure.gp && [[ ! -e cont/evaluation_data/p3_s0.dat ]]; then
-  pass "continuous loop: y, e, n at the sample times, no u panel, said in the title"
+if "$pidlab" plot --plant oscillator --gains 2,1,1 --horizon 25 --sample-time 0.1 --out cont >/dev/null &&
+   "$pidlab" evaluate --plant oscillator --gains 2,1,1 --horizon 25 --sample-time 0.1 --samples-csv cont.csv >/dev/null &&
+   grep -q "y, e, n and u at the sample times" cont/evaluation_data/figure.gp && python3 - cont <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open("cont.csv")))
+u = [tuple(map(float, l.split())) for l in open(sys.argv[1] + "/evaluation_data/p2_s0.dat") if l.strip() and not l.startswith("#")]
+assert len(u) == len(rows), (len(u), len(rows))
+for k, row in enumerate(rows):
+    assert u[k] == (float(row["t"]), float(row["u"])), (k, u[k], row["u"])
+PY
+then
+  pass "continuous loop: y, e, n and u at the sample times (u that of evaluate --samples-csv), said in the title"
 else
   fail "plot of the continuous loop"
 fi

@@ -12,10 +12,13 @@
 namespace pidlab::plot {
 
 /// One run of the loop on its own time grid. Every non-empty vector has the
-/// size of t; u may be empty (the continuous loop has no sampled command).
+/// size of t; u may be empty (a run that recorded no command).
 struct LoopTrace {
   std::string name;  // legend entry, e.g. "kp=1 ki=0.5 kd=2" or "episode 3"
   std::vector<double> t, r, y, e, u, n;
+  /// u is held over each step (the sampled loop's); false: u is the
+  /// continuous loop's at the sample times, drawn as a line.
+  bool u_held = true;
 };
 
 /// Units used in the axis labels.

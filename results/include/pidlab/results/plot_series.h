@@ -4,9 +4,12 @@
 // loop analysis, never by the page.
 
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/analysis/monte_carlo.h"
+#include "pidlab/evaluation/command_series.h"
 #include "pidlab/evaluation/evaluation.h"
 #include "pidlab/spec/status.h"
 
@@ -25,12 +28,9 @@ struct PlotSeriesOptions {
 /// `options`; a sampled loop evaluated with record_trajectory) and `analysis`
 /// found (AnalyzeLoop of the same loop), as the JSON object
 ///   t, y          the evaluation's sample times and y (== `--samples-csv`)
-///   u             the command at those times: the sampled loop's recorded u;
-///                 the continuous loop's u of the undisturbed step response
-///                 (null with dead time)
+///   u             the command at those times (evaluation::CommandAndLoadSeries)
 ///   load_y, load_u  the load response (r = 0, unit step at the plant input,
-///                 the load IAE's run; null for a nonlinear plant or the
-///                 continuous loop with dead time)
+///                 the load IAE's run; null for a nonlinear plant)
 ///   w, s, t_mag, cs |S|, |T|, |C S| on a log grid (rad/s) of the continuous
 ///                 loop (with its dead time; the sampled loop's C(s) G(s) too,
 ///                 "frequency_loop" says which), ms, mt, noise_gain (the analysis)
