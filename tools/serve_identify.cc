@@ -4,7 +4,8 @@
 // record readers, a record beyond max_samples decimated), with its progress
 // at most ten times a second, cancelled within one solver iteration. The
 // result carries the fit's curves and the path of a model file written in
-// the uploads' directory: the plant "model:PATH" of the page's next specs.
+// the uploads' directory: the plant "model:PATH" of the page's next specs,
+// and that file's text, which the page offers as a download.
 
 #include <cmath>
 #include <memory>
@@ -144,12 +145,14 @@ nlohmann::json Fit(const Record& record, const std::string& model, const identif
   if (!status.ok()) return {{"type", "identify_result"}, {"error", Truncate(status.message(), 300)}};
   run.json["source"] = record.source;
   std::string error;
-  const std::string path = ServedLogs()->StoreModel(run.json.dump(1) + "\n", &error);
+  const std::string text = run.json.dump(1) + "\n";
+  const std::string path = ServedLogs()->StoreModel(text, &error);
   if (path.empty()) return {{"type", "identify_result"}, {"error", error}};
   return {{"type", "identify_result"},
           {"result", run.json},
           {"fit", results::IdentifyFitSeries(run.data, run.result)},
-          {"plant", std::string(tune::kModelPlantPrefix) + path}};
+          {"plant", std::string(tune::kModelPlantPrefix) + path},
+          {"model_file", text}};
 }
 
 // The fit on the job's thread: cancelled within one iteration of every

@@ -112,7 +112,8 @@ function commandOf(s, verb, extra) {
   return words.concat(extra || ['--json']).join(' ');
 }
 pidlab.spec = spec;
-pidlab.command = () => commandOf(spec(), 'evaluate');
+// The command names the fitted model by its download (design.js), not the server's file.
+pidlab.command = () => commandOf(views.design ? views.design.portable(spec()) : spec(), 'evaluate');
 
 function setStatus(text) { $('status').textContent = text; }
 

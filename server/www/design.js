@@ -65,32 +65,66 @@ function showFit(reply) {
     table.append(tr);
   }
   $('data-warnings').textContent = (r.warnings || []).map((w) => 'warning: ' + w).join(' ');
+  const box = $('data-box');
+  box.classList.remove('hidden');
+  box.open = true;
   drawFit(reply.fit, r.whiteness);
-  $('data-box').classList.remove('hidden');
+  offerModel(reply);
+  box.scrollIntoView({block: 'start'});
 }
 
+// The fit, its residuals and their autocorrelation, at the fit box's width
+// (the fit across it, the other two side by side), with axis labels.
 function drawFit(fit, whiteness) {
   for (const c of design.fitCharts) c.destroy();
   design.fitCharts = [];
-  const width = Math.max(280, $('data-plots').clientWidth || 320);
+  const full = Math.max(480, $('data-plots').clientWidth || 640);
+  const half = Math.floor(full / 2) - 4;
   const t = fit.t;
-  design.fitCharts.push(new uPlot({
-    title: 'measured (grey) and model (blue) y', width, height: 150, scales: { x: { time: false } },
-    series: [{ label: 't s' }, { label: 'measured', stroke: '#555', width: 1 }, { label: 'model', stroke: '#1f77b4', width: 2 }],
-    legend: { show: false }, axes: [{}, {}],
-  }, [t, fit.y, fit.simulated], $('data-plots')));
+  const chart = (title, width, height, series, axes, data) => design.fitCharts.push(new uPlot(
+      {title, width, height, scales: {x: {time: false}}, series, legend: {show: false}, axes}, data,
+      $('data-plots')));
+  chart(
+      'measured (grey) and model (blue) y', full, 220,
+      [
+        {label: 't s'}, {label: 'measured', stroke: '#555', width: 1},
+        {label: 'model', stroke: '#1f77b4', width: 2}
+      ],
+      [{label: 't (s)'}, {label: 'y'}], [t, fit.y, fit.simulated]);
+  chart(
+      'residuals y - model', half, 170, [{label: 't s'}, {label: 'y - model', stroke: '#d62728', width: 1}],
+      [{label: 't (s)'}, {label: 'y - model'}], [t, fit.residuals]);
   const lags = whiteness.autocorrelation.map((_, i) => i + 1);
   const band = whiteness.band;
-  design.fitCharts.push(new uPlot({
-    title: 'residuals', width, height: 110, scales: { x: { time: false } },
-    series: [{ label: 't s' }, { label: 'y - model', stroke: '#d62728', width: 1 }], legend: { show: false }, axes: [{}, {}],
-  }, [t, fit.residuals], $('data-plots')));
-  design.fitCharts.push(new uPlot({
-    title: 'residual autocorrelation (\u00b1' + app.fmt(band) + ' band)', width, height: 110, scales: { x: { time: false } },
-    series: [{ label: 'lag' }, { label: 'r', stroke: '#1f77b4', width: 0, points: { show: true, size: 4 } },
-      { label: 'band', stroke: '#888', dash: [4, 4], width: 1 }, { label: '-band', stroke: '#888', dash: [4, 4], width: 1 }],
-    legend: { show: false }, axes: [{}, {}],
-  }, [lags, whiteness.autocorrelation, lags.map(() => band), lags.map(() => -band)], $('data-plots')));
+  chart(
+      'residual autocorrelation (\u00b1' + app.fmt(band) + ' band)', half, 170,
+      [
+        {label: 'lag'}, {label: 'r', stroke: '#1f77b4', width: 0, points: {show: true, size: 4}},
+        {label: 'band', stroke: '#888', dash: [4, 4], width: 1},
+        {label: '-band', stroke: '#888', dash: [4, 4], width: 1}
+      ],
+      [{label: 'lag (samples)'}, {label: 'r'}],
+      [lags, whiteness.autocorrelation, lags.map(() => band), lags.map(() => -band)]);
+}
+
+// The model file the server wrote, as a download named after the record.
+function offerModel(reply) {
+  const a = $('data-download');
+  if (a.href) URL.revokeObjectURL(a.href);
+  const name = (design.upload ? design.upload.name.replace(/\.[^.]*$/, '') : 'record') + '.model.json';
+  a.href = URL.createObjectURL(new Blob([reply.model_file], {type: 'application/json'}));
+  a.download = name;
+  a.textContent = 'download the model (' + name + ')';
+  a.classList.remove('hidden');
+  design.modelFile = {name, path: reply.plant.slice('model:'.length)};
+}
+
+// The spec as a user runs it: the fitted model named by its download, not
+// by the server's file (gone when the server stops).
+function portable(s) {
+  const m = design && design.modelFile;
+  if (!m || s.plant !== 'model:' + m.path) return s;
+  return {...s, plant: 'model:' + m.name};
 }
 
 // The fitted model becomes the plant ("model:PATH", the file the server
@@ -339,10 +373,34 @@ export function suggestDt(result) {
 export function initDesign(context) {
   app = context;
   design = window.pidlab.design = {
-    upload: null, fit: null, fitCharts: [], sampled: null, export: null, pil: null,
-    knob: { defaultMs: 0, robustnessMoved: false, running: null, pending: false, last: null, error: null,
-      designs: new Map(), generation: 0, ahead: -1, ready: false },
-    uploadCsv, identify, acceptModel, knobDesign, firmware, pilCost, resetKnob, onIdentifyProgress: identifyProgress,
+    upload: null,
+    fit: null,
+    fitCharts: [],
+    sampled: null,
+    export: null,
+    pil: null,
+    knob: {
+      defaultMs: 0,
+      robustnessMoved: false,
+      running: null,
+      pending: false,
+      last: null,
+      error: null,
+      designs: new Map(),
+      generation: 0,
+      ahead: -1,
+      ready: false
+    },
+    uploadCsv,
+    identify,
+    acceptModel,
+    knobDesign,
+    firmware,
+    pilCost,
+    resetKnob,
+    onIdentifyProgress: identifyProgress,
+    portable,
+    modelFile: null,
   };
   $('data-file').addEventListener('change', () => {
     const f = $('data-file').files[0];

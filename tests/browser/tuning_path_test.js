@@ -18,6 +18,12 @@ const { execFileSync } = require('child_process');
 const { parseArgs, launch, waitForPage, makeStep } = require('./page_driver.js');
 
 const args = parseArgs(process.argv.slice(2), ['url', 'pidlab', 'modules', 'chromium', 'csv', 'out', 'tmp']);
+function canonical(v) {
+  if (Array.isArray(v)) return '[' + v.map(canonical).join(',') + ']';
+  if (v && typeof v === 'object')
+    return '{' + Object.keys(v).sort().map((k) => JSON.stringify(k) + ':' + canonical(v[k])).join(',') + '}';
+  return JSON.stringify(v);
+}
 const waitMs = 60000;  // a fit or a design on a loaded machine
 
 function pidlab(argv) {
@@ -104,6 +110,42 @@ async function main() {
     const rows = await page.$$eval('#data-params tr[data-parameter]', (trs) => trs.length);
     if (rows !== Object.keys(cli.parameters).length) throw new Error('#data-params has ' + rows + ' rows');
     if (fit.fit.simulated.length !== fit.fit.y.length) throw new Error('the fit\'s curves differ in length');
+    // The fit in view: open, in the viewport, at a readable size with axis labels; the model downloads.
+    const view = await page.evaluate(async () => {
+      const box = document.getElementById('data-box');
+      const r = box.getBoundingClientRect();
+      const a = document.getElementById('data-download');
+      return {
+        open: box.open,
+        top: r.top,
+        height: r.height,
+        inner: window.innerHeight,
+        widths: Array.from(document.querySelectorAll('#data-plots .uplot'))
+                    .map((e) => e.getBoundingClientRect().width),
+        labels:
+            window.pidlab.design.fitCharts.flatMap((c) => c.axes.map((x) => x.label)),  // drawn on the canvas
+        name: a.download,
+        hidden: a.classList.contains('hidden')
+      };
+    });
+    // The download as a user gets it: clicked, into the downloads folder.
+    if (!view.hidden) await page.click('#data-download');
+    const saved = path.join(downloads, view.name || 'none');
+    for (const deadline = Date.now() + 20000; !fs.existsSync(saved) && Date.now() < deadline;)
+      await new Promise((r) => setTimeout(r, 50));
+    view.text = fs.existsSync(saved) ? fs.readFileSync(saved, 'utf8') : '';
+    if (!view.open || view.top < -2 || view.top > view.inner - 200 || view.height < 300)
+      throw new Error(
+          'the fit is not in view: ' + JSON.stringify({open: view.open, top: view.top, height: view.height}));
+    if (view.widths.length !== 3 || view.widths[0] < 480 || Math.min(...view.widths) < 240)
+      throw new Error('the fit plots are ' + view.widths.join(', ') + ' px wide');
+    if (!view.labels.includes('t (s)') || !view.labels.includes('y'))
+      throw new Error('axis labels: ' + view.labels.join(', '));
+    if (view.hidden || view.text !== fit.model_file ||
+        canonical(JSON.parse(view.text)) !== canonical(fit.result))
+      throw new Error('the download ' + view.name + ' is not the model file the server wrote');
+    fit.download = view.name;
+    fit.downloads = downloads;
     await shot('fit');
     return cli.model + ', AIC ' + cli.aic.toFixed(3) + ', ' + rows + ' parameters, bit for bit';
   });
@@ -133,7 +175,16 @@ async function main() {
     await page.click('#data-accept');
     const got = await knobGains('no design for the accepted model');
     if (got.spec.plant !== fit.plant) throw new Error('the design ran on ' + got.spec.plant + ', not ' + fit.plant);
-    return compareWithTune(got);
+    // The printed command names the downloaded file, and runs where it is, without the server's.
+    const command = await page.evaluate(() => window.pidlab.command());
+    if (!command.includes('--plant model:' + fit.download + ' '))
+      throw new Error('the command does not name the download: ' + command);
+    const env = Object.assign({}, process.env, {PATH: path.dirname(args.pidlab) + ':' + process.env.PATH});
+    const out = JSON.parse(
+        execFileSync('bash', ['-c', command], {encoding: 'utf8', env, cwd: fit.downloads, timeout: 60000}));
+    const iae = await page.evaluate(() => window.pidlab.lastResult.iae);
+    if (out.iae !== iae) throw new Error('the command gives IAE ' + out.iae + ', the page ' + iae);
+    return compareWithTune(got) + '; ' + command;
   });
 
   await step('4. the response knob, then the robustness knob: the gains of pidlab tune at the front\'s Ms bound (1e-12)', async () => {
