@@ -17,15 +17,9 @@
 #include "pidlab/results/spec_run.h"
 #include "pidlab/tune/problem.h"
 
-using pidlab::analysis::Distribution;
-using pidlab::analysis::MonteCarloOptions;
-using pidlab::analysis::MonteCarloSummary;
 using pidlab::episode_client::EpisodeClient;
-using pidlab::evaluation::Evaluation;
-using pidlab::evaluation::LoopKind;
 using pidlab::evaluation::LoopOptions;
 using pidlab::evaluation::SampledStep;
-using pidlab::spec::NameStyle;
 
 namespace pidlab::cli {
 namespace {
@@ -66,7 +60,7 @@ struct EvaluateCommand {
   int Run() {
     spec::EvaluateSpec s;
     tune::BuildOptions build;
-    build.style = NameStyle::kFlag;
+    build.style = spec::NameStyle::kFlag;
     build.backend = backend == "lcm" ? tune::Backend::kRunner : tune::Backend::kInProcess;
     flags.Apply(&s, &build.given);
     tune::EvaluationProblem problem;
@@ -74,7 +68,7 @@ struct EvaluateCommand {
     const LoopOptions& options = problem.loop;
     tune::EvaluationRunOptions run;
     run.what.record_trajectory = !trajectory_csv.empty();
-    if (run.what.record_trajectory && options.loop != LoopKind::kSampled)
+    if (run.what.record_trajectory && options.loop != evaluation::LoopKind::kSampled)
       throw BadInput("--trajectory-csv needs --loop sampled");
     if (run.what.record_trajectory && options.TotalSteps() + 1 > kMaxRecordedPoints)
       throw BadInput(
@@ -143,7 +137,7 @@ struct EvaluateCommand {
     return text;
   }
 
-  static std::string FormatMonteCarlo(const MonteCarloOptions& mc, const MonteCarloSummary& s) {
+  static std::string FormatMonteCarlo(const analysis::MonteCarloOptions& mc, const analysis::MonteCarloSummary& s) {
     char line[256];
     std::string out;
     if (s.perturbed == analysis::kCovariancePerturbed)
@@ -157,7 +151,7 @@ struct EvaluateCommand {
                   s.invalid ? (" (" + std::to_string(s.invalid) + " invalid draws)").c_str() : "");
     out += line;
     out += "                 min          median       p95          max\n";
-    const std::pair<const char*, const Distribution*> rows[] = {
+    const std::pair<const char*, const analysis::Distribution*> rows[] = {
         {"  IAE          ", &s.iae}, {"  overshoot %  ", &s.overshoot_pct}, {"  Ms           ", &s.ms}};
     for (const auto& [name, d] : rows) {
       std::snprintf(line, sizeof line, "%s  %-12.6g %-12.6g %-12.6g %-12.6g\n", name, d->min, d->median,
@@ -167,7 +161,7 @@ struct EvaluateCommand {
     return out;
   }
 
-  static void WriteTrajectoryCsv(const Evaluation& ev, const std::string& path) {
+  static void WriteTrajectoryCsv(const evaluation::Evaluation& ev, const std::string& path) {
     std::unique_ptr<io::AtomicFile> f;
     Status opened = io::AtomicFile::Open(path, &f);
     if (!opened.ok()) Require(Status(opened.code(), "--trajectory-csv " + opened.message()));

@@ -312,19 +312,10 @@ void RelayTuner::OnCycle(const RelayCycle& c, double t_s) {
   // start where the last one did, and only a sum over many telescopes that out.
   const int n = 3.0 * sigma_ > 0.01 * c.amplitude() ? std::max(o_.settled_cycles, kNoisySettledCycles)
                                                     : o_.settled_cycles;
-  if (static_cast<int>(cycles_.size()) < n + 1) return;  // the first cycle is the approach
   double period = 0.0, amplitude = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const RelayCycle& k = cycles_[cycles_.size() - 1 - i];
-    period += k.period_s() / n;
-    amplitude += k.amplitude() / n;
-  }
-  for (int i = 0; i < n; ++i) {
-    const RelayCycle& k = cycles_[cycles_.size() - 1 - i];
-    if (!(std::abs(k.period_s() - period) <= Tolerance(k) * period) ||
-        !(std::abs(k.amplitude() - amplitude) <= Tolerance(k) * amplitude))
-      return;
-  }
+  if (!LastCyclesAgree(
+          cycles_, n, [this](const RelayCycle& k) { return Tolerance(k); }, &period, &amplitude))
+    return;
   End(RelayPhase::kDone, t_s,
       "converged after " + std::to_string(cycles_.size()) + " cycles: period " + Num(period) +
           " s, amplitude " + Num(amplitude));

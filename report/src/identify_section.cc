@@ -14,10 +14,6 @@
 #include "pidlab/plant_sim/stepper_nonlinear.h"
 #include "pidlab/plot/fit_figure.h"
 
-using pidlab::evaluation::Evaluate;
-using pidlab::evaluation::EvaluateOptions;
-using pidlab::evaluation::Evaluation;
-using pidlab::evaluation::LoopKind;
 using pidlab::evaluation::LoopOptions;
 
 namespace pidlab::report {
@@ -55,7 +51,7 @@ Plant ModelPlant(const identify::IdentifyResult& fit) {
 
 LoopOptions ExperimentLoop(const IdentifySection& s) {
   LoopOptions o;
-  o.loop = LoopKind::kSampled;
+  o.loop = evaluation::LoopKind::kSampled;
   o.dt_s = s.dt_s;
   o.horizon_s = s.horizon_s;
   o.disturbance.kind = DisturbanceKind::kPrbs;
@@ -69,7 +65,7 @@ LoopOptions ExperimentLoop(const IdentifySection& s) {
 
 LoopOptions TuneLoop(const IdentifySection& s) {
   LoopOptions o;
-  o.loop = LoopKind::kSampled;
+  o.loop = evaluation::LoopKind::kSampled;
   o.dt_s = s.tune_dt_s;
   o.horizon_s = s.tune_horizon_s;
   return o;
@@ -77,11 +73,11 @@ LoopOptions TuneLoop(const IdentifySection& s) {
 
 // The open-loop experiment: the record the plant saw (u + n, measured y).
 bool RunExperiment(IdentifySection* s, std::string* error) {
-  EvaluateOptions what;
+  evaluation::EvaluateOptions what;
   what.compute_iae_continuous = false;
   what.record_trajectory = true;
-  Evaluation ev;
-  if (const Status st = Evaluate(Motor(), PidGains{}, ExperimentLoop(*s), what, &ev); !st.ok()) {
+  evaluation::Evaluation ev;
+  if (const Status st = evaluation::Evaluate(Motor(), PidGains{}, ExperimentLoop(*s), what, &ev); !st.ok()) {
     if (error) *error = st.message();
     return false;
   }
@@ -133,12 +129,12 @@ bool TuneAndRun(const IdentifySection& s, const Plant& plant, int robust_samples
   if (!set->tuned) return true;
   LoopOptions run = o.loop;
   run.reference = s.move_rad;
-  EvaluateOptions what;
+  evaluation::EvaluateOptions what;
   what.compute_iae_continuous = false;
   for (const bool motor : {false, true}) {
     const Plant target = motor ? Motor() : Eq3();
-    Evaluation ev;
-    if (const Status st = Evaluate(target, set->tune.gains, run, what, &ev); !st.ok()) {
+    evaluation::Evaluation ev;
+    if (const Status st = evaluation::Evaluate(target, set->tune.gains, run, what, &ev); !st.ok()) {
       if (error) *error = st.message();
       return false;
     }

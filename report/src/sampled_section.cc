@@ -9,10 +9,6 @@
 #include "format.h"
 #include "report_internal.h"
 
-using pidlab::evaluation::Evaluate;
-using pidlab::evaluation::EvaluateOptions;
-using pidlab::evaluation::Evaluation;
-using pidlab::evaluation::LoopKind;
 using pidlab::evaluation::LoopOptions;
 
 namespace pidlab::report {
@@ -99,14 +95,14 @@ bool EvaluateSampledLoops(SampledSection* s, std::string* error) {
     return false;
   }
   LoopOptions sampled = PaperLoop(0.0);
-  sampled.loop = LoopKind::kSampled;
+  sampled.loop = evaluation::LoopKind::kSampled;
   sampled.dt_s = s->dt_s;
-  EvaluateOptions what;
+  evaluation::EvaluateOptions what;
   what.compute_iae_continuous = false;
   // The gains on `loop`, their metrics into *metrics; false with *error.
   const auto evaluate = [&](const LoopOptions& loop, Metrics* metrics) {
-    Evaluation ev;
-    if (const Status st = Evaluate(stepper, s->gains, loop, what, &ev); !st.ok()) {
+    evaluation::Evaluation ev;
+    if (const Status st = evaluation::Evaluate(stepper, s->gains, loop, what, &ev); !st.ok()) {
       if (error) *error = st.message();
       return false;
     }

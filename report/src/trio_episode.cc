@@ -8,11 +8,6 @@
 
 using pidlab::episode_client::EpisodeClient;
 using pidlab::episode_client::EpisodeClientOptions;
-using pidlab::evaluation::Evaluate;
-using pidlab::evaluation::EvaluateOptions;
-using pidlab::evaluation::Evaluation;
-using pidlab::evaluation::LoopKind;
-using pidlab::evaluation::LoopOptions;
 
 namespace pidlab::report {
 
@@ -39,12 +34,12 @@ bool RunTrioEpisode(const TrioEpisodeOptions& options, const Plant& plant, const
   EpisodeClientOptions co;
   co.lcm_url = trio.lcm_url();
   EpisodeClient client(co);
-  LoopOptions loop;
-  loop.loop = LoopKind::kSampled;
+  evaluation::LoopOptions loop;
+  loop.loop = evaluation::LoopKind::kSampled;
   loop.dt_s = dt_s;
   loop.horizon_s = horizon_s;
-  Evaluation ev;
-  if (const Status st = Evaluate(plant, gains, loop, EvaluateOptions{}, &ev, client.AsRunner()); !st.ok()) {
+  evaluation::Evaluation ev;
+  if (const Status st = evaluation::Evaluate(plant, gains, loop, evaluation::EvaluateOptions{}, &ev, client.AsRunner()); !st.ok()) {
     *note = "the trio episode failed: " + st.message() + " (see " + options.log_path + ")";
     return false;
   }

@@ -106,21 +106,9 @@ double RelayExperiment::Step(double t_s, double y) {
 }
 
 bool RelayExperiment::Converged() const {
-  const int n = o_.settled_cycles;
-  if (static_cast<int>(cycles_.size()) < n + 1) return false;  // the first cycle is the approach
   double period = 0.0, amplitude = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const RelayCycle& c = cycles_[cycles_.size() - 1 - i];
-    period += c.period_s() / n;
-    amplitude += c.amplitude() / n;
-  }
-  for (int i = 0; i < n; ++i) {
-    const RelayCycle& c = cycles_[cycles_.size() - 1 - i];
-    if (!(std::abs(c.period_s() - period) <= o_.tolerance * period) ||
-        !(std::abs(c.amplitude() - amplitude) <= o_.tolerance * amplitude))
-      return false;
-  }
-  return true;
+  return LastCyclesAgree(
+      cycles_, o_.settled_cycles, [this](const RelayCycle&) { return o_.tolerance; }, &period, &amplitude);
 }
 
 RelayEstimates RelayExperiment::Estimate() const { return EstimateFromCycles(o_, cycles_, Converged(), 0.0); }

@@ -33,6 +33,7 @@
 // Every decision reads only the measurements and the options, so a log of
 // the episode gives the same cycles and the same end.
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -91,6 +92,30 @@ struct RelayCycle {
   double period_s() const { return t_on_s + t_off_s; }
   double amplitude() const { return 0.5 * (e_max - e_min); }
 };
+
+/// The mean period and amplitude of the last n cycles, and whether each of
+/// them lies within tolerance(cycle) (relative) of both: false with fewer than
+/// n + 1 cycles (the first is the approach). *period and *amplitude are
+/// written whenever there are enough cycles.
+template <typename Tolerance>
+bool LastCyclesAgree(const std::vector<RelayCycle>& cycles, int n, Tolerance tolerance, double* period,
+                     double* amplitude) {
+  if (n < 1 || static_cast<int>(cycles.size()) < n + 1) return false;
+  *period = *amplitude = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const RelayCycle& c = cycles[cycles.size() - 1 - i];
+    *period += c.period_s() / n;
+    *amplitude += c.amplitude() / n;
+  }
+  for (int i = 0; i < n; ++i) {
+    const RelayCycle& c = cycles[cycles.size() - 1 - i];
+    const double tol = tolerance(c);
+    if (!(std::abs(c.period_s() - *period) <= tol * *period) ||
+        !(std::abs(c.amplitude() - *amplitude) <= tol * *amplitude))
+      return false;
+  }
+  return true;
+}
 
 class RelayTuner {
  public:
