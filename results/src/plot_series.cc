@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "pidlab/results/results_json.h"
+#include "pidlab/spec/field.h"
+
 namespace pidlab::results {
 namespace {
 using analysis::LoopAnalysis;
@@ -52,6 +55,83 @@ std::vector<double> FrequencyGrid(const LoopAnalysis& a, const LoopOptions& opti
   return w;
 }
 
+constexpr double kPi = 3.14159265358979323846;
+// The dead time's phase turns by at most this between neighbours of the grid
+// (4 points per turn), and the served phase by at most kServedStepDeg.
+constexpr double kDelayStepRad = kPi / 2.0;
+constexpr double kServedStepDeg = 120.0;
+constexpr int kPhaseRefinements = 8;
+
+// `w` with points inserted evenly wherever the dead time's phase, -rate_s w
+// (rad), turns by more than kDelayStepRad between neighbours; cut where it
+// would exceed max_points (*cut_rad_s its last frequency, else +inf).
+std::vector<double> DelayResolvedGrid(const std::vector<double>& w, double rate_s, int max_points,
+                                      double* cut_rad_s) {
+  *cut_rad_s = std::numeric_limits<double>::infinity();
+  if (!(rate_s > 0.0) || w.empty()) return w;
+  std::vector<double> out{w.front()};
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    const double span = w[i] - w[i - 1];
+    const double parts = std::max(1.0, std::ceil(span * rate_s / kDelayStepRad));
+    if (static_cast<double>(out.size()) + parts > static_cast<double>(max_points)) {
+      *cut_rad_s = out.back();
+      break;
+    }
+    for (double k = 1.0; k < parts; k += 1.0) out.push_back(w[i - 1] + span * (k / parts));
+    out.push_back(w[i]);
+  }
+  return out;
+}
+
+// `w` with the geometric midpoint of every interval whose phase step exceeds
+// kServedStepDeg (a fast turn of the rational part), while within max_points.
+std::vector<double> SplitPhaseSteps(const std::vector<double>& w, const std::vector<double>& phase_deg,
+                                    int max_points) {
+  std::vector<double> out{w.front()};
+  std::size_t room = static_cast<std::size_t>(max_points) - std::min(w.size(), std::size_t(max_points));
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    if (room > 0 && std::abs(phase_deg[i] - phase_deg[i - 1]) > kServedStepDeg) {
+      out.push_back(std::sqrt(w[i - 1] * w[i]));
+      --room;
+    }
+    out.push_back(w[i]);
+  }
+  return out;
+}
+
+// L, S, T, C S and the continuous phase of L (analysis::LoopPhaseDeg) on the
+// grid: FrequencyGrid's, resolved for the dead time and the phase's turns.
+Status ResolvedFrequencyResponse(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
+                                 const LoopAnalysis& analysis, const PlotSeriesOptions& o,
+                                 std::vector<LoopFrequencyPoint>* response, std::vector<double>* phase_deg,
+                                 std::vector<std::string>* notes) {
+  std::vector<double> w = FrequencyGrid(analysis, options, o);
+  const auto evaluate = [&]() {
+    if (const Status st = analysis::LoopFrequencyResponse(plant, typed_gains, options, w, response); !st.ok())
+      return st;
+    return analysis::LoopPhaseDeg(plant, typed_gains, options, *response, phase_deg);
+  };
+  if (const Status st = evaluate(); !st.ok()) return st;
+  // The dead time's phase is -rate w: its rate from the first point.
+  const double rate_s = -response->front().delay_phase_rad / w.front();
+  double cut_rad_s = std::numeric_limits<double>::infinity();
+  if (rate_s > 0.0) {
+    w = DelayResolvedGrid(w, rate_s, o.max_frequency_points, &cut_rad_s);
+    if (const Status st = evaluate(); !st.ok()) return st;
+  }
+  for (int round = 0; round < kPhaseRefinements; ++round) {
+    std::vector<double> refined = SplitPhaseSteps(w, *phase_deg, o.max_frequency_points);
+    if (refined.size() == w.size()) break;
+    w.swap(refined);
+    if (const Status st = evaluate(); !st.ok()) return st;
+  }
+  if (std::isfinite(cut_rad_s))
+    notes->push_back("the frequency plots end at " + spec::FormatNumber(cut_rad_s) +
+                     " rad/s: above, the dead time's phase turns faster than " +
+                     std::to_string(o.max_frequency_points) + " points resolve");
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const LoopOptions& options,
@@ -60,15 +140,23 @@ Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const LoopOpt
   if (!(series_options.frequency_points >= 10 && series_options.frequency_points <= 5000))
     return Status::InvalidInput("frequency_points " + std::to_string(series_options.frequency_points) +
                                 " must be in 10..5000");
+  if (!(series_options.max_frequency_points >= series_options.frequency_points + 3 &&
+        series_options.max_frequency_points <= 20000))
+    return Status::InvalidInput("max_frequency_points " +
+                                std::to_string(series_options.max_frequency_points) +
+                                " must be in frequency_points + 3..20000");
   std::vector<std::string> notes;
   *series = nlohmann::json::object();
   TimeSeries(plant, typed_gains, options, evaluation, series, &notes);
-  const std::vector<double> w = FrequencyGrid(analysis, options, series_options);
   std::vector<LoopFrequencyPoint> response;
-  if (const Status st = analysis::LoopFrequencyResponse(plant, typed_gains, options, w, &response); !st.ok())
+  std::vector<double> phase_deg;
+  if (const Status st = ResolvedFrequencyResponse(plant, typed_gains, options, analysis, series_options,
+                                                  &response, &phase_deg, &notes);
+      !st.ok())
     return Status::RunnerFailed(st.message());
-  std::vector<double> s, t, cs, l_re, l_im;
+  std::vector<double> w, s, t, cs, l_re, l_im;
   for (const LoopFrequencyPoint& p : response) {
+    w.push_back(p.w_rad_s);
     s.push_back(std::abs(p.s));
     t.push_back(std::abs(p.t));
     cs.push_back(std::abs(p.cs));
@@ -81,6 +169,9 @@ Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const LoopOpt
   (*series)["cs"] = cs;
   (*series)["l_re"] = l_re;
   (*series)["l_im"] = l_im;
+  (*series)["l_phase_deg"] = phase_deg;
+  (*series)["gain_crossovers_rad_s"] = analysis.gain_crossovers_rad_s;
+  (*series)["phase_crossover_rad_s"] = JsonNumber(analysis.phase_crossover_rad_s);
   (*series)["frequency_loop"] = evaluation::ToString(options.loop);
   (*series)["ms"] = analysis.ms;
   (*series)["mt"] = analysis.mt;

@@ -121,7 +121,8 @@ function drawKick(u, clip) {
 }
 
 // Bode: |L|, |S|, |T| and |CS| in dB (the Ms line dashed), the phase of L
-// in degrees on the right axis.
+// in degrees on the right axis: the server's l_phase_deg, its view clipped
+// to the crossovers' range (phaseView).
 function freqChart(el, pinned) {
   const series = [{ label: 'w rad/s' },
     { label: '|L| dB', stroke: '#000', width: 1.5 },
@@ -134,30 +135,78 @@ function freqChart(el, pinned) {
     series.push({ label: p.label + ' |S| dB', stroke: pinColour(i), width: 1, dash: [6, 3] });
     series.push({ label: p.label + ' |T| dB', stroke: pinColour(i), width: 1, dash: [2, 2] });
   });
+  const degRange = (u, lo, hi) => {
+    u.pidlabPhase = phaseView(u.data[0] || [], u.data[6] || [], u.pidlabCrossovers || []);
+    return u.pidlabPhase.range || autoRange(lo, hi);
+  };
   return new uPlot({
     title: 'Bode: |L|, |S|, |T|, |CS| (dB) and the phase of L', ...size(el), series,
-    scales: { x: { time: false, distr: 3 }, y: { auto: true }, deg: { auto: true } },
-    axes: [{ label: 'w (rad/s)', values: logTicks }, { label: 'dB' }, { label: 'phase (deg)', scale: 'deg', side: 1, grid: { show: false } }],
+    scales: { x: { time: false, distr: 3 }, y: { auto: true }, deg: { auto: true, range: degRange } },
+    axes: [{ label: 'w (rad/s)', values: logTicks }, { label: 'dB' },
+      { label: 'phase (deg)', scale: 'deg', side: 1, grid: { show: false }, incrs: [15, 30, 45, 90, 180, 360, 720, 1440, 2880] }],
+    hooks: { draw: [(u) => drawPhaseNotes(u, u.pidlabPhase)] },
   }, [[], [], [], [], [], [], [], ...pinned.flatMap(() => [[], []])], el);
 }
 
 const dB = (v) => (v === null || !(v > 0) ? null : 20 * Math.log10(v));
 
-// The phase of L in degrees, unwrapped along the grid (drawing only).
-function phaseDeg(re, im) {
-  const out = [];
-  let last = null, turn = 0;
-  for (let i = 0; i < re.length; i++) {
-    if (re[i] === null || im[i] === null) { out.push(null); continue; }
-    let p = (Math.atan2(im[i], re[i]) * 180) / Math.PI + turn;
-    if (last !== null) {
-      while (p - last > 180) { p -= 360; turn -= 360; }
-      while (p - last < -180) { p += 360; turn += 360; }
-    }
-    out.push(p);
-    last = p;
+// The phase axis's view: the phase from a decade below the lowest of the
+// `crossovers` (gain, and the gain margin's phase crossover) to twice the highest, -180 included, padded and widened to
+// multiples of 45 degrees; where the curve leaves it, `exits` say where and
+// how far it goes ({w, side: 'below' | 'above', extreme}). Without a
+// crossover: no clip (range null).
+export function phaseView(w, phase, crossovers) {
+  const at = crossovers.filter((x) => typeof x === 'number' && x > 0 && isFinite(x));
+  if (!at.length || !w.length) return { range: null, exits: [] };
+  const from = Math.min(...at) / 10, to = Math.max(...at) * 2;
+  let lo = -180, hi = -180;
+  for (let i = 0; i < w.length; i++) {
+    if (w[i] < from || w[i] > to || phase[i] === null || !isFinite(phase[i])) continue;
+    lo = Math.min(lo, phase[i]);
+    hi = Math.max(hi, phase[i]);
   }
-  return out;
+  const pad = Math.max(0.05 * (hi - lo), 10);
+  const range = [45 * Math.floor((lo - pad) / 45), 45 * Math.ceil((hi + pad) / 45)];
+  // Each stretch outside the view: where it starts and its farthest value.
+  const exits = [];
+  let cur = null;
+  for (let i = 0; i < w.length; i++) {
+    const v = phase[i];
+    const side = v === null || !isFinite(v) ? null : v < range[0] ? 'below' : v > range[1] ? 'above' : null;
+    if (side && (!cur || cur.side !== side)) { cur = { w: w[i], side, extreme: v }; exits.push(cur); }
+    else if (side) cur.extreme = side === 'below' ? Math.min(cur.extreme, v) : Math.max(cur.extreme, v);
+    else cur = null;
+  }
+  return { range, exits };
+}
+
+// The -180 degree line and a note per stretch of the phase outside its view.
+function drawPhaseNotes(u, view) {
+  if (!view || !view.range) return;
+  const ctx = u.ctx, px = devicePixelRatio;
+  const y = u.valToPos(-180, 'deg', true);
+  ctx.save();
+  ctx.strokeStyle = 'rgba(148,103,189,0.5)';
+  ctx.lineWidth = px;
+  ctx.setLineDash([2 * px, 3 * px]);
+  ctx.beginPath();
+  ctx.moveTo(u.bbox.left, y);
+  ctx.lineTo(u.bbox.left + u.bbox.width, y);
+  ctx.stroke();
+  ctx.fillStyle = '#6a3d9a';
+  ctx.font = (11 * px) + 'px system-ui, sans-serif';
+  ctx.textBaseline = 'alphabetic';
+  ctx.textAlign = 'left';
+  view.exits.slice(0, 2).forEach((e, i) => {
+    const text = (e.side === 'below' ? '\u2193 phase below ' + view.range[0] : '\u2191 phase above ' + view.range[1]) +
+      '\u00b0 from ' + Number(e.w.toPrecision(3)) + ' rad/s (to ' + Math.round(e.extreme) + '\u00b0, clipped)';
+    // At the exit, kept inside the plotting area.
+    const width = ctx.measureText(text).width;
+    const x = Math.max(u.bbox.left + 4 * px, Math.min(u.valToPos(e.w, 'x', true) + 4 * px, u.bbox.left + u.bbox.width - width - 4 * px));
+    const y = e.side === 'below' ? u.bbox.top + u.bbox.height - (6 + 14 * i) * px : u.bbox.top + (14 + 14 * i) * px;
+    ctx.fillText(text, x, y);
+  });
+  ctx.restore();
 }
 
 const kNyquistX = [-3.5, 1.5];
@@ -338,8 +387,11 @@ export function drawPlots(plots, series, pinned, trio, sampled) {
   // frequencies by interpolation on log w (drawing only; its numbers are its reply's).
   const onGrid = (p, key) => (p.series ? resample(p.series.w, p.series[key], series.w).map(dB) : new Array(m).fill(null));
   const lMag = series.l_re.map((re, i) => (re === null || series.l_im[i] === null ? null : Math.hypot(re, series.l_im[i])));
+  // The crossovers that matter: every gain crossover and the gain margin's
+  // phase crossover (a dead time has phase crossovers without end).
+  plots.freq.pidlabCrossovers = [...(series.gain_crossovers_rad_s || []), series.phase_crossover_rad_s];
   plots.freq.setData([series.w, lMag.map(dB), series.s.map(dB), series.t_mag.map(dB), series.cs.map(dB), new Array(m).fill(dB(series.ms)),
-    phaseDeg(series.l_re, series.l_im), ...pinned.flatMap((p) => [onGrid(p, 's'), onGrid(p, 't_mag')])]);
+    orEmpty(series.l_phase_deg, m), ...pinned.flatMap((p) => [onGrid(p, 's'), onGrid(p, 't_mag')])]);
   plots.nyquist.setData([null, ...nyquistSegments(series), circle(series.ms), [[-1], [0]],
     ...pinned.flatMap((p) => nyquistSegments(p.series))]);
 }

@@ -458,6 +458,7 @@ bool LoopFrequencyResponseOrExplain(const Plant& plant, const PidGains& typed_ga
     for (const double w : w_rad_s) {
       const Point p = r.At(w);
       response->push_back(FrequencyPoint(w, p.a, p.b, p.c));
+      response->back().delay_phase_rad = r.DelayPhase(w);
     }
     return true;
   }
@@ -468,6 +469,7 @@ bool LoopFrequencyResponseOrExplain(const Plant& plant, const PidGains& typed_ga
     cd av = Eval(a, cd(0.0, w));
     if (plant.delay_s > 0.0) av *= std::polar(1.0, -w * plant.delay_s);
     response->push_back(FrequencyPoint(w, av, Eval(b, cd(0.0, w)), Eval(c, cd(0.0, w))));
+    response->back().delay_phase_rad = -w * plant.delay_s;
   }
   return true;
 }

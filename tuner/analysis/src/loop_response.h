@@ -97,11 +97,13 @@ class SampledResponse : public Response {
     // The plant with its dead time: z^-d C (zI - Phi)^-1 (Gamma0 z + Gamma1)
     // (docs/deadtime.md); without one, C (zI - Phi)^-1 Gamma.
     cd g = static_cast<int>(phi_.rows()) <= kSmallOrder ? SmallPlantAt(z) : PlantAt(z);
-    if (delay_steps_ > 0) g *= std::polar(1.0, -w * dt_ * static_cast<double>(delay_steps_));
+    if (delay_steps_ > 0) g *= std::polar(1.0, DelayPhase(w));
     const cd nc = Eval(nc_, z);
     return {nc * g, Eval(dc_, z), nc};
   }
   const Polynomial& controller_num() const { return nc_; }
+  // The phase of z^{-d} at w, rad.
+  double DelayPhase(double w) const { return -w * dt_ * static_cast<double>(delay_steps_); }
 
  private:
   // Up to this order the plant's response is solved on the stack: the

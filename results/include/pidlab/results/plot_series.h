@@ -19,6 +19,11 @@ struct PlotSeriesOptions {
   /// Points of the log frequency grid (plus the frequencies of Ms, Mt and the
   /// noise gain, so that the grid's peaks are the reported ones). 10..5000.
   int frequency_points = 300;
+  /// The grid's points at most, after points are inserted where the dead
+  /// time's phase turns by more than pi/2 between neighbours and where the
+  /// phase of L steps by more than 120 degrees; the grid is cut below its top
+  /// (with a note) rather than exceed it. frequency_points + 3..20000.
+  int max_frequency_points = 2000;
   /// The grid spans this factor below and above the gain crossover (1 rad/s
   /// without one). > 1.
   double decades_around_crossover = 3.0;
@@ -35,6 +40,13 @@ struct PlotSeriesOptions {
 ///                 loop (with its dead time; the sampled loop's C(s) G(s) too,
 ///                 "frequency_loop" says which), ms, mt, noise_gain (the analysis)
 ///   l_re, l_im    L(jw) on that grid (the Nyquist curve)
+///   l_phase_deg   the phase of L, degrees, continuous along the grid
+///                 (analysis::LoopPhaseDeg); the grid resolves the dead time:
+///                 its phase turns by at most 90 degrees between neighbours,
+///                 and the phase of L steps by at most 120 (within
+///                 max_frequency_points)
+///   gain_crossovers_rad_s  the analysis's gain crossovers
+///   phase_crossover_rad_s  its phase crossover of the gain margin (NaN: null)
 ///   notes         what is missing and why.
 /// kRunnerFailed with the message if the frequency response fails.
 Status PlotSeries(const Plant& plant, const PidGains& typed_gains, const evaluation::LoopOptions& options,

@@ -16,7 +16,8 @@
 // its stability is the Nyquist count (CountNyquist), its crossovers are
 // bracketed on a grid on which e^{-jwL} turns by at most pi/16 per point, and
 // no closed-loop pole is computed (no time constant, no cancellation). The
-// sampled loop with dead time is refused (not supported yet).
+// sampled loop with dead time holds it as z^{-d} times the ZOH plant of the
+// remaining fraction of a step (plant_sim/discrete_plant.h).
 //
 // Peaks are found by a method that cannot miss a narrow one: a log grid
 // (points_per_decade) merged with every frequency where a narrow feature can
@@ -128,6 +129,11 @@ Status AnalyzeLoop(const Plant& plant, const PidGains& gains, const evaluation::
 struct LoopFrequencyPoint {
   double w_rad_s = 0.0;
   std::complex<double> l, s, t, cs;
+  /// The phase of the pure delay in l, rad (<= 0): -w L of the continuous
+  /// loop's e^{-jwL}, -w d dt of the sampled loop's z^{-d} (d the whole steps
+  /// of DiscretePlant::delay_steps(); the fraction of a step is in the ZOH
+  /// plant's rational part). 0 without dead time.
+  double delay_phase_rad = 0.0;
 };
 
 /// L, S, T and C S of the loop of `plant` with `gains` (LoopGains of
@@ -141,6 +147,19 @@ struct LoopFrequencyPoint {
 Status LoopFrequencyResponse(const Plant& plant, const PidGains& gains,
                              const evaluation::LoopOptions& options, const std::vector<double>& w_rad_s,
                              std::vector<LoopFrequencyPoint>* response);
+
+/// The phase of L in degrees at every point of `response` (LoopFrequencyResponse
+/// of this loop at increasing frequencies), continuous in w: the phase of L's
+/// rational part, l e^{-j delay_phase_rad}, followed from its low-frequency
+/// asymptote c (jw)^-k (taken in (-315, 45] degrees; six decades below the
+/// first point) and along the points, each step of more than 45 degrees
+/// bisected until it is resolved; plus the pure delay's phase exactly, in
+/// degrees. Equal to arg l modulo 360 at every point; NaN where l is not
+/// finite. Every figure of a loop's phase uses it (docs/workbench.md, "The
+/// phase"). kInvalidInput as LoopFrequencyResponse, or for frequencies that
+/// do not increase.
+Status LoopPhaseDeg(const Plant& plant, const PidGains& gains, const evaluation::LoopOptions& options,
+                    const std::vector<LoopFrequencyPoint>& response, std::vector<double>* phase_deg);
 
 /// Bounds on a loop (+inf / 0 = none), checked by LoopBoundsViolation.
 struct LoopBounds {
