@@ -271,6 +271,21 @@ async function main() {
               shown.frame.horizon_s + ' s');
         }
         await shot('deadtime');
+        // docs/workbench-thermal.png: the knob's default design on a thermal plant with dead time, 1280x800.
+        await page.setViewport({ width: 1280, height: 800 });
+        await page.evaluate(() => window.pidlab.resetPlant({ plant: 'custom', num: '2', den: '60,1', delay: '8' }));
+        await page.click('#knob-design');
+        await waitForPage(session, 'no default design for the thermal plant', tuneMs, () => {
+          const k = window.pidlab.design.knob, r = window.pidlab.lastResult;
+          return k.last && !k.running && !k.pending && r && r.spec.delay === 8 && r.gains.kp === k.last.result.gains.kp;
+        });
+        const thermal = await page.evaluate(() => ({ u: window.pidlab.lastSeries.u, load: window.pidlab.lastSeries.load_y }));
+        if (!Array.isArray(thermal.u) || !Array.isArray(thermal.load))
+          throw new Error('the thermal design has no u or load response');
+        await page.evaluate(() => window.scrollTo(0, 0));
+        await page.screenshot({ path: path.join(args.out, 'workbench-thermal.png') });
+        await page.setViewport({ width: 1400, height: 1000 });
+        details.push('the thermal plant\'s default design drawn (workbench-thermal.png)');
         return details.join('; ');
       });
 
