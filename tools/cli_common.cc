@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "pidlab/plant_sim/plants.h"
 #include "pidlab/transport/wire.h"
 
 using pidlab::analysis::AnalyzeLoop;
@@ -401,16 +403,26 @@ std::string FormatEvaluation(const Evaluation& ev) {
   else
     os << "closed-loop poles " << (ev.options.loop == LoopKind::kSampled ? "(z) " : "(s) ")
        << FormatPoles(ev.stability.poles) << "\n";
-  os << "IAE (eq. 4)      " << num(ev.iae) << "\n";
-  if (ev.options.reference != 1.0) os << "IAE / A          " << num(ev.iae_per_unit) << "\n";
+  // The integrals of |e| in the plant's units head the scores; eq. (4)'s sum
+  // of samples (which changes with the sample time) keeps its name and the
+  // first place on the paper's plants (docs/tuning.md, "Any plant").
+  std::ostringstream integrals, sums;
+  integrals << "integral |e| dt  " << num(ev.iae_continuous) << "\n";
+  if (!std::isnan(ev.load_iae_continuous))
+    integrals << "load |e| dt      " << num(ev.load_iae_continuous) << "   (integral of |y|, the unit load step)\n";
+  const std::vector<std::string> builtin = BuiltinPlantNames();
+  const bool paper = std::find(builtin.begin(), builtin.end(), ev.plant.name) != builtin.end();
+  sums << (paper ? "IAE (eq. 4)      " : "sum |e(t_k)|     ") << num(ev.iae)
+       << (paper ? "" : "   (eq. 4's form: over the samples, it changes with --sample-time)") << "\n";
+  if (ev.options.reference != 1.0) sums << "IAE / A          " << num(ev.iae_per_unit) << "\n";
   if (ev.options.disturbance.kind != DisturbanceKind::kNone)
-    os << "IAE undisturbed  " << num(ev.iae_undisturbed) << "\n";
-  os << "load IAE         " << num(ev.load_iae) << "   (unit step at the plant input, r = 0)\n";
+    sums << "IAE undisturbed  " << num(ev.iae_undisturbed) << "\n";
+  sums << (paper ? "load IAE         " : "load sum |e|     ") << num(ev.load_iae)
+       << "   (unit step at the plant input, r = 0)\n";
+  os << (paper ? sums.str() : integrals.str() + sums.str());
   os << "ISE              " << num(ev.ise) << "\n";
   os << "ITAE             " << num(ev.itae) << "\n";
-  os << "integral |e| dt  " << num(ev.iae_continuous) << "\n";
-  if (!std::isnan(ev.load_iae_continuous))
-    os << "load |e| dt      " << num(ev.load_iae_continuous) << "   (integral of |y|, the unit load step)\n";
+  if (paper) os << integrals.str();
   if (ev.step.valid) {
     os << "rise time        " << num(ev.step.rise_time_s) << " s   (10-90 %, stepinfo)\n";
     os << "overshoot        " << num(ev.step.overshoot_pct) << " %\n";

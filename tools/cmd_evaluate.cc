@@ -35,9 +35,11 @@ struct EvaluateCommand {
 
   std::function<int()> Register(CLI::App* app) {
     app->description(
-        "Evaluate one PID gain set on a plant: the paper's IAE (eq. 4) and other error sums, closed-loop "
-        "poles and strict stability, MATLAB-stepinfo rise/overshoot/settling of the unit-step response, "
-        "margins, Ms, Mt, noise gain and the slowest time constant (docs/robustness.md).");
+        "Evaluate one PID gain set on a plant: the integral of |e| of the setpoint step and of a unit load "
+        "step at the plant input (in the plant's units; on the paper's plants eq. (4)'s IAE first), the "
+        "other error sums, closed-loop poles and strict stability, MATLAB-stepinfo rise/overshoot/settling "
+        "of the unit-step response, margins, Ms, Mt, noise gain and the slowest time constant "
+        "(docs/robustness.md).");
     flags.Register(app, spec::EvaluateSpec{});
     app->add_flag("--json", json,
                   "print one JSON object instead of the table (with the spec it ran, \"spec\")");
