@@ -83,7 +83,17 @@ case $case in
 import json; x = json.load(open("out.json"))["experiment"]
 ok = 0.03 < x["noise_sigma"] < 0.07 and abs(x["hysteresis"] - 3 * x["noise_sigma"]) < 1e-12
 print(("PASS " if ok else "FAIL ") + "the hold measured the noise (sigma %.4g of 0.05) and set the hysteresis to 3 sigma (%.4g)"
-      % (x["noise_sigma"], x["hysteresis"]))' ;;
+      % (x["noise_sigma"], x["hysteresis"]))
+# The verification read through the noise (issue 60): smoothed, the band widened and said, a settling
+# time that is not 0, adopted because the smoothed step stays in the band; stepinfo of the raw y beside it.
+j = json.load(open("out.json")); v = j["verification"]; s = v["smoothing"]
+ok = (v["read"] == "smoothed" and s["window_samples"] > 1 and s["band_widening"] > 0 and
+      abs(s["band"] - 0.02 - s["band_widening"]) < 1e-12 and 0 < v["settling_time_s"] < v["horizon_s"] - s["tail_s"] and
+      v["settled"] is True and j["adopted"] is True and v["overshoot_pct"] < v["stepinfo"]["overshoot_pct"])
+print(("PASS " if ok else "FAIL ") + "the verification is read smoothed over %d samples in the band 2 %% + %.3g: overshoot %.3g %% "
+      "(raw %.3g %%), settling %.4g s (raw %.4g s), settled and adopted"
+      % (s["window_samples"], s["band_widening"], v["overshoot_pct"], v["stepinfo"]["overshoot_pct"],
+         v["settling_time_s"], v["stepinfo"]["settling_time_s"]))' ;;
   heat_only)  # u in [0, 2], the previous PI holding r = 0.2: the relay's low side is cut to u = 0
     autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --reference 0.2 --output-limits 0,2 --gains 0.5,0.5,0 \
       || echo "FAIL autotune: $(tail -1 err)"
