@@ -18,9 +18,10 @@ constexpr ProcessModelKind kAutoKinds[] = {ProcessModelKind::kP1D, ProcessModelK
                                            ProcessModelKind::kP2DZ};
 
 // Why auto does not choose candidate `c` (AutoCandidate::set_aside), or
-// "": a parameter the record does not identify, no covariance, or its
-// design's starts pruned by AIC against `lowest` (the kind of lowest AIC
-// before it).
+// "": a parameter the record does not identify, or its design's starts
+// pruned by AIC against `lowest` (the kind of lowest AIC before it). No
+// covariance alone is no reason: P2D's two equal lags (a double pole) have
+// none, the pair identified but not which lag is which.
 std::string SetAsideReason(const AutoCandidate& c, const AutoCandidate* lowest) {
   if (!c.status.ok()) return "";
   const IdentifyResult& r = c.result;
@@ -34,9 +35,6 @@ std::string SetAsideReason(const AutoCandidate& c, const AutoCandidate* lowest) 
            " was more than " + internal::Number(internal::kPruneAic) + " above " + ToString(lowest->kind) +
            "'s " + internal::Number(lowest->result.aic) + ", so its other " +
            std::to_string(r.starts_skipped) + " starts were not run";
-  if (!r.covariance_ok)
-    return "no covariance (" + r.covariance_message +
-           "): a combination of its parameters is not identifiable";
   return "";
 }
 
