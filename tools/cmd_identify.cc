@@ -410,7 +410,7 @@ struct IdentifyCommand {
         os << "  " << std::left << std::setw(6) << identify::ToString(c.kind)
            << (c.status.ok() ? "AIC " + Num(c.result.aic, 8) + ", fit " + Num(c.result.fit_percent, 6) + " %"
                              : "failed: " + c.status.message())
-           << "\n";
+           << (c.set_aside.empty() ? "" : "; set aside: " + c.set_aside) << "\n";
       header = os.str();
     }
     if (!log.empty()) {

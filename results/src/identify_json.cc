@@ -64,6 +64,34 @@ void WarnIfTooCoarse(const identify::Decimation& d, identify::IdentifyResult* r)
 
 }  // namespace
 
+namespace {
+
+// {name: {value, standard_error, at_bound if at one}}.
+nlohmann::json ParametersJson(const identify::IdentifyResult& r) {
+  nlohmann::json parameters = nlohmann::json::object();
+  for (std::size_t i = 0; i < r.names.size(); ++i) {
+    parameters[r.names[i]] = {{"value", JsonNumber(r.values[i])},
+                              {"standard_error", JsonNumber(r.standard_errors.at(i))}};
+    // A parameter at a bound: its interval is one-sided, so no standard error.
+    if (i < r.at_bound.size() && !r.at_bound[i].empty()) parameters[r.names[i]]["at_bound"] = r.at_bound[i];
+  }
+  return parameters;
+}
+
+// [{parameter, reason, simpler_model or null}].
+nlohmann::json NotIdentifiableJson(const identify::IdentifyResult& r) {
+  nlohmann::json not_identifiable = nlohmann::json::array();
+  for (const identify::IdentifyResult::NotIdentifiable& n : r.not_identifiable)
+    not_identifiable.push_back(
+        {{"parameter", n.parameter},
+         {"reason", n.reason},
+         {"simpler_model",
+          n.simpler_model.empty() ? nlohmann::json(nullptr) : nlohmann::json(n.simpler_model)}});
+  return not_identifiable;
+}
+
+}  // namespace
+
 nlohmann::json IdentifyAutoJson(const identify::AutoResult& a) {
   nlohmann::json j = IdentifyResultJson(a.candidates.at(static_cast<std::size_t>(a.chosen)).result);
   nlohmann::json candidates = nlohmann::json::array();
@@ -75,9 +103,11 @@ nlohmann::json IdentifyAutoJson(const identify::AutoResult& a) {
       cj["delta_aic"] = JsonNumber(c.result.aic - best);
       cj["fit_percent"] = JsonNumber(c.result.fit_percent);
       cj["operating_point"] = {{"u0", JsonNumber(c.result.u0)}, {"source", c.result.u0_source}};
+      cj["parameters"] = ParametersJson(c.result);
     } else {
       cj["message"] = c.status.message();
     }
+    cj["set_aside"] = c.set_aside.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.set_aside);
     candidates.push_back(cj);
   }
   j["auto"] = {{"chosen", identify::ToString(a.candidates.at(static_cast<std::size_t>(a.chosen)).kind)},
@@ -87,13 +117,7 @@ nlohmann::json IdentifyAutoJson(const identify::AutoResult& a) {
 }
 
 nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
-  nlohmann::json parameters = nlohmann::json::object();
-  for (std::size_t i = 0; i < r.names.size(); ++i) {
-    parameters[r.names[i]] = {{"value", JsonNumber(r.values[i])},
-                              {"standard_error", JsonNumber(r.standard_errors.at(i))}};
-    // A parameter at a bound: its interval is one-sided, so no standard error.
-    if (i < r.at_bound.size() && !r.at_bound[i].empty()) parameters[r.names[i]]["at_bound"] = r.at_bound[i];
-  }
+  const nlohmann::json parameters = ParametersJson(r);
   const TransferFunction tf = r.model.ToTransferFunction();
   nlohmann::json num = nlohmann::json::array(), den = nlohmann::json::array();
   for (double c : tf.num) num.push_back(JsonNumber(c));
@@ -151,6 +175,8 @@ nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r) {
       {"seed", r.seed},
       {"arx_start", r.arx_start},
       {"nested_starts", r.nested_starts},
+      {"starts_skipped", r.starts_skipped},
+      {"not_identifiable", NotIdentifiableJson(r)},
       {"delay_profile_improved", r.delay_profile_improved},
       {"bounds_refit_improved", r.bounds_refit_improved},
       {"operating_point", OperatingPointJson(r)},

@@ -109,7 +109,10 @@ void BuildProblem(const Record& record, double* theta, ceres::Problem* problem);
 void SetGainByLeastSquares(const Record& record, std::vector<double>* theta);
 
 /// One start's fit from *theta; the final cost, or infinity if Ceres failed.
-double FitFrom(const Record& record, const IdentifyOptions& options, std::vector<double>* theta);
+/// best_cost finite (the best of the starts before it): the fit ends once it
+/// has reached that cost within 1e-9 relative and stalls there.
+double FitFrom(const Record& record, const IdentifyOptions& options, std::vector<double>* theta,
+               double best_cost = std::numeric_limits<double>::infinity());
 /// The parameters `held` held where *theta has them, the others refitted.
 double FitHolding(const Record& record, const IdentifyOptions& options, const std::vector<int>& held,
                   std::vector<double>* theta);
@@ -125,7 +128,31 @@ std::string Number(double v);
 struct Seeds {
   const IdentifyResult* contained = nullptr;
   const IdentifyResult* same_kind = nullptr;
+  /// IdentifyAuto's lowest AIC of the kinds fitted before (infinity: none):
+  /// once a quarter of the design's starts are done, the rest are skipped
+  /// while the best AIC is more than kPruneAic above it.
+  double aic_to_beat = std::numeric_limits<double>::infinity();
 };
+/// How far above auto's lowest AIC a kind's best start may be before its
+/// remaining design starts are skipped: more than 10 is a kind the data rule
+/// out (Burnham and Anderson), and those starts would have to find an
+/// optimum below all that the seeded starts and a quarter of the design saw.
+inline constexpr double kPruneAic = 10.0;
+
+/// Starts at the optimum `inner` of the model `record`'s kind contains
+/// (nested_starts.cc), in Ceres's coordinates, the offsets relative to the
+/// record's u0 and y0; and the optimum of the same kind fitted with another
+/// loss (empty if `prior` is of another kind).
+std::vector<std::vector<double>> NestedStarts(const Record& record, const IdentifyResult& inner, double u0,
+                                              double y0);
+std::vector<double> SameKindStart(const Record& record, const IdentifyResult& prior, double u0, double y0);
+
+/// The parameters `r` (summarised on `record`) does not identify
+/// (IdentifyResult::not_identifiable; identifiability.cc), and the warning
+/// that says one, against the contained model's fit when given.
+std::vector<IdentifyResult::NotIdentifiable> NotIdentifiable(const Record& record, const IdentifyResult& r);
+std::string NotIdentifiableWarning(const IdentifyResult::NotIdentifiable& n, const IdentifyResult& r,
+                                   const IdentifyResult* contained);
 /// One fit of `kind` (identify.cc): u0 as the options give it (NaN: the
 /// first sample), from the design's starts, the ARX start and the seeds.
 Status FitKind(const IdentifyData& data, ProcessModelKind kind, const IdentifyOptions& options,
@@ -155,6 +182,6 @@ double DerivedLossScale(Loss loss, const std::vector<double>& residuals, const s
 /// the model, the covariance, the residuals, the bounds, the warnings
 /// (fit_summary.cc).
 void Summarise(const Record& record, const IdentifyData& data, const std::vector<double>& theta, double cost,
-               IdentifyResult* result);
+               IdentifyResult* result, const IdentifyResult* contained = nullptr);
 
 }  // namespace pidlab::identify::internal

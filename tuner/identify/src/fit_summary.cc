@@ -106,7 +106,7 @@ std::vector<std::string> AtBound(const Record& record, const std::vector<double>
 
 // The plain warnings of IdentifyResult::warnings.
 std::vector<std::string> Warnings(const Record& record, const IdentifyResult& r) {
-  const double dt_s = record.dt_s, length_s = record.length_s, max_delay_s = record.max_delay_s;
+  const double max_delay_s = record.max_delay_s;
   std::vector<std::string> w;
   if (!r.covariance_ok) w.push_back("no intervals: " + r.covariance_message);
   for (std::size_t i = 0; i < r.names.size() && r.covariance_ok; ++i) {
@@ -139,14 +139,6 @@ std::vector<std::string> Warnings(const Record& record, const IdentifyResult& r)
   if (td >= max_delay_s * (1 - 1e-6))
     w.push_back("Td = " + Number(td) + " s is at its bound (" + Number(max_delay_s) +
                 " s, half the record): the delay may be longer than the record can show");
-  for (std::size_t i = 0; i < r.names.size(); ++i) {
-    if (!IsLogParameter(record, static_cast<int>(i))) continue;
-    const double t = r.values[i];
-    if (t <= dt_s / kTimeConstantRange * (1 + 1e-6) || t >= length_s * kTimeConstantRange * (1 - 1e-6))
-      w.push_back(r.names[i] + " = " + Number(t) + " s is at its bound [" +
-                  Number(dt_s / kTimeConstantRange) + ", " + Number(length_s * kTimeConstantRange) +
-                  "] s: the model's order may be wrong; its interval is one-sided and not reported");
-  }
   // An exact fit (residual RMS below 1e-9 of the output's spread, as with
   // noise-free data) leaves rounding in its residuals: not worth a warning.
   const bool exact = r.fit_percent > 100.0 * (1.0 - 1e-9);
@@ -177,7 +169,7 @@ void SummariseLoss(const Record& record, double spread, IdentifyResult* result) 
 
 // Figures of merit of the fit at `theta` into *result.
 void Summarise(const Record& record, const IdentifyData& data, const std::vector<double>& theta, double cost,
-               IdentifyResult* result) {
+               IdentifyResult* result, const IdentifyResult* contained) {
   const double n = static_cast<double>(data.y.size());
   result->model = ModelOf(record, theta.data());
   result->names = ParameterNames(record.kind, record.poles, record.zeros);
@@ -219,6 +211,9 @@ void Summarise(const Record& record, const IdentifyData& data, const std::vector
   for (std::size_t i = 0; i < result->at_bound.size(); ++i)
     if (!result->at_bound[i].empty() && i < result->standard_errors.size()) result->standard_errors[i] = kNaN;
   result->warnings = Warnings(record, *result);
+  result->not_identifiable = NotIdentifiable(record, *result);
+  for (const IdentifyResult::NotIdentifiable& entry : result->not_identifiable)
+    result->warnings.push_back(NotIdentifiableWarning(entry, *result, contained));
 }
 
 }  // namespace pidlab::identify::internal

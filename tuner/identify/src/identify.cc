@@ -35,10 +35,12 @@ using internal::kMaxZeta;
 using internal::kMinZeta;
 using internal::kTimeConstantRange;
 using internal::ModelOf;
+using internal::NestedStarts;
 using internal::Number;
 using internal::OffsetOf;
 using internal::ParameterCount;
 using internal::Record;
+using internal::SameKindStart;
 using internal::SetGainByLeastSquares;
 using internal::Summarise;
 using internal::TrySimulate;
@@ -215,10 +217,21 @@ bool ProfileDelay(const Record& record, const IdentifyOptions& options, std::vec
   return true;
 }
 
-// The best of the starts: its theta, and every start's cost.
+// AIC of a fit of `cost` on `record` (Summarise's, the initial state's
+// entries of kEstimate left out: lower, so that pruning errs on the side of
+// fitting).
+double AicOf(const Record& record, double cost) {
+  const double n = static_cast<double>(record.dy.size());
+  return n * std::log(2.0 * cost / n) + 2.0 * BlockSize(record);
+}
+
+// The best of the starts: its theta, and every start's cost. The design's
+// starts after the first quarter are skipped (counted in *skipped) while the
+// best AIC is more than kPruneAic above aic_to_beat.
 std::vector<double> MultiStart(const Record& record, const IdentifyOptions& options,
                                const std::vector<std::vector<double>>& nested, std::vector<double>* costs,
-                               bool* arx_used) {
+                               bool* arx_used, double aic_to_beat = std::numeric_limits<double>::infinity(),
+                               int* skipped = nullptr) {
   std::vector<double> best;
   double best_cost = std::numeric_limits<double>::infinity();
   const int dimensions = record.kind == ProcessModelKind::kTf ? internal::TfDesignDimensions(record.poles)
@@ -237,7 +250,7 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
       cost = FitAtDelay(record, options, theta[static_cast<std::size_t>(p - 1)], &theta);
     }
     std::vector<double> freed = theta;
-    const double free_cost = FitFrom(record, options, &freed);
+    const double free_cost = FitFrom(record, options, &freed, best_cost);
     if (!(cost <= free_cost)) {
       cost = free_cost;
       theta = freed;
@@ -258,92 +271,15 @@ std::vector<double> MultiStart(const Record& record, const IdentifyOptions& opti
   const auto stop = [&] { return options.cancelled && options.cancelled(); };
   for (const std::vector<double>& theta : nested)
     if (!stop()) fit(theta, true);
-  for (int s = 0; s < options.starts && !stop(); ++s) fit(StartPoint(record, sobol, s), false);
-  return stop() ? std::vector<double>{} : best;
-}
-
-// Starts at the optimum `inner` of the model that `record`'s kind contains,
-// in Ceres's coordinates (the offsets relative to the record's u0 and y0).
-// P2D from P1D twice: a second lag at its lower bound (P1D's optimum as
-// nearly as the bound allows: a free fit from a lag just above it can stall
-// there, its step projected onto the bound), and one of half a sample taken
-// out of the delay (a short lag and a short delay look alike).
-std::vector<std::vector<double>> NestedStarts(const Record& record, const IdentifyResult& inner, double u0,
-                                              double y0) {
-  ProcessModelKind expected;
-  if (!ContainedKind(record.kind, &expected) || inner.model.kind != expected) return {};
-  const int p = ParameterCount(record);
-  const std::vector<double>& v = inner.values;
-  std::vector<double> theta(static_cast<std::size_t>(BlockSize(record)), 0.0);
-  if (record.offset) theta[static_cast<std::size_t>(p)] = inner.y0 - y0;
-  if (record.input_offset) theta[static_cast<std::size_t>(InputOffsetIndex(record))] = inner.u0 - u0;
-  const auto log_lag = [&](double tau) {
-    return std::clamp(std::log(tau), std::log(record.dt_s / kTimeConstantRange),
-                      std::log(record.length_s * kTimeConstantRange));
-  };
-  const auto delay = [&](double td) { return std::clamp(td, 0.0, record.max_delay_s); };
-  theta[0] = v[0];
-  std::vector<std::vector<double>> starts;
-  switch (record.kind) {
-    case ProcessModelKind::kP2D:  // from Kp, Tp1, Td
-      theta[1] = log_lag(v[1]);
-      theta[2] = log_lag(record.dt_s / kTimeConstantRange);
-      theta[3] = delay(v[2]);
-      starts.push_back(theta);
-      theta[2] = log_lag(record.dt_s / 2.0);
-      theta[3] = delay(v[2] - record.dt_s / 2.0);
-      starts.push_back(theta);
-      break;
-    case ProcessModelKind::kP2DU: {  // from Kp, Tp1, Tp2, Td
-      const double tw = std::sqrt(v[1] * v[2]), zeta = (v[1] + v[2]) / (2.0 * tw);
-      theta[1] = log_lag(tw);
-      theta[2] = std::clamp(zeta, kMinZeta, kMaxZeta);
-      theta[3] = delay(v[3]);
-      starts.push_back(theta);
-      // Lags too far apart for a pair: the critically damped pair of the
-      // same sum of time constants (2 Zeta Tw = Tp1 + Tp2) too.
-      if (zeta > kMaxZeta) {
-        theta[1] = log_lag(0.5 * (v[1] + v[2]));
-        theta[2] = kMaxZeta;
-        starts.push_back(theta);
-      }
+  const int at_least = std::max(1, (options.starts + 3) / 4);
+  for (int s = 0; s < options.starts && !stop(); ++s) {
+    if (s >= at_least && AicOf(record, best_cost) > aic_to_beat + internal::kPruneAic) {
+      if (skipped) *skipped = options.starts - s;
       break;
     }
-    case ProcessModelKind::kP2DZ:  // from Kp, Tp1, Tp2, Td; Tz = 0
-      theta[1] = log_lag(v[1]);
-      theta[2] = log_lag(v[2]);
-      theta[3] = 0.0;
-      theta[4] = delay(v[3]);
-      starts.push_back(theta);
-      break;
-    default:
-      break;
+    fit(StartPoint(record, sobol, s), false);
   }
-  return starts;
-}
-// The optimum of the same kind fitted with another loss (the l2 fit before
-// a robust one), in Ceres's coordinates, the offsets relative to the
-// record's u0 and y0; empty if `prior` is of another kind.
-std::vector<double> SameKindStart(const Record& record, const IdentifyResult& prior, double u0, double y0) {
-  const int p = ParameterCount(record);
-  if (prior.model.kind != record.kind || static_cast<int>(prior.values.size()) != p) return {};
-  std::vector<double> theta(static_cast<std::size_t>(BlockSize(record)), 0.0);
-  for (int i = 0; i < p; ++i) {
-    const double v = prior.values[static_cast<std::size_t>(i)];
-    double& t = theta[static_cast<std::size_t>(i)];
-    if (IsLogParameter(record, i))
-      t = std::clamp(std::log(v), std::log(record.dt_s / kTimeConstantRange),
-                     std::log(record.length_s * kTimeConstantRange));
-    else if (i == p - 1)
-      t = std::clamp(v, 0.0, record.max_delay_s);
-    else if (record.kind == ProcessModelKind::kP2DU && i == 2)
-      t = std::clamp(v, kMinZeta, kMaxZeta);
-    else
-      t = v;
-  }
-  if (record.offset) theta[static_cast<std::size_t>(p)] = prior.y0 - y0;
-  if (record.input_offset) theta[static_cast<std::size_t>(InputOffsetIndex(record))] = prior.u0 - u0;
-  return theta;
+  return stop() ? std::vector<double>{} : best;
 }
 
 // The loss of IdentifyOptions on the record; a robust one needs its scale
@@ -508,7 +444,7 @@ Status FitFromDecimatedStarts(const IdentifyData& data, ProcessModelKind kind, c
   result->seed = options.seed;
   result->samples = static_cast<int>(data.y.size());
   result->dt_s = record.dt_s;
-  Summarise(record, data, theta, best, result);
+  Summarise(record, data, theta, best, result, seeds.contained);
   return Status::Ok();
 }
 
@@ -543,7 +479,8 @@ Status FitKind(const IdentifyData& data, ProcessModelKind kind, const IdentifyOp
     if (!theta.empty()) nested.push_back(theta);
   }
   result->nested_starts = static_cast<int>(nested.size());
-  std::vector<double> theta = MultiStart(record, options, nested, &result->start_costs, &result->arx_start);
+  std::vector<double> theta = MultiStart(record, options, nested, &result->start_costs, &result->arx_start,
+                                         seeds.aic_to_beat, &result->starts_skipped);
   if (options.cancelled && options.cancelled()) return Status::RunnerFailed("cancelled");
   if (theta.empty())
     return Status::RunnerFailed(
@@ -557,7 +494,7 @@ Status FitKind(const IdentifyData& data, ProcessModelKind kind, const IdentifyOp
   result->seed = options.seed;
   result->samples = static_cast<int>(data.y.size());
   result->dt_s = record.dt_s;
-  Summarise(record, data, theta, best, result);
+  Summarise(record, data, theta, best, result, seeds.contained);
   return Status::Ok();
 }
 

@@ -17,9 +17,41 @@ constexpr ProcessModelKind kAutoKinds[] = {ProcessModelKind::kP1D, ProcessModelK
                                            ProcessModelKind::kP2DU, ProcessModelKind::kP1DI,
                                            ProcessModelKind::kP2DZ};
 
+// Why auto does not choose candidate `c` (AutoCandidate::set_aside), or
+// "": a parameter the record does not identify, or its design's starts
+// pruned by AIC against `lowest` (the kind of lowest AIC before it). No
+// covariance alone is no reason: P2D's two equal lags (a double pole) have
+// none, the pair identified but not which lag is which.
+std::string SetAsideReason(const AutoCandidate& c, const AutoCandidate* lowest) {
+  if (!c.status.ok()) return "";
+  const IdentifyResult& r = c.result;
+  if (!r.not_identifiable.empty()) {
+    const IdentifyResult::NotIdentifiable& n = r.not_identifiable.front();
+    return n.parameter + " is not identifiable (" + n.reason + ")" +
+           (n.simpler_model.empty() ? "" : "; " + n.simpler_model + " describes the record without it");
+  }
+  if (r.starts_skipped > 0 && lowest)
+    return "pruned by AIC: after " + std::to_string(r.starts) + " starts its AIC " + internal::Number(r.aic) +
+           " was more than " + internal::Number(internal::kPruneAic) + " above " + ToString(lowest->kind) +
+           "'s " + internal::Number(lowest->result.aic) + ", so its other " +
+           std::to_string(r.starts_skipped) + " starts were not run";
+  return "";
+}
+
+// The candidate of lowest AIC among those not set aside; nullptr if none.
+const AutoCandidate* Lowest(const std::vector<AutoCandidate>& candidates) {
+  const AutoCandidate* lowest = nullptr;
+  for (const AutoCandidate& c : candidates)
+    if (c.status.ok() && c.set_aside.empty() && std::isfinite(c.result.aic) &&
+        (!lowest || c.result.aic < lowest->result.aic))
+      lowest = &c;
+  return lowest;
+}
+
 // Every kind at u0 as the options give it, each from the optimum of the
 // kind it contains (fitted before it) and of the same kind in `prior` (the
-// l2 fits before robust ones; nullptr: none).
+// l2 fits before robust ones; nullptr: none), its design's starts pruned by
+// AIC against the kinds before it (internal::Seeds::aic_to_beat).
 Status FitCandidates(const IdentifyData& data, const IdentifyOptions& options, const AutoResult* prior,
                      std::vector<AutoCandidate>* candidates) {
   candidates->clear();
@@ -34,9 +66,12 @@ Status FitCandidates(const IdentifyData& data, const IdentifyOptions& options, c
     for (std::size_t i = 0; prior && i < prior->candidates.size(); ++i)
       if (prior->candidates[i].kind == kind && prior->candidates[i].status.ok())
         seeds.same_kind = &prior->candidates[i].result;
+    const AutoCandidate* lowest = Lowest(*candidates);
+    if (lowest) seeds.aic_to_beat = lowest->result.aic;
     c.status = internal::FitKind(data, kind, options, seeds, &c.result);
     // Bad data or options are the same for every kind: say it once.
     if (c.status.code() == StatusCode::kInvalidInput) return c.status;
+    c.set_aside = SetAsideReason(c, lowest);
     candidates->push_back(std::move(c));
   }
   return Status::Ok();
@@ -60,6 +95,7 @@ Status FitCandidatesAtRest(const IdentifyData& data, const IdentifyOptions& opti
     c.kind = first[i].kind;
     c.status = internal::ChooseRest(data.u[0], first[i].status, &first[i].result, zero[i].status,
                                     &zero[i].result, &c.result);
+    c.set_aside = (c.result.rest_hypotheses.size() == 2 && c.result.u0 == 0.0 ? zero[i] : first[i]).set_aside;
     candidates->push_back(std::move(c));
   }
   return Status::Ok();
@@ -73,7 +109,7 @@ Status ChooseKind(AutoResult* result) {
   const auto aic = [&](int i) { return result->candidates[static_cast<std::size_t>(i)].result.aic; };
   const auto usable = [&](int i) {
     const AutoCandidate& c = result->candidates[static_cast<std::size_t>(i)];
-    return c.status.ok() && std::isfinite(c.result.aic);
+    return c.status.ok() && c.set_aside.empty() && std::isfinite(c.result.aic);
   };
   const int count = static_cast<int>(result->candidates.size());
   for (int i = 0; i < count; ++i)
@@ -81,7 +117,9 @@ Status ChooseKind(AutoResult* result) {
   if (lowest < 0) {
     std::string why;
     for (const AutoCandidate& c : result->candidates)
-      if (!c.status.ok() && why.empty()) why = std::string(ToString(c.kind)) + ": " + c.status.message();
+      if (why.empty() && (!c.status.ok() || !c.set_aside.empty()))
+        why = std::string(ToString(c.kind)) +
+              (c.status.ok() ? " set aside: " + c.set_aside : ": " + c.status.message());
     return Status::RunnerFailed("no model kind could be fitted (p1d, p2d, p2du, p1di and p2dz tried" +
                                 (why.empty() ? std::string(")") : "; " + spec::Truncate(why, 150) + ")"));
   }
@@ -120,14 +158,23 @@ Status ChooseKind(AutoResult* result) {
        << ", with fewer parameters (" << best.result.names.size() << " against " << parameters(lowest)
        << "): the data hardly tell them apart, so the simpler is kept";
   }
+  std::string aside;
+  for (const AutoCandidate& c : result->candidates)
+    if (!c.set_aside.empty()) aside += (aside.empty() ? "" : ", ") + std::string(ToString(c.kind));
+  if (!aside.empty()) os << "; set aside: " << aside;
   result->reason = os.str();
   return Status::Ok();
 }
 
 }  // namespace
 
-Status IdentifyAuto(const IdentifyData& data, const IdentifyOptions& options, AutoResult* result) {
+Status IdentifyAuto(const IdentifyData& data, const IdentifyOptions& given, AutoResult* result) {
   *result = AutoResult{};
+  // A long record's starts on a shorter copy, the best of each kind refitted
+  // on all of it (IdentifyOptions::start_samples, as for a decimated record).
+  IdentifyOptions options = given;
+  if (options.start_samples == 0 && data.y.size() > kAutoStartSamples)
+    options.start_samples = kAutoStartSamples;
   if (options.loss == Loss::kL2 || !std::isnan(options.loss_scale)) {
     if (Status s = FitCandidatesAtRest(data, options, nullptr, &result->candidates); !s.ok()) return s;
     return ChooseKind(result);

@@ -16,13 +16,15 @@ namespace pidlab::results {
 /// samples, dt_s (the mean interval), sampling {uniform, min_interval_s,
 /// max_interval_s}, u0, y0, operating_point {u0, source, hypotheses [{u0,
 /// aic, message if not fitted}]}, loss {name, scale, scale_source,
-/// downweighted {below_weight, count, samples}}, starts, starts_at_best, seed, whiteness {lags,
+/// downweighted {below_weight, count, samples}}, starts, starts_at_best, seed, starts_skipped,
+/// not_identifiable [{parameter, reason, simpler_model or null}], whiteness {lags,
 /// autocorrelation, band, outside_band, ljung_box_q, p_value, white},
 /// warnings [text], covariance {ok, message, matrix} (null for NaN and +-inf).
 nlohmann::json IdentifyResultJson(const identify::IdentifyResult& r);
 nlohmann::json WhitenessJson(const identify::Whiteness& w);
 /// The chosen kind's IdentifyResultJson with "auto" {chosen, reason,
-/// candidates [{model, ok, aic, delta_aic, fit_percent | message}]}.
+/// candidates [{model, ok, aic, delta_aic, fit_percent, operating_point,
+/// parameters | message, set_aside (why auto did not choose it, or null)}]}.
 nlohmann::json IdentifyAutoJson(const identify::AutoResult& a);
 
 /// One fit as `pidlab identify --model MODEL` makes it: its JSON (the

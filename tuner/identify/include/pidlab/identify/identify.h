@@ -262,6 +262,9 @@ struct IdentifyResult {
   int starts_at_best = 0;               // starts whose cost is the best's within 1e-8 relative
   std::vector<double> start_costs;      // final cost of every start, in design order
   int nested_starts = 0;                // starts from a contained model's optimum (after the ARX start)
+  /// The design's starts not run: IdentifyAuto skipped them once a quarter
+  /// were done with the best AIC still more than 10 above another kind's.
+  int starts_skipped = 0;
   bool delay_profile_improved = false;  // the delay's profile found a lower cost than every start
   bool bounds_refit_improved = false;   // holding the parameters at a bound, the rest refitted, lowered it
   /// For each parameter, "lower" or "upper" if it is at (within 1e-6 of) a
@@ -271,11 +274,31 @@ struct IdentifyResult {
   /// The model's output y0 + yhat_k at every sample, and y_k - that.
   std::vector<double> simulated, residuals;
   Whiteness whiteness;
+  /// The parameters the record does not identify: one at a bound of the fit
+  /// (Td at 0 excepted: a record without dead time), a lag under a tenth of
+  /// dt with no standard error or an interval wider than it, a time
+  /// constant or Tz beyond kUnboundedRecordLengths times the record (an
+  /// unbounded optimum). Each is also said in `warnings`, with the smaller
+  /// model that describes the record without it.
+  struct NotIdentifiable {
+    std::string parameter;      // as in `names`
+    std::string reason;         // "2.2e-06 s, under a tenth of dt = 0.002 s, with no standard error"
+    std::string simpler_model;  // the kind without it ("p1d"), or "" if none of the process kinds
+  };
+  std::vector<NotIdentifiable> not_identifiable;
   /// Plain sentences on what the data leave undetermined: a parameter whose
   /// 95 % interval is wider than its value, residuals that are not white, a
   /// delay or time constant at its bound, no covariance.
   std::vector<std::string> warnings;
 };
+
+/// A time constant (or P2DZ's |Tz|) beyond this many record lengths is an
+/// unbounded optimum: over the record its pole is an integrator's, and Kp
+/// and it are known only as their ratio.
+inline constexpr double kUnboundedRecordLengths = 100.0;
+/// A lag under this fraction of dt whose interval is undetermined cannot be
+/// told from a delay of its length.
+inline constexpr double kUnresolvedLagOfDt = 0.1;
 
 /// `pidlab identify --model auto`: every kind fitted, one chosen by AIC
 /// (IdentifyAuto), and why in one sentence.
@@ -283,6 +306,9 @@ struct AutoCandidate {
   ProcessModelKind kind = ProcessModelKind::kP1D;
   Status status;  // of Identify for this kind
   IdentifyResult result;
+  /// Why auto does not choose it, in words ("Tp2 is not identifiable (...)",
+  /// or that it cannot beat the lowest AIC), else empty.
+  std::string set_aside;
 };
 struct AutoResult {
   std::vector<AutoCandidate> candidates;  // in the order of the kinds
@@ -365,6 +391,11 @@ struct PoleEstimate {
 /// The poles of `result.model` (roots of its denominator, the upper one of a
 /// complex pair first), with standard errors when the covariance is ok.
 std::vector<PoleEstimate> PoleEstimates(const IdentifyResult& result);
+
+/// IdentifyAuto runs the starts of a record longer than this on it decimated
+/// to this many samples (IdentifyOptions::start_samples), unless the options
+/// set start_samples.
+inline constexpr std::size_t kAutoStartSamples = 2500;
 
 /// Fits every process kind (P1D, P2D, P2DU, P1DI, P2DZ; not TF), each at the
 /// rest Identify would choose (both rests fitted, the lower AIC kept per
