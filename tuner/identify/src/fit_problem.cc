@@ -256,35 +256,47 @@ class ReachedBestCallback : public ceres::IterationCallback {
 
 }  // namespace
 
-// One start's fit; the final cost, or infinity if Ceres failed.
-double FitFrom(const Record& record, const IdentifyOptions& options, std::vector<double>* theta,
-               double best_cost) {
-  ceres::Problem problem;
-  BuildProblem(record, theta->data(), &problem);
+namespace {
+
+// Ceres on `problem` with the tolerances given, one thread, silent, cancelled
+// by the options, ended early by `reached` (or null); the final cost, or
+// infinity if Ceres failed. A TF's start may walk to the edge of stability,
+// where a central difference fails and Ceres stops with FAILURE, logged
+// through glog as an error; the start's cost (infinite) says it, so glog is
+// kept quiet.
+double Solve(ceres::Problem* problem, const IdentifyOptions& options, double function_tolerance,
+             double parameter_tolerance, ceres::IterationCallback* reached) {
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
   solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = 1e-15;
+  solver.function_tolerance = function_tolerance;
   solver.gradient_tolerance = 1e-20;
-  solver.parameter_tolerance = 1e-13;
+  solver.parameter_tolerance = parameter_tolerance;
   solver.logging_type = ceres::SILENT;
   solver.num_threads = 1;
   CancelCallback cancel(options);
   solver.callbacks.push_back(&cancel);
-  ReachedBestCallback reached(best_cost);
-  if (std::isfinite(best_cost)) solver.callbacks.push_back(&reached);
+  if (reached) solver.callbacks.push_back(reached);
   ceres::Solver::Summary summary;
-  // A TF's start may walk to the edge of stability, where a central
-  // difference fails and Ceres stops with FAILURE, logged through glog as an
-  // error; the start's cost (infinite) says it, so keep glog quiet.
   const int log_level = FLAGS_minloglevel;
   FLAGS_minloglevel = google::GLOG_FATAL;
-  ceres::Solve(solver, &problem, &summary);
+  ceres::Solve(solver, problem, &summary);
   FLAGS_minloglevel = log_level;
   if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE ||
       !std::isfinite(summary.final_cost))
     return std::numeric_limits<double>::infinity();
   return summary.final_cost;
+}
+
+}  // namespace
+
+// One start's fit; the final cost, or infinity if Ceres failed.
+double FitFrom(const Record& record, const IdentifyOptions& options, std::vector<double>* theta,
+               double best_cost) {
+  ceres::Problem problem;
+  BuildProblem(record, theta->data(), &problem);
+  ReachedBestCallback reached(best_cost);
+  return Solve(&problem, options, 1e-15, 1e-13, std::isfinite(best_cost) ? &reached : nullptr);
 }
 
 // The parameters `held` (indices into theta) held where *theta has them,
@@ -294,25 +306,7 @@ double FitHolding(const Record& record, const IdentifyOptions& options, const st
   ceres::Problem problem;
   BuildProblem(record, theta->data(), &problem);
   problem.SetManifold(theta->data(), new ceres::SubsetManifold(BlockSize(record), held));
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_QR;
-  solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = 1e-12;
-  solver.gradient_tolerance = 1e-20;
-  solver.parameter_tolerance = 1e-10;
-  solver.logging_type = ceres::SILENT;
-  solver.num_threads = 1;
-  CancelCallback cancel(options);
-  solver.callbacks.push_back(&cancel);
-  ceres::Solver::Summary summary;
-  const int log_level = FLAGS_minloglevel;
-  FLAGS_minloglevel = google::GLOG_FATAL;
-  ceres::Solve(solver, &problem, &summary);
-  FLAGS_minloglevel = log_level;
-  if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE ||
-      !std::isfinite(summary.final_cost))
-    return std::numeric_limits<double>::infinity();
-  return summary.final_cost;
+  return Solve(&problem, options, 1e-12, 1e-10, nullptr);
 }
 
 // Td held at `td`, the other parameters refitted from *theta.
