@@ -234,16 +234,8 @@ double RelayTuner::RelayStep(double t_s, double r, double y) {
     }
     if (!high_ && e < -eps_) {
       const bool complete = t_high_ >= 0.0 && t_low_ > t_high_;
-      RelayCycle c;
-      if (complete) {
-        c.start_s = t_high_;
-        c.t_on_s = t_low_ - t_high_;
-        c.t_off_s = t_s - t_low_;
-        c.e_max = e_max_;
-        c.e_min = e_min_;
-        c.integral_e = integral_;
-        c.integral_on_e = integral_on_;
-      }
+      const RelayCycle c =
+          complete ? RelayCycle::Closed(t_high_, t_low_, t_s, e_max_, e_min_, integral_, integral_on_) : RelayCycle{};
       high_ = true;
       t_high_ = t_s;
       t_low_ = -1.0;

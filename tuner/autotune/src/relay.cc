@@ -76,17 +76,8 @@ double RelayExperiment::Step(double t_s, double y) {
       e_min_ = std::min(e_min_, e);
     }
     if (!high_ && e < -o_.hysteresis) {
-      if (t_high_ >= 0.0 && t_low_ > t_high_) {
-        RelayCycle c;
-        c.start_s = t_high_;
-        c.t_on_s = t_low_ - t_high_;
-        c.t_off_s = t_s - t_low_;
-        c.e_max = e_max_;
-        c.e_min = e_min_;
-        c.integral_e = integral_;
-        c.integral_on_e = integral_on_;
-        cycles_.push_back(c);
-      }
+      if (t_high_ >= 0.0 && t_low_ > t_high_)
+        cycles_.push_back(RelayCycle::Closed(t_high_, t_low_, t_s, e_max_, e_min_, integral_, integral_on_));
       high_ = true;
       t_high_ = t_s;
       t_low_ = -1.0;

@@ -91,6 +91,12 @@ struct RelayCycle {
   double integral_on_e = 0.0;          ///< of e over its first part, at +d_high
   double period_s() const { return t_on_s + t_off_s; }
   double amplitude() const { return 0.5 * (e_max - e_min); }
+  /// The cycle from the switch to high at t_high, to low at t_low, to high
+  /// again at t_end, with its extremes and integrals.
+  static RelayCycle Closed(double t_high, double t_low, double t_end, double e_max, double e_min,
+                           double integral_e, double integral_on_e) {
+    return RelayCycle{t_high, t_low - t_high, t_end - t_low, e_max, e_min, integral_e, integral_on_e};
+  }
 };
 
 /// The mean period and amplitude of the last n cycles, and whether each of
