@@ -64,6 +64,17 @@ Status BuildAutotuneDesign(const spec::AutotuneSpec& s, double max_ms, NameStyle
   o.max_ms = max_ms;
   o.max_overshoot_pct = s.max_overshoot_pct;
   std::string why;
+  if (!s.verify_gains.empty()) {
+    const std::vector<double>& v = s.verify_gains;
+    const std::string name = DisplayName("verify_gains", style);
+    std::string list;
+    for (double x : v) list += (list.empty() ? "" : ",") + FormatNumber(x);
+    if (v.size() != 3 && v.size() != 4)
+      return Status::InvalidInput(name + " " + list + " needs KP,KI,KD or KP,KI,KD,TF");
+    o.verify_given = true;
+    o.verify_gains = {v[0], v[1], v[2], v.size() == 4 ? v[3] : 0.0};
+    if (!GainsAreValid(o.verify_gains, &why)) return Status::InvalidInput(name + " " + list + ": " + why);
+  }
   if (!o.IsValid(&why)) return Status::InvalidInput(why);
   *design = o;
   return Status::Ok();

@@ -9,6 +9,7 @@
 #include "pidlab/replay/log_reader.h"
 #include "pidlab/replay/replay.h"
 #include "pidlab/results/results_json.h"
+#include "pidlab/results/spec_run.h"
 #include "pidlab/results/tune_run.h"
 
 namespace pidlab::results {
@@ -117,17 +118,24 @@ json ReadingJson(const autotune::StepReading& r) {
           {"settled", r.settled}};
 }
 
-// The design on the model and its verification; false with *verdict.
-bool DesignAndVerify(const ExperimentSummary& x, const AutotuneDesignOptions& o, const StepRunner& step,
-                     const std::function<void(const std::string&)>& say, json* out, PidGains* adopted,
-                     std::string* verdict) {
-  const autotune::FopdtModel& m = x.estimates.model;
-  json spec = {{"num", {m.gain}},
-               {"delay", m.delay_s},
-               {"method", o.method},
-               {"robustness", o.robustness},
-               {"response_time", o.response_time_s}};
-  spec["den"] = m.integrating ? json::array({1.0, 0.0}) : json::array({m.time_constant_s, 1.0});
+// The identified model as a spec's plant keys.
+json ModelPlant(const autotune::FopdtModel& m) {
+  json plant = {{"num", {m.gain}}, {"delay", m.delay_s}};
+  plant["den"] = m.integrating ? json::array({1.0, 0.0}) : json::array({m.time_constant_s, 1.0});
+  return plant;
+}
+
+double MsOf(const json& result) {
+  return result["robustness"].is_object() && result["robustness"]["ms"].is_number()
+             ? result["robustness"]["ms"].get<double>()
+             : std::numeric_limits<double>::infinity();
+}
+
+// The design on the model (out["design"]); false with *verdict.
+bool DesignOnModel(const ExperimentSummary& x, const AutotuneDesignOptions& o, json* out, PidGains* gains,
+                   double* ms, bool* stable, std::string* verdict) {
+  json spec = ModelPlant(x.estimates.model);
+  spec.update({{"method", o.method}, {"robustness", o.robustness}, {"response_time", o.response_time_s}});
   json design;
   const Status designed = TuneSpecJson(spec, nullptr, &design);
   if (!designed.ok()) {
@@ -136,23 +144,38 @@ bool DesignAndVerify(const ExperimentSummary& x, const AutotuneDesignOptions& o,
     return false;
   }
   const json& g = design["gains"];
-  const PidGains gains{g.value("kp", 0.0), g.value("ki", 0.0), g.value("kd", 0.0), g.value("tf", 0.0)};
-  const double ms = design["robustness"].is_object() && design["robustness"]["ms"].is_number()
-                        ? design["robustness"]["ms"].get<double>()
-                        : std::numeric_limits<double>::infinity();
+  *gains = PidGains{g.value("kp", 0.0), g.value("ki", 0.0), g.value("kd", 0.0), g.value("tf", 0.0)};
+  *ms = MsOf(design);
+  *stable = design.value("stable", false);
   (*out)["design"] = {{"method", o.method},
                       {"spec", spec},
                       {"gains", design["gains"]},
-                      {"ms", JsonNumber(ms)},
+                      {"ms", JsonNumber(*ms)},
                       {"robustness", design["robustness"]},
                       {"stable", design["stable"]}};
-  if (say)
-    say("design (" + o.method + " on the identified model): kp " + Num(gains.kp) + ", ki " + Num(gains.ki) +
-        ", kd " + Num(gains.kd) + ", Ms " + Num(ms));
-  if (!(ms <= o.max_ms) || !design.value("stable", false)) {
-    *verdict = "the design's Ms on the identified model is " + Num(ms) + ", above the bound " + Num(o.max_ms);
-    return false;
-  }
+  return true;
+}
+
+// The given gains (verify_gains) on the model (out["verify_gains"]).
+void GivenOnModel(const ExperimentSummary& x, const AutotuneDesignOptions& o, json* out, double* ms,
+                  bool* stable) {
+  json spec = ModelPlant(x.estimates.model);
+  const PidGains& g = o.verify_gains;
+  spec.update({{"gains", {g.kp, g.ki, g.kd}}, {"derivative_filter", g.tf}});
+  json result;
+  const Status st = EvaluateSpecJson(spec, &result);
+  *ms = st.ok() ? MsOf(result) : std::numeric_limits<double>::infinity();
+  *stable = st.ok() && result["robustness"].is_object() && result["robustness"].value("stable", false);
+  (*out)["verify_gains"] = {{"gains", ToJson(g)},
+                            {"ms", JsonNumber(*ms)},
+                            {"stable", *stable},
+                            {"robustness", st.ok() ? result["robustness"] : json(st.message())}};
+}
+
+// The verification step of `gains` (`who` names them); false with *verdict.
+bool VerifyStep(const ExperimentSummary& x, const AutotuneDesignOptions& o, const StepRunner& step,
+                const std::function<void(const std::string&)>& say, const PidGains& gains,
+                const std::string& who, json* out, std::string* verdict) {
   StepRun run;
   if (const Status st = step(gains, x.estimates.pu_s, &run); !st.ok()) {
     *verdict = st.message();
@@ -169,7 +192,8 @@ bool DesignAndVerify(const ExperimentSummary& x, const AutotuneDesignOptions& o,
   const bool settled = std::isfinite(ev.iae) && std::isfinite(settling) &&
                        (noisy ? reading.settled : settling < run.horizon_s);
   const bool calm = overshoot <= o.max_overshoot_pct;
-  (*out)["verification"] = {{"iae", JsonNumber(ev.iae)},
+  (*out)["verification"] = {{"gains", who},
+                            {"iae", JsonNumber(ev.iae)},
                             {"overshoot_pct", JsonNumber(overshoot)},
                             {"settling_time_s", JsonNumber(settling)},
                             {"horizon_s", run.horizon_s},
@@ -188,20 +212,60 @@ bool DesignAndVerify(const ExperimentSummary& x, const AutotuneDesignOptions& o,
                      Num(reading.widening) + " for the noise)"
                : ""));
   if (!settled) {
-    *verdict = noisy ? "the step with the new gains, smoothed, does not stay in the band ±" +
-                           Num(reading.band) + " (2 % widened by " + Num(reading.widening) +
-                           " for the noise) over the last " + Num(reading.tail_s) + " s of " +
-                           Num(run.horizon_s) + " s"
-                     : "the step with the new gains did not settle within " + Num(run.horizon_s) + " s";
+    *verdict = noisy
+                   ? "the step with " + who + ", smoothed, does not stay in the band ±" + Num(reading.band) +
+                         " (2 % widened by " + Num(reading.widening) + " for the noise) over the last " +
+                         Num(reading.tail_s) + " s of " + Num(run.horizon_s) + " s"
+                   : "the step with " + who + " did not settle within " + Num(run.horizon_s) + " s";
     return false;
   }
   if (!calm) {
-    *verdict =
-        "the step overshoots " + Num(overshoot) + " %, above the bound " + Num(o.max_overshoot_pct) + " %";
+    *verdict = "the step with " + who + " overshoots " + Num(overshoot) + " %, above the bound " +
+               Num(o.max_overshoot_pct) + " %";
     return false;
   }
+  return true;
+}
+
+// The design on the model and the verification of its gains, or of the
+// given ones (verify_gains) under the same verdict; false with *verdict.
+bool DesignAndVerify(const ExperimentSummary& x, const AutotuneDesignOptions& o, const StepRunner& step,
+                     const std::function<void(const std::string&)>& say, json* out, PidGains* adopted,
+                     std::string* verdict) {
+  PidGains gains;
+  double ms = 0.0;
+  bool stable = false;
+  if (!DesignOnModel(x, o, out, &gains, &ms, &stable, verdict)) return false;
+  if (say)
+    say("design (" + o.method + " on the identified model): kp " + Num(gains.kp) + ", ki " + Num(gains.ki) +
+        ", kd " + Num(gains.kd) + ", Ms " + Num(ms));
+  std::string who = "the new gains", whose = "the design's";
+  if (o.verify_given) {
+    gains = o.verify_gains;
+    GivenOnModel(x, o, out, &ms, &stable);
+    who = "the given gains";
+    whose = "the given gains'";
+    if (say)
+      say("verify_gains: kp " + Num(gains.kp) + ", ki " + Num(gains.ki) + ", kd " + Num(gains.kd) + ", tf " +
+          Num(gains.tf) + ", Ms " + Num(ms) + " on the identified model");
+  }
+  if (!stable) {
+    *verdict = whose + " loop on the identified model is unstable" +
+               (o.verify_given && gains.kd != 0.0 && gains.tf == 0.0
+                    ? std::string(" (an ideal derivative against the model's dead time: give KP,KI,KD,TF)")
+                    : std::string());
+    return false;
+  }
+  if (!(ms <= o.max_ms)) {
+    *verdict = whose + " Ms on the identified model is " + Num(ms) + ", above the bound " + Num(o.max_ms);
+    return false;
+  }
+  if (!VerifyStep(x, o, step, say, gains, who, out, verdict)) return false;
   *adopted = gains;
-  *verdict = "adopted: " + o.method + " on the identified model, Ms " + Num(ms) + ", verified by a step";
+  *verdict =
+      o.verify_given
+          ? "adopted: the given gains, Ms " + Num(ms) + " on the identified model, verified by a step"
+          : "adopted: " + o.method + " on the identified model, Ms " + Num(ms) + ", verified by a step";
   return true;
 }
 

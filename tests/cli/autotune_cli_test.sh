@@ -43,6 +43,9 @@ bad "the relay in float" "float" --num 1 --den 1,1 --scalar float
 bad "fixed point without an input range" "--input-range" --num 1 --den 1,1 --output-limits -2,2 --scalar q31
 bad "fixed point without output limits" "output limits" --num 1 --den 1,1 --scalar q15 --input-range -2,2
 bad "an input range in double" "--input-range" --num 1 --den 1,1 --input-range -2,2
+bad "verify gains of two values" "--verify-gains 1,2" --num 1 --den 1,1 --verify-gains 1,2
+bad "verify gains that differ in sign" "-1" --num 1 --den 1,1 --verify-gains 1,-1,0
+bad "verify gains with a negative filter" "-0.1" --num 1 --den 1,1 --verify-gains 1,1,0.1,-0.1
 bad "--log of a missing file" "nothing.lcmlog" --log nothing.lcmlog
 printf 'not a log' >empty.lcmlog
 bad "--log of a file that is no log" "empty.lcmlog" --log empty.lcmlog

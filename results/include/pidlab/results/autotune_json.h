@@ -26,6 +26,10 @@ struct AutotuneDesignOptions {
   double response_time_s = 0.0;     ///< optimal, migo: the response time (0: fastest)
   double max_ms = 2.0;              ///< the design's Ms on the model at most this (> 1)
   double max_overshoot_pct = 60.0;  ///< the verification step's overshoot at most this
+  /// Given (verify_gains), these gains are verified and adopted or refused
+  /// instead of the design's, under the same verdict.
+  bool verify_given = false;
+  PidGains verify_gains;
   bool IsValid(std::string* error) const;
 };
 

@@ -33,6 +33,7 @@ struct AutotuneSpec {
   double relay_time_s = 60.0, max_time_s = 7200.0;
   std::string method = "optimal";
   double robustness = 1.4, response_time_s = 0.0, max_overshoot_pct = 60.0;
+  std::vector<double> verify_gains;  // KP,KI,KD[,TF]: these, not the design's
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -86,6 +87,12 @@ struct AutotuneSpec {
     a->Visit({"max_overshoot", "adopt only gains whose step on the trio overshoots at most this, %", "",
               kNone, "30"},
              &max_overshoot_pct);
+    a->Visit({"verify_gains",
+              "KP,KI,KD[,TF]: verify these gains on the process instead of the design's, under the same "
+              "verdict (their Ms on the identified model, then the step); the design is still made and "
+              "shown beside them",
+              "", kNone, "[1.2, 0.8, 0.1]"},
+             &verify_gains);
   }
 };
 

@@ -303,9 +303,12 @@ struct TuneSpec {
          "multi-start (Sobol' design + Nelder-Mead polish) | nelder-mead | paper-nm | ziegler-nichols | ga | "
          "pso-gsa | simc | amigo (tuning rules on a reduced model) | migo (the largest ki under an Ms "
          "bound) | optimal (the design engine: the least load integral |e| dt under Ms, Mt and noise-gain "
-         "bounds, docs/tuning.md). Not given: migo, unless a flag asks for a search (an objective, a box, a budget, a step "
-         "or robustness bound, robust, the sampled loop) or the plant is the nonlinear stepper: then "
-         "multi-start (docs/tuning.md, \"Any plant\")",
+         "bounds, docs/tuning.md). Not given: optimal, on the continuous loop and on --loop sampled, unless "
+         "a "
+         "flag asks for a search (an objective, a box, a budget, a margin, a settling or time-constant "
+         "bound, "
+         "robust, --backend lcm) or the plant is the nonlinear stepper: then multi-start, and the line "
+         "'method chosen' names the flag (docs/tuning.md, \"Any plant\")",
          "", kNone, R"("nelder-mead")"},
         &method);
     a->Visit({"objective",
@@ -372,19 +375,22 @@ struct TuneSpec {
              &two_dof);
     a->Visit(
         {"robustness",
-         "migo: the bound on Ms and Mt, in (1, 4]: lower is more robust and slower (not given: SIMC's Ms "
+         "optimal and migo: the bound on Ms and Mt, in (1, 4]: lower is more robust and slower (not given: "
+         "SIMC's Ms "
          "on the plant, within [1.4, 1.6]; 1.4 is a gain margin >= 3.5 and a phase margin >= 41 deg); or "
          "a phase margin in [20, 80] deg, e.g. 60 as MATLAB's pidtune: the largest Ms bound whose design "
          "keeps it",
          "", kNone, "1.6"},
         &robustness);
     a->Visit({"response_time",
-              "migo: a slower design than --robustness allows, the loop's gain crossover at most 2/T (0 = as "
+              "optimal and migo: a slower design than --robustness allows, the loop's gain crossover at most "
+              "2/T (0 = as "
               "fast as the bound allows)",
               "s", kNone, "5"},
              &response_time_s);
     a->Visit({"crossover",
-              "migo: the response time as a gain crossover W, the same as --response-time 2/W (0 = as fast as "
+              "optimal and migo: the response time as a gain crossover W, the same as --response-time 2/W (0 "
+              "= as fast as "
               "the bound allows; not with --response-time)",
               "rad/s", kNone, "0.1"},
              &crossover_rad_s);
