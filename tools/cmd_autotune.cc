@@ -205,6 +205,8 @@ struct AutotuneCommand {
                 x["hysteresis"].is_number() ? x["hysteresis"].get<double>() : NAN,
                 x["d_high"].is_number() ? x["d_high"].get<double>() : NAN,
                 x["d_low"].is_number() ? x["d_low"].get<double>() : NAN);
+    if (x.value("clipped", std::string()) != "")
+      std::printf("clipped:      %s\n", x["clipped"].get<std::string>().c_str());
     const json& e = out["estimates"];
     if (e.is_object()) {
       std::printf("period:       %.6g +- %.2g s (95 %%, %d cycles)\n", e["period_s"].get<double>(),

@@ -56,6 +56,7 @@ json ExperimentJson(const ExperimentSummary& x) {
   e["hysteresis"] = JsonNumber(x.hysteresis);
   e["d_high"] = JsonNumber(x.d_high);
   e["d_low"] = JsonNumber(x.d_low);
+  e["clipped"] = x.clipped;
   e["relay_start_s"] = JsonNumber(x.relay_start_s);
   e["end_s"] = JsonNumber(x.end_s);
   e["horizon_s"] = JsonNumber(x.horizon_s);

@@ -101,8 +101,19 @@ print(("PASS " if ok else "FAIL ") + "the verification is read smoothed over %d 
     /usr/bin/python3 -c '
 import json; x = json.load(open("out.json"))["experiment"]
 ok = abs(x["u0"] - 0.2) < 1e-3 and abs(x["u0"] - x["d_low"]) < 1e-12 and x["d_high"] > x["d_low"]
-print(("PASS " if ok else "FAIL ") + "a heat-only relay: u0 %.6g, low side cut to u = 0 (d_low %.6g), high side %.6g"
-      % (x["u0"], x["d_low"], x["d_high"]))' ;;
+ok = ok and "the low side cut" in x["clipped"]
+print(("PASS " if ok else "FAIL ") + "a heat-only relay: u0 %.6g, low side cut to u = 0 (d_low %.6g), high side %.6g: %s"
+      % (x["u0"], x["d_low"], x["d_high"], x["clipped"]))' ;;
+  clipped)  # a relay of +-1000 under +-30 limits (issue 60): one line names the cut and what was used
+    autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --relay-amplitude 1000 --relay-bias 0 --output-limits -30,30
+    line=$(grep -c "the relay +1000 / -1000 about u0 0 was clipped by the output limits -30, 30: +30 / -30 used" err)
+    /usr/bin/python3 - "$line" <<'PY'
+import json, sys
+x = json.load(open("out.json"))["experiment"]
+ok = (sys.argv[1] == "1" and x["d_high"] == 30 and x["d_low"] == 30 and "both sides cut" in x["clipped"])
+print(("PASS " if ok else "FAIL ") + f"a relay of +-1000 under +-30 says it was clipped, once: {x['clipped']}")
+PY
+    ;;
   load_step)  # a load step on the plant input at t = 14.5 s, once the relay has settled (its cycles start at
     # 10.5, 12.3, 14.1 and 15.8 s without it, converged at 17.6 s): detected, the test restarts from the hold
     autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --gains 1,1,0 --disturbance step \

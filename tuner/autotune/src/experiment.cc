@@ -60,6 +60,34 @@ Status ReplayRelay(const RelayTuneOptions& relay, const PidGains& previous, cons
   return Status::Ok();
 }
 
+namespace {
+
+// The line that names a relay the output limits cut ("" if none): the
+// asked +(d + b) / -(d - b), what was used about u0, and the limits.
+std::string ClippedNote(const ExperimentOptions& options, const ExperimentSummary& out) {
+  const double asked_high = options.relay.amplitude + options.relay.bias;
+  const double asked_low = options.relay.amplitude - options.relay.bias;
+  if (!(out.d_high > 0.0) || !(out.d_low > 0.0)) return "";
+  // A fixed-point relay rounds its amplitudes to the output grid: a cut is
+  // more than that rounding.
+  const double slack = 1e-9 * std::max({1.0, std::abs(asked_high), std::abs(asked_low)}) +
+                       (options.relay.q_bits > 0 ? 1e-6 * std::max(asked_high, asked_low) : 0.0);
+  const bool high = out.d_high < asked_high - slack, low = out.d_low < asked_low - slack;
+  if (!high && !low) return "";
+  std::string line = "the relay +" + Num(asked_high) + " / -" + Num(asked_low) + " about u0 " + Num(out.u0) +
+                     " was clipped by the output limits " + Num(options.pid.output_min) + ", " +
+                     Num(options.pid.output_max) + ": +" + Num(out.d_high) + " / -" + Num(out.d_low) +
+                     " used" +
+                     (high && low ? " (both sides cut)"
+                      : high      ? " (the high side cut)"
+                                  : " (the low side cut)");
+  if (options.relay.bias != 0.0 && std::abs(out.d_high - out.d_low) <= slack)
+    line += "; cut to a symmetric relay, which identifies no FOPDT gain: lower --relay-amplitude";
+  return line;
+}
+
+}  // namespace
+
 Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySample> samples,
                           ExperimentSummary* summary) {
   ExperimentSummary& out = *summary;
@@ -82,6 +110,7 @@ Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySam
   out.load_changes_s = tuner.load_changes_s();
   out.cycles = tuner.cycles();
   out.samples = std::move(samples);
+  out.clipped = ClippedNote(options, out);
   return Status::Ok();
 }
 
@@ -138,6 +167,7 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
         std::to_string(out.cycles.size()) + " cycles" +
         (out.cycles.empty() ? std::string() : ", last period " + Num(out.cycles.back().period_s()) + " s") +
         (out.why.empty() ? std::string() : ": " + out.why));
+    if (!out.clipped.empty() && out.episodes == 1) say("  " + out.clipped);
     if (out.end == RelayPhase::kDone || out.end == RelayPhase::kAborted) break;
     if (window >= options.max_window_s) {
       out.why = "the relay ran " + Num(window) + " s (the longest window, --max-time) without " +

@@ -58,6 +58,10 @@ struct ExperimentSummary {
   RelayEstimates estimates;  ///< kDone only (estimates.converged)
   /// The estimates' relay (setpoint, u0, d_high, d_low, hysteresis).
   RelayOptions relay;
+  /// Where the output limits cut the relay asked for (amplitude +- bias
+  /// about u0): one line saying what was asked and what was used; "" if
+  /// nothing was cut.
+  std::string clipped;
 };
 
 /// Progress: one line per episode and per end.
