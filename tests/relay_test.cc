@@ -175,3 +175,52 @@ TEST(Relay, OptionsNameTheBadValue) {
 
 }  // namespace
 }  // namespace pidlab
+
+namespace pidlab {
+namespace {
+
+// A symmetric relay's cycle on K e^(-sL)/(Ts + 1), in closed form: the
+// amplitude a = Kd - (Kd - eps) e^(-L/T), the half period
+// h = L + T ln((Kd + a) / (Kd - eps)).
+RelayCycle SymmetricCycle(const autotune::FopdtModel& p, double d, double eps) {
+  const double x = p.gain * d, a = x - (x - eps) * std::exp(-p.delay_s / p.time_constant_s);
+  const double h = p.delay_s + p.time_constant_s * std::log((x + a) / (x - eps));
+  RelayCycle c;
+  c.e_max = a;
+  c.e_min = -a;
+  c.t_on_s = c.t_off_s = h;
+  return c;
+}
+
+TEST(Relay, ASymmetricRelaysCycleAndItsDelayToTheExtremesGiveTheFopdtBack) {
+  for (const autotune::FopdtModel& p :
+       {autotune::FopdtModel{2.0, 3.0, 1.0}, autotune::FopdtModel{0.5, 1.0, 2.0},
+        autotune::FopdtModel{1.0, 1.0, 0.1}}) {
+    for (const double eps : {0.0, 0.02}) {
+      autotune::RelayOptions o;
+      o.d_high = o.d_low = 0.7;
+      o.hysteresis = eps;
+      autotune::FopdtModel m;
+      ASSERT_TRUE(IsOk(autotune::FopdtFromSymmetric(o, SymmetricCycle(p, 0.7, eps), p.delay_s, &m)));
+      EXPECT_NEAR(m.gain, p.gain, 1e-9 * p.gain);
+      EXPECT_NEAR(m.time_constant_s, p.time_constant_s, 1e-9 * p.time_constant_s);
+      EXPECT_EQ(m.delay_s, p.delay_s);
+    }
+  }
+}
+
+TEST(Relay, ASymmetricRelaysHalfPeriodTooLongForItsDelayIsNoFopdt) {
+  autotune::RelayOptions o;
+  o.d_high = o.d_low = 1.0;
+  RelayCycle c;
+  c.e_max = 1.0;
+  c.e_min = -1.0;
+  c.t_on_s = c.t_off_s = 3.0;  // an integrator K/s with L = 1 has h = 2 L exactly: more is no FOPDT
+  autotune::FopdtModel m;
+  const Status st = autotune::FopdtFromSymmetric(o, c, 1.0, &m);
+  EXPECT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("too long"), std::string::npos) << st.message();
+}
+
+}  // namespace
+}  // namespace pidlab

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 
 namespace pidlab::autotune {
@@ -62,6 +63,27 @@ Status ReplayRelay(const RelayTuneOptions& relay, const PidGains& previous, cons
 
 namespace {
 
+// The mean time from each of the last `halves` switches of u after the
+// relay's start to the extreme of y before the next switch (NaN if there
+// are fewer).
+double ApparentDelay(const std::vector<RelaySample>& samples, double relay_start_s, int halves) {
+  std::vector<std::size_t> switches;
+  for (std::size_t k = 1; k < samples.size(); ++k)
+    if (samples[k].t_s >= relay_start_s && samples[k].u != samples[k - 1].u) switches.push_back(k);
+  if (static_cast<int>(switches.size()) < halves + 1) return std::numeric_limits<double>::quiet_NaN();
+  double sum = 0.0;
+  for (std::size_t i = switches.size() - 1 - halves; i + 1 < switches.size(); ++i) {
+    const std::size_t from = switches[i], to = switches[i + 1];
+    const bool rising = samples[from].u > samples[from - 1].u;  // y turns at its minimum
+    std::size_t at = from;
+    for (std::size_t k = from; k < to; ++k)
+      if (rising ? samples[k].y < samples[at].y : samples[k].y > samples[at].y) at = k;
+    // The new u is applied from its own sample on.
+    sum += samples[at].t_s - samples[from].t_s;
+  }
+  return sum / halves;
+}
+
 // The line that names a relay the output limits cut ("" if none): the
 // asked +(d + b) / -(d - b), what was used about u0, and the limits.
 std::string ClippedNote(const ExperimentOptions& options, const ExperimentSummary& out) {
@@ -82,7 +104,7 @@ std::string ClippedNote(const ExperimentOptions& options, const ExperimentSummar
                       : high      ? " (the high side cut)"
                                   : " (the low side cut)");
   if (options.relay.bias != 0.0 && std::abs(out.d_high - out.d_low) <= slack)
-    line += "; cut to a symmetric relay, which identifies no FOPDT gain: lower --relay-amplitude";
+    line += "; cut to a symmetric relay: its model needs clean extremes (the delay to them)";
   return line;
 }
 
@@ -132,7 +154,13 @@ void EstimateFromRecord(const ExperimentOptions& options, ExperimentSummary* sum
     RelayOptions averaged = out.relay;
     if (3.0 * out.noise_sigma > 0.01 * out.cycles.back().amplitude())
       averaged.settled_cycles = std::max(averaged.settled_cycles, static_cast<int>(out.cycles.size()) - 1);
-    out.estimates = EstimateFromCycles(averaged, out.cycles, true, out.noise_sigma);
+    // A symmetric relay's model needs the delay to the extremes, which
+    // noise hides: only where the extremes are clean.
+    const bool clean = !(3.0 * out.noise_sigma > 0.01 * out.cycles.back().amplitude());
+    const double delay = out.d_high == out.d_low && clean
+                             ? ApparentDelay(out.samples, out.relay_start_s, 2 * averaged.settled_cycles)
+                             : std::numeric_limits<double>::quiet_NaN();
+    out.estimates = EstimateFromCycles(averaged, out.cycles, true, out.noise_sigma, delay);
     if (out.estimates.model_found)
       say("  estimates: period " + Num(out.estimates.period_s) + " +- " + Num(out.estimates.period_ci_s) +
           " s, Ku " + Num(out.estimates.ku) + " (describing function " +

@@ -105,7 +105,7 @@ bool RelayExperiment::Converged() const {
 RelayEstimates RelayExperiment::Estimate() const { return EstimateFromCycles(o_, cycles_, Converged(), 0.0); }
 
 RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<RelayCycle>& cycles,
-                                  bool converged, double noise_sigma) {
+                                  bool converged, double noise_sigma, double delay_s) {
   RelayEstimates r;
   r.converged = converged;
   const int available = static_cast<int>(cycles.size()) - 1;  // without the approach
@@ -136,8 +136,12 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
   const double mean_v = o.d_high * mean.t_on_s - o.d_low * mean.t_off_s;
   const bool integrating =
       o.d_high != o.d_low && std::abs(mean_v) <= 0.02 * (o.d_high * mean.t_on_s + o.d_low * mean.t_off_s);
+  const bool symmetric = o.d_high == o.d_low && delay_s > 0.0;
   Status fitted;
-  if (integrating) {
+  if (symmetric) {
+    fitted = FopdtFromSymmetric(o, mean, delay_s, &r.model);
+    r.model_from = "the period, the amplitude and the delay to the extremes (a symmetric relay)";
+  } else if (integrating) {
     fitted = IntegratingFromCycle(o, mean, &r.model);
     r.model_from = "extremes";
   } else if (3.0 * noise_sigma > 0.01 * r.amplitude) {
@@ -168,7 +172,9 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
     const RelayCycle& c = cycles[cycles.size() - 1 - i];
     FopdtModel m;
     Status st;
-    if (r.model.integrating)
+    if (symmetric)
+      st = FopdtFromSymmetric(o, c, delay_s, &m);
+    else if (r.model.integrating)
       st = IntegratingFromCycle(o, c, &m);
     else if (r.model_from == "extremes")
       st = FopdtFromCycle(o, c, &m);
@@ -410,6 +416,38 @@ Status FopdtFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtModel* mo
   model->gain = k;
   model->time_constant_s = t;
   model->delay_s = t * l_over_t;
+  model->integrating = false;
+  return Status::Ok();
+}
+
+Status FopdtFromSymmetric(const RelayOptions& o, const RelayCycle& c, double delay_s, FopdtModel* model) {
+  const double d = 0.5 * (o.d_high + o.d_low), eps = o.hysteresis, l = delay_s;
+  const double a = 0.5 * (c.e_max - c.e_min), h = 0.5 * (c.t_on_s + c.t_off_s);
+  if (!(l > 0.0) || !(h > l) || !(a > eps) || !(d > 0.0))
+    return Status::InvalidInput("a symmetric relay's cycle (amplitude " + Number(a) + ", half period " +
+                                Number(h) + " s, delay to the extremes " + Number(l) +
+                                " s) gives no first order plus dead time");
+  // g(x), x = Kd: the half period the amplitude's T gives, less the measured.
+  const auto g = [&](double x) {
+    return l * std::log((x + a) / (x - eps)) / std::log((x - eps) / (x - a)) - (h - l);
+  };
+  if (!(l * (a + eps) / (a - eps) - (h - l) > 0.0))
+    return Status::InvalidInput("a symmetric relay's half period " + Number(h) +
+                                " s is too long for its delay " + Number(l) + " s and amplitude " +
+                                Number(a) +
+                                ": no first order plus dead time (an integrating or higher-order process)");
+  double lo = std::log(1e-12 * a), hi = std::log(1e12 * a);
+  for (int i = 0; i < 200 && hi - lo > 1e-14; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (g(a + std::exp(mid)) < 0.0 ? lo : hi) = mid;
+  }
+  const double x = a + std::exp(0.5 * (lo + hi));
+  const double t = l / std::log((x - eps) / (x - a));
+  if (!(t > 0.0) || !std::isfinite(t))
+    return Status::InvalidInput("a symmetric relay's cycle gives a time constant " + Number(t) + " s");
+  model->gain = x / d;
+  model->time_constant_s = t;
+  model->delay_s = l;
   model->integrating = false;
   return Status::Ok();
 }

@@ -43,7 +43,9 @@ struct AutotuneSpec {
         &relay_amplitude);
     a->Visit({"relay_bias",
               "relay bias b, |b| < d: +d+b above, -(d-b) below the operating point's input; empty: d/3 (an "
-              "asymmetric relay, which identifies a FOPDT model); 0 is the symmetric relay",
+              "asymmetric relay, whose mean output gives a FOPDT gain); 0 is the symmetric relay (its FOPDT "
+              "from the "
+              "delay to the extremes, on a clean process)",
               "", kNone, R"("0.1")"},
              &relay_bias);
     a->Visit({"hysteresis",

@@ -18,6 +18,7 @@
 // the mean of v: K = (integral of e over a cycle) / (d_high t_on - d_low t_off),
 // which the asymmetric relay makes nonzero.
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -104,8 +105,22 @@ class RelayExperiment {
 /// min(settled_cycles, size - 1) are averaged) under `options`' relay;
 /// where 3 noise_sigma is more than 1 % of the amplitude, the FOPDT model
 /// from the switching times (FopdtFromTimes), else from the extremes.
+/// A symmetric relay (d_high == d_low) gives no FOPDT gain by its
+/// integrals; with `delay_s`, the apparent delay from each switch to the
+/// extreme that follows it (ApparentDelay), FopdtFromSymmetric gives one.
 RelayEstimates EstimateFromCycles(const RelayOptions& options, const std::vector<RelayCycle>& cycles,
-                                  bool converged, double noise_sigma);
+                                  bool converged, double noise_sigma,
+                                  double delay_s = std::numeric_limits<double>::quiet_NaN());
+
+/// K, T and L of K e^(-sL)/(Ts + 1) under a symmetric relay d with
+/// hysteresis eps from the cycle's amplitude a, its half period h and the
+/// delay L from a switch to the extreme after it (a FOPDT turns exactly L
+/// after its input does): a = Kd - (Kd - eps) e^(-L/T) and
+/// h = L + T ln((Kd + a) / (Kd - eps)), one equation in Kd > a solved by
+/// bisection. kInvalidInput where no Kd solves it (h - L at least
+/// L (a + eps) / (a - eps): an integrating or higher-order process).
+Status FopdtFromSymmetric(const RelayOptions& options, const RelayCycle& cycle, double delay_s,
+                          FopdtModel* model);
 
 /// K, T and L from a cycle's mean t_on, t_off, integral of e and integral
 /// over the part at +d_high, not its extremes: K from the integral; then,
