@@ -218,7 +218,7 @@ struct AutotuneCommand {
         const auto ci = [](const json& v) { return v.is_number() ? v.get<double>() : NAN; };
         std::printf(
             "Ku, Pu:       %.6g +- %.2g, %.6g +- %.2g s (the model's phase crossover; 95 %% over the "
-            "cycles)\n",
+            "cycles: their spread only, not the model-structure error)\n",
             e["ku"].get<double>(), ci(e["ku_ci"]), e["pu_s"].get<double>(), ci(e["pu_ci_s"]));
         std::printf("Ku (DF):      %.6g (describing function 4d/(pi a), labelled: no correction)\n",
                     e["ku_describing_function"].get<double>());

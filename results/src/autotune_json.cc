@@ -75,6 +75,11 @@ json ExperimentJson(const ExperimentSummary& x) {
   return e;
 }
 
+// What the 95 % intervals hold (issue 60, "honest intervals").
+constexpr const char* kIntervalsAre =
+    "the cycle-to-cycle spread only (95 %, Student's t): the model-structure error of a FOPDT fitted to "
+    "another process is not in them";
+
 json EstimatesJson(const ExperimentSummary& x) {
   const autotune::RelayEstimates& r = x.estimates;
   if (x.end != RelayPhase::kDone) return nullptr;
@@ -93,6 +98,7 @@ json EstimatesJson(const ExperimentSummary& x) {
     e["ku_ci"] = JsonNumber(r.ku_ci);
     e["pu_s"] = JsonNumber(r.pu_s);
     e["pu_ci_s"] = JsonNumber(r.pu_ci_s);
+    e["intervals"] = kIntervalsAre;
     e["model"] = {{"kind", r.model.integrating ? "ipdt" : "fopdt"},
                   {"gain", r.model.gain},
                   {"time_constant_s", r.model.time_constant_s},
