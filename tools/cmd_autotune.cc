@@ -19,6 +19,7 @@
 #include "pidlab/results/spec_run.h"
 #include "pidlab/results/tune_run.h"
 #include "pidlab/tune/problem.h"
+#include "pidlab/tune/time_scale.h"
 
 using nlohmann::json;
 using pidlab::autotune::ExperimentOptions;
@@ -99,6 +100,17 @@ struct AutotuneCommand {
     s.loop.loop = "sampled";
     Plant plant;
     LoopOptions loop;
+    // Off the paper's plants, dt from the plant's time scales unless given
+    // (the plant built on the continuous loop, which takes any delay).
+    spec::LoopSpec continuous = s.loop;
+    continuous.loop = "continuous";
+    std::string dt_line;  // said once the input is known good (bad input is one line)
+    if (!given.count("dt") && !tune::IsPaperPlant(s.plant) &&
+        tune::BuildPlantInLoop(s.plant, continuous, NameStyle::kFlag, &plant, &loop).ok() &&
+        !plant.nonlinear) {
+      s.loop.dt_s = tune::SampledDtFromPlant(plant, &dt_line);
+      given.insert("dt");
+    }
     Require(tune::BuildPlantInLoop(s.plant, s.loop, NameStyle::kFlag, &plant, &loop));
     loop.loop = LoopKind::kSampled;
     const PidGains previous{s.gains[0], s.gains[1], s.gains[2]};
@@ -108,6 +120,7 @@ struct AutotuneCommand {
     results::AutotuneRun autotune_run;
     Require(
         results::BuildAutotune(a, a_given, previous, pid, s.bounds.max_ms, NameStyle::kFlag, &autotune_run));
+    if (!dt_line.empty()) Say(dt_line);
     const ExperimentOptions& xo = autotune_run.experiment;
     const results::AutotuneDesignOptions& design = autotune_run.design;
 

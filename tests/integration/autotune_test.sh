@@ -305,6 +305,12 @@ ok = x["d_high"] == x["d_low"] and "symmetric relay" in e["model"]["from"]
 print(("PASS " if ok else "FAIL ") + "a symmetric relay (+%.3g / -%.3g): the model from %s; Ku %.5g, the describing function %.5g"
       % (x["d_high"], x["d_low"], e["model"]["from"], e["ku"], e["ku_describing_function"]))'
     done ;;
+  no_flags)  # issue 60's command with no other flag: dt from the plant (0.002 s, said in one line), Ku and
+    # Pu within 5 %
+    autotune --num 1 --den 1,1 --delay 2 || echo "FAIL autotune: $(tail -1 err)"
+    check fopdt 1 1 2
+    if grep -q "^dt 0.002 s: min(L, the plant's fastest time 1 s) / 400" err; then echo "PASS dt from the plant: $(grep '^dt ' err)"
+    else echo "FAIL no dt line from the plant: $(grep -m1 '^dt' err)"; fi ;;
   mismatch)  # honest intervals (issue 60): five processes no FOPDT is (two lags, a lag plus a zero, three
     # lags); the relay's Ku and Pu against the exact ones of the true plant (scipy, its phase crossover).
     # Each 95 % interval either contains the exact value or is labelled the cycle spread only.

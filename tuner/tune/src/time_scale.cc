@@ -126,4 +126,39 @@ TimeScale ResolveGainsTimeScale(const spec::PlantSpec& plant_spec, const Plant& 
   return derived;
 }
 
+namespace {
+
+// The 1-2-5 value at most x (up: at least x).
+double OneTwoFive(double x, bool up) {
+  const double decade = std::pow(10.0, std::floor(std::log10(x)));
+  const double steps[] = {1.0, 2.0, 5.0, 10.0};
+  if (up) {
+    for (double m : steps)
+      if (m * decade >= x * (1 - 1e-12)) return m * decade;
+  }
+  double best = decade;
+  for (double m : steps)
+    if (m * decade <= x * (1 + 1e-12)) best = m * decade;
+  return best;
+}
+
+}  // namespace
+
+double SampledDtFromPlant(const Plant& plant, std::string* why) {
+  double fastest = 0.0, slowest = 0.0;
+  PlantTimes(plant, &fastest, &slowest);
+  const double l = plant.delay_s;
+  const double base = l > 0.0 ? std::min(l, fastest) : fastest;
+  double dt = OneTwoFive(base / kDtPerFastestTime, false);
+  std::string reason = "min(L, the plant's fastest time " + spec::FormatNumber(fastest) + " s) / " +
+                       spec::FormatNumber(kDtPerFastestTime) + ", a 1-2-5 value";
+  if (l > 0.0 && std::ceil(l / dt - 1e-9) > static_cast<double>(evaluation::kMaxAnalysedDelaySteps)) {
+    dt = OneTwoFive(l / static_cast<double>(evaluation::kMaxAnalysedDelaySteps), true);
+    reason = "L / " + std::to_string(evaluation::kMaxAnalysedDelaySteps) +
+             " (the delay line the analysis takes), a 1-2-5 value";
+  }
+  if (why) *why = "dt " + spec::FormatNumber(dt) + " s: " + reason + " (give --dt to choose)";
+  return dt;
+}
+
 }  // namespace pidlab::tune

@@ -28,6 +28,13 @@ TimeScale GainsTimeScale(const Plant& plant, const std::vector<PidGains>& gains,
 /// number (the continuous loop, or a dt its caller refuses).
 void OnSampledGrid(double dt_s, double* sample_time_s, double* horizon_s);
 
+/// The sampled loop's period for a plant when none is given (autotune):
+/// min(L, the plant's fastest time) / kDtPerFastestTime, rounded down to a
+/// 1-2-5 value, and at least L / kMaxAnalysedDelaySteps (rounded up) so
+/// that the delay line stays analysable. *why says which, in one line.
+inline constexpr double kDtPerFastestTime = 400.0;
+double SampledDtFromPlant(const Plant& plant, std::string* why);
+
 /// Which loops take a derived time scale.
 enum class TimeScaleScope {
   kNotPaper,  ///< every plant but the paper's (evaluate: eq. 4's numbers stay)
