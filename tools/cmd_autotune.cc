@@ -100,17 +100,7 @@ struct AutotuneCommand {
     s.loop.loop = "sampled";
     Plant plant;
     LoopOptions loop;
-    // Off the paper's plants, dt from the plant's time scales unless given
-    // (the plant built on the continuous loop, which takes any delay).
-    spec::LoopSpec continuous = s.loop;
-    continuous.loop = "continuous";
-    std::string dt_line;  // said once the input is known good (bad input is one line)
-    if (!given.count("dt") && !tune::IsPaperPlant(s.plant) &&
-        tune::BuildPlantInLoop(s.plant, continuous, NameStyle::kFlag, &plant, &loop).ok() &&
-        !plant.nonlinear) {
-      s.loop.dt_s = tune::SampledDtFromPlant(plant, &dt_line);
-      given.insert("dt");
-    }
+    const std::string dt_line = DtFromPlant(&s, &given);  // said once the input is known good
     Require(tune::BuildPlantInLoop(s.plant, s.loop, NameStyle::kFlag, &plant, &loop));
     loop.loop = LoopKind::kSampled;
     const PidGains previous{s.gains[0], s.gains[1], s.gains[2]};
@@ -138,41 +128,7 @@ struct AutotuneCommand {
     };
     ExperimentSummary x;
     Require(autotune::RunExperiment(xo, runner, &x, Say));
-    // The verification: a closed-loop step on the trio, the spec of the
-    // flags with the new gains, 15 Pu at Pu/100 unless given.
-    const results::StepRunner step = [&](const PidGains& gains, double pu, results::StepRun* run) {
-      spec::EvaluateSpec v = s;
-      v.gains = {gains.kp, gains.ki, gains.kd};
-      v.loop.loop = "sampled";
-      if (gains.tf > 0.0) {
-        v.loop.derivative_filter_s = gains.tf;
-        v.loop.derivative_filter_ratio = 0.0;
-      }
-      std::set<std::string> keys = given;
-      if (!given.count("sample_time")) v.loop.sample_time_s = CeilTo(pu / 100.0, loop.dt_s);
-      if (!given.count("horizon")) v.loop.horizon_s = CeilTo(15.0 * pu, v.loop.sample_time_s);
-      for (const char* k : {"sample_time", "horizon", "gains", "loop"}) keys.insert(k);
-      tune::BuildOptions build;
-      build.style = NameStyle::kFlag;
-      build.backend = tune::Backend::kRunner;
-      build.given = keys;
-      tune::EvaluationProblem problem;
-      if (const Status st = tune::BuildEvaluation(v, build, &problem); !st.ok())
-        return Status::RunnerFailed("the verification step does not build: " + st.message());
-      tune::EvaluationRunOptions options;
-      options.monte_carlo = false;
-      options.runner = [&client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
-                                 const DisturbanceOptions& d, std::vector<double>* y,
-                                 std::vector<SampledStep>* tr) { return client->Run(pl, ga, lo, d, y, tr); };
-      Say("verification: a closed-loop step on the trio, " + std::to_string(v.loop.horizon_s) + " s");
-      tune::EvaluationResult result;
-      if (const Status st = tune::RunEvaluation(problem, options, &result); !st.ok())
-        return Status::RunnerFailed("the verification step failed: " + st.message());
-      run->evaluation = result.evaluation;
-      run->horizon_s = v.loop.horizon_s;
-      run->json = results::EvaluationJson(problem, result, "lcm");
-      return Status::Ok();
-    };
+    const results::StepRunner step = VerificationStep(s, given, loop.dt_s, client.get());
     bool adopted = false;
     json out = results::AutotuneJson(x, previous, design, step, Say, &adopted);
     out["backend"] = "lcm";
@@ -191,6 +147,63 @@ struct AutotuneCommand {
       // A watcher's message never stops the command.
     }
     return Print(out, adopted);
+  }
+
+  // Off the paper's plants, dt from the plant's time scales unless given
+  // (the plant built on the continuous loop, which takes any delay): its
+  // line, or "".
+  static std::string DtFromPlant(spec::EvaluateSpec* s, std::set<std::string>* given) {
+    spec::LoopSpec continuous = s->loop;
+    continuous.loop = "continuous";
+    Plant plant;
+    LoopOptions loop;
+    std::string line;
+    if (!given->count("dt") && !tune::IsPaperPlant(s->plant) &&
+        tune::BuildPlantInLoop(s->plant, continuous, NameStyle::kFlag, &plant, &loop).ok() &&
+        !plant.nonlinear) {
+      s->loop.dt_s = tune::SampledDtFromPlant(plant, &line);
+      given->insert("dt");
+    }
+    return line;
+  }
+
+  // The verification: a closed-loop step on the trio, the spec of the flags
+  // `s` with the new gains, 15 Pu at Pu/100 unless given.
+  static results::StepRunner VerificationStep(const spec::EvaluateSpec& s, const std::set<std::string>& given,
+                                              double dt_s, EpisodeClient* client) {
+    return [s, given, dt_s, client](const PidGains& gains, double pu, results::StepRun* run) {
+      spec::EvaluateSpec v = s;
+      v.gains = {gains.kp, gains.ki, gains.kd};
+      v.loop.loop = "sampled";
+      if (gains.tf > 0.0) {
+        v.loop.derivative_filter_s = gains.tf;
+        v.loop.derivative_filter_ratio = 0.0;
+      }
+      std::set<std::string> keys = given;
+      if (!given.count("sample_time")) v.loop.sample_time_s = CeilTo(pu / 100.0, dt_s);
+      if (!given.count("horizon")) v.loop.horizon_s = CeilTo(15.0 * pu, v.loop.sample_time_s);
+      for (const char* k : {"sample_time", "horizon", "gains", "loop"}) keys.insert(k);
+      tune::BuildOptions build;
+      build.style = NameStyle::kFlag;
+      build.backend = tune::Backend::kRunner;
+      build.given = keys;
+      tune::EvaluationProblem problem;
+      if (const Status st = tune::BuildEvaluation(v, build, &problem); !st.ok())
+        return Status::RunnerFailed("the verification step does not build: " + st.message());
+      tune::EvaluationRunOptions options;
+      options.monte_carlo = false;
+      options.runner = [client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
+                                const DisturbanceOptions& d, std::vector<double>* y,
+                                std::vector<SampledStep>* tr) { return client->Run(pl, ga, lo, d, y, tr); };
+      Say("verification: a closed-loop step on the trio, " + std::to_string(v.loop.horizon_s) + " s");
+      tune::EvaluationResult result;
+      if (const Status st = tune::RunEvaluation(problem, options, &result); !st.ok())
+        return Status::RunnerFailed("the verification step failed: " + st.message());
+      run->evaluation = result.evaluation;
+      run->horizon_s = v.loop.horizon_s;
+      run->json = results::EvaluationJson(problem, result, "lcm");
+      return Status::Ok();
+    };
   }
 
   int Print(const json& out, bool adopted) const {
