@@ -80,6 +80,62 @@ TEST(RelayTuner, FindsTheOperatingPointAndTheNoiseInTheHoldAndConvergesAroundIt)
   EXPECT_GE(static_cast<int>(tuner.cycles().size()), kNoisySettledCycles + 1);
 }
 
+// 1 e^(-0.5s)/(s+1) measured with noise sigma 0.05 (seeded), the hysteresis
+// 3 sigma, from rest.
+RelayTuner RunNoisyRelay(int seed, double d, double bias, double t_end_s) {
+  Fopdt plant;
+  plant.sigma = 0.05;
+  plant.rng.seed(static_cast<unsigned>(seed));
+  RelayTuneOptions o;
+  o.amplitude = d;
+  o.bias = bias;
+  o.noise_multiple = 3.0;
+  RelayTuner tuner(o, PidGains{}, Loop());
+  RunTuner(&tuner, &plant, 0.0, t_end_s);
+  return tuner;
+}
+
+TEST(RelayTuner, StopsARelayTooSmallForTheNoiseWithinThreeOfItsPeriodsNamingTheAmplitudeThatWould) {
+  // A relay of 0.05 moves y by at most 0.05, under the hysteresis 0.15, so
+  // only the noise switches it. Against the period of a relay that beats the
+  // noise (0.35), over 40 seeds: the noise switches at random, so most stop
+  // within 3 periods and every one within 4.
+  const RelayTuner working = RunNoisyRelay(1, 0.35, 0.0, 200.0);
+  ASSERT_EQ(working.phase(), RelayPhase::kDone) << working.why();
+  const double period = working.cycles().back().period_s();
+  int within_3 = 0;
+  for (int seed = 1; seed <= 40; ++seed) {
+    const RelayTuner tuner = RunNoisyRelay(seed, 0.05, 0.0, 120.0);
+    ASSERT_EQ(tuner.phase(), RelayPhase::kAborted) << "seed " << seed;
+    EXPECT_NE(tuner.why().find("cannot beat the noise"), std::string::npos) << tuner.why();
+    EXPECT_NE(tuner.why().find("(now 0.05)"), std::string::npos) << tuner.why();
+    const double ran = tuner.end_s() - tuner.relay_start_s();
+    EXPECT_LT(ran, 4.0 * period) << "seed " << seed << ": " << tuner.why();
+    within_3 += ran < 3.0 * period;
+  }
+  EXPECT_GE(within_3, 35) << "of 40 within 3 periods of " << period << " s";
+}
+
+TEST(RelayTuner, NeverStopsARelayThatBeatsTheNoiseOnTheNoiseGuard) {
+  // The same process and noise, relays with K d over 3 hysteresis, over 40
+  // seeds: none is taken for the noise, and none times out, though noise cuts
+  // cycles short (the timeout counts the longest cycle's periods).
+  int done = 0;
+  for (int seed = 1; seed <= 40; ++seed) {
+    for (double d : {0.5, 1.0}) {
+      const RelayTuner tuner = RunNoisyRelay(seed, d, 0.2 * d, 200.0);
+      EXPECT_NE(tuner.phase(), RelayPhase::kRelay) << "seed " << seed << ", d " << d;
+      EXPECT_EQ(tuner.why().find("noise"), std::string::npos)
+          << "seed " << seed << ", d " << d << ": " << tuner.why();
+      EXPECT_EQ(tuner.why().find("did not converge"), std::string::npos)
+          << "seed " << seed << ", d " << d << ": " << tuner.why();
+      done += tuner.phase() == RelayPhase::kDone;
+    }
+  }
+  // The rest end on a noise-cut cycle read as a load change (no PID to hold).
+  EXPECT_GE(done, 74) << "of 80";
+}
+
 TEST(RelayTuner, CutsTheRelayToTheOutputRangeForAHeatOnlyActuator) {
   Fopdt plant;
   RelayTuneOptions o;

@@ -150,11 +150,13 @@ struct AutotuneCommand {
   }
 
   // Off the paper's plants, dt from the plant's time scales unless given
-  // (the plant built on the continuous loop, which takes any delay): its
+  // (the plant built on the noiseless continuous loop, which takes any
+  // delay), and the sample time and horizon on its grid unless given: its
   // line, or "".
   static std::string DtFromPlant(spec::EvaluateSpec* s, std::set<std::string>* given) {
     spec::LoopSpec continuous = s->loop;
     continuous.loop = "continuous";
+    continuous.measurement_noise = 0.0;
     Plant plant;
     LoopOptions loop;
     std::string line;
@@ -163,6 +165,10 @@ struct AutotuneCommand {
         !plant.nonlinear) {
       s->loop.dt_s = tune::SampledDtFromPlant(plant, &line);
       given->insert("dt");
+      double sample_time = s->loop.sample_time_s, horizon = s->loop.horizon_s;
+      tune::OnSampledGrid(s->loop.dt_s, &sample_time, &horizon);
+      if (!given->count("sample_time")) s->loop.sample_time_s = sample_time;
+      if (!given->count("horizon")) s->loop.horizon_s = horizon;
     }
     return line;
   }
@@ -195,7 +201,7 @@ struct AutotuneCommand {
       options.runner = [client](const Plant& pl, const PidGains& ga, const LoopOptions& lo,
                                 const DisturbanceOptions& d, std::vector<double>* y,
                                 std::vector<SampledStep>* tr) { return client->Run(pl, ga, lo, d, y, tr); };
-      Say("verification: a closed-loop step on the trio, " + std::to_string(v.loop.horizon_s) + " s");
+      Say("verification: a closed-loop step on the trio, " + spec::FormatNumber(v.loop.horizon_s) + " s");
       tune::EvaluationResult result;
       if (const Status st = tune::RunEvaluation(problem, options, &result); !st.ok())
         return Status::RunnerFailed("the verification step failed: " + st.message());

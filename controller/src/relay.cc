@@ -41,6 +41,10 @@ std::string NoRoom(double u0, double out_min, double out_max) {
          Num(out_max) + "]";
 }
 
+// The smoothing of e: f += (e - f) * kQuietGain (exact: a power of 2).
+constexpr double kQuietGain = 1.0 / static_cast<double>(1 << kQuietShift);
+static_assert(kQuietFraction == 0.6, "the fixed point's quiet rule is 5 range < 6 eps");
+
 }  // namespace
 
 const char* ToString(RelayPhase phase) {
@@ -215,6 +219,10 @@ void RelayTuner::EndHold(double t_s, double r, double y) {
   e_prev_ = y - y0_;
   t_high_ = t_low_ = -1.0;
   integral_ = 0.0;
+  f_ = f_max_ = f_min_ = 0.0;
+  cycle_steps_ = 0;
+  quiet_ = 0;
+  longest_period_s_ = 0.0;
   cycles_.clear();
   changes_.clear();
 }
@@ -227,21 +235,29 @@ double RelayTuner::RelayStep(double t_s, double r, double y) {
           "y - y0 = " + Num(e) + " at t = " + Num(t_s) + " s is beyond the limit " + Num(o_.y_limit));
       return After(r, y);
     }
+    f_ += (e - f_) * kQuietGain;
     if (t_high_ >= 0.0) {  // inside a cycle: its integral and extremes
       integral_ += 0.5 * (e + e_prev_) * (t_s - t_prev_);
       e_max_ = std::max(e_max_, e);
       e_min_ = std::min(e_min_, e);
+      f_max_ = std::max(f_max_, f_);
+      f_min_ = std::min(f_min_, f_);
+      ++cycle_steps_;
     }
     if (!high_ && e < -eps_) {
       const bool complete = t_high_ >= 0.0 && t_low_ > t_high_;
       const RelayCycle c =
           complete ? RelayCycle::Closed(t_high_, t_low_, t_s, e_max_, e_min_, integral_, integral_on_) : RelayCycle{};
+      const double smoothed = 0.5 * (f_max_ - f_min_);
+      const bool quiet = cycle_steps_ >= kQuietMinSteps && smoothed < kQuietFraction * eps_;
       high_ = true;
       t_high_ = t_s;
       t_low_ = -1.0;
       integral_ = 0.0;
       e_max_ = e_min_ = e;
-      if (complete) OnCycle(c, t_s);
+      f_max_ = f_min_ = f_;
+      cycle_steps_ = 0;
+      if (complete) OnCycle(c, t_s, quiet, smoothed);
       if (phase_ == RelayPhase::kHold) return After(r, y);  // restarted
       if (phase_ != RelayPhase::kRelay) return After(r, y);
     } else if (high_ && e > eps_) {
@@ -251,8 +267,8 @@ double RelayTuner::RelayStep(double t_s, double r, double y) {
         integral_on_ = integral_;
       }
     }
-    if (!cycles_.empty() && t_s - relay_start_s_ > o_.timeout_periods * cycles_.back().period_s()) {
-      EndTimedOut(t_s, o_.timeout_periods * cycles_.back().period_s());
+    if (!cycles_.empty() && t_s - relay_start_s_ > o_.timeout_periods * longest_period_s_) {
+      EndTimedOut(t_s, o_.timeout_periods * longest_period_s_);
       return After(r, y);
     }
   }
@@ -261,13 +277,32 @@ double RelayTuner::RelayStep(double t_s, double r, double y) {
   return u0_ + (high_ ? d_high_ : -d_low_);
 }
 
+std::string RelayTuner::NoiseBeatsRelay(double smoothed) const {
+  // A relay's oscillation grows with its amplitude: twice the hysteresis.
+  const double d = 0.5 * (d_high_ + d_low_);
+  const double needed = d * 2.0 * eps_ / std::max(smoothed, 1e-3 * eps_);
+  return "the relay cannot beat the noise: over its last " + std::to_string(kQuietCycles) +
+         " cycles its oscillation, smoothed, is about " + Num(smoothed) + ", under the hysteresis " +
+         Num(eps_) + " (noise sigma " + Num(sigma_) +
+         "), so the noise switches it; a relay amplitude of about " + Num(needed) + " (now " + Num(d) +
+         ") would beat it";
+}
+
 double RelayTuner::Tolerance(const RelayCycle& c) const {
   // The extremes of a noisy y, and the switching times with them, jitter by
   // about sigma / amplitude: a cycle agrees within that as well.
   return o_.tolerance + (c.amplitude() > 0.0 ? 2.0 * sigma_ / c.amplitude() : 0.0);
 }
 
-void RelayTuner::OnCycle(const RelayCycle& c, double t_s) {
+void RelayTuner::OnCycle(const RelayCycle& c, double t_s, bool quiet, double smoothed) {
+  if (sigma_ > 0.0 && quiet) {
+    if (++quiet_ >= kQuietCycles) {
+      End(RelayPhase::kAborted, t_s, NoiseBeatsRelay(smoothed));
+      return;
+    }
+  } else {
+    quiet_ = 0;
+  }
   if (!cycles_.empty()) {
     const RelayCycle& p = cycles_.back();
     const double change = std::max({std::abs(c.period_s() - p.period_s()) / p.period_s(),
@@ -300,6 +335,7 @@ void RelayTuner::OnCycle(const RelayCycle& c, double t_s) {
     changes_.push_back(0.0);
   }
   cycles_.push_back(c);
+  longest_period_s_ = std::max(longest_period_s_, c.period_s());
   // Under noise the estimates average more cycles: a noisy cycle does not
   // start where the last one did, and only a sum over many telescopes that out.
   const int n = 3.0 * sigma_ > 0.01 * c.amplitude() ? std::max(o_.settled_cycles, kNoisySettledCycles)
@@ -395,6 +431,10 @@ void RelayTuner::FixedEndHold(double t_s, std::int64_t r, std::int64_t y) {
   e_prev_q_ = y - y0_q_;
   k_high_ = k_low_ = -1;
   integral_q_ = 0;
+  f_q_ = f_max_q_ = f_min_q_ = 0;
+  cycle_steps_ = 0;
+  quiet_ = 0;
+  timeout_q_ = 0;
   cycles_.clear();
   changes_.clear();
 }
@@ -408,10 +448,14 @@ double RelayTuner::FixedRelayStep(double t_s, double r, std::int64_t y) {
               " s is beyond the limit " + Num(o_.y_limit));
       return FixedAfter(r, static_cast<double>(y) * qy_);
     }
+    f_q_ += ShiftRound(e - f_q_, kQuietShift);
     if (k_high_ >= 0) {
       integral_q_ += e + e_prev_q_;
       e_max_q_ = std::max(e_max_q_, e);
       e_min_q_ = std::min(e_min_q_, e);
+      f_max_q_ = std::max(f_max_q_, f_q_);
+      f_min_q_ = std::min(f_min_q_, f_q_);
+      ++cycle_steps_;
     }
     if (!high_ && e < -eps_q_) {
       const bool complete = k_high_ >= 0 && k_low_ > k_high_;
@@ -427,18 +471,24 @@ double RelayTuner::FixedRelayStep(double t_s, double r, std::int64_t y) {
         c.integral_on_e = static_cast<double>(integral_on_q_) * (0.5 * dt * qy_);
       }
       const std::int64_t period_k = k_ - k_high_;
+      // 0.5 range < kQuietFraction (0.6) eps, in integers.
+      const bool quiet = cycle_steps_ >= kQuietMinSteps && 5 * (f_max_q_ - f_min_q_) < 6 * eps_q_;
+      const double smoothed = 0.5 * static_cast<double>(f_max_q_ - f_min_q_) * qy_;
       high_ = true;
       k_high_ = k_;
       k_low_ = -1;
       integral_q_ = 0;
       e_max_q_ = e_min_q_ = e;
+      f_max_q_ = f_min_q_ = f_q_;
+      cycle_steps_ = 0;
       if (complete) {
         const std::size_t before = cycles_.size();
-        OnCycle(c, t_s);
+        OnCycle(c, t_s, quiet, smoothed);
         if (phase_ != RelayPhase::kRelay) return FixedAfter(r, static_cast<double>(y) * qy_);
         if (cycles_.size() > before)
-          timeout_q_ =
-              static_cast<std::int64_t>(std::floor(o_.timeout_periods * static_cast<double>(period_k)));
+          timeout_q_ = std::max(
+              timeout_q_,
+              static_cast<std::int64_t>(std::floor(o_.timeout_periods * static_cast<double>(period_k))));
       }
     } else if (high_ && e > eps_q_) {
       high_ = false;

@@ -94,6 +94,30 @@ print(("PASS " if ok else "FAIL ") + "the verification is read smoothed over %d 
       "(raw %.3g %%), settling %.4g s (raw %.4g s), settled and adopted"
       % (s["window_samples"], s["band_widening"], v["overshoot_pct"], v["stepinfo"]["overshoot_pct"],
          v["settling_time_s"], v["stepinfo"]["settling_time_s"]))' ;;
+  too_small)  # a relay of 0.05 against sigma 0.05 (issue 60): the noise switches it, so it is stopped within
+    # 3 of the plant's ultimate periods, the why naming its oscillation, the hysteresis and the amplitude that
+    # would work; that amplitude then converges and adopts
+    autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --measurement-noise 0.05 --seed 7 --relay-amplitude 0.05 \
+      --relay-bias 0 && echo "FAIL a relay under the noise exited 0"
+    /usr/bin/python3 -c '
+import json, math, re
+from scipy.optimize import brentq
+j = json.load(open("out.json")); x = j["experiment"]; why = x["why"]
+pu = 2 * math.pi / brentq(lambda w: math.atan(w) + 0.5 * w - math.pi, 0.1, 10)
+m = re.search(r"smoothed, is about ([0-9.e+-]+), under the hysteresis ([0-9.e+-]+) .*amplitude of about ([0-9.e+-]+) \(now 0.05\)", why)
+ran = x["end_s"] - x["relay_start_s"]
+ok = (x["end"] == "aborted" and m is not None and float(m.group(1)) < float(m.group(2)) and
+      abs(float(m.group(2)) - x["hysteresis"]) < 1e-3 * x["hysteresis"] and ran < 3 * pu and not j["adopted"])
+print(("PASS " if ok else "FAIL ") + "a relay of 0.05 under sigma 0.05 stopped after %.4g s of relay (3 Pu = %.4g s): %s"
+      % (ran, 3 * pu, why))
+open("needed", "w").write(m.group(3) if m else "1")'
+    needed=$(cat needed)
+    autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --measurement-noise 0.05 --seed 7 --relay-amplitude "$needed" \
+      || echo "FAIL the amplitude the guard named ($needed): $(tail -1 err)"
+    /usr/bin/python3 -c '
+import json; j = json.load(open("out.json")); x = j["experiment"]
+ok = x["end"] == "done" and j["adopted"]
+print(("PASS " if ok else "FAIL ") + "the amplitude the guard named converges and adopts: %s; %s" % (x["why"], j["verdict"]))' ;;
   heat_only)  # u in [0, 2], the previous PI holding r = 0.2: the relay's low side is cut to u = 0
     autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --reference 0.2 --output-limits 0,2 --gains 0.5,0.5,0 \
       || echo "FAIL autotune: $(tail -1 err)"
@@ -305,6 +329,23 @@ ok = x["d_high"] == x["d_low"] and "symmetric relay" in e["model"]["from"]
 print(("PASS " if ok else "FAIL ") + "a symmetric relay (+%.3g / -%.3g): the model from %s; Ku %.5g, the describing function %.5g"
       % (x["d_high"], x["d_low"], e["model"]["from"], e["ku"], e["ku_describing_function"]))'
     done ;;
+  noisy_tank)  # issue 60's tank 0.8 e^(-150s)/((120s+1)(10s+1)), sigma 0.05, no --dt: dt from the plant on
+    # the sample time's grid (noise-free plant time scales), Ku within 5 % of the exact one, and the gains
+    # adopted only on a smoothed verification that settles at a time that is not 0
+    autotune --num 0.8 --den 1200,130,1 --delay 150 --measurement-noise 0.05 --seed 7 \
+      || echo "FAIL autotune: $(tail -1 err)"
+    grep -q "^dt 0.2 s" err && echo "PASS dt from the plant: $(grep '^dt ' err)" \
+      || echo "FAIL no dt 0.2 s line: $(grep -m1 '^dt' err)"
+    /usr/bin/python3 -c '
+import json, math
+from scipy.optimize import brentq
+w = brentq(lambda w: math.atan(120 * w) + math.atan(10 * w) + 150 * w - math.pi, 1e-4, 1)
+ku = abs((120j * w + 1) * (10j * w + 1)) / 0.8; pu = 2 * math.pi / w
+j = json.load(open("out.json")); e = j["estimates"]; v = j["verification"]
+ok = (abs(e["ku"] / ku - 1) < 0.05 and abs(e["pu_s"] / pu - 1) < 0.1 and j["adopted"] and v["read"] == "smoothed"
+      and v["settled"] and 0 < v["settling_time_s"] < v["horizon_s"])
+print(("PASS " if ok else "FAIL ") + "the noisy tank: Ku %.5g (exact %.5g), Pu %.5g s (exact %.5g s), adopted %s on a "
+      "smoothed step settling at %.4g s of %.5g s" % (e["ku"], ku, e["pu_s"], pu, j["adopted"], v["settling_time_s"], v["horizon_s"]))' ;;
   no_flags)  # issue 60's command with no other flag: dt from the plant (0.002 s, said in one line), Ku and
     # Pu within 5 %
     autotune --num 1 --den 1,1 --delay 2 || echo "FAIL autotune: $(tail -1 err)"

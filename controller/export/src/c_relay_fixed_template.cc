@@ -50,6 +50,12 @@ extern "C" {
 /* Under noise (3 sigma above 1 % of a cycle's amplitude) at least this
  * many settled cycles. */
 #define PIDLAB_RELAY_NOISY_SETTLED_CYCLES 10
+/* A relay the noise switches (pidlab/controller/relay.h, kQuietShift): under
+ * noise, this many cycles in a row of at least PIDLAB_RELAY_QUIET_MIN_STEPS
+ * steps whose smoothed e (f += (e - f) / 16) keeps a half range under 0.6
+ * of the hysteresis end the relay (PIDLAB_RELAY_END_NOISE). */
+#define PIDLAB_RELAY_QUIET_CYCLES 2
+#define PIDLAB_RELAY_QUIET_MIN_STEPS 128
 
 typedef enum {
   PIDLAB_RELAY_HOLD = 0,
@@ -65,7 +71,8 @@ typedef enum {
   PIDLAB_RELAY_END_Y_LIMIT = 3,          /* |y - y0| beyond y_limit */
   PIDLAB_RELAY_END_TIMEOUT = 4,          /* no convergence within timeout_periods periods */
   PIDLAB_RELAY_END_LOAD_CHANGE = 5,      /* a load change with no PID to hold the process */
-  PIDLAB_RELAY_END_TOO_MANY_RESTARTS = 6 /* a load change after max_restarts restarts */
+  PIDLAB_RELAY_END_TOO_MANY_RESTARTS = 6, /* a load change after max_restarts restarts */
+  PIDLAB_RELAY_END_NOISE = 7              /* the noise switches the relay: a larger amplitude is needed */
 } pidlab_relay_end;
 
 /* In the loop's units (read once by init). */
@@ -104,6 +111,9 @@ typedef struct {
   int64_t u0, y0, eps, d_high, d_low, relay_start;
   int high;
   int64_t e_prev, k_high, k_low, e_max, e_min, integral, integral_on, timeout;
+  int64_t f, f_max, f_min; /* e smoothed (f += (e - f) / 16, rounded), its extremes in the cycle */
+  long cycle_steps;
+  int quiet; /* cycles in a row whose smoothed e stayed inside the hysteresis */
   pidlab_relay_cycle cycles[PIDLAB_RELAY_MAX_CYCLES]; /* a ring: the last ones */
   long n_cycles;                                      /* since the relay's last start */
   long n_changes;
@@ -167,6 +177,8 @@ static int64_t shift_round(int64_t d) {
   return d >= 0 ? (d + half) >> PIDLAB_RELAY_SHIFT : -((-d + half) >> PIDLAB_RELAY_SHIFT);
 #endif
 }
+/* d / 16 rounded half away from zero. */
+static int64_t quiet_shift(int64_t d) { return d >= 0 ? (d + 8) >> 4 : -((-d + 8) >> 4); }
 static int64_t max64(int64_t a, int64_t b) { return a < b ? b : a; }
 static int64_t min64(int64_t a, int64_t b) { return b < a ? b : a; }
 static double period(const pidlab_relay_cycle *c) { return c->t_on_s + c->t_off_s; }
@@ -276,13 +288,25 @@ static void end_hold(pidlab_relay *s, int64_t r, int64_t y) {
   s->e_prev = y - s->y0;
   s->k_high = s->k_low = -1;
   s->integral = 0;
+  s->f = s->f_max = s->f_min = 0;
+  s->cycle_steps = 0;
+  s->quiet = 0;
+  s->timeout = 0;
   s->n_cycles = 0;
   s->n_changes = 0;
 }
 
-static void on_cycle(pidlab_relay *s, const pidlab_relay_cycle *c) {
+static void on_cycle(pidlab_relay *s, const pidlab_relay_cycle *c, int quiet) {
   long i, n;
   double p_sum = 0.0, a_sum = 0.0;
+  if (s->sigma > 0.0 && quiet) {
+    if (++s->quiet >= PIDLAB_RELAY_QUIET_CYCLES) {
+      end(s, PIDLAB_RELAY_ABORTED, PIDLAB_RELAY_END_NOISE);
+      return;
+    }
+  } else {
+    s->quiet = 0;
+  }
   if (s->n_cycles > 0) {
     const pidlab_relay_cycle *p = back(s, 0);
     double change = fabs(period(c) - period(p)) / period(p);
@@ -335,14 +359,19 @@ static int64_t relay_step(pidlab_relay *s, pidlab_q r, pidlab_q y) {
       end(s, PIDLAB_RELAY_ABORTED, PIDLAB_RELAY_END_Y_LIMIT);
       return after(s, r, y);
     }
+    s->f += quiet_shift(e - s->f);
     if (s->k_high >= 0) {
       s->integral += e + s->e_prev;
       s->e_max = max64(s->e_max, e);
       s->e_min = min64(s->e_min, e);
+      s->f_max = max64(s->f_max, s->f);
+      s->f_min = min64(s->f_min, s->f);
+      ++s->cycle_steps;
     }
     if (!s->high && e < -s->eps) {
       const int complete = s->k_high >= 0 && s->k_low > s->k_high;
       const int64_t period_k = s->k - s->k_high;
+      const int quiet = s->cycle_steps >= PIDLAB_RELAY_QUIET_MIN_STEPS && 5 * (s->f_max - s->f_min) < 6 * s->eps;
       pidlab_relay_cycle c = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
       if (complete) {
         c.start_s = (double)s->k_high * s->dt_s;
@@ -358,11 +387,16 @@ static int64_t relay_step(pidlab_relay *s, pidlab_q r, pidlab_q y) {
       s->k_low = -1;
       s->integral = 0;
       s->e_max = s->e_min = e;
+      s->f_max = s->f_min = s->f;
+      s->cycle_steps = 0;
       if (complete) {
         const long before = s->n_cycles;
-        on_cycle(s, &c);
+        on_cycle(s, &c, quiet);
         if (s->phase != PIDLAB_RELAY_RELAY) return after(s, r, y);
-        if (s->n_cycles > before) s->timeout = (int64_t)floor(s->config.timeout_periods * (double)period_k);
+        if (s->n_cycles > before) { /* the longest cycle's periods: noise cuts a cycle short */
+          const int64_t timeout = (int64_t)floor(s->config.timeout_periods * (double)period_k);
+          if (timeout > s->timeout) s->timeout = timeout;
+        }
       }
     } else if (s->high && e > s->eps) {
       s->high = 0;

@@ -40,6 +40,12 @@ extern "C" {
 /* Under noise (3 sigma above 1 % of a cycle's amplitude) at least this
  * many settled cycles. */
 #define PIDLAB_RELAY_NOISY_SETTLED_CYCLES 10
+/* A relay the noise switches (pidlab/controller/relay.h, kQuietShift): under
+ * noise, this many cycles in a row of at least PIDLAB_RELAY_QUIET_MIN_STEPS
+ * steps whose smoothed e (f += (e - f) / 16) keeps a half range under 0.6
+ * of the hysteresis end the relay (PIDLAB_RELAY_END_NOISE). */
+#define PIDLAB_RELAY_QUIET_CYCLES 2
+#define PIDLAB_RELAY_QUIET_MIN_STEPS 128
 
 typedef enum {
   PIDLAB_RELAY_HOLD = 0,
@@ -55,7 +61,8 @@ typedef enum {
   PIDLAB_RELAY_END_Y_LIMIT = 3,          /* |y - y0| beyond y_limit */
   PIDLAB_RELAY_END_TIMEOUT = 4,          /* no convergence within timeout_periods periods */
   PIDLAB_RELAY_END_LOAD_CHANGE = 5,      /* a load change with no PID to hold the process */
-  PIDLAB_RELAY_END_TOO_MANY_RESTARTS = 6 /* a load change after max_restarts restarts */
+  PIDLAB_RELAY_END_TOO_MANY_RESTARTS = 6, /* a load change after max_restarts restarts */
+  PIDLAB_RELAY_END_NOISE = 7              /* the noise switches the relay: a larger amplitude is needed */
 } pidlab_relay_end;
 
 typedef struct {
@@ -89,6 +96,10 @@ typedef struct {
   double u0, y0, sigma, eps, d_high, d_low, relay_start_s;
   int high;
   double t_prev, e_prev, t_high, t_low, e_max, e_min, integral, integral_on;
+  double f, f_max, f_min; /* e smoothed (f += (e - f) / 16), its extremes in the cycle */
+  long cycle_steps;
+  int quiet; /* cycles in a row whose smoothed e stayed inside the hysteresis */
+  double longest_period; /* since the relay's start: the timeout counts its periods */
   pidlab_relay_cycle cycles[PIDLAB_RELAY_MAX_CYCLES]; /* a ring: the last ones */
   long n_cycles;                                      /* since the relay's last start */
   long n_changes;
@@ -222,13 +233,25 @@ static void end_hold(pidlab_relay *s, double t, double r, double y) {
   s->e_prev = y - s->y0;
   s->t_high = s->t_low = -1.0;
   s->integral = 0.0;
+  s->f = s->f_max = s->f_min = 0.0;
+  s->cycle_steps = 0;
+  s->quiet = 0;
+  s->longest_period = 0.0;
   s->n_cycles = 0;
   s->n_changes = 0;
 }
 
-static void on_cycle(pidlab_relay *s, const pidlab_relay_cycle *c, double t) {
+static void on_cycle(pidlab_relay *s, const pidlab_relay_cycle *c, double t, int quiet) {
   long i, n;
   double p_sum = 0.0, a_sum = 0.0;
+  if (s->sigma > 0.0 && quiet) {
+    if (++s->quiet >= PIDLAB_RELAY_QUIET_CYCLES) {
+      end(s, PIDLAB_RELAY_ABORTED, t, PIDLAB_RELAY_END_NOISE);
+      return;
+    }
+  } else {
+    s->quiet = 0;
+  }
   if (s->n_cycles > 0) {
     const pidlab_relay_cycle *p = back(s, 0);
     double change = fabs(period(c) - period(p)) / period(p);
@@ -257,6 +280,7 @@ static void on_cycle(pidlab_relay *s, const pidlab_relay_cycle *c, double t) {
   ++s->n_changes;
   s->cycles[s->n_cycles % PIDLAB_RELAY_MAX_CYCLES] = *c;
   ++s->n_cycles;
+  if (period(c) > s->longest_period) s->longest_period = period(c);
   n = 3.0 * s->sigma > 0.01 * amplitude(c) && s->config.settled_cycles < PIDLAB_RELAY_NOISY_SETTLED_CYCLES
           ? PIDLAB_RELAY_NOISY_SETTLED_CYCLES
           : s->config.settled_cycles;
@@ -281,13 +305,18 @@ static double relay_step(pidlab_relay *s, double t, double r, double y) {
       end(s, PIDLAB_RELAY_ABORTED, t, PIDLAB_RELAY_END_Y_LIMIT);
       return after(s, r, y);
     }
+    s->f += (e - s->f) * 0.0625;
     if (s->t_high >= 0.0) {
       s->integral += 0.5 * (e + s->e_prev) * (t - s->t_prev);
       s->e_max = max2(s->e_max, e);
       s->e_min = min2(s->e_min, e);
+      s->f_max = max2(s->f_max, s->f);
+      s->f_min = min2(s->f_min, s->f);
+      ++s->cycle_steps;
     }
     if (!s->high && e < -s->eps) {
       const int complete = s->t_high >= 0.0 && s->t_low > s->t_high;
+      const int quiet = s->cycle_steps >= PIDLAB_RELAY_QUIET_MIN_STEPS && 0.5 * (s->f_max - s->f_min) < 0.6 * s->eps;
       pidlab_relay_cycle c = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
       if (complete) {
         c.start_s = s->t_high;
@@ -303,7 +332,9 @@ static double relay_step(pidlab_relay *s, double t, double r, double y) {
       s->t_low = -1.0;
       s->integral = 0.0;
       s->e_max = s->e_min = e;
-      if (complete) on_cycle(s, &c, t);
+      s->f_max = s->f_min = s->f;
+      s->cycle_steps = 0;
+      if (complete) on_cycle(s, &c, t, quiet);
       if (s->phase != PIDLAB_RELAY_RELAY) return after(s, r, y);
     } else if (s->high && e > s->eps) {
       s->high = 0;
@@ -312,7 +343,7 @@ static double relay_step(pidlab_relay *s, double t, double r, double y) {
         s->integral_on = s->integral;
       }
     }
-    if (s->n_cycles > 0 && t - s->relay_start_s > s->config.timeout_periods * period(back(s, 0))) {
+    if (s->n_cycles > 0 && t - s->relay_start_s > s->config.timeout_periods * s->longest_period) {
       end(s, PIDLAB_RELAY_ABORTED, t, PIDLAB_RELAY_END_TIMEOUT);
       return after(s, r, y);
     }

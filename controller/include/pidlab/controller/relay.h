@@ -23,7 +23,10 @@
 //                     a noisy y's extremes and switches jitter) of their mean;
 //            aborted  |y - y0| > y_limit; or no convergence within timeout_periods
 //                     of the last period after the relay's start; or a load
-//                     change with no previous PID to hold the process again.
+//                     change with no previous PID to hold the process again;
+//                     or, under noise, kQuietCycles cycles whose smoothed e
+//                     stays inside the hysteresis (the noise switches the
+//                     relay: kQuietShift).
 //          A load change (a cycle that differs from the one before by more
 //          than 5 times that tolerance, twice as much as that one differed from its own
 //          predecessor, where a converging oscillation's changes shrink)
@@ -46,6 +49,20 @@ namespace pidlab {
 /// Under noise (3 sigma above 1 % of a cycle's amplitude) the relay runs at
 /// least this many settled cycles.
 inline constexpr int kNoisySettledCycles = 10;
+
+/// The relay that cannot beat the noise: e is smoothed by f += (e - f) /
+/// 2^kQuietShift (a 16-sample lag; its noise is 0.18 sigma). A cycle of at
+/// least kQuietMinSteps steps is quiet when its smoothed e's half range
+/// stays under kQuietFraction of the hysteresis: its switches came from the
+/// noise, not from the oscillation. Under noise (sigma > 0), kQuietCycles
+/// quiet cycles in a row end the relay, naming the smoothed amplitude, the
+/// hysteresis and the relay amplitude that would beat it. The lag passes a
+/// real oscillation of kQuietMinSteps samples at 0.79 of its amplitude (at
+/// least the hysteresis), above kQuietFraction.
+inline constexpr int kQuietShift = 4;
+inline constexpr long kQuietMinSteps = 128;
+inline constexpr double kQuietFraction = 0.6;
+inline constexpr int kQuietCycles = 2;
 
 struct RelayTuneOptions {
   double hold_s = 10.0;         ///< the hold before the relay, s, >= 0
@@ -160,8 +177,12 @@ class RelayTuner {
   void StartHold(double t_s);
   void EndHold(double t_s, double r, double y);
   double RelayStep(double t_s, double r, double y);
-  void OnCycle(const RelayCycle& c, double t_s);
+  // `quiet`: the cycle's smoothed e stayed inside the hysteresis
+  // (kQuietFraction), its half range `smoothed` in units of y.
+  void OnCycle(const RelayCycle& c, double t_s, bool quiet, double smoothed);
   double Tolerance(const RelayCycle& c) const;
+  // The abort of a relay the noise switches, `smoothed` its oscillation.
+  std::string NoiseBeatsRelay(double smoothed) const;
   void End(RelayPhase phase, double t_s, const std::string& why);
   // Ends the relay as aborted: no convergence within `timeout_s`.
   void EndTimedOut(double t_s, double timeout_s);
@@ -193,6 +214,12 @@ class RelayTuner {
   double t_prev_ = 0.0, e_prev_ = 0.0;
   double t_high_ = -1.0, t_low_ = -1.0;
   double e_max_ = 0.0, e_min_ = 0.0, integral_ = 0.0, integral_on_ = 0.0;
+  double f_ = 0.0, f_max_ = 0.0, f_min_ = 0.0;  // the smoothed e, its extremes in the cycle
+  long cycle_steps_ = 0;
+  int quiet_ = 0;  // quiet cycles in a row
+  // The timeout counts periods of the longest cycle since the relay's start:
+  // noise cuts a cycle short, never long.
+  double longest_period_s_ = 0.0;
   std::vector<RelayCycle> cycles_;
   std::vector<double> changes_;  // each cycle's change from the one before
   int restarts_ = 0;
@@ -208,6 +235,7 @@ class RelayTuner {
   std::int64_t u0_q_ = 0, y0_q_ = 0, eps_q_ = 0, d_high_q_ = 0, d_low_q_ = 0, relay_start_k_ = 0;
   std::int64_t e_prev_q_ = 0, k_high_ = -1, k_low_ = -1, e_max_q_ = 0, e_min_q_ = 0, integral_q_ = 0,
                integral_on_q_ = 0, timeout_q_ = 0;
+  std::int64_t f_q_ = 0, f_max_q_ = 0, f_min_q_ = 0;
 };
 
 }  // namespace pidlab
