@@ -41,6 +41,27 @@ std::string NoRoom(double u0, double out_min, double out_max) {
          Num(out_max) + "]";
 }
 
+// The relay that cannot beat the noise: e is smoothed by f += (e - f) /
+// 2^kQuietShift (a 16-sample lag; its noise is 0.18 sigma). A cycle of at
+// least kQuietMinSteps steps is quiet when its smoothed e's half range
+// stays under kQuietFraction of the hysteresis: its switches came from the
+// noise, not from the oscillation. Under noise (sigma > 0), kQuietCycles
+// quiet cycles in a row end the relay, naming the smoothed amplitude, the
+// hysteresis and the relay amplitude that would beat it. The lag passes a
+// real oscillation of kQuietMinSteps samples at 0.79 of its amplitude (at
+// least the hysteresis), above kQuietFraction.
+constexpr int kQuietShift = 4;
+constexpr long kQuietMinSteps = 128;
+constexpr double kQuietFraction = 0.6;
+constexpr int kQuietCycles = 2;
+
+// [*lo, *hi] widened to hold v: a cycle's extremes.
+template <typename T>
+void Widen(T v, T* lo, T* hi) {
+  *lo = std::min(*lo, v);
+  *hi = std::max(*hi, v);
+}
+
 // The smoothing of e: f += (e - f) * kQuietGain (exact: a power of 2).
 constexpr double kQuietGain = 1.0 / static_cast<double>(1 << kQuietShift);
 static_assert(kQuietFraction == 0.6, "the fixed point's quiet rule is 5 range < 6 eps");
@@ -212,17 +233,22 @@ void RelayTuner::EndHold(double t_s, double r, double y) {
     End(RelayPhase::kAborted, t_s, NoRoom(u0_, out_min_, out_max_));
     return;
   }
-  phase_ = RelayPhase::kRelay;
-  relay_start_s_ = t_s;
+  StartRelay(t_s);
   high_ = y - y0_ < 0.0;  // towards the operating point
   t_prev_ = t_s;
   e_prev_ = y - y0_;
   t_high_ = t_low_ = -1.0;
   integral_ = 0.0;
   f_ = f_max_ = f_min_ = 0.0;
+}
+
+void RelayTuner::StartRelay(double t_s) {
+  phase_ = RelayPhase::kRelay;
+  relay_start_s_ = t_s;
   cycle_steps_ = 0;
   quiet_ = 0;
   longest_period_s_ = 0.0;
+  timeout_q_ = 0;
   cycles_.clear();
   changes_.clear();
 }
@@ -238,10 +264,8 @@ double RelayTuner::RelayStep(double t_s, double r, double y) {
     f_ += (e - f_) * kQuietGain;
     if (t_high_ >= 0.0) {  // inside a cycle: its integral and extremes
       integral_ += 0.5 * (e + e_prev_) * (t_s - t_prev_);
-      e_max_ = std::max(e_max_, e);
-      e_min_ = std::min(e_min_, e);
-      f_max_ = std::max(f_max_, f_);
-      f_min_ = std::min(f_min_, f_);
+      Widen(e, &e_min_, &e_max_);
+      Widen(f_, &f_min_, &f_max_);
       ++cycle_steps_;
     }
     if (!high_ && e < -eps_) {
@@ -424,19 +448,13 @@ void RelayTuner::FixedEndHold(double t_s, std::int64_t r, std::int64_t y) {
     End(RelayPhase::kAborted, t_s, NoRoom(u0_, out_min_, out_max_));
     return;
   }
-  phase_ = RelayPhase::kRelay;
-  relay_start_s_ = t_s;
+  StartRelay(t_s);
   relay_start_k_ = k_;
   high_ = y - y0_q_ < 0;
   e_prev_q_ = y - y0_q_;
   k_high_ = k_low_ = -1;
   integral_q_ = 0;
   f_q_ = f_max_q_ = f_min_q_ = 0;
-  cycle_steps_ = 0;
-  quiet_ = 0;
-  timeout_q_ = 0;
-  cycles_.clear();
-  changes_.clear();
 }
 
 double RelayTuner::FixedRelayStep(double t_s, double r, std::int64_t y) {
@@ -451,10 +469,8 @@ double RelayTuner::FixedRelayStep(double t_s, double r, std::int64_t y) {
     f_q_ += ShiftRound(e - f_q_, kQuietShift);
     if (k_high_ >= 0) {
       integral_q_ += e + e_prev_q_;
-      e_max_q_ = std::max(e_max_q_, e);
-      e_min_q_ = std::min(e_min_q_, e);
-      f_max_q_ = std::max(f_max_q_, f_q_);
-      f_min_q_ = std::min(f_min_q_, f_q_);
+      Widen(e, &e_min_q_, &e_max_q_);
+      Widen(f_q_, &f_min_q_, &f_max_q_);
       ++cycle_steps_;
     }
     if (!high_ && e < -eps_q_) {
@@ -473,14 +489,14 @@ double RelayTuner::FixedRelayStep(double t_s, double r, std::int64_t y) {
       const std::int64_t period_k = k_ - k_high_;
       // 0.5 range < kQuietFraction (0.6) eps, in integers.
       const bool quiet = cycle_steps_ >= kQuietMinSteps && 5 * (f_max_q_ - f_min_q_) < 6 * eps_q_;
+      cycle_steps_ = 0;
       const double smoothed = 0.5 * static_cast<double>(f_max_q_ - f_min_q_) * qy_;
+      f_max_q_ = f_min_q_ = f_q_;
       high_ = true;
       k_high_ = k_;
       k_low_ = -1;
       integral_q_ = 0;
       e_max_q_ = e_min_q_ = e;
-      f_max_q_ = f_min_q_ = f_q_;
-      cycle_steps_ = 0;
       if (complete) {
         const std::size_t before = cycles_.size();
         OnCycle(c, t_s, quiet, smoothed);

@@ -50,20 +50,6 @@ namespace pidlab {
 /// least this many settled cycles.
 inline constexpr int kNoisySettledCycles = 10;
 
-/// The relay that cannot beat the noise: e is smoothed by f += (e - f) /
-/// 2^kQuietShift (a 16-sample lag; its noise is 0.18 sigma). A cycle of at
-/// least kQuietMinSteps steps is quiet when its smoothed e's half range
-/// stays under kQuietFraction of the hysteresis: its switches came from the
-/// noise, not from the oscillation. Under noise (sigma > 0), kQuietCycles
-/// quiet cycles in a row end the relay, naming the smoothed amplitude, the
-/// hysteresis and the relay amplitude that would beat it. The lag passes a
-/// real oscillation of kQuietMinSteps samples at 0.79 of its amplitude (at
-/// least the hysteresis), above kQuietFraction.
-inline constexpr int kQuietShift = 4;
-inline constexpr long kQuietMinSteps = 128;
-inline constexpr double kQuietFraction = 0.6;
-inline constexpr int kQuietCycles = 2;
-
 struct RelayTuneOptions {
   double hold_s = 10.0;         ///< the hold before the relay, s, >= 0
   double u0 = 0.0;              ///< the open-loop hold's input (previous gains all 0)
@@ -176,6 +162,8 @@ class RelayTuner {
  private:
   void StartHold(double t_s);
   void EndHold(double t_s, double r, double y);
+  // The relay's start, both scalars: the phase, and no cycle yet.
+  void StartRelay(double t_s);
   double RelayStep(double t_s, double r, double y);
   // `quiet`: the cycle's smoothed e stayed inside the hysteresis
   // (kQuietFraction), its half range `smoothed` in units of y.
