@@ -1,4 +1,4 @@
-// The relay experiment (tuner/autotune) against an outside implementation:
+// The one relay state machine (RelayTuner, run bare by tuner/autotune's BareRelay) against
 // the Modelica Buildings Library's PIDWithAutotuning (LBL, Berner's
 // asymmetric relay plus AMIGO), on the plant, relay and reference results of
 // its validation models.
@@ -60,7 +60,6 @@ namespace {
 
 using autotune::RelayCycle;
 using autotune::RelayEstimates;
-using autotune::RelayExperiment;
 using autotune::RelayOptions;
 
 // The published gains, PIDWitTun.con.{k,Ti,Td} and PIWitTun.con.{k,Ti}
@@ -106,14 +105,14 @@ RelayOptions TheirRelay() {
 // (h divides 240 s) and the lag's update is exact for its held input, so the
 // only error is the relay's switch, up to h late. `observe` sees (t, y, u)
 // each step; the run stops when `stop` says so or at t_end.
-void RunTheirPlant(RelayExperiment* relay, double y0, long n0, double t_end,
+void RunTheirPlant(RelayTuner* relay, double y0, long n0, double t_end,
                    const std::function<void(double, double, double)>& observe,
                    const std::function<bool()>& stop) {
   const double a = std::exp(-kStep / kLag);
   double x = y0, held = y0, out = y0;
   for (long n = n0; n * kStep < t_end; ++n) {
     const double t = n * kStep;
-    const double u = relay->Step(t, x);
+    const double u = relay->Step(t, kSetpoint, x);
     if (observe) observe(t, x, u);
     if (n % kStepsPerSample == 0) {  // UnitDelay: y = pre(sample), sample = u
       out = held;
@@ -212,10 +211,10 @@ constexpr double kIntegral = (0.5 - kSetpoint) * 4.0 * kSamplePeriod;
 
 TEST(RelayAgainstModelicaBuildings, IdentifiesTheirValidationPlantAsTheirReferenceResultsDo) {
   RelayOptions o = TheirRelay();
-  RelayExperiment relay(o);
-  RunTheirPlant(&relay, kSetpoint, 0, 40000.0, nullptr, [&] { return relay.Converged(); });
-  ASSERT_TRUE(relay.Converged()) << relay.Cycles().size() << " cycles";
-  const RelayCycle c = MeanOfSettled(relay.Cycles(), o.settled_cycles);
+  RelayTuner relay = autotune::BareRelay(o, kStep);
+  RunTheirPlant(&relay, kSetpoint, 0, 40000.0, nullptr, [&] { return relay.phase() == RelayPhase::kDone; });
+  ASSERT_EQ(relay.phase(), RelayPhase::kDone) << relay.why() << ": " << relay.cycles().size() << " cycles";
+  const RelayCycle c = MeanOfSettled(relay.cycles(), o.settled_cycles);
 
   // pidlab's relay measures the sampled plant's limit cycle.
   EXPECT_NEAR(c.t_on_s, kTOn, 2.0 * kStep);
@@ -242,7 +241,7 @@ TEST(RelayAgainstModelicaBuildings, IdentifiesTheirValidationPlantAsTheirReferen
   // their 1e-3 guard): both 7.2 % above the plant's 1, because the hold delays
   // the switch to high 19.5 s less than the switch to low, so the relay's
   // duty (499.5 s high, 460.5 s low) is not the plant input's (480 s each).
-  const RelayEstimates e = relay.Estimate();
+  const RelayEstimates e = autotune::EstimateBare(o, relay);
   ASSERT_TRUE(e.converged);
   ASSERT_TRUE(e.model_found) << e.message;
   EXPECT_FALSE(e.model.integrating);
@@ -261,7 +260,7 @@ struct Window {
   double integral_e = 0.0;
 };
 Window SecondTuningWindow(double y0) {
-  RelayExperiment relay(TheirRelay());
+  RelayTuner relay = autotune::BareRelay(TheirRelay(), kStep);
   Window w;
   double t_prev = 0.0, e_prev = 0.0, u_prev = -1.0;
   RunTheirPlant(
@@ -327,12 +326,12 @@ TEST(RelayAgainstModelicaBuildings, TheirFinalGainsComeFromAWindowThatStartsOffT
 // as near.
 TEST(RelayAgainstModelicaBuildings, OnTheirSampledNearPureDelayPlantPidlabsModelIsNearerTheTruthThanBerners) {
   RelayOptions o = TheirRelay();
-  RelayExperiment relay(o);
-  RunTheirPlant(&relay, kSetpoint, 0, 40000.0, nullptr, [&] { return relay.Converged(); });
-  const RelayEstimates e = relay.Estimate();
+  RelayTuner relay = autotune::BareRelay(o, kStep);
+  RunTheirPlant(&relay, kSetpoint, 0, 40000.0, nullptr, [&] { return relay.phase() == RelayPhase::kDone; });
+  const RelayEstimates e = autotune::EstimateBare(o, relay);
   ASSERT_TRUE(e.converged);
   ASSERT_TRUE(e.model_found) << e.message;
-  const RelayCycle c = MeanOfSettled(relay.Cycles(), o.settled_cycles);
+  const RelayCycle c = MeanOfSettled(relay.cycles(), o.settled_cycles);
   const Fopdt theirs = Berner(c.t_on_s, c.t_off_s, c.integral_e);
   const double l_after_low = 2.0 * kSamplePeriod - kSwitchLow;    // 457.0 s
   const double l_after_high = 2.0 * kSamplePeriod - kSwitchHigh;  // 476.4 s

@@ -1,4 +1,4 @@
-// The relay experiment (tuner/autotune, issue 43) on first-order plus
+// The relay (RelayTuner, run bare: autotune::BareRelay; issue 43) on first-order plus
 // dead-time and integrating processes simulated in process: the ultimate gain and period
 // from the asymmetric relay's FOPDT model against pidlab's own frequency
 // analysis of the same process (within 5 %), the model against the process
@@ -23,14 +23,13 @@ using autotune::FopdtFromCycle;
 using autotune::FopdtModel;
 using autotune::FopdtUltimate;
 using autotune::RelayEstimates;
-using autotune::RelayExperiment;
 using autotune::RelayOptions;
 
 constexpr double kPi = 3.14159265358979323846;
 
 // K e^(-sL)/(Ts + 1) at step h (L a multiple of h), the relay sampling y
 // every step, from rest at y = r (u = u0); until converged or `cycles_max`.
-RelayEstimates RunRelay(const FopdtModel& p, const RelayOptions& o, double h, RelayExperiment* relay) {
+RelayEstimates RunRelay(const FopdtModel& p, const RelayOptions& o, double h, RelayTuner* relay) {
   const int delay_steps = static_cast<int>(std::lround(p.delay_s / h));
   const double a = std::exp(-h / p.time_constant_s);
   std::vector<double> pipe(delay_steps, o.u0);  // inputs on their way
@@ -38,16 +37,16 @@ RelayEstimates RunRelay(const FopdtModel& p, const RelayOptions& o, double h, Re
   std::size_t head = 0;
   const double t_end = 400.0 * (p.time_constant_s + p.delay_s);
   for (long k = 0; k * h < t_end; ++k) {
-    const double u = relay->Step(k * h, x);
+    const double u = relay->Step(k * h, o.setpoint, x);
     const double arriving = delay_steps > 0 ? pipe[head] : u;
     if (delay_steps > 0) pipe[head] = u, head = (head + 1) % pipe.size();
     if (p.integrating)
       x += h * p.gain * (arriving - o.u0);  // K e^(-sL)/s at rest at u0
     else
       x = a * x + (1.0 - a) * p.gain * arriving;  // exact for an input held over the step
-    if (relay->Converged()) break;
+    if (relay->phase() != RelayPhase::kRelay && relay->phase() != RelayPhase::kHold) break;
   }
-  return relay->Estimate();
+  return autotune::EstimateBare(o, *relay);
 }
 
 // Ku (kp times the gain margin of a stable P loop) and Pu of the process by
@@ -80,10 +79,10 @@ TEST(Relay, AsymmetricRelayGivesTheUltimateGainAndPeriodWithin5PercentAndTheMode
       o.d_high = 0.5;
       o.d_low = 0.25;
       o.hysteresis = eps;
-      RelayExperiment relay(o);
+      RelayTuner relay = autotune::BareRelay(o, p.delay_s / 400.0);
       const RelayEstimates e = RunRelay(p, o, p.delay_s / 400.0, &relay);
       const std::string what = "L/T " + std::to_string(l_over_t) + ", eps " + std::to_string(eps);
-      ASSERT_TRUE(e.converged) << what << ": " << relay.Cycles().size() << " cycles";
+      ASSERT_TRUE(e.converged) << what << ": " << relay.cycles().size() << " cycles";
       ASSERT_TRUE(e.model_found) << what << ": " << e.message;
       double ku = 0.0, pu = 0.0;
       ExactUltimate(p, &ku, &pu);
@@ -111,7 +110,7 @@ TEST(Relay, AsymmetricRelayOnAnIntegratingProcessGivesItsModelAndUltimatePoint) 
     o.d_high = 0.5;
     o.d_low = 0.25;
     o.hysteresis = eps;
-    RelayExperiment relay(o);
+    RelayTuner relay = autotune::BareRelay(o, p.delay_s / 400.0);
     const RelayEstimates e = RunRelay(p, o, p.delay_s / 400.0, &relay);
     ASSERT_TRUE(e.converged) << "eps " << eps;
     ASSERT_TRUE(e.model_found) << e.message;
@@ -132,7 +131,7 @@ TEST(Relay, PlainDescribingFunctionIsAbout15PercentLowOnASymmetricRelayAndTheGai
   o.setpoint = 1.0;
   o.u0 = 1.0;
   o.d_high = o.d_low = 0.3;
-  RelayExperiment relay(o);
+  RelayTuner relay = autotune::BareRelay(o, p.delay_s / 400.0);
   const RelayEstimates e = RunRelay(p, o, p.delay_s / 400.0, &relay);
   ASSERT_TRUE(e.converged);
   double ku = 0.0, pu = 0.0;

@@ -62,47 +62,23 @@ bool RelayOptions::IsValid(std::string* error) const {
   return false;
 }
 
-RelayExperiment::RelayExperiment(const RelayOptions& options) : o_(options) {}
-
-double RelayExperiment::Step(double t_s, double y) {
-  const double e = y - o_.setpoint;
-  if (!started_) {
-    started_ = true;
-    high_ = e < 0.0;  // towards the setpoint
-  } else {
-    if (t_high_ >= 0.0) {  // inside a cycle: its integral and extremes
-      integral_ += 0.5 * (e + e_prev_) * (t_s - t_prev_);
-      e_max_ = std::max(e_max_, e);
-      e_min_ = std::min(e_min_, e);
-    }
-    if (!high_ && e < -o_.hysteresis) {
-      if (t_high_ >= 0.0 && t_low_ > t_high_)
-        cycles_.push_back(RelayCycle::Closed(t_high_, t_low_, t_s, e_max_, e_min_, integral_, integral_on_));
-      high_ = true;
-      t_high_ = t_s;
-      t_low_ = -1.0;
-      integral_ = 0.0;
-      e_max_ = e_min_ = e;
-    } else if (high_ && e > o_.hysteresis) {
-      high_ = false;
-      if (t_high_ >= 0.0) {
-        t_low_ = t_s;
-        integral_on_ = integral_;
-      }
-    }
-  }
-  t_prev_ = t_s;
-  e_prev_ = e;
-  return o_.u0 + (high_ ? o_.d_high : -o_.d_low);
+RelayTuner BareRelay(const RelayOptions& o, double dt_s) {
+  RelayTuneOptions t;
+  t.hold_s = 0.0;
+  t.u0 = o.u0;
+  t.amplitude = 0.5 * (o.d_high + o.d_low);
+  t.bias = 0.5 * (o.d_high - o.d_low);
+  t.hysteresis = o.hysteresis;
+  t.settled_cycles = o.settled_cycles;
+  t.tolerance = o.tolerance;
+  PidOptions pid;
+  pid.dt_s = dt_s;
+  return RelayTuner(t, PidGains{}, pid);
 }
 
-bool RelayExperiment::Converged() const {
-  double period = 0.0, amplitude = 0.0;
-  return LastCyclesAgree(
-      cycles_, o_.settled_cycles, [this](const RelayCycle&) { return o_.tolerance; }, &period, &amplitude);
+RelayEstimates EstimateBare(const RelayOptions& o, const RelayTuner& relay) {
+  return EstimateFromCycles(o, relay.cycles(), relay.phase() == RelayPhase::kDone, 0.0);
 }
-
-RelayEstimates RelayExperiment::Estimate() const { return EstimateFromCycles(o_, cycles_, Converged(), 0.0); }
 
 RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<RelayCycle>& cycles,
                                   bool converged, double noise_sigma, double delay_s) {

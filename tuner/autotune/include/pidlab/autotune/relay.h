@@ -80,26 +80,18 @@ struct RelayEstimates {
   std::string message;  ///< why something was not found
 };
 
-/// The relay as a step-by-step state machine: Step() takes each measurement
-/// and returns the input to apply until the next one.
-class RelayExperiment {
- public:
-  explicit RelayExperiment(const RelayOptions& options);
-  /// The input for measurement y at time t_s (strictly increasing).
-  double Step(double t_s, double y);
-  bool Converged() const;
-  const std::vector<RelayCycle>& Cycles() const { return cycles_; }
-  /// The estimates from the settled cycles (or the last ones seen).
-  RelayEstimates Estimate() const;
+/// `options`' relay run by the one relay state machine, RelayTuner
+/// (controller/relay.h), as the controller and the firmware run it: no hold,
+/// so the relay is centred on the setpoint; open loop at u0 (no previous
+/// PID); amplitude (d_high + d_low) / 2 and bias (d_high - d_low) / 2; the
+/// hysteresis as given (no noise multiple); settled_cycles and tolerance as
+/// given. Step it with r = options.setpoint at the period dt_s > 0; it is
+/// done (RelayPhase::kDone) when its last cycles agree, and EstimateFromCycles
+/// reads its cycles().
+RelayTuner BareRelay(const RelayOptions& options, double dt_s);
 
- private:
-  RelayOptions o_;
-  bool started_ = false, high_ = false;
-  double t_prev_ = 0.0, e_prev_ = 0.0;
-  double t_high_ = -1.0, t_low_ = -1.0;  // the current cycle's switches (-1: none yet)
-  double e_max_ = 0.0, e_min_ = 0.0, integral_ = 0.0, integral_on_ = 0.0;
-  std::vector<RelayCycle> cycles_;
-};
+/// EstimateFromCycles on a bare relay's cycles, converged when it is done.
+RelayEstimates EstimateBare(const RelayOptions& options, const RelayTuner& relay);
 
 /// The estimates from `cycles` (the first is the approach: the last
 /// min(settled_cycles, size - 1) are averaged) under `options`' relay;
