@@ -118,6 +118,27 @@ open("needed", "w").write(m.group(3) if m else "1")'
 import json; j = json.load(open("out.json")); x = j["experiment"]
 ok = x["end"] == "done" and j["adopted"]
 print(("PASS " if ok else "FAIL ") + "the amplitude the guard named converges and adopts: %s; %s" % (x["why"], j["verdict"]))' ;;
+  stuck)  # a relay that sits on one side of its band while y settles there (issue 60): stopped after the
+    # first episode, naming a reverse-acting process, or the amplitude that would cross the band, which then converges
+    autotune --num -1 --den 1,1 --delay 0.5 --dt 0.001 && echo "FAIL a reverse-acting process exited 0"
+    /usr/bin/python3 -c '
+import json; j = json.load(open("out.json")); x = j["experiment"]
+ok = x["end"] == "aborted" and x["episodes"] == 1 and "the process acts in reverse" in x["why"] and not j["adopted"]
+print(("PASS " if ok else "FAIL ") + "a reverse-acting process stops after %d episode: %s" % (x["episodes"], x["why"]))'
+    autotune --num 0.01 --den 1,1 --delay 0.5 --dt 0.001 --hysteresis 0.1 && echo "FAIL a relay too small exited 0"
+    /usr/bin/python3 -c '
+import json, re; j = json.load(open("out.json")); x = j["experiment"]
+m = re.search(r"a relay amplitude of about ([0-9.e+-]+) \(now 1\)", x["why"])
+ok = x["end"] == "aborted" and x["episodes"] == 1 and "too small to cross its band" in x["why"] and m is not None
+print(("PASS " if ok else "FAIL ") + "a relay too small for its band stops after %d episode: %s" % (x["episodes"], x["why"]))
+open("needed", "w").write(m.group(1) if m else "1")'
+    needed=$(cat needed)
+    autotune --num 0.01 --den 1,1 --delay 0.5 --dt 0.001 --hysteresis 0.1 --relay-amplitude "$needed" \
+      || echo "FAIL the amplitude the guard named ($needed): $(tail -1 err)"
+    /usr/bin/python3 -c '
+import json; j = json.load(open("out.json")); x = j["experiment"]
+ok = x["end"] == "done" and j["adopted"]
+print(("PASS " if ok else "FAIL ") + "the amplitude the guard named converges and adopts: %s; %s" % (x["why"], j["verdict"]))' ;;
   heat_only)  # u in [0, 2], the previous PI holding r = 0.2: the relay's low side is cut to u = 0
     autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --reference 0.2 --output-limits 0,2 --gains 0.5,0.5,0 \
       || echo "FAIL autotune: $(tail -1 err)"

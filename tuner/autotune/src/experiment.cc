@@ -108,6 +108,43 @@ std::string ClippedNote(const ExperimentOptions& options, const ExperimentSummar
   return line;
 }
 
+// Where the relay has sat on one side since its last switch (no full cycle
+// yet) and y has settled there: the last quarter of that stretch moves y by
+// at most a tenth of its whole move there, and by no more than the noise
+// allows (6 sigma). A process that has settled will not switch the relay by
+// waiting longer. "" otherwise (y still moving: a longer window may do).
+std::string StuckRelay(const ExperimentSummary& out) {
+  const std::vector<RelaySample>& s = out.samples;
+  std::size_t from = 0;
+  for (std::size_t k = 1; k < s.size(); ++k)
+    if (s[k].t_s > out.relay_start_s && s[k].u != s[k - 1].u) from = k;
+  if (from == 0) {  // no switch: from the relay's start
+    while (from < s.size() && s[from].t_s < out.relay_start_s) ++from;
+  }
+  if (from + 8 >= s.size()) return "";
+  const double e_from = s[from].y - out.y0, e_end = s.back().y - out.y0;
+  const double move = e_end - e_from, t_from = s[from].t_s, span_s = s.back().t_s - t_from;
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (std::size_t k = from; k < s.size(); ++k)
+    if (s[k].t_s >= t_from + 0.75 * span_s) lo = std::min(lo, s[k].y), hi = std::max(hi, s[k].y);
+  const double noise = 6.0 * out.noise_sigma;
+  if (!(std::abs(move) > noise) || !(hi - lo <= std::max(0.1 * std::abs(move), noise))) return "";
+  const bool high = s[from].u > out.u0;  // the relay pushes y up (a direct-acting process)
+  const std::string side = high ? "high (u = u0 + " + Num(out.d_high) : "low (u = u0 - " + Num(out.d_low);
+  const std::string moved = "with the relay " + side + ") for " + Num(span_s) + " s, y moved from " +
+                            Num(s[from].y) + " to " + Num(s.back().y) + " and settled there";
+  if ((move > 0.0) != high)
+    return "the process acts in reverse: " + moved +
+           ", away from its band; the relay needs a y that rises with u: for a reverse-acting process "
+           "negate u or y at the process, or check the actuator's and the sensor's wiring";
+  const double needed = std::abs((high ? out.hysteresis : -out.hysteresis) - e_from);
+  // Both sides scale with the amplitude (d +- b, b a fraction of d or 0).
+  const double amplitude = 0.5 * (out.d_high + out.d_low);
+  return "the relay is too small to cross its band: " + moved + ", short of y0 " + (high ? "+ " : "- ") +
+         Num(out.hysteresis) + " (the hysteresis); a relay amplitude of about " +
+         Num(2.0 * amplitude * needed / std::abs(move)) + " (now " + Num(amplitude) + ") would cross it";
+}
+
 }  // namespace
 
 Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySample> samples,
@@ -197,6 +234,14 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
         (out.why.empty() ? std::string() : ": " + out.why));
     if (!out.clipped.empty() && out.episodes == 1) say("  " + out.clipped);
     if (out.end == RelayPhase::kDone || out.end == RelayPhase::kAborted) break;
+    if (out.end == RelayPhase::kRelay && out.cycles.empty()) {
+      if (std::string stuck = StuckRelay(out); !stuck.empty()) {
+        out.end = RelayPhase::kAborted;
+        out.why = std::move(stuck);
+        say("  aborted: " + out.why);
+        break;
+      }
+    }
     if (window >= options.max_window_s) {
       out.why = "the relay ran " + Num(window) + " s (the longest window, --max-time) without " +
                 (out.cycles.empty() ? std::string("a single cycle: the process did not oscillate")

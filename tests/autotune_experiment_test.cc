@@ -1,0 +1,99 @@
+// The relay experiment over episodes (tuner/autotune/experiment.h) on an
+// in-process runner that steps the relay as the controller does: a relay
+// that sits on one side of its band while y settles there is stopped after
+// that episode, naming why (a reverse-acting process, or a relay too small
+// for the process's gain, with the amplitude that would cross the band),
+// instead of doubling its window up to --max-time; a slow process still
+// moving gets its longer window (issue 60, "Guards that explain").
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "pidlab/autotune/experiment.h"
+#include "test_status.h"
+
+namespace pidlab::autotune {
+namespace {
+
+// K e^(-sL)/(Ts + 1) from rest, exact for an input held over each step.
+struct Process {
+  double k = 1.0, t = 1.0, l = 0.5;
+};
+
+RelayEpisodeRunner Runner(const Process& p, const ExperimentOptions& x) {
+  return [p, x](const RelayTuneOptions& relay, double horizon_s, std::vector<RelaySample>* samples) {
+    const double h = x.pid.dt_s, a = std::exp(-h / p.t);
+    std::vector<double> pipe(static_cast<std::size_t>(std::lround(p.l / h)) + 1, 0.0);
+    std::size_t head = 0;
+    double y = 0.0;
+    RelayTuner tuner(relay, x.previous, x.pid);
+    samples->clear();
+    for (long i = 0; static_cast<double>(i) * h <= horizon_s; ++i) {
+      const double t = static_cast<double>(i) * h;
+      const double u = tuner.Step(t, 0.0, y);
+      samples->push_back({t, 0.0, y, u});
+      pipe[head] = u;
+      head = (head + 1) % pipe.size();
+      y = a * y + (1.0 - a) * p.k * pipe[head];
+    }
+    return Status::Ok();
+  };
+}
+
+ExperimentOptions Options(double hysteresis) {
+  ExperimentOptions x;
+  x.relay.hold_s = 1.0;
+  x.relay.amplitude = 1.0;
+  x.relay.bias = 1.0 / 3.0;
+  x.relay.hysteresis = hysteresis;
+  x.pid.dt_s = 1e-2;
+  x.first_window_s = 30.0;
+  x.max_window_s = 480.0;
+  return x;
+}
+
+TEST(RelayEpisodes, OnAReverseActingProcessItStopsAfterTheFirstEpisodeSayingSo) {
+  const ExperimentOptions x = Options(0.0);
+  ExperimentSummary s;
+  ASSERT_TRUE(IsOk(RunExperiment(x, Runner({-1.0, 1.0, 0.5}, x), &s)));
+  EXPECT_EQ(s.end, RelayPhase::kAborted);
+  EXPECT_EQ(s.episodes, 1);
+  EXPECT_NE(s.why.find("the process acts in reverse"), std::string::npos) << s.why;
+  EXPECT_NE(s.why.find("y moved from 0 to 0.66667 and settled there"), std::string::npos) << s.why;
+}
+
+TEST(RelayEpisodes, ARelayTooSmallForItsBandIsStoppedNamingAnAmplitudeThatThenConverges) {
+  ExperimentOptions x = Options(0.1);
+  const Process small_gain{0.01, 1.0, 0.5};
+  ExperimentSummary s;
+  ASSERT_TRUE(IsOk(RunExperiment(x, Runner(small_gain, x), &s)));
+  EXPECT_EQ(s.end, RelayPhase::kAborted);
+  EXPECT_EQ(s.episodes, 1);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(s.why, m, std::regex("a relay amplitude of about ([0-9.e+-]+) \\(now 1\\)")))
+      << s.why;
+  const double needed = std::strtod(m[1].str().c_str(), nullptr);
+  // y settles at -0.01 d_low = -0.0066667: crossing -0.1 takes 15 d; twice that.
+  EXPECT_NEAR(needed, 30.0, 0.1) << s.why;
+  x.relay.amplitude = needed;
+  x.relay.bias = needed / 3.0;
+  ExperimentSummary again;
+  ASSERT_TRUE(IsOk(RunExperiment(x, Runner(small_gain, x), &again)));
+  EXPECT_EQ(again.end, RelayPhase::kDone) << again.why;
+}
+
+TEST(RelayEpisodes, ASlowProcessStillMovingGetsALongerWindowNotAStop) {
+  const ExperimentOptions x = Options(0.0);
+  ExperimentSummary s;
+  ASSERT_TRUE(IsOk(RunExperiment(x, Runner({1.0, 100.0, 5.0}, x), &s)));
+  EXPECT_GE(s.episodes, 2);
+  EXPECT_EQ(s.why.find("settled there"), std::string::npos) << s.why;
+}
+
+}  // namespace
+}  // namespace pidlab::autotune
