@@ -129,5 +129,13 @@ PY"
 check "--setpoint-filter -1 exits 2 in one line naming the value" \
   "[ $? -eq 2 ] && only_line_ok \"$tmp/err\" 'setpoint-filter -1'"
 
+# 1/(s^2 (0.005 s + 1)): migo finds no design (no ultimate gain), so the time
+# scale comes from the design engine's own closed loop. Before, it came from the
+# plant's 5 ms alone, a 0.05 s horizon under the loop's 61 ms slowest mode, and
+# the printed load integral was the truncated 6.1e-6 against the design's 1.69e-5.
+"$pidlab" tune --num 1 --den 0.005,1,0,0 --json > "$tmp/dint.json" 2>"$tmp/err"
+check "a double integrator with a lag: the horizon covers the engine's closed loop, the load integral the design's" \
+  "/usr/bin/python3 -c \"import json; j=json.load(open('$tmp/dint.json')); t=j['time_scale']; tau=j['robustness']['slowest_time_constant_s']; assert t['horizon_s'] >= 10*tau and 'design engine' in t['reason'], t; assert abs(j['load_iae']*t['sample_time_s']/j['design']['load_iae']-1) < 0.01, (j['load_iae'], j['design']['load_iae'])\""
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -7,6 +7,7 @@
 
 #include "pidlab/spec/field.h"
 #include "pidlab/spec/json.h"
+#include "pidlab/tune/design.h"
 #include "pidlab/tune/time_scale.h"
 #include "pidlab/tune/tuning_rules.h"
 #include "pidlab/tune/two_dof.h"
@@ -232,14 +233,31 @@ TimeScale DerivedTimeScale(const spec::TuningSpec& s, const Plant& plant) {
   MigoDesign design;
   analysis::LoopAnalysis a;
   std::string from = "the plant's own time constants";
-  if (!plant.nonlinear && DesignMigo(plant, o, &design).ok()) {
+  const auto closed = [&](const PidGains& gains, double crossover_rad_s, const char* what) {
     evaluation::LoopOptions loop;
-    if (analysis::AnalyzeLoop(plant, design.gains, loop, analysis::LoopAnalysisOptions{}, &a).ok() &&
-        a.stable && std::isfinite(a.slowest_time_constant_s) && design.crossover_rad_s > 0.0) {
-      slowest = a.slowest_time_constant_s;
-      fastest = std::min(fastest, 1.0 / design.crossover_rad_s);
-      from = "the migo design's closed loop";
-    }
+    if (!analysis::AnalyzeLoop(plant, gains, loop, analysis::LoopAnalysisOptions{}, &a).ok() || !a.stable ||
+        !std::isfinite(a.slowest_time_constant_s) || !(crossover_rad_s > 0.0))
+      return false;
+    slowest = a.slowest_time_constant_s;
+    fastest = std::min(fastest, 1.0 / crossover_rad_s);
+    from = what;
+    return true;
+  };
+  bool found = !plant.nonlinear && DesignMigo(plant, o, &design).ok() &&
+               closed(design.gains, design.crossover_rad_s, "the migo design's closed loop");
+  // Where migo finds none (1/(s^2 (0.005 s + 1)): no ultimate gain to start
+  // from), the design engine's own closed loop, as the default tune designs
+  // it: the plant's times alone can be shorter than its slowest mode.
+  if (!found && !plant.nonlinear && s.tune.method == "optimal") {
+    DesignOptions d;
+    d.max_ms = o.ms;
+    d.max_noise_gain = s.bounds.max_noise_gain;
+    d.crossover_rad_s = s.tune.crossover_rad_s > 0.0 ? s.tune.crossover_rad_s
+                        : o.response_time_s > 0.0    ? 2.0 / o.response_time_s
+                                                     : 0.0;
+    DesignSummary engine;
+    found = DesignOptimal(plant, d, &engine).ok() &&
+            closed(engine.gains, engine.crossover_rad_s, "the design engine's closed loop");
   }
   TimeScale t = LoopTimeScale(fastest, slowest, plant.delay_s);
   if (s.loop.loop == "sampled") OnSampledGrid(s.loop.dt_s, &t.sample_time_s, &t.horizon_s);
