@@ -50,10 +50,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <vector>
 
+#include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/autotune/relay.h"
+#include "pidlab/tune/design.h"
 
 namespace pidlab {
 namespace {
@@ -364,6 +367,83 @@ TEST(RelayAgainstModelicaBuildings, OnTheirSampledNearPureDelayPlantPidlabsModel
   EXPECT_LT(Rel(e.ku, 1.0), 0.06) << e.ku;
   EXPECT_LT(Rel(e.pu_s, 4.0 * kSamplePeriod), 0.02) << e.pu_s;
   EXPECT_LT(Rel(e.pu_s, 4.0 * kSamplePeriod), Rel(pu, 4.0 * kSamplePeriod));
+}
+
+}  // namespace
+}  // namespace pidlab
+
+namespace pidlab {
+namespace {
+
+// Their plant is a sample-and-hold: the relay run on its 240 s grid (a PLC
+// scans so), the estimates told so (RelayOptions::sample_period_s), fit the
+// sampled first order plus dead time y(k+1) = a y(k) + (1 - a) K v(k - n):
+// the cycle is 480 s high and 480 s low, the plant input's own duty, so K is
+// the plant's 1 with no duty bias; n = 1 (the unit delay; the hold is in the
+// ZOH image); a is e^-24 in truth, below the cycle's rounding, so only
+// T < 240 s is known and does not matter. The sampled loop's ultimate point
+// is then the truth's, Ku 1 and Pu 960 s, nearer than their first (0.947)
+// and final (0.993) tunings' models. The design engine on the model and the
+// sampled loop gives gains whose loop on the true plant meets its Ms.
+TEST(RelayAgainstModelicaBuildings, OnTheirSampleGridTheSampledModelGivesTheTrueUltimatePointAndGains) {
+  RelayOptions o = TheirRelay();
+  o.sample_period_s = kSamplePeriod;
+  RelayTuner relay = autotune::BareRelay(o, kSamplePeriod);
+  const double a = std::exp(-kStep / kLag);
+  double x = kSetpoint, held = kSetpoint, out = kSetpoint;
+  for (long n = 0; n * kStep < 40000.0 && relay.phase() != RelayPhase::kDone; ++n) {
+    if (n % kStepsPerSample == 0) {  // the relay samples y and the hold u at the same instant
+      out = held;
+      held = relay.Step(n * kStep, kSetpoint, x);
+    }
+    x = a * x + (1.0 - a) * out;
+  }
+  ASSERT_EQ(relay.phase(), RelayPhase::kDone) << relay.why();
+  const RelayEstimates e = autotune::EstimateBare(o, relay);
+  ASSERT_TRUE(e.model_found) << e.message;
+  EXPECT_EQ(e.model_from, "the sampled cycle (a sample-and-hold of 240 s, the relay on its grid)");
+  EXPECT_NEAR(e.model.gain, 1.0, 1e-6);
+  EXPECT_EQ(e.model.delay_s, kSamplePeriod);
+  EXPECT_LT(e.model.time_constant_s, kSamplePeriod);
+  EXPECT_NEAR(e.ku, 1.0, 1e-6);
+  EXPECT_NEAR(e.pu_s, 4.0 * kSamplePeriod, 1e-6 * 4.0 * kSamplePeriod);
+  // Nearer the truth than either of their tunings' models, and than pidlab's continuous fit (0.941).
+  double ku_first = 0.0, ku_final = 0.0, pu = 0.0;
+  const Fopdt first = InvertAmigoPid(kTheirFirstPid), final = InvertAmigoPid(kTheirFinalPid);
+  ASSERT_TRUE(autotune::FopdtUltimate({first.k, first.t_s, first.l_s}, &ku_first, &pu).ok());
+  ASSERT_TRUE(autotune::FopdtUltimate({final.k, final.t_s, final.l_s}, &ku_final, &pu).ok());
+  EXPECT_NEAR(ku_first, 0.9468, 1e-4);
+  EXPECT_NEAR(ku_final, 0.9930, 1e-4);
+  EXPECT_LT(std::abs(e.ku - 1.0), 0.1 * std::abs(ku_final - 1.0));
+
+  // Gains: the design engine on the model, for the sampled loop at 240 s.
+  Plant model;
+  model.name = "custom";
+  model.tf.num = {e.model.gain};
+  model.tf.den = {e.model.time_constant_s, 1.0};
+  model.delay_s = e.model.delay_s;
+  tune::DesignOptions d;
+  d.max_ms = 1.4;
+  d.loop.loop = evaluation::LoopKind::kSampled;
+  d.loop.dt_s = kSamplePeriod;
+  d.loop.sample_time_s = kSamplePeriod;
+  d.loop.horizon_s = 100 * kSamplePeriod;
+  tune::DesignSummary g;
+  ASSERT_TRUE(tune::DesignOptimal(model, d, &g).ok());
+  Plant truth = model;
+  truth.tf.num = {1.0};
+  truth.tf.den = {kLag, 1.0};
+  truth.delay_s = kSamplePeriod;
+  analysis::LoopAnalysis on_truth;
+  ASSERT_TRUE(analysis::AnalyzeLoop(truth, g.gains, d.loop, analysis::LoopAnalysisOptions{}, &on_truth).ok());
+  EXPECT_TRUE(on_truth.stable);
+  EXPECT_NEAR(on_truth.ms, 1.4, 0.014)
+      << "kp " << g.gains.kp << ", ki " << g.gains.ki << ", kd " << g.gains.kd;
+  std::printf(
+      "sampled model: K %.6g, T %.4g s, L %.4g s; Ku %.6g, Pu %.6g s (their first %.4g, final %.4g); "
+      "gains kp %.4g ki %.4g kd %.4g, Ms on the true plant %.4g\n",
+      e.model.gain, e.model.time_constant_s, e.model.delay_s, e.ku, e.pu_s, ku_first, ku_final, g.gains.kp,
+      g.gains.ki, g.gains.kd, on_truth.ms);
 }
 
 }  // namespace

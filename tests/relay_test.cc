@@ -223,3 +223,73 @@ TEST(Relay, ASymmetricRelaysHalfPeriodTooLongForItsDelayIsNoFopdt) {
 
 }  // namespace
 }  // namespace pidlab
+
+namespace pidlab {
+namespace {
+
+// K e^(-sL)/(Ts + 1) behind a sample-and-hold of period h, the relay on its
+// grid: y(k+1) = a y(k) + (1 - a) K v(k - n), exact. The sampled fit gives
+// K, T and L back, and its Ku and Pu are the sampled loop's own (pidlab's
+// frequency analysis of a P gain on the loop sampled at h).
+TEST(Relay, OnASampleAndHoldTheSampledFitGivesTheProcessAndTheSampledLoopsUltimatePoint) {
+  const double h = 1.0;
+  // (T/h, n): lags of half a sample to two (a scan slower than the process,
+  // as Modelica's). Where T is long against h and the delay short (T/h 2,
+  // n 0; T/h 8, n 1) the relay on the grid settles to no single period: its
+  // half periods alternate between whole samples and it times out. There
+  // the hold is small against the process and the continuous fit applies.
+  const std::vector<std::pair<double, int>> cases = {{0.5, 0}, {0.5, 1}, {2.0, 1},
+                                                     {0.5, 3}, {2.0, 3}, {8.0, 3}};
+  for (const auto& [t_over_h, n] : cases) {
+    {
+      const double k = 2.0, t = t_over_h * h, a = std::exp(-h / t);
+      RelayOptions o;
+      o.setpoint = 1.0;
+      o.u0 = 0.5;
+      o.d_high = 0.5;
+      o.d_low = 0.25;
+      o.hysteresis = 0.02;
+      o.tolerance = 1e-4;
+      o.sample_period_s = h;
+      RelayTuner relay = autotune::BareRelay(o, h);
+      std::vector<double> v(static_cast<std::size_t>(n) + 1, 0.0);  // v(k - n) .. v(k)
+      double y = 1.0;
+      for (long i = 0; i < 4000 && (i == 0 || relay.phase() == RelayPhase::kRelay); ++i) {
+        const double u = relay.Step(static_cast<double>(i) * h, o.setpoint, y);
+        v.erase(v.begin());
+        v.push_back(u - o.u0);
+        y = a * y + (1.0 - a) * (k * o.u0 + k * v.front());
+      }
+      const std::string what = "T/h " + std::to_string(t_over_h) + ", n " + std::to_string(n);
+      ASSERT_EQ(relay.phase(), RelayPhase::kDone) << what << ": " << relay.why();
+      const RelayEstimates e = autotune::EstimateBare(o, relay);
+      ASSERT_TRUE(e.model_found) << what << ": " << e.message;
+      EXPECT_LT(Rel(e.model.gain, k), 1e-3) << what << ": K " << e.model.gain;
+      EXPECT_LT(Rel(e.model.time_constant_s, t), 1e-3) << what << ": T " << e.model.time_constant_s;
+      EXPECT_EQ(e.model.delay_s, n * h) << what;
+      Plant plant;
+      plant.name = "custom";
+      plant.tf.num = {k};
+      plant.tf.den = {t, 1.0};
+      plant.delay_s = n * h;
+      evaluation::LoopOptions loop;
+      loop.loop = evaluation::LoopKind::kSampled;
+      loop.dt_s = loop.sample_time_s = h;
+      loop.horizon_s = 100 * h;
+      PidGains g;
+      g.kp = 0.01 / k;
+      analysis::LoopAnalysis an;
+      ASSERT_TRUE(IsOk(analysis::AnalyzeLoop(plant, g, loop, analysis::LoopAnalysisOptions{}, &an))) << what;
+      // With no delay past the hold (n = 0) the phase reaches -pi only at the
+      // Nyquist frequency, which the analysis does not count: there
+      // |G(-1)| = K (1 - a) / (1 + a) and Pu = 2 h.
+      const double ku = n > 0 ? g.kp * an.gain_margin : (1.0 + a) / (k * (1.0 - a));
+      const double pu = n > 0 ? 2.0 * kPi / an.phase_crossover_rad_s : 2.0 * h;
+      EXPECT_LT(Rel(e.ku, ku), 1e-3) << what << ": Ku " << e.ku << ", exact " << ku;
+      EXPECT_LT(Rel(e.pu_s, pu), 1e-3) << what << ": Pu " << e.pu_s << ", exact " << pu;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pidlab

@@ -57,6 +57,8 @@ bool RelayOptions::IsValid(std::string* error) const {
     e = "settled cycles " + std::to_string(settled_cycles) + " must be at least 2";
   else if (!(tolerance > 0.0 && tolerance < 1.0))
     e = "tolerance " + Number(tolerance) + " must be in (0, 1)";
+  else if (!(sample_period_s >= 0.0) || !std::isfinite(sample_period_s))
+    e = "sample period " + Number(sample_period_s) + " s must be >= 0 and finite";
   if (e.empty()) return true;
   if (error) *error = e;
   return false;
@@ -113,8 +115,13 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
   const bool integrating =
       o.d_high != o.d_low && std::abs(mean_v) <= 0.02 * (o.d_high * mean.t_on_s + o.d_low * mean.t_off_s);
   const bool symmetric = o.d_high == o.d_low && delay_s > 0.0;
+  const bool sampled = o.sample_period_s > 0.0 && !integrating;
   Status fitted;
-  if (symmetric) {
+  if (sampled) {
+    fitted = SampledFopdtFromCycle(o, mean, &r.model);
+    r.model_from =
+        "the sampled cycle (a sample-and-hold of " + Number(o.sample_period_s) + " s, the relay on its grid)";
+  } else if (symmetric) {
     fitted = FopdtFromSymmetric(o, mean, delay_s, &r.model);
     r.model_from = "the period, the amplitude and the delay to the extremes (a symmetric relay)";
   } else if (integrating) {
@@ -135,7 +142,10 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
     r.message = fitted.message();
     return r;
   }
-  const Status ultimate = FopdtUltimate(r.model, &r.ku, &r.pu_s);
+  const auto ultimate_of = [&](const FopdtModel& m, double* ku, double* pu) {
+    return sampled ? SampledUltimate(m, o.sample_period_s, ku, pu) : FopdtUltimate(m, ku, pu);
+  };
+  const Status ultimate = ultimate_of(r.model, &r.ku, &r.pu_s);
   if (!ultimate.ok()) {
     r.message = ultimate.message();
     return r;
@@ -148,7 +158,9 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
     const RelayCycle& c = cycles[cycles.size() - 1 - i];
     FopdtModel m;
     Status st;
-    if (symmetric)
+    if (sampled)
+      st = SampledFopdtFromCycle(o, c, &m);
+    else if (symmetric)
       st = FopdtFromSymmetric(o, c, delay_s, &m);
     else if (r.model.integrating)
       st = IntegratingFromCycle(o, c, &m);
@@ -157,7 +169,7 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
     else
       st = FopdtFromTimes(o, c, &m);
     double ku = 0.0, pu = 0.0;
-    if (!st.ok() || !FopdtUltimate(m, &ku, &pu).ok()) {
+    if (!st.ok() || !ultimate_of(m, &ku, &pu).ok()) {
       ks.clear();
       break;
     }
@@ -425,6 +437,85 @@ Status FopdtFromSymmetric(const RelayOptions& o, const RelayCycle& c, double del
   model->time_constant_s = t;
   model->delay_s = l;
   model->integrating = false;
+  return Status::Ok();
+}
+
+}  // namespace pidlab::autotune
+
+namespace pidlab::autotune {
+
+namespace {
+
+// The whole number of samples h in t, or -1 if t is off the grid.
+long Samples(double t, double h) {
+  const double n = std::round(t / h);
+  return n >= 1.0 && std::abs(t - n * h) <= 1e-6 * h ? static_cast<long>(n) : -1;
+}
+
+// The samples the sampled process takes from e0 towards its final value
+// `to` until it is beyond `level` (up: above it), 0 if it never is.
+long SamplesToCross(double a, double e0, double to, double level, bool up, long most) {
+  double e = e0;
+  for (long j = 1; j <= most; ++j) {
+    e = to + a * (e - to);
+    if (up ? e > level : e < level) return j;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Status SampledFopdtFromCycle(const RelayOptions& o, const RelayCycle& c, FopdtModel* model) {
+  const double h = o.sample_period_s, eps = o.hysteresis;
+  const long n_on = h > 0.0 ? Samples(c.t_on_s, h) : -1, n_off = h > 0.0 ? Samples(c.t_off_s, h) : -1;
+  if (n_on < 0 || n_off < 0)
+    return Status::InvalidInput("the half periods " + Number(c.t_on_s) + " s and " + Number(c.t_off_s) +
+                                " s are not whole samples of " + Number(h) +
+                                " s: the relay did not switch on the process's sample grid");
+  double k = 0.0;
+  if (Status s = FirstOrderGain(o, c, &k); !s.ok()) return s;
+  const double kh = k * o.d_high, kl = k * o.d_low;
+  const double r_on = (kh - c.e_max) / (kh - c.e_min), r_off = (kl + c.e_min) / (kl + c.e_max);
+  if (!(r_on >= 0.0 && r_on < 1.0) || !(r_off >= 0.0 && r_off < 1.0))
+    return Status::InvalidInput("the cycle's extremes " + Number(c.e_max) + ", " + Number(c.e_min) +
+                                " lie beyond the gain " + Number(k) +
+                                " times the relay: no sampled first order");
+  const double a_on = std::pow(r_on, 1.0 / n_on), a_off = std::pow(r_off, 1.0 / n_off);
+  // Relative on h/T = -ln a near a = 1, absolute near a = 0.
+  if (!(std::abs(a_on - a_off) <= 0.02 * std::max(1.0 - a_on, 1.0 - a_off)))
+    return Status::InvalidInput("the half periods give a = e^(-h/T) " + Number(a_on) + " and " +
+                                Number(a_off) + ": no sampled first order plus dead time");
+  const double a = 0.5 * (a_on + a_off);
+  const long j_on = SamplesToCross(a, c.e_min, kh, eps, true, n_on);
+  const long j_off = SamplesToCross(a, c.e_max, -kl, -eps, false, n_off);
+  const long delay_on = n_on - j_on, delay_off = n_off - j_off;
+  if (j_on == 0 || j_off == 0 || delay_on != delay_off || delay_on < 0)
+    return Status::InvalidInput("the half periods give a delay of " + std::to_string(delay_on) + " and " +
+                                std::to_string(delay_off) +
+                                " samples: no sampled first order plus dead time");
+  model->gain = k;
+  model->time_constant_s = a > 0.0 ? -h / std::log(a) : 0.0;
+  model->delay_s = static_cast<double>(delay_on) * h;
+  model->integrating = false;
+  return Status::Ok();
+}
+
+Status SampledUltimate(const FopdtModel& m, double h, double* ku, double* pu_s) {
+  if (!(h > 0.0) || !(m.gain != 0.0) || m.integrating || !(m.time_constant_s >= 0.0) || !(m.delay_s >= 0.0))
+    return Status::InvalidInput("no sampled ultimate point for this model at h " + Number(h) + " s");
+  const double a = m.time_constant_s > 0.0 ? std::exp(-h / m.time_constant_s) : 0.0;
+  const double n = std::round(m.delay_s / h);
+  // The phase of G(e^(j w h)) is -n w h - arg(e^(j w h) - a): from 0 down to
+  // -(n + 1) pi over w h in (0, pi], so -pi once (n = 0: at pi).
+  const auto phase = [&](double th) { return -n * th - std::atan2(std::sin(th), std::cos(th) - a); };
+  double lo = 0.0, hi = kPi;
+  for (int i = 0; i < 200 && hi - lo > 1e-15 && n > 0.0; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (phase(mid) + kPi > 0.0 ? lo : hi) = mid;
+  }
+  const double th = n > 0.0 ? 0.5 * (lo + hi) : kPi;
+  *ku = std::hypot(std::cos(th) - a, std::sin(th)) / (std::abs(m.gain) * (1.0 - a));
+  *pu_s = 2.0 * kPi * h / th;
   return Status::Ok();
 }
 

@@ -37,6 +37,12 @@ struct RelayOptions {
   /// each lie within `tolerance` (relative) of their mean.
   int settled_cycles = 3;
   double tolerance = 0.01;
+  /// h > 0: the process is behind a sample-and-hold of period h (a PLC's
+  /// scan, a sampled sensor) and the relay ran on its grid, so its half
+  /// periods are whole samples; EstimateFromCycles then fits the sampled
+  /// model (SampledFopdtFromCycle) and its ultimate point is the sampled
+  /// loop's (SampledUltimate). 0: a continuous process.
+  double sample_period_s = 0.0;
   bool IsValid(std::string* error) const;
 };
 
@@ -135,6 +141,25 @@ Status FopdtUltimate(const FopdtModel& model, double* ku, double* pu_s);
 ///   t_on = L + (2 eps + K L d_low) / (K d_high),  t_off = L + (2 eps + K L d_high) / (K d_low);
 /// a periodic cycle needs d_high t_on = d_low t_off (the mean output zero).
 Status IntegratingFromCycle(const RelayOptions& options, const RelayCycle& cycle, FopdtModel* model);
+
+/// K, T and L of K e^(-sL)/(Ts + 1) behind a sample-and-hold of period
+/// h = options.sample_period_s, the relay on its grid: the process seen at
+/// the samples is y(k+1) = a y(k) + (1 - a) K v(k - n), a = e^(-h/T), L = n h
+/// (the exact image of the ZOH, the hold in it). K from the cycle's
+/// integral; a from each half period N h and the extremes,
+///   a^N_on  = (K d_high - e_max) / (K d_high - e_min),
+///   a^N_off = (K d_low + e_min) / (K d_low + e_max),
+/// which agree for such a process; n is N less the samples the response
+/// takes from its extreme across the band, the same in both halves.
+/// kInvalidInput, naming why, where the half periods are not whole samples or
+/// the halves disagree (no such process).
+Status SampledFopdtFromCycle(const RelayOptions& options, const RelayCycle& cycle, FopdtModel* model);
+
+/// The ultimate gain and period of the sampled loop: a gain k on `model`
+/// behind a ZOH at h, G(z) = K (1 - a) z^-n / (z - a): the frequency where
+/// its phase is -pi (n = 0: the Nyquist frequency), Ku = 1 / |G|,
+/// Pu = 2 pi / w.
+Status SampledUltimate(const FopdtModel& model, double h, double* ku, double* pu_s);
 
 /// K, T and L from a limit cycle's mean t_on, t_off, e_max, e_min and
 /// integral of e (RelayCycle) under `options`' relay: the closed forms above.
