@@ -2,6 +2,7 @@
 
 #include "pidlab/results/autotune_json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -179,6 +180,52 @@ void GivenOnModel(const ExperimentSummary& x, const AutotuneDesignOptions& o, js
                             {"robustness", st.ok() ? result["robustness"] : json(st.message())}};
 }
 
+// How far the measured step's overshoot may exceed the predicted one, in
+// points of the step, besides the noise's widening: a first-order model of a
+// higher-order process under-predicts the overshoot by a few points; a loop
+// near instability rings by tens.
+constexpr double kModelOvershootPoints = 10.0;
+// The step the design predicts: the same loop, gains and step on the
+// identified model, without the measurement noise.
+bool PredictedStep(const ExperimentSummary& x, const PidGains& gains, const evaluation::Evaluation& measured,
+                   evaluation::Evaluation* predicted) {
+  const autotune::FopdtModel& m = x.estimates.model;
+  Plant model;
+  model.name = "custom";
+  model.tf.num = {m.gain};
+  model.tf.den = m.integrating ? std::vector<double>{1.0, 0.0} : std::vector<double>{m.time_constant_s, 1.0};
+  model.delay_s = m.delay_s;
+  evaluation::LoopOptions loop = measured.options;
+  loop.measurement_noise = MeasurementNoise{};
+  if (evaluation::Evaluate(model, gains, loop, evaluation::EvaluateOptions{}, predicted).ok() &&
+      predicted->step.valid)
+    return true;
+  // A delay of more than 1000 samples (2 s at 2 ms) is past the sampled
+  // loop's analysis: the continuous loop, whose hold of dt is nothing to it.
+  loop.loop = evaluation::LoopKind::kContinuous;
+  return evaluation::Evaluate(model, gains, loop, evaluation::EvaluateOptions{}, predicted).ok() &&
+         predicted->step.valid;
+}
+
+// The measured step against the predicted one: "" if it rings no more than
+// the model and the noise allow, else why. (A drift is the band's: the
+// smoothed step leaves it over the tail. Settling is not compared: a load
+// change during the step moves it, not the gains.)
+std::string AgainstPrediction(const evaluation::Evaluation& predicted, double overshoot,
+                              const autotune::StepReading& reading, double reference, json* out) {
+  const double noise_points = 100.0 * reading.widening / std::max(std::abs(reference), 1e-300);
+  const double os_bound = predicted.step.overshoot_pct + kModelOvershootPoints + noise_points;
+  (*out) = {{"overshoot_pct", JsonNumber(predicted.step.overshoot_pct)},
+            {"settling_time_s", JsonNumber(predicted.step.settling_time_s)},
+            {"overshoot_bound_pct", JsonNumber(os_bound)}};
+  if (!(overshoot <= os_bound))
+    return "rings: it overshoots " + Num(overshoot) + " % where the design predicts " +
+           Num(predicted.step.overshoot_pct) + " % (at most " + Num(os_bound) +
+           " %: " + Num(kModelOvershootPoints) + " points for the model and " + Num(noise_points) +
+           " for the noise)";
+  return "";
+}
+
 // The verification step of `gains` (`who` names them); false with *verdict.
 bool VerifyStep(const ExperimentSummary& x, const AutotuneDesignOptions& o, const StepRunner& step,
                 const std::function<void(const std::string&)>& say, const PidGains& gains,
@@ -229,6 +276,21 @@ bool VerifyStep(const ExperimentSummary& x, const AutotuneDesignOptions& o, cons
   if (!calm) {
     *verdict = "the step with " + who + " overshoots " + Num(overshoot) + " %, above the bound " +
                Num(o.max_overshoot_pct) + " %";
+    return false;
+  }
+  evaluation::Evaluation predicted;
+  if (!PredictedStep(x, gains, ev, &predicted)) {
+    *verdict = "the step with " + who + " has no prediction on the identified model to compare with";
+    return false;
+  }
+  json against;
+  const std::string off = AgainstPrediction(predicted, overshoot, reading, ev.options.reference, &against);
+  (*out)["verification"]["predicted"] = against;
+  if (say)
+    say("  predicted on the model: overshoot " + Num(predicted.step.overshoot_pct) + " %, settling " +
+        Num(predicted.step.settling_time_s) + " s");
+  if (!off.empty()) {
+    *verdict = "the step with " + who + " " + off;
     return false;
   }
   return true;
