@@ -97,3 +97,29 @@ TEST(RelayEpisodes, ASlowProcessStillMovingGetsALongerWindowNotAStop) {
 
 }  // namespace
 }  // namespace pidlab::autotune
+
+namespace pidlab::autotune {
+namespace {
+
+// A dead time of 20 s, the first window 10 s: doubling, the relay sees its
+// first switch in the third episode (40 s) and its first full cycle in the
+// fourth (80 s), then runs the window its period sets: 5 episodes. Sized by
+// the first switch (a period is at least twice the time to it), the fourth
+// episode's window is long enough to converge in: 4.
+TEST(RelayEpisodes, AfterAFirstSwitchTheNextWindowIsSizedByItNotDoubled) {
+  ExperimentOptions x = Options(0.0);
+  x.first_window_s = 10.0;
+  x.max_window_s = 4000.0;
+  std::string windows;
+  ExperimentSummary s;
+  ASSERT_TRUE(IsOk(RunExperiment(x, Runner({1.0, 1.0, 20.0}, x), &s, [&](const std::string& line) {
+    if (line.rfind("relay episode", 0) == 0) windows += line.substr(line.find("up to")) + "; ";
+  })));
+  EXPECT_EQ(s.end, RelayPhase::kDone) << s.why;
+  EXPECT_EQ(s.episodes, 4) << windows;
+  // The fourth: 20 periods of twice the 20.01 s to the first switch.
+  EXPECT_NE(windows.find("up to 800.42 s"), std::string::npos) << windows;
+}
+
+}  // namespace
+}  // namespace pidlab::autotune

@@ -108,6 +108,13 @@ std::string ClippedNote(const ExperimentOptions& options, const ExperimentSummar
   return line;
 }
 
+// The time from the relay's start to its first switch (0: none).
+double FirstSwitchAfter(const std::vector<RelaySample>& s, double relay_start_s) {
+  for (std::size_t k = 1; k < s.size(); ++k)
+    if (s[k - 1].t_s >= relay_start_s && s[k].u != s[k - 1].u) return s[k].t_s - relay_start_s;
+  return 0.0;
+}
+
 // Where the relay has sat on one side since its last switch (no full cycle
 // yet) and y has settled there: the last quarter of that stretch moves y by
 // at most a tenth of its whole move there, and by no more than the noise
@@ -116,14 +123,23 @@ std::string ClippedNote(const ExperimentOptions& options, const ExperimentSummar
 std::string StuckRelay(const ExperimentSummary& out) {
   const std::vector<RelaySample>& s = out.samples;
   std::size_t from = 0;
+  double t_switch = out.relay_start_s, longest = 0.0;  // the longest stretch between switches before the last
   for (std::size_t k = 1; k < s.size(); ++k)
-    if (s[k].t_s > out.relay_start_s && s[k].u != s[k - 1].u) from = k;
+    if (s[k].t_s > out.relay_start_s && s[k].u != s[k - 1].u) {
+      longest = std::max(longest, s[k].t_s - t_switch);
+      t_switch = s[k].t_s;
+      from = k;
+    }
   if (from == 0) {  // no switch: from the relay's start
     while (from < s.size() && s[from].t_s < out.relay_start_s) ++from;
   }
   if (from + 8 >= s.size()) return "";
   const double e_from = s[from].y - out.y0, e_end = s.back().y - out.y0;
   const double move = e_end - e_from, t_from = s[from].t_s, span_s = s.back().t_s - t_from;
+  // After a switch, y runs on its old course for the dead time, which is
+  // shorter than the stretch before it (the process answered within it):
+  // a stretch not twice that long may still be the old course settling.
+  if (!(span_s >= 2.0 * longest)) return "";
   double lo = HUGE_VAL, hi = -HUGE_VAL;
   for (std::size_t k = from; k < s.size(); ++k)
     if (s[k].t_s >= t_from + 0.75 * span_s) lo = std::min(lo, s[k].y), hi = std::max(hi, s[k].y);
@@ -252,6 +268,11 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
     if (!out.cycles.empty()) {  // the timeout the last period sets, and a little more
       const double needed = options.relay.timeout_periods * out.cycles.back().period_s() + 2.0 * dt + 1e-9;
       if (needed > window) next = needed;
+    } else if (const double first = FirstSwitchAfter(out.samples, out.relay_start_s); first > 0.0) {
+      // No full cycle, but a switch: a period is at least twice the time to
+      // it (the approach from rest to the band is shorter than a half
+      // period's swing across it), so the timeout that period would set.
+      next = std::max(next, options.relay.timeout_periods * 2.0 * first + 2.0 * dt + 1e-9);
     }
     if (out.end == RelayPhase::kHold) next = 2.0 * window;  // a restart's hold at the end
     window = std::min(next, options.max_window_s);
