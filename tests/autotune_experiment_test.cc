@@ -23,6 +23,7 @@ namespace {
 // K e^(-sL)/(Ts + 1) from rest, exact for an input held over each step.
 struct Process {
   double k = 1.0, t = 1.0, l = 0.5;
+  double y_start = 0.0;  ///< y at t = 0, decaying with T (a process not yet at rest)
 };
 
 RelayEpisodeRunner Runner(const Process& p, const ExperimentOptions& x) {
@@ -30,7 +31,7 @@ RelayEpisodeRunner Runner(const Process& p, const ExperimentOptions& x) {
     const double h = x.pid.dt_s, a = std::exp(-h / p.t);
     std::vector<double> pipe(static_cast<std::size_t>(std::lround(p.l / h)) + 1, 0.0);
     std::size_t head = 0;
-    double y = 0.0;
+    double y = p.y_start;
     RelayTuner tuner(relay, x.previous, x.pid);
     samples->clear();
     for (long i = 0; static_cast<double>(i) * h <= horizon_s; ++i) {
@@ -65,6 +66,7 @@ TEST(RelayEpisodes, OnAReverseActingProcessItStopsAfterTheFirstEpisodeSayingSo) 
   EXPECT_EQ(s.episodes, 1);
   EXPECT_NE(s.why.find("the process acts in reverse"), std::string::npos) << s.why;
   EXPECT_NE(s.why.find("y moved from 0 to 0.66667 and settled there"), std::string::npos) << s.why;
+  EXPECT_EQ(s.hold_note, "") << "a hold at rest";
 }
 
 TEST(RelayEpisodes, ARelayTooSmallForItsBandIsStoppedNamingAnAmplitudeThatThenConverges) {
@@ -119,6 +121,26 @@ TEST(RelayEpisodes, AfterAFirstSwitchTheNextWindowIsSizedByItNotDoubled) {
   EXPECT_EQ(s.episodes, 4) << windows;
   // The fourth: 20 periods of twice the 20.01 s to the first switch.
   EXPECT_NE(windows.find("up to 800.42 s"), std::string::npos) << windows;
+}
+
+}  // namespace
+}  // namespace pidlab::autotune
+
+namespace pidlab::autotune {
+namespace {
+
+// A process still settling from y = 2 (T = 2 s) when the test starts: over
+// the 1 s hold's second half y falls from 2 e^-0.25 to 2 e^-0.5, by 0.34,
+// far more than the noise, the band and 5 % of the oscillation: named.
+TEST(RelayEpisodes, AHoldThatDriftsIsNamedAsSuch) {
+  const ExperimentOptions x = Options(0.0);
+  ExperimentSummary s;
+  Process settling{1.0, 2.0, 0.5};
+  settling.y_start = 2.0;
+  ASSERT_TRUE(IsOk(RunExperiment(x, Runner(settling, x), &s)));
+  EXPECT_NEAR(s.hold_drift, 2.0 * (std::exp(-0.5 / 2.0) - std::exp(-1.0 / 2.0)) * -1.0, 0.02) << s.hold_note;
+  EXPECT_EQ(s.hold_note.rfind("the hold drifts or was disturbed: y moved -0.", 0), 0u) << s.hold_note;
+  EXPECT_NE(s.hold_note.find("a longer --hold"), std::string::npos) << s.hold_note;
 }
 
 }  // namespace

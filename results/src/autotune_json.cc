@@ -58,6 +58,8 @@ json ExperimentJson(const ExperimentSummary& x) {
   e["d_high"] = JsonNumber(x.d_high);
   e["d_low"] = JsonNumber(x.d_low);
   e["clipped"] = x.clipped;
+  e["hold_drift"] = JsonNumber(x.hold_drift);
+  e["hold_note"] = x.hold_note;
   e["relay_start_s"] = JsonNumber(x.relay_start_s);
   e["end_s"] = JsonNumber(x.end_s);
   e["horizon_s"] = JsonNumber(x.horizon_s);
@@ -355,6 +357,8 @@ json AutotuneJson(const ExperimentSummary& x, const PidGains& previous, const Au
     verdict = "no model from the cycles: " + x.estimates.message;
   else
     ok = DesignAndVerify(x, options, step, say, &out, &gains, &verdict);
+  // A refusal after a drifting hold says so: the hold's y0 centred the relay.
+  if (!ok && !x.hold_note.empty()) verdict += "; " + x.hold_note;
   out["adopted"] = ok;
   out["verdict"] = verdict;
   out["gains"] = ToJson(gains);

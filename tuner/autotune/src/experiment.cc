@@ -108,6 +108,43 @@ std::string ClippedNote(const ExperimentOptions& options, const ExperimentSummar
   return line;
 }
 
+// A hold's drift is named past this fraction of the relay's oscillation.
+constexpr double kHoldDriftOfAmplitude = 0.05;
+
+// The hold's drift and its note (ExperimentSummary::hold_drift).
+void HoldDrift(double hold_s, ExperimentSummary* out) {
+  const std::vector<RelaySample>& s = out->samples;
+  const double from = out->relay_start_s - 0.5 * hold_s;
+  double n = 0.0, st = 0.0, sy = 0.0;
+  for (const RelaySample& k : s)
+    if (k.t_s >= from && k.t_s < out->relay_start_s) n += 1.0, st += k.t_s, sy += k.y;
+  out->hold_drift = 0.0;
+  out->hold_note.clear();
+  if (n < 8.0) return;
+  const double tm = st / n, ym = sy / n;
+  double stt = 0.0, sty = 0.0;
+  for (const RelaySample& k : s)
+    if (k.t_s >= from && k.t_s < out->relay_start_s)
+      stt += (k.t_s - tm) * (k.t_s - tm), sty += (k.t_s - tm) * (k.y - ym);
+  if (!(stt > 0.0)) return;
+  const double slope = sty / stt;
+  double ss = 0.0;
+  for (const RelaySample& k : s)
+    if (k.t_s >= from && k.t_s < out->relay_start_s) ss += std::pow(k.y - ym - slope * (k.t_s - tm), 2);
+  const double se = std::sqrt(ss / (n - 2.0) / stt), half = 0.5 * hold_s;
+  out->hold_drift = slope * half;
+  // It matters against the noise, the band and the oscillation it centres.
+  const double amplitude = out->cycles.empty() ? 0.0 : out->cycles.back().amplitude();
+  const double floor = std::max({2.0 * out->noise_sigma, out->hysteresis, kHoldDriftOfAmplitude * amplitude,
+                                 1e-9 * std::max(1.0, std::abs(out->y0))});
+  if (!(std::abs(slope) > 4.0 * se) || !(std::abs(out->hold_drift) > floor)) return;
+  out->hold_note = "the hold drifts or was disturbed: y moved " + Num(out->hold_drift) + " over its last " +
+                   Num(half) + " s (" + Num(slope) + " per s, noise sigma " + Num(out->noise_sigma) +
+                   "), so y0 " + Num(out->y0) +
+                   " is no resting operating point and the relay's centre and the estimates are biased; a "
+                   "longer --hold lets the process settle first";
+}
+
 // The time from the relay's start to its first switch (0: none).
 double FirstSwitchAfter(const std::vector<RelaySample>& s, double relay_start_s) {
   for (std::size_t k = 1; k < s.size(); ++k)
@@ -186,6 +223,7 @@ Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySam
   out.cycles = tuner.cycles();
   out.samples = std::move(samples);
   out.clipped = ClippedNote(options, out);
+  HoldDrift(options.relay.hold_s, &out);
   return Status::Ok();
 }
 
@@ -249,6 +287,7 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
         (out.cycles.empty() ? std::string() : ", last period " + Num(out.cycles.back().period_s()) + " s") +
         (out.why.empty() ? std::string() : ": " + out.why));
     if (!out.clipped.empty() && out.episodes == 1) say("  " + out.clipped);
+    if (!out.hold_note.empty()) say("  " + out.hold_note);
     if (out.end == RelayPhase::kDone || out.end == RelayPhase::kAborted) break;
     if (out.end == RelayPhase::kRelay && out.cycles.empty()) {
       if (std::string stuck = StuckRelay(out); !stuck.empty()) {

@@ -58,6 +58,14 @@ struct ExperimentSummary {
   RelayEstimates estimates;  ///< kDone only (estimates.converged)
   /// The estimates' relay (setpoint, u0, d_high, d_low, hysteresis).
   RelayOptions relay;
+  /// The hold before the relay's last start: the drift of y over its second
+  /// half (a least-squares line's slope times that half), and where it is
+  /// both significant (4 standard errors of the slope) and more than 2
+  /// sigma of the noise, the hysteresis and 5 % of the last cycle's
+  /// amplitude, one line naming a drifting or disturbed hold: its y0 is no
+  /// resting operating point ("" otherwise).
+  double hold_drift = 0.0;
+  std::string hold_note;
   /// Where the output limits cut the relay asked for (amplitude +- bias
   /// about u0): one line saying what was asked and what was used; "" if
   /// nothing was cut.
