@@ -134,6 +134,7 @@ function freqChart(el, pinned) {
   pinned.forEach((p, i) => {
     series.push({ label: p.label + ' |S| dB', stroke: pinColour(i), width: 1, dash: [6, 3] });
     series.push({ label: p.label + ' |T| dB', stroke: pinColour(i), width: 1, dash: [2, 2] });
+    series.push({ label: p.label + ' phase L deg', stroke: pinColour(i), width: 1, dash: [8, 3], scale: 'deg' });
   });
   const degRange = (u, lo, hi) => {
     u.pidlabPhase = phaseView(u.data[0] || [], u.data[6] || [], u.pidlabCrossovers || []);
@@ -145,7 +146,7 @@ function freqChart(el, pinned) {
     axes: [{ label: 'w (rad/s)', values: logTicks }, { label: 'dB' },
       { label: 'phase (deg)', scale: 'deg', side: 1, grid: { show: false }, incrs: [15, 30, 45, 90, 180, 360, 720, 1440, 2880] }],
     hooks: { draw: [(u) => drawPhaseNotes(u, u.pidlabPhase)] },
-  }, [[], [], [], [], [], [], [], ...pinned.flatMap(() => [[], []])], el);
+  }, [[], [], [], [], [], [], [], ...pinned.flatMap(() => [[], [], []])], el);
 }
 
 const dB = (v) => (v === null || !(v > 0) ? null : 20 * Math.log10(v));
@@ -386,12 +387,15 @@ export function drawPlots(plots, series, pinned, trio, sampled) {
   // A pinned design has its own grid: its curve is drawn at this grid's
   // frequencies by interpolation on log w (drawing only; its numbers are its reply's).
   const onGrid = (p, key) => (p.series ? resample(p.series.w, p.series[key], series.w).map(dB) : new Array(m).fill(null));
+  // Its phase likewise, in degrees (continuous on its own grid, so linear in log w between its points).
+  const phaseOnGrid = (p) => (p.series && Array.isArray(p.series.l_phase_deg)
+    ? resample(p.series.w, p.series.l_phase_deg, series.w) : new Array(m).fill(null));
   const lMag = series.l_re.map((re, i) => (re === null || series.l_im[i] === null ? null : Math.hypot(re, series.l_im[i])));
   // The crossovers that matter: every gain crossover and the gain margin's
   // phase crossover (a dead time has phase crossovers without end).
   plots.freq.pidlabCrossovers = [...(series.gain_crossovers_rad_s || []), series.phase_crossover_rad_s];
   plots.freq.setData([series.w, lMag.map(dB), series.s.map(dB), series.t_mag.map(dB), series.cs.map(dB), new Array(m).fill(dB(series.ms)),
-    orEmpty(series.l_phase_deg, m), ...pinned.flatMap((p) => [onGrid(p, 's'), onGrid(p, 't_mag')])]);
+    orEmpty(series.l_phase_deg, m), ...pinned.flatMap((p) => [onGrid(p, 's'), onGrid(p, 't_mag'), phaseOnGrid(p)])]);
   plots.nyquist.setData([null, ...nyquistSegments(series), circle(series.ms), [[-1], [0]],
     ...pinned.flatMap((p) => nyquistSegments(p.series))]);
 }

@@ -63,6 +63,80 @@ async function main() {
         ' deg, largest step ' + largest.toFixed(1) + ' deg, view ' + lo + '..' + hi + ', ' + shown.view.exits.length + ' clipped stretch(es)';
     });
   }
+  // A pinned design draws its phase of L too (issue 58): pin the tank, move
+  // its kp, and read the pin's phase series back, on the current grid.
+  await step(
+      'tank pinned: its phase of L is drawn beside the current one, its own served phase on this grid',
+      async () => {
+        const tank = loops[0];
+        await page.goto('about:blank');
+        await page.goto(
+            args.url + '#' + encodeURIComponent(JSON.stringify(tank.state)),
+            {waitUntil: 'load', timeout: 30000});
+        await waitForPage(session, 'no redraw of the tank', redrawMs, () => {
+          const p = window.pidlab;
+          return p && p.rendered >= 1 && p.lastSeries && p.lastResult && p.lastResult.spec.delay === 150;
+        });
+        await page.evaluate(() => window.pidlab.pin('tank kp 0.5'));
+        await waitForPage(
+            session, 'the pin did not arrive', redrawMs,
+            () => window.pidlab.pinned.length === 1 && window.pidlab.pinned[0].series);
+        const before = await page.evaluate(() => window.pidlab.rendered);
+        await page.evaluate(() => {
+          const e = document.getElementById('kp');
+          e.value = '0.3';
+          e.dispatchEvent(new Event('input', {bubbles: true}));
+          e.dispatchEvent(new Event('change', {bubbles: true}));
+        });
+        await waitForPage(
+            session, 'no redraw after kp 0.3', redrawMs,
+            (n) => window.pidlab.rendered > n && window.pidlab.lastResult.spec.gains[0] === 0.3, before);
+        const shown = await page.evaluate(() => {
+          const f = window.pidlab.plots.freq, pin = window.pidlab.pinned[0];
+          const k = f.series.findIndex((s) => s.label === pin.label + ' phase L deg');
+          return {
+            k,
+            labels: f.series.map((s) => s.label),
+            w: Array.from(f.data[0]),
+            drawn: k > 0 ? Array.from(f.data[k]) : [],
+            current: Array.from(f.data[6]),
+            pinW: pin.series.w,
+            pinPhase: pin.series.l_phase_deg
+          };
+        });
+        if (shown.k < 0) throw new Error('no pinned phase series among ' + JSON.stringify(shown.labels));
+        // The pin's grid is its own: at each of this grid's frequencies inside
+        // it, the drawn pin phase is its served phase between its two nearest
+        // frequencies, linear in log w (the served phase is continuous).
+        let checked = 0, differs = 0;
+        for (let i = 0; i < shown.w.length; i++) {
+          const x = shown.w[i];
+          const j =
+              shown.pinW.findIndex((v, k) => k + 1 < shown.pinW.length && v <= x && x <= shown.pinW[k + 1]);
+          if (j >= 0 && shown.pinPhase[j] !== null && shown.pinPhase[j + 1] !== null) {
+            const f = (Math.log(x) - Math.log(shown.pinW[j])) /
+                (Math.log(shown.pinW[j + 1]) - Math.log(shown.pinW[j]));
+            const want = shown.pinPhase[j] + f * (shown.pinPhase[j + 1] - shown.pinPhase[j]);
+            if (!(Math.abs(shown.drawn[i] - want) <= 1e-9 * Math.max(1, Math.abs(want))))
+              throw new Error(
+                  'pin phase at ' + x + ' rad/s: drawn ' + shown.drawn[i] + ', its served phase there ' +
+                  want);
+            checked++;
+          }
+          if (shown.drawn[i] !== null && shown.current[i] !== null &&
+              Math.abs(shown.drawn[i] - shown.current[i]) > 1e-6)
+            differs++;
+        }
+        if (checked < shown.w.length / 2)
+          throw new Error('only ' + checked + ' of ' + shown.w.length + ' points inside the pin\'s grid');
+        const finite = shown.drawn.filter((v) => v !== null && isFinite(v)).length;
+        if (finite < shown.w.length / 2)
+          throw new Error('only ' + finite + ' of ' + shown.w.length + ' pinned phase points drawn');
+        if (!differs)
+          throw new Error('the pinned phase is the current one: the pin draws nothing of its own');
+        return finite + ' of ' + shown.w.length + ' points drawn, ' + checked +
+            ' checked against the pin\'s served phase, ' + differs + ' apart from the current design';
+      });
   console.log('screenshots in ' + args.out);
   await browser.close();
 }
