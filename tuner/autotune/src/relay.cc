@@ -82,6 +82,76 @@ RelayEstimates EstimateBare(const RelayOptions& o, const RelayTuner& relay) {
   return EstimateFromCycles(o, relay.cycles(), relay.phase() == RelayPhase::kDone, 0.0);
 }
 
+namespace {
+
+// Which fit the estimates take (EstimateFromCycles).
+enum class Fit { kSampled, kSymmetric, kIntegrating, kTimes, kExtremes };
+
+Status FitCycle(const RelayOptions& o, const RelayCycle& c, Fit fit, double delay_s, FopdtModel* m) {
+  switch (fit) {
+    case Fit::kSampled:
+      return SampledFopdtFromCycle(o, c, m);
+    case Fit::kSymmetric:
+      return FopdtFromSymmetric(o, c, delay_s, m);
+    case Fit::kIntegrating:
+      return IntegratingFromCycle(o, c, m);
+    case Fit::kTimes:
+      return FopdtFromTimes(o, c, m);
+    case Fit::kExtremes:
+      break;
+  }
+  return FopdtFromCycle(o, c, m);
+}
+
+Status UltimateOf(const RelayOptions& o, Fit fit, const FopdtModel& m, double* ku, double* pu) {
+  return fit == Fit::kSampled ? SampledUltimate(m, o.sample_period_s, ku, pu) : FopdtUltimate(m, ku, pu);
+}
+
+const char* FitName(Fit fit) {
+  switch (fit) {
+    case Fit::kSymmetric:
+      return "the period, the amplitude and the delay to the extremes (a symmetric relay)";
+    case Fit::kTimes:
+      return "switching times and integrals";
+    case Fit::kSampled:  // named with its period by the caller
+    case Fit::kIntegrating:
+    case Fit::kExtremes:
+      break;
+  }
+  return "extremes";
+}
+
+// The intervals: the same fit on each of the last n cycles alone, the
+// spread of its K, T, L, Ku and Pu (95 %, Student's t); NaN where a cycle
+// alone gives no model.
+void CycleIntervals(const RelayOptions& o, const std::vector<RelayCycle>& cycles, int n, Fit fit,
+                    double delay_s, RelayEstimates* r) {
+  std::vector<double> ks, ts, ls, kus, pus;
+  for (int i = 0; i < n; ++i) {
+    FopdtModel m;
+    double ku = 0.0, pu = 0.0;
+    if (!FitCycle(o, cycles[cycles.size() - 1 - i], fit, delay_s, &m).ok() ||
+        !UltimateOf(o, fit, m, &ku, &pu).ok()) {
+      r->gain_ci = r->time_constant_ci_s = r->delay_ci_s = r->ku_ci = r->pu_ci_s =
+          std::numeric_limits<double>::quiet_NaN();
+      return;
+    }
+    ks.push_back(m.gain);
+    ts.push_back(m.time_constant_s);
+    ls.push_back(m.delay_s);
+    kus.push_back(ku);
+    pus.push_back(pu);
+  }
+  double centre = 0.0;
+  MeanInterval(ks, &centre, &r->gain_ci);
+  MeanInterval(ts, &centre, &r->time_constant_ci_s);
+  MeanInterval(ls, &centre, &r->delay_ci_s);
+  MeanInterval(kus, &centre, &r->ku_ci);
+  MeanInterval(pus, &centre, &r->pu_ci_s);
+}
+
+}  // namespace
+
 RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<RelayCycle>& cycles,
                                   bool converged, double noise_sigma, double delay_s) {
   RelayEstimates r;
@@ -114,82 +184,29 @@ RelayEstimates EstimateFromCycles(const RelayOptions& o, const std::vector<Relay
   const double mean_v = o.d_high * mean.t_on_s - o.d_low * mean.t_off_s;
   const bool integrating =
       o.d_high != o.d_low && std::abs(mean_v) <= 0.02 * (o.d_high * mean.t_on_s + o.d_low * mean.t_off_s);
-  const bool symmetric = o.d_high == o.d_low && delay_s > 0.0;
-  const bool sampled = o.sample_period_s > 0.0 && !integrating;
-  Status fitted;
-  if (sampled) {
-    fitted = SampledFopdtFromCycle(o, mean, &r.model);
-    r.model_from =
-        "the sampled cycle (a sample-and-hold of " + Number(o.sample_period_s) + " s, the relay on its grid)";
-  } else if (symmetric) {
-    fitted = FopdtFromSymmetric(o, mean, delay_s, &r.model);
-    r.model_from = "the period, the amplitude and the delay to the extremes (a symmetric relay)";
-  } else if (integrating) {
-    fitted = IntegratingFromCycle(o, mean, &r.model);
-    r.model_from = "extremes";
-  } else if (3.0 * noise_sigma > 0.01 * r.amplitude) {
-    fitted = FopdtFromTimes(o, mean, &r.model);
-    r.model_from = "switching times and integrals";
-  } else {
-    fitted = FopdtFromCycle(o, mean, &r.model);
-    r.model_from = "extremes";
-    if (!fitted.ok()) {  // no FOPDT by its extremes: its half periods and integrals
-      fitted = FopdtFromTimes(o, mean, &r.model);
-      r.model_from = "switching times and integrals";
-    }
+  Fit fit = o.sample_period_s > 0.0 && !integrating  ? Fit::kSampled
+            : o.d_high == o.d_low && delay_s > 0.0   ? Fit::kSymmetric
+            : integrating                            ? Fit::kIntegrating
+            : 3.0 * noise_sigma > 0.01 * r.amplitude ? Fit::kTimes
+                                                     : Fit::kExtremes;
+  Status fitted = FitCycle(o, mean, fit, delay_s, &r.model);
+  if (!fitted.ok() && fit == Fit::kExtremes) {  // no FOPDT by its extremes: its half periods and integrals
+    fit = Fit::kTimes;
+    fitted = FitCycle(o, mean, fit, delay_s, &r.model);
   }
+  r.model_from = fit == Fit::kSampled ? "the sampled cycle (a sample-and-hold of " +
+                                            Number(o.sample_period_s) + " s, the relay on its grid)"
+                                      : FitName(fit);
   if (!fitted.ok()) {
     r.message = fitted.message();
     return r;
   }
-  const auto ultimate_of = [&](const FopdtModel& m, double* ku, double* pu) {
-    return sampled ? SampledUltimate(m, o.sample_period_s, ku, pu) : FopdtUltimate(m, ku, pu);
-  };
-  const Status ultimate = ultimate_of(r.model, &r.ku, &r.pu_s);
-  if (!ultimate.ok()) {
+  if (const Status ultimate = UltimateOf(o, fit, r.model, &r.ku, &r.pu_s); !ultimate.ok()) {
     r.message = ultimate.message();
     return r;
   }
   r.model_found = true;
-  // The intervals: the same fit on each settled cycle alone, the spread of
-  // its K, T, L, Ku and Pu (95 %, Student's t).
-  std::vector<double> ks, ts, ls, kus, pus;
-  for (int i = 0; i < n; ++i) {
-    const RelayCycle& c = cycles[cycles.size() - 1 - i];
-    FopdtModel m;
-    Status st;
-    if (sampled)
-      st = SampledFopdtFromCycle(o, c, &m);
-    else if (symmetric)
-      st = FopdtFromSymmetric(o, c, delay_s, &m);
-    else if (r.model.integrating)
-      st = IntegratingFromCycle(o, c, &m);
-    else if (r.model_from == "extremes")
-      st = FopdtFromCycle(o, c, &m);
-    else
-      st = FopdtFromTimes(o, c, &m);
-    double ku = 0.0, pu = 0.0;
-    if (!st.ok() || !ultimate_of(m, &ku, &pu).ok()) {
-      ks.clear();
-      break;
-    }
-    ks.push_back(m.gain);
-    ts.push_back(m.time_constant_s);
-    ls.push_back(m.delay_s);
-    kus.push_back(ku);
-    pus.push_back(pu);
-  }
-  if (!ks.empty()) {
-    double centre = 0.0;
-    MeanInterval(ks, &centre, &r.gain_ci);
-    MeanInterval(ts, &centre, &r.time_constant_ci_s);
-    MeanInterval(ls, &centre, &r.delay_ci_s);
-    MeanInterval(kus, &centre, &r.ku_ci);
-    MeanInterval(pus, &centre, &r.pu_ci_s);
-  } else {
-    r.gain_ci = r.time_constant_ci_s = r.delay_ci_s = r.ku_ci = r.pu_ci_s =
-        std::numeric_limits<double>::quiet_NaN();
-  }
+  CycleIntervals(o, cycles, n, fit, delay_s, &r);
   return r;
 }
 
