@@ -120,11 +120,18 @@ ok = x["end"] == "done" and j["adopted"]
 print(("PASS " if ok else "FAIL ") + "the amplitude the guard named converges and adopts: %s; %s" % (x["why"], j["verdict"]))' ;;
   stuck)  # a relay that sits on one side of its band while y settles there (issue 60): stopped after the
     # first episode, naming a reverse-acting process, or the amplitude that would cross the band, which then converges
-    autotune --num -1 --den 1,1 --delay 0.5 --dt 0.001 && echo "FAIL a reverse-acting process exited 0"
+    "$bin/pidlab" launch --isolated --log stuck.lcmlog -- "$bin/pidlab" autotune --backend lcm --num -1 --den 1,1 \
+      --delay 0.5 --dt 0.001 --json >out.json 2>err && echo "FAIL a reverse-acting process exited 0"
     /usr/bin/python3 -c '
 import json; j = json.load(open("out.json")); x = j["experiment"]
 ok = x["end"] == "aborted" and x["episodes"] == 1 and "the process acts in reverse" in x["why"] and not j["adopted"]
 print(("PASS " if ok else "FAIL ") + "a reverse-acting process stops after %d episode: %s" % (x["episodes"], x["why"]))'
+    # Its log alone reads the same end.
+    "$bin/pidlab" autotune --log stuck.lcmlog --json >fromlog.json 2>err && echo "FAIL autotune --log of it exited 0"
+    /usr/bin/python3 -c '
+import json; a, b = json.load(open("out.json")), json.load(open("fromlog.json"))
+ok = a["experiment"]["why"] == b["experiment"]["why"] and b["experiment"]["end"] == "aborted" and a["verdict"] == b["verdict"]
+print(("PASS " if ok else "FAIL ") + "its log alone gives the same end and verdict: %s" % b["verdict"])'
     autotune --num 0.01 --den 1,1 --delay 0.5 --dt 0.001 --hysteresis 0.1 && echo "FAIL a relay too small exited 0"
     /usr/bin/python3 -c '
 import json, re; j = json.load(open("out.json")); x = j["experiment"]

@@ -224,6 +224,13 @@ Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySam
   out.samples = std::move(samples);
   out.clipped = ClippedNote(options, out);
   HoldDrift(options.relay.hold_s, &out);
+  // A relay stuck on one side ends here, for the live run and its log alike.
+  if (out.end == RelayPhase::kRelay && out.cycles.empty()) {
+    if (std::string stuck = StuckRelay(out); !stuck.empty()) {
+      out.end = RelayPhase::kAborted;
+      out.why = std::move(stuck);
+    }
+  }
   return Status::Ok();
 }
 
@@ -289,14 +296,6 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
     if (!out.clipped.empty() && out.episodes == 1) say("  " + out.clipped);
     if (!out.hold_note.empty()) say("  " + out.hold_note);
     if (out.end == RelayPhase::kDone || out.end == RelayPhase::kAborted) break;
-    if (out.end == RelayPhase::kRelay && out.cycles.empty()) {
-      if (std::string stuck = StuckRelay(out); !stuck.empty()) {
-        out.end = RelayPhase::kAborted;
-        out.why = std::move(stuck);
-        say("  aborted: " + out.why);
-        break;
-      }
-    }
     if (window >= options.max_window_s) {
       out.why = "the relay ran " + Num(window) + " s (the longest window, --max-time) without " +
                 (out.cycles.empty() ? std::string("a single cycle: the process did not oscillate")

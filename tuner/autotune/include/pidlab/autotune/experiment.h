@@ -83,7 +83,10 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
 
 /// One relay episode's record (every step, as the controller saw it):
 /// ReplayRelay, then the tuner's end, operating point, relay and cycles into
-/// *summary (its estimates untouched). The runner's failure or ReplayRelay's.
+/// *summary (its estimates untouched), the hold's drift, and, where the relay
+/// has run no full cycle and y has settled on one side of its band, the end
+/// aborted naming why (a reverse-acting process, or a relay too small for its
+/// band). The runner's failure or ReplayRelay's.
 Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySample> samples,
                           ExperimentSummary* summary);
 
