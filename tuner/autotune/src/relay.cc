@@ -88,19 +88,10 @@ namespace {
 enum class Fit { kSampled, kSymmetric, kIntegrating, kTimes, kExtremes };
 
 Status FitCycle(const RelayOptions& o, const RelayCycle& c, Fit fit, double delay_s, FopdtModel* m) {
-  switch (fit) {
-    case Fit::kSampled:
-      return SampledFopdtFromCycle(o, c, m);
-    case Fit::kSymmetric:
-      return FopdtFromSymmetric(o, c, delay_s, m);
-    case Fit::kIntegrating:
-      return IntegratingFromCycle(o, c, m);
-    case Fit::kTimes:
-      return FopdtFromTimes(o, c, m);
-    case Fit::kExtremes:
-      break;
-  }
-  return FopdtFromCycle(o, c, m);
+  if (fit == Fit::kSampled) return SampledFopdtFromCycle(o, c, m);
+  if (fit == Fit::kSymmetric) return FopdtFromSymmetric(o, c, delay_s, m);
+  if (fit == Fit::kIntegrating) return IntegratingFromCycle(o, c, m);
+  return fit == Fit::kTimes ? FopdtFromTimes(o, c, m) : FopdtFromCycle(o, c, m);
 }
 
 Status UltimateOf(const RelayOptions& o, Fit fit, const FopdtModel& m, double* ku, double* pu) {
@@ -108,17 +99,10 @@ Status UltimateOf(const RelayOptions& o, Fit fit, const FopdtModel& m, double* k
 }
 
 const char* FitName(Fit fit) {
-  switch (fit) {
-    case Fit::kSymmetric:
-      return "the period, the amplitude and the delay to the extremes (a symmetric relay)";
-    case Fit::kTimes:
-      return "switching times and integrals";
-    case Fit::kSampled:  // named with its period by the caller
-    case Fit::kIntegrating:
-    case Fit::kExtremes:
-      break;
-  }
-  return "extremes";
+  return fit == Fit::kSymmetric
+             ? "the period, the amplitude and the delay to the extremes (a symmetric relay)"
+         : fit == Fit::kTimes ? "switching times and integrals"
+                              : "extremes";  // (kSampled is named with its period by the caller)
 }
 
 // The intervals: the same fit on each of the last n cycles alone, the
