@@ -242,6 +242,33 @@ TEST(Design, ANoiseBoundIsHonouredAndCostsLoadIae) {
   EXPECT_NE(std::find(bound.active.begin(), bound.active.end(), "noise_gain"), bound.active.end());
 }
 
+TEST(Design, TheGapToTheUnconstrainedDesignIsWhatTheActiveBoundsCostUnderTheSameMs) {
+  DesignOptions loose;
+  loose.max_ms = 1.5;
+  const DesignSummary free = DesignOrDie(Cube(), loose);
+  DesignOptions tight = loose;
+  tight.max_noise_gain = 0.5 * free.noise_gain;
+  const DesignSummary bound = DesignOrDie(Cube(), tight);
+  // The noise bound dropped: the unconstrained design's load IAE is at most
+  // the free design's (the same bounds but the noise gain's) within 1 %, and
+  // the gap is the ratio to it.
+  ASSERT_EQ(bound.dropped, std::vector<std::string>{"noise_gain"}) << bound.unconstrained_note;
+  EXPECT_LE(bound.unconstrained_load_iae, free.load_iae * 1.01);
+  EXPECT_LT(bound.unconstrained_load_iae, bound.load_iae);
+  EXPECT_NEAR(bound.unconstrained_gap_pct, 100.0 * (bound.load_iae / bound.unconstrained_load_iae - 1.0),
+              1e-9);
+  EXPECT_GT(bound.unconstrained_gap_pct, 5.0);
+  EXPECT_NE(bound.unconstrained_note.find("noise_gain"), std::string::npos) << bound.unconstrained_note;
+  // The free design's own gap: what its active bounds other than Ms cost,
+  // 0 where Ms alone is active.
+  if (free.dropped.empty()) {
+    EXPECT_EQ(free.unconstrained_gap_pct, 0.0);
+    EXPECT_EQ(free.unconstrained_load_iae, free.load_iae);
+  } else {
+    EXPECT_GE(free.unconstrained_gap_pct, 0.0);
+  }
+}
+
 TEST(Design, ADoubleIntegratorWithAFastLagIsDesignedWithinItsBoundsAndItsUnityGainTime) {
   // 1/(s^2 (0.005 s + 1)): migo finds no start on it; its lag is not the
   // plant's dominant time, the double integrator's unity-gain time 1 s is.

@@ -218,6 +218,7 @@ struct TuneCommand {
     std::cout << "design           " << s.design.message << "\n";
     std::cout << "active bounds    "
               << (s.design.active.empty() ? std::string("none") : Join(s.design.active)) << "\n";
+    std::cout << "unconstrained    " << s.design.unconstrained_note << "\n";
     std::cout << "setpoint         b = " << s.design.b << ", c = " << s.design.c;
     if (s.design.setpoint_filter_s > 0.0) std::cout << ", filter " << s.design.setpoint_filter_s << " s";
     std::cout << ": " << s.two_dof.message << "\n";

@@ -75,6 +75,14 @@ f = json.load(open(sys.argv[1])); p = json.load(open(sys.argv[2]))
 assert f['design']['load_iae'] <= 1.015 and f['robustness']['ms'] <= 1.39 * 1.001, f['design']
 assert f['robustness']['noise_gain'] <= 199 * 1.001, f['robustness']['noise_gain']
 assert p['design']['load_iae'] <= 2.203 and p['robustness']['ms'] <= 1.629 * 1.001 and p['gains']['kd'] == 0
+# The gap to the unconstrained design: the active bounds but Ms dropped,
+# never a better load than the design's own with a negative gap.
+for d in (f['design'], p['design']):
+    u = d['unconstrained']
+    assert u['dropped'] == [a for a in d['active'] if a != 'ms'], (u, d['active'])
+    assert u['load_iae'] <= d['load_iae'] and u['gap_pct'] >= 0, u
+    assert abs(u['gap_pct'] - 100 * (d['load_iae'] / u['load_iae'] - 1)) < 1e-9, u
+    assert u['dropped'] or (u['gap_pct'] == 0 and u['load_iae'] == d['load_iae']), u
 PY"
 
 # The README's command: the default is the engine, the bounds given taken.

@@ -243,6 +243,38 @@ std::vector<std::string> ActiveBounds(const analysis::LoopAnalysis& a, const des
   return active;
 }
 
+// The gap to the unconstrained design (DesignSummary::unconstrained_*):
+// the bounds active at the optimum other than Ms dropped, searched from the
+// optimum's shape, and checked exactly under Ms alone.
+void Unconstrained(const Plant& plant, const design::Engine& engine, design::Bounds b,
+                   const design::Optimum& o, DesignSummary* s) {
+  s->dropped.clear();
+  for (const std::string& name : s->active)
+    if (name != "ms") s->dropped.push_back(name);
+  if (s->dropped.empty()) {
+    s->unconstrained_load_iae = s->load_iae;
+    s->unconstrained_gap_pct = 0.0;
+    s->unconstrained_note = "no bound but Ms is active: the unconstrained design is this one";
+    return;
+  }
+  b.mt = b.noise_gain = std::numeric_limits<double>::infinity();
+  b.td_max_s = std::max(b.td_max_s, 1e4 * engine.Time());
+  design::Optimum u;
+  analysis::LoopAnalysis a;
+  if (!engine.Optimize(b, o.shape, &u, true) || !ExactlyWithin(plant, engine, b, &u, &a) ||
+      !(u.load_iae <= s->load_iae)) {
+    u = o;  // no better design found from here: a gap of 0 at the least
+  }
+  s->unconstrained_load_iae = u.load_iae;
+  s->unconstrained_gap_pct = 100.0 * (s->load_iae / u.load_iae - 1.0);
+  std::string names;
+  for (const std::string& name : s->dropped) names += (names.empty() ? "" : ", ") + name;
+  s->unconstrained_note = "without the " + names + " bound" + (s->dropped.size() > 1 ? "s" : "") +
+                          " (Ms <= " + FormatNumber(b.ms) + " alone) the load \u222b|e|dt would be " +
+                          FormatNumber(u.load_iae) + ": they cost " + FormatNumber(s->unconstrained_gap_pct) +
+                          " %";
+}
+
 }  // namespace
 
 namespace design {
@@ -440,6 +472,7 @@ Status DesignOn(const Plant& plant, const design::Engine& engine, const DesignOp
   b.ms = ms_bound;
   s.active = ActiveBounds(a, b, s.gains);
   s.evaluations = o.evaluations;
+  Unconstrained(plant, engine, b, o, &s);
   ShapeSetpoint(plant, engine, options, &s);
   std::ostringstream os;
   os << "optimal: the least load \u222b|e|dt with Ms <= " << FormatNumber(ms_bound)

@@ -32,6 +32,8 @@ constexpr double kInfeasible = 1e200;
 constexpr double kStepsPerRadian = 30.0;
 // The first estimate's shape on a plant no rule applies to.
 constexpr double kGenericTiFactor = 1.0;
+// The evaluations of a search from a warm start alone.
+constexpr int kWarmOnlyEvaluations = 80;
 
 // The rule's shape (Ti, Td, N = 10) where SIMC or AMIGO applies.
 bool RuleShape(const Plant& plant, TuningRule rule, bool pi, Eigen::VectorXd* shape) {
@@ -327,7 +329,8 @@ std::vector<Eigen::VectorXd> Engine::Starts(const Bounds& bounds) const {
   return starts;
 }
 
-bool Engine::Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum* best) const {
+bool Engine::Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum* best,
+                      bool warm_only) const {
   evaluations_ = 0;
   const int dims = pi_ ? 1 : 3;
   optim::Bounds box{Eigen::VectorXd(dims), Eigen::VectorXd(dims)};
@@ -340,7 +343,8 @@ bool Engine::Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum
     box.lower(2) = std::log(kDesignMinFilterRatio);
     box.upper(2) = std::log(kDesignMaxFilterRatio);
   }
-  std::vector<Eigen::VectorXd> starts = Starts(bounds);
+  std::vector<Eigen::VectorXd> starts;
+  if (!(warm_only && warm.size() == dims)) starts = Starts(bounds);
   if (warm.size() == dims) starts.insert(starts.begin(), warm);
   double kp_hint = 0.0;
   const optim::ObjectiveFunction f = [&](const Eigen::VectorXd& x) {
@@ -364,18 +368,22 @@ bool Engine::Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum
   };
   for (const Eigen::VectorXd& x0 : starts)
     run(x0.cwiseMax(box.lower).cwiseMin(box.upper), 0.03,
-        warm.size() == dims && &x0 != &starts.front() ? 60 : 160, 1e-5, 1e-7, 0);
+        warm_only                                       ? kWarmOnlyEvaluations
+        : warm.size() == dims && &x0 != &starts.front() ? 60
+                                                        : 160,
+        1e-5, 1e-7, 0);
   if (!result.IsUsable()) return false;
-  // Polish from the best, with a fresh simplex.
+  // Polish from the best, with a fresh simplex (not from a warm start alone:
+  // a quick look nearby).
   const Eigen::VectorXd from = result.x;
-  run(from, 0.01, 120, 1e-6, 1e-9, 1);
+  if (!warm_only) run(from, 0.01, 120, 1e-6, 1e-9, 1);
   kp_hint = 0.0;
   PidGains g;
   double value = Cost(result.x, 0.0, bounds, &kp_hint, &g);
   // A bound that is not active: kp below the largest (a fourth coordinate).
   PidGains lower;
   double hint = kp_hint;
-  if (Cost(result.x, std::log(0.97), bounds, &hint, &lower) < value) {
+  if (!warm_only && Cost(result.x, std::log(0.97), bounds, &hint, &lower) < value) {
     Eigen::VectorXd x0(dims + 1), lo(dims + 1), hi(dims + 1);
     x0 << result.x, std::log(0.97);
     lo << box.lower, -4.0;

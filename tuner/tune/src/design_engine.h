@@ -45,8 +45,11 @@ class Engine {
   Engine(const Plant& plant, bool pi, double min_tf_s = 0.0, double crossover_hint = 0.0,
          double speed_cap = 0.0);
   /// The optimum under `bounds`, from the rules' shapes and `warm` (if not
-  /// empty). False when no shape has a stable loop meeting the bounds.
-  bool Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum* best) const;
+  /// empty; `warm_only`: one short search from it alone, not polished).
+  /// False when no shape has a stable
+  /// loop meeting the bounds.
+  bool Optimize(const Bounds& bounds, const Eigen::VectorXd& warm, Optimum* best,
+                bool warm_only = false) const;
   /// \int|y|dt of the unit load step (+inf when it does not settle).
   double LoadIae(const PidGains& g) const;
   /// The shape of gains (kp, ki > 0; a PID's kd, tf > 0), to start from.

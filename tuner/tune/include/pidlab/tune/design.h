@@ -112,6 +112,16 @@ struct DesignSummary {
   /// The constraints within 1 % of their bound at the optimum: "ms", "mt",
   /// "noise_gain", "td".
   std::vector<std::string> active;
+  /// The gap to the unconstrained design: the least load \int|e|dt under
+  /// the same Ms bound alone, the other bounds active at the optimum
+  /// ("mt", "noise_gain", "td") dropped (`dropped`), searched from this
+  /// design; the gap is 100 (load_iae / unconstrained_load_iae - 1) %. Where
+  /// none of them is active, the same design (gap 0, nothing dropped).
+  double unconstrained_load_iae = std::numeric_limits<double>::quiet_NaN();
+  double unconstrained_gap_pct = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::string> dropped;
+  /// One clause: what the bounds cost, or why the gap is 0.
+  std::string unconstrained_note;
   /// A crossover asked for that the front does not reach within 1 % (it
   /// jumps there: another optimum takes over): the nearest design, said so.
   std::string front_note;
