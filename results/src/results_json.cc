@@ -155,6 +155,8 @@ void AddDesign(const tune::DesignSummary& d, nlohmann::json* j) {
       {"overshoot_pct", JsonNumber(d.overshoot_pct)},
       {"overshoot_unit_weights_pct", JsonNumber(d.overshoot_unit_weights_pct)},
       {"overshoot_met", d.overshoot_met},
+      {"overshoot_target_pct", JsonNumber(d.overshoot_target_pct)},
+      {"overshoot_cap_note", d.overshoot_cap_note},
       {"setpoint_filter_s", JsonNumber(d.setpoint_filter_s)},
       {"setpoint_note", d.setpoint_note},
       {"front_note", d.front_note},

@@ -334,6 +334,24 @@ void ShapeSetpoint(const Plant& plant, const design::Engine& engine, const Desig
         " reach " + FormatNumber(s->overshoot_pct) + " % at the least";
 }
 
+// Along a knob: the setpoint stage again under the front's cap where the
+// design overshoots more than a faster knot (FrontOvershootCap).
+void CapAlongTheFront(const Plant& plant, const design::Engine& engine, const DesignOptions& options,
+                      DesignSummary* s) {
+  s->overshoot_target_pct = options.max_overshoot_pct;
+  if (!options.monotone_front) return;
+  double from = 0.0;
+  const double cap = design::FrontOvershootCap(plant, options, s->ms_bound, &from);
+  if (!(from > 0.0) || s->overshoot_pct <= cap) return;
+  DesignOptions capped = options;
+  capped.max_overshoot_pct = cap;
+  ShapeSetpoint(plant, engine, capped, s);
+  s->overshoot_target_pct = cap;
+  s->overshoot_cap_note = "the overshoot target " + FormatNumber(options.max_overshoot_pct) +
+                          " % capped at " + FormatNumber(cap) + " %, the front's faster design at Ms " +
+                          FormatNumber(from) + ": a slower design never overshoots more";
+}
+
 // migo's design as the engine's start. Where migo finds none on a plant of
 // two or more integrators (their lags take its grid), its design on the
 // integrators alone k / (a s^n) is the start.
@@ -416,7 +434,10 @@ Status DesignOptimal(const Plant& plant, const DesignOptions& options, DesignSum
     const design::Engine engine(design_plant, options.pi, sampled ? options.loop.dt_s : 0.0, hint, cap);
     const bool warm = has_migo || pass > 0;
     const Status st = DesignOn(plant, engine, options, sampled, warm ? &previous : nullptr, summary);
-    if (!st.ok() || !(summary->crossover_rad_s > 3.0 * engine.Crossover())) return st;
+    if (!st.ok() || pass == 2 || !(summary->crossover_rad_s > 3.0 * engine.Crossover())) {
+      if (st.ok()) CapAlongTheFront(plant, engine, options, summary);
+      return st;
+    }
     hint = summary->crossover_rad_s;
     previous = *summary;
   }

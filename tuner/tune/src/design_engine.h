@@ -88,4 +88,12 @@ class Engine {
   mutable int evaluations_ = 0;
 };
 
+/// The setpoint overshoot target of a design at Ms bound `ms_bound` along a
+/// knob (DesignOptions::monotone_front, design_front.cc): options'
+/// max_overshoot_pct capped by the overshoot of the front's designs at the
+/// knots Ms = kFrontMaxMs, kFrontMaxMs - 0.1, ... above ms_bound, each
+/// designed under the cap of the knots above it. *from_ms: the knot that set
+/// the cap (0: none did).
+double FrontOvershootCap(const Plant& plant, const DesignOptions& options, double ms_bound, double* from_ms);
+
 }  // namespace pidlab::tune::design

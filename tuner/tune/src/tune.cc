@@ -213,6 +213,9 @@ bool OptimalSearch(const Plant& plant, const TuneOptions& options,
   Status status = options.robustness_phase_margin_deg > 0.0
                       ? DesignMsForPhaseMargin(plant, options.robustness_phase_margin_deg, &o)
                       : Status::Ok();
+  // Along a knob the setpoint stage keeps to the front's faster overshoot
+  // (after the phase margin's bisection, which designs without it).
+  o.monotone_front = options.robustness_given || o.crossover_rad_s > 0.0;
   if (status.ok()) status = DesignOptimal(plant, o, &summary->design);
   if (!status.ok()) {
     if (error) *error = status.message();
@@ -228,10 +231,11 @@ bool OptimalSearch(const Plant& plant, const TuneOptions& options,
   two.message =
       d.setpoint_note.empty()
           ? "the setpoint overshoot " + spec::FormatNumber(d.overshoot_pct) +
-                " % <= " + spec::FormatNumber(o.max_overshoot_pct) +
+                " % <= " + spec::FormatNumber(d.overshoot_target_pct) +
                 " %, the least setpoint integral |e| dt" +
                 (d.setpoint_filter_s > 0.0 ? " (with a setpoint filter: no weights b, c reach it alone)" : "")
           : d.setpoint_note;
+  if (!d.overshoot_cap_note.empty()) two.message += "; " + d.overshoot_cap_note;
   RuleResult(d.gains, evaluator, d.message, &summary->optimizer);
   return true;
 }

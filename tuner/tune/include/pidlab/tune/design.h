@@ -70,6 +70,12 @@ struct DesignOptions {
   /// The setpoint stage's overshoot target (%), >= 0; +inf: no target (the
   /// weights of the smallest setpoint IAE).
   double max_overshoot_pct = kDesignDefaultOvershootPct;
+  /// Along a knob (`--robustness`, `--response-time`, `--crossover`): the
+  /// overshoot target is also capped by the overshoot of the front's designs
+  /// at the knots Ms = 2.0, 1.9, ... above this design's Ms bound, each
+  /// capped the same way from the top, so a slower design never overshoots
+  /// more (the knots' designs cost a design each).
+  bool monotone_front = false;
   /// The loop designed for: continuous (default), or the sampled loop at
   /// loop.dt_s (the ZOH plant and the discrete PID the trio and the exported
   /// C run): designed with the hold's half sample of delay, tf >= dt, and
@@ -101,6 +107,10 @@ struct DesignSummary {
   /// overshoot b and c reach, said in `setpoint_note`).
   bool overshoot_met = true;
   std::string setpoint_note;
+  /// The overshoot target the stage ran under (%): max_overshoot_pct, or
+  /// along a knob the front's cap below it, said in `overshoot_cap_note`.
+  double overshoot_target_pct = kDesignDefaultOvershootPct;
+  std::string overshoot_cap_note;
   /// The exact analysis of the loop (AnalyzeLoop): Ms, Mt, the noise gain,
   /// the highest gain crossover (rad/s) and the phase margin (deg).
   double ms = 0.0, mt = 0.0, noise_gain = 0.0, crossover_rad_s = 0.0, phase_margin_deg = 0.0;
