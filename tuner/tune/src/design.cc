@@ -493,7 +493,7 @@ Status DesignOn(const Plant& plant, const design::Engine& engine, const DesignOp
   b.ms = ms_bound;
   s.active = ActiveBounds(a, b, s.gains);
   s.evaluations = o.evaluations;
-  Unconstrained(plant, engine, b, o, &s);
+  if (options.unconstrained_gap) Unconstrained(plant, engine, b, o, &s);
   ShapeSetpoint(plant, engine, options, &s);
   std::ostringstream os;
   os << "optimal: the least load \u222b|e|dt with Ms <= " << FormatNumber(ms_bound)

@@ -69,6 +69,7 @@ double FrontOvershootCap(const Plant& plant, const DesignOptions& options, doubl
     }
     DesignOptions knot = options;
     knot.monotone_front = false;
+    knot.unconstrained_gap = false;
     knot.crossover_rad_s = 0.0;
     knot.max_ms = tenth / 10.0;
     // The response-time front keeps its Mt bound (the top's); the robustness

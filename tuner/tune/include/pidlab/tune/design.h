@@ -76,6 +76,10 @@ struct DesignOptions {
   /// capped the same way from the top, so a slower design never overshoots
   /// more (the knots' designs cost a design each).
   bool monotone_front = false;
+  /// Search for the gap to the unconstrained design (DesignSummary::
+  /// unconstrained_*; a short search where a bound but Ms is active). Off
+  /// for the front's knots, whose overshoot alone is used.
+  bool unconstrained_gap = true;
   /// The loop designed for: continuous (default), or the sampled loop at
   /// loop.dt_s (the ZOH plant and the discrete PID the trio and the exported
   /// C run): designed with the hold's half sample of delay, tf >= dt, and
