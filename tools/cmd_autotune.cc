@@ -111,6 +111,14 @@ struct AutotuneCommand {
     Require(
         results::BuildAutotune(a, a_given, previous, pid, s.bounds.max_ms, NameStyle::kFlag, &autotune_run));
     if (!dt_line.empty()) Say(dt_line);
+    // --y-limit not given: from the plant's expected relay amplitude.
+    RelayTuneOptions& relay = autotune_run.experiment.relay;
+    std::string y_line = "y limit " + spec::FormatNumber(relay.y_limit) + " from the hold's level (given)";
+    if (!a_given.count("y_limit")) {
+      relay.y_limit = tune::RelayYLimitFromPlant(plant, relay.amplitude + std::abs(relay.bias),
+                                                 s.loop.measurement_noise, &y_line);
+      Say(y_line);
+    }
     const ExperimentOptions& xo = autotune_run.experiment;
     const results::AutotuneDesignOptions& design = autotune_run.design;
 
@@ -132,6 +140,7 @@ struct AutotuneCommand {
     bool adopted = false;
     json out = results::AutotuneJson(x, previous, design, step, Say, &adopted);
     out["backend"] = "lcm";
+    out["y_limit_note"] = y_line;
     out["episode_ids"] = client->stats().episode_ids;
     // The verdict to live watchers (pidlab serve --lcm-url: the Live tab's
     // tunings): the adopted gains (or the previous ones) and the design's Ms.

@@ -55,6 +55,7 @@ json ExperimentJson(const ExperimentSummary& x) {
   e["y0"] = JsonNumber(x.y0);
   e["noise_sigma"] = JsonNumber(x.noise_sigma);
   e["hysteresis"] = JsonNumber(x.hysteresis);
+  e["y_limit"] = JsonNumber(x.y_limit);
   e["d_high"] = JsonNumber(x.d_high);
   e["d_low"] = JsonNumber(x.d_low);
   e["clipped"] = x.clipped;

@@ -145,7 +145,20 @@ open("needed", "w").write(m.group(1) if m else "1")'
     /usr/bin/python3 -c '
 import json; j = json.load(open("out.json")); x = j["experiment"]
 ok = x["end"] == "done" and j["adopted"]
-print(("PASS " if ok else "FAIL ") + "the amplitude the guard named converges and adopts: %s; %s" % (x["why"], j["verdict"]))' ;;
+print(("PASS " if ok else "FAIL ") + "the amplitude the guard named converges and adopts: %s; %s" % (x["why"], j["verdict"]))'
+    # A reverse-acting integrating process never settles, so only a y limit
+    # stops it: with no --y-limit, 10 x the relay's expected amplitude
+    # 4 d / (pi Ku), d = 4/3 (1 + the bias 1/3), Ku = pi of -e^(-0.5s)/s's mirror.
+    autotune --num -1 --den 1,0 --delay 0.5 --dt 0.001 && echo "FAIL a runaway exited 0"
+    /usr/bin/python3 -c '
+import json, math; j = json.load(open("out.json")); x = j["experiment"]
+want = 10 * 4 * (4 / 3) / (math.pi * math.pi)
+ok = (x["end"] == "aborted" and x["episodes"] == 1 and "beyond the limit" in x["why"] and not j["adopted"]
+      and abs(x["y_limit"] / want - 1) < 1e-4 and "expected amplitude" in j["y_limit_note"])
+print(("PASS " if ok else "FAIL ") + "a runaway stops at the default y limit %.5g (10 x 4 d / (pi Ku) = %.5g) after %d episode: %s"
+      % (x["y_limit"], want, x["episodes"], x["why"]))'
+    grep -q "^y limit 5.4038 from the hold's level: 10 x the relay's expected amplitude" err &&
+      echo "PASS the default y limit is said in one line" || echo "FAIL no y limit line: $(grep -m1 'y limit' err)" ;;
   drifting_hold)  # a hold too short for the previous PI to settle (issue 60): named as drifting, with its
     # drift; a hold long enough is not named
     autotune --num 1 --den 1,1 --delay 0.5 --dt 0.001 --gains 0.5,0.5,0 --reference 1 --hold 2

@@ -213,6 +213,7 @@ Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySam
   out.y0 = tuner.y0();
   out.noise_sigma = tuner.noise_sigma();
   out.hysteresis = tuner.hysteresis();
+  out.y_limit = options.relay.y_limit;
   out.d_high = tuner.d_high();
   out.d_low = tuner.d_low();
   out.relay_start_s = tuner.relay_start_s();

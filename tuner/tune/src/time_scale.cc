@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "pidlab/analysis/loop_analysis.h"
 #include "pidlab/spec/field.h"
+#include "pidlab/tune/design.h"
 #include "pidlab/tune/problem.h"
 #include "spec_build.h"
 
@@ -159,6 +161,45 @@ double SampledDtFromPlant(const Plant& plant, std::string* why) {
   }
   if (why) *why = "dt " + spec::FormatNumber(dt) + " s: " + reason + " (give --dt to choose)";
   return dt;
+}
+
+double RelayYLimitFromPlant(const Plant& plant, double d, double noise_sigma, std::string* why) {
+  const double widen = noise_sigma > 0.0 ? kRelayYLimitSigmas * noise_sigma : 0.0;
+  const std::string set =
+      (widen > 0.0 ? ", widened by " + spec::FormatNumber(kRelayYLimitSigmas) +
+                         " sigma of the measurement noise " + spec::FormatNumber(noise_sigma)
+                   : std::string()) +
+      " (give --y-limit to choose, inf for none)";
+  if (plant.nonlinear || plant.tf.num.empty() || plant.tf.den.size() < 2) {
+    if (why) *why = "no y limit: plant " + plant.name + " is not linear" + set;
+    return std::numeric_limits<double>::infinity();
+  }
+  Plant forward = plant;
+  const double dc = plant.tf.DcGain();
+  if (dc < 0.0 || (std::isinf(dc) && plant.tf.num.back() * plant.tf.den[plant.tf.den.size() - 2] < 0.0))
+    for (double& n : forward.tf.num) n = -n;
+  double w180 = 0.0;
+  const double ku = UltimateGain(forward, &w180);
+  if (std::isfinite(ku) && ku > 0.0) {
+    const double a = 4.0 * d / (M_PI * ku);
+    if (why)
+      *why = "y limit " + spec::FormatNumber(kRelayYLimitAmplitudes * a + widen) +
+             " from the hold's level: " + spec::FormatNumber(kRelayYLimitAmplitudes) +
+             " x the relay's expected amplitude 4 d / (pi Ku) = " + spec::FormatNumber(a) + " (d " +
+             spec::FormatNumber(d) + ", Ku " + spec::FormatNumber(ku) + " at " + spec::FormatNumber(w180) +
+             " rad/s)" + set;
+    return kRelayYLimitAmplitudes * a + widen;
+  }
+  if (std::isfinite(dc) && dc != 0.0) {
+    const double span = 2.0 * std::abs(dc) * d + widen;
+    if (why)
+      *why = "y limit " + spec::FormatNumber(span) +
+             " from the hold's level: 2 x the static response |K| d (K " + spec::FormatNumber(dc) + ", d " +
+             spec::FormatNumber(d) + "; no ultimate gain)" + set;
+    return span;
+  }
+  if (why) *why = "no y limit: plant " + plant.name + " has no ultimate gain and no finite static gain" + set;
+  return std::numeric_limits<double>::infinity();
 }
 
 }  // namespace pidlab::tune

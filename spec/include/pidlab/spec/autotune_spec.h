@@ -56,7 +56,9 @@ struct AutotuneSpec {
              &hold_s);
     a->Visit({"u0", "the open-loop hold's input (when the previous gains are 0,0,0)", "", kNone, "0.3"}, &u0);
     a->Visit(
-        {"y_limit", "stop the relay when |y - y0| (from the operating point) exceeds this (default: none)",
+        {"y_limit",
+         "stop the relay when |y - y0| (from the operating point) exceeds this; not given: 10 x the relay's "
+         "expected amplitude 4 d / (pi Ku) on the plant (docs/autotune.md); inf: none",
          "", kInfinite, "2"},
         &y_limit);
     a->Visit(

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,8 @@ struct ExperimentSummary {
   RelayPhase end = RelayPhase::kRelay;
   std::string why;
   double u0 = 0.0, y0 = 0.0, noise_sigma = 0.0, hysteresis = 0.0, d_high = 0.0, d_low = 0.0;
+  /// The relay's limit on |y - y0| (RelayTuneOptions::y_limit; +inf: none).
+  double y_limit = std::numeric_limits<double>::infinity();
   double relay_start_s = 0.0, end_s = 0.0, horizon_s = 0.0;
   int restarts = 0;
   std::vector<double> load_changes_s;

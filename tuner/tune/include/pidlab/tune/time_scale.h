@@ -35,6 +35,20 @@ void OnSampledGrid(double dt_s, double* sample_time_s, double* horizon_s);
 inline constexpr double kDtPerFastestTime = 400.0;
 double SampledDtFromPlant(const Plant& plant, std::string* why);
 
+/// The relay's default y limit for a plant when none is given (autotune,
+/// `--y-limit`; docs/autotune.md, "Settings from the process"): the span of
+/// |y - y0| from the hold's level beyond which the relay stops. It is
+/// kRelayYLimitAmplitudes times the relay's expected amplitude, the
+/// describing function's 4 d / (pi Ku) for a relay of d (the larger of its
+/// two sides) on the plant's ultimate gain Ku (a reverse-acting plant's
+/// mirror's); where the plant has no ultimate gain, twice its static
+/// response |K| d; +inf where it has neither (or is nonlinear). *why says
+/// which, in one line. A measurement noise of standard deviation sigma
+/// (the simulated process's) widens it by kRelayYLimitSigmas sigma.
+inline constexpr double kRelayYLimitAmplitudes = 10.0;
+inline constexpr double kRelayYLimitSigmas = 6.0;
+double RelayYLimitFromPlant(const Plant& plant, double d, double noise_sigma, std::string* why);
+
 /// Which loops take a derived time scale.
 enum class TimeScaleScope {
   kNotPaper,  ///< every plant but the paper's (evaluate: eq. 4's numbers stay)
