@@ -100,7 +100,7 @@ struct AutotuneCommand {
     s.loop.loop = "sampled";
     Plant plant;
     LoopOptions loop;
-    const std::string dt_line = DtFromPlant(&s, &given);  // said once the input is known good
+    const std::string dt_line = tune::SampledDtFromSpec(&s, &given);  // said once the input is known good
     Require(tune::BuildPlantInLoop(s.plant, s.loop, NameStyle::kFlag, &plant, &loop));
     loop.loop = LoopKind::kSampled;
     const PidGains previous{s.gains[0], s.gains[1], s.gains[2]};
@@ -156,30 +156,6 @@ struct AutotuneCommand {
       // A watcher's message never stops the command.
     }
     return Print(out, adopted);
-  }
-
-  // Off the paper's plants, dt from the plant's time scales unless given
-  // (the plant built on the noiseless continuous loop, which takes any
-  // delay), and the sample time and horizon on its grid unless given: its
-  // line, or "".
-  static std::string DtFromPlant(spec::EvaluateSpec* s, std::set<std::string>* given) {
-    spec::LoopSpec continuous = s->loop;
-    continuous.loop = "continuous";
-    continuous.measurement_noise = 0.0;
-    Plant plant;
-    LoopOptions loop;
-    std::string line;
-    if (!given->count("dt") && !tune::IsPaperPlant(s->plant) &&
-        tune::BuildPlantInLoop(s->plant, continuous, NameStyle::kFlag, &plant, &loop).ok() &&
-        !plant.nonlinear) {
-      s->loop.dt_s = tune::SampledDtFromPlant(plant, &line);
-      given->insert("dt");
-      double sample_time = s->loop.sample_time_s, horizon = s->loop.horizon_s;
-      tune::OnSampledGrid(s->loop.dt_s, &sample_time, &horizon);
-      if (!given->count("sample_time")) s->loop.sample_time_s = sample_time;
-      if (!given->count("horizon")) s->loop.horizon_s = horizon;
-    }
-    return line;
   }
 
   // The verification: a closed-loop step on the trio, the spec of the flags

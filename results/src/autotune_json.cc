@@ -129,11 +129,20 @@ json ReadingJson(const autotune::StepReading& r) {
           {"settled", r.settled}};
 }
 
+// The identified model K e^(-Ls)/(Ts+1), or K e^(-Ls)/s, as a plant.
+Plant ModelAsPlant(const autotune::FopdtModel& m) {
+  Plant model;
+  model.name = "custom";
+  model.tf.num = {m.gain};
+  model.tf.den = m.integrating ? std::vector<double>{1.0, 0.0} : std::vector<double>{m.time_constant_s, 1.0};
+  model.delay_s = m.delay_s;
+  return model;
+}
+
 // The identified model as a spec's plant keys.
 json ModelPlant(const autotune::FopdtModel& m) {
-  json plant = {{"num", {m.gain}}, {"delay", m.delay_s}};
-  plant["den"] = m.integrating ? json::array({1.0, 0.0}) : json::array({m.time_constant_s, 1.0});
-  return plant;
+  const Plant model = ModelAsPlant(m);
+  return {{"num", model.tf.num}, {"den", model.tf.den}, {"delay", model.delay_s}};
 }
 
 double MsOf(const json& result) {
@@ -192,12 +201,7 @@ constexpr double kModelOvershootPoints = 10.0;
 // identified model, without the measurement noise.
 bool PredictedStep(const ExperimentSummary& x, const PidGains& gains, const evaluation::Evaluation& measured,
                    evaluation::Evaluation* predicted) {
-  const autotune::FopdtModel& m = x.estimates.model;
-  Plant model;
-  model.name = "custom";
-  model.tf.num = {m.gain};
-  model.tf.den = m.integrating ? std::vector<double>{1.0, 0.0} : std::vector<double>{m.time_constant_s, 1.0};
-  model.delay_s = m.delay_s;
+  const Plant model = ModelAsPlant(x.estimates.model);
   evaluation::LoopOptions loop = measured.options;
   loop.measurement_noise = MeasurementNoise{};
   if (evaluation::Evaluate(model, gains, loop, evaluation::EvaluateOptions{}, predicted).ok() &&

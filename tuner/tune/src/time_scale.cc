@@ -163,6 +163,25 @@ double SampledDtFromPlant(const Plant& plant, std::string* why) {
   return dt;
 }
 
+std::string SampledDtFromSpec(spec::EvaluateSpec* s, std::set<std::string>* given) {
+  spec::LoopSpec continuous = s->loop;
+  continuous.loop = "continuous";
+  continuous.measurement_noise = 0.0;
+  Plant plant;
+  evaluation::LoopOptions loop;
+  std::string line;
+  if (given->count("dt") || IsPaperPlant(s->plant) ||
+      !BuildPlantInLoop(s->plant, continuous, spec::NameStyle::kFlag, &plant, &loop).ok() || plant.nonlinear)
+    return line;
+  s->loop.dt_s = SampledDtFromPlant(plant, &line);
+  given->insert("dt");
+  double sample_time = s->loop.sample_time_s, horizon = s->loop.horizon_s;
+  OnSampledGrid(s->loop.dt_s, &sample_time, &horizon);
+  if (!given->count("sample_time")) s->loop.sample_time_s = sample_time;
+  if (!given->count("horizon")) s->loop.horizon_s = horizon;
+  return line;
+}
+
 double RelayYLimitFromPlant(const Plant& plant, double d, double noise_sigma, std::string* why) {
   const double widen = noise_sigma > 0.0 ? kRelayYLimitSigmas * noise_sigma : 0.0;
   const std::string set =

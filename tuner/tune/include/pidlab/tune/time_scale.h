@@ -35,6 +35,13 @@ void OnSampledGrid(double dt_s, double* sample_time_s, double* horizon_s);
 inline constexpr double kDtPerFastestTime = 400.0;
 double SampledDtFromPlant(const Plant& plant, std::string* why);
 
+/// SampledDtFromPlant on a spec (autotune): off the paper's plants and
+/// unless dt is in *given, the spec's dt from its plant's time scales (the
+/// plant built on the noiseless continuous loop, which takes any delay), and
+/// its sample time and horizon on that grid unless given; "dt" joins *given.
+/// Returns the line that says so, or "" (nothing derived).
+std::string SampledDtFromSpec(spec::EvaluateSpec* s, std::set<std::string>* given);
+
 /// The relay's default y limit for a plant when none is given (autotune,
 /// `--y-limit`; docs/autotune.md, "Settings from the process"): the span of
 /// |y - y0| from the hold's level beyond which the relay stops. It is
