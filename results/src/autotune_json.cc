@@ -61,6 +61,7 @@ json ExperimentJson(const ExperimentSummary& x) {
   e["clipped"] = x.clipped;
   e["hold_drift"] = JsonNumber(x.hold_drift);
   e["hold_note"] = x.hold_note;
+  e["hold_s"] = JsonNumber(x.hold_s);
   e["relay_start_s"] = JsonNumber(x.relay_start_s);
   e["end_s"] = JsonNumber(x.end_s);
   e["horizon_s"] = JsonNumber(x.horizon_s);

@@ -111,6 +111,10 @@ std::string ClippedNote(const ExperimentOptions& options, const ExperimentSummar
 // A hold's drift is named past this fraction of the relay's oscillation.
 constexpr double kHoldDriftOfAmplitude = 0.05;
 
+// A drifting hold is doubled, episode by episode, up to this many times the
+// hold given (RunExperiment).
+constexpr double kMaxHoldGrowth = 16.0;
+
 // The hold's drift and its note (ExperimentSummary::hold_drift).
 void HoldDrift(double hold_s, ExperimentSummary* out) {
   const std::vector<RelaySample>& s = out->samples;
@@ -224,6 +228,7 @@ Status AnalyzeRelayRecord(const ExperimentOptions& options, std::vector<RelaySam
   out.cycles = tuner.cycles();
   out.samples = std::move(samples);
   out.clipped = ClippedNote(options, out);
+  out.hold_s = options.relay.hold_s;
   HoldDrift(options.relay.hold_s, &out);
   // A relay stuck on one side ends here, for the live run and its log alike.
   if (out.end == RelayPhase::kRelay && out.cycles.empty()) {
@@ -280,14 +285,17 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
   ExperimentSummary& out = *summary;
   out = ExperimentSummary{};
   double window = options.first_window_s;
+  // The hold grows while it drifts (HoldDrift): doubled, up to
+  // kMaxHoldGrowth times the one given, so the relay starts from rest.
+  ExperimentOptions episode = options;
   for (;;) {
-    const double horizon = options.relay.hold_s + window;
-    say("relay episode " + std::to_string(out.episodes + 1) + ": hold " + Num(options.relay.hold_s) +
+    const double horizon = episode.relay.hold_s + window;
+    say("relay episode " + std::to_string(out.episodes + 1) + ": hold " + Num(episode.relay.hold_s) +
         " s, then up to " + Num(window) + " s of relay");
     std::vector<RelaySample> samples;
-    if (const Status st = runner(options.relay, horizon, &samples); !st.ok()) return st;
+    if (const Status st = runner(episode.relay, horizon, &samples); !st.ok()) return st;
     ++out.episodes;
-    if (const Status st = AnalyzeRelayRecord(options, std::move(samples), &out); !st.ok()) return st;
+    if (const Status st = AnalyzeRelayRecord(episode, std::move(samples), &out); !st.ok()) return st;
     const double dt = out.samples.size() > 1 ? out.samples[1].t_s - out.samples[0].t_s : 0.0;
     say("  " + std::string(ToString(out.end)) + ": u0 " + Num(out.u0) + ", y0 " + Num(out.y0) +
         ", noise sigma " + Num(out.noise_sigma) + ", hysteresis " + Num(out.hysteresis) + ", " +
@@ -296,6 +304,12 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
         (out.why.empty() ? std::string() : ": " + out.why));
     if (!out.clipped.empty() && out.episodes == 1) say("  " + out.clipped);
     if (!out.hold_note.empty()) say("  " + out.hold_note);
+    if (!out.hold_note.empty() && episode.relay.hold_s > 0.0 &&
+        2.0 * episode.relay.hold_s <= kMaxHoldGrowth * options.relay.hold_s * (1.0 + 1e-12)) {
+      episode.relay.hold_s *= 2.0;
+      say("  the hold drifts: the next episode holds " + Num(episode.relay.hold_s) + " s");
+      continue;
+    }
     if (out.end == RelayPhase::kDone || out.end == RelayPhase::kAborted) break;
     if (window >= options.max_window_s) {
       out.why = "the relay ran " + Num(window) + " s (the longest window, --max-time) without " +
@@ -316,7 +330,7 @@ Status RunExperiment(const ExperimentOptions& options, const RelayEpisodeRunner&
     if (out.end == RelayPhase::kHold) next = 2.0 * window;  // a restart's hold at the end
     window = std::min(next, options.max_window_s);
   }
-  EstimateFromRecord(options, &out, say);
+  EstimateFromRecord(episode, &out, say);
   return Status::Ok();
 }
 

@@ -69,6 +69,10 @@ struct ExperimentSummary {
   /// resting operating point ("" otherwise).
   double hold_drift = 0.0;
   std::string hold_note;
+  /// The last episode's hold (s): the one given, or where the hold drifted,
+  /// doubled episode by episode until it did not (at most 16 times the one
+  /// given), so the relay starts from a resting operating point.
+  double hold_s = 0.0;
   /// Where the output limits cut the relay asked for (amplitude +- bias
   /// about u0): one line saying what was asked and what was used; "" if
   /// nothing was cut.
